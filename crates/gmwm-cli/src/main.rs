@@ -1,0 +1,2 @@
+//! `gmwm`: command-line front end. IN PROGRESS (lead).
+fn main() {}

@@ -1,0 +1,119 @@
+//! Error types of the engine. Every fallible public function returns [`Error`] or one of the
+//! module errors that convert into it.
+
+use thiserror::Error;
+
+/// Any error the engine can return.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Reading or parsing an input file failed.
+    #[error(transparent)]
+    Read(#[from] crate::imu::ReadError),
+    /// A series is unusable for the requested computation.
+    #[error(transparent)]
+    Series(#[from] SeriesError),
+    /// A parameter or option has an impossible value.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+}
+
+/// A series that cannot be analysed.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum SeriesError {
+    /// No samples at all.
+    #[error("series is empty")]
+    Empty,
+    /// Fewer samples than the computation needs.
+    #[error("series has {n} samples; {what} needs at least {needed}")]
+    TooShort {
+        /// Number of samples given.
+        n: usize,
+        /// Minimum number of samples needed.
+        needed: usize,
+        /// What needed them (e.g. "one wavelet level").
+        what: String,
+    },
+    /// A sample is NaN or infinite.
+    #[error("sample {index} (0-based) is not a finite number ({value})")]
+    NonFinite {
+        /// 0-based index of the sample.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// Every sample has the same value: all variances are zero and nothing can be estimated.
+    #[error("series is constant (every sample equals {value}); its variances are all zero")]
+    Constant {
+        /// The constant value.
+        value: f64,
+    },
+}
+
+/// A parameter or option with an impossible value.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("invalid {name} = {value}: {expected}")]
+pub struct ParamError {
+    /// Parameter name as the user knows it (e.g. `eff`, `levels`, `alpha`).
+    pub name: &'static str,
+    /// The value given, as text.
+    pub value: String,
+    /// What would have been valid.
+    pub expected: String,
+}
+
+impl ParamError {
+    /// Builds a parameter error.
+    pub fn new(name: &'static str, value: impl ToString, expected: impl Into<String>) -> Self {
+        Self {
+            name,
+            value: value.to_string(),
+            expected: expected.into(),
+        }
+    }
+}
+
+/// Checks that a series is non-empty, finite and not constant (METHODS §0.1 preconditions).
+///
+/// # Errors
+/// [`SeriesError::Empty`], [`SeriesError::NonFinite`] (first offending index) or
+/// [`SeriesError::Constant`].
+pub fn check_series(x: &[f64]) -> Result<(), SeriesError> {
+    let first = *x.first().ok_or(SeriesError::Empty)?;
+    let mut constant = true;
+    for (index, &value) in x.iter().enumerate() {
+        if !value.is_finite() {
+            return Err(non_finite(index, value));
+        }
+        constant &= value == first;
+    }
+    if constant {
+        return Err(SeriesError::Constant { value: first });
+    }
+    Ok(())
+}
+
+#[cold]
+fn non_finite(index: usize, value: f64) -> SeriesError {
+    SeriesError::NonFinite { index, value }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_series_rejects_bad_input() {
+        assert_eq!(check_series(&[]), Err(SeriesError::Empty));
+        assert_eq!(
+            check_series(&[1.0, f64::NAN]).unwrap_err().to_string(),
+            "sample 1 (0-based) is not a finite number (NaN)"
+        );
+        assert!(matches!(
+            check_series(&[2.0, 2.0, 2.0]),
+            Err(SeriesError::Constant { value }) if value == 2.0
+        ));
+        assert!(check_series(&[1.0, 2.0]).is_ok());
+    }
+}

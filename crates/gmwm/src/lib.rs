@@ -1,0 +1,33 @@
+//! # gmwm — stochastic error calibration of inertial sensors
+//!
+//! The engine of the gmwm platform: wavelet transforms, the wavelet variance (classical and
+//! robust), Allan and Hadamard variances, IMU data readers, and (in later modules) latent error
+//! models estimated by the Generalized Method of Wavelet Moments.
+//!
+//! Conventions, stated once:
+//! - scales are labelled `tau_j = 2^j` samples (`2^j / freq_hz` seconds), the package label of
+//!   METHODS §0.1; Allan cluster lengths `m` are in samples, and `AV(m) = 2 WV(tau = 2m)` (§3.4);
+//! - every variance is a variance, never a standard deviation, in the squared unit of the data;
+//! - section numbers such as "METHODS §1.7" refer to `shared/spec/METHODS.md`.
+//!
+//! ```
+//! use gmwm::{wavelet_variance, WvOptions};
+//! // a ramp x_t = t + 1: the Haar MODWT WV is 0.25 at tau = 2 and 1.0 at tau = 4 (METHODS §1.10)
+//! let x: Vec<f64> = (1..=8).map(f64::from).collect();
+//! let wv = wavelet_variance(&x, 1.0, &WvOptions { levels: Some(2), ..WvOptions::default() }).unwrap();
+//! assert!((wv.wv[0] - 0.25).abs() < 1e-12 && (wv.wv[1] - 1.0).abs() < 1e-12);
+//! ```
+#![deny(missing_docs)]
+
+pub mod error;
+pub mod imu;
+pub mod math;
+pub mod sim;
+pub mod variance;
+pub mod wavelet;
+
+pub use error::{Error, ParamError, SeriesError};
+pub use variance::allan::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
+pub use variance::robust::{RobustConvention, RobustOptions};
+pub use variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};
+pub use wavelet::{Transform, WaveletFilter};

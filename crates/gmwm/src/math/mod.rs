@@ -1,0 +1,3 @@
+//! Numerical building blocks (METHODS §12): compensated sums, 1-D minimisation and root finding.
+
+pub mod sum;

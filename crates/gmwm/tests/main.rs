@@ -1,0 +1,3 @@
+//! The engine's single integration-test binary (STYLE §1): reference data, properties, Monte Carlo.
+
+mod common;
