@@ -5,3 +5,13 @@ pub mod allan;
 pub mod ci;
 pub mod robust;
 pub mod wv;
+
+pub use wv::{default_levels, kept_count};
+
+use rayon::prelude::*;
+
+/// Applies a per-series computation to several series in parallel (rayon), in order.
+/// Results are independent of the thread count.
+pub fn per_column<T: Send>(columns: &[&[f64]], f: impl Fn(&[f64]) -> T + Sync + Send) -> Vec<T> {
+    columns.par_iter().map(|x| f(x)).collect()
+}

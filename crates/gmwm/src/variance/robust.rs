@@ -51,3 +51,9 @@ pub fn robust_ci(
 ) -> (f64, f64) {
     unimplemented!()
 }
+
+impl std::fmt::Display for RobustConvention {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("exact")
+    }
+}

@@ -1,22 +1,33 @@
-//! Wavelet variance (METHODS §1.5–§1.7). IN PROGRESS (lead).
+//! Wavelet variance: classical (METHODS §1.5, paper eq. 1) and robust (§2), with chi-square
+//! confidence intervals (§1.7), for the MODWT (default) and the DWT with any filter of §1.8.
+//!
+//! The Haar MODWT classical WV — the one every later step of the platform uses — is computed by
+//! [`HaarWvAccumulator`], a streaming O(N·J) pass that never stores the coefficients and can
+//! consume its input in chunks.
 
-use crate::error::Error;
-use crate::variance::robust::RobustOptions;
-use crate::wavelet::{Transform, WaveletFilter};
+use crate::error::{check_series, Error, ParamError, SeriesError};
+use crate::math::sum::NeumaierSum;
+use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
+use crate::variance::robust::{robust_ci, robust_scale, tuning_constant, RobustOptions};
+use crate::wavelet::{dwt_boundary, modwt_boundary, Dwt, Modwt, Transform, WaveletFilter};
 use serde::{Deserialize, Serialize};
+use std::fmt;
 
-/// Options.
+/// Largest number of levels accepted anywhere (2^40 samples is far beyond any IMU log).
+pub const MAX_LEVELS: usize = 40;
+
+/// Options of [`wavelet_variance`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct WvOptions {
-    /// Transform.
+    /// Transform; default MODWT, the package default and the only one with exact implied WV.
     pub transform: Transform,
-    /// Filter.
+    /// Wavelet filter; default Haar, the filter every implied-WV formula of METHODS §4 assumes.
     pub filter: WaveletFilter,
-    /// Levels (None: default).
+    /// Number of levels J; `None` chooses [`default_levels`].
     pub levels: Option<usize>,
-    /// CI level.
+    /// Confidence level of the intervals; default 0.05 (95% intervals), as the package.
     pub alpha: f64,
-    /// Robust estimation.
+    /// Robust (Tukey biweight M-) estimation when `Some` (METHODS §2).
     pub robust: Option<RobustOptions>,
 }
 
@@ -32,20 +43,745 @@ impl Default for WvOptions {
     }
 }
 
-/// Result.
+/// The wavelet variance of one series across levels `j = 1..J`, with its confidence intervals.
+///
+/// Wire format (`Serialize`): equal-length arrays `tau` (scale `2^j` in samples), `tau_s`
+/// (seconds), `wv`, `ci_low`, `ci_high`, `n_coefficients` (kept coefficients `M_j`) and `eta`
+/// (equivalent degrees of freedom), plus the settings that produced them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WaveletVariance {
-    /// Samples.
+    /// Length of the series.
     pub n: usize,
-    /// WV.
+    /// Sampling rate in Hz (labels `tau_s` only).
+    pub freq_hz: f64,
+    /// Transform used.
+    pub transform: Transform,
+    /// Filter used.
+    pub filter: WaveletFilter,
+    /// Confidence level of the intervals.
+    pub alpha: f64,
+    /// Robust options, `None` for the classical estimator.
+    pub robust: Option<RobustOptions>,
+    /// Scale `tau_j = 2^j` in samples (METHODS §0.1).
+    pub tau: Vec<f64>,
+    /// Scale in seconds, `2^j / freq_hz`.
+    pub tau_s: Vec<f64>,
+    /// Wavelet variance `nu2_j`.
     pub wv: Vec<f64>,
+    /// Lower confidence bound.
+    pub ci_low: Vec<f64>,
+    /// Upper confidence bound.
+    pub ci_high: Vec<f64>,
+    /// Number of boundary-free coefficients `M_j` behind each estimate.
+    pub n_coefficients: Vec<usize>,
+    /// Equivalent degrees of freedom of the chi-square interval.
+    pub eta: Vec<f64>,
 }
 
-/// Streaming Haar accumulator.
-#[derive(Debug, Clone)]
-pub struct HaarWvAccumulator {}
+impl WaveletVariance {
+    /// Number of levels J.
+    pub fn levels(&self) -> usize {
+        self.wv.len()
+    }
 
-/// Computes the WV.
-pub fn wavelet_variance(_x: &[f64], _freq_hz: f64, _opts: &WvOptions) -> Result<WaveletVariance, Error> {
-    unimplemented!()
+    /// Assembles the result from per-level estimates and counts: scales, chi-square intervals
+    /// (METHODS §1.7) and, for robust estimates, the robust intervals of §2.5.
+    fn assemble(
+        n: usize,
+        freq_hz: f64,
+        opts: &WvOptions,
+        classical: &[f64],
+        robust: Option<&[f64]>,
+        n_coefficients: Vec<usize>,
+        eta: Vec<f64>,
+    ) -> Self {
+        let levels = classical.len();
+        let tau: Vec<f64> = (1..=levels).map(|j| (j as f64).exp2()).collect();
+        let tau_s = tau.iter().map(|t| t / freq_hz).collect();
+        let mut wv = Vec::with_capacity(levels);
+        let mut ci_low = Vec::with_capacity(levels);
+        let mut ci_high = Vec::with_capacity(levels);
+        let mut lowest: Option<f64> = None;
+        for (i, (&nu_c, &e)) in classical.iter().zip(&eta).enumerate() {
+            let (lo_c, hi_c) = chi_square_interval(nu_c, e, opts.alpha);
+            match (robust, opts.robust) {
+                (Some(r), Some(ro)) => {
+                    let (lo, hi) = robust_ci(r[i], nu_c, lo_c, hi_c, ro.eff, lowest);
+                    lowest = Some(lowest.map_or(lo, |l| l.min(lo)));
+                    wv.push(r[i]);
+                    ci_low.push(lo);
+                    ci_high.push(hi);
+                }
+                _ => {
+                    wv.push(nu_c);
+                    ci_low.push(lo_c);
+                    ci_high.push(hi_c);
+                }
+            }
+        }
+        Self {
+            n,
+            freq_hz,
+            transform: opts.transform,
+            filter: opts.filter,
+            alpha: opts.alpha,
+            robust: opts.robust,
+            tau,
+            tau_s,
+            wv,
+            ci_low,
+            ci_high,
+            n_coefficients,
+            eta,
+        }
+    }
+}
+
+impl fmt::Display for WaveletVariance {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let kind = match self.robust {
+            Some(r) => format!("robust (eff {}, {})", r.eff, r.convention),
+            None => "classical".to_string(),
+        };
+        writeln!(
+            f,
+            "{} wavelet variance, {} {}, N = {}, {:.0}% CI",
+            kind,
+            self.transform,
+            self.filter,
+            self.n,
+            100.0 * (1.0 - self.alpha)
+        )?;
+        writeln!(
+            f,
+            "{:>5} {:>10} {:>12} {:>13} {:>13} {:>13}",
+            "level", "tau", "tau_s", "wv", "ci_low", "ci_high"
+        )?;
+        for j in 0..self.levels() {
+            writeln!(
+                f,
+                "{:>5} {:>10} {:>12.6} {:>13.6e} {:>13.6e} {:>13.6e}",
+                j + 1,
+                self.tau[j],
+                self.tau_s[j],
+                self.wv[j],
+                self.ci_low[j],
+                self.ci_high[j]
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Default number of levels (METHODS §1.6, port recommendation): the largest J with
+/// `2^J <= N` whose last level keeps at least two boundary-free coefficients. For the Haar MODWT
+/// this is `floor(log2 N)` (the package's default), minus one when N is a power of two — where
+/// the package's last level is NaN (§13.1). For the DWT, J is also limited by the number of
+/// times N can be halved exactly (§1.4). Returns 0 when not even one level fits.
+pub fn default_levels(n: usize, transform: Transform, filter: WaveletFilter) -> usize {
+    let mut j = 0;
+    while j < MAX_LEVELS && level_fits(n, j + 1, transform, filter, 2) {
+        j += 1;
+    }
+    j
+}
+
+/// Kept (boundary-free) coefficient count of level `j` (METHODS §1.3, §1.4), `None` when the
+/// level does not exist for this length.
+pub fn kept_count(
+    n: usize,
+    j: usize,
+    transform: Transform,
+    filter: WaveletFilter,
+) -> Option<usize> {
+    let width = 1usize.checked_shl(j as u32)?;
+    if width > n {
+        return None;
+    }
+    match transform {
+        Transform::Modwt => n.checked_sub(modwt_boundary(filter.len(), j)),
+        Transform::Dwt => {
+            if n % width != 0 {
+                return None;
+            }
+            (n / width).checked_sub(dwt_boundary(filter.len(), j))
+        }
+    }
+}
+
+fn level_fits(
+    n: usize,
+    j: usize,
+    transform: Transform,
+    filter: WaveletFilter,
+    min_kept: usize,
+) -> bool {
+    kept_count(n, j, transform, filter).is_some_and(|k| k >= min_kept)
+}
+
+/// Validates a requested level count against the series length.
+fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<(), Error> {
+    if levels == 0 || levels > MAX_LEVELS {
+        return Err(
+            ParamError::new("levels", levels, format!("must be in 1..={MAX_LEVELS}")).into(),
+        );
+    }
+    for j in 1..=levels {
+        if !level_fits(n, j, opts.transform, opts.filter, 1) {
+            let what = match opts.transform {
+                Transform::Dwt if (1usize << j.min(63)) <= n => {
+                    return Err(ParamError::new(
+                        "levels",
+                        levels,
+                        format!(
+                            "a {levels}-level DWT needs N divisible by 2^{levels}; N = {n} allows at most {} levels (or use the MODWT)",
+                            default_levels(n, Transform::Dwt, opts.filter)
+                        ),
+                    )
+                    .into())
+                }
+                _ => format!("level {j} of a {} {} transform", opts.filter, opts.transform),
+            };
+            let needed = match opts.transform {
+                Transform::Modwt => modwt_boundary(opts.filter.len(), j) + 1,
+                Transform::Dwt => 1usize << j.min(63),
+            };
+            return Err(SeriesError::TooShort { n, needed, what }.into());
+        }
+    }
+    Ok(())
+}
+
+/// Wavelet variance of `x` sampled at `freq_hz`, METHODS §1.5 (classical) or §2 (robust), with
+/// chi-square intervals (§1.7; robust intervals §2.5).
+///
+/// The classical Haar MODWT path is a streaming O(N·J) pass ([`HaarWvAccumulator`]); other
+/// filters and the DWT go through the transform ([`Modwt`], [`Dwt`]) and keep O(N·J) memory.
+/// The DWT estimate is normalised to the MODWT scale (`mean(W^2) / 2^j`), unlike the package's
+/// raw mean which is `2^j` times larger (§13.3); its equivalent degrees of freedom are the
+/// number of kept DWT coefficients (independent for white noise), not `M_j / 2^j`.
+///
+/// # Errors
+/// Empty, non-finite or constant series ([`SeriesError`]); bad `alpha`, `levels`, `freq_hz` or
+/// robust efficiency ([`ParamError`]); a series too short for the requested levels.
+pub fn wavelet_variance(
+    x: &[f64],
+    freq_hz: f64,
+    opts: &WvOptions,
+) -> Result<WaveletVariance, Error> {
+    if x.len() == 1 {
+        return Err(SeriesError::TooShort {
+            n: 1,
+            needed: 2,
+            what: "one level of the wavelet variance".into(),
+        }
+        .into());
+    }
+    check_series(x)?;
+    check_alpha(opts.alpha)?;
+    check_freq(freq_hz)?;
+    let n = x.len();
+    let levels = match opts.levels {
+        Some(j) => j,
+        None => match default_levels(n, opts.transform, opts.filter) {
+            0 => default_levels_or_one(n, opts),
+            j => j,
+        },
+    };
+    check_levels(n, levels, opts)?;
+    if let Some(r) = opts.robust {
+        RobustOptions::new(r.eff, r.convention)?;
+    }
+
+    if opts.robust.is_none()
+        && opts.transform == Transform::Modwt
+        && opts.filter == WaveletFilter::Haar
+    {
+        let mut acc = HaarWvAccumulator::with_offset(levels, mean(x))?;
+        acc.push(x)?;
+        return acc.finish(freq_hz, opts.alpha);
+    }
+
+    let coefs = match opts.transform {
+        Transform::Modwt => Modwt::new(opts.filter, levels)?.transform(x)?,
+        Transform::Dwt => Dwt::new(opts.filter, levels)?.transform(x)?,
+    };
+    let c = opts
+        .robust
+        .map(|r| tuning_constant(r.eff, r.convention))
+        .transpose()?;
+    let mut classical = Vec::with_capacity(levels);
+    let mut robust = Vec::with_capacity(levels);
+    let mut counts = Vec::with_capacity(levels);
+    let mut eta = Vec::with_capacity(levels);
+    for j in 1..=levels {
+        let kept = coefs.kept(j);
+        let scale = match opts.transform {
+            Transform::Modwt => 1.0,
+            Transform::Dwt => (j as f64).exp2(),
+        };
+        classical.push(mean_square(kept) / scale);
+        if let (Some(c), Some(r)) = (c, opts.robust) {
+            robust.push(robust_scale(kept, c, r.convention)? / scale);
+        }
+        counts.push(kept.len());
+        eta.push(match opts.transform {
+            Transform::Modwt => eta3(kept.len(), j),
+            Transform::Dwt => (kept.len() as f64).max(1.0),
+        });
+    }
+    let robust = opts.robust.map(|_| robust.as_slice());
+    Ok(WaveletVariance::assemble(
+        n, freq_hz, opts, &classical, robust, counts, eta,
+    ))
+}
+
+/// When no level keeps two coefficients, fall back to one level if it keeps one, so that the
+/// error (if any) comes from [`check_levels`] with the precise reason.
+fn default_levels_or_one(_n: usize, _opts: &WvOptions) -> usize {
+    1
+}
+
+fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
+    if freq_hz.is_finite() && freq_hz > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(
+            "freq",
+            freq_hz,
+            "must be a positive number of hertz",
+        ))
+    }
+}
+
+/// Compensated mean.
+fn mean(x: &[f64]) -> f64 {
+    let mut s = NeumaierSum::default();
+    x.iter().for_each(|&v| s.add(v));
+    s.total() / x.len() as f64
+}
+
+/// Mean of squares with a compensated accumulation of block sums.
+fn mean_square(x: &[f64]) -> f64 {
+    let mut s = NeumaierSum::default();
+    for block in x.chunks(BLOCK) {
+        s.add(sum_squares(block));
+    }
+    s.total() / x.len() as f64
+}
+
+/// Block length of the streaming pass: 4096 doubles (32 KiB) per buffer keeps the working set
+/// of one level in L1/L2 while amortising the per-block bookkeeping.
+const BLOCK: usize = 4096;
+
+/// Sum of squares with four independent accumulators (lets the compiler vectorise; the partial
+/// sums of one block are then combined with a compensated sum by the caller).
+#[inline]
+fn sum_squares(x: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let mut quads = x.chunks_exact(4);
+    for q in &mut quads {
+        acc[0] += q[0] * q[0];
+        acc[1] += q[1] * q[1];
+        acc[2] += q[2] * q[2];
+        acc[3] += q[3] * q[3];
+    }
+    let tail: f64 = quads.remainder().iter().map(|v| v * v).sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+/// Streaming Haar MODWT classical wavelet variance (METHODS §1.2 pyramid, §1.3, §1.5).
+///
+/// Feed the series in chunks of any size with [`push`](Self::push), then [`finish`](Self::finish).
+/// Level j keeps a ring of the last `2^{j-1}` values of the level-(j-1) scaling coefficients,
+/// so memory is `8 · 2^J` bytes whatever N and the chunk sizes; time is O(N·J).
+///
+/// Numerical care: a constant offset (the series mean for [`wavelet_variance`], the first sample
+/// by default here) is subtracted before the pyramid — the Haar wavelet filter annihilates
+/// constants, so this changes nothing mathematically but keeps an accelerometer's −1 g bias from
+/// eating digits — and the squared coefficients are summed per block, block sums then added with
+/// Neumaier's compensated sum.
+///
+/// # Formula
+/// `V_{j,t} = (V_{j-1,t} + V_{j-1,t-m}) / 2`, `W_{j,t} = (V_{j-1,t} - V_{j-1,t-m}) / 2`,
+/// `m = 2^{j-1}`; coefficients with `t < 2^j - 1` (boundary) are skipped.
+#[derive(Debug, Clone)]
+pub struct HaarWvAccumulator {
+    levels: usize,
+    offset: Option<f64>,
+    n: u64,
+    first: Option<f64>,
+    constant: bool,
+    rings: Vec<Vec<f64>>,
+    pos: Vec<usize>,
+    sums: Vec<NeumaierSum>,
+    scratch_in: Vec<f64>,
+    scratch_out: Vec<f64>,
+}
+
+impl HaarWvAccumulator {
+    /// A new accumulator for `levels` levels; the offset is the first sample pushed.
+    ///
+    /// # Errors
+    /// [`ParamError`] when `levels` is 0 or above [`MAX_LEVELS`].
+    pub fn new(levels: usize) -> Result<Self, ParamError> {
+        if levels == 0 || levels > MAX_LEVELS {
+            return Err(ParamError::new(
+                "levels",
+                levels,
+                format!("must be in 1..={MAX_LEVELS}"),
+            ));
+        }
+        Ok(Self {
+            levels,
+            offset: None,
+            n: 0,
+            first: None,
+            constant: true,
+            rings: (1..=levels).map(|j| vec![0.0; 1usize << (j - 1)]).collect(),
+            pos: vec![0; levels],
+            sums: vec![NeumaierSum::default(); levels],
+            scratch_in: Vec::with_capacity(BLOCK),
+            scratch_out: Vec::with_capacity(BLOCK),
+        })
+    }
+
+    /// A new accumulator that subtracts `offset` (e.g. the series mean) from every sample.
+    ///
+    /// # Errors
+    /// As [`new`](Self::new); also when `offset` is not finite.
+    pub fn with_offset(levels: usize, offset: f64) -> Result<Self, ParamError> {
+        if !offset.is_finite() {
+            return Err(ParamError::new("offset", offset, "must be finite"));
+        }
+        let mut acc = Self::new(levels)?;
+        acc.offset = Some(offset);
+        Ok(acc)
+    }
+
+    /// Number of samples pushed so far.
+    pub fn n(&self) -> u64 {
+        self.n
+    }
+
+    /// Number of levels.
+    pub fn levels(&self) -> usize {
+        self.levels
+    }
+
+    /// Feeds the next chunk of the series.
+    ///
+    /// # Errors
+    /// [`SeriesError::NonFinite`] with the global 0-based index of the first NaN/Inf sample; the
+    /// accumulator is then unusable for a meaningful result.
+    pub fn push(&mut self, chunk: &[f64]) -> Result<(), SeriesError> {
+        for block in chunk.chunks(BLOCK) {
+            self.push_block(block)?;
+        }
+        Ok(())
+    }
+
+    fn push_block(&mut self, block: &[f64]) -> Result<(), SeriesError> {
+        let Some(&head) = block.first() else {
+            return Ok(());
+        };
+        let offset = *self.offset.get_or_insert(head);
+        let first = *self.first.get_or_insert(head);
+        let mut input = std::mem::take(&mut self.scratch_in);
+        let mut output = std::mem::take(&mut self.scratch_out);
+        input.clear();
+        for (i, &v) in block.iter().enumerate() {
+            if !v.is_finite() {
+                self.scratch_in = input;
+                self.scratch_out = output;
+                return Err(SeriesError::NonFinite {
+                    index: self.n as usize + i,
+                    value: v,
+                });
+            }
+            self.constant &= v == first;
+            input.push(v - offset);
+        }
+        output.resize(input.len(), 0.0);
+        let t0 = self.n;
+        for j in 1..=self.levels {
+            // First boundary-free coefficient of level j is at t = 2^j - 1.
+            let first_valid = (1u64 << j) - 1;
+            let skip = first_valid.saturating_sub(t0).min(input.len() as u64) as usize;
+            let ring = &mut self.rings[j - 1];
+            let s = haar_level(&input, &mut output, ring, &mut self.pos[j - 1], skip);
+            self.sums[j - 1].add(s);
+            std::mem::swap(&mut input, &mut output);
+        }
+        self.n += block.len() as u64;
+        self.scratch_in = input;
+        self.scratch_out = output;
+        Ok(())
+    }
+
+    /// Finishes the pass: wavelet variance with chi-square intervals (METHODS §1.5, §1.7).
+    ///
+    /// # Errors
+    /// [`SeriesError`] when nothing was pushed, the series is constant, or it is too short for
+    /// the levels requested; [`ParamError`] for a bad `freq_hz` or `alpha`.
+    pub fn finish(self, freq_hz: f64, alpha: f64) -> Result<WaveletVariance, Error> {
+        check_alpha(alpha)?;
+        check_freq(freq_hz)?;
+        let n = self.n as usize;
+        match self.first {
+            None => return Err(SeriesError::Empty.into()),
+            Some(value) if self.constant => return Err(SeriesError::Constant { value }.into()),
+            _ => {}
+        }
+        let opts = WvOptions {
+            levels: Some(self.levels),
+            alpha,
+            ..WvOptions::default()
+        };
+        check_levels(n, self.levels, &opts)?;
+        let mut wv = Vec::with_capacity(self.levels);
+        let mut counts = Vec::with_capacity(self.levels);
+        let mut eta = Vec::with_capacity(self.levels);
+        for (j, sum) in (1..=self.levels).zip(&self.sums) {
+            let kept = n + 1 - (1usize << j);
+            wv.push(sum.total() / kept as f64);
+            counts.push(kept);
+            eta.push(eta3(kept, j));
+        }
+        Ok(WaveletVariance::assemble(
+            n, freq_hz, &opts, &wv, None, counts, eta,
+        ))
+    }
+}
+
+/// One Haar pyramid level over a block: reads `V_{j-1}` from `input`, writes `V_j` to `output`,
+/// updates the lag ring (length `m = 2^{j-1}`, oldest value at `*pos`), and returns the sum of
+/// squared wavelet coefficients from index `skip` on.
+#[inline]
+fn haar_level(
+    input: &[f64],
+    output: &mut [f64],
+    ring: &mut [f64],
+    pos: &mut usize,
+    skip: usize,
+) -> f64 {
+    let m = ring.len();
+    let b = input.len();
+    let mut ss = 0.0;
+    if m <= b {
+        // Lags of the first m samples come from the ring (oldest first, from *pos); the rest
+        // from the block itself.
+        let (newer, older) = ring.split_at(*pos);
+        let split = older.len();
+        ss += level_span(&input[..split], older, &mut output[..split], skip);
+        ss += level_span(
+            &input[split..m],
+            newer,
+            &mut output[split..m],
+            skip.saturating_sub(split),
+        );
+        let (head, body) = output.split_at_mut(m);
+        let _ = head;
+        ss += level_span(&input[m..], &input[..b - m], body, skip.saturating_sub(m));
+        ring.copy_from_slice(&input[b - m..]);
+        *pos = 0;
+    } else {
+        // The ring holds every lag: at most two contiguous segments since b < m.
+        let mut i = 0;
+        while i < b {
+            let run = (m - *pos).min(b - i);
+            let seg = &mut ring[*pos..*pos + run];
+            ss += level_span(
+                &input[i..i + run],
+                seg,
+                &mut output[i..i + run],
+                skip.saturating_sub(i),
+            );
+            seg.copy_from_slice(&input[i..i + run]);
+            i += run;
+            *pos = (*pos + run) % m;
+        }
+    }
+    ss
+}
+
+/// `output = (new + old) / 2`; returns the sum of `((new - old) / 2)^2` over indices `>= skip`.
+#[inline]
+fn level_span(new: &[f64], old: &[f64], output: &mut [f64], skip: usize) -> f64 {
+    let skip = skip.min(new.len());
+    let (new_skip, new_kept) = new.split_at(skip);
+    let (old_skip, old_kept) = old.split_at(skip);
+    let (out_skip, out_kept) = output.split_at_mut(skip);
+    for ((o, &v), &u) in out_skip.iter_mut().zip(new_skip).zip(old_skip) {
+        *o = 0.5 * (v + u);
+    }
+    let mut acc = [0.0f64; 4];
+    let mut outs = out_kept.chunks_exact_mut(4);
+    let mut news = new_kept.chunks_exact(4);
+    let mut olds = old_kept.chunks_exact(4);
+    for ((o, v), u) in (&mut outs).zip(&mut news).zip(&mut olds) {
+        for k in 0..4 {
+            o[k] = 0.5 * (v[k] + u[k]);
+            let w = v[k] - u[k];
+            acc[k] += w * w;
+        }
+    }
+    let mut tail = 0.0;
+    for ((o, &v), &u) in outs
+        .into_remainder()
+        .iter_mut()
+        .zip(news.remainder())
+        .zip(olds.remainder())
+    {
+        *o = 0.5 * (v + u);
+        tail += (v - u) * (v - u);
+    }
+    0.25 * ((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values of METHODS §1.10 are given to 7 significant digits.
+    const METHODS_TOL: f64 = 5e-7;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs().max(1e-300)
+    }
+
+    /// Direct Haar MODWT WV by the closed form of §1.2: the oracle of the streaming pass.
+    fn naive_haar_wv(x: &[f64], levels: usize) -> Vec<f64> {
+        (1..=levels)
+            .map(|j| {
+                let m = 1usize << (j - 1);
+                let ts = (2 * m - 1)..x.len();
+                let count = ts.len() as f64;
+                ts.map(|t| {
+                    let newer: f64 = x[t + 1 - m..=t].iter().sum::<f64>() / m as f64;
+                    let older: f64 = x[t + 1 - 2 * m..=t - m].iter().sum::<f64>() / m as f64;
+                    (0.5 * (newer - older)).powi(2)
+                })
+                .sum::<f64>()
+                    / count
+            })
+            .collect()
+    }
+
+    #[test]
+    fn haar_wv_matches_methods_1_10() {
+        let x: Vec<f64> = (1..=8).map(f64::from).collect();
+        // The package returns NaN at level 3 (one coefficient dropped, §13.1); we keep it.
+        let wv = wavelet_variance(
+            &x,
+            1.0,
+            &WvOptions {
+                levels: Some(3),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(rel(wv.wv[0], 0.25) < 1e-14 && rel(wv.wv[1], 1.0) < 1e-14);
+        assert_eq!(wv.n_coefficients, vec![7, 5, 1]);
+        assert!(
+            rel(wv.wv[2], 4.0) < 1e-14,
+            "level 3 keeps W = (mean(5..8) - mean(1..4))/2 = 2"
+        );
+        assert!(rel(wv.ci_low[0], 0.08526516) < METHODS_TOL);
+        assert!(rel(wv.ci_high[1], 271.909147) < METHODS_TOL);
+        let y = [1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0];
+        let wv = wavelet_variance(
+            &y,
+            1.0,
+            &WvOptions {
+                levels: Some(2),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(rel(wv.wv[0], 6.0 / 7.0) < 1e-14 && rel(wv.wv[1], 1.05) < 1e-14);
+    }
+
+    #[test]
+    fn default_levels_follow_methods_1_6() {
+        assert_eq!(
+            default_levels(1_000_000, Transform::Modwt, WaveletFilter::Haar),
+            19
+        );
+        assert_eq!(
+            default_levels(1024, Transform::Modwt, WaveletFilter::Haar),
+            9
+        );
+        assert_eq!(default_levels(1000, Transform::Dwt, WaveletFilter::Haar), 3);
+        assert_eq!(default_levels(1, Transform::Modwt, WaveletFilter::Haar), 0);
+    }
+
+    #[test]
+    fn streaming_matches_naive_for_any_chunking() {
+        let mut state = 12345u64;
+        let x: Vec<f64> = (0..5000)
+            .map(|i| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5 + 1e-3 * i as f64
+            })
+            .collect();
+        let levels = 12;
+        let oracle = naive_haar_wv(&x, levels);
+        for chunk in [1, 3, 64, 4095, 4096, 5000] {
+            let mut acc = HaarWvAccumulator::new(levels).unwrap();
+            for c in x.chunks(chunk) {
+                acc.push(c).unwrap();
+            }
+            let wv = acc.finish(1.0, 0.05).unwrap();
+            for j in 0..levels {
+                assert!(
+                    rel(wv.wv[j], oracle[j]) < 1e-11,
+                    "chunk {chunk} level {}",
+                    j + 1
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn bad_series_are_errors() {
+        let o = WvOptions::default();
+        assert!(matches!(
+            wavelet_variance(&[], 1.0, &o),
+            Err(Error::Series(SeriesError::Empty))
+        ));
+        assert!(matches!(
+            wavelet_variance(&[1.0, f64::INFINITY, 2.0], 1.0, &o),
+            Err(Error::Series(SeriesError::NonFinite { index: 1, .. }))
+        ));
+        assert!(matches!(
+            wavelet_variance(&[3.0; 16], 1.0, &o),
+            Err(Error::Series(SeriesError::Constant { .. }))
+        ));
+        assert!(matches!(
+            wavelet_variance(&[1.0], 1.0, &o),
+            Err(Error::Series(SeriesError::TooShort { .. }))
+        ));
+        let x = [1.0, 2.0, 4.0, 3.0];
+        let too_many = WvOptions {
+            levels: Some(3),
+            ..o
+        };
+        assert!(matches!(
+            wavelet_variance(&x, 1.0, &too_many),
+            Err(Error::Series(SeriesError::TooShort { .. }))
+        ));
+        assert!(matches!(
+            wavelet_variance(&x, 0.0, &o),
+            Err(Error::Param(_))
+        ));
+        assert!(matches!(
+            wavelet_variance(&x, 1.0, &WvOptions { alpha: 1.5, ..o }),
+            Err(Error::Param(_))
+        ));
+        let mut acc = HaarWvAccumulator::new(2).unwrap();
+        assert!(acc.push(&[1.0, f64::NAN]).is_err());
+    }
 }

@@ -1,0 +1,235 @@
+//! Raw command-line arguments (clap derive). Validation into engine types happens in
+//! `config.rs`-style helpers of each subcommand, before any heavy work.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+const EXAMPLES: &str = "\
+Examples:
+  gmwm demo                                   simulate the built-in sensor and show its WV
+  gmwm wv imu.csv.gz                          wavelet variance of every column
+  gmwm wv imu.csv.gz --columns gyro_x,3 --robust --eff 0.6 --json
+  gmwm avar imu.csv.gz --kind modified --csv
+  gmwm wv log.bin --format f64 --ncols 6 --columns 1 --freq 400";
+
+/// Stochastic error calibration of inertial sensors with the Generalized Method of Wavelet
+/// Moments: wavelet, Allan and Hadamard variances of IMU recordings.
+#[derive(Debug, Parser)]
+#[command(name = "gmwm", version, about, after_long_help = EXAMPLES)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate the built-in sensor (known truth) and print its wavelet variance.
+    #[command(after_long_help = "Examples:\n  gmwm demo\n  gmwm demo --n 100000 --seed 7 --json")]
+    Demo(DemoArgs),
+    /// Wavelet variance (classical or robust) with confidence intervals, per column.
+    #[command(
+        after_long_help = "Examples:\n  gmwm wv imu.csv.gz\n  gmwm wv imu.csv.gz --columns gyro_x --robust --eff 0.6\n  gmwm wv imu.csv.gz --transform dwt --filter la8 --levels 6 --csv\n  gmwm wv log.f64 --format f64 --ncols 3 --freq 200 --json"
+    )]
+    Wv(WvArgs),
+    /// Allan, modified Allan or Hadamard variance with confidence intervals, per column.
+    #[command(
+        after_long_help = "Examples:\n  gmwm avar imu.csv.gz\n  gmwm avar imu.csv.gz --kind non-overlapping --columns accel_z\n  gmwm avar imu.csv.gz --kind hadamard --json"
+    )]
+    Avar(AvarArgs),
+}
+
+/// Where the data come from and how to read them.
+#[derive(Debug, Args)]
+pub struct InputArgs {
+    /// Data file: CSV/TSV (optionally .gz) or raw little-endian binary (--format f64|f32).
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// Columns to analyse, comma-separated names or 1-based indices [default: all].
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub columns: Vec<String>,
+    /// Sampling rate in Hz [default: from a time column or the JSON sidecar beside FILE].
+    #[arg(long, value_name = "HZ")]
+    pub freq: Option<f64>,
+    /// Input format.
+    #[arg(long, value_enum, default_value_t = FormatArg::Auto)]
+    pub format: FormatArg,
+    /// Number of interleaved columns of a binary file.
+    #[arg(long, value_name = "K")]
+    pub ncols: Option<usize>,
+    /// Whether the first row of a text file is a header.
+    #[arg(long, value_enum, default_value_t = HeaderArg::Auto)]
+    pub header: HeaderArg,
+    /// Column holding time stamps in seconds (name or 1-based index); excluded from analysis.
+    #[arg(long, value_name = "COL")]
+    pub time_column: Option<String>,
+}
+
+/// Output format shared by the analysis commands.
+#[derive(Debug, Args)]
+pub struct OutputArgs {
+    /// Print JSON (machine-readable, full precision) instead of a table.
+    #[arg(long, conflicts_with = "csv")]
+    pub json: bool,
+    /// Print CSV (one row per series and scale) instead of a table.
+    #[arg(long)]
+    pub csv: bool,
+}
+
+/// Wavelet-variance estimator settings.
+#[derive(Debug, Args)]
+pub struct WvEstimatorArgs {
+    /// Use the robust (Tukey biweight) wavelet variance.
+    #[arg(long)]
+    pub robust: bool,
+    /// Gaussian efficiency of the robust estimator, in (0, 0.99].
+    #[arg(long, value_name = "E", default_value_t = 0.6)]
+    pub eff: f64,
+    /// Robust tuning constant and solver: the correct formula, or the R package's.
+    #[arg(long, value_enum, default_value_t = RobustConventionArg::Exact)]
+    pub robust_convention: RobustConventionArg,
+    /// Wavelet filter (METHODS §1.8): haar, d4, d6, d8, d16, fk4, fk8, fk14, fk22, bl14, bl20,
+    /// la8, la16, la20, mb4, mb8, mb16, mb24.
+    #[arg(long, value_name = "NAME", default_value = "haar")]
+    pub filter: String,
+    /// Wavelet transform.
+    #[arg(long, value_enum, default_value_t = TransformArg::Modwt)]
+    pub transform: TransformArg,
+    /// Number of levels J [default: floor(log2 N), one fewer if the last would keep < 2 coefficients].
+    #[arg(long, value_name = "J")]
+    pub levels: Option<usize>,
+    /// Confidence level of the intervals (0.05 gives 95% intervals).
+    #[arg(long, value_name = "A", default_value_t = 0.05)]
+    pub alpha: f64,
+}
+
+/// `gmwm demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Number of samples to simulate.
+    #[arg(long, value_name = "N", default_value_t = 1 << 20)]
+    pub n: usize,
+    /// Seed of the simulation.
+    #[arg(long, value_name = "S", default_value_t = 2018)]
+    pub seed: u64,
+    /// Estimator settings.
+    #[command(flatten)]
+    pub estimator: WvEstimatorArgs,
+    /// Output format.
+    #[command(flatten)]
+    pub output: OutputArgs,
+}
+
+/// `gmwm wv`.
+#[derive(Debug, Args)]
+pub struct WvArgs {
+    /// Input.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Estimator settings.
+    #[command(flatten)]
+    pub estimator: WvEstimatorArgs,
+    /// Output format.
+    #[command(flatten)]
+    pub output: OutputArgs,
+}
+
+/// `gmwm avar`.
+#[derive(Debug, Args)]
+pub struct AvarArgs {
+    /// Input.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Which variance.
+    #[arg(long, value_enum, default_value_t = KindArg::Overlapping)]
+    pub kind: KindArg,
+    /// Textbook estimators, or the R package's (with its off-by-one terms, METHODS §13.8–13.10).
+    #[arg(long, value_enum, default_value_t = ConventionArg::Textbook)]
+    pub convention: ConventionArg,
+    /// Confidence level of the intervals (0.05 gives 95% intervals).
+    #[arg(long, value_name = "A", default_value_t = 0.05)]
+    pub alpha: f64,
+    /// Output format.
+    #[command(flatten)]
+    pub output: OutputArgs,
+}
+
+/// `--format`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FormatArg {
+    /// From the file name (.csv, .tsv, .txt, optionally .gz).
+    Auto,
+    /// Comma-separated text.
+    Csv,
+    /// Tab-separated text.
+    Tsv,
+    /// Raw little-endian 64-bit floats.
+    F64,
+    /// Raw little-endian 32-bit floats.
+    F32,
+}
+
+/// `--header`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum HeaderArg {
+    /// A header iff the first row has a non-numeric field.
+    Auto,
+    /// The first row is a header.
+    Yes,
+    /// There is no header.
+    No,
+}
+
+/// `--transform`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TransformArg {
+    /// Maximal-overlap DWT.
+    Modwt,
+    /// Decimated DWT.
+    Dwt,
+}
+
+/// `--robust-convention`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RobustConventionArg {
+    /// Correct tuning constant, root-finder from a robust start.
+    Exact,
+    /// The R package's constant and solver (for comparisons).
+    Package,
+}
+
+/// `--kind`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum KindArg {
+    /// Maximal-overlap Allan variance.
+    Overlapping,
+    /// Non-overlapping Allan variance.
+    NonOverlapping,
+    /// Modified Allan variance.
+    Modified,
+    /// Overlapping Hadamard variance.
+    Hadamard,
+    /// Non-overlapping Hadamard variance.
+    HadamardNonOverlapping,
+}
+
+/// `--convention`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ConventionArg {
+    /// Textbook estimators.
+    Textbook,
+    /// The R package's estimators.
+    Package,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+}

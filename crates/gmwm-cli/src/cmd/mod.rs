@@ -1,0 +1,5 @@
+//! One module per subcommand.
+
+pub mod avar;
+pub mod demo;
+pub mod wv;

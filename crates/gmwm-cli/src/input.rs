@@ -1,0 +1,74 @@
+//! Turning `InputArgs` into engine read options and loaded columns.
+
+use crate::args::{FormatArg, HeaderArg, InputArgs};
+use anyhow::{Context, Result};
+use gmwm::imu::{read_table, ColumnSelector, HeaderMode, InputFormat, ReadOptions, Table};
+
+/// A loaded input: the table and the sampling rate to use.
+pub struct Loaded {
+    /// Columns read.
+    pub table: Table,
+    /// Sampling rate in Hz.
+    pub freq_hz: f64,
+}
+
+fn selector(text: &str) -> ColumnSelector {
+    match text.trim().parse::<usize>() {
+        Ok(i) => ColumnSelector::Index(i),
+        Err(_) => ColumnSelector::Name(text.trim().to_string()),
+    }
+}
+
+/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
+/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
+pub fn load(args: &InputArgs) -> Result<Loaded> {
+    if let Some(f) = args.freq {
+        anyhow::ensure!(
+            f.is_finite() && f > 0.0,
+            "invalid --freq {f}: must be a positive number of hertz"
+        );
+    }
+    if let Some(k) = args.ncols {
+        anyhow::ensure!(k >= 1, "invalid --ncols 0: a binary file has at least one column");
+    }
+    let opts = ReadOptions {
+        format: match args.format {
+            FormatArg::Auto => InputFormat::Auto,
+            FormatArg::Csv => InputFormat::Csv,
+            FormatArg::Tsv => InputFormat::Tsv,
+            FormatArg::F64 => InputFormat::F64,
+            FormatArg::F32 => InputFormat::F32,
+        },
+        header: match args.header {
+            HeaderArg::Auto => HeaderMode::Auto,
+            HeaderArg::Yes => HeaderMode::Present,
+            HeaderArg::No => HeaderMode::Absent,
+        },
+        time_column: args.time_column.as_deref().map(selector),
+        columns: args.columns.iter().map(|c| selector(c)).collect(),
+        ncols: args.ncols,
+        freq_hz: args.freq,
+        ..ReadOptions::default()
+    };
+    let table = read_table(&args.file, &opts)?;
+    let freq_hz = match args.freq.or(table.freq_hz) {
+        Some(f) => f,
+        None => {
+            eprintln!(
+                "gmwm: warning: {}: no sampling rate (no --freq, time column or JSON sidecar); using 1 Hz, so tau_s is in samples",
+                args.file.display()
+            );
+            1.0
+        }
+    };
+    Ok(Loaded { table, freq_hz })
+}
+
+/// Adds "FILE: column NAME" to a per-column engine error.
+pub fn column_context<T>(
+    r: Result<T, gmwm::Error>,
+    file: &std::path::Path,
+    column: &str,
+) -> Result<T> {
+    r.with_context(|| format!("{}: column {column}", file.display()))
+}
