@@ -163,6 +163,10 @@ impl WaveletFilter {
     ///   [`3.5e-10`] (the `filters.json` note's "1e-10 or better" does not hold for these two);
     /// - `fk8`: `2e-9` [`1.6e-9`];
     /// - `mb4`, `mb8`, `mb16`, `mb24`: 7 significant digits, `5e-7` [`2.0e-7`, `sum g^2` of `mb4`].
+    ///
+    /// The wavelet filter's sum `sum h` (its gain at frequency 0) then vanishes only to about the
+    /// square root of this tolerance: `fk22` has `sum h = 9.7e-6`, so its MODWT of a constant
+    /// series is about `7e-6` times the constant, not zero.
     pub fn orthonormality_tolerance(&self) -> f64 {
         match self {
             WaveletFilter::Haar | WaveletFilter::D4 | WaveletFilter::D6 | WaveletFilter::Fk4 => {
@@ -544,3 +548,100 @@ const MB24: [f64; 24] = [
     0.0004745736,
     -2.132706e-05,
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::SQRT_2;
+
+    /// METHODS §1.8: `sum g = sqrt2`, `sum g^2 = 1`, `sum_l g_l g_{l+2k} = 0` (k >= 1), each to
+    /// the precision of the published table.
+    #[test]
+    fn filter_scaling_is_orthonormal() {
+        for f in WaveletFilter::ALL {
+            let g = f.scaling();
+            let tol = f.orthonormality_tolerance();
+            assert_eq!(g.len(), f.len());
+            assert!(f.len() % 2 == 0 && f.len() <= MAX_FILTER_LEN, "{f}");
+            let sum: f64 = g.iter().sum();
+            assert!((sum - SQRT_2).abs() <= tol, "{f}: sum g = {sum}");
+            let energy: f64 = g.iter().map(|c| c * c).sum();
+            assert!((energy - 1.0).abs() <= tol, "{f}: sum g^2 = {energy}");
+            for k in 1..f.len() / 2 {
+                let dot: f64 = (0..f.len() - 2 * k).map(|l| g[l] * g[l + 2 * k]).sum();
+                assert!(dot.abs() <= tol, "{f}: shift {k}: {dot}");
+            }
+        }
+    }
+
+    /// The tolerance is tight: the 7-digit `mb4` fails the full-precision tolerance of `d4`.
+    #[test]
+    fn filter_tolerance_is_not_vacuous() {
+        let g = WaveletFilter::Mb4.scaling();
+        let energy: f64 = g.iter().map(|c| c * c).sum();
+        assert!((energy - 1.0).abs() > WaveletFilter::D4.orthonormality_tolerance());
+    }
+
+    /// METHODS §1.1: `h_l = (-1)^l g_{L-1-l}`; `h` sums to 0, has unit energy and is orthogonal
+    /// to every even shift of `g`.
+    #[test]
+    fn filter_wavelet_is_quadrature_mirror() {
+        for f in WaveletFilter::ALL {
+            let (g, h) = (f.scaling(), f.wavelet());
+            let len = f.len();
+            for l in 0..len {
+                let sign = if l % 2 == 0 { 1.0 } else { -1.0 };
+                assert_eq!(h[l], sign * g[len - 1 - l], "{f} l = {l}");
+            }
+            let tol = f.orthonormality_tolerance();
+            // sum h = +-G(1/2) vanishes only to about sqrt(tol): |G(0)|^2 + |G(1/2)|^2 =
+            // 2 (sum g^2 + 2 sum_k sum_l g_l g_{l+2k}) gives (sum h)^2 <= (2L + 6) tol
+            let sum_h: f64 = h.iter().sum();
+            assert!(sum_h * sum_h <= (2 * len + 6) as f64 * tol, "{f}: sum h = {sum_h}");
+            for k in 0..len / 2 {
+                let dot: f64 = (0..len - 2 * k).map(|l| g[l] * h[l + 2 * k]).sum();
+                assert!(dot.abs() <= tol, "{f}: shift {k}: {dot}");
+            }
+            let taps = Taps::new(f, 0.5);
+            assert!(taps.h().iter().zip(&h).all(|(a, b)| *a == 0.5 * b), "{f}");
+            assert!(taps.g().iter().zip(g).all(|(a, b)| *a == 0.5 * b), "{f}");
+        }
+        let h = WaveletFilter::D4.wavelet();
+        let g = WaveletFilter::D4.scaling();
+        assert_eq!(h, vec![g[3], -g[2], g[1], -g[0]]);
+    }
+
+    /// METHODS §1.1: MODWT filters are the DWT filters over sqrt2.
+    #[test]
+    fn filter_modwt_filters_are_rescaled() {
+        assert_eq!(WaveletFilter::Haar.modwt_scaling().len(), 2);
+        for (a, b) in WaveletFilter::Haar.modwt_wavelet().iter().zip([0.5, -0.5]) {
+            assert!((a - b).abs() < 1e-16);
+        }
+    }
+
+    #[test]
+    fn filter_names_round_trip() {
+        assert_eq!(WaveletFilter::ALL.len(), 18);
+        for f in WaveletFilter::ALL {
+            assert_eq!(f.to_string(), f.name());
+            assert_eq!(f.name().parse::<WaveletFilter>(), Ok(f));
+            assert_eq!(f.name().to_uppercase().parse::<WaveletFilter>(), Ok(f));
+            let json = serde_json::to_string(&f).unwrap();
+            assert_eq!(json, format!("\"{}\"", f.name()));
+            assert_eq!(serde_json::from_str::<WaveletFilter>(&json).unwrap(), f);
+        }
+        assert_eq!(WaveletFilter::default(), WaveletFilter::Haar);
+        assert_eq!(format!("{:>5}", WaveletFilter::D4), "   d4");
+    }
+
+    #[test]
+    fn filter_bad_names_rejected() {
+        for bad in ["", "fk6", "w4", "d5", "haar2", "la 8"] {
+            let e = bad.parse::<WaveletFilter>().unwrap_err();
+            assert_eq!(e.name, "filter");
+            assert_eq!(e.value, bad);
+            assert!(e.expected.contains("haar, d4, d6") && e.expected.contains("mb24"));
+        }
+    }
+}

@@ -203,3 +203,56 @@ pub(crate) fn check_levels(levels: usize) -> Result<(), ParamError> {
         ))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transform_names_round_trip() {
+        for t in [Transform::Modwt, Transform::Dwt] {
+            assert_eq!(t.to_string().parse::<Transform>(), Ok(t));
+            assert_eq!(t.name().to_uppercase().parse::<Transform>(), Ok(t));
+            let json = serde_json::to_string(&t).unwrap();
+            assert_eq!(json, format!("\"{t}\""));
+            assert_eq!(serde_json::from_str::<Transform>(&json).unwrap(), t);
+        }
+        assert_eq!(Transform::default(), Transform::Modwt);
+        let e = "fft".parse::<Transform>().unwrap_err();
+        assert_eq!((e.name, e.value.as_str()), ("transform", "fft"));
+    }
+
+    /// METHODS §1.3: `n_j = (2^j - 1)(L - 1)`.
+    #[test]
+    fn modwt_boundary_formula() {
+        assert_eq!(modwt_boundary(2, 1), 1);
+        assert_eq!(modwt_boundary(2, 3), 7);
+        assert_eq!(modwt_boundary(4, 2), 9);
+        assert_eq!(modwt_boundary(24, 60), usize::MAX); // saturates
+    }
+
+    /// METHODS §1.4: `ceil((L - 2)(1 - 2^-j))`, checked against the real-valued formula.
+    #[test]
+    fn dwt_boundary_formula() {
+        for len in (2..=24).step_by(2) {
+            for j in 1..=8 {
+                let exact = ((len as f64 - 2.0) * (1.0 - 0.5f64.powi(j as i32))).ceil() as usize;
+                assert_eq!(dwt_boundary(len, j), exact, "L = {len}, j = {j}");
+            }
+        }
+        assert_eq!(dwt_boundary(24, 60), 22);
+    }
+
+    #[test]
+    fn pow2_saturates() {
+        assert_eq!(pow2(0), 1);
+        assert_eq!(pow2(10), 1024);
+        assert_eq!(pow2(200), usize::MAX);
+    }
+
+    #[test]
+    #[should_panic(expected = "out of range")]
+    fn wavelet_coefficients_kept_rejects_level_zero() {
+        WaveletCoefficients::default().kept(0);
+    }
+}
