@@ -90,11 +90,20 @@ fn check_transform(
             Kind::Modwt => (x.len(), modwt_boundary(filter.len(), j)),
             Kind::Dwt => (x.len() >> j, dwt_boundary(filter.len(), j)),
         };
-        assert_eq!((w.len(), out.boundary[j - 1]), (len, boundary), "{what} level {j}");
+        assert_eq!(
+            (w.len(), out.boundary[j - 1]),
+            (len, boundary),
+            "{what} level {j}"
+        );
         assert_eq!(out.kept(j), &w[boundary..], "{what} level {j}");
         assert!(!out.kept(j).is_empty(), "{what} level {j}");
     }
-    assert_close(scratch.scaling(), &oracle.scaling, floor, &format!("{what} V_J"));
+    assert_close(
+        scratch.scaling(),
+        &oracle.scaling,
+        floor,
+        &format!("{what} V_J"),
+    );
 }
 
 /// METHODS §1.2: the pyramid equals direct circular convolution with the level-j equivalent
@@ -116,7 +125,14 @@ fn modwt_matches_naive() {
         let x = series(250, 200 + i as u64);
         let max = Modwt::max_levels(filter, 250);
         check_transform(Kind::Modwt, filter, max, &x, &mut out, &mut scratch);
-        check_transform(Kind::Modwt, filter, 1, &x[..filter.len()], &mut out, &mut scratch);
+        check_transform(
+            Kind::Modwt,
+            filter,
+            1,
+            &x[..filter.len()],
+            &mut out,
+            &mut scratch,
+        );
     }
 }
 
@@ -141,7 +157,10 @@ fn dwt_matches_naive() {
 #[test]
 fn modwt_oracle_comparison_detects_errors() {
     let x = series(64, 1);
-    let w = Modwt::new(WaveletFilter::D4, 2).unwrap().transform(&x).unwrap();
+    let w = Modwt::new(WaveletFilter::D4, 2)
+        .unwrap()
+        .transform(&x)
+        .unwrap();
     let oracle = naive::modwt(WaveletFilter::D4, 2, &x);
     let mut bad = w.w[1].clone();
     bad[40] += 1e-9 * scale(&x);
@@ -167,7 +186,10 @@ fn wavelet_transforms_preserve_energy() {
             .unwrap();
         let total: f64 = out.w.iter().map(|w| sum_sq(w)).sum::<f64>() + sum_sq(scratch.scaling());
         let r = (total - energy).abs() / energy;
-        assert!(r <= levels as f64 * tol, "MODWT {filter}: relative energy error {r}");
+        assert!(
+            r <= levels as f64 * tol,
+            "MODWT {filter}: relative energy error {r}"
+        );
         let levels = Dwt::max_levels(filter, x.len());
         Dwt::new(filter, levels)
             .unwrap()
@@ -176,7 +198,10 @@ fn wavelet_transforms_preserve_energy() {
         assert_eq!(scratch.scaling().len(), x.len() >> levels);
         let total: f64 = out.w.iter().map(|w| sum_sq(w)).sum::<f64>() + sum_sq(scratch.scaling());
         let r = (total - energy).abs() / energy;
-        assert!(r <= levels as f64 * tol, "DWT {filter}: relative energy error {r}");
+        assert!(
+            r <= levels as f64 * tol,
+            "DWT {filter}: relative energy error {r}"
+        );
     }
 }
 
@@ -185,12 +210,17 @@ fn wavelet_transforms_preserve_energy() {
 #[test]
 fn modwt_haar_ramp_methods_1_10() {
     let x: Vec<f64> = (1..=8).map(f64::from).collect();
-    let w = Modwt::new(WaveletFilter::Haar, 3).unwrap().transform(&x).unwrap();
+    let w = Modwt::new(WaveletFilter::Haar, 3)
+        .unwrap()
+        .transform(&x)
+        .unwrap();
     assert_eq!(w.boundary, vec![1, 3, 7]);
     assert_close(w.kept(1), &[0.5; 7], 1.0, "level 1");
     assert_close(w.kept(2), &[1.0; 5], 1.0, "level 2");
     assert_close(w.kept(3), &[2.0], 1.0, "level 3");
-    let wv: Vec<f64> = (1..=2).map(|j| sum_sq(w.kept(j)) / w.kept(j).len() as f64).collect();
+    let wv: Vec<f64> = (1..=2)
+        .map(|j| sum_sq(w.kept(j)) / w.kept(j).len() as f64)
+        .collect();
     assert_close(&wv, &[0.25, 1.0], 1.0, "WV (METHODS §1.10)");
 }
 
@@ -198,8 +228,16 @@ fn modwt_haar_ramp_methods_1_10() {
 #[test]
 fn modwt_haar_second_series_methods_1_10() {
     let x = [1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0];
-    let w = Modwt::new(WaveletFilter::Haar, 2).unwrap().transform(&x).unwrap();
-    assert_close(w.kept(1), &[1.0, -0.5, 1.5, -0.5, 1.0, 1.0, -0.5], 1.0, "level 1");
+    let w = Modwt::new(WaveletFilter::Haar, 2)
+        .unwrap()
+        .transform(&x)
+        .unwrap();
+    assert_close(
+        w.kept(1),
+        &[1.0, -0.5, 1.5, -0.5, 1.0, 1.0, -0.5],
+        1.0,
+        "level 1",
+    );
     assert_close(w.kept(2), &[0.75, 1.0, 0.75, 1.25, 1.25], 1.0, "level 2");
     assert!((sum_sq(w.kept(1)) / 7.0 - 6.0 / 7.0).abs() < 1e-15);
     assert!((sum_sq(w.kept(2)) / 5.0 - 1.05).abs() < 1e-15);
@@ -211,7 +249,10 @@ fn modwt_haar_second_series_methods_1_10() {
 fn modwt_haar_closed_form() {
     let x = series(100, 11);
     let n = x.len() as isize;
-    let w = Modwt::new(WaveletFilter::Haar, 6).unwrap().transform(&x).unwrap();
+    let w = Modwt::new(WaveletFilter::Haar, 6)
+        .unwrap()
+        .transform(&x)
+        .unwrap();
     let at = |i: isize| x[i.rem_euclid(n) as usize];
     for j in 1..=6usize {
         let m = 1isize << (j - 1);
@@ -231,7 +272,10 @@ fn modwt_haar_closed_form() {
 #[test]
 fn modwt_boundary_counts_la8() {
     let x = series(64, 12);
-    let w = Modwt::new(WaveletFilter::La8, 3).unwrap().transform(&x).unwrap();
+    let w = Modwt::new(WaveletFilter::La8, 3)
+        .unwrap()
+        .transform(&x)
+        .unwrap();
     assert_eq!(w.boundary, vec![7, 21, 49]);
     let kept: Vec<usize> = (1..=3).map(|j| w.kept(j).len()).collect();
     assert_eq!(kept, vec![57, 43, 15]);
@@ -241,7 +285,10 @@ fn modwt_boundary_counts_la8() {
 #[test]
 fn dwt_haar_closed_form() {
     let x = series(64, 13);
-    let w = Dwt::new(WaveletFilter::Haar, 3).unwrap().transform(&x).unwrap();
+    let w = Dwt::new(WaveletFilter::Haar, 3)
+        .unwrap()
+        .transform(&x)
+        .unwrap();
     assert_eq!(w.boundary, vec![0, 0, 0]);
     let expected: Vec<f64> = x
         .chunks(2)
@@ -259,8 +306,13 @@ fn dwt_haar_wv_methods_1_10() {
         (&[1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0], [2.25, 4.25]),
     ];
     for (x, expected) in cases {
-        let w = Dwt::new(WaveletFilter::Haar, 2).unwrap().transform(x).unwrap();
-        let wv: Vec<f64> = (1..=2).map(|j| sum_sq(w.kept(j)) / w.kept(j).len() as f64).collect();
+        let w = Dwt::new(WaveletFilter::Haar, 2)
+            .unwrap()
+            .transform(x)
+            .unwrap();
+        let wv: Vec<f64> = (1..=2)
+            .map(|j| sum_sq(w.kept(j)) / w.kept(j).len() as f64)
+            .collect();
         assert_close(&wv, &expected, 1.0, "DWT WV");
     }
 }
@@ -287,7 +339,10 @@ fn modwt_too_short_rejected() {
         }
         other => panic!("{other:?}"),
     }
-    assert!(Modwt::new(WaveletFilter::Haar, 2).unwrap().transform(&x).is_ok());
+    assert!(Modwt::new(WaveletFilter::Haar, 2)
+        .unwrap()
+        .transform(&x)
+        .is_ok());
 }
 
 /// METHODS §1.3: every level must keep at least one coefficient, `N >= L_j`.
@@ -302,7 +357,10 @@ fn modwt_level_without_kept_coefficient_rejected() {
         }
         other => panic!("{other:?}"),
     }
-    let w = Modwt::new(WaveletFilter::La8, 2).unwrap().transform(&series(22, 14)).unwrap();
+    let w = Modwt::new(WaveletFilter::La8, 2)
+        .unwrap()
+        .transform(&series(22, 14))
+        .unwrap();
     assert_eq!(w.kept(2).len(), 1);
 }
 
@@ -311,7 +369,10 @@ fn modwt_level_without_kept_coefficient_rejected() {
 #[test]
 fn dwt_not_divisible_rejected() {
     let x = series(100, 15);
-    let e = Dwt::new(WaveletFilter::Haar, 3).unwrap().transform(&x).unwrap_err();
+    let e = Dwt::new(WaveletFilter::Haar, 3)
+        .unwrap()
+        .transform(&x)
+        .unwrap_err();
     match &e {
         Error::Param(p) => {
             assert_eq!(p.name, "levels");
@@ -320,19 +381,33 @@ fn dwt_not_divisible_rejected() {
         }
         other => panic!("{other:?}"),
     }
-    assert!(Dwt::new(WaveletFilter::Haar, 2).unwrap().transform(&x).is_ok());
+    assert!(Dwt::new(WaveletFilter::Haar, 2)
+        .unwrap()
+        .transform(&x)
+        .is_ok());
 }
 
 /// METHODS §1.4: too few samples for 2^J, or no boundary-free coefficient at some level.
 #[test]
 fn dwt_too_short_rejected() {
-    let e = Dwt::new(WaveletFilter::Haar, 3).unwrap().transform(&[1.0, 2.0, 3.0, 4.0]);
+    let e = Dwt::new(WaveletFilter::Haar, 3)
+        .unwrap()
+        .transform(&[1.0, 2.0, 3.0, 4.0]);
     assert!(
-        matches!(e, Err(Error::Series(SeriesError::TooShort { n: 4, needed: 8, .. }))),
+        matches!(
+            e,
+            Err(Error::Series(SeriesError::TooShort {
+                n: 4,
+                needed: 8,
+                ..
+            }))
+        ),
         "{e:?}"
     );
     // la8 level 2: N_2 = 4 coefficients, ceil(6 * 3/4) = 5 boundary ones
-    let e = Dwt::new(WaveletFilter::La8, 2).unwrap().transform(&series(16, 16));
+    let e = Dwt::new(WaveletFilter::La8, 2)
+        .unwrap()
+        .transform(&series(16, 16));
     match e {
         Err(Error::Series(SeriesError::TooShort { n, needed, what })) => {
             assert_eq!((n, needed), (16, 24));
@@ -340,7 +415,10 @@ fn dwt_too_short_rejected() {
         }
         other => panic!("{other:?}"),
     }
-    let w = Dwt::new(WaveletFilter::La8, 2).unwrap().transform(&series(24, 16)).unwrap();
+    let w = Dwt::new(WaveletFilter::La8, 2)
+        .unwrap()
+        .transform(&series(24, 16))
+        .unwrap();
     assert_eq!(w.kept(2).len(), 1);
 }
 

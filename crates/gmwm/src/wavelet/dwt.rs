@@ -235,6 +235,9 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("divisible by 2^3 = 8"), "{e}");
-        assert!(e.contains("at most 2 levels") && e.contains("8 or 16 samples"), "{e}");
+        assert!(
+            e.contains("at most 2 levels") && e.contains("8 or 16 samples"),
+            "{e}"
+        );
     }
 }

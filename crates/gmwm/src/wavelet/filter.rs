@@ -155,14 +155,16 @@ impl WaveletFilter {
     /// Precision the published table carries: the largest acceptable deviation in
     /// `sum g = sqrt2`, `sum g^2 = 1` and `sum_l g_l g_{l+2k} = 0` (METHODS §1.8).
     ///
-    /// Per family (observed worst deviation in brackets, tolerance about 2–3 times that):
-    /// - `haar`, `d4`, `d6`, `fk4`: full double precision, `1e-14` [`9e-16`];
-    /// - `d8`, `d16`, `la8`, `la16`, `fk14`: 13–16 published digits, `1e-11` [`2.4e-12`];
-    /// - `bl14`, `fk22`: `1e-10` [`4.7e-11`];
-    /// - `la20`, `bl20`: some coefficients carry only 11–13 significant digits, `1e-9`
-    ///   [`3.5e-10`] (the `filters.json` note's "1e-10 or better" does not hold for these two);
-    /// - `fk8`: `2e-9` [`1.6e-9`];
-    /// - `mb4`, `mb8`, `mb16`, `mb24`: 7 significant digits, `5e-7` [`2.0e-7`, `sum g^2` of `mb4`].
+    /// Per family: worst deviation observed in the table, then the tolerance (about 2–3 times it).
+    /// - `haar`, `d4`, `d6`, `fk4`: full double precision; worst `9e-16`, tolerance `1e-14`.
+    /// - `d8`, `d16`, `la8`, `la16`, `fk14`: 13–16 published digits; worst `2.4e-12`, tolerance
+    ///   `1e-11`.
+    /// - `bl14`, `fk22`: worst `4.7e-11`, tolerance `1e-10`.
+    /// - `la20`, `bl20`: some coefficients carry only 11–13 significant digits; worst `3.5e-10`,
+    ///   tolerance `1e-9` (the `filters.json` note's "1e-10 or better" does not hold for these).
+    /// - `fk8`: worst `1.6e-9`, tolerance `2e-9`.
+    /// - `mb4`, `mb8`, `mb16`, `mb24`: 7 significant digits; worst `2.0e-7` (`sum g^2` of `mb4`),
+    ///   tolerance `5e-7`.
     ///
     /// The wavelet filter's sum `sum h` (its gain at frequency 0) then vanishes only to about the
     /// square root of this tolerance: `fk22` has `sum h = 9.7e-6`, so its MODWT of a constant
@@ -281,10 +283,7 @@ impl FromStr for WaveletFilter {
 
 /// Published scaling filter `haar` (L = 2), copied from `shared/spec/filters.json`.
 #[allow(clippy::approx_constant)] // the published digits, 1 ulp below FRAC_1_SQRT_2
-const HAAR: [f64; 2] = [
-    0.7071067811865475,
-    0.7071067811865475,
-];
+const HAAR: [f64; 2] = [0.7071067811865475, 0.7071067811865475];
 /// Published scaling filter `d4` (L = 4), copied from `shared/spec/filters.json`.
 const D4: [f64; 4] = [
     0.4829629131445341,
@@ -485,12 +484,7 @@ const LA20: [f64; 20] = [
     -0.0004593294205481,
 ];
 /// Published scaling filter `mb4` (L = 4), copied from `shared/spec/filters.json`.
-const MB4: [f64; 4] = [
-    0.4801755,
-    0.8372545,
-    0.2269312,
-    -0.1301477,
-];
+const MB4: [f64; 4] = [0.4801755, 0.8372545, 0.2269312, -0.1301477];
 /// Published scaling filter `mb8` (L = 8), copied from `shared/spec/filters.json`.
 const MB8: [f64; 8] = [
     0.06436345,
@@ -597,7 +591,10 @@ mod tests {
             // sum h = +-G(1/2) vanishes only to about sqrt(tol): |G(0)|^2 + |G(1/2)|^2 =
             // 2 (sum g^2 + 2 sum_k sum_l g_l g_{l+2k}) gives (sum h)^2 <= (2L + 6) tol
             let sum_h: f64 = h.iter().sum();
-            assert!(sum_h * sum_h <= (2 * len + 6) as f64 * tol, "{f}: sum h = {sum_h}");
+            assert!(
+                sum_h * sum_h <= (2 * len + 6) as f64 * tol,
+                "{f}: sum h = {sum_h}"
+            );
             for k in 0..len / 2 {
                 let dot: f64 = (0..len - 2 * k).map(|l| g[l] * h[l + 2 * k]).sum();
                 assert!(dot.abs() <= tol, "{f}: shift {k}: {dot}");

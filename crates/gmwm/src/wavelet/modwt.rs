@@ -191,7 +191,10 @@ mod tests {
             for n in [1usize, 2, 3, 7, 8, 9, 63, 64, 100, 1000, 4096] {
                 let j = Modwt::max_levels(f, n);
                 if j > 0 {
-                    assert!(Modwt::new(f, j).unwrap().check_len(n).is_ok(), "{f} {n} {j}");
+                    assert!(
+                        Modwt::new(f, j).unwrap().check_len(n).is_ok(),
+                        "{f} {n} {j}"
+                    );
                 }
                 assert!(
                     Modwt::new(f, j + 1).unwrap().check_len(n).is_err(),

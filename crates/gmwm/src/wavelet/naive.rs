@@ -104,7 +104,10 @@ pub fn modwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform 
 /// If `x` is empty or `2^levels` does not divide its length.
 pub fn dwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform {
     let n = x.len();
-    assert!(n > 0 && n % (1usize << levels) == 0, "N must be a multiple of 2^J");
+    assert!(
+        n > 0 && n % (1usize << levels) == 0,
+        "N must be a multiple of 2^J"
+    );
     let g = filter.scaling();
     let h = filter.wavelet();
     let at = |j: usize| move |t: usize| (t + 1) * (1usize << j) - 1;
