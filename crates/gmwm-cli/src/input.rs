@@ -29,7 +29,10 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
         );
     }
     if let Some(k) = args.ncols {
-        anyhow::ensure!(k >= 1, "invalid --ncols 0: a binary file has at least one column");
+        anyhow::ensure!(
+            k >= 1,
+            "invalid --ncols 0: a binary file has at least one column"
+        );
     }
     let opts = ReadOptions {
         format: match args.format {

@@ -46,7 +46,11 @@ struct SeriesDoc<'a, T> {
 }
 
 /// Writes wavelet variances.
-pub fn wavelet_variances(out: &mut impl Write, items: &[Named<WaveletVariance>], style: Style) -> Result<()> {
+pub fn wavelet_variances(
+    out: &mut impl Write,
+    items: &[Named<WaveletVariance>],
+    style: Style,
+) -> Result<()> {
     match style {
         Style::Json => json(out, items),
         Style::Table => {
@@ -83,7 +87,11 @@ pub fn wavelet_variances(out: &mut impl Write, items: &[Named<WaveletVariance>],
 }
 
 /// Writes Allan/Hadamard variances.
-pub fn allan_variances(out: &mut impl Write, items: &[Named<AllanVariance>], style: Style) -> Result<()> {
+pub fn allan_variances(
+    out: &mut impl Write,
+    items: &[Named<AllanVariance>],
+    style: Style,
+) -> Result<()> {
     match style {
         Style::Json => json(out, items),
         Style::Table => {

@@ -26,12 +26,23 @@ pub fn run(args: &AvarArgs, out: &mut impl Write) -> Result<()> {
         },
     };
     let loaded = load(&args.input)?;
-    let columns: Vec<&[f64]> = loaded.table.columns.iter().map(|c| c.values.as_slice()).collect();
+    let columns: Vec<&[f64]> = loaded
+        .table
+        .columns
+        .iter()
+        .map(|c| c.values.as_slice())
+        .collect();
     let results = per_column(&columns, |x| allan_variance(x, loaded.freq_hz, &opts));
     let mut items = Vec::with_capacity(results.len());
     for (col, r) in loaded.table.columns.iter().zip(results) {
-        items.push((col.name.as_str(), column_context(r, &args.input.file, &col.name)?));
+        items.push((
+            col.name.as_str(),
+            column_context(r, &args.input.file, &col.name)?,
+        ));
     }
-    let named: Vec<Named<_>> = items.iter().map(|(name, result)| Named { name, result }).collect();
+    let named: Vec<Named<_>> = items
+        .iter()
+        .map(|(name, result)| Named { name, result })
+        .collect();
     render::allan_variances(out, &named, Style::from(&args.output))
 }

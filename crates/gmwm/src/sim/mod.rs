@@ -69,7 +69,11 @@ impl DemoSensor {
             }
         }
         if !(self.ar1_phi.is_finite() && self.ar1_phi.abs() < 1.0) {
-            return Err(ParamError::new("ar1_phi", self.ar1_phi, "must satisfy |phi| < 1"));
+            return Err(ParamError::new(
+                "ar1_phi",
+                self.ar1_phi,
+                "must satisfy |phi| < 1",
+            ));
         }
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut z = || -> f64 { StandardNormal.sample(&mut rng) };

@@ -9,12 +9,11 @@ use crate::error::{check_series, Error, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
 use crate::variance::robust::{robust_ci, robust_scale, tuning_constant, RobustOptions};
-use crate::wavelet::{dwt_boundary, modwt_boundary, Dwt, Modwt, Transform, WaveletFilter};
+use crate::wavelet::{
+    dwt_boundary, modwt_boundary, Dwt, Modwt, Transform, WaveletFilter, MAX_LEVELS,
+};
 use serde::{Deserialize, Serialize};
 use std::fmt;
-
-/// Largest number of levels accepted anywhere (2^40 samples is far beyond any IMU log).
-pub const MAX_LEVELS: usize = 40;
 
 /// Options of [`wavelet_variance`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

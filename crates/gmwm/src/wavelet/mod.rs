@@ -54,28 +54,6 @@ impl Transform {
             Transform::Dwt => "dwt",
         }
     }
-    /// Length.
-    pub fn len(&self) -> usize {
-        2
-    }
-}
-impl std::fmt::Display for WaveletFilter {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-impl std::fmt::Display for Transform {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("modwt")
-    }
-}
-/// n_j.
-pub fn modwt_boundary(filter_len: usize, j: usize) -> usize {
-    ((1usize << j) - 1) * (filter_len - 1)
-}
-/// DWT boundary.
-pub fn dwt_boundary(_filter_len: usize, _j: usize) -> usize {
-    0
 }
 
 impl fmt::Display for Transform {
