@@ -42,3 +42,35 @@ pub fn f64s(v: &serde_json::Value) -> Vec<f64> {
 pub fn rel_diff(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
 }
+
+/// Reads a whole dataset `<name>.csv.gz` of `../shared/data` with the library's reader.
+pub fn read_dataset(name: &str) -> gmwm::imu::Table {
+    let path = data_dir().join(format!("{name}.csv.gz"));
+    gmwm::imu::read_table(&path, &gmwm::imu::ReadOptions::default())
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+}
+
+/// One column of a dataset.
+pub fn read_column(name: &str, column: &str) -> Vec<f64> {
+    let table = read_dataset(name);
+    table
+        .columns
+        .into_iter()
+        .find(|c| c.name == column)
+        .unwrap_or_else(|| panic!("{name} has no column {column}"))
+        .values
+}
+
+/// Seeded white noise N(0, sigma2).
+pub fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
+    use rand::SeedableRng;
+    use rand_distr::Distribution;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let sd = sigma2.sqrt();
+    (0..n)
+        .map(|_| {
+            let z: f64 = rand_distr::StandardNormal.sample(&mut rng);
+            sd * z
+        })
+        .collect()
+}
