@@ -1,0 +1,259 @@
+//! End-to-end tests of the `gmwm` binary: outputs on real data, and one test per bad-input
+//! class checking the exit code and the one-line error (STYLE §6.8).
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use std::io::Write;
+use std::path::PathBuf;
+
+fn gmwm() -> Command {
+    Command::cargo_bin("gmwm").expect("binary built")
+}
+
+fn data(name: &str) -> PathBuf {
+    let dir = std::env::var_os("GMWM_DATA_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    dir.join(name)
+}
+
+fn temp_file(suffix: &str, bytes: &[u8]) -> tempfile::NamedTempFile {
+    let mut f = tempfile::Builder::new()
+        .suffix(suffix)
+        .tempfile()
+        .expect("temp file");
+    f.write_all(bytes).expect("write");
+    f
+}
+
+/// Runs `gmwm ARGS FILE` on a text file and checks a one-line error containing `needles`.
+fn assert_one_line_error(args: &[&str], needles: &[&str]) {
+    let out = gmwm().args(args).output().expect("runs");
+    assert_eq!(out.status.code(), Some(1), "args {args:?}: {out:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("warning:")).collect();
+    assert_eq!(lines.len(), 1, "one line expected, got {stderr:?}");
+    assert!(lines[0].starts_with("gmwm: error: "), "{stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "{n:?} not in {stderr:?}");
+    }
+    assert!(out.stdout.is_empty(), "no partial results on stdout");
+}
+
+#[test]
+fn wv_json_on_real_data_has_the_documented_shape() {
+    let out = gmwm()
+        .arg("wv")
+        .arg(data("adis_16405_imu1.csv.gz"))
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let series = doc["series"].as_array().unwrap();
+    assert_eq!(series.len(), 6);
+    for s in series {
+        assert_eq!(s["n"], 1_000_000);
+        let len = s["tau"].as_array().unwrap().len();
+        assert_eq!(len, 19);
+        for key in ["tau_s", "wv", "ci_low", "ci_high"] {
+            assert_eq!(s[key].as_array().unwrap().len(), len, "{key}");
+        }
+        assert!(s["name"].is_string());
+    }
+    assert_eq!(series[0]["name"], "gyro_x");
+    assert_eq!(series[0]["tau_s"][0], 0.02);
+}
+
+#[test]
+fn avar_json_and_csv_have_the_documented_fields() {
+    let out = gmwm()
+        .args(["avar", "--columns", "gyro_x", "--json"])
+        .arg(data("adis_16405_imu1.csv.gz"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let s = &doc["series"][0];
+    let len = s["tau"].as_array().unwrap().len();
+    for key in ["tau_s", "avar", "adev", "ci_low", "ci_high"] {
+        assert_eq!(s[key].as_array().unwrap().len(), len, "{key}");
+    }
+    gmwm()
+        .args(["avar", "--columns", "1", "--csv", "--kind", "modified"])
+        .arg(data("adis_16405_imu1.csv.gz"))
+        .assert()
+        .success()
+        .stdout(predicate::str::starts_with(
+            "series,tau,tau_s,avar,adev,ci_low,ci_high\ngyro_x,",
+        ));
+}
+
+#[test]
+fn wv_table_and_csv_render() {
+    let f = temp_file(".csv", b"a,b\n1,5\n3,2\n2,8\n5,1\n4,4\n6,7\n8,3\n7,9\n");
+    gmwm()
+        .args(["wv", "--freq", "10", "--levels", "2"])
+        .arg(f.path())
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("a\nclassical wavelet variance"));
+    gmwm()
+        .args([
+            "wv",
+            "--freq",
+            "10",
+            "--levels",
+            "2",
+            "--csv",
+            "--columns",
+            "a",
+        ])
+        .arg(f.path())
+        .assert()
+        .success()
+        .stdout(predicate::str::starts_with(
+            "series,level,tau,tau_s,wv,ci_low,ci_high\na,1,2,2e-1,8.571428571428571e-1,",
+        ));
+}
+
+#[test]
+fn demo_runs_and_prints_its_truth() {
+    gmwm()
+        .args(["demo", "--n", "4096"])
+        .assert()
+        .success()
+        .stdout(
+            predicate::str::contains("demo sensor: AR1(phi=")
+                .and(predicate::str::contains("wavelet variance")),
+        );
+}
+
+#[test]
+fn help_shows_examples() {
+    gmwm().args(["wv", "--help"]).assert().success().stdout(
+        predicate::str::contains("Examples:").and(predicate::str::contains("--robust-convention")),
+    );
+}
+
+#[test]
+fn bad_usage_exits_2() {
+    gmwm().args(["wv"]).assert().code(2);
+    gmwm()
+        .args(["avar", "x.csv", "--kind", "sideways"])
+        .assert()
+        .code(2);
+}
+
+#[test]
+fn nan_cell_names_file_line_and_column() {
+    let f = temp_file(".csv", b"gyro_x,gyro_y\n1,2\n3,nan\n5,6\n");
+    let name = f.path().file_name().unwrap().to_str().unwrap().to_string();
+    assert_one_line_error(
+        &["wv", f.path().to_str().unwrap()],
+        &[&name, ":3", "gyro_y"],
+    );
+}
+
+#[test]
+fn infinite_cell_is_an_error() {
+    let f = temp_file(".csv", b"x\n1\ninf\n5\n");
+    assert_one_line_error(&["wv", f.path().to_str().unwrap()], &[":3"]);
+}
+
+#[test]
+fn ragged_row_is_an_error() {
+    let f = temp_file(".csv", b"a,b\n1,2\n3\n5,6\n");
+    assert_one_line_error(&["wv", f.path().to_str().unwrap()], &[":3"]);
+}
+
+#[test]
+fn non_numeric_text_is_an_error() {
+    let f = temp_file(".csv", b"a,b\n1,2\n3,abc\n5,6\n");
+    assert_one_line_error(&["avar", f.path().to_str().unwrap()], &[":3", "abc"]);
+}
+
+#[test]
+fn empty_file_is_an_error() {
+    let f = temp_file(".csv", b"");
+    assert_one_line_error(&["wv", f.path().to_str().unwrap()], &["empty"]);
+}
+
+#[test]
+fn too_short_series_is_an_error() {
+    let f = temp_file(".csv", b"x\n1.5\n");
+    assert_one_line_error(
+        &["wv", "--freq", "1", f.path().to_str().unwrap()],
+        &["column x", "1 samples"],
+    );
+}
+
+#[test]
+fn constant_series_is_an_error() {
+    let f = temp_file(".csv", b"x\n2\n2\n2\n2\n2\n2\n2\n2\n");
+    assert_one_line_error(
+        &["wv", "--freq", "1", f.path().to_str().unwrap()],
+        &["column x", "constant"],
+    );
+    assert_one_line_error(
+        &["avar", "--freq", "1", f.path().to_str().unwrap()],
+        &["column x", "constant"],
+    );
+}
+
+#[test]
+fn unknown_column_is_an_error() {
+    let f = temp_file(".csv", b"a,b\n1,2\n3,4\n");
+    assert_one_line_error(
+        &["wv", "--columns", "zz", f.path().to_str().unwrap()],
+        &["zz"],
+    );
+}
+
+#[test]
+fn truncated_binary_is_an_error() {
+    let f = temp_file(".bin", &[0u8; 8 * 5 + 3]);
+    assert_one_line_error(
+        &[
+            "wv",
+            "--format",
+            "f64",
+            "--freq",
+            "1",
+            f.path().to_str().unwrap(),
+        ],
+        &["43"],
+    );
+}
+
+#[test]
+fn impossible_parameters_are_errors() {
+    let f = temp_file(".csv", b"x\n1\n3\n2\n5\n4\n6\n8\n7\n");
+    let p = f.path().to_str().unwrap();
+    assert_one_line_error(&["wv", "--robust", "--eff", "1.5", p], &["eff"]);
+    assert_one_line_error(&["wv", "--filter", "db99", p], &["db99"]);
+    assert_one_line_error(&["wv", "--alpha", "2", p], &["alpha"]);
+    assert_one_line_error(&["wv", "--levels", "9", p], &["level"]);
+    assert_one_line_error(&["wv", "--freq", "-3", p], &["freq"]);
+    assert_one_line_error(
+        &[
+            "wv",
+            "--transform",
+            "dwt",
+            "--levels",
+            "2",
+            "--filter",
+            "d4",
+            "/nonexistent/file.csv",
+        ],
+        &["/nonexistent/file.csv"],
+    );
+}
