@@ -18,6 +18,8 @@ const C_TABLE_TOL: f64 = 1e-6;
 /// The package constant is only as good as R's `optimize` tolerance eps^0.25 ~ 1.22e-4
 /// (METHODS §2.3, §2.5 "c = 4.9734 (+-2e-4)").
 const PACKAGE_C_TOL: f64 = 2e-4;
+/// Our Brent minimiser takes R's steps, so its iterate matches R's printed 6 decimals.
+const PACKAGE_PATH_TOL: f64 = 1e-6;
 /// Efficiencies in the §2.3 table are printed to 5 decimals.
 const EFF_TABLE_TOL: f64 = 5e-6;
 /// Monte Carlo bound of METHODS §2.5: "within 0.05 of 1".
@@ -147,6 +149,8 @@ fn tuning_constant_package_matches_methods_2_3_table() {
     for (eff, c_ref, true_eff) in table {
         let c = tuning_constant(eff, RobustConvention::Package).unwrap();
         assert!((c - c_ref).abs() < PACKAGE_C_TOL, "eff {eff}: c = {c}");
+        // same Brent path as R's optimize: the printed digits themselves are reproduced
+        assert!((c - c_ref).abs() < PACKAGE_PATH_TOL, "eff {eff}: c = {c}");
         assert!(
             (efficiency(c_ref) - true_eff).abs() < EFF_TABLE_TOL,
             "eff {eff}: true eff {}",
@@ -318,6 +322,63 @@ fn robust_scale_is_consistent_at_the_gaussian() {
         let c = tuning_constant(0.6, conv).unwrap();
         let s2 = robust_scale(&y, c, conv).unwrap();
         assert!(rel(s2, 9.0) < CLEAN_TOL, "{conv}: {s2}");
+    }
+}
+
+/// Slow, obviously right twin of the port route (METHODS §2.4 "Port"): MAD start and the plain
+/// fixed point `s^2 <- s^2 mean(psi_c(y/s)^2) / a(c)` to a relative change of 1e-14.
+fn fixed_point_oracle(y: &[f64], c: f64) -> f64 {
+    let mut abs: Vec<f64> = y.iter().map(|v| v.abs()).collect();
+    abs.sort_by(f64::total_cmp);
+    let n = abs.len();
+    let median = if n % 2 == 1 {
+        abs[n / 2]
+    } else {
+        0.5 * (abs[n / 2 - 1] + abs[n / 2])
+    };
+    let a = a_of_c(c);
+    let mut s2 = (median / 0.6744897501960817).powi(2);
+    for _ in 0..100_000 {
+        let s = s2.sqrt();
+        let m = y
+            .iter()
+            .map(|v| gmwm::variance::robust::psi_biweight(v / s, c).powi(2))
+            .sum::<f64>()
+            / n as f64;
+        let next = s2 * m / a;
+        if (next - s2).abs() <= 1e-14 * next {
+            return next;
+        }
+        s2 = next;
+    }
+    panic!("oracle did not converge");
+}
+
+/// Agreement between the polished fixed point and the plain one: both solve the equation to
+/// ~1e-12 relative; 1e-9 leaves room for the oracle's slower linear convergence.
+const ORACLE_TOL: f64 = 1e-9;
+
+#[test]
+fn robust_scale_matches_fixed_point_oracle() {
+    let c = tuning_constant(0.6, RobustConvention::Exact).unwrap();
+    for seed in 0..6u64 {
+        let mut y = gaussian(3_000 + 17 * seed as usize, 100 + seed);
+        // contaminate 0%, 2%, 4%, ... with outliers of growing size
+        for v in y.iter_mut().step_by(50).take(30 * seed as usize) {
+            *v = 5.0 * (seed as f64 + 1.0);
+        }
+        let expected = fixed_point_oracle(&y, c);
+        let got = robust_scale(&y, c, RobustConvention::Exact).unwrap();
+        assert!(
+            rel(got, expected) < ORACLE_TOL,
+            "seed {seed}: {got} vs {expected}"
+        );
+    }
+    for y in [&Y10[..], &Y_PATH[..]] {
+        for c in [C_EXACT_06, C_PACKAGE_06] {
+            let got = robust_scale(y, c, RobustConvention::Exact).unwrap();
+            assert!(rel(got, fixed_point_oracle(y, c)) < ORACLE_TOL);
+        }
     }
 }
 
