@@ -406,6 +406,14 @@ fn robust_scale_rejects_empty_and_zero_input() {
             ));
         }
     }
+    // tiny tuning constants (far below any from tuning_constant): a value or an error, no panic
+    for c in [1e-3, 0.1, 0.5, 1.0] {
+        for conv in [RobustConvention::Exact, RobustConvention::Package] {
+            if let Ok(s2) = robust_scale(&Y10, c, conv) {
+                assert!(s2.is_finite() && s2 > 0.0, "c {c} {conv}: {s2}");
+            }
+        }
+    }
     // more than half exactly zero: MAD = 0, robust scale undefined
     let err = robust_scale(
         &[0.0, 0.0, 0.0, 1.0, -2.0],

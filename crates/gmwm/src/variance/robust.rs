@@ -412,6 +412,15 @@ pub fn robust_scale(y: &[f64], c: f64, convention: RobustConvention) -> Result<f
         return Err(SeriesError::NonFinite { index, value }.into());
     }
     let a = a_of_c(c);
+    if !(a.is_finite() && a > 0.0) {
+        // only for c far below any tuning constant (c < ~1), where §2.2's recursion breaks down
+        return Err(ParamError::new(
+            "c",
+            c,
+            "a tuning constant with a(c) > 0; constants from tuning_constant are above 2.39",
+        )
+        .into());
+    }
     match convention {
         RobustConvention::Exact => scale_exact(y, c, a),
         RobustConvention::Package => scale_package(y, c, a),
@@ -491,7 +500,9 @@ fn polish(y: &[f64], c: f64, a: f64, s: f64, change: f64) -> Option<f64> {
     for _ in 0..POLISH_WIDENINGS {
         let (lo, hi) = (s * (1.0 - delta), s * (1.0 + delta));
         if lo > 0.0 && h(lo) > 0.0 && h(hi) <= 0.0 {
-            return find_root(h, lo, hi, S_ROOT_RTOL * lo).ok().map(|r| r.x);
+            return find_root(h, lo, hi, (S_ROOT_RTOL * lo).max(f64::MIN_POSITIVE))
+                .ok()
+                .map(|r| r.x);
         }
         delta *= 4.0;
     }
@@ -554,7 +565,7 @@ fn scale_exact_bracketed(y: &[f64], c: f64, a: f64, s0: f64) -> Result<f64, Erro
             ),
         )
     })?;
-    let root = find_root(h, lo, hi, S_ROOT_RTOL * lo)?;
+    let root = find_root(h, lo, hi, (S_ROOT_RTOL * lo).max(f64::MIN_POSITIVE))?;
     Ok(root.x * root.x)
 }
 
