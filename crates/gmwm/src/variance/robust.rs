@@ -775,9 +775,3 @@ mod tests {
         assert_eq!(lo, 1.0);
     }
 }
-
-impl std::fmt::Display for RobustConvention {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("exact")
-    }
-}
