@@ -1,0 +1,328 @@
+//! Delimited text (CSV/TSV/other single-byte delimiter), plain or gzip-compressed.
+//!
+//! One pass with the `csv` crate into a reused [`ByteRecord`]; cells are parsed straight from
+//! their bytes (`str::parse::<f64>`), never copied into a `String`, and only the selected
+//! columns are stored.
+
+use super::{default_name, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
+use crate::imu::read::HeaderMode;
+use crate::imu::ReadError;
+use csv::ByteRecord;
+use flate2::read::MultiGzDecoder;
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, Cursor, Read};
+use std::path::Path;
+
+/// Read buffer: large enough that system calls and gzip refills are rare.
+const BUF_CAPACITY: usize = 1 << 20;
+/// The two magic bytes that start every gzip member (RFC 1952 §2.3.1).
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+/// UTF-8 byte order mark, dropped if a file starts with it.
+const UTF8_BOM: [u8; 3] = [0xef, 0xbb, 0xbf];
+
+/// The byte source of a text file, remembering whether it is gzip so that stream errors can be
+/// reported as [`ReadError::Gzip`].
+struct Source {
+    reader: Box<dyn BufRead>,
+    gzip: bool,
+}
+
+/// Opens a file, decompressing it if it starts with the gzip magic bytes (whatever its name).
+fn open(path: &Path) -> Result<Source, ReadError> {
+    let file = File::open(path).map_err(|e| io_error(path, e))?;
+    let mut buffered = BufReader::with_capacity(BUF_CAPACITY, file);
+    let head = buffered.fill_buf().map_err(|e| io_error(path, e))?;
+    let gzip = head.starts_with(&GZIP_MAGIC);
+    let reader: Box<dyn BufRead> = if gzip {
+        Box::new(BufReader::with_capacity(
+            BUF_CAPACITY,
+            MultiGzDecoder::new(buffered),
+        ))
+    } else {
+        Box::new(buffered)
+    };
+    Ok(Source { reader, gzip })
+}
+
+/// Chooses the delimiter: fixed for [`InputFormat::Csv`]/[`InputFormat::Tsv`], else the most
+/// frequent of `,` `\t` `;` in the first line, ties and absence resolved by the extension
+/// (`.tsv` → tab, otherwise comma).
+fn delimiter(format: InputFormat, path: &Path, first_line: &[u8]) -> u8 {
+    match format {
+        InputFormat::Csv => return b',',
+        InputFormat::Tsv => return b'\t',
+        _ => {}
+    }
+    let name = path
+        .file_name()
+        .and_then(|f| f.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    let preferred = if name.ends_with(".tsv") { b'\t' } else { b',' };
+    let count = |d: u8| first_line.iter().filter(|&&b| b == d).count();
+    let mut best = (count(preferred), preferred);
+    for d in [b',', b'\t', b';'] {
+        let c = count(d);
+        if c > best.0 {
+            best = (c, d);
+        }
+    }
+    best.1
+}
+
+/// Parses one cell; `None` if it is not a number (NaN and infinities are numbers here).
+#[inline]
+fn parse_cell(bytes: &[u8]) -> Option<f64> {
+    std::str::from_utf8(bytes).ok()?.parse::<f64>().ok()
+}
+
+/// Reads a delimited text file (see [`super::read_table`] for the options).
+pub(crate) fn read_text_table(
+    path: &Path,
+    format: InputFormat,
+    opts: &ReadOptions,
+) -> Result<RawTable, ReadError> {
+    let Source { mut reader, gzip } = open(path)?;
+    let stream_error = |e: io::Error| {
+        if gzip {
+            ReadError::Gzip {
+                path: path.to_path_buf(),
+                source: e,
+            }
+        } else {
+            io_error(path, e)
+        }
+    };
+    let mut first_line = Vec::new();
+    reader
+        .read_until(b'\n', &mut first_line)
+        .map_err(stream_error)?;
+    if first_line.starts_with(&UTF8_BOM) {
+        first_line.drain(..UTF8_BOM.len());
+    }
+    let delim = delimiter(format, path, &first_line);
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .delimiter(delim)
+        .buffer_capacity(BUF_CAPACITY)
+        .from_reader(Cursor::new(first_line).chain(reader));
+    let mut next = |rec: &mut ByteRecord| -> Result<bool, ReadError> {
+        rdr.read_byte_record(rec).map_err(|e| match e.into_kind() {
+            csv::ErrorKind::Io(e) => stream_error(e),
+            other => io_error(
+                path,
+                io::Error::new(io::ErrorKind::InvalidData, format!("{other:?}")),
+            ),
+        })
+    };
+
+    let mut rec = ByteRecord::new();
+    if !next(&mut rec)? {
+        return Err(ReadError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    let first_line_no = line_of(&rec);
+    let ncols = rec.len();
+    let has_header = match opts.header {
+        HeaderMode::Present => true,
+        HeaderMode::Absent => false,
+        HeaderMode::Auto => rec.iter().any(|f| parse_cell(f).is_none()),
+    };
+    let names: Vec<String> = if has_header {
+        rec.iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let n = String::from_utf8_lossy(f).trim().to_string();
+                if n.is_empty() {
+                    default_name(k)
+                } else {
+                    n
+                }
+            })
+            .collect()
+    } else {
+        (0..ncols).map(default_name).collect()
+    };
+    let sel = resolve_selection(path, &names, opts)?;
+
+    let mut rows = Rows {
+        path,
+        names: &names,
+        ncols,
+        first_line: first_line_no,
+        columns: &sel.columns,
+        time_index: sel.time,
+        values: vec![Vec::new(); sel.columns.len()],
+        time: Vec::new(),
+    };
+    if !has_header {
+        rows.push(&rec, first_line_no)?;
+    }
+    while next(&mut rec)? {
+        rows.push(&rec, line_of(&rec))?;
+    }
+    let n = if sel.columns.is_empty() {
+        rows.time.len()
+    } else {
+        rows.values[0].len()
+    };
+    if n == 0 {
+        return Err(if has_header {
+            ReadError::HeaderOnly {
+                path: path.to_path_buf(),
+            }
+        } else {
+            ReadError::Empty {
+                path: path.to_path_buf(),
+            }
+        });
+    }
+    let columns = sel
+        .columns
+        .iter()
+        .zip(rows.values)
+        .map(|(&k, values)| Column {
+            name: names[k].clone(),
+            values,
+        })
+        .collect();
+    let time = sel.time.map(|k| Column {
+        name: names[k].clone(),
+        values: rows.time,
+    });
+    Ok(RawTable { columns, time })
+}
+
+/// 1-based physical line where a record starts.
+#[inline]
+fn line_of(rec: &ByteRecord) -> u64 {
+    rec.position().map_or(0, |p| p.line())
+}
+
+/// Accumulates the selected cells of each data row.
+struct Rows<'a> {
+    path: &'a Path,
+    names: &'a [String],
+    ncols: usize,
+    first_line: u64,
+    columns: &'a [usize],
+    time_index: Option<usize>,
+    values: Vec<Vec<f64>>,
+    time: Vec<f64>,
+}
+
+impl Rows<'_> {
+    #[inline]
+    fn push(&mut self, rec: &ByteRecord, line: u64) -> Result<(), ReadError> {
+        if rec.len() != self.ncols {
+            return Err(self.ragged(line, rec.len()));
+        }
+        for (j, &k) in self.columns.iter().enumerate() {
+            let v = self.cell(rec, k, line)?;
+            self.values[j].push(v);
+        }
+        if let Some(k) = self.time_index {
+            let t = self.cell(rec, k, line)?;
+            if let Some(&previous) = self.time.last() {
+                if t <= previous {
+                    return Err(self.not_increasing(k, line, previous, t));
+                }
+            }
+            self.time.push(t);
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn cell(&self, rec: &ByteRecord, k: usize, line: u64) -> Result<f64, ReadError> {
+        let bytes = rec.get(k).unwrap_or_default();
+        match parse_cell(bytes) {
+            Some(v) if v.is_finite() => Ok(v),
+            Some(_) => Err(self.bad_cell(k, line, bytes, true)),
+            None => Err(self.bad_cell(k, line, bytes, false)),
+        }
+    }
+
+    #[cold]
+    fn ragged(&self, line: u64, found: usize) -> ReadError {
+        ReadError::Ragged {
+            path: self.path.to_path_buf(),
+            line,
+            first_line: self.first_line,
+            expected: self.ncols,
+            found,
+        }
+    }
+
+    #[cold]
+    fn bad_cell(&self, k: usize, line: u64, bytes: &[u8], numeric: bool) -> ReadError {
+        let path = self.path.to_path_buf();
+        let column = self.names[k].clone();
+        let text = String::from_utf8_lossy(bytes).into_owned();
+        if numeric {
+            ReadError::NonFinite {
+                path,
+                line,
+                column,
+                text,
+            }
+        } else {
+            ReadError::NotANumber {
+                path,
+                line,
+                column,
+                text,
+            }
+        }
+    }
+
+    #[cold]
+    fn not_increasing(&self, k: usize, line: u64, previous: f64, value: f64) -> ReadError {
+        ReadError::TimeNotIncreasing {
+            path: self.path.to_path_buf(),
+            line,
+            column: self.names[k].clone(),
+            previous,
+            value,
+        }
+    }
+}
+
+#[cold]
+fn io_error(path: &Path, source: io::Error) -> ReadError {
+    ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn delimiter_sniffing() {
+        let p = Path::new("x.txt");
+        assert_eq!(delimiter(InputFormat::Auto, p, b"a\tb\tc\n"), b'\t');
+        assert_eq!(delimiter(InputFormat::Auto, p, b"a;b;c\n"), b';');
+        assert_eq!(delimiter(InputFormat::Auto, p, b"a\n"), b',');
+        assert_eq!(
+            delimiter(InputFormat::Auto, Path::new("x.tsv.gz"), b"a\n"),
+            b'\t'
+        );
+        assert_eq!(delimiter(InputFormat::Csv, p, b"a\tb\n"), b',');
+    }
+
+    #[test]
+    fn parse_cell_accepts_numbers_only() {
+        assert_eq!(parse_cell(b"-1.5e-3"), Some(-1.5e-3));
+        assert!(parse_cell(b"nan").is_some_and(f64::is_nan));
+        assert_eq!(parse_cell(b"gyro_x"), None);
+        assert_eq!(parse_cell(b""), None);
+        assert_eq!(parse_cell(&[0xff, 0x31]), None);
+    }
+}
