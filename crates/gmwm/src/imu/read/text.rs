@@ -102,30 +102,49 @@ pub(crate) fn read_text_table(
         first_line.drain(..UTF8_BOM.len());
     }
     let delim = delimiter(format, path, &first_line);
+    // Lines end at `\n` only (a `\r` before it is trimmed with the field), and a final `\n` is
+    // appended, so that after each record the reader has consumed exactly its terminator and
+    // its physical line is `position().line() - 1` (csv's own record positions point at the
+    // start of the scan, before any skipped blank line).
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
         .delimiter(delim)
+        .terminator(csv::Terminator::Any(b'\n'))
         .buffer_capacity(BUF_CAPACITY)
-        .from_reader(Cursor::new(first_line).chain(reader));
-    let mut next = |rec: &mut ByteRecord| -> Result<bool, ReadError> {
-        rdr.read_byte_record(rec).map_err(|e| match e.into_kind() {
-            csv::ErrorKind::Io(e) => stream_error(e),
-            other => io_error(
-                path,
-                io::Error::new(io::ErrorKind::InvalidData, format!("{other:?}")),
-            ),
-        })
+        .from_reader(
+            Cursor::new(first_line)
+                .chain(reader)
+                .chain(Cursor::new(&b"\n"[..])),
+        );
+    // Next non-blank record and its 1-based physical line; a record made of one empty field
+    // is a blank (or whitespace-only) line and is skipped.
+    let mut next = |rec: &mut ByteRecord| -> Result<Option<u64>, ReadError> {
+        loop {
+            let more = rdr.read_byte_record(rec).map_err(|e| match e.into_kind() {
+                csv::ErrorKind::Io(e) => stream_error(e),
+                other => io_error(
+                    path,
+                    io::Error::new(io::ErrorKind::InvalidData, format!("{other:?}")),
+                ),
+            })?;
+            if !more {
+                return Ok(None);
+            }
+            if rec.len() == 1 && rec.get(0).is_some_and(<[u8]>::is_empty) {
+                continue;
+            }
+            return Ok(Some(rdr.position().line().saturating_sub(1)));
+        }
     };
 
     let mut rec = ByteRecord::new();
-    if !next(&mut rec)? {
+    let Some(first_line_no) = next(&mut rec)? else {
         return Err(ReadError::Empty {
             path: path.to_path_buf(),
         });
-    }
-    let first_line_no = line_of(&rec);
+    };
     let ncols = rec.len();
     let has_header = match opts.header {
         HeaderMode::Present => true,
@@ -162,8 +181,8 @@ pub(crate) fn read_text_table(
     if !has_header {
         rows.push(&rec, first_line_no)?;
     }
-    while next(&mut rec)? {
-        rows.push(&rec, line_of(&rec))?;
+    while let Some(line) = next(&mut rec)? {
+        rows.push(&rec, line)?;
     }
     let n = if sel.columns.is_empty() {
         rows.time.len()
@@ -195,12 +214,6 @@ pub(crate) fn read_text_table(
         values: rows.time,
     });
     Ok(RawTable { columns, time })
-}
-
-/// 1-based physical line where a record starts.
-#[inline]
-fn line_of(rec: &ByteRecord) -> u64 {
-    rec.position().map_or(0, |p| p.line())
 }
 
 /// Accumulates the selected cells of each data row.
