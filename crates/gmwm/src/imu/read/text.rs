@@ -71,10 +71,62 @@ fn delimiter(format: InputFormat, path: &Path, first_line: &[u8]) -> u8 {
     best.1
 }
 
-/// Parses one cell; `None` if it is not a number (NaN and infinities are numbers here).
+/// Largest integer below which every integer is exactly representable in an f64 (2^53).
+const EXACT_INT: u64 = 1 << 53;
+/// Powers of ten exactly representable in an f64 (10^0 ..= 10^22: 5^22 < 2^53).
+const EXACT_POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// Parses one cell (surrounding ASCII whitespace, including a `\r`, ignored); `None` if it is
+/// not a number (NaN and infinities are numbers here, rejected by the caller).
 #[inline]
 fn parse_cell(bytes: &[u8]) -> Option<f64> {
-    std::str::from_utf8(bytes).ok()?.parse::<f64>().ok()
+    let bytes = bytes.trim_ascii();
+    match parse_simple_decimal(bytes) {
+        Some(v) => Some(v),
+        None => std::str::from_utf8(bytes).ok()?.parse::<f64>().ok(),
+    }
+}
+
+/// Clinger's fast path for plain decimals `[+-]digits[.digits]` with at most 19 significant
+/// digits: when the digit string `m < 2^53` and the number of fraction digits `k <= 22`, both
+/// `m` and `10^k` are exact f64 values and one IEEE division `m / 10^k` is correctly rounded,
+/// i.e. equal to `str::parse`. Anything else (exponents, long mantissas, `nan`) returns `None`
+/// and goes to `str::parse`.
+#[inline]
+fn parse_simple_decimal(bytes: &[u8]) -> Option<f64> {
+    let (negative, digits) = match bytes.first()? {
+        b'-' => (true, &bytes[1..]),
+        b'+' => (false, &bytes[1..]),
+        _ => (false, bytes),
+    };
+    let mut mantissa: u64 = 0;
+    let mut n_digits = 0usize;
+    let mut frac_digits = 0usize;
+    let mut seen_point = false;
+    for &b in digits {
+        match b {
+            b'0'..=b'9' => {
+                if n_digits >= 19 {
+                    return None;
+                }
+                mantissa = mantissa * 10 + u64::from(b - b'0');
+                n_digits += 1;
+                if seen_point {
+                    frac_digits += 1;
+                }
+            }
+            b'.' if !seen_point => seen_point = true,
+            _ => return None,
+        }
+    }
+    if n_digits == 0 || mantissa >= EXACT_INT || frac_digits >= EXACT_POW10.len() {
+        return None;
+    }
+    let v = mantissa as f64 / EXACT_POW10[frac_digits];
+    Some(if negative { -v } else { v })
 }
 
 /// Reads a delimited text file (see [`super::read_table`] for the options).
@@ -102,14 +154,14 @@ pub(crate) fn read_text_table(
         first_line.drain(..UTF8_BOM.len());
     }
     let delim = delimiter(format, path, &first_line);
-    // Lines end at `\n` only (a `\r` before it is trimmed with the field), and a final `\n` is
+    // Lines end at `\n` only (a `\r` before it is trimmed with the field, see
+    // [`parse_cell`]), and a final `\n` is
     // appended, so that after each record the reader has consumed exactly its terminator and
     // its physical line is `position().line() - 1` (csv's own record positions point at the
     // start of the scan, before any skipped blank line).
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
-        .trim(csv::Trim::All)
         .delimiter(delim)
         .terminator(csv::Terminator::Any(b'\n'))
         .buffer_capacity(BUF_CAPACITY)
@@ -132,7 +184,7 @@ pub(crate) fn read_text_table(
             if !more {
                 return Ok(None);
             }
-            if rec.len() == 1 && rec.get(0).is_some_and(<[u8]>::is_empty) {
+            if rec.len() == 1 && rec.get(0).is_some_and(|f| f.trim_ascii().is_empty()) {
                 continue;
             }
             return Ok(Some(rdr.position().line().saturating_sub(1)));
@@ -275,7 +327,7 @@ impl Rows<'_> {
     fn bad_cell(&self, k: usize, line: u64, bytes: &[u8], numeric: bool) -> ReadError {
         let path = self.path.to_path_buf();
         let column = self.names[k].clone();
-        let text = String::from_utf8_lossy(bytes).into_owned();
+        let text = String::from_utf8_lossy(bytes.trim_ascii()).into_owned();
         if numeric {
             ReadError::NonFinite {
                 path,
@@ -337,5 +389,54 @@ mod tests {
         assert_eq!(parse_cell(b"gyro_x"), None);
         assert_eq!(parse_cell(b""), None);
         assert_eq!(parse_cell(&[0xff, 0x31]), None);
+        assert_eq!(parse_cell(b" 2.5\r"), Some(2.5));
+        assert_eq!(parse_cell(b"-"), None);
+        assert_eq!(parse_cell(b"."), None);
+        assert_eq!(parse_cell(b"1.2.3"), None);
+        assert_eq!(parse_cell(b"+.5"), Some(0.5));
+        assert_eq!(parse_cell(b"-0"), Some(-0.0));
+        assert!(parse_cell(b"-0").unwrap().is_sign_negative());
+    }
+
+    /// The fast path is bit-identical to `str::parse` on every input it accepts.
+    #[test]
+    fn parse_simple_decimal_matches_std() {
+        let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut accepted = 0;
+        for _ in 0..200_000 {
+            let r = next();
+            let int_digits = (r % 12) as usize;
+            let frac_digits = ((r >> 8) % 20) as usize;
+            let mut s = String::new();
+            if r >> 20 & 1 == 1 {
+                s.push('-');
+            }
+            for _ in 0..int_digits {
+                s.push(char::from(b'0' + (next() % 10) as u8));
+            }
+            if frac_digits > 0 || r >> 21 & 1 == 1 {
+                s.push('.');
+            }
+            for _ in 0..frac_digits {
+                s.push(char::from(b'0' + (next() % 10) as u8));
+            }
+            let std = s.parse::<f64>().ok();
+            if let Some(v) = parse_simple_decimal(s.as_bytes()) {
+                accepted += 1;
+                assert_eq!(Some(v.to_bits()), std.map(f64::to_bits), "{s}");
+            }
+            assert_eq!(
+                parse_cell(s.as_bytes()).map(f64::to_bits),
+                std.map(f64::to_bits),
+                "{s}"
+            );
+        }
+        assert!(accepted > 100_000, "{accepted}");
     }
 }
