@@ -782,3 +782,12 @@ fn read_line_numbers_with_crlf_blank_lines_and_no_final_newline() {
     let p = write(&d, "ok.csv", b"x,y\r\n1,2\r\n\r\n3,4");
     assert_eq!(read(&p).unwrap().columns[1].values, [2.0, 4.0]);
 }
+
+#[test]
+fn read_multi_member_gzip() {
+    let d = tempfile::tempdir().unwrap();
+    let mut z = gzip(b"x\n1\n2\n");
+    z.extend(gzip(b"3\n4\n"));
+    let p = write(&d, "m.csv.gz", &z);
+    assert_eq!(read(&p).unwrap().columns[0].values, [1.0, 2.0, 3.0, 4.0]);
+}

@@ -178,5 +178,5 @@ pub enum ReadError {
     },
     /// An option has an impossible value (e.g. `ncols = 0`, `freq_hz = -1`).
     #[error(transparent)]
-    Option(#[from] ParamError),
+    InvalidOption(#[from] ParamError),
 }

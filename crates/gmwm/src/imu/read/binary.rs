@@ -198,7 +198,7 @@ impl BinaryChunks {
     /// one may be shorter).
     ///
     /// # Errors
-    /// [`ReadError::Option`] for a text format, `ncols = 0` or `chunk_len = 0`;
+    /// [`ReadError::InvalidOption`] for a text format, `ncols = 0` or `chunk_len = 0`;
     /// [`ReadError::ColumnOutOfRange`]; [`ReadError::Io`]; [`ReadError::Empty`];
     /// [`ReadError::BinarySize`] if the size is not a multiple of `width · ncols`.
     pub fn open(
