@@ -78,10 +78,6 @@ pub struct AllanVariance {
 }
 
 /// Computes it.
-pub fn allan_variance(
-    _x: &[f64],
-    _freq_hz: f64,
-    _opts: &AllanOptions,
-) -> Result<AllanVariance, Error> {
+pub fn allan_variance(_x: &[f64], _freq_hz: f64, _opts: &AllanOptions) -> Result<AllanVariance, Error> {
     unimplemented!()
 }
