@@ -1,6 +1,7 @@
 //! The engine's single integration-test binary (STYLE §1): reference data, properties, Monte Carlo.
 
 mod common;
+mod read;
 mod robust;
 mod wavelet;
 mod wv;

@@ -1,98 +1,35 @@
-//! IMU data and readers. STUB: owned by the reader helper.
+//! IMU data and readers (METHODS §9).
+//!
+//! - [`read_table`]: CSV/TSV text (plain or gzip) and raw little-endian f64/f32 binary into a
+//!   [`Table`] of named columns, with the JSON [`Sidecar`] and the sampling rate;
+//! - [`BinaryChunks`] / [`for_each_chunk`]: one column of a huge binary file in bounded memory;
+//! - [`read_imu_record_file`]: the binary IMU epoch records of METHODS §9.2–9.3;
+//! - [`Imu`]: gyroscope/accelerometer axes with a common rate (METHODS §9.1).
+//!
+//! This module knows no statistics; every error is a [`ReadError`] (or a
+//! [`ParamError`](crate::error::ParamError) for impossible options) naming the file, line and
+//! column.
+//!
+//! ```no_run
+//! use gmwm::imu::{read_table, Imu, ReadOptions};
+//! use std::path::Path;
+//! let table = read_table(Path::new("adis_16405_imu1.csv.gz"), &ReadOptions::default())?;
+//! let imu = Imu::from_table(table)?;
+//! for (tag, axis) in imu.iter() {
+//!     println!("{tag}: {} samples at {} Hz", axis.values().len(), imu.freq_hz());
+//! }
+//! # Ok::<(), gmwm::Error>(())
+//! ```
 
-use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
-use thiserror::Error;
+mod error;
+pub mod read;
+mod sensor;
+pub mod sidecar;
 
-/// Reading errors.
-#[derive(Debug, Error)]
-#[non_exhaustive]
-pub enum ReadError {
-    /// I/O.
-    #[error("{path}: {source}")]
-    Io {
-        /// File.
-        path: PathBuf,
-        /// Cause.
-        source: std::io::Error,
-    },
-}
-
-/// Column selector: 1-based index or header name.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum ColumnSelector {
-    /// 1-based index.
-    Index(usize),
-    /// Header name.
-    Name(String),
-}
-
-/// Input format.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum InputFormat {
-    /// From the extension.
-    #[default]
-    Auto,
-    /// Comma separated.
-    Csv,
-    /// Tab separated.
-    Tsv,
-    /// Raw little-endian f64.
-    F64,
-    /// Raw little-endian f32.
-    F32,
-}
-
-/// Header handling.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum HeaderMode {
-    /// Detect.
-    #[default]
-    Auto,
-    /// First row is a header.
-    Present,
-    /// No header.
-    Absent,
-}
-
-/// Options.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ReadOptions {
-    /// Format.
-    pub format: InputFormat,
-    /// Header.
-    pub header: HeaderMode,
-    /// Time column, if any.
-    pub time_column: Option<ColumnSelector>,
-    /// Columns to read (empty: all but the time column).
-    pub columns: Vec<ColumnSelector>,
-    /// Interleaved columns in a binary file.
-    pub ncols: Option<usize>,
-    /// Sampling rate override.
-    pub freq_hz: Option<f64>,
-}
-
-/// One column.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Column {
-    /// Name.
-    pub name: String,
-    /// Values.
-    pub values: Vec<f64>,
-}
-
-/// A table read from a file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Table {
-    /// File.
-    pub path: PathBuf,
-    /// Columns.
-    pub columns: Vec<Column>,
-    /// Rate.
-    pub freq_hz: Option<f64>,
-}
-
-/// Reads a file.
-pub fn read_table(_path: &Path, _opts: &ReadOptions) -> Result<Table, ReadError> {
-    unimplemented!()
-}
+pub use error::ReadError;
+pub use read::{
+    for_each_chunk, read_imu_record_file, read_table, BinaryChunks, Column, ColumnSelector,
+    HeaderMode, ImuRecordType, InputFormat, ReadOptions, Table,
+};
+pub use sensor::{Axis, Imu, Sensor, SensorInfo};
+pub use sidecar::{find_sidecar, ColumnSummary, Sidecar, SidecarColumn, SidecarUnits};

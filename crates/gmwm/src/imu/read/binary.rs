@@ -1,0 +1,525 @@
+//! Raw little-endian binary: interleaved f64/f32 columns, and the IMU epoch records of
+//! METHODS §9.2.
+//!
+//! Values are decoded with `from_le_bytes` (never text parsing). Whole-file reads memory-map the
+//! file; [`BinaryChunks`] reads fixed-size blocks so that series of 10^9 samples can be consumed
+//! in bounded memory.
+
+use super::{default_name, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
+use crate::error::{Error, ParamError};
+use crate::imu::{Imu, ReadError, Sensor, SensorInfo};
+use memmap2::Mmap;
+use std::fmt;
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// Read buffer of [`BinaryChunks`].
+const BUF_CAPACITY: usize = 1 << 20;
+
+/// Decodes one little-endian value of `width` (8 or 4) bytes starting at `bytes[0]`.
+///
+/// # Panics
+/// If `bytes` is shorter than the width (an internal invariant: callers slice whole records).
+#[inline]
+fn decode(bytes: &[u8], width: usize) -> f64 {
+    if width == 8 {
+        let mut a = [0u8; 8];
+        a.copy_from_slice(&bytes[..8]);
+        f64::from_le_bytes(a)
+    } else {
+        let mut a = [0u8; 4];
+        a.copy_from_slice(&bytes[..4]);
+        f64::from(f32::from_le_bytes(a))
+    }
+}
+
+#[inline]
+fn decode_i32(bytes: &[u8]) -> f64 {
+    let mut a = [0u8; 4];
+    a.copy_from_slice(&bytes[..4]);
+    f64::from(i32::from_le_bytes(a))
+}
+
+#[cold]
+fn io_error(path: &Path, source: std::io::Error) -> ReadError {
+    ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+#[cold]
+fn non_finite(path: &Path, index: usize, column: usize, value: f64) -> ReadError {
+    ReadError::BinaryNonFinite {
+        path: path.to_path_buf(),
+        index: index as u64,
+        column,
+        value,
+    }
+}
+
+/// Opens a binary file and checks its size: non-empty and a whole number of `record` bytes.
+/// Returns the file and the number of records.
+fn open_records(path: &Path, record: usize) -> Result<(File, u64), ReadError> {
+    let file = File::open(path).map_err(|e| io_error(path, e))?;
+    let size = file.metadata().map_err(|e| io_error(path, e))?.len();
+    let record = record as u64;
+    if size == 0 {
+        return Err(ReadError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    if size % record != 0 {
+        return Err(ReadError::BinarySize {
+            path: path.to_path_buf(),
+            size,
+            record_size: record,
+            remainder: size % record,
+        });
+    }
+    Ok((file, size / record))
+}
+
+/// Memory-maps a whole file read-only.
+fn map(path: &Path, file: &File) -> Result<Mmap, ReadError> {
+    // SAFETY: the map is read-only and private to this call; as with any memory map, the file
+    // must not be truncated by another process while it is read (documented on the public
+    // readers).
+    unsafe { Mmap::map(file) }.map_err(|e| io_error(path, e))
+}
+
+/// Width in bytes of a binary format, or an option error for text formats.
+fn width_of(format: InputFormat) -> Result<usize, ParamError> {
+    format.value_width().ok_or_else(|| {
+        ParamError::new(
+            "format",
+            format!("{format:?}").to_lowercase(),
+            "f64 or f32 for a raw binary file",
+        )
+    })
+}
+
+fn check_ncols(ncols: usize) -> Result<(), ParamError> {
+    if ncols == 0 {
+        Err(ParamError::new("ncols", 0, "at least 1 interleaved column"))
+    } else {
+        Ok(())
+    }
+}
+
+/// Reads a raw binary table (memory-mapped). The file must not change while it is read.
+pub(crate) fn read_binary_table(
+    path: &Path,
+    format: InputFormat,
+    opts: &ReadOptions,
+) -> Result<RawTable, ReadError> {
+    let width = width_of(format)?;
+    let ncols = opts.ncols.unwrap_or(1);
+    check_ncols(ncols)?;
+    let names: Vec<String> = (0..ncols).map(default_name).collect();
+    let sel = resolve_selection(path, &names, opts)?;
+    let (file, _rows) = open_records(path, width * ncols)?;
+    let bytes = map(path, &file)?;
+    let record = width * ncols;
+    let column = |k: usize| -> Result<Vec<f64>, ReadError> {
+        let values: Vec<f64> = bytes
+            .chunks_exact(record)
+            .map(|r| decode(&r[k * width..], width))
+            .collect();
+        match values.iter().position(|v| !v.is_finite()) {
+            Some(i) => Err(non_finite(path, i, k + 1, values[i])),
+            None => Ok(values),
+        }
+    };
+    let time = match sel.time {
+        Some(k) => {
+            let values = column(k)?;
+            if let Some(i) = values.windows(2).position(|w| w[1] <= w[0]) {
+                return Err(ReadError::TimeNotIncreasing {
+                    path: path.to_path_buf(),
+                    line: i as u64 + 2,
+                    column: names[k].clone(),
+                    previous: values[i],
+                    value: values[i + 1],
+                });
+            }
+            Some(Column {
+                name: names[k].clone(),
+                values,
+            })
+        }
+        None => None,
+    };
+    let columns = sel
+        .columns
+        .iter()
+        .map(|&k| {
+            Ok(Column {
+                name: names[k].clone(),
+                values: column(k)?,
+            })
+        })
+        .collect::<Result<_, ReadError>>()?;
+    Ok(RawTable { columns, time })
+}
+
+/// Streaming reader of one column of a raw binary file, chunk by chunk, in bounded memory
+/// (`chunk_len · ncols · width` bytes plus a 1 MiB buffer); the column is never materialised.
+///
+/// ```no_run
+/// # use gmwm::imu::{BinaryChunks, InputFormat};
+/// # use std::path::Path;
+/// let mut chunks = BinaryChunks::open(Path::new("x.f64le.bin"), InputFormat::F64, 1, 1, 1 << 16)?;
+/// let mut sum = 0.0;
+/// while let Some(chunk) = chunks.next_chunk()? {
+///     sum += chunk.iter().sum::<f64>();
+/// }
+/// # Ok::<(), gmwm::imu::ReadError>(())
+/// ```
+#[derive(Debug)]
+pub struct BinaryChunks {
+    path: PathBuf,
+    reader: BufReader<File>,
+    width: usize,
+    ncols: usize,
+    column: usize,
+    chunk_len: usize,
+    rows: u64,
+    row: u64,
+    bytes: Vec<u8>,
+    values: Vec<f64>,
+}
+
+impl BinaryChunks {
+    /// Opens `path` holding `ncols` interleaved little-endian columns of `format` (F64 or F32)
+    /// and prepares to read column `column` (1-based) in chunks of `chunk_len` samples (the last
+    /// one may be shorter).
+    ///
+    /// # Errors
+    /// [`ReadError::InvalidOption`] for a text format, `ncols = 0` or `chunk_len = 0`;
+    /// [`ReadError::ColumnOutOfRange`]; [`ReadError::Io`]; [`ReadError::Empty`];
+    /// [`ReadError::BinarySize`] if the size is not a multiple of `width · ncols`.
+    pub fn open(
+        path: &Path,
+        format: InputFormat,
+        ncols: usize,
+        column: usize,
+        chunk_len: usize,
+    ) -> Result<Self, ReadError> {
+        let width = width_of(format)?;
+        check_ncols(ncols)?;
+        if chunk_len == 0 {
+            return Err(ParamError::new("chunk_len", 0, "at least 1 sample").into());
+        }
+        if !(1..=ncols).contains(&column) {
+            return Err(ReadError::ColumnOutOfRange {
+                path: path.to_path_buf(),
+                index: column,
+                ncols,
+            });
+        }
+        let (file, rows) = open_records(path, width * ncols)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            reader: BufReader::with_capacity(BUF_CAPACITY, file),
+            width,
+            ncols,
+            column: column - 1,
+            chunk_len,
+            rows,
+            row: 0,
+            bytes: Vec::new(),
+            values: Vec::with_capacity(chunk_len),
+        })
+    }
+
+    /// Number of rows (samples per column) of the file.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// The next chunk, `None` after the last one.
+    ///
+    /// # Errors
+    /// [`ReadError::Io`] (including a file truncated while reading) and
+    /// [`ReadError::BinaryNonFinite`] with the 0-based sample index.
+    pub fn next_chunk(&mut self) -> Result<Option<&[f64]>, ReadError> {
+        let left = self.rows - self.row;
+        if left == 0 {
+            return Ok(None);
+        }
+        let n = usize::try_from(left).map_or(self.chunk_len, |l| l.min(self.chunk_len));
+        let record = self.width * self.ncols;
+        self.bytes.resize(n * record, 0);
+        self.reader
+            .read_exact(&mut self.bytes)
+            .map_err(|e| io_error(&self.path, e))?;
+        self.values.clear();
+        let offset = self.column * self.width;
+        let width = self.width;
+        self.values.extend(
+            self.bytes
+                .chunks_exact(record)
+                .map(|r| decode(&r[offset..], width)),
+        );
+        if let Some(i) = self.values.iter().position(|v| !v.is_finite()) {
+            let index = self.row as usize + i;
+            return Err(non_finite(
+                &self.path,
+                index,
+                self.column + 1,
+                self.values[i],
+            ));
+        }
+        self.row += n as u64;
+        Ok(Some(&self.values))
+    }
+}
+
+/// Calls `f` on consecutive chunks of one column of a raw binary file (see [`BinaryChunks`]);
+/// stops at the first error, from the file or from `f`.
+///
+/// # Errors
+/// As [`BinaryChunks::open`] and [`BinaryChunks::next_chunk`], or the first error of `f`.
+pub fn for_each_chunk(
+    path: &Path,
+    format: InputFormat,
+    ncols: usize,
+    column: usize,
+    chunk_len: usize,
+    mut f: impl FnMut(&[f64]) -> Result<(), Error>,
+) -> Result<(), Error> {
+    let mut chunks = BinaryChunks::open(path, format, ncols, column, chunk_len)?;
+    while let Some(chunk) = chunks.next_chunk()? {
+        f(chunk)?;
+    }
+    Ok(())
+}
+
+/// Binary IMU record types of METHODS §9.2–9.3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ImuRecordType {
+    /// iMAR: int32 counts, gyro 0.1 arcsec, accel 1.52588e-6 m/s.
+    Imar,
+    /// Northrop Grumman LN-200: int32 counts, gyro 2^-21 rad, accel 2^-14 m/s.
+    Ln200,
+    /// LN-200 IG: int32 counts, gyro 2^-19 rad, accel 2^-14 m/s.
+    Ln200Ig,
+    /// iXblue (IXSEA): doubles, gyro 1 arcsec, accel 0.001 m/s.
+    Ixsea,
+    /// NavChip, float records: doubles, gyro 1 arcsec, accel 0.001 m/s.
+    NavchipFlt,
+    /// NavChip, integer records: int32 counts, gyro 6.25e-6 rad, accel 3.90625e-5 m/s.
+    NavchipInt,
+}
+
+/// One arcsecond in radians: pi / (180 · 3600) (METHODS §9.3).
+const ARCSEC_RAD: f64 = std::f64::consts::PI / (180.0 * 3600.0);
+
+impl ImuRecordType {
+    /// Every type, in the order of METHODS §9.3.
+    pub const ALL: [Self; 6] = [
+        Self::Imar,
+        Self::Ln200,
+        Self::Ln200Ig,
+        Self::Ixsea,
+        Self::NavchipFlt,
+        Self::NavchipInt,
+    ];
+
+    /// The package's type name (`IMAR`, `LN200`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Imar => "IMAR",
+            Self::Ln200 => "LN200",
+            Self::Ln200Ig => "LN200IG",
+            Self::Ixsea => "IXSEA",
+            Self::NavchipFlt => "NAVCHIP_FLT",
+            Self::NavchipInt => "NAVCHIP_INT",
+        }
+    }
+
+    /// Whether the six values are 8-byte doubles (else 32-bit signed integers).
+    pub fn is_double(self) -> bool {
+        matches!(self, Self::Ixsea | Self::NavchipFlt)
+    }
+
+    /// Bytes per epoch: 8 (time) + 6 · 4 = 32 or 8 + 6 · 8 = 56 (METHODS §9.2).
+    pub fn record_size(self) -> usize {
+        if self.is_double() {
+            56
+        } else {
+            32
+        }
+    }
+
+    /// METHODS §9.3: gyroscope scale, rad per count.
+    pub fn scale_gyro(self) -> f64 {
+        match self {
+            Self::Imar => 0.1 * ARCSEC_RAD,
+            Self::Ln200 => 1.0 / 2_097_152.0,
+            Self::Ln200Ig => 1.0 / 524_288.0,
+            Self::Ixsea => ARCSEC_RAD,
+            Self::NavchipFlt => 2.0 * std::f64::consts::PI / (3600.0 * 360.0),
+            Self::NavchipInt => 6.25e-6,
+        }
+    }
+
+    /// METHODS §9.3: accelerometer scale, m/s per count.
+    pub fn scale_accel(self) -> f64 {
+        match self {
+            Self::Imar => 0.001_525_88 / 1000.0,
+            Self::Ln200 | Self::Ln200Ig => 1.0 / 16_384.0,
+            Self::Ixsea | Self::NavchipFlt => 0.001,
+            Self::NavchipInt => 3.906_25e-5,
+        }
+    }
+}
+
+impl fmt::Display for ImuRecordType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ImuRecordType {
+    type Err = ParamError;
+
+    /// Case-insensitive type name (METHODS §9.2).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let t = s.trim();
+        Self::ALL
+            .into_iter()
+            .find(|ty| ty.name().eq_ignore_ascii_case(t))
+            .ok_or_else(|| {
+                ParamError::new(
+                    "imu type",
+                    s,
+                    "one of IMAR, LN200, LN200IG, IXSEA, NAVCHIP_FLT, NAVCHIP_INT",
+                )
+            })
+    }
+}
+
+/// `round(1 / mean(diff(t)))` of METHODS §9.2 (rounded, unlike [`super::read_table`]).
+fn record_freq(path: &Path, t: &[f64]) -> Result<f64, ReadError> {
+    let not_derivable = |reason| ReadError::FreqNotDerivable {
+        path: path.to_path_buf(),
+        reason,
+    };
+    match (t.first(), t.last()) {
+        (Some(first), Some(last)) if t.len() >= 2 => {
+            let freq = ((t.len() - 1) as f64 / (last - first)).round();
+            if freq.is_finite() && freq > 0.0 {
+                Ok(freq)
+            } else {
+                Err(not_derivable(
+                    "round(1 / mean(diff(time))) is not a positive finite rate",
+                ))
+            }
+        }
+        _ => Err(not_derivable("fewer than 2 epochs")),
+    }
+}
+
+/// Reads a binary IMU record file (METHODS §9.2): each epoch is a little-endian f64 time then
+/// gyro X, Y, Z and accel X, Y, Z increments (int32 or f64 by type). Returns an [`Imu`] with
+/// `freq = round(1 / mean(diff(time)))` and rates `raw · freq · scale` (METHODS §9.3), in rad/s
+/// and m/s^2, columns named `gyro_x` ... `accel_z`.
+///
+/// The file is memory-mapped and must not change while it is read.
+///
+/// # Errors
+/// [`ReadError::Io`], [`ReadError::Empty`], [`ReadError::BinarySize`] (size not a multiple of
+/// 32 or 56 bytes), [`ReadError::BinaryNonFinite`] (column 1 is the time),
+/// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span).
+pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<Imu, Error> {
+    let record = record_type.record_size();
+    let (file, _rows) = open_records(path, record)?;
+    let bytes = map(path, &file)?;
+    let time: Vec<f64> = bytes.chunks_exact(record).map(|r| decode(r, 8)).collect();
+    if let Some(i) = time.iter().position(|v| !v.is_finite()) {
+        return Err(non_finite(path, i, 1, time[i]).into());
+    }
+    let freq = record_freq(path, &time)?;
+    let names = [
+        "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+    ];
+    let mut columns = Vec::with_capacity(6);
+    let mut info = Vec::with_capacity(6);
+    for (k, name) in names.into_iter().enumerate() {
+        let (sensor, scale, unit) = if k < 3 {
+            (Sensor::Gyroscope, record_type.scale_gyro(), "rad/s")
+        } else {
+            (Sensor::Accelerometer, record_type.scale_accel(), "m/s^2")
+        };
+        let factor = freq * scale;
+        let values: Vec<f64> = if record_type.is_double() {
+            let raw: Vec<f64> = bytes
+                .chunks_exact(record)
+                .map(|r| decode(&r[8 + 8 * k..], 8))
+                .collect();
+            if let Some(i) = raw.iter().position(|v| !v.is_finite()) {
+                return Err(non_finite(path, i, k + 2, raw[i]).into());
+            }
+            raw.into_iter().map(|v| v * factor).collect()
+        } else {
+            bytes
+                .chunks_exact(record)
+                .map(|r| decode_i32(&r[8 + 4 * k..]) * factor)
+                .collect()
+        };
+        columns.push(Column {
+            name: name.to_string(),
+            values,
+        });
+        info.push(SensorInfo {
+            sensor,
+            axis: ["X", "Y", "Z"][k % 3].to_string(),
+            unit: Some(unit.to_string()),
+        });
+    }
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let imu = Imu::new(columns, info, freq)?
+        .with_name(name)
+        .with_record_type(record_type);
+    Ok(imu)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn imu_record_type_from_str_and_sizes() {
+        assert_eq!(
+            "ln200ig".parse::<ImuRecordType>().unwrap(),
+            ImuRecordType::Ln200Ig
+        );
+        assert_eq!(
+            "Navchip_Flt".parse::<ImuRecordType>().unwrap(),
+            ImuRecordType::NavchipFlt
+        );
+        assert!("ln201".parse::<ImuRecordType>().is_err());
+        assert_eq!(ImuRecordType::Imar.record_size(), 32);
+        assert_eq!(ImuRecordType::Ixsea.record_size(), 56);
+    }
+
+    /// METHODS §9.3 table values.
+    #[test]
+    fn imu_record_scales_match_methods_9_3() {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-7 * b.abs();
+        assert!(close(ImuRecordType::Imar.scale_gyro(), 4.8481368e-7));
+        assert!(close(ImuRecordType::Ixsea.scale_gyro(), 4.8481368e-6));
+        assert!(close(ImuRecordType::NavchipFlt.scale_gyro(), 4.8481368e-6));
+        assert!(close(ImuRecordType::Imar.scale_accel(), 1.52588e-6));
+        assert_eq!(ImuRecordType::Ln200.scale_gyro(), 2f64.powi(-21));
+        assert_eq!(ImuRecordType::Ln200Ig.scale_gyro(), 2f64.powi(-19));
+        assert_eq!(ImuRecordType::Ln200Ig.scale_accel(), 2f64.powi(-14));
+    }
+}

@@ -1,0 +1,442 @@
+//! Delimited text (CSV/TSV/other single-byte delimiter), plain or gzip-compressed.
+//!
+//! One pass with the `csv` crate into a reused [`ByteRecord`]; cells are parsed straight from
+//! their bytes (`str::parse::<f64>`), never copied into a `String`, and only the selected
+//! columns are stored.
+
+use super::{default_name, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
+use crate::imu::read::HeaderMode;
+use crate::imu::ReadError;
+use csv::ByteRecord;
+use flate2::read::MultiGzDecoder;
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, Cursor, Read};
+use std::path::Path;
+
+/// Read buffer: large enough that system calls and gzip refills are rare.
+const BUF_CAPACITY: usize = 1 << 20;
+/// The two magic bytes that start every gzip member (RFC 1952 §2.3.1).
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+/// UTF-8 byte order mark, dropped if a file starts with it.
+const UTF8_BOM: [u8; 3] = [0xef, 0xbb, 0xbf];
+
+/// The byte source of a text file, remembering whether it is gzip so that stream errors can be
+/// reported as [`ReadError::Gzip`].
+struct Source {
+    reader: Box<dyn BufRead>,
+    gzip: bool,
+}
+
+/// Opens a file, decompressing it if it starts with the gzip magic bytes (whatever its name).
+fn open(path: &Path) -> Result<Source, ReadError> {
+    let file = File::open(path).map_err(|e| io_error(path, e))?;
+    let mut buffered = BufReader::with_capacity(BUF_CAPACITY, file);
+    let head = buffered.fill_buf().map_err(|e| io_error(path, e))?;
+    let gzip = head.starts_with(&GZIP_MAGIC);
+    let reader: Box<dyn BufRead> = if gzip {
+        Box::new(BufReader::with_capacity(
+            BUF_CAPACITY,
+            MultiGzDecoder::new(buffered),
+        ))
+    } else {
+        Box::new(buffered)
+    };
+    Ok(Source { reader, gzip })
+}
+
+/// Chooses the delimiter: fixed for [`InputFormat::Csv`]/[`InputFormat::Tsv`], else the most
+/// frequent of `,` `\t` `;` in the first line, ties and absence resolved by the extension
+/// (`.tsv` → tab, otherwise comma).
+fn delimiter(format: InputFormat, path: &Path, first_line: &[u8]) -> u8 {
+    match format {
+        InputFormat::Csv => return b',',
+        InputFormat::Tsv => return b'\t',
+        _ => {}
+    }
+    let name = path
+        .file_name()
+        .and_then(|f| f.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    let preferred = if name.ends_with(".tsv") { b'\t' } else { b',' };
+    let count = |d: u8| first_line.iter().filter(|&&b| b == d).count();
+    let mut best = (count(preferred), preferred);
+    for d in [b',', b'\t', b';'] {
+        let c = count(d);
+        if c > best.0 {
+            best = (c, d);
+        }
+    }
+    best.1
+}
+
+/// Largest integer below which every integer is exactly representable in an f64 (2^53).
+const EXACT_INT: u64 = 1 << 53;
+/// Powers of ten exactly representable in an f64 (10^0 ..= 10^22: 5^22 < 2^53).
+const EXACT_POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// Parses one cell (surrounding ASCII whitespace, including a `\r`, ignored); `None` if it is
+/// not a number (NaN and infinities are numbers here, rejected by the caller).
+#[inline]
+fn parse_cell(bytes: &[u8]) -> Option<f64> {
+    let bytes = bytes.trim_ascii();
+    match parse_simple_decimal(bytes) {
+        Some(v) => Some(v),
+        None => std::str::from_utf8(bytes).ok()?.parse::<f64>().ok(),
+    }
+}
+
+/// Clinger's fast path for plain decimals `[+-]digits[.digits]` with at most 19 significant
+/// digits: when the digit string `m < 2^53` and the number of fraction digits `k <= 22`, both
+/// `m` and `10^k` are exact f64 values and one IEEE division `m / 10^k` is correctly rounded,
+/// i.e. equal to `str::parse`. Anything else (exponents, long mantissas, `nan`) returns `None`
+/// and goes to `str::parse`.
+#[inline]
+fn parse_simple_decimal(bytes: &[u8]) -> Option<f64> {
+    let (negative, digits) = match bytes.first()? {
+        b'-' => (true, &bytes[1..]),
+        b'+' => (false, &bytes[1..]),
+        _ => (false, bytes),
+    };
+    let mut mantissa: u64 = 0;
+    let mut n_digits = 0usize;
+    let mut frac_digits = 0usize;
+    let mut seen_point = false;
+    for &b in digits {
+        match b {
+            b'0'..=b'9' => {
+                if n_digits >= 19 {
+                    return None;
+                }
+                mantissa = mantissa * 10 + u64::from(b - b'0');
+                n_digits += 1;
+                if seen_point {
+                    frac_digits += 1;
+                }
+            }
+            b'.' if !seen_point => seen_point = true,
+            _ => return None,
+        }
+    }
+    if n_digits == 0 || mantissa >= EXACT_INT || frac_digits >= EXACT_POW10.len() {
+        return None;
+    }
+    let v = mantissa as f64 / EXACT_POW10[frac_digits];
+    Some(if negative { -v } else { v })
+}
+
+/// Reads a delimited text file (see [`super::read_table`] for the options).
+pub(crate) fn read_text_table(
+    path: &Path,
+    format: InputFormat,
+    opts: &ReadOptions,
+) -> Result<RawTable, ReadError> {
+    let Source { mut reader, gzip } = open(path)?;
+    let stream_error = |e: io::Error| {
+        if gzip {
+            ReadError::Gzip {
+                path: path.to_path_buf(),
+                source: e,
+            }
+        } else {
+            io_error(path, e)
+        }
+    };
+    let mut first_line = Vec::new();
+    reader
+        .read_until(b'\n', &mut first_line)
+        .map_err(stream_error)?;
+    if first_line.starts_with(&UTF8_BOM) {
+        first_line.drain(..UTF8_BOM.len());
+    }
+    let delim = delimiter(format, path, &first_line);
+    // Lines end at `\n` only (a `\r` before it is trimmed with the field, see
+    // [`parse_cell`]), and a final `\n` is
+    // appended, so that after each record the reader has consumed exactly its terminator and
+    // its physical line is `position().line() - 1` (csv's own record positions point at the
+    // start of the scan, before any skipped blank line).
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .delimiter(delim)
+        .terminator(csv::Terminator::Any(b'\n'))
+        .buffer_capacity(BUF_CAPACITY)
+        .from_reader(
+            Cursor::new(first_line)
+                .chain(reader)
+                .chain(Cursor::new(&b"\n"[..])),
+        );
+    // Next non-blank record and its 1-based physical line; a record made of one empty field
+    // is a blank (or whitespace-only) line and is skipped.
+    let mut next = |rec: &mut ByteRecord| -> Result<Option<u64>, ReadError> {
+        loop {
+            let more = rdr.read_byte_record(rec).map_err(|e| match e.into_kind() {
+                csv::ErrorKind::Io(e) => stream_error(e),
+                other => io_error(
+                    path,
+                    io::Error::new(io::ErrorKind::InvalidData, format!("{other:?}")),
+                ),
+            })?;
+            if !more {
+                return Ok(None);
+            }
+            if rec.len() == 1 && rec.get(0).is_some_and(|f| f.trim_ascii().is_empty()) {
+                continue;
+            }
+            return Ok(Some(rdr.position().line().saturating_sub(1)));
+        }
+    };
+
+    let mut rec = ByteRecord::new();
+    let Some(first_line_no) = next(&mut rec)? else {
+        return Err(ReadError::Empty {
+            path: path.to_path_buf(),
+        });
+    };
+    let ncols = rec.len();
+    let has_header = match opts.header {
+        HeaderMode::Present => true,
+        HeaderMode::Absent => false,
+        HeaderMode::Auto => rec.iter().any(|f| parse_cell(f).is_none()),
+    };
+    let names: Vec<String> = if has_header {
+        rec.iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let n = String::from_utf8_lossy(f).trim().to_string();
+                if n.is_empty() {
+                    default_name(k)
+                } else {
+                    n
+                }
+            })
+            .collect()
+    } else {
+        (0..ncols).map(default_name).collect()
+    };
+    let sel = resolve_selection(path, &names, opts)?;
+
+    let mut rows = Rows {
+        path,
+        names: &names,
+        ncols,
+        first_line: first_line_no,
+        columns: &sel.columns,
+        time_index: sel.time,
+        values: vec![Vec::new(); sel.columns.len()],
+        time: Vec::new(),
+    };
+    if !has_header {
+        rows.push(&rec, first_line_no)?;
+    }
+    while let Some(line) = next(&mut rec)? {
+        rows.push(&rec, line)?;
+    }
+    let n = if sel.columns.is_empty() {
+        rows.time.len()
+    } else {
+        rows.values[0].len()
+    };
+    if n == 0 {
+        return Err(if has_header {
+            ReadError::HeaderOnly {
+                path: path.to_path_buf(),
+            }
+        } else {
+            ReadError::Empty {
+                path: path.to_path_buf(),
+            }
+        });
+    }
+    let columns = sel
+        .columns
+        .iter()
+        .zip(rows.values)
+        .map(|(&k, values)| Column {
+            name: names[k].clone(),
+            values,
+        })
+        .collect();
+    let time = sel.time.map(|k| Column {
+        name: names[k].clone(),
+        values: rows.time,
+    });
+    Ok(RawTable { columns, time })
+}
+
+/// Accumulates the selected cells of each data row.
+struct Rows<'a> {
+    path: &'a Path,
+    names: &'a [String],
+    ncols: usize,
+    first_line: u64,
+    columns: &'a [usize],
+    time_index: Option<usize>,
+    values: Vec<Vec<f64>>,
+    time: Vec<f64>,
+}
+
+impl Rows<'_> {
+    #[inline]
+    fn push(&mut self, rec: &ByteRecord, line: u64) -> Result<(), ReadError> {
+        if rec.len() != self.ncols {
+            return Err(self.ragged(line, rec.len()));
+        }
+        for (j, &k) in self.columns.iter().enumerate() {
+            let v = self.cell(rec, k, line)?;
+            self.values[j].push(v);
+        }
+        if let Some(k) = self.time_index {
+            let t = self.cell(rec, k, line)?;
+            if let Some(&previous) = self.time.last() {
+                if t <= previous {
+                    return Err(self.not_increasing(k, line, previous, t));
+                }
+            }
+            self.time.push(t);
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn cell(&self, rec: &ByteRecord, k: usize, line: u64) -> Result<f64, ReadError> {
+        let bytes = rec.get(k).unwrap_or_default();
+        match parse_cell(bytes) {
+            Some(v) if v.is_finite() => Ok(v),
+            Some(_) => Err(self.bad_cell(k, line, bytes, true)),
+            None => Err(self.bad_cell(k, line, bytes, false)),
+        }
+    }
+
+    #[cold]
+    fn ragged(&self, line: u64, found: usize) -> ReadError {
+        ReadError::Ragged {
+            path: self.path.to_path_buf(),
+            line,
+            first_line: self.first_line,
+            expected: self.ncols,
+            found,
+        }
+    }
+
+    #[cold]
+    fn bad_cell(&self, k: usize, line: u64, bytes: &[u8], numeric: bool) -> ReadError {
+        let path = self.path.to_path_buf();
+        let column = self.names[k].clone();
+        let text = String::from_utf8_lossy(bytes.trim_ascii()).into_owned();
+        if numeric {
+            ReadError::NonFinite {
+                path,
+                line,
+                column,
+                text,
+            }
+        } else {
+            ReadError::NotANumber {
+                path,
+                line,
+                column,
+                text,
+            }
+        }
+    }
+
+    #[cold]
+    fn not_increasing(&self, k: usize, line: u64, previous: f64, value: f64) -> ReadError {
+        ReadError::TimeNotIncreasing {
+            path: self.path.to_path_buf(),
+            line,
+            column: self.names[k].clone(),
+            previous,
+            value,
+        }
+    }
+}
+
+#[cold]
+fn io_error(path: &Path, source: io::Error) -> ReadError {
+    ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn delimiter_sniffing() {
+        let p = Path::new("x.txt");
+        assert_eq!(delimiter(InputFormat::Auto, p, b"a\tb\tc\n"), b'\t');
+        assert_eq!(delimiter(InputFormat::Auto, p, b"a;b;c\n"), b';');
+        assert_eq!(delimiter(InputFormat::Auto, p, b"a\n"), b',');
+        assert_eq!(
+            delimiter(InputFormat::Auto, Path::new("x.tsv.gz"), b"a\n"),
+            b'\t'
+        );
+        assert_eq!(delimiter(InputFormat::Csv, p, b"a\tb\n"), b',');
+    }
+
+    #[test]
+    fn parse_cell_accepts_numbers_only() {
+        assert_eq!(parse_cell(b"-1.5e-3"), Some(-1.5e-3));
+        assert!(parse_cell(b"nan").is_some_and(f64::is_nan));
+        assert_eq!(parse_cell(b"gyro_x"), None);
+        assert_eq!(parse_cell(b""), None);
+        assert_eq!(parse_cell(&[0xff, 0x31]), None);
+        assert_eq!(parse_cell(b" 2.5\r"), Some(2.5));
+        assert_eq!(parse_cell(b"-"), None);
+        assert_eq!(parse_cell(b"."), None);
+        assert_eq!(parse_cell(b"1.2.3"), None);
+        assert_eq!(parse_cell(b"+.5"), Some(0.5));
+        assert_eq!(parse_cell(b"-0"), Some(-0.0));
+        assert!(parse_cell(b"-0").unwrap().is_sign_negative());
+    }
+
+    /// The fast path is bit-identical to `str::parse` on every input it accepts.
+    #[test]
+    fn parse_simple_decimal_matches_std() {
+        let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut accepted = 0;
+        for _ in 0..200_000 {
+            let r = next();
+            let int_digits = (r % 12) as usize;
+            let frac_digits = ((r >> 8) % 20) as usize;
+            let mut s = String::new();
+            if r >> 20 & 1 == 1 {
+                s.push('-');
+            }
+            for _ in 0..int_digits {
+                s.push(char::from(b'0' + (next() % 10) as u8));
+            }
+            if frac_digits > 0 || r >> 21 & 1 == 1 {
+                s.push('.');
+            }
+            for _ in 0..frac_digits {
+                s.push(char::from(b'0' + (next() % 10) as u8));
+            }
+            let std = s.parse::<f64>().ok();
+            if let Some(v) = parse_simple_decimal(s.as_bytes()) {
+                accepted += 1;
+                assert_eq!(Some(v.to_bits()), std.map(f64::to_bits), "{s}");
+            }
+            assert_eq!(
+                parse_cell(s.as_bytes()).map(f64::to_bits),
+                std.map(f64::to_bits),
+                "{s}"
+            );
+        }
+        assert!(accepted > 100_000, "{accepted}");
+    }
+}

@@ -1,0 +1,386 @@
+//! The [`Imu`] object of METHODS §9.1: sensor columns with their sensor type, axis, unit and a
+//! common sampling rate.
+
+use super::read::{check_freq, Column, ImuRecordType, Table};
+use super::ReadError;
+use crate::error::{Error, ParamError};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Kind of sensor behind a column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Sensor {
+    /// Gyroscope (angular rate).
+    Gyroscope,
+    /// Accelerometer (specific force).
+    Accelerometer,
+    /// Anything else (temperature, an unnamed column, ...).
+    Other,
+}
+
+impl Sensor {
+    /// Short tag used in axis tags: `gyro`, `accel`, `other`.
+    pub fn tag(self) -> &'static str {
+        match self {
+            Self::Gyroscope => "gyro",
+            Self::Accelerometer => "accel",
+            Self::Other => "other",
+        }
+    }
+}
+
+impl fmt::Display for Sensor {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Gyroscope => "Gyroscope",
+            Self::Accelerometer => "Accelerometer",
+            Self::Other => "Other",
+        })
+    }
+}
+
+/// What a column measures.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SensorInfo {
+    /// Sensor type.
+    pub sensor: Sensor,
+    /// Axis label, e.g. `X` (for [`Sensor::Other`], usually the column name).
+    pub axis: String,
+    /// Unit, free text (e.g. `rad/s`), if known.
+    pub unit: Option<String>,
+}
+
+impl SensorInfo {
+    /// Infers sensor and axis from a column name or a meaning text: a word starting with `gyro`
+    /// → gyroscope, with `acc` → accelerometer; the axis is a one-letter word `x`/`y`/`z` or a
+    /// suffix glued to the sensor word (`gyrox`, `accz`). `gyro_x`, `Gyro. X`,
+    /// `"gyroscope X axis, ..."` all give gyroscope X. `None` when either part is missing.
+    pub fn infer(text: &str) -> Option<(Sensor, String)> {
+        let lower = text.to_ascii_lowercase();
+        let words: Vec<&str> = lower
+            .split(|c: char| !c.is_ascii_alphanumeric())
+            .filter(|w| !w.is_empty())
+            .collect();
+        let (pos, sensor, rest) = words.iter().enumerate().find_map(|(i, w)| {
+            if let Some(r) = strip_any(w, &["gyroscope", "gyro"]) {
+                Some((i, Sensor::Gyroscope, r))
+            } else {
+                strip_any(w, &["accelerometer", "accel", "acc"])
+                    .map(|r| (i, Sensor::Accelerometer, r))
+            }
+        })?;
+        let is_axis = |w: &str| matches!(w, "x" | "y" | "z");
+        let axis = if is_axis(rest) {
+            rest
+        } else {
+            words.iter().skip(pos + 1).copied().find(|w| is_axis(w))?
+        };
+        Some((sensor, axis.to_ascii_uppercase()))
+    }
+}
+
+fn strip_any<'a>(w: &'a str, prefixes: &[&str]) -> Option<&'a str> {
+    prefixes.iter().find_map(|p| w.strip_prefix(p))
+}
+
+/// One column of an [`Imu`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Axis {
+    /// What the column measures.
+    pub info: SensorInfo,
+    /// The data (name as in the file, finite values).
+    pub column: Column,
+}
+
+impl Axis {
+    /// Tag such as `gyro_x` or `accel_z`; for [`Sensor::Other`] the column name.
+    pub fn tag(&self) -> String {
+        match self.info.sensor {
+            Sensor::Other => self.column.name.clone(),
+            s => format!("{}_{}", s.tag(), self.info.axis.to_ascii_lowercase()),
+        }
+    }
+
+    /// Sensor type.
+    pub fn sensor(&self) -> Sensor {
+        self.info.sensor
+    }
+
+    /// The samples.
+    pub fn values(&self) -> &[f64] {
+        &self.column.values
+    }
+}
+
+/// An inertial measurement unit recording (METHODS §9.1): gyroscope columns first, then
+/// accelerometers, then other columns, all of the same length, sampled at `freq_hz`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Imu {
+    axes: Vec<Axis>,
+    freq_hz: f64,
+    name: Option<String>,
+    record_type: Option<ImuRecordType>,
+}
+
+impl Imu {
+    /// Builds an IMU from columns and what each measures.
+    ///
+    /// Columns are reordered stably: gyroscopes, accelerometers, others (METHODS §9.1).
+    ///
+    /// # Errors
+    /// [`ParamError`] if there are no columns, `info` and `columns` differ in length, columns
+    /// differ in length or are empty, an axis label is empty, an axis repeats within one sensor
+    /// (METHODS §9.1 "duplicates within one sensor are refused"), or `freq_hz` is not positive
+    /// and finite.
+    pub fn new(
+        columns: Vec<Column>,
+        info: Vec<SensorInfo>,
+        freq_hz: f64,
+    ) -> Result<Self, ParamError> {
+        check_freq(freq_hz)?;
+        if columns.is_empty() {
+            return Err(ParamError::new("columns", 0, "at least one column"));
+        }
+        if info.len() != columns.len() {
+            return Err(ParamError::new(
+                "sensors",
+                info.len(),
+                format!("one entry per column ({})", columns.len()),
+            ));
+        }
+        let n = columns[0].values.len();
+        if let Some(c) = columns.iter().find(|c| c.values.len() != n || n == 0) {
+            return Err(ParamError::new(
+                "columns",
+                format!("{} with {} samples", c.name, c.values.len()),
+                format!("non-empty columns of equal length ({n})"),
+            ));
+        }
+        let mut axes: Vec<Axis> = columns
+            .into_iter()
+            .zip(info)
+            .map(|(column, info)| Axis { info, column })
+            .collect();
+        for (i, a) in axes.iter().enumerate() {
+            if a.info.axis.trim().is_empty() {
+                return Err(ParamError::new(
+                    "axis",
+                    format!("\"\" for column {}", a.column.name),
+                    "a non-empty label such as X",
+                ));
+            }
+            if a.info.sensor == Sensor::Other {
+                continue;
+            }
+            let dup = axes[..i].iter().any(|b| {
+                b.info.sensor == a.info.sensor && b.info.axis.eq_ignore_ascii_case(&a.info.axis)
+            });
+            if dup {
+                return Err(ParamError::new(
+                    "axis",
+                    format!("{} {} twice", a.info.sensor, a.info.axis),
+                    "each axis at most once per sensor",
+                ));
+            }
+        }
+        axes.sort_by_key(|a| a.info.sensor);
+        Ok(Self {
+            axes,
+            freq_hz,
+            name: None,
+            record_type: None,
+        })
+    }
+
+    /// Builds an IMU from a table, inferring sensor and axis of each column from its name, else
+    /// from the sidecar's meaning ([`SensorInfo::infer`]); columns that match neither become
+    /// [`Sensor::Other`] with the column name as label. Units come from the sidecar; the name
+    /// from the sidecar, else the file name.
+    ///
+    /// # Errors
+    /// [`ReadError::FreqNotDerivable`] if `table.freq_hz` is `None`; [`ParamError`] as
+    /// [`Imu::new`] (e.g. two `gyro_x` columns).
+    pub fn from_table(table: Table) -> Result<Self, Error> {
+        let Some(freq_hz) = table.freq_hz else {
+            return Err(ReadError::FreqNotDerivable {
+                path: table.path,
+                reason: "no freq_hz given, no time column, no sampling_frequency_hz in a sidecar",
+            }
+            .into());
+        };
+        let sidecar = table.sidecar.as_ref();
+        let info = table
+            .columns
+            .iter()
+            .map(|c| {
+                let inferred = SensorInfo::infer(&c.name).or_else(|| {
+                    sidecar
+                        .and_then(|s| s.meaning(&c.name))
+                        .and_then(SensorInfo::infer)
+                });
+                let (sensor, axis) = inferred.unwrap_or((Sensor::Other, c.name.clone()));
+                let units = sidecar.and_then(|s| s.units.as_ref());
+                let unit = match sensor {
+                    Sensor::Gyroscope => units.and_then(|u| u.gyro.clone()),
+                    Sensor::Accelerometer => units.and_then(|u| u.accel.clone()),
+                    Sensor::Other => None,
+                };
+                SensorInfo { sensor, axis, unit }
+            })
+            .collect();
+        let name = sidecar.and_then(|s| s.name.clone()).or_else(|| {
+            table
+                .path
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+        });
+        let mut imu = Self::new(table.columns, info, freq_hz)?;
+        imu.name = name;
+        Ok(imu)
+    }
+
+    /// Sets the name.
+    pub fn with_name(mut self, name: impl Into<String>) -> Self {
+        self.name = Some(name.into());
+        self
+    }
+
+    /// Records the binary record type the data came from (METHODS §9.1 `stype`).
+    pub fn with_record_type(mut self, record_type: ImuRecordType) -> Self {
+        self.record_type = Some(record_type);
+        self
+    }
+
+    /// All axes: gyroscopes, then accelerometers, then others.
+    pub fn axes(&self) -> &[Axis] {
+        &self.axes
+    }
+
+    /// Iterates over `(tag, axis)` pairs, tags like `gyro_x`.
+    pub fn iter(&self) -> impl Iterator<Item = (String, &Axis)> {
+        self.axes.iter().map(|a| (a.tag(), a))
+    }
+
+    /// The gyroscope axes.
+    pub fn gyroscopes(&self) -> impl Iterator<Item = &Axis> {
+        self.axes
+            .iter()
+            .filter(|a| a.info.sensor == Sensor::Gyroscope)
+    }
+
+    /// The accelerometer axes.
+    pub fn accelerometers(&self) -> impl Iterator<Item = &Axis> {
+        self.axes
+            .iter()
+            .filter(|a| a.info.sensor == Sensor::Accelerometer)
+    }
+
+    /// The axis with this tag (`gyro_x`, case-insensitive).
+    pub fn axis(&self, tag: &str) -> Option<&Axis> {
+        self.axes.iter().find(|a| a.tag().eq_ignore_ascii_case(tag))
+    }
+
+    /// `(number of gyroscopes, number of accelerometers)` (METHODS §9.1 `num.sensor`).
+    pub fn num_sensor(&self) -> (usize, usize) {
+        (self.gyroscopes().count(), self.accelerometers().count())
+    }
+
+    /// Sampling rate in Hz.
+    pub fn freq_hz(&self) -> f64 {
+        self.freq_hz
+    }
+
+    /// Name, if known.
+    pub fn name(&self) -> Option<&str> {
+        self.name.as_deref()
+    }
+
+    /// Binary record type, if read from one (METHODS §9.1 `stype`).
+    pub fn record_type(&self) -> Option<ImuRecordType> {
+        self.record_type
+    }
+
+    /// Number of samples per axis.
+    pub fn len(&self) -> usize {
+        self.axes.first().map_or(0, |a| a.column.values.len())
+    }
+
+    /// Always `false`: an [`Imu`] holds at least one sample.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn col(name: &str) -> Column {
+        Column {
+            name: name.into(),
+            values: vec![1.0, 2.0],
+        }
+    }
+
+    fn info(sensor: Sensor, axis: &str) -> SensorInfo {
+        SensorInfo {
+            sensor,
+            axis: axis.into(),
+            unit: None,
+        }
+    }
+
+    #[test]
+    fn sensor_info_infer() {
+        let g = |s: &str| SensorInfo::infer(s);
+        assert_eq!(g("gyro_x"), Some((Sensor::Gyroscope, "X".into())));
+        assert_eq!(g("Accel. Z"), Some((Sensor::Accelerometer, "Z".into())));
+        assert_eq!(g("accy"), Some((Sensor::Accelerometer, "Y".into())));
+        assert_eq!(
+            g("gyroscope X axis, static error signal"),
+            Some((Sensor::Gyroscope, "X".into()))
+        );
+        assert_eq!(g("temperature"), None);
+        assert_eq!(g("gyro"), None);
+    }
+
+    #[test]
+    fn imu_new_orders_and_validates() {
+        let imu = Imu::new(
+            vec![col("a"), col("g")],
+            vec![
+                info(Sensor::Accelerometer, "X"),
+                info(Sensor::Gyroscope, "X"),
+            ],
+            100.0,
+        )
+        .unwrap();
+        let tags: Vec<String> = imu.iter().map(|(t, _)| t).collect();
+        assert_eq!(tags, ["gyro_x", "accel_x"]);
+        assert_eq!(imu.num_sensor(), (1, 1));
+
+        let dup = Imu::new(
+            vec![col("a"), col("b")],
+            vec![info(Sensor::Gyroscope, "X"), info(Sensor::Gyroscope, "x")],
+            100.0,
+        );
+        assert_eq!(
+            dup.unwrap_err().to_string(),
+            "invalid axis = Gyroscope x twice: each axis at most once per sensor"
+        );
+        for f in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(Imu::new(vec![col("a")], vec![info(Sensor::Other, "a")], f).is_err());
+        }
+        assert!(Imu::new(vec![], vec![], 1.0).is_err());
+        let short = Column {
+            name: "s".into(),
+            values: vec![1.0],
+        };
+        assert!(Imu::new(
+            vec![col("a"), short],
+            vec![info(Sensor::Other, "a"), info(Sensor::Other, "s")],
+            1.0
+        )
+        .is_err());
+    }
+}

@@ -1,0 +1,172 @@
+//! JSON sidecar files: `<name>.json` beside `<name>.csv.gz` (see `shared/data/README.md`).
+//!
+//! Reading is tolerant: every field is optional and unknown fields are ignored, so sidecars of
+//! other origins can be used. A sidecar that is not valid JSON, or whose known fields have the
+//! wrong type, is an error ([`ReadError::Sidecar`]), never silently skipped.
+
+use super::ReadError;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Extensions stripped (from the right) when looking for a sidecar: `x.csv.gz` → `x.csv.json`,
+/// then `x.json`.
+const DATA_EXTENSIONS: &[&str] = &[
+    "gz", "csv", "tsv", "txt", "dat", "bin", "raw", "f64", "f32", "f64le", "f32le",
+];
+
+/// Metadata of a recording.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Sidecar {
+    /// Dataset name (e.g. `adis_16405_imu1`).
+    pub name: Option<String>,
+    /// Free-text sensor description.
+    pub sensor: Option<String>,
+    /// Sampling frequency in Hz.
+    pub sampling_frequency_hz: Option<f64>,
+    /// Units of the gyroscope and accelerometer columns (free text).
+    pub units: Option<SidecarUnits>,
+    /// Column names and meanings, in file order.
+    pub columns: Vec<SidecarColumn>,
+    /// Number of data rows.
+    pub n_rows: Option<u64>,
+    /// Per-column summary statistics, keyed by column name.
+    pub summary: BTreeMap<String, ColumnSummary>,
+}
+
+/// Units given by a sidecar.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SidecarUnits {
+    /// Gyroscope unit, e.g. `"deg/s"` (may carry a comment).
+    pub gyro: Option<String>,
+    /// Accelerometer unit, e.g. `"g"` (may carry a comment).
+    pub accel: Option<String>,
+}
+
+/// One column described by a sidecar.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SidecarColumn {
+    /// Column name as in the data file header.
+    pub name: String,
+    /// Free-text meaning, e.g. `"gyroscope X axis, ..."`.
+    pub meaning: Option<String>,
+}
+
+/// Summary statistics of a column given by a sidecar.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ColumnSummary {
+    /// Mean.
+    pub mean: Option<f64>,
+    /// Variance.
+    pub var: Option<f64>,
+    /// Minimum.
+    pub min: Option<f64>,
+    /// Maximum.
+    pub max: Option<f64>,
+}
+
+impl Sidecar {
+    /// Parses sidecar JSON text; `path` only names the file in errors.
+    ///
+    /// # Errors
+    /// [`ReadError::Sidecar`] if the text is not JSON or a known field has the wrong type.
+    pub fn from_json(text: &str, path: &Path) -> Result<Self, ReadError> {
+        serde_json::from_str(text).map_err(|source| ReadError::Sidecar {
+            path: path.to_path_buf(),
+            source,
+        })
+    }
+
+    /// Reads a sidecar file.
+    ///
+    /// # Errors
+    /// [`ReadError::Io`] if the file cannot be read, [`ReadError::Sidecar`] if it cannot be parsed.
+    pub fn read(path: &Path) -> Result<Self, ReadError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ReadError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json(&text, path)
+    }
+
+    /// The meaning of the column named `name`, if the sidecar gives one.
+    pub fn meaning(&self, name: &str) -> Option<&str> {
+        self.columns
+            .iter()
+            .find(|c| c.name == name)
+            .and_then(|c| c.meaning.as_deref())
+    }
+}
+
+/// Candidate sidecar paths of a data file, most specific first: known data extensions are
+/// stripped one at a time from the right and `.json` appended (`x.csv.gz` → `x.csv.json`,
+/// `x.json`).
+pub fn sidecar_candidates(data: &Path) -> Vec<PathBuf> {
+    let Some(file_name) = data.file_name().and_then(|f| f.to_str()) else {
+        return Vec::new();
+    };
+    let mut stem = file_name;
+    let mut out = Vec::new();
+    while let Some((head, ext)) = stem.rsplit_once('.') {
+        if head.is_empty() || !DATA_EXTENSIONS.contains(&ext.to_ascii_lowercase().as_str()) {
+            break;
+        }
+        out.push(data.with_file_name(format!("{head}.json")));
+        stem = head;
+    }
+    out
+}
+
+/// Finds and reads the sidecar of a data file, if one exists.
+///
+/// # Errors
+/// As [`Sidecar::read`], for the first candidate of [`sidecar_candidates`] that exists.
+pub fn find_sidecar(data: &Path) -> Result<Option<Sidecar>, ReadError> {
+    match sidecar_candidates(data).into_iter().find(|p| p.is_file()) {
+        Some(p) => Sidecar::read(&p).map(Some),
+        None => Ok(None),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sidecar_candidates_strip_data_extensions() {
+        let c = sidecar_candidates(Path::new("/d/x.csv.gz"));
+        assert_eq!(
+            c,
+            vec![PathBuf::from("/d/x.csv.json"), PathBuf::from("/d/x.json")]
+        );
+        let c = sidecar_candidates(Path::new("a.b.f64le.bin"));
+        assert_eq!(
+            c,
+            vec![PathBuf::from("a.b.f64le.json"), PathBuf::from("a.b.json")]
+        );
+        assert!(sidecar_candidates(Path::new("noext")).is_empty());
+        assert!(sidecar_candidates(Path::new(".csv")).is_empty());
+    }
+
+    #[test]
+    fn sidecar_is_tolerant_but_typed() {
+        let s = Sidecar::from_json(
+            r#"{"sampling_frequency_hz": 250.5, "extra": [1, 2], "columns": [{"name": "gyro_x"}]}"#,
+            Path::new("s.json"),
+        )
+        .unwrap();
+        assert_eq!(s.sampling_frequency_hz, Some(250.5));
+        assert_eq!(s.columns[0].name, "gyro_x");
+        let e = Sidecar::from_json(r#"{"sampling_frequency_hz": "fast"}"#, Path::new("s.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("s.json: sidecar JSON is unreadable: invalid type"),
+            "{e}"
+        );
+    }
+}
