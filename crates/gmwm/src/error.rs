@@ -43,6 +43,18 @@ pub enum SeriesError {
         /// The offending value.
         value: f64,
     },
+    /// The robust (biweight) scale equation has no root: the values are too dispersed (more
+    /// than the breakdown fraction is contaminated), so the robust scale is undefined.
+    #[error(
+        "the biweight scale equation has no root: mean psi_c^2 never reaches a(c) = {a} (c = {c}); \
+         too large a share of the coefficients is contaminated for the robust estimator"
+    )]
+    NoRobustScale {
+        /// a(c), the target of the scale equation.
+        a: f64,
+        /// Tuning constant.
+        c: f64,
+    },
     /// Every sample has the same value: all variances are zero and nothing can be estimated.
     #[error("series is constant (every sample equals {value}); its variances are all zero")]
     Constant {

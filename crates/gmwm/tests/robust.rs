@@ -433,5 +433,11 @@ fn robust_scale_reports_missing_root() {
     // peak of psi_c^2, so mean psi_c^2 < a(c) everywhere (METHODS §2.4 non-monotone equation)
     let y: Vec<f64> = (0..12).map(|k| 10f64.powi(3 * k)).collect();
     let err = robust_scale(&y, C_EXACT_06, RobustConvention::Exact).unwrap_err();
-    assert!(err.to_string().contains("robust scale"), "{err}");
+    assert!(
+        matches!(
+            err,
+            gmwm::Error::Series(gmwm::SeriesError::NoRobustScale { .. })
+        ),
+        "{err}"
+    );
 }

@@ -53,11 +53,10 @@ fn streaming_wv_is_chunk_invariant_on_real_data() {
     }
     let streamed = acc.finish(100.0, 0.05).unwrap();
     for j in 0..whole.levels() {
-        assert!(
-            rel_diff(streamed.wv[j], whole.wv[j]) < 1e-12,
-            "level {}",
-            j + 1
-        );
+        // Level 19 averages 2^18 samples and its WV is ~1e4 times below the sample variance, so
+        // the different offsets (first sample vs mean) show at ~5e-12; parity needs 1e-9.
+        let d = rel_diff(streamed.wv[j], whole.wv[j]);
+        assert!(d < 1e-10, "level {}: {d:e}", j + 1);
     }
 }
 
@@ -128,7 +127,15 @@ fn robust_wv_resists_one_percent_gross_outliers() {
     let classical_dirty = wavelet_variance(&dirty, 1.0, &WvOptions::default())
         .unwrap()
         .wv[0];
-    let robust_dirty = wavelet_variance(&dirty, 1.0, &robust).unwrap().wv[0];
+    let robust_all = wavelet_variance(&dirty, 1.0, &robust).unwrap();
+    let robust_dirty = robust_all.wv[0];
+    // From level 5 on, a filter of 2^j >= 32 samples spans an outlier in >= 32% of positions,
+    // past the ~29% share at which the eff-0.6 biweight scale equation loses its root
+    // ((1 - share) * max_t E psi_c^2(Z/t) < a(c)): those levels are reported, never filled.
+    for w in &robust_all.warnings {
+        let gmwm::variance::wv::WvWarning::NoRobustScale { level } = w;
+        assert!(*level >= 5 && robust_all.wv[level - 1].is_nan(), "{w}");
+    }
     assert!(
         rel_diff(robust_dirty, clean_wv) < 0.08,
         "robust {robust_dirty} vs clean {clean_wv}"
@@ -164,25 +171,44 @@ fn package_convention_matches_r_robust_wv_on_adis_imu1() {
     }
 }
 
-/// Monte Carlo: the eta3 interval of white noise covers the true WV sigma2 / 2^j at about the
-/// stated rate. B replicates at level 1..4 pooled per level; bound 3 binomial standard errors.
+/// Equivalent degrees of freedom of the level-j Haar MODWT WV of white noise with `m_kept`
+/// coefficients, exactly (Satterthwaite): `e = 2 E[nu]^2 / Var[nu]` with
+/// `Var[nu] = (2 sigma_W^4 / M^2) sum_{|k|<M} (M - |k|) rho_k^2`, `rho_k` the autocorrelation
+/// of the level-j Haar wavelet filter (+1/2^j on 2^{j-1} taps, -1/2^j on the next 2^{j-1}).
+fn white_noise_edf(j: usize, m_kept: usize) -> f64 {
+    let width = 1usize << j;
+    let h: Vec<f64> = (0..width)
+        .map(|l| if l < width / 2 { 1.0 } else { -1.0 })
+        .collect();
+    let r0: f64 = h.iter().map(|v| v * v).sum();
+    let mut s = m_kept as f64; // k = 0
+    for k in 1..width.min(m_kept) {
+        let rho: f64 = (0..width - k).map(|l| h[l] * h[l + k]).sum::<f64>() / r0;
+        s += 2.0 * (m_kept - k) as f64 * rho * rho;
+    }
+    (m_kept as f64).powi(2) / s
+}
+
+/// Monte Carlo: coverage of the eta3 interval for white noise. eta3 = M_j / 2^j understates the
+/// true degrees of freedom of white noise (2M/3 at level 1, ~1.1 M at level 2), so the interval
+/// is conservative; the test predicts its coverage from the exact edf (scaled chi-square) and
+/// checks the simulated rate against that prediction within 3 binomial standard errors (plus
+/// 0.01 for the chi-square approximation), and never below the nominal 0.95 minus 3 SE.
 #[test]
 fn eta3_ci_covers_white_noise_wv_at_nominal_rate() {
+    use gmwm::variance::ci::chi_square_quantile;
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
     const B: usize = 400;
-    let sigma2 = 1.0;
-    let levels = 4;
+    let (n, sigma2, levels, alpha) = (1024usize, 1.0, 4usize, 0.05);
     let mut covered = vec![0usize; levels];
     for b in 0..B {
-        let x = white_noise(1024, sigma2, 1000 + b as u64);
-        let wv = wavelet_variance(
-            &x,
-            1.0,
-            &WvOptions {
-                levels: Some(levels),
-                ..WvOptions::default()
-            },
-        )
-        .unwrap();
+        let x = white_noise(n, sigma2, 1000 + b as u64);
+        let opts = WvOptions {
+            levels: Some(levels),
+            alpha,
+            ..WvOptions::default()
+        };
+        let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
         for j in 0..levels {
             let truth = sigma2 / wv.tau[j];
             if wv.ci_low[j] <= truth && truth <= wv.ci_high[j] {
@@ -190,13 +216,24 @@ fn eta3_ci_covers_white_noise_wv_at_nominal_rate() {
             }
         }
     }
-    let se = (0.95f64 * 0.05 / B as f64).sqrt();
-    for (j, &c) in covered.iter().enumerate() {
+    let nominal_se = (0.95f64 * 0.05 / B as f64).sqrt();
+    for (j0, &c) in covered.iter().enumerate() {
+        let j = j0 + 1;
+        let m_kept = n + 1 - (1 << j);
+        let eta = (m_kept as f64 / (1 << j) as f64).max(1.0);
+        let e = white_noise_edf(j, m_kept);
+        let chi = ChiSquared::new(e).unwrap();
+        let predicted = chi.cdf(e * chi_square_quantile(1.0 - alpha / 2.0, eta) / eta)
+            - chi.cdf(e * chi_square_quantile(alpha / 2.0, eta) / eta);
         let rate = c as f64 / B as f64;
+        let se = (predicted * (1.0 - predicted) / B as f64).sqrt();
         assert!(
-            (rate - 0.95).abs() < 3.0 * se + 0.01,
-            "level {}: coverage {rate}",
-            j + 1
+            (rate - predicted).abs() < 3.0 * se + 0.01,
+            "level {j}: coverage {rate}, predicted {predicted} (edf {e:.0} vs eta3 {eta:.0})"
+        );
+        assert!(
+            rate > 0.95 - 3.0 * nominal_se,
+            "level {j}: coverage {rate} below nominal"
         );
     }
 }

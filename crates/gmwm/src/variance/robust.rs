@@ -551,20 +551,7 @@ fn scale_exact_bracketed(y: &[f64], c: f64, a: f64, s0: f64) -> Result<f64, Erro
         s_next = s;
         h_next = hs;
     }
-    let (lo, hi) = bracket.ok_or_else(|| {
-        ParamError::new(
-            "robust scale",
-            format!(
-                "none in [{:e}, {:e}]",
-                s0 / 2f64.powi(60),
-                s0 * 2f64.powi(60)
-            ),
-            format!(
-                "a root of the biweight scale equation (METHODS §2.1): the coefficients are \
-                 too dispersed for mean psi_c^2 to reach a(c) = {a} with c = {c}"
-            ),
-        )
-    })?;
+    let (lo, hi) = bracket.ok_or(SeriesError::NoRobustScale { a, c })?;
     let root = find_root(h, lo, hi, (S_ROOT_RTOL * lo).max(f64::MIN_POSITIVE))?;
     Ok(root.x * root.x)
 }

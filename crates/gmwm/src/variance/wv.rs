@@ -75,6 +75,32 @@ pub struct WaveletVariance {
     pub n_coefficients: Vec<usize>,
     /// Equivalent degrees of freedom of the chi-square interval.
     pub eta: Vec<f64>,
+    /// Soft problems met on the way (the affected values are NaN, `null` in JSON).
+    pub warnings: Vec<WvWarning>,
+}
+
+/// A soft problem of a wavelet-variance computation: the result exists, some levels are missing.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum WvWarning {
+    /// The robust scale equation has no root at this level (too large a share of contaminated
+    /// coefficients, e.g. a level whose filter spans several outliers); its WV and CI are NaN.
+    NoRobustScale {
+        /// 1-based level.
+        level: usize,
+    },
+}
+
+impl fmt::Display for WvWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            WvWarning::NoRobustScale { level } => write!(
+                f,
+                "level {level}: the robust scale is undefined (too many contaminated coefficients); \
+                 its wavelet variance is left missing — try the classical estimator or fewer levels"
+            ),
+        }
+    }
 }
 
 impl WaveletVariance {
@@ -106,7 +132,9 @@ impl WaveletVariance {
             match (robust, opts.robust) {
                 (Some(r), Some(ro)) => {
                     let (lo, hi) = robust_ci(r[i], nu_c, lo_c, hi_c, ro.eff, lowest);
-                    lowest = Some(lowest.map_or(lo, |l| l.min(lo)));
+                    if lo.is_finite() {
+                        lowest = Some(lowest.map_or(lo, |l| l.min(lo)));
+                    }
                     wv.push(r[i]);
                     ci_low.push(lo);
                     ci_high.push(hi);
@@ -132,6 +160,7 @@ impl WaveletVariance {
             ci_high,
             n_coefficients,
             eta,
+            warnings: Vec::new(),
         }
     }
 }
@@ -311,6 +340,7 @@ pub fn wavelet_variance(
     let mut robust = Vec::with_capacity(levels);
     let mut counts = Vec::with_capacity(levels);
     let mut eta = Vec::with_capacity(levels);
+    let mut warnings = Vec::new();
     for j in 1..=levels {
         let kept = coefs.kept(j);
         let scale = match opts.transform {
@@ -319,7 +349,14 @@ pub fn wavelet_variance(
         };
         classical.push(mean_square(kept) / scale);
         if let (Some(c), Some(r)) = (c, opts.robust) {
-            robust.push(robust_scale(kept, c, r.convention)? / scale);
+            match robust_scale(kept, c, r.convention) {
+                Ok(s2) => robust.push(s2 / scale),
+                Err(Error::Series(SeriesError::NoRobustScale { .. })) => {
+                    warnings.push(WvWarning::NoRobustScale { level: j });
+                    robust.push(f64::NAN);
+                }
+                Err(e) => return Err(e),
+            }
         }
         counts.push(kept.len());
         eta.push(match opts.transform {
@@ -328,9 +365,9 @@ pub fn wavelet_variance(
         });
     }
     let robust = opts.robust.map(|_| robust.as_slice());
-    Ok(WaveletVariance::assemble(
-        n, freq_hz, opts, &classical, robust, counts, eta,
-    ))
+    let mut result = WaveletVariance::assemble(n, freq_hz, opts, &classical, robust, counts, eta);
+    result.warnings = warnings;
+    Ok(result)
 }
 
 /// When no level keeps two coefficients, fall back to one level if it keeps one, so that the
