@@ -1,3 +1,4 @@
 //! The engine's single integration-test binary (STYLE §1): reference data, properties, Monte Carlo.
 
+mod allan;
 mod common;
