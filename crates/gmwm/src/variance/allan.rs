@@ -11,13 +11,17 @@
 //! - [`AvConvention::Package`]: the R package's estimators, defects included (METHODS §13.8–§13.10),
 //!   at the package's cluster lengths, so that results compare with `gmwm::avar`/`gmwm::hadam`.
 //!
-//! How far apart the two conventions are on real data (adis_16405_imu1, first 1e5 samples, checked
-//! in `tests/allan.rs`): overlapping AV differs by one dropped term out of `N - 2m + 1`, i.e. the
-//! package value is low by a relative 1e-7 to 2e-4 (ratio to `2 WV` 0.99984 to 1; more at the
-//! largest `m`, where one term weighs more); the non-overlapping AV uses only disjoint pairs, about
-//! half the differences, so it differs from the textbook value by sampling noise (a few percent at
-//! small `m`, tens of percent at the largest); the Hadamard "to" divisor `6(M-2)` instead of `6M`
-//! inflates it by `M/(M-2)` (1.00005 at `m = 3` up to 1.4 at the largest `m`).
+//! How far apart the two conventions are on real data (adis_16405_imu1 gyro_x and accel_x, first
+//! 1e5 samples; bounds checked in `tests/allan.rs`):
+//! - overlapping AV ("mo"): the package drops one of the `N - 2m + 1` terms but keeps the divisor,
+//!   so it is low by a relative 1e-7 to 1.6e-4 (ratio to `2 WV` 0.99984 to 1); overlapping HV: low
+//!   by 0 to 1e-4;
+//! - non-overlapping AV ("to"): disjoint pairs use about half the differences, so the two differ
+//!   by sampling noise: 0.2% to 5% for `m <= 256`, up to 70% at the largest `m` (always inside the
+//!   textbook 95% interval);
+//! - non-overlapping HV ("to"): disjoint triples and the `6(M-2)` divisor (a factor `M/(M-2)`,
+//!   1.00002 at `m = 3` up to 5/3 at `m = 6561`): 0.02% to 3% for `m <= 243`, up to a factor 2.9
+//!   at the largest `m`.
 //!
 //! # Cost
 //! O(N) per cluster length through prefix sums (and prefix sums of prefix sums for the modified
