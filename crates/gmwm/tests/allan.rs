@@ -705,3 +705,29 @@ fn allan_variance_types_are_send_sync_clone() {
     check::<AllanVariance>();
     check::<AllanOptions>();
 }
+
+#[test]
+fn allan_variance_every_short_length_matches_oracle() {
+    for n in 2..=90usize {
+        let x = white_noise(n, 1.0, SEED + 5000 + n as u64);
+        for kind in AllanKind::ALL {
+            for convention in [TEXTBOOK, PACKAGE] {
+                match allan_variance(&x, 1.0, &opts(kind, convention)) {
+                    Ok(fast) => {
+                        for (&m, &v) in fast.tau.iter().zip(&fast.avar) {
+                            let s = slow(&x, m as usize, kind, convention);
+                            assert!(
+                                (v - s).abs() <= TOL_ORACLE * s.abs().max(1e-300),
+                                "{kind} {convention} n {n} m {m}: fast {v} slow {s}"
+                            );
+                        }
+                    }
+                    Err(Error::Series(SeriesError::TooShort { needed, .. })) => {
+                        assert!(n < needed, "{kind} {convention} n {n}")
+                    }
+                    Err(e) => panic!("{kind} {convention} n {n}: {e}"),
+                }
+            }
+        }
+    }
+}

@@ -480,9 +480,13 @@ impl Method {
             // N - 3m + 1 >= 1 (and K >= 3, the same condition)
             Method::HvOverlap | Method::HvNonOverlap => powers(3, 0, |m| 3 * m <= n),
             // package: i = 1..floor(log10(N)/log10(2)) - 1, evaluated as the C++ does
-            Method::AvOverlapPackage | Method::AvNonOverlapPackage => package_levels(n, 2.0, 1, 2),
-            Method::HvOverlapPackage => package_levels(n, 3.0, 1, 3),
-            Method::HvNonOverlapPackage => package_levels(n, 3.0, 2, 3),
+            // (the filters only guard against a floating-point level count one too high, so that
+            // no index can leave the series; they never bind for the package's own counts)
+            Method::AvOverlapPackage | Method::AvNonOverlapPackage => {
+                package_levels(n, 2.0, 1, 2, |m| 2 * m <= n)
+            }
+            Method::HvOverlapPackage => package_levels(n, 3.0, 1, 3, |m| 3 * m <= n),
+            Method::HvNonOverlapPackage => package_levels(n, 3.0, 2, 3, |m| 9 * m <= n),
         }
     }
 
@@ -617,10 +621,17 @@ fn powers(base: usize, first: u32, keep: impl Fn(usize) -> bool) -> Vec<usize> {
 /// The package's cluster set `base^i`, `i = 1..floor(log10(N)/log10(base)) - drop`, with the
 /// level count evaluated in floating point exactly as `avar_*_cpp`/`hadam_*_cpp` do (METHODS §3.1,
 /// §3.5).
-fn package_levels(n: usize, base: f64, drop: i64, base_int: usize) -> Vec<usize> {
+fn package_levels(
+    n: usize,
+    base: f64,
+    drop: i64,
+    base_int: usize,
+    fits: impl Fn(usize) -> bool,
+) -> Vec<usize> {
     let levels = ((n as f64).log10() / base.log10()).floor() as i64 - drop;
     (1..=levels.max(0))
         .map(|i| base_int.pow(i as u32))
+        .take_while(|&m| fits(m))
         .collect()
 }
 
@@ -797,12 +808,12 @@ mod tests {
     #[test]
     fn package_levels_match_the_cpp_counts() {
         // METHODS §3.1, §3.5: N = 1e5 gives 15 AV, 9 HV "mo" and 8 HV "to" levels
-        assert_eq!(package_levels(100_000, 2.0, 1, 2).len(), 15);
-        assert_eq!(package_levels(100_000, 3.0, 1, 3).len(), 9);
-        assert_eq!(package_levels(100_000, 3.0, 2, 3).len(), 8);
-        assert_eq!(package_levels(8, 2.0, 1, 2), vec![2, 4]);
-        assert_eq!(package_levels(27, 3.0, 2, 3), vec![3]);
-        assert!(package_levels(3, 2.0, 1, 2).is_empty());
+        assert_eq!(package_levels(100_000, 2.0, 1, 2, |_| true).len(), 15);
+        assert_eq!(package_levels(100_000, 3.0, 1, 3, |_| true).len(), 9);
+        assert_eq!(package_levels(100_000, 3.0, 2, 3, |_| true).len(), 8);
+        assert_eq!(package_levels(8, 2.0, 1, 2, |_| true), vec![2, 4]);
+        assert_eq!(package_levels(27, 3.0, 2, 3, |_| true), vec![3]);
+        assert!(package_levels(3, 2.0, 1, 2, |_| true).is_empty());
     }
 
     #[test]
