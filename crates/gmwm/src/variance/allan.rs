@@ -287,7 +287,8 @@ impl fmt::Display for AllanVariance {
 /// §3.4); the non-overlapping kinds use the exact edf of a sum of squared Gaussian white-noise
 /// differences (lag correlations -1/2 for first differences; -2/3 and 1/6 for second differences).
 /// The package convention's disjoint pairs/triples are independent under white noise, so their
-/// edf is the number `M` of pairs/triples. The interval is the chi-square interval of METHODS
+/// edf is the number `M` of pairs/triples; its "mo" estimators use the textbook overlapping
+/// rule (with the full count `N - 2m + 1` or `N - 3m + 1`). The interval is the chi-square interval of METHODS
 /// §1.7 on the variance scale.
 ///
 /// Package convention: see [`AvConvention::Package`] and METHODS §3.1, §3.2, §3.5. A
