@@ -46,10 +46,6 @@ pub struct WaveletVariance {
 pub struct HaarWvAccumulator {}
 
 /// Computes the WV.
-pub fn wavelet_variance(
-    _x: &[f64],
-    _freq_hz: f64,
-    _opts: &WvOptions,
-) -> Result<WaveletVariance, Error> {
+pub fn wavelet_variance(_x: &[f64], _freq_hz: f64, _opts: &WvOptions) -> Result<WaveletVariance, Error> {
     unimplemented!()
 }
