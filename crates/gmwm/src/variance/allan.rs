@@ -366,7 +366,7 @@ pub fn allan_variance(
     for (&m, row) in clusters.iter().zip(rows) {
         let mf = m as f64;
         let edf = row.edf.max(1.0);
-        let (lo, hi) = interval(row.value, edf, opts.alpha);
+        let (lo, hi) = chi_square_interval(row.value, edf, opts.alpha);
         out.tau.push(mf);
         out.tau_s.push(mf / freq_hz);
         out.avar.push(row.value);
@@ -378,46 +378,6 @@ pub fn allan_variance(
         out.error.push(package_error(n, m));
     }
     Ok(out)
-}
-
-/// Chi-square interval of METHODS §1.7 ([`chi_square_interval`]), with a bisection fallback
-/// for a bound that comes back non-finite: statrs 0.18's `inverse_cdf` returns NaN for small
-/// probabilities at edf near 1 (e.g. df 1, p 0.025), which the top cluster lengths reach.
-fn interval(estimate: f64, edf: f64, alpha: f64) -> (f64, f64) {
-    let (mut lo, mut hi) = chi_square_interval(estimate, edf, alpha);
-    if !lo.is_finite() {
-        lo = edf * estimate / chi_square_quantile(edf, 1.0 - alpha / 2.0);
-    }
-    if !hi.is_finite() {
-        hi = edf * estimate / chi_square_quantile(edf, alpha / 2.0);
-    }
-    (lo, hi)
-}
-
-/// Quantile of the chi-square distribution with `df >= 1` degrees of freedom at `p` in (0, 1),
-/// by bisection on its CDF (METHODS §1.7; the fallback of [`interval`]).
-fn chi_square_quantile(df: f64, p: f64) -> f64 {
-    use statrs::distribution::{ChiSquared, ContinuousCDF};
-    let Ok(chi) = ChiSquared::new(df) else {
-        return f64::NAN;
-    };
-    let mut hi = df.max(1.0);
-    while chi.cdf(hi) < p && hi < 1e300 {
-        hi *= 2.0;
-    }
-    let mut lo = 0.0;
-    for _ in 0..2000 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if chi.cdf(mid) < p {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))`, METHODS §3.3.
@@ -815,16 +775,6 @@ mod tests {
         assert_eq!(package_levels(8, 2.0, 1, 2, |_| true), vec![2, 4]);
         assert_eq!(package_levels(27, 3.0, 2, 3, |_| true), vec![3]);
         assert!(package_levels(3, 2.0, 1, 2, |_| true).is_empty());
-    }
-
-    #[test]
-    fn interval_is_finite_at_one_degree_of_freedom() {
-        // R: qchisq(0.025, 1) = 0.000982069117175, qchisq(0.975, 1) = 5.02388618731489
-        let q = chi_square_quantile(1.0, 0.025);
-        assert!((q / 0.000982069117175 - 1.0).abs() < 1e-9, "{q}");
-        let (lo, hi) = interval(2.0, 1.0, 0.05);
-        assert!((lo / (2.0 / 5.02388618731489) - 1.0).abs() < 1e-9, "{lo}");
-        assert!((hi / (2.0 / 0.000982069117175) - 1.0).abs() < 1e-9, "{hi}");
     }
 
     #[test]

@@ -142,8 +142,10 @@ mod tests {
                 );
             }
         }
-        // R: qchisq(0.975, 1) = 5.023886187314888
+        // R: qchisq(0.975, 1) = 5.023886187314888, qchisq(0.025, 1) = 0.000982069117175
+        // (statrs' inverse_cdf returns NaN for the latter)
         assert!((chi_square_quantile(0.975, 1.0) - 5.023886187314888).abs() < 1e-13);
+        assert!((chi_square_quantile(0.025, 1.0) / 0.000982069117175 - 1.0).abs() < 1e-9);
     }
 
     #[test]
