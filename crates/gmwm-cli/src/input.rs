@@ -51,7 +51,6 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
         columns: args.columns.iter().map(|c| selector(c)).collect(),
         ncols: args.ncols,
         freq_hz: args.freq,
-        ..ReadOptions::default()
     };
     let table = read_table(&args.file, &opts)?;
     let freq_hz = match args.freq.or(table.freq_hz) {

@@ -242,7 +242,9 @@ fn impossible_parameters_are_errors() {
     assert_one_line_error(&["wv", "--filter", "db99", p], &["db99"]);
     assert_one_line_error(&["wv", "--alpha", "2", p], &["alpha"]);
     assert_one_line_error(&["wv", "--levels", "9", p], &["level"]);
-    assert_one_line_error(&["wv", "--freq", "-3", p], &["freq"]);
+    assert_one_line_error(&["wv", "--freq=-3", p], &["freq"]);
+    assert_one_line_error(&["wv", "--freq", "0", p], &["freq"]);
+    assert_one_line_error(&["avar", "--alpha", "0", p], &["alpha"]);
     assert_one_line_error(
         &[
             "wv",

@@ -80,7 +80,7 @@ pub fn chi_square_quantile(p: f64, df: f64) -> f64 {
         }
         let step = r / chi.pdf(x);
         let mut next = x - step;
-        if !(next > lo && next < hi) || !next.is_finite() {
+        if !(next > lo && next < hi && next.is_finite()) {
             next = 0.5 * (lo + hi);
         }
         if (next - x).abs() <= 1e-15 * x || hi - lo <= 1e-15 * hi {

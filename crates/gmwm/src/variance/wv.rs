@@ -752,6 +752,7 @@ fn level_span(new: &[f64], old: &[f64], output: &mut [f64], skip: usize) -> f64 
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // per-level arrays compared by index
 mod tests {
     use super::*;
 
