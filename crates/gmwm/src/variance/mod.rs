@@ -3,6 +3,7 @@
 
 pub mod allan;
 pub mod ci;
+pub mod cov;
 pub mod robust;
 pub mod wv;
 

@@ -309,13 +309,11 @@ pub fn wavelet_variance(
     check_alpha(opts.alpha)?;
     check_freq(freq_hz)?;
     let n = x.len();
-    let levels = match opts.levels {
-        Some(j) => j,
-        None => match default_levels(n, opts.transform, opts.filter) {
-            0 => default_levels_or_one(n, opts),
-            j => j,
-        },
-    };
+    // With no level keeping two coefficients, ask for one so that check_levels reports the
+    // precise reason.
+    let levels = opts
+        .levels
+        .unwrap_or_else(|| default_levels(n, opts.transform, opts.filter).max(1));
     check_levels(n, levels, opts)?;
     if let Some(r) = opts.robust {
         RobustOptions::new(r.eff, r.convention)?;
@@ -336,44 +334,49 @@ pub fn wavelet_variance(
         .robust
         .map(|r| tuning_constant(r.eff, r.convention))
         .transpose()?;
-    let mut classical = Vec::with_capacity(levels);
-    let mut robust = Vec::with_capacity(levels);
-    let mut counts = Vec::with_capacity(levels);
-    let mut eta = Vec::with_capacity(levels);
-    let mut warnings = Vec::new();
-    for j in 1..=levels {
-        let kept = coefs.kept(j);
-        let scale = match opts.transform {
-            Transform::Modwt => 1.0,
-            Transform::Dwt => (j as f64).exp2(),
-        };
-        classical.push(mean_square(kept) / scale);
-        if let (Some(c), Some(r)) = (c, opts.robust) {
-            match robust_scale(kept, c, r.convention) {
-                Ok(s2) => robust.push(s2 / scale),
-                Err(Error::Series(SeriesError::NoRobustScale { .. })) => {
-                    warnings.push(WvWarning::NoRobustScale { level: j });
-                    robust.push(f64::NAN);
-                }
-                Err(e) => return Err(e),
-            }
-        }
-        counts.push(kept.len());
-        eta.push(match opts.transform {
-            Transform::Modwt => eta3(kept.len(), j),
-            Transform::Dwt => (kept.len() as f64).max(1.0),
-        });
-    }
+    // Levels are independent once the transform is done: the robust solves (the expensive
+    // part, O(n) per fixed-point step) run in parallel across levels.
+    use rayon::prelude::*;
+    let per_level: Vec<(f64, Option<f64>, usize)> = (1..=levels)
+        .into_par_iter()
+        .map(|j| {
+            let kept = coefs.kept(j);
+            let scale = match opts.transform {
+                Transform::Modwt => 1.0,
+                Transform::Dwt => (j as f64).exp2(),
+            };
+            let robust = match (c, opts.robust) {
+                (Some(c), Some(r)) => match robust_scale(kept, c, r.convention) {
+                    Ok(s2) => Some(s2 / scale),
+                    Err(Error::Series(SeriesError::NoRobustScale { .. })) => Some(f64::NAN),
+                    Err(e) => return Err(e),
+                },
+                _ => None,
+            };
+            Ok((mean_square(kept) / scale, robust, kept.len()))
+        })
+        .collect::<Result<_, Error>>()?;
+    let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
+    let robust: Vec<f64> = per_level.iter().filter_map(|l| l.1).collect();
+    let warnings = robust
+        .iter()
+        .zip(1..)
+        .filter(|(v, _)| v.is_nan())
+        .map(|(_, level)| WvWarning::NoRobustScale { level })
+        .collect();
+    let counts: Vec<usize> = per_level.iter().map(|l| l.2).collect();
+    let eta = counts
+        .iter()
+        .zip(1..)
+        .map(|(&kept, j)| match opts.transform {
+            Transform::Modwt => eta3(kept, j),
+            Transform::Dwt => (kept as f64).max(1.0),
+        })
+        .collect();
     let robust = opts.robust.map(|_| robust.as_slice());
     let mut result = WaveletVariance::assemble(n, freq_hz, opts, &classical, robust, counts, eta);
     result.warnings = warnings;
     Ok(result)
-}
-
-/// When no level keeps two coefficients, fall back to one level if it keeps one, so that the
-/// error (if any) comes from [`check_levels`] with the precise reason.
-fn default_levels_or_one(_n: usize, _opts: &WvOptions) -> usize {
-    1
 }
 
 fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
@@ -813,6 +816,40 @@ mod tests {
         )
         .unwrap();
         assert!(rel(wv.wv[0], 6.0 / 7.0) < 1e-14 && rel(wv.wv[1], 1.05) < 1e-14);
+    }
+
+    #[test]
+    fn dwt_wv_is_normalised_to_the_modwt_scale() {
+        // METHODS §1.10 DWT values: the package's raw means (0.5, 4.0) and (2.25, 4.25) are 2^j
+        // times the MODWT-scale WV (§13.3); we divide by 2^j.
+        for (x, raw) in [
+            ((1..=8).map(f64::from).collect::<Vec<_>>(), [0.5, 4.0]),
+            (vec![1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0], [2.25, 4.25]),
+        ] {
+            let o = WvOptions {
+                transform: Transform::Dwt,
+                levels: Some(2),
+                ..Default::default()
+            };
+            let wv = wavelet_variance(&x, 1.0, &o).unwrap();
+            assert!(rel(wv.wv[0], raw[0] / 2.0) < 1e-14 && rel(wv.wv[1], raw[1] / 4.0) < 1e-14);
+            assert_eq!(wv.eta, vec![4.0, 2.0]);
+        }
+    }
+
+    #[test]
+    fn overlapping_allan_variance_is_twice_the_wv() {
+        // METHODS §3.4: AV(m = 2^{j-1}) = 2 WV_j over the same index set, exactly
+        let x: Vec<f64> = (0..3000)
+            .map(|i| ((i * 7919) % 1013) as f64 * 0.01 - 9.81)
+            .collect();
+        let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+        let av = crate::allan_variance(&x, 1.0, &crate::AllanOptions::default()).unwrap();
+        for j in 0..wv.levels() {
+            assert_eq!(av.tau[j], wv.tau[j] / 2.0);
+            assert!(rel(av.avar[j], 2.0 * wv.wv[j]) < 1e-12, "level {}", j + 1);
+            assert!(rel(av.ci_low[j], 2.0 * wv.ci_low[j]) < 1e-12);
+        }
     }
 
     #[test]
