@@ -88,26 +88,51 @@ impl ParamError {
 
 /// Checks that a series is non-empty, finite and not constant (METHODS §0.1 preconditions).
 ///
+/// One vectorisable pass (min, max and a NaN-propagating probe); the offending index is looked
+/// up only on failure.
+///
 /// # Errors
 /// [`SeriesError::Empty`], [`SeriesError::NonFinite`] (first offending index) or
 /// [`SeriesError::Constant`].
 pub fn check_series(x: &[f64]) -> Result<(), SeriesError> {
     let first = *x.first().ok_or(SeriesError::Empty)?;
-    let mut constant = true;
-    for (index, &value) in x.iter().enumerate() {
-        if !value.is_finite() {
-            return Err(non_finite(index, value));
-        }
-        constant &= value == first;
-    }
-    if constant {
+    check_finite(x)?;
+    let (lo, hi) = x
+        .iter()
+        .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    if lo == hi {
         return Err(SeriesError::Constant { value: first });
     }
     Ok(())
 }
 
+/// Checks that every value is finite (an empty slice passes).
+///
+/// # Errors
+/// [`SeriesError::NonFinite`] with the first offending index.
+pub fn check_finite(x: &[f64]) -> Result<(), SeriesError> {
+    // v * 0 is 0 for finite v and NaN for NaN or +-inf; the sum is NaN iff one of them is.
+    let mut acc = [0.0f64; 4];
+    let mut quads = x.chunks_exact(4);
+    for q in &mut quads {
+        for k in 0..4 {
+            acc[k] += q[k] * 0.0;
+        }
+    }
+    let probe = acc.iter().sum::<f64>() + quads.remainder().iter().map(|v| v * 0.0).sum::<f64>();
+    if probe.is_nan() {
+        return Err(first_non_finite(x));
+    }
+    Ok(())
+}
+
 #[cold]
-fn non_finite(index: usize, value: f64) -> SeriesError {
+fn first_non_finite(x: &[f64]) -> SeriesError {
+    let (index, &value) = x
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !v.is_finite())
+        .expect("a non-finite value exists");
     SeriesError::NonFinite { index, value }
 }
 

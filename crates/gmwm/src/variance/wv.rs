@@ -5,7 +5,7 @@
 //! [`HaarWvAccumulator`], a streaming O(N·J) pass that never stores the coefficients and can
 //! consume its input in chunks.
 
-use crate::error::{check_series, Error, ParamError, SeriesError};
+use crate::error::{check_finite, check_series, Error, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
 use crate::variance::robust::{robust_ci, robust_scale, tuning_constant, RobustOptions};
@@ -394,8 +394,25 @@ fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
 /// Compensated mean.
 fn mean(x: &[f64]) -> f64 {
     let mut s = NeumaierSum::default();
-    x.iter().for_each(|&v| s.add(v));
+    for block in x.chunks(BLOCK) {
+        s.add(sum_plain(block));
+    }
     s.total() / x.len() as f64
+}
+
+/// Sum with four independent accumulators (vectorisable; blocks are then combined with a
+/// compensated sum by the caller).
+#[inline]
+fn sum_plain(x: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let mut quads = x.chunks_exact(4);
+    for q in &mut quads {
+        for k in 0..4 {
+            acc[k] += q[k];
+        }
+    }
+    let tail: f64 = quads.remainder().iter().sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// Mean of squares with a compensated accumulation of block sums.
@@ -448,7 +465,6 @@ pub struct HaarWvAccumulator {
     offset: Option<f64>,
     n: u64,
     first: Option<f64>,
-    constant: bool,
     rings: Vec<Vec<f64>>,
     pos: Vec<usize>,
     sums: Vec<NeumaierSum>,
@@ -474,7 +490,6 @@ impl HaarWvAccumulator {
             offset: None,
             n: 0,
             first: None,
-            constant: true,
             rings: (1..=levels).map(|j| vec![0.0; 1usize << (j - 1)]).collect(),
             pos: vec![0; levels],
             sums: vec![NeumaierSum::default(); levels],
@@ -508,7 +523,6 @@ impl HaarWvAccumulator {
         };
         acc.n = t0 as u64;
         acc.first = Some(head);
-        acc.constant = history.iter().all(|&v| v == head);
         let value = |i: isize| {
             if i < 0 {
                 0.0
@@ -562,19 +576,20 @@ impl HaarWvAccumulator {
         let first = *self.first.get_or_insert(head);
         let mut input = std::mem::take(&mut self.scratch_in);
         let mut output = std::mem::take(&mut self.scratch_out);
-        input.clear();
-        for (i, &v) in block.iter().enumerate() {
-            if !v.is_finite() {
-                self.scratch_in = input;
-                self.scratch_out = output;
-                return Err(SeriesError::NonFinite {
-                    index: self.n as usize + i,
-                    value: v,
-                });
-            }
-            self.constant &= v == first;
-            input.push(v - offset);
+        let _ = first;
+        if let Err(e) = check_finite(block) {
+            self.scratch_in = input;
+            self.scratch_out = output;
+            return Err(match e {
+                SeriesError::NonFinite { index, value } => SeriesError::NonFinite {
+                    index: self.n as usize + index,
+                    value,
+                },
+                other => other,
+            });
         }
+        input.clear();
+        input.extend(block.iter().map(|&v| v - offset));
         output.resize(input.len(), 0.0);
         let t0 = self.n;
         for j in 1..=self.levels {
@@ -601,9 +616,13 @@ impl HaarWvAccumulator {
         check_alpha(alpha)?;
         check_freq(freq_hz)?;
         let n = self.n as usize;
+        // Level-1 coefficients are halved differences of consecutive samples: they are all zero
+        // exactly when the series is constant.
         match self.first {
             None => return Err(SeriesError::Empty.into()),
-            Some(value) if self.constant => return Err(SeriesError::Constant { value }.into()),
+            Some(value) if self.sums[0].total() == 0.0 => {
+                return Err(SeriesError::Constant { value }.into())
+            }
             _ => {}
         }
         let opts = WvOptions {
@@ -664,7 +683,6 @@ fn haar_wv_parallel(
             a.add(b.total());
         }
         total.n = part.n;
-        total.constant &= part.constant && part.first == total.first;
     }
     total.finish(freq_hz, alpha)
 }
