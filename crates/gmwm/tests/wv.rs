@@ -340,7 +340,7 @@ fn streaming_wv_is_exact_to_1e_9_at_30_million_samples() {
 }
 
 #[test]
-#[ignore = "10^9 samples: ~10 min and 12 GB; run with `cargo test --release -p gmwm --test integration -- --ignored streaming_wv_is_exact_to_1e_9_at_a_billion`"]
+#[ignore = "10^9 samples: ~3 min and 12 GB; run with `cargo test --release -p gmwm --test integration -- --ignored streaming_wv_is_exact_to_1e_9_at_a_billion`"]
 fn streaming_wv_is_exact_to_1e_9_at_a_billion_samples() {
     check_streaming_exact(1_000_000_001);
 }
