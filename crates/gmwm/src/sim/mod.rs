@@ -45,7 +45,10 @@ impl DemoSensor {
     pub fn model_text(&self) -> String {
         format!(
             "AR1(phi={}, sigma2={})+WN(sigma2={})+RW(gamma2={})",
-            self.ar1_phi, self.ar1_sigma2, self.wn_sigma2, self.rw_gamma2
+            number(self.ar1_phi),
+            number(self.ar1_sigma2),
+            number(self.wn_sigma2),
+            number(self.rw_gamma2)
         )
     }
 
@@ -98,6 +101,16 @@ impl DemoSensor {
     }
 }
 
+/// Shortest round-tripping text of a parameter, in scientific notation when it is small or
+/// large (`1.414585e-11` rather than `0.00000000001414585`).
+fn number(v: f64) -> String {
+    if v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,6 +121,10 @@ mod tests {
         assert_eq!(s.simulate(100, 7).unwrap(), s.simulate(100, 7).unwrap());
         assert_ne!(s.simulate(100, 7).unwrap(), s.simulate(100, 8).unwrap());
         assert!(s.simulate(0, 7).is_err());
+        assert_eq!(
+            s.model_text(),
+            "AR1(phi=0.9990005, sigma2=1.414585e-11)+WN(sigma2=6.94e-7)+RW(gamma2=3.9e-14)"
+        );
         let bad = DemoSensor { ar1_phi: 1.0, ..s };
         assert!(bad.simulate(10, 1).is_err());
     }
