@@ -74,3 +74,34 @@ pub fn column_context<T>(
 ) -> Result<T> {
     r.with_context(|| format!("{}: column {column}", file.display()))
 }
+
+/// Runs a per-series computation over every loaded column in parallel (the engine's
+/// `per_column`), naming any failure by file and column.
+pub fn analyse_columns<T: Send>(
+    loaded: &Loaded,
+    file: &std::path::Path,
+    f: impl Fn(&[f64]) -> Result<T, gmwm::Error> + Sync + Send,
+) -> Result<Vec<(String, T)>> {
+    let columns: Vec<&[f64]> = loaded
+        .table
+        .columns
+        .iter()
+        .map(|c| c.values.as_slice())
+        .collect();
+    let results = gmwm::variance::per_column(&columns, f);
+    loaded
+        .table
+        .columns
+        .iter()
+        .zip(results)
+        .map(|(col, r)| Ok((col.name.clone(), column_context(r, file, &col.name)?)))
+        .collect()
+}
+
+/// Borrows `(name, result)` pairs as [`Named`](crate::render::Named) items.
+pub fn named<T>(items: &[(String, T)]) -> Vec<crate::render::Named<'_, T>> {
+    items
+        .iter()
+        .map(|(name, result)| crate::render::Named { name, result })
+        .collect()
+}

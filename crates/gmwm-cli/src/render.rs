@@ -45,55 +45,62 @@ struct SeriesDoc<'a, T> {
     series: &'a [Named<'a, T>],
 }
 
-/// Writes wavelet variances.
-pub fn wavelet_variances(
-    out: &mut impl Write,
-    items: &[Named<WaveletVariance>],
-    style: Style,
-) -> Result<()> {
-    match style {
-        Style::Json => json(out, items),
-        Style::Table => {
-            for (i, it) in items.iter().enumerate() {
-                if i > 0 {
-                    writeln!(out)?;
-                }
-                writeln!(out, "{}", it.name)?;
-                write!(out, "{}", it.result)?;
-            }
-            Ok(())
+/// A result with a CSV form: one header, then one row per scale.
+pub trait CsvRows {
+    /// Header line (without the newline), first column `series`.
+    const HEADER: &'static str;
+    /// Writes the rows of the series `name`.
+    fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()>;
+}
+
+impl CsvRows for WaveletVariance {
+    const HEADER: &'static str = "series,level,tau,tau_s,wv,ci_low,ci_high";
+    fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()> {
+        for j in 0..self.wv.len() {
+            writeln!(
+                out,
+                "{},{},{},{:e},{:e},{:e},{:e}",
+                csv_field(name),
+                j + 1,
+                self.tau[j],
+                self.tau_s[j],
+                self.wv[j],
+                self.ci_low[j],
+                self.ci_high[j]
+            )?;
         }
-        Style::Csv => {
-            writeln!(out, "series,level,tau,tau_s,wv,ci_low,ci_high")?;
-            for it in items {
-                let r = it.result;
-                for j in 0..r.wv.len() {
-                    writeln!(
-                        out,
-                        "{},{},{},{:e},{:e},{:e},{:e}",
-                        csv_field(it.name),
-                        j + 1,
-                        r.tau[j],
-                        r.tau_s[j],
-                        r.wv[j],
-                        r.ci_low[j],
-                        r.ci_high[j]
-                    )?;
-                }
-            }
-            Ok(())
-        }
+        Ok(())
     }
 }
 
-/// Writes Allan/Hadamard variances.
-pub fn allan_variances(
+impl CsvRows for AllanVariance {
+    const HEADER: &'static str = "series,tau,tau_s,avar,adev,ci_low,ci_high";
+    fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()> {
+        for k in 0..self.avar.len() {
+            writeln!(
+                out,
+                "{},{},{:e},{:e},{:e},{:e},{:e}",
+                csv_field(name),
+                self.tau[k],
+                self.tau_s[k],
+                self.avar[k],
+                self.adev[k],
+                self.ci_low[k],
+                self.ci_high[k]
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes per-series results as a table (their `Display`), JSON (`{"series": [...]}`) or CSV.
+pub fn series<T: Serialize + std::fmt::Display + CsvRows>(
     out: &mut impl Write,
-    items: &[Named<AllanVariance>],
+    items: &[Named<T>],
     style: Style,
 ) -> Result<()> {
     match style {
-        Style::Json => json(out, items),
+        Style::Json => json(out, items)?,
         Style::Table => {
             for (i, it) in items.iter().enumerate() {
                 if i > 0 {
@@ -102,29 +109,15 @@ pub fn allan_variances(
                 writeln!(out, "{}", it.name)?;
                 write!(out, "{}", it.result)?;
             }
-            Ok(())
         }
         Style::Csv => {
-            writeln!(out, "series,tau,tau_s,avar,adev,ci_low,ci_high")?;
+            writeln!(out, "{}", T::HEADER)?;
             for it in items {
-                let r = it.result;
-                for k in 0..r.avar.len() {
-                    writeln!(
-                        out,
-                        "{},{},{:e},{:e},{:e},{:e},{:e}",
-                        csv_field(it.name),
-                        r.tau[k],
-                        r.tau_s[k],
-                        r.avar[k],
-                        r.adev[k],
-                        r.ci_low[k],
-                        r.ci_high[k]
-                    )?;
-                }
+                it.result.write_rows(it.name, out)?;
             }
-            Ok(())
         }
     }
+    Ok(())
 }
 
 fn json<T: Serialize>(out: &mut impl Write, items: &[Named<T>]) -> Result<()> {

@@ -327,3 +327,39 @@ fn binary_input_streams_to_the_same_wv_as_text() {
         assert!((a - b).abs() <= 1e-11 * b.abs(), "{a} vs {b}");
     }
 }
+
+#[test]
+fn robust_levels_without_a_scale_are_warned_and_null() {
+    let mut csv = String::from("x\n");
+    let mut s = 7u64;
+    for i in 0..8192 {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        let v = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5 + if i % 50 == 0 { 1e3 } else { 0.0 };
+        csv.push_str(&format!("{v}\n"));
+    }
+    let f = temp_file(".csv", csv.as_bytes());
+    let out = gmwm()
+        .args(["wv", "--robust", "--freq", "1", "--json"])
+        .arg(f.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("gmwm: warning:") && stderr.contains("robust scale is undefined"),
+        "{stderr}"
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let wv = doc["series"][0]["wv"].as_array().unwrap();
+    assert!(wv[0].is_f64(), "level 1 has a robust estimate");
+    assert!(
+        wv.iter().any(|v| v.is_null()),
+        "missing levels are null, never numbers"
+    );
+}

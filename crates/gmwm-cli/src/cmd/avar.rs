@@ -1,10 +1,9 @@
 //! `gmwm avar`: Allan, modified Allan or Hadamard variance of each selected column.
 
 use crate::args::{AvarArgs, ConventionArg, KindArg};
-use crate::input::{column_context, load};
-use crate::render::{self, Named, Style};
+use crate::input::{analyse_columns, load, named};
+use crate::render::{self, Style};
 use anyhow::Result;
-use gmwm::variance::per_column;
 use gmwm::{allan_variance, AllanKind, AllanOptions, AvConvention};
 use std::io::Write;
 
@@ -26,23 +25,8 @@ pub fn run(args: &AvarArgs, out: &mut impl Write) -> Result<()> {
         },
     };
     let loaded = load(&args.input)?;
-    let columns: Vec<&[f64]> = loaded
-        .table
-        .columns
-        .iter()
-        .map(|c| c.values.as_slice())
-        .collect();
-    let results = per_column(&columns, |x| allan_variance(x, loaded.freq_hz, &opts));
-    let mut items = Vec::with_capacity(results.len());
-    for (col, r) in loaded.table.columns.iter().zip(results) {
-        items.push((
-            col.name.as_str(),
-            column_context(r, &args.input.file, &col.name)?,
-        ));
-    }
-    let named: Vec<Named<_>> = items
-        .iter()
-        .map(|(name, result)| Named { name, result })
-        .collect();
-    render::allan_variances(out, &named, Style::from(&args.output))
+    let items = analyse_columns(&loaded, &args.input.file, |x| {
+        allan_variance(x, loaded.freq_hz, &opts)
+    })?;
+    render::series(out, &named(&items), Style::from(&args.output))
 }

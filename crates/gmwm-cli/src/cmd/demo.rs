@@ -27,5 +27,5 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
         )?;
     }
     let name = "demo";
-    render::wavelet_variances(out, &[Named { name, result: &wv }], style)
+    render::series(out, &[Named { name, result: &wv }], style)
 }

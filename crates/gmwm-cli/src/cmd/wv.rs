@@ -1,11 +1,11 @@
 //! `gmwm wv`: wavelet variance of each selected column.
 
 use crate::args::{FormatArg, RobustConventionArg, TransformArg, WvArgs, WvEstimatorArgs};
-use crate::input::{column_context, load};
-use crate::render::{self, Named, Style};
+use crate::input::{analyse_columns, column_context, load, named};
+use crate::render::{self, Style};
 use anyhow::Result;
 use gmwm::imu::{BinaryChunks, InputFormat};
-use gmwm::variance::{default_levels, per_column};
+use gmwm::variance::default_levels;
 use gmwm::{
     wavelet_variance, HaarWvAccumulator, RobustConvention, RobustOptions, Transform, WaveletFilter,
     WaveletVariance, WvOptions,
@@ -80,11 +80,7 @@ fn run_streaming(args: &WvArgs, opts: &WvOptions, out: &mut impl Write) -> Resul
         )?;
         results.push((name, wv));
     }
-    let named: Vec<Named<_>> = results
-        .iter()
-        .map(|(name, result)| Named { name, result })
-        .collect();
-    render::wavelet_variances(out, &named, Style::from(&args.output))
+    render::series(out, &named(&results), Style::from(&args.output))
 }
 
 fn stream_column(
@@ -152,23 +148,16 @@ pub fn run(args: &WvArgs, out: &mut impl Write) -> Result<()> {
         return run_streaming(args, &opts, out);
     }
     let loaded = load(&args.input)?;
-    let columns: Vec<&[f64]> = loaded
-        .table
-        .columns
-        .iter()
-        .map(|c| c.values.as_slice())
-        .collect();
-    let results = per_column(&columns, |x| wavelet_variance(x, loaded.freq_hz, &opts));
-    let mut items = Vec::with_capacity(results.len());
-    for (col, r) in loaded.table.columns.iter().zip(results) {
-        items.push((
-            col.name.as_str(),
-            column_context(r, &args.input.file, &col.name)?,
-        ));
+    let items = analyse_columns(&loaded, &args.input.file, |x| {
+        wavelet_variance(x, loaded.freq_hz, &opts)
+    })?;
+    for (name, wv) in &items {
+        for w in &wv.warnings {
+            eprintln!(
+                "gmwm: warning: {}: column {name}: {w}",
+                args.input.file.display()
+            );
+        }
     }
-    let named: Vec<Named<_>> = items
-        .iter()
-        .map(|(name, result)| Named { name, result })
-        .collect();
-    render::wavelet_variances(out, &named, Style::from(&args.output))
+    render::series(out, &named(&items), Style::from(&args.output))
 }
