@@ -523,24 +523,27 @@ impl HaarWvAccumulator {
         };
         acc.n = t0 as u64;
         acc.first = Some(head);
-        let value = |i: isize| {
-            if i < 0 {
-                0.0
-            } else {
-                history[i as usize] - offset
-            }
-        };
+        // Prefix sums of the demeaned history over the last 2^J samples (all any ring needs):
+        // prefix[k] = sum of the first k of them; samples before the series start count as 0.
+        let span = t0.min(1usize << levels);
+        let base = t0 - span;
+        let mut prefix = Vec::with_capacity(span + 1);
+        let mut running = 0.0;
+        prefix.push(0.0);
+        for &v in &history[base..] {
+            running += v - offset;
+            prefix.push(running);
+        }
         for (ring, j) in acc.rings.iter_mut().zip(1..) {
-            let m = 1isize << (j - 1);
-            let t0 = t0 as isize;
-            // window of t = t0 - m: samples t0 - 2m + 1 ..= t0 - m
-            let mut window: f64 = (t0 - 2 * m + 1..=t0 - m).map(value).sum();
+            let m = 1usize << (j - 1);
+            // ring[k] = V_{j-1, t} for t = t0 - m + k: mean of samples t - m + 1 ..= t
             for (k, slot) in ring.iter_mut().enumerate() {
-                let t = t0 - m + k as isize;
-                if k > 0 {
-                    window += value(t) - value(t - m);
-                }
-                *slot = window / m as f64;
+                let Some(t) = (t0 + k).checked_sub(m) else {
+                    continue; // before the series start: the pyramid's zero ring
+                };
+                let end = t + 1 - base;
+                let start = (t + 1).saturating_sub(m).max(base) - base;
+                *slot = (prefix[end] - prefix[start]) / m as f64;
             }
         }
         Ok(acc)
