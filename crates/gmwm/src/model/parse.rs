@@ -26,7 +26,7 @@
 //! ```
 //! use gmwm::model::{Model, ParseErrorKind};
 //! let e = Model::parse("AR1(phi=0.9,, sigma2=1)").unwrap_err();
-//! assert_eq!((e.column, e.kind.clone()), (13, ParseErrorKind::Syntax));
+//! assert_eq!((e.column(), e.kind()), (13, &ParseErrorKind::Syntax));
 //! assert_eq!(
 //!     e.to_string(),
 //!     r#"model "AR1(phi=0.9,, sigma2=1)": at column 13: expected a parameter name, found ",""#
@@ -36,7 +36,7 @@
 
 use super::Model;
 use super::{validate, Component, ModelError, ProcessKind, MAX_MULTIPLIER, MAX_ORDER};
-use thiserror::Error;
+use std::fmt;
 
 /// What went wrong in [`Model::parse`]; the position and the expected/found texts are in
 /// [`ModelParseError`].
@@ -83,48 +83,98 @@ pub enum ParseErrorKind {
 /// A model text that could not be parsed (or that breaks a model rule), with the position of
 /// the offending character.
 ///
-/// Displays as `model "<text>": at column <c>: expected <e>, found <f>[; hint]`.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[error(
-    "model {input:?}: at column {column}: expected {expected}, found {found}{}",
-    .hint.as_ref().map(|h| format!("; {h}")).unwrap_or_default()
-)]
-#[non_exhaustive]
-pub struct ModelParseError {
-    /// The whole input text.
-    pub input: String,
-    /// Byte offset of the offending character in `input` (`input.len()` at the end).
-    pub offset: usize,
-    /// 1-based column (in characters) of the offending character.
-    pub column: usize,
-    /// What would have been valid there.
-    pub expected: String,
-    /// What was found (quoted text, or `end of input`).
-    pub found: String,
-    /// A suggested fix, if one is obvious.
-    pub hint: Option<String>,
-    /// The kind of error, for callers that act on it.
-    pub kind: ParseErrorKind,
+/// Displays as `model "<text>": at column <c>: expected <e>, found <f>[; hint]`. The fields are
+/// behind accessors so that the error stays one pointer wide in `Result`s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelParseError(Box<ErrorData>);
+
+#[derive(Debug, Clone, PartialEq)]
+struct ErrorData {
+    input: String,
+    offset: usize,
+    column: usize,
+    expected: String,
+    found: String,
+    hint: Option<String>,
+    kind: ParseErrorKind,
 }
 
 impl ModelParseError {
+    /// The whole input text.
+    pub fn input(&self) -> &str {
+        &self.0.input
+    }
+
+    /// Byte offset of the offending character in [`input`](Self::input) (`input().len()` when
+    /// the text ended too early); always a char boundary.
+    pub fn offset(&self) -> usize {
+        self.0.offset
+    }
+
+    /// 1-based column, in characters, of the offending character.
+    pub fn column(&self) -> usize {
+        self.0.column
+    }
+
+    /// What would have been valid there, e.g. `a parameter name`.
+    pub fn expected(&self) -> &str {
+        &self.0.expected
+    }
+
+    /// What was found: quoted text such as `","`, or `end of input`.
+    pub fn found(&self) -> &str {
+        &self.0.found
+    }
+
+    /// A suggested fix, if one is obvious (e.g. `did you mean GM()?`).
+    pub fn hint(&self) -> Option<&str> {
+        self.0.hint.as_deref()
+    }
+
+    /// The kind of error, for callers that act on it.
+    pub fn kind(&self) -> &ParseErrorKind {
+        &self.0.kind
+    }
+
     /// Two lines: the input (control characters shown as spaces) and a `^` under the offending
     /// character.
     pub fn render(&self) -> String {
         let line: String = self
+            .0
             .input
             .chars()
             .map(|c| if c.is_control() { ' ' } else { c })
             .collect();
-        format!("{line}\n{}^", " ".repeat(self.column.saturating_sub(1)))
+        format!("{line}\n{}^", " ".repeat(self.0.column.saturating_sub(1)))
     }
 
     /// The model-rule violation, for [`ParseErrorKind::Rule`].
     pub fn rule(&self) -> Option<&ModelError> {
-        match &self.kind {
+        match &self.0.kind {
             ParseErrorKind::Rule(e) => Some(e),
             _ => None,
         }
+    }
+}
+
+impl fmt::Display for ModelParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let d = &self.0;
+        write!(
+            f,
+            "model {:?}: at column {}: expected {}, found {}",
+            d.input, d.column, d.expected, d.found
+        )?;
+        if let Some(h) = &d.hint {
+            write!(f, "; {h}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for ModelParseError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.rule().map(|e| e as _)
     }
 }
 
@@ -262,7 +312,7 @@ impl<'a> Parser<'a> {
         // offsets only ever stop on ASCII bytes or before the first non-ASCII one, so `at` is a
         // char boundary; fall back to a byte count otherwise
         let column = self.text.get(..at).map_or(at, |s| s.chars().count()) + 1;
-        ModelParseError {
+        ModelParseError(Box::new(ErrorData {
             input: self.text.to_string(),
             offset: at,
             column,
@@ -270,7 +320,7 @@ impl<'a> Parser<'a> {
             found,
             hint,
             kind,
-        }
+        }))
     }
 
     #[cold]
@@ -478,10 +528,14 @@ impl<'a> Parser<'a> {
         } else {
             PROCESSES
                 .iter()
-                .map(|(n, syntax)| (edit_distance(&upper, n), *syntax))
-                .filter(|(d, _)| *d <= 2)
-                .min_by_key(|(d, _)| *d)
-                .map(|(_, s)| s.to_string())
+                .map(|(n, syntax)| {
+                    // ties go to the name with the same first letter ("GN" -> GM, not WN)
+                    let other_start = upper.as_bytes().first() != n.as_bytes().first();
+                    (edit_distance(&upper, n), other_start, *syntax)
+                })
+                .filter(|(d, _, _)| *d <= 2)
+                .min_by_key(|(d, o, _)| (*d, *o))
+                .map(|(_, _, s)| s.to_string())
         };
         let hint = suggestion.as_ref().map(|s| format!("did you mean {s}?"));
         self.error_with(
@@ -558,7 +612,7 @@ impl<'a> Parser<'a> {
                             values.len(),
                             names.join(", ")
                         ),
-                        format!("value {} {}", positional + 1, self.found_at(at)),
+                        format!("{} as value {}", self.found_at(at), positional + 1),
                         None,
                     ));
                 }
