@@ -475,7 +475,11 @@ fn model_error_messages_point_at_the_problem() {
         }
     );
     assert!(e.to_string().contains("beta, sigma2_gm"), "{e}");
-    let e = Model::parse("WN(sigma2=-1)").unwrap_err();
+    let e = Model::parse("2*GM()+WN(sigma2=-1)").unwrap_err();
+    assert!(
+        matches!(e.rule(), Some(ModelError::BadParameter { component: 2, value, .. }) if *value == -1.0),
+        "{e}"
+    );
     assert!(e.to_string().contains("variance > 0"), "{e}");
     assert!(e.to_string().contains(r#"found "-1""#), "{e}");
     let e = Model::parse("AR1(phi=0.9").unwrap_err();

@@ -73,7 +73,7 @@ pub enum ParseErrorKind {
     },
     /// A malformed or non-finite number.
     BadNumber,
-    /// A multiplier `k` outside 1..=[`MAX_MULTIPLIER`](super::MAX_MULTIPLIER).
+    /// A multiplier `k` outside 1..=[`MAX_MULTIPLIER`].
     BadMultiplier,
     /// A model rule (METHODS §0.2) or a value domain is violated; the position points at the
     /// offending term or value.
@@ -226,7 +226,7 @@ pub(crate) fn parse_model(text: &str) -> Res<Model> {
     let mut starts = Vec::new();
     loop {
         let start = p.pos;
-        let (k, c) = p.term()?;
+        let (k, c) = p.term(components.len())?;
         for _ in 0..k {
             components.push(c.clone());
             starts.push(start);
@@ -393,7 +393,8 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn term(&mut self) -> Res<(usize, Component)> {
+    /// One term; `index` is the 0-based index its (first) component will have in the model.
+    fn term(&mut self, index: usize) -> Res<(usize, Component)> {
         let mut k = 1;
         if self.peek().is_some_and(|b| b.is_ascii_digit()) {
             k = self.integer(
@@ -455,7 +456,7 @@ impl<'a> Parser<'a> {
         self.skip_ws();
         if self.peek() == Some(b'(') {
             self.pos += 1;
-            self.args(kind, &mut values)?;
+            self.args(index, kind, &mut values)?;
         } else {
             self.pos = after_name;
         }
@@ -551,7 +552,7 @@ impl<'a> Parser<'a> {
     }
 
     /// The argument list after `(`, through the closing `)`.
-    fn args(&mut self, kind: ProcessKind, values: &mut [Option<f64>]) -> Res<()> {
+    fn args(&mut self, component: usize, kind: ProcessKind, values: &mut [Option<f64>]) -> Res<()> {
         self.skip_ws();
         if self.peek() == Some(b')') {
             self.pos += 1;
@@ -634,7 +635,7 @@ impl<'a> Parser<'a> {
                     return Err(self.error_with(
                         value_at,
                         ParseErrorKind::Rule(ModelError::BadParameter {
-                            component: 0,
+                            component,
                             kind,
                             name: names[index].clone(),
                             value: v,
