@@ -1,0 +1,855 @@
+//! Latent error models: an ordered sum of stochastic process components (METHODS §0.2).
+//!
+//! A [`Model`] is what the GMWM estimator fits: for example `3*GM()+WN()+QN()+RW()`, three
+//! Gauss–Markov processes plus white noise, quantisation noise and a random walk. Its parameter
+//! vector `theta` is the concatenation of the components' parameters in model order, with the
+//! names and order of METHODS §0.2 ([`ProcessKind::param_names`]).
+//!
+//! Three ways to build one, all validated by the same rules ([`Model::new`]):
+//! - text, as users of the R package write it: [`Model::parse`] / [`str::parse`], grammar in
+//!   [`parse`](mod@parse);
+//! - free functions and operators: `(3 * gm() + wn() + qn() + rw()).build()` (see [`ModelSpec`]);
+//! - components directly: `Model::new(vec![Component::guess(ProcessKind::Wn)])`.
+//!
+//! # Guess mode and user values (METHODS §0.3)
+//! Every parameter value is optional ([`Component::values`] holds `Option<f64>`). A component
+//! without values is in *guess mode*: the estimator computes its starting values (METHODS §6).
+//! **Deviation from the package (METHODS §13.20):** in a partly specified model such as
+//! `AR1(phi=0.9, sigma2=0.1)+WN()` the missing values stay `None` here, and the estimator fills
+//! them from its own starting values; the package instead starts them at fixed placeholders
+//! (WN at 3, ...), which is rarely what the user meant.
+//!
+//! # Rules (METHODS §0.2, plus one of ours)
+//! - `GM` and `AR1` may repeat (`k*GM()`), but may not be mixed in one model;
+//! - `WN`, `QN`, `RW`, `DR` appear at most once each (identifiability);
+//! - **at most one ARMA-family term** (`MA1`, `ARMA11`, `AR(p)`, `MA(q)`, `ARMA(p,q)`): two such
+//!   terms are not identifiable from one another by the wavelet variance (a sum of ARMAs is an
+//!   ARMA). METHODS does not state this rule; it is ours;
+//! - orders: `AR(p)`, `MA(q)` need an order from 1 to [`MAX_ORDER`]; `ARMA(p,q)` needs
+//!   `p + q >= 1`, each at most [`MAX_ORDER`];
+//! - every given value is finite and in its basic domain ([`ParamDomain`]).
+//!
+//! ```
+//! use gmwm::model::{gm, qn, rw, wn, Model};
+//! let text: Model = "3*GM()+WN()+QN()+RW()".parse().unwrap();
+//! let built = (3 * gm() + wn() + qn() + rw()).build().unwrap();
+//! assert_eq!(text, built);
+//! assert_eq!(built.n_params(), 9);
+//! assert!(built.is_guess_mode());
+//! assert_eq!(built.to_string(), "3*GM()+WN()+QN()+RW()");
+//! ```
+
+mod builder;
+pub mod parse;
+
+pub use builder::{
+    ar, ar1, ar1_with, ar_with, arma, arma11, arma11_with, arma_with, dr, dr_with, gm, gm_with, ma,
+    ma1, ma1_with, ma_with, qn, qn_with, rw, rw_with, wn, wn_with, ModelSpec,
+};
+pub use parse::{ModelParseError, ParseErrorKind};
+
+use std::fmt;
+use thiserror::Error;
+
+/// Largest order accepted for `AR(p)`, `MA(q)` and each order of `ARMA(p,q)`.
+///
+/// A guard against absurd allocations from typos such as `AR(20000000)`; IMU error models use
+/// orders of 1 to 3, and the implied WV of METHODS §4.4 becomes numerically meaningless long
+/// before 100 lags.
+pub const MAX_ORDER: usize = 100;
+
+/// Largest multiplier `k` accepted in `k*GM()` / `k*AR1()` (and by `k * gm()`).
+///
+/// A guard against absurd allocations from typos; the package's largest automatic search
+/// (METHODS §8.4) uses 3 GMs, and more than a handful is never identifiable.
+pub const MAX_MULTIPLIER: usize = 100;
+
+/// The kind of one latent process (METHODS §0.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ProcessKind {
+    /// White noise, parameter `sigma2`.
+    Wn,
+    /// Quantisation noise, parameter `q2` (Q^2).
+    Qn,
+    /// Random walk, parameter `gamma2` (increment variance).
+    Rw,
+    /// Deterministic drift, parameter `omega` (slope per sample).
+    Dr,
+    /// First-order autoregression, parameters `phi`, `sigma2`.
+    Ar1,
+    /// Gauss–Markov process (AR1 reparametrised with the sampling rate, METHODS §4.3),
+    /// parameters `beta`, `sigma2_gm`.
+    Gm,
+    /// First-order moving average, parameters `theta`, `sigma2`.
+    Ma1,
+    /// ARMA(1,1), parameters `phi`, `theta`, `sigma2`.
+    Arma11,
+    /// Autoregression of order p, parameters `ar1..arp`, `sigma2`.
+    Ar(usize),
+    /// Moving average of order q, parameters `ma1..maq`, `sigma2`.
+    Ma(usize),
+    /// ARMA(p, q) (package name `SARIMA` without seasonal part), parameters `ar1..arp`,
+    /// `ma1..maq`, `sigma2`; R sign convention (METHODS §0.2).
+    Arma(usize, usize),
+}
+
+/// The basic domain of one parameter value, checked whenever a value is given (METHODS §5.3
+/// lists the transforms the optimiser applies on these domains).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ParamDomain {
+    /// A variance (`sigma2`, `sigma2_gm`, `q2`, `gamma2`): finite and > 0 (log transform).
+    Variance,
+    /// The GM `beta`: finite and > 0 (`phi = exp(-beta / freq)` lies in (0, 1), METHODS §4.3).
+    Rate,
+    /// The AR1/MA1/ARMA11 coefficients `phi`, `theta`: in the open interval (-1, 1)
+    /// (the pseudo-logit domain of METHODS §5.3).
+    UnitInterval,
+    /// Any finite number: DR `omega` and the `AR(p)`/`MA(q)`/`ARMA(p,q)` coefficients (METHODS
+    /// §5.3 imposes no joint stationarity; the package's placeholders are -1 and -2).
+    Finite,
+}
+
+impl ParamDomain {
+    /// Whether `value` lies in this domain.
+    pub fn contains(self, value: f64) -> bool {
+        match self {
+            ParamDomain::Variance | ParamDomain::Rate => value.is_finite() && value > 0.0,
+            ParamDomain::UnitInterval => value > -1.0 && value < 1.0,
+            ParamDomain::Finite => value.is_finite(),
+        }
+    }
+
+    /// What a valid value looks like, for error messages.
+    pub fn expected(self) -> &'static str {
+        match self {
+            ParamDomain::Variance => "a finite variance > 0",
+            ParamDomain::Rate => "a finite rate > 0",
+            ParamDomain::UnitInterval => "a value in the open interval (-1, 1)",
+            ParamDomain::Finite => "a finite number",
+        }
+    }
+}
+
+impl ProcessKind {
+    /// The canonical name: `"WN"`, `"AR1"`, `"AR(2)"`, `"ARMA(2,1)"` (METHODS §0.2).
+    pub fn name(&self) -> String {
+        match self {
+            ProcessKind::Ar(p) => format!("AR({p})"),
+            ProcessKind::Ma(q) => format!("MA({q})"),
+            ProcessKind::Arma(p, q) => format!("ARMA({p},{q})"),
+            other => other.base_name().to_string(),
+        }
+    }
+
+    /// The name without orders: `"AR"` for `AR(2)`, `"WN"` for `WN`.
+    pub fn base_name(&self) -> &'static str {
+        match self {
+            ProcessKind::Wn => "WN",
+            ProcessKind::Qn => "QN",
+            ProcessKind::Rw => "RW",
+            ProcessKind::Dr => "DR",
+            ProcessKind::Ar1 => "AR1",
+            ProcessKind::Gm => "GM",
+            ProcessKind::Ma1 => "MA1",
+            ProcessKind::Arma11 => "ARMA11",
+            ProcessKind::Ar(_) => "AR",
+            ProcessKind::Ma(_) => "MA",
+            ProcessKind::Arma(..) => "ARMA",
+        }
+    }
+
+    /// Parameter names in `theta` order (METHODS §0.2): WN `sigma2`; QN `q2`; RW `gamma2`;
+    /// DR `omega`; AR1 `phi, sigma2`; GM `beta, sigma2_gm`; MA1 `theta, sigma2`; ARMA11
+    /// `phi, theta, sigma2`; AR(p) `ar1..arp, sigma2`; MA(q) `ma1..maq, sigma2`; ARMA(p,q)
+    /// `ar1..arp, ma1..maq, sigma2`.
+    pub fn param_names(&self) -> Vec<String> {
+        let fixed: &[&str] = match self {
+            ProcessKind::Wn => &["sigma2"],
+            ProcessKind::Qn => &["q2"],
+            ProcessKind::Rw => &["gamma2"],
+            ProcessKind::Dr => &["omega"],
+            ProcessKind::Ar1 => &["phi", "sigma2"],
+            ProcessKind::Gm => &["beta", "sigma2_gm"],
+            ProcessKind::Ma1 => &["theta", "sigma2"],
+            ProcessKind::Arma11 => &["phi", "theta", "sigma2"],
+            ProcessKind::Ar(_) | ProcessKind::Ma(_) | ProcessKind::Arma(..) => &[],
+        };
+        if !fixed.is_empty() {
+            return fixed.iter().map(|s| s.to_string()).collect();
+        }
+        let (p, q) = self.orders();
+        (1..=p)
+            .map(|i| format!("ar{i}"))
+            .chain((1..=q).map(|i| format!("ma{i}")))
+            .chain(std::iter::once("sigma2".to_string()))
+            .collect()
+    }
+
+    /// Number of parameters, `param_names().len()`.
+    pub fn n_params(&self) -> usize {
+        match self {
+            ProcessKind::Wn | ProcessKind::Qn | ProcessKind::Rw | ProcessKind::Dr => 1,
+            ProcessKind::Ar1 | ProcessKind::Gm | ProcessKind::Ma1 => 2,
+            ProcessKind::Arma11 => 3,
+            ProcessKind::Ar(p) => p.saturating_add(1),
+            ProcessKind::Ma(q) => q.saturating_add(1),
+            ProcessKind::Arma(p, q) => p.saturating_add(*q).saturating_add(1),
+        }
+    }
+
+    /// The index of a parameter by name (ASCII case-insensitive), if the kind has it.
+    pub fn param_index(&self, name: &str) -> Option<usize> {
+        self.param_names()
+            .iter()
+            .position(|n| n.eq_ignore_ascii_case(name))
+    }
+
+    /// The basic domain of parameter `index` (see [`ParamDomain`]); `None` past the end.
+    pub fn param_domain(&self, index: usize) -> Option<ParamDomain> {
+        let n = self.n_params();
+        if index >= n {
+            return None;
+        }
+        if index == n - 1 {
+            // the last parameter is a variance for every kind but DR
+            return Some(match self {
+                ProcessKind::Dr => ParamDomain::Finite,
+                _ => ParamDomain::Variance,
+            });
+        }
+        Some(match self {
+            ProcessKind::Gm => ParamDomain::Rate,
+            ProcessKind::Ar1 | ProcessKind::Ma1 | ProcessKind::Arma11 => ParamDomain::UnitInterval,
+            _ => ParamDomain::Finite,
+        })
+    }
+
+    /// The AR and MA orders `(p, q)` of the ARMA-family kinds; `(0, 0)` for the others except
+    /// AR1 `(1, 0)`, MA1 `(0, 1)`, ARMA11 `(1, 1)`.
+    pub fn orders(&self) -> (usize, usize) {
+        match self {
+            ProcessKind::Ar1 => (1, 0),
+            ProcessKind::Ma1 => (0, 1),
+            ProcessKind::Arma11 => (1, 1),
+            ProcessKind::Ar(p) => (*p, 0),
+            ProcessKind::Ma(q) => (0, *q),
+            ProcessKind::Arma(p, q) => (*p, *q),
+            _ => (0, 0),
+        }
+    }
+
+    /// Whether the kind may repeat in a model (`k*GM()`, `k*AR1()`; METHODS §0.2).
+    pub fn may_repeat(&self) -> bool {
+        matches!(self, ProcessKind::Gm | ProcessKind::Ar1)
+    }
+
+    /// Whether the kind belongs to the ARMA family (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)), of
+    /// which a model holds at most one term.
+    pub fn is_arma_family(&self) -> bool {
+        matches!(
+            self,
+            ProcessKind::Ma1
+                | ProcessKind::Arma11
+                | ProcessKind::Ar(_)
+                | ProcessKind::Ma(_)
+                | ProcessKind::Arma(..)
+        )
+    }
+
+    /// Checks the orders of `AR(p)`, `MA(q)`, `ARMA(p,q)` (1..=[`MAX_ORDER`], `p + q >= 1`).
+    ///
+    /// # Errors
+    /// [`ModelError::BadOrder`].
+    pub fn check_orders(&self) -> Result<(), ModelError> {
+        let bad = |order: usize, expected: &'static str| {
+            Err(ModelError::BadOrder {
+                kind: *self,
+                order,
+                expected,
+            })
+        };
+        match *self {
+            ProcessKind::Ar(p) | ProcessKind::Ma(p) if p == 0 || p > MAX_ORDER => {
+                bad(p, "an order from 1 to 100")
+            }
+            ProcessKind::Arma(p, _) if p > MAX_ORDER => bad(p, "orders from 0 to 100"),
+            ProcessKind::Arma(_, q) if q > MAX_ORDER => bad(q, "orders from 0 to 100"),
+            ProcessKind::Arma(0, 0) => bad(0, "p + q >= 1 (ARMA(0,0) is white noise: use WN)"),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl fmt::Display for ProcessKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+/// One term of a model: a process kind and its (optional) parameter values (METHODS §0.2–§0.3).
+///
+/// `values` has one entry per parameter of `kind`, in [`ProcessKind::param_names`] order; `None`
+/// means "not given" (the estimator chooses the starting value). The fields are public for
+/// reading and pattern matching; a component built by hand is checked when it enters a
+/// [`Model`] (or by [`Component::new`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Component {
+    /// The process.
+    pub kind: ProcessKind,
+    /// One optional value per parameter, `values.len() == kind.n_params()`.
+    pub values: Vec<Option<f64>>,
+}
+
+impl Component {
+    /// A component in guess mode: no value given (METHODS §0.3).
+    ///
+    /// The kind's orders are not checked here (see [`ProcessKind::check_orders`]); a bad order
+    /// is reported when the component enters a [`Model`].
+    pub fn guess(kind: ProcessKind) -> Component {
+        let n = kind.n_params().min(2 * MAX_ORDER + 1);
+        Component {
+            kind,
+            values: vec![None; n],
+        }
+    }
+
+    /// A validated component with the given optional values.
+    ///
+    /// # Errors
+    /// [`ModelError::BadOrder`], [`ModelError::WrongLength`] or [`ModelError::BadParameter`]
+    /// (with `component` 0).
+    pub fn new(kind: ProcessKind, values: Vec<Option<f64>>) -> Result<Component, ModelError> {
+        let c = Component { kind, values };
+        c.check(0)?;
+        Ok(c)
+    }
+
+    /// Sets the parameter called `name` (ASCII case-insensitive, METHODS §0.2 names) to `value`,
+    /// e.g. `ar1().with("phi", 0.9)?`.
+    ///
+    /// # Errors
+    /// [`ModelError::UnknownParameter`] (with the valid names) or [`ModelError::BadParameter`]
+    /// when `value` is outside the parameter's [`ParamDomain`].
+    pub fn with(mut self, name: &str, value: f64) -> Result<Component, ModelError> {
+        let index = self
+            .kind
+            .param_index(name)
+            .ok_or_else(|| ModelError::UnknownParameter {
+                kind: self.kind,
+                name: name.to_string(),
+                valid: self.kind.param_names(),
+            })?;
+        check_value(0, self.kind, index, value)?;
+        if let Some(slot) = self.values.get_mut(index) {
+            *slot = Some(value);
+        }
+        Ok(self)
+    }
+
+    /// Whether no value is given (guess mode, METHODS §0.3).
+    pub fn is_guess(&self) -> bool {
+        self.values.iter().all(Option::is_none)
+    }
+
+    /// Whether every value is given.
+    pub fn is_fully_specified(&self) -> bool {
+        self.values.iter().all(Option::is_some)
+    }
+
+    /// Checks orders, length and values; `component` is the index reported in errors.
+    fn check(&self, component: usize) -> Result<(), ModelError> {
+        self.kind.check_orders()?;
+        if self.values.len() != self.kind.n_params() {
+            return Err(ModelError::WrongLength {
+                component,
+                kind: self.kind,
+                expected: self.kind.n_params(),
+                found: self.values.len(),
+            });
+        }
+        for (index, v) in self.values.iter().enumerate() {
+            if let Some(v) = *v {
+                check_value(component, self.kind, index, v)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks one value against its [`ParamDomain`].
+fn check_value(
+    component: usize,
+    kind: ProcessKind,
+    index: usize,
+    value: f64,
+) -> Result<(), ModelError> {
+    let domain = kind.param_domain(index).unwrap_or(ParamDomain::Finite);
+    if domain.contains(value) {
+        Ok(())
+    } else {
+        Err(ModelError::BadParameter {
+            component,
+            kind,
+            name: kind.param_names().get(index).cloned().unwrap_or_default(),
+            value,
+            expected: domain.expected(),
+        })
+    }
+}
+
+impl fmt::Display for Component {
+    /// Canonical text: `WN()`, `AR(2)`, `AR1(phi=0.9, sigma2=0.1)`, `ARMA(2,1)(ar1=0.5)`; only
+    /// the given values are written, by name, in the shortest text that parses back to the same
+    /// bits ([`format_value`]).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let has_orders = matches!(
+            self.kind,
+            ProcessKind::Ar(_) | ProcessKind::Ma(_) | ProcessKind::Arma(..)
+        );
+        f.write_str(&self.kind.name())?;
+        if has_orders && self.is_guess() {
+            return Ok(());
+        }
+        f.write_str("(")?;
+        let names = self.kind.param_names();
+        let mut first = true;
+        for (name, v) in names.iter().zip(&self.values) {
+            if let Some(v) = v {
+                if !first {
+                    f.write_str(", ")?;
+                }
+                first = false;
+                write!(f, "{name}={}", format_value(*v))?;
+            }
+        }
+        f.write_str(")")
+    }
+}
+
+/// The canonical text of a parameter value: Rust's shortest round-tripping `{}` for ordinary
+/// magnitudes, `{:e}` (also shortest round-tripping) for `0 < |v| < 1e-4` and `|v| >= 1e6`.
+///
+/// `format_value(v).parse::<f64>()` returns exactly `v` (same bits, including `-0`).
+///
+/// ```
+/// use gmwm::model::format_value;
+/// assert_eq!(format_value(0.1), "0.1");
+/// assert_eq!(format_value(7.08e-9), "7.08e-9");
+/// assert_eq!(format_value(2.5e6), "2.5e6");
+/// ```
+pub fn format_value(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && (!(1e-4..1e6).contains(&a)) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// A model-rule violation (METHODS §0.2) or an invalid component.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// A model needs at least one component.
+    #[error("a model needs at least one component, e.g. WN() or 3*GM()+WN()")]
+    Empty,
+    /// WN, QN, RW or DR (or an ARMA kind) appears more than once.
+    #[error(
+        "{kind} appears {count} times but may appear at most once; only GM and AR1 may repeat \
+         (METHODS §0.2)"
+    )]
+    Repeated {
+        /// The repeated kind.
+        kind: ProcessKind,
+        /// How many times it appears.
+        count: usize,
+    },
+    /// GM and AR1 in the same model.
+    #[error(
+        "GM and AR1 may not be mixed in one model (found {gm} GM and {ar1} AR1); use one of \
+         them (METHODS §0.2)"
+    )]
+    GmAr1Mixed {
+        /// Number of GM components.
+        gm: usize,
+        /// Number of AR1 components.
+        ar1: usize,
+    },
+    /// Two ARMA-family terms (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)).
+    #[error(
+        "at most one ARMA-family term (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)) per model, found \
+         {first} and {second}; a sum of ARMAs is one ARMA of higher order"
+    )]
+    ArmaFamily {
+        /// The first ARMA-family term.
+        first: ProcessKind,
+        /// The second one.
+        second: ProcessKind,
+    },
+    /// An order of AR(p), MA(q) or ARMA(p,q) out of range.
+    #[error("{kind}: order {order} is invalid: expected {expected}")]
+    BadOrder {
+        /// The kind with the bad order.
+        kind: ProcessKind,
+        /// The offending order.
+        order: usize,
+        /// What would be valid.
+        expected: &'static str,
+    },
+    /// A multiplier `k` in `k * gm()` outside 1..=[`MAX_MULTIPLIER`].
+    #[error("multiplier {k} is invalid: expected an integer from 1 to 100")]
+    BadMultiplier {
+        /// The multiplier given.
+        k: usize,
+    },
+    /// A parameter value outside its basic domain ([`ParamDomain`]).
+    #[error(
+        "component {component} (0-based) {kind}: {name} = {value} is invalid: expected {expected}"
+    )]
+    BadParameter {
+        /// 0-based component index in the model (0 for a standalone component).
+        component: usize,
+        /// Its kind.
+        kind: ProcessKind,
+        /// The parameter name (METHODS §0.2).
+        name: String,
+        /// The value given.
+        value: f64,
+        /// What would be valid.
+        expected: &'static str,
+    },
+    /// A parameter name the kind does not have.
+    #[error("{kind} has no parameter {name:?}; its parameters are {}", .valid.join(", "))]
+    UnknownParameter {
+        /// The kind.
+        kind: ProcessKind,
+        /// The name given.
+        name: String,
+        /// The kind's parameter names.
+        valid: Vec<String>,
+    },
+    /// A component whose `values` length differs from its kind's parameter count.
+    #[error(
+        "component {component} (0-based) {kind} has {found} values; {kind} has {expected} \
+         parameters"
+    )]
+    WrongLength {
+        /// 0-based component index.
+        component: usize,
+        /// Its kind.
+        kind: ProcessKind,
+        /// `kind.n_params()`.
+        expected: usize,
+        /// `values.len()`.
+        found: usize,
+    },
+    /// A parameter vector whose length differs from the model's parameter count.
+    #[error("theta has {found} values; the model has {expected} parameters")]
+    ThetaLength {
+        /// `Model::n_params()`.
+        expected: usize,
+        /// Length given.
+        found: usize,
+    },
+}
+
+/// A validated latent error model: an ordered, non-empty sum of components obeying the rules of
+/// METHODS §0.2 (see the [module docs](self)).
+///
+/// Its `Display` is the canonical text, which [`Model::parse`] reads back to an equal model
+/// (bitwise-equal values); serde (de)serialises a model as that string.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    components: Vec<Component>,
+}
+
+/// Checks every component and the model rules; on failure also returns the index of the
+/// component the error points at (for the parser's column).
+pub(crate) fn validate(components: &[Component]) -> Result<(), (usize, ModelError)> {
+    if components.is_empty() {
+        return Err((0, ModelError::Empty));
+    }
+    for (i, c) in components.iter().enumerate() {
+        c.check(i).map_err(|e| (i, e))?;
+    }
+    // WN, QN, RW, DR at most once: report at the second occurrence.
+    for kind in [
+        ProcessKind::Wn,
+        ProcessKind::Qn,
+        ProcessKind::Rw,
+        ProcessKind::Dr,
+    ] {
+        let at: Vec<usize> = (0..components.len())
+            .filter(|&i| components[i].kind == kind)
+            .collect();
+        if at.len() > 1 {
+            return Err((
+                at[1],
+                ModelError::Repeated {
+                    kind,
+                    count: at.len(),
+                },
+            ));
+        }
+    }
+    let gm = components
+        .iter()
+        .filter(|c| c.kind == ProcessKind::Gm)
+        .count();
+    let ar1 = components
+        .iter()
+        .filter(|c| c.kind == ProcessKind::Ar1)
+        .count();
+    if gm > 0 && ar1 > 0 {
+        // point at the first component of whichever kind came second
+        let first_rep = components
+            .iter()
+            .find(|c| c.kind.may_repeat())
+            .map(|c| c.kind);
+        let at = components
+            .iter()
+            .position(|c| c.kind.may_repeat() && Some(c.kind) != first_rep)
+            .unwrap_or(0);
+        return Err((at, ModelError::GmAr1Mixed { gm, ar1 }));
+    }
+    let arma: Vec<usize> = (0..components.len())
+        .filter(|&i| components[i].kind.is_arma_family())
+        .collect();
+    if arma.len() > 1 {
+        let (first, second) = (components[arma[0]].kind, components[arma[1]].kind);
+        let err = if first == second {
+            ModelError::Repeated {
+                kind: first,
+                count: arma
+                    .iter()
+                    .filter(|&&i| components[i].kind == first)
+                    .count(),
+            }
+        } else {
+            ModelError::ArmaFamily { first, second }
+        };
+        return Err((arma[1], err));
+    }
+    Ok(())
+}
+
+impl Model {
+    /// A model from its components, in order, validated against the rules of METHODS §0.2
+    /// (module docs).
+    ///
+    /// # Errors
+    /// [`ModelError::Empty`], [`ModelError::Repeated`], [`ModelError::GmAr1Mixed`],
+    /// [`ModelError::ArmaFamily`], [`ModelError::BadOrder`], [`ModelError::WrongLength`] or
+    /// [`ModelError::BadParameter`].
+    pub fn new(components: Vec<Component>) -> Result<Model, ModelError> {
+        validate(&components).map_err(|(_, e)| e)?;
+        Ok(Model { components })
+    }
+
+    /// Parses the text language of the R package, e.g. `"3*GM()+WN()+QN()+RW()"` or
+    /// `"AR1(phi=0.9, sigma2=0.1)+WN()"`; grammar in [`parse`](mod@parse).
+    ///
+    /// # Errors
+    /// [`ModelParseError`] with the byte offset and column of the offending character; a
+    /// model-rule violation is [`ParseErrorKind::Rule`] pointing at the offending term.
+    pub fn parse(text: &str) -> Result<Model, ModelParseError> {
+        parse::parse_model(text)
+    }
+
+    /// The components in model order.
+    pub fn components(&self) -> &[Component] {
+        &self.components
+    }
+
+    /// Number of components (a `k*GM()` term counts k times).
+    pub fn n_components(&self) -> usize {
+        self.components.len()
+    }
+
+    /// Number of parameters, the length of `theta` (METHODS §0.2).
+    pub fn n_params(&self) -> usize {
+        self.components.iter().map(|c| c.kind.n_params()).sum()
+    }
+
+    /// `(component index, parameter name)` for each entry of `theta`, in order (METHODS §0.2).
+    pub fn param_names(&self) -> Vec<(usize, String)> {
+        self.components
+            .iter()
+            .enumerate()
+            .flat_map(|(i, c)| c.kind.param_names().into_iter().map(move |n| (i, n)))
+            .collect()
+    }
+
+    /// Whether no value is given anywhere: the estimator computes all starting values
+    /// (METHODS §0.3).
+    pub fn is_guess_mode(&self) -> bool {
+        self.components.iter().all(Component::is_guess)
+    }
+
+    /// Whether every value is given.
+    pub fn is_fully_specified(&self) -> bool {
+        self.components.iter().all(Component::is_fully_specified)
+    }
+
+    /// The flattened `theta` in model order, `None` where no value is given.
+    pub fn values(&self) -> Vec<Option<f64>> {
+        self.components
+            .iter()
+            .flat_map(|c| c.values.iter().copied())
+            .collect()
+    }
+
+    /// The same structure with every value set from `theta` (model order, METHODS §0.2).
+    ///
+    /// # Errors
+    /// [`ModelError::ThetaLength`] or [`ModelError::BadParameter`].
+    pub fn with_values(&self, theta: &[f64]) -> Result<Model, ModelError> {
+        if theta.len() != self.n_params() {
+            return Err(ModelError::ThetaLength {
+                expected: self.n_params(),
+                found: theta.len(),
+            });
+        }
+        let mut rest = theta;
+        let mut components = Vec::with_capacity(self.components.len());
+        for (i, c) in self.components.iter().enumerate() {
+            let (mine, tail) = rest.split_at(c.kind.n_params());
+            rest = tail;
+            for (index, &v) in mine.iter().enumerate() {
+                check_value(i, c.kind, index, v)?;
+            }
+            components.push(Component {
+                kind: c.kind,
+                values: mine.iter().map(|&v| Some(v)).collect(),
+            });
+        }
+        Ok(Model { components })
+    }
+
+    /// The same structure in guess mode (every value `None`).
+    pub fn without_values(&self) -> Model {
+        Model {
+            components: self
+                .components
+                .iter()
+                .map(|c| Component::guess(c.kind))
+                .collect(),
+        }
+    }
+
+    /// How many components have exactly this kind (`AR(2)` and `AR(3)` differ).
+    pub fn count(&self, kind: ProcessKind) -> usize {
+        self.components.iter().filter(|c| c.kind == kind).count()
+    }
+
+    /// Whether the model has a GM component (GM parametrisation, METHODS §4.3).
+    pub fn uses_gm(&self) -> bool {
+        self.count(ProcessKind::Gm) > 0
+    }
+
+    /// Whether the model has an AR1 component.
+    pub fn uses_ar1(&self) -> bool {
+        self.count(ProcessKind::Ar1) > 0
+    }
+
+    /// The kinds in model order.
+    pub fn kinds(&self) -> Vec<ProcessKind> {
+        self.components.iter().map(|c| c.kind).collect()
+    }
+}
+
+impl fmt::Display for Model {
+    /// Canonical text: components joined by `+`; consecutive identical value-less GM/AR1
+    /// components collapse to `k*GM()`; values by name ([`Component`]'s `Display`).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut i = 0;
+        let mut first = true;
+        while i < self.components.len() {
+            let c = &self.components[i];
+            let mut run = 1;
+            if c.kind.may_repeat() && c.is_guess() {
+                while self.components.get(i + run) == Some(c) {
+                    run += 1;
+                }
+            }
+            if !first {
+                f.write_str("+")?;
+            }
+            first = false;
+            if run > 1 {
+                write!(f, "{run}*")?;
+            }
+            write!(f, "{c}")?;
+            i += run;
+        }
+        Ok(())
+    }
+}
+
+impl std::str::FromStr for Model {
+    type Err = ModelParseError;
+
+    fn from_str(s: &str) -> Result<Model, ModelParseError> {
+        Model::parse(s)
+    }
+}
+
+impl TryFrom<Vec<Component>> for Model {
+    type Error = ModelError;
+
+    fn try_from(components: Vec<Component>) -> Result<Model, ModelError> {
+        Model::new(components)
+    }
+}
+
+impl serde::Serialize for Model {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Model {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Model, D::Error> {
+        let text = String::deserialize(d)?;
+        Model::parse(&text).map_err(serde::de::Error::custom)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn param_names_follow_methods_0_2() {
+        assert_eq!(ProcessKind::Gm.param_names(), ["beta", "sigma2_gm"]);
+        assert_eq!(
+            ProcessKind::Arma(2, 1).param_names(),
+            ["ar1", "ar2", "ma1", "sigma2"]
+        );
+        assert_eq!(ProcessKind::Ma(3).n_params(), 4);
+        assert_eq!(ProcessKind::Arma(2, 1).name(), "ARMA(2,1)");
+    }
+
+    #[test]
+    fn component_new_accepts_and_rejects() {
+        assert!(Component::new(ProcessKind::Wn, vec![Some(1.0)]).is_ok());
+        assert!(Component::new(ProcessKind::Wn, vec![Some(-1.0)]).is_err());
+        assert!(Component::new(ProcessKind::Wn, vec![]).is_err());
+        assert!(Component::new(ProcessKind::Ar(0), vec![None]).is_err());
+        assert!(Component::new(ProcessKind::Dr, vec![Some(-3.0)]).is_ok());
+        assert!(Component::new(ProcessKind::Ar1, vec![Some(1.0), None]).is_err());
+    }
+
+    #[test]
+    fn format_value_round_trips() {
+        for v in [
+            0.1, -0.0, 7.08e-9, 1e300, 5e-324, 123456.789, 1e6, 9.99e-5, 1e-4,
+        ] {
+            assert_eq!(
+                format_value(v).parse::<f64>().unwrap().to_bits(),
+                v.to_bits()
+            );
+        }
+    }
+}
