@@ -1,4 +1,4 @@
-//! Error types of the engine. Every fallible public function returns [`Error`] or one of the
+//! Error types of the engine. Every fallible public function returns [`enum@Error`] or one of the
 //! module errors that convert into it.
 
 use thiserror::Error;
@@ -16,6 +16,12 @@ pub enum Error {
     /// A parameter or option has an impossible value.
     #[error(transparent)]
     Param(#[from] ParamError),
+    /// A model text could not be parsed or breaks a model rule (METHODS §0.2).
+    #[error(transparent)]
+    ModelParse(#[from] crate::model::ModelParseError),
+    /// A model breaks a rule of METHODS §0.2 or has an invalid value.
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
 }
 
 /// A series that cannot be analysed.
