@@ -7,5 +7,6 @@ mod allan;
 mod common;
 mod read;
 mod robust;
+mod sim;
 mod wavelet;
 mod wv;
