@@ -40,41 +40,46 @@ const MAX_BURN_IN: usize = 100_000_000;
 /// `>= 0`, stationary AR parts).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Generator {
-    /// White noise: `x_t ~ N(0, sigma2)` i.i.d.
+    /// METHODS §10.1 white noise: `x_t ~ N(0, sigma2)` i.i.d.
     Wn {
         /// Variance.
         sigma2: f64,
     },
-    /// Quantisation noise: `x_t = sqrt(q2) (u_{t+1} - u_t)`, `u ~ sqrt(12) U(0, 1)`.
+    /// METHODS §10.1 quantisation noise: `x_t = sqrt(q2) (u_{t+1} - u_t)`,
+    /// `u ~ sqrt(12) U(0, 1)` (see [`quantisation_noise`]).
     Qn {
         /// Quantisation parameter `Q^2` (variance of `x_t` is `2 q2`).
         q2: f64,
     },
-    /// Random walk: `x_t = sum_{i=0}^{t} w_i`, `w ~ N(0, gamma2)`.
+    /// METHODS §10.1 random walk: `x_t = sum_{i=0}^{t} w_i`, `w ~ N(0, gamma2)` (the first
+    /// value is `w_0`, not 0).
     Rw {
         /// Increment variance.
         gamma2: f64,
     },
-    /// Deterministic drift: `x_t = omega (t + 1)`.
+    /// METHODS §10.1 deterministic drift: `x_t = omega (t + 1)`, t = 0, 1, ... across calls.
     Dr {
         /// Slope per sample.
         omega: f64,
     },
-    /// First-order autoregression: `x_t = phi x_{t-1} + w_t`, `w ~ N(0, sigma2)`.
+    /// METHODS §10.1 first-order autoregression: `x_t = phi x_{t-1} + w_t`,
+    /// `w ~ N(0, sigma2)`; start per [`StartMode`].
     Ar1 {
         /// Autoregressive coefficient, `|phi| < 1`.
         phi: f64,
         /// Innovation variance.
         sigma2: f64,
     },
-    /// First-order moving average: `x_t = w_t + theta w_{t-1}`.
+    /// METHODS §10.1 first-order moving average: `x_t = w_t + theta w_{t-1}`, stationary in
+    /// both start modes (one extra innovation).
     Ma1 {
         /// Moving-average coefficient.
         theta: f64,
         /// Innovation variance.
         sigma2: f64,
     },
-    /// ARMA(1, 1): `x_t = phi x_{t-1} + w_t + theta w_{t-1}`.
+    /// METHODS §10.1 ARMA(1, 1): `x_t = phi x_{t-1} + w_t + theta w_{t-1}`; start per
+    /// [`StartMode`].
     Arma11 {
         /// Autoregressive coefficient, `|phi| < 1`.
         phi: f64,
@@ -83,7 +88,7 @@ pub enum Generator {
         /// Innovation variance.
         sigma2: f64,
     },
-    /// ARMA(p, q) in R's sign convention (METHODS §0.2):
+    /// METHODS §10.1 ARMA(p, q) in R's sign convention (§0.2); start per [`StartMode`]:
     /// `x_t = sum_i ar_i x_{t-i} + w_t + sum_k ma_k w_{t-k}`.
     Arma {
         /// `ar_1..ar_p`; the AR polynomial `1 - sum ar_i B^i` must have all roots outside the
@@ -108,7 +113,8 @@ pub enum StartMode {
     /// The package (METHODS §10.1, §13.21): AR1 and ARMA11 start at `x = 0` (the first kept
     /// value is `w_1`, resp. `w_1 + theta w_0`); a generic ARMA follows R's `arima.sim`
     /// (first `q` MA outputs set to 0, AR recursion from zeros, burn-in
-    /// `p + q + ceil(6 / ln(min root modulus))`).
+    /// `p + q + ceil(6 / ln(min root modulus))`). The burn-in innovations come first in the
+    /// component's stream (R draws them after the kept ones); the law is the same.
     Zero,
 }
 
@@ -157,7 +163,7 @@ impl Simulator {
     }
 
     /// Chooses how AR parts start (METHODS §10.1, §13.21) and restarts the simulation from its
-    /// first sample (same seed).
+    /// first sample (same seed). Cost: the burn-ins of generic ARMA components again.
     pub fn with_start(mut self, mode: StartMode) -> Self {
         self.start = mode;
         // Validation and burn-in lengths do not depend on the mode beyond what `new` checked:
@@ -183,9 +189,13 @@ impl Simulator {
     ///
     /// Cost: O(len (1 + p + q)) per call, no allocation.
     pub fn fill(&mut self, out: &mut [f64]) {
-        out.fill(0.0);
-        for c in &mut self.components {
-            c.run(out, |o, v| *o += v);
+        // Blocks keep the running sum in cache while every component adds to it; the bits do
+        // not depend on the block size (each component's stream is its own).
+        for block in out.chunks_mut(FILL_BLOCK) {
+            block.fill(0.0);
+            for c in &mut self.components {
+                c.run(block, |o, v| *o += v);
+            }
         }
     }
 
@@ -456,6 +466,9 @@ fn arma_burn_in(ar: &[f64], q: usize, mode: StartMode) -> Result<usize, ParamErr
     }
     Ok(p + q + extra as usize)
 }
+
+/// Samples per cache block of [`Simulator::fill`] (32 KiB of `f64`, an L1 data cache).
+const FILL_BLOCK: usize = 4096;
 
 /// The running state of one component.
 #[derive(Debug, Clone)]
