@@ -383,9 +383,11 @@ fn validate(g: &Generator) -> Result<(), ParamError> {
     }
 }
 
-/// Largest modulus of the roots of `lambda^m - a_1 lambda^{m-1} - ... - a_m` (the inverse
-/// roots of the AR polynomial), by Durand–Kerner iteration; trailing zero coefficients (roots
-/// at 0) are dropped first. Used only to size burn-ins, so modest accuracy suffices.
+/// Largest modulus `rho` of the inverse roots of the AR polynomial `1 - sum ar_i B^i` (the
+/// roots of `lambda^p - ar_1 lambda^{p-1} - ... - ar_p`), by bisection on `r` with the
+/// Schur–Cohn test: the coefficients `ar_i / r^i` are stationary iff `r > rho`. Robust to
+/// repeated and complex roots; returns an upper bracket (a conservative burn-in), to about
+/// 1e-15 for simple roots and 1e-6 for a double root. Used only to size burn-ins.
 fn inverse_root_radius(ar: &[f64]) -> f64 {
     let m = ar.iter().rposition(|&a| a != 0.0).map_or(0, |i| i + 1);
     let a = &ar[..m];
@@ -394,50 +396,27 @@ fn inverse_root_radius(ar: &[f64]) -> f64 {
         1 => return a[0].abs(),
         _ => {}
     }
-    type C = (f64, f64);
-    let mul = |x: C, y: C| (x.0 * y.0 - x.1 * y.1, x.0 * y.1 + x.1 * y.0);
-    let sub = |x: C, y: C| (x.0 - y.0, x.1 - y.1);
-    let div = |x: C, y: C| {
-        let d = y.0 * y.0 + y.1 * y.1;
-        ((x.0 * y.0 + x.1 * y.1) / d, (x.1 * y.0 - x.0 * y.1) / d)
-    };
-    // Monic polynomial: coefficients of lambda^m, ..., lambda^0 are 1, -a_1, ..., -a_m.
-    let eval = |z: C| {
-        let mut acc: C = (1.0, 0.0);
-        for &ai in a {
-            acc = sub(mul(acc, z), (ai, 0.0));
-        }
-        acc
-    };
-    // Cauchy bound on the root moduli; start on a circle of that radius, off the real axis.
-    let bound = 1.0 + a.iter().fold(0.0f64, |b, x| b.max(x.abs()));
-    let mut z: Vec<C> = (0..m)
-        .map(|k| {
-            let t = 2.0 * std::f64::consts::PI * k as f64 / m as f64 + 0.4;
-            (bound * t.cos(), bound * t.sin())
-        })
-        .collect();
-    for _ in 0..2000 {
-        let mut change = 0.0f64;
-        for k in 0..m {
-            let mut den: C = (1.0, 0.0);
-            for j in 0..m {
-                if j != k {
-                    den = mul(den, sub(z[k], z[j]));
-                }
-            }
-            if den.0 == 0.0 && den.1 == 0.0 {
-                den = (f64::EPSILON, 0.0);
-            }
-            let step = div(eval(z[k]), den);
-            z[k] = sub(z[k], step);
-            change = change.max(step.0.hypot(step.1));
-        }
-        if change <= 1e-15 {
+    // Cauchy bound: every inverse root has modulus < 1 + max |ar_i|.
+    let mut hi = 1.0 + a.iter().fold(0.0f64, |b, x| b.max(x.abs()));
+    let mut lo = 0.0f64;
+    let mut scaled = vec![0.0; m];
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
             break;
         }
+        let mut rk = 1.0;
+        for (s, &ai) in scaled.iter_mut().zip(a) {
+            rk *= mid;
+            *s = ai / rk;
+        }
+        if ar_is_stationary(&scaled) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
     }
-    z.iter().fold(0.0f64, |r, c| r.max(c.0.hypot(c.1)))
+    hi
 }
 
 /// Burn-in length of a generic ARMA in each start mode (METHODS §10.1).
@@ -762,8 +741,10 @@ mod tests {
         // complex pair of modulus 0.9: lambda^2 - 2*0.9 cos(1) lambda + 0.81
         let c = 2.0 * 0.9 * 1f64.cos();
         assert!((inverse_root_radius(&[c, -0.81]) - 0.9).abs() < 1e-10);
-        // double root 0.9 (Durand–Kerner converges linearly there)
-        assert!((inverse_root_radius(&[1.8, -0.81]) - 0.9).abs() < 1e-6);
+        // double root 0.9: rounding in the Schur–Cohn step blurs the boundary to ~1e-6, on the
+        // conservative side (longer burn-in)
+        let r = inverse_root_radius(&[1.8, -0.81]);
+        assert!((0.9..0.9 + 1e-5).contains(&r), "{r}");
     }
 
     #[test]
