@@ -8,5 +8,6 @@ mod common;
 mod model;
 mod read;
 mod robust;
+mod sim;
 mod wavelet;
 mod wv;

@@ -1,0 +1,45 @@
+//! Criterion bench of the streaming simulator (STYLE §7, METHODS §10): 10^7 samples of the
+//! NavChip-like truth 3*AR1 + WN + QN + RW (per-sample parameters, METHODS §5.10), simulator
+//! built outside the timed loop, output buffer reused.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use gmwm::sim::{Generator, Simulator};
+
+fn navchip() -> Vec<Generator> {
+    vec![
+        Generator::Ar1 {
+            phi: 0.9990005,
+            sigma2: 1.414585e-11,
+        },
+        Generator::Ar1 {
+            phi: 0.9999749,
+            sigma2: 6.430559e-13,
+        },
+        Generator::Ar1 {
+            phi: 0.9666488,
+            sigma2: 4.250234e-10,
+        },
+        Generator::Wn { sigma2: 6.94e-7 },
+        Generator::Qn { q2: 2.29e-6 },
+        Generator::Rw { gamma2: 3.90e-14 },
+    ]
+}
+
+fn bench_simulate(c: &mut Criterion) {
+    let mut group = c.benchmark_group("simulate");
+    group.sample_size(10);
+    let n = 10_000_000usize;
+    let mut sim = Simulator::new(navchip(), 42).expect("valid parameters");
+    let mut out = vec![0.0; n];
+    group.throughput(Throughput::Elements(n as u64));
+    group.bench_function(BenchmarkId::new("3ar1-wn-qn-rw", n), |b| {
+        b.iter(|| {
+            sim.fill(&mut out);
+            out[n - 1]
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(simulate, bench_simulate);
+criterion_main!(simulate);

@@ -1,0 +1,659 @@
+//! Simulation (METHODS §10): hand values, determinism and chunking invariance, Monte Carlo
+//! moments and wavelet variances against closed forms (§4.2), and rejected parameters.
+
+use gmwm::sim::{quantisation_noise, replicate_seed, simulate, Generator, Simulator, StartMode};
+use gmwm::{wavelet_variance, WvOptions};
+
+/// Master seed of every Monte Carlo test here (replicates use `replicate_seed(SEED, r)`).
+const SEED: u64 = 42;
+
+/// Monte Carlo bound: a replicate mean must lie within this many standard errors (estimated
+/// from the replicates) of its truth. Two-sided normal tail 6e-5 per check, so a correct
+/// simulator fails a few dozen checks with probability well under 1%, while a wrong law (a
+/// bias of a few SE) is caught.
+const MC_SE: f64 = 4.0;
+
+/// Hand values of METHODS §10.3 are compared to the 8 digits they are quoted with.
+const HAND_TOL: f64 = 5e-8;
+
+/// Every kind of generator, with parameters far from degenerate.
+fn every_generator() -> Vec<Generator> {
+    vec![
+        Generator::Wn { sigma2: 2.0 },
+        Generator::Qn { q2: 0.5 },
+        Generator::Rw { gamma2: 0.1 },
+        Generator::Dr { omega: 0.01 },
+        Generator::Ar1 {
+            phi: 0.9,
+            sigma2: 1.0,
+        },
+        Generator::Ma1 {
+            theta: 0.5,
+            sigma2: 1.0,
+        },
+        Generator::Arma11 {
+            phi: 0.8,
+            theta: -0.3,
+            sigma2: 1.0,
+        },
+        arma21(),
+    ]
+}
+
+fn arma21() -> Generator {
+    Generator::Arma {
+        ar: vec![1.3, -0.4],
+        ma: vec![0.5],
+        sigma2: 1.0,
+    }
+}
+
+/// Mean and standard error of replicate values.
+fn mean_se(v: &[f64]) -> (f64, f64) {
+    let r = v.len() as f64;
+    let m = v.iter().sum::<f64>() / r;
+    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (r - 1.0);
+    (m, (var / r).sqrt())
+}
+
+fn assert_mc(values: &[f64], truth: f64, what: &str) {
+    let (m, se) = mean_se(values);
+    assert!(se > 0.0, "{what}: zero spread over replicates");
+    assert!(
+        (m - truth).abs() <= MC_SE * se,
+        "{what}: Monte Carlo mean {m:e} vs truth {truth:e} ({:.2} SE, SE {se:e})",
+        (m - truth) / se
+    );
+}
+
+/// Exact autocovariances `gamma_0..gamma_h_max` of an ARMA(p, q) from its MA(inf) weights
+/// `psi_i = ma_i + sum_l ar_l psi_{i-l}` (METHODS §4.4), `gamma_h = sigma2 sum_k psi_k
+/// psi_{k+h}`, truncated where the weights are below 1e-300 relative.
+fn arma_autocov(ar: &[f64], ma: &[f64], sigma2: f64, h_max: usize) -> Vec<f64> {
+    let k_max = 20_000;
+    let mut psi = vec![0.0; k_max + h_max + 1];
+    psi[0] = 1.0;
+    for i in 1..psi.len() {
+        let mut v = if i <= ma.len() { ma[i - 1] } else { 0.0 };
+        for l in 1..=ar.len().min(i) {
+            v += ar[l - 1] * psi[i - l];
+        }
+        psi[i] = v;
+    }
+    (0..=h_max)
+        .map(|h| sigma2 * (0..=k_max).map(|k| psi[k] * psi[k + h]).sum::<f64>())
+        .collect()
+}
+
+fn bits(x: &[f64]) -> Vec<u64> {
+    x.iter().map(|v| v.to_bits()).collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hand values (METHODS §10.3)
+
+#[test]
+fn simulate_drift_matches_hand_values() {
+    let x = simulate(&[Generator::Dr { omega: 2.0 }], 4, 1).unwrap();
+    assert_eq!(x, vec![2.0, 4.0, 6.0, 8.0]);
+    // The ramp continues across fill calls.
+    let mut sim = Simulator::new(vec![Generator::Dr { omega: 2.0 }], 1).unwrap();
+    let (mut a, mut b) = ([0.0; 3], [0.0; 2]);
+    sim.fill(&mut a);
+    sim.fill(&mut b);
+    assert_eq!((a, b), ([2.0, 4.0, 6.0], [8.0, 10.0]));
+}
+
+#[test]
+fn quantisation_noise_matches_hand_values() {
+    let s12 = 12f64.sqrt();
+    let x = quantisation_noise(1.0, &[0.0, s12, 0.0]);
+    assert_eq!(x.len(), 2);
+    assert!((x[0] - 3.4641016).abs() < HAND_TOL, "{}", x[0]);
+    assert!((x[1] + 3.4641016).abs() < HAND_TOL, "{}", x[1]);
+    assert_eq!(quantisation_noise(4.0, &[1.0, 2.0]), vec![2.0]);
+    assert!(quantisation_noise(1.0, &[0.5]).is_empty());
+}
+
+#[test]
+fn quantisation_noise_stream_telescopes() {
+    // x_t = sqrt(q2)(u_{t+1} - u_t) with u in [0, sqrt 12): every partial sum equals
+    // sqrt(q2)(u_{t+1} - u_0), so it stays inside (-sqrt(12 q2), sqrt(12 q2)); independent
+    // draws of the same variance would wander like a random walk far beyond it.
+    let q2 = 2.0;
+    let x = simulate(&[Generator::Qn { q2 }], 100_000, SEED).unwrap();
+    // The range of the partial sums is sqrt(q2)(max u - min u), which nears sqrt(12 q2).
+    let bound = (12.0 * q2).sqrt();
+    let (mut s, mut lo, mut hi) = (0.0, 0.0f64, 0.0f64);
+    for v in &x {
+        s += v;
+        lo = lo.min(s);
+        hi = hi.max(s);
+    }
+    let range = hi - lo;
+    assert!(range < bound * (1.0 + 1e-9), "{range} vs {bound}");
+    assert!(
+        range > 0.999 * bound,
+        "{range}: the uniforms never neared their range"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Determinism
+
+#[test]
+fn simulator_fill_is_chunking_invariant() {
+    let n = 10_000;
+    let mut gens = every_generator();
+    gens.push(Generator::Arma {
+        ar: vec![0.5, -0.2, 0.1],
+        ma: vec![0.3, 0.2],
+        sigma2: 0.5,
+    });
+    for mode in [StartMode::Stationary, StartMode::Zero] {
+        // One component at a time, then the whole sum.
+        let mut cases: Vec<Vec<Generator>> = gens.iter().map(|g| vec![g.clone()]).collect();
+        cases.push(gens.clone());
+        for case in cases {
+            let mut whole = vec![0.0; n];
+            Simulator::new(case.clone(), SEED)
+                .unwrap()
+                .with_start(mode)
+                .fill(&mut whole);
+            for chunk in [1usize, 7, 4096, n] {
+                let mut sim = Simulator::new(case.clone(), SEED).unwrap().with_start(mode);
+                let mut x = vec![0.0; n];
+                for c in x.chunks_mut(chunk) {
+                    sim.fill(c);
+                }
+                assert_eq!(bits(&x), bits(&whole), "{case:?} {mode:?} chunk {chunk}");
+            }
+        }
+    }
+}
+
+#[test]
+fn simulator_same_seed_same_bits_other_seed_differs() {
+    let gens = every_generator();
+    let a = simulate(&gens, 1000, 5).unwrap();
+    assert_eq!(bits(&a), bits(&simulate(&gens, 1000, 5).unwrap()));
+    let b = simulate(&gens, 1000, 6).unwrap();
+    assert!(a.iter().zip(&b).all(|(x, y)| x != y));
+    // A prefix of a longer run is the shorter run.
+    assert_eq!(bits(&simulate(&gens, 1500, 5).unwrap()[..1000]), bits(&a));
+    // Every stochastic generator depends on the seed.
+    for g in gens.iter().filter(|g| !matches!(g, Generator::Dr { .. })) {
+        let a = simulate(std::slice::from_ref(g), 10, 5).unwrap();
+        let b = simulate(std::slice::from_ref(g), 10, 6).unwrap();
+        assert_ne!(a, b, "{g:?}");
+    }
+}
+
+#[test]
+fn replicate_seed_gives_distinct_streams() {
+    let seeds: Vec<u64> = (0..1000).map(|r| replicate_seed(SEED, r)).collect();
+    let set: std::collections::HashSet<u64> = seeds.iter().copied().collect();
+    assert_eq!(set.len(), seeds.len());
+    assert_eq!(replicate_seed(SEED, 3), replicate_seed(SEED, 3));
+    assert_ne!(replicate_seed(SEED, 0), SEED);
+    let g = [Generator::Wn { sigma2: 1.0 }];
+    assert_ne!(
+        simulate(&g, 10, seeds[0]).unwrap(),
+        simulate(&g, 10, seeds[1]).unwrap()
+    );
+}
+
+#[test]
+fn simulator_components_add_up_to_the_sum() {
+    let gens = every_generator();
+    let n = 3000;
+    for mode in [StartMode::Stationary, StartMode::Zero] {
+        let mut sum = vec![0.0; n];
+        Simulator::new(gens.clone(), SEED)
+            .unwrap()
+            .with_start(mode)
+            .fill(&mut sum);
+        let mut sim = Simulator::new(gens.clone(), SEED).unwrap().with_start(mode);
+        let mut cols = vec![vec![0.0; 1000]; gens.len()];
+        let mut added = Vec::with_capacity(n);
+        for _ in 0..3 {
+            sim.fill_components(&mut cols).unwrap();
+            for t in 0..1000 {
+                let mut s = 0.0;
+                for col in &cols {
+                    s += col[t];
+                }
+                added.push(s);
+            }
+        }
+        assert_eq!(bits(&added), bits(&sum), "{mode:?}");
+        // Each column is that component simulated alone (its own stream = its index).
+        let alone = Simulator::new(gens.clone(), SEED).unwrap().with_start(mode);
+        let mut cols = vec![vec![0.0; 50]; gens.len()];
+        alone.clone().fill_components(&mut cols).unwrap();
+        let mut again = vec![vec![0.0; 50]; gens.len()];
+        alone.clone().fill_components(&mut again).unwrap();
+        assert_eq!(cols, again);
+    }
+    let mut sim = Simulator::new(gens.clone(), SEED).unwrap();
+    assert!(sim.fill_components(&mut vec![vec![0.0; 4]; 2]).is_err());
+    let mut ragged = vec![vec![0.0; 4]; gens.len()];
+    ragged[3].push(0.0);
+    assert!(sim.fill_components(&mut ragged).is_err());
+}
+
+#[test]
+fn simulator_clone_continues_the_same_streams() {
+    let mut a = Simulator::new(every_generator(), SEED).unwrap();
+    let mut x = vec![0.0; 100];
+    a.fill(&mut x);
+    let mut b = a.clone();
+    let (mut ya, mut yb) = (vec![0.0; 100], vec![0.0; 100]);
+    a.fill(&mut ya);
+    b.fill(&mut yb);
+    assert_eq!(bits(&ya), bits(&yb));
+    fn contract<T: Send + Sync + Clone>() {}
+    contract::<Simulator>();
+    contract::<Generator>();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Monte Carlo moments (METHODS §10.1)
+
+/// Replicates of length `n`: per replicate the known-mean (zero) estimators mean x_t^2 and
+/// mean x_t x_{t+1}, unbiased for gamma_0 and gamma_1 of a stationary zero-mean series.
+fn check_moments(g: &Generator, mode: StartMode, gamma0: f64, gamma1: f64) {
+    let (reps, n) = (400u64, 2000usize);
+    let mut m0 = Vec::new();
+    let mut m1 = Vec::new();
+    let mut x = vec![0.0; n];
+    for r in 0..reps {
+        Simulator::new(vec![g.clone()], replicate_seed(SEED, r))
+            .unwrap()
+            .with_start(mode)
+            .fill(&mut x);
+        m0.push(x.iter().map(|v| v * v).sum::<f64>() / n as f64);
+        m1.push(x.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (n - 1) as f64);
+    }
+    assert_mc(&m0, gamma0, &format!("{g:?} {mode:?} gamma_0"));
+    assert_mc(&m1, gamma1, &format!("{g:?} {mode:?} gamma_1"));
+}
+
+#[test]
+fn simulate_moments_match_autocovariances() {
+    let st = StartMode::Stationary;
+    check_moments(&Generator::Wn { sigma2: 2.0 }, st, 2.0, 0.0);
+    // QN: Var = 2 q2, lag-1 covariance -q2 (METHODS §10.1).
+    check_moments(&Generator::Qn { q2: 0.5 }, st, 1.0, -0.5);
+    let (phi, s2) = (0.95, 0.3);
+    let g0 = s2 / (1.0 - phi * phi);
+    check_moments(&Generator::Ar1 { phi, sigma2: s2 }, st, g0, phi * g0);
+    let (theta, s2) = (-0.6, 1.5);
+    check_moments(
+        &Generator::Ma1 { theta, sigma2: s2 },
+        st,
+        s2 * (1.0 + theta * theta),
+        s2 * theta,
+    );
+    for mode in [StartMode::Stationary, StartMode::Zero] {
+        // MA1 is stationary in both modes (one extra innovation, METHODS §10.1).
+        check_moments(
+            &Generator::Ma1 { theta, sigma2: s2 },
+            mode,
+            s2 * (1.0 + theta * theta),
+            s2 * theta,
+        );
+    }
+    let (phi, theta, s2) = (0.9, 0.4, 0.7);
+    let g = arma_autocov(&[phi], &[theta], s2, 1);
+    check_moments(
+        &Generator::Arma11 {
+            phi,
+            theta,
+            sigma2: s2,
+        },
+        st,
+        g[0],
+        g[1],
+    );
+    let g = arma_autocov(&[1.3, -0.4], &[0.5], 1.0, 1);
+    check_moments(&arma21(), st, g[0], g[1]);
+    // A generic ARMA(1, 0) must agree with AR1.
+    let g0 = 0.3 / (1.0 - 0.95 * 0.95);
+    check_moments(
+        &Generator::Arma {
+            ar: vec![0.95],
+            ma: vec![],
+            sigma2: 0.3,
+        },
+        st,
+        g0,
+        0.95 * g0,
+    );
+}
+
+#[test]
+fn arma_autocov_oracle_matches_closed_forms() {
+    // The test's own oracle, pinned: AR1 and MA1 autocovariances.
+    let g = arma_autocov(&[0.5], &[], 3.0, 2);
+    for (h, v) in g.iter().enumerate() {
+        let truth = 3.0 / 0.75 * 0.5f64.powi(h as i32);
+        assert!((v - truth).abs() < 1e-12 * truth, "AR1 lag {h}");
+    }
+    assert_eq!(arma_autocov(&[], &[0.5], 2.0, 2), vec![2.5, 1.0, 0.0]);
+}
+
+#[test]
+fn simulate_random_walk_increments_have_variance_gamma2() {
+    let gamma2 = 0.25;
+    let (reps, n) = (200u64, 2000usize);
+    let (mut d0, mut d1, mut first) = (Vec::new(), Vec::new(), Vec::new());
+    for r in 0..reps {
+        let x = simulate(&[Generator::Rw { gamma2 }], n, replicate_seed(SEED, r)).unwrap();
+        let d: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
+        d0.push(d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64);
+        d1.push(d.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (d.len() - 1) as f64);
+        first.push(x[0] * x[0]);
+    }
+    assert_mc(&d0, gamma2, "RW increment variance");
+    assert_mc(&d1, 0.0, "RW increment lag-1 covariance");
+    // The first value is w_0, not 0 (METHODS §10.1).
+    assert_mc(&first, gamma2, "RW first value");
+}
+
+/// Mean of x_0^2 over many short runs: the law of the very first sample.
+fn first_sample_second_moment(g: &Generator, mode: StartMode, reps: u64) -> Vec<f64> {
+    (0..reps)
+        .map(|r| {
+            let mut x = [0.0];
+            Simulator::new(vec![g.clone()], replicate_seed(SEED, r))
+                .unwrap()
+                .with_start(mode)
+                .fill(&mut x);
+            x[0] * x[0]
+        })
+        .collect()
+}
+
+#[test]
+fn simulate_stationary_start_has_stationary_variance() {
+    let reps = 4000;
+    let (phi, s2) = (0.99, 1.0);
+    let g0 = s2 / (1.0 - phi * phi);
+    let ar1 = Generator::Ar1 { phi, sigma2: s2 };
+    assert_mc(
+        &first_sample_second_moment(&ar1, StartMode::Stationary, reps),
+        g0,
+        "AR1 x_0^2, stationary start",
+    );
+    // Package start (METHODS §10.1, §13.21): x = 0, so the first kept value is one innovation.
+    let zero = first_sample_second_moment(&ar1, StartMode::Zero, reps);
+    assert_mc(&zero, s2, "AR1 x_0^2, zero start");
+    assert!(mean_se(&zero).0 < g0 / 10.0);
+
+    let (phi, theta) = (0.98, 0.5);
+    let g = arma_autocov(&[phi], &[theta], s2, 0);
+    let arma11 = Generator::Arma11 {
+        phi,
+        theta,
+        sigma2: s2,
+    };
+    assert_mc(
+        &first_sample_second_moment(&arma11, StartMode::Stationary, reps),
+        g[0],
+        "ARMA11 x_0^2, stationary start",
+    );
+    // Zero start: x_1 = w_1 + theta w_0.
+    assert_mc(
+        &first_sample_second_moment(&arma11, StartMode::Zero, reps),
+        s2 * (1.0 + theta * theta),
+        "ARMA11 x_0^2, zero start",
+    );
+
+    // Generic ARMA with a slow root: the burn-in reaches the stationary law.
+    let (ar, ma) = (vec![1.5, -0.56], vec![0.4]); // inverse roots 0.8 and 0.7
+    let g = arma_autocov(&ar, &ma, s2, 0);
+    let arma = Generator::Arma { ar, ma, sigma2: s2 };
+    assert_mc(
+        &first_sample_second_moment(&arma, StartMode::Stationary, reps),
+        g[0],
+        "ARMA(2,1) x_0^2, stationary start",
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Empirical Haar WV against the closed forms of METHODS §4.2
+
+/// `K(phi, tau) = 3 - 4 phi^{tau/2} + phi^tau` (METHODS §4.2).
+fn k_term(phi: f64, tau: f64) -> f64 {
+    3.0 - 4.0 * phi.powf(tau / 2.0) + phi.powf(tau)
+}
+
+/// The closed forms of METHODS §4.2, typed here as the independent truth.
+fn closed_form_wv(g: &Generator, tau: f64) -> f64 {
+    match *g {
+        Generator::Wn { sigma2 } => sigma2 / tau,
+        Generator::Qn { q2 } => 6.0 * q2 / (tau * tau),
+        Generator::Rw { gamma2 } => gamma2 * (tau * tau + 2.0) / (12.0 * tau),
+        Generator::Dr { omega } => omega * omega * tau * tau / 16.0,
+        Generator::Ar1 { phi, sigma2 } => {
+            sigma2 * (tau * (1.0 - phi * phi) - 2.0 * phi * k_term(phi, tau))
+                / (tau * tau * (1.0 - phi).powi(3) * (1.0 + phi))
+        }
+        Generator::Ma1 { theta, sigma2 } => {
+            sigma2 * ((1.0 + theta).powi(2) * tau - 6.0 * theta) / (tau * tau)
+        }
+        Generator::Arma11 { phi, theta, sigma2 } => {
+            sigma2
+                * ((1.0 + theta).powi(2) * (1.0 - phi * phi) * tau
+                    - 2.0 * (theta + phi) * (1.0 + theta * phi) * k_term(phi, tau))
+                / (tau * tau * (1.0 - phi).powi(3) * (1.0 + phi))
+        }
+        Generator::Arma { .. } => unreachable!("no closed form in §4.2"),
+    }
+}
+
+#[test]
+fn simulate_wv_matches_closed_forms() {
+    let (reps, n, levels) = (300u64, 4096usize, 7usize);
+    let opts = WvOptions {
+        levels: Some(levels),
+        ..WvOptions::default()
+    };
+    let gens = [
+        Generator::Wn { sigma2: 2.0 },
+        Generator::Qn { q2: 0.5 },
+        Generator::Rw { gamma2: 0.1 },
+        Generator::Ar1 {
+            phi: 0.9,
+            sigma2: 1.0,
+        },
+        Generator::Ma1 {
+            theta: 0.5,
+            sigma2: 1.0,
+        },
+        Generator::Arma11 {
+            phi: 0.8,
+            theta: -0.3,
+            sigma2: 1.0,
+        },
+    ];
+    for g in &gens {
+        let mut per_level = vec![Vec::new(); levels];
+        for r in 0..reps {
+            let x = simulate(std::slice::from_ref(g), n, replicate_seed(SEED, r)).unwrap();
+            let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
+            for j in 0..levels {
+                per_level[j].push(wv.wv[j]);
+            }
+        }
+        for j in 0..levels {
+            let tau = 2f64.powi(j as i32 + 1);
+            assert_mc(
+                &per_level[j],
+                closed_form_wv(g, tau),
+                &format!("{g:?} WV at tau {tau}"),
+            );
+        }
+    }
+    // A sum: WV of independent components add (METHODS §4.1), DR included.
+    let mut sum = gens[..4].to_vec();
+    sum.push(Generator::Dr { omega: 0.01 });
+    let mut per_level = vec![Vec::new(); levels];
+    for r in 0..reps {
+        let x = simulate(&sum, n, replicate_seed(SEED, r)).unwrap();
+        let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
+        for j in 0..levels {
+            per_level[j].push(wv.wv[j]);
+        }
+    }
+    for j in 0..levels {
+        let tau = 2f64.powi(j as i32 + 1);
+        let truth: f64 = sum.iter().map(|g| closed_form_wv(g, tau)).sum();
+        assert_mc(&per_level[j], truth, &format!("sum WV at tau {tau}"));
+    }
+}
+
+#[test]
+fn simulate_drift_wv_is_exact() {
+    // DR is deterministic: its empirical Haar WV equals omega^2 tau^2 / 16 (METHODS §4.2,
+    // §10.3) in every replicate.
+    let g = Generator::Dr { omega: 0.01 };
+    let x = simulate(std::slice::from_ref(&g), 4096, SEED).unwrap();
+    let wv = wavelet_variance(
+        &x,
+        1.0,
+        &WvOptions {
+            levels: Some(7),
+            ..WvOptions::default()
+        },
+    )
+    .unwrap();
+    for j in 0..7 {
+        let tau = 2f64.powi(j as i32 + 1);
+        let truth = closed_form_wv(&g, tau);
+        assert!(
+            (wv.wv[j] - truth).abs() <= 1e-9 * truth,
+            "tau {tau}: {} vs {truth}",
+            wv.wv[j]
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad parameters
+
+#[test]
+fn simulator_rejects_bad_parameters() {
+    let bad = [
+        Generator::Ar1 {
+            phi: 1.0,
+            sigma2: 1.0,
+        },
+        Generator::Ar1 {
+            phi: -1.5,
+            sigma2: 1.0,
+        },
+        Generator::Ar1 {
+            phi: f64::NAN,
+            sigma2: 1.0,
+        },
+        Generator::Ar1 {
+            phi: 0.5,
+            sigma2: -1.0,
+        },
+        Generator::Arma11 {
+            phi: 1.0,
+            theta: 0.0,
+            sigma2: 1.0,
+        },
+        Generator::Arma11 {
+            phi: 0.5,
+            theta: f64::INFINITY,
+            sigma2: 1.0,
+        },
+        Generator::Ma1 {
+            theta: f64::NAN,
+            sigma2: 1.0,
+        },
+        Generator::Wn { sigma2: -1.0 },
+        Generator::Wn { sigma2: f64::NAN },
+        Generator::Qn { q2: -0.1 },
+        Generator::Rw {
+            gamma2: f64::INFINITY,
+        },
+        Generator::Dr { omega: f64::NAN },
+        Generator::Arma {
+            ar: vec![0.5, 0.6],
+            ma: vec![],
+            sigma2: 1.0,
+        },
+        Generator::Arma {
+            ar: vec![2.0, -1.0],
+            ma: vec![0.1],
+            sigma2: 1.0,
+        },
+        Generator::Arma {
+            ar: vec![0.5],
+            ma: vec![f64::NAN],
+            sigma2: 1.0,
+        },
+        Generator::Arma {
+            ar: vec![0.5],
+            ma: vec![],
+            sigma2: -2.0,
+        },
+        // stationary in exact arithmetic but too close to a unit root for a burn-in
+        Generator::Arma {
+            ar: vec![1.0 - 1e-12],
+            ma: vec![],
+            sigma2: 1.0,
+        },
+    ];
+    for g in bad {
+        let good = Generator::Wn { sigma2: 1.0 };
+        assert!(
+            Simulator::new(vec![good, g.clone()], 1).is_err(),
+            "{g:?} accepted"
+        );
+        assert!(
+            simulate(std::slice::from_ref(&g), 10, 1).is_err(),
+            "{g:?} accepted"
+        );
+    }
+    assert!(Simulator::new(vec![], 1).is_err());
+    assert!(simulate(&[Generator::Wn { sigma2: 1.0 }], 0, 1).is_err());
+    let e = Simulator::new(
+        vec![Generator::Arma {
+            ar: vec![0.5, 0.6],
+            ma: vec![],
+            sigma2: 1.0,
+        }],
+        1,
+    )
+    .unwrap_err();
+    assert_eq!(e.name, "ar");
+    // Boundary values that are valid.
+    for g in [
+        Generator::Wn { sigma2: 0.0 },
+        Generator::Ar1 {
+            phi: -0.999999,
+            sigma2: 1.0,
+        },
+        Generator::Arma {
+            ar: vec![],
+            ma: vec![],
+            sigma2: 1.0,
+        },
+        Generator::Arma {
+            ar: vec![0.0, 0.0],
+            ma: vec![2.0],
+            sigma2: 1.0,
+        },
+    ] {
+        assert!(
+            simulate(std::slice::from_ref(&g), 10, 1).is_ok(),
+            "{g:?} rejected"
+        );
+    }
+}
