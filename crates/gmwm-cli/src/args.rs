@@ -38,6 +38,56 @@ pub enum Command {
         after_long_help = "Examples:\n  gmwm avar imu.csv.gz\n  gmwm avar imu.csv.gz --kind non-overlapping --columns accel_z\n  gmwm avar imu.csv.gz --kind hadamard --json"
     )]
     Avar(AvarArgs),
+    /// Simulate a fully specified error model (seeded; CSV on stdout or to a file).
+    #[command(
+        after_long_help = "Examples:\n  gmwm simulate --model \"AR1(phi=0.99, sigma2=0.01)+WN(sigma2=1)\" --n 100000 --seed 1 -o sim.csv.gz\n  gmwm simulate --model \"GM(beta=0.25, sigma2_gm=7e-9)+WN(sigma2=7e-7)\" --freq 250 --n 1000 --components"
+    )]
+    Simulate(SimulateArgs),
+    /// Implied (theoretical) wavelet variance of a fully specified model and of each process.
+    #[command(
+        after_long_help = "Examples:\n  gmwm implied --model \"3*AR1(phi=0.9, sigma2=1)+WN(sigma2=2)\" --levels 10\n  gmwm implied --model \"GM(beta=0.25, sigma2_gm=7.08e-9)+RW(gamma2=3.9e-14)\" --levels 20 --freq 250 --json"
+    )]
+    Implied(ImpliedArgs),
+}
+
+/// `gmwm simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Fully specified model, e.g. "AR1(phi=0.9, sigma2=0.1)+WN(sigma2=1)".
+    #[arg(long, value_name = "MODEL")]
+    pub model: String,
+    /// Number of samples.
+    #[arg(long, value_name = "N")]
+    pub n: usize,
+    /// Sampling rate in Hz (converts GM parameters; written to the sidecar).
+    #[arg(long, value_name = "HZ", default_value_t = 1.0)]
+    pub freq: f64,
+    /// Seed of the simulation (same seed, same bits).
+    #[arg(long, value_name = "S", default_value_t = 0)]
+    pub seed: u64,
+    /// Output file (.csv or .csv.gz) with a JSON sidecar beside it [default: CSV on stdout].
+    #[arg(short = 'o', long, value_name = "FILE")]
+    pub output: Option<std::path::PathBuf>,
+    /// Also write each component as its own column (x is their sum).
+    #[arg(long)]
+    pub components: bool,
+}
+
+/// `gmwm implied`.
+#[derive(Debug, Args)]
+pub struct ImpliedArgs {
+    /// Fully specified model.
+    #[arg(long, value_name = "MODEL")]
+    pub model: String,
+    /// Number of levels J (scales 2^1 .. 2^J samples).
+    #[arg(long, value_name = "J")]
+    pub levels: usize,
+    /// Sampling rate in Hz (converts GM parameters; labels tau_s).
+    #[arg(long, value_name = "HZ", default_value_t = 1.0)]
+    pub freq: f64,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Where the data come from and how to read them.

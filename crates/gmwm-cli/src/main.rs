@@ -20,6 +20,8 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Command::Demo(a) => cmd::demo::run(a, &mut out)?,
         Command::Wv(a) => cmd::wv::run(a, &mut out)?,
         Command::Avar(a) => cmd::avar::run(a, &mut out)?,
+        Command::Simulate(a) => cmd::simulate::run(a, &mut out)?,
+        Command::Implied(a) => cmd::implied::run(a, &mut out)?,
     }
     out.flush()?;
     Ok(())

@@ -2,4 +2,6 @@
 
 pub mod avar;
 pub mod demo;
+pub mod implied;
+pub mod simulate;
 pub mod wv;

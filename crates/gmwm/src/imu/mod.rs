@@ -25,6 +25,7 @@ mod error;
 pub mod read;
 mod sensor;
 pub mod sidecar;
+pub mod write;
 
 pub use error::ReadError;
 pub use read::{

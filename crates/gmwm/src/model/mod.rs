@@ -41,12 +41,14 @@
 
 mod builder;
 pub mod parse;
+mod realize;
 
 pub use builder::{
     ar, ar1, ar1_with, ar_with, arma, arma11, arma11_with, arma_with, dr, dr_with, gm, gm_with, ma,
     ma1, ma1_with, ma_with, qn, qn_with, rw, rw_with, wn, wn_with, ModelSpec,
 };
 pub use parse::{ModelParseError, ParseErrorKind};
+pub use realize::{ComponentWv, ImpliedWv};
 
 use std::fmt;
 use thiserror::Error;

@@ -1,110 +1,47 @@
-//! The built-in demo sensor behind `gmwm demo` (METHODS §5.10, §10.1–§10.2).
+//! The built-in demo sensor behind `gmwm demo`: a known truth to simulate, analyse and (once
+//! estimation lands) recover (METHODS §5.10, §10).
 
-use crate::error::ParamError;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
-use serde::{Deserialize, Serialize};
+use crate::error::Error;
+use crate::model::Model;
+use serde::Serialize;
 
-/// The built-in demo sensor: white noise + random walk + one first-order autoregressive
-/// process, per-sample parameters, with the values of the NavChip gyroscope of paper Table I
-/// (METHODS §5.10; its slowest GM component only).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// The NavChip Y-axis gyroscope of paper Table I (METHODS §5.10), classical column, at 250 Hz:
+/// `3*GM() + WN() + QN() + RW()` with beta = (0.250, 6.28e-3, 8.48) 1/s,
+/// sigma2_gm = (7.08e-9, 1.28e-8, 6.48e-9), WN 6.94e-7, QN 2.29e-6, RW 3.90e-14.
+pub const DEMO_MODEL: &str = "GM(beta=0.25, sigma2_gm=7.08e-9)+GM(beta=6.28e-3, sigma2_gm=1.28e-8)\
++GM(beta=8.48, sigma2_gm=6.48e-9)+WN(sigma2=6.94e-7)+QN(q2=2.29e-6)+RW(gamma2=3.9e-14)";
+
+/// Sampling rate of the demo sensor (NavChip, paper Sec. III).
+pub const DEMO_FREQ_HZ: f64 = 250.0;
+
+/// A simulated sensor with known truth.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DemoSensor {
+    /// The true error model (fully specified).
+    pub model: Model,
     /// Sampling rate in Hz.
     pub freq_hz: f64,
-    /// White-noise variance `sigma2`.
-    pub wn_sigma2: f64,
-    /// Random-walk increment variance `gamma2`.
-    pub rw_gamma2: f64,
-    /// AR1 coefficient `phi`.
-    pub ar1_phi: f64,
-    /// AR1 innovation variance `sigma2`.
-    pub ar1_sigma2: f64,
 }
 
 impl Default for DemoSensor {
-    /// NavChip-like truth at 250 Hz (METHODS §5.10): WN 6.94e-7, RW 3.90e-14,
-    /// AR1 (0.9990005, 1.414585e-11).
+    /// The NavChip truth of METHODS §5.10 ([`DEMO_MODEL`] at [`DEMO_FREQ_HZ`]).
     fn default() -> Self {
         Self {
-            freq_hz: 250.0,
-            wn_sigma2: 6.94e-7,
-            rw_gamma2: 3.90e-14,
-            ar1_phi: 0.9990005,
-            ar1_sigma2: 1.414585e-11,
+            model: DEMO_MODEL
+                .parse()
+                .expect("the built-in demo model is valid text"),
+            freq_hz: DEMO_FREQ_HZ,
         }
     }
 }
 
 impl DemoSensor {
-    /// Canonical model text of the truth, in the model language of METHODS §0.2.
-    pub fn model_text(&self) -> String {
-        format!(
-            "AR1(phi={}, sigma2={})+WN(sigma2={})+RW(gamma2={})",
-            number(self.ar1_phi),
-            number(self.ar1_sigma2),
-            number(self.wn_sigma2),
-            number(self.rw_gamma2)
-        )
-    }
-
-    /// Simulates `n` samples with the given seed (METHODS §10.1–§10.2): components drawn in
-    /// model order from one ChaCha8 stream (same seed, same bits on every platform), the AR1
-    /// started from its stationary law `N(0, sigma2 / (1 - phi^2))` (the port's default, §10.1).
+    /// Simulates `n` samples with `seed` (METHODS §10.2, stationary starts).
     ///
     /// # Errors
-    /// [`ParamError`] for `n == 0` or a parameter outside its domain (variances >= 0, |phi| < 1).
-    pub fn simulate(&self, n: usize, seed: u64) -> Result<Vec<f64>, ParamError> {
-        if n == 0 {
-            return Err(ParamError::new("n", n, "must be at least 1"));
-        }
-        for (name, v) in [
-            ("wn_sigma2", self.wn_sigma2),
-            ("rw_gamma2", self.rw_gamma2),
-            ("ar1_sigma2", self.ar1_sigma2),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(ParamError::new(name, v, "must be a finite variance >= 0"));
-            }
-        }
-        if !(self.ar1_phi.is_finite() && self.ar1_phi.abs() < 1.0) {
-            return Err(ParamError::new(
-                "ar1_phi",
-                self.ar1_phi,
-                "must satisfy |phi| < 1",
-            ));
-        }
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut z = || -> f64 { StandardNormal.sample(&mut rng) };
-        let sd_ar = self.ar1_sigma2.sqrt();
-        let mut ar = z() * (self.ar1_sigma2 / (1.0 - self.ar1_phi * self.ar1_phi)).sqrt();
-        let mut x = Vec::with_capacity(n);
-        for _ in 0..n {
-            x.push(ar);
-            ar = self.ar1_phi * ar + sd_ar * z();
-        }
-        let sd_wn = self.wn_sigma2.sqrt();
-        for v in x.iter_mut() {
-            *v += sd_wn * z();
-        }
-        let sd_rw = self.rw_gamma2.sqrt();
-        let mut rw = 0.0;
-        for v in x.iter_mut() {
-            rw += sd_rw * z();
-            *v += rw;
-        }
-        Ok(x)
-    }
-}
-
-/// Shortest round-tripping text of a parameter, in scientific notation when it is small or
-/// large (`1.414585e-11` rather than `0.00000000001414585`).
-fn number(v: f64) -> String {
-    if v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
+    /// `n == 0`.
+    pub fn simulate(&self, n: usize, seed: u64) -> Result<Vec<f64>, Error> {
+        super::simulate_model(&self.model, n, self.freq_hz, seed)
     }
 }
 
@@ -113,16 +50,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn demo_sensor_is_reproducible_and_validated() {
+    fn demo_sensor_reproduces_methods_5_10() {
+        // METHODS §5.10: implied WV at tau = 2, 2^10, 2^21 (package and hand agree, 7 digits)
         let s = DemoSensor::default();
-        assert_eq!(s.simulate(100, 7).unwrap(), s.simulate(100, 7).unwrap());
-        assert_ne!(s.simulate(100, 7).unwrap(), s.simulate(100, 8).unwrap());
+        let wv = s.model.implied_wv(21, s.freq_hz).unwrap();
+        for (j, want) in [(1, 3.782112e-6), (10, 1.927074e-9), (21, 7.281275e-9)] {
+            let got = wv.wv[j - 1];
+            assert!((got / want - 1.0).abs() < 5e-7, "tau 2^{j}: {got:e} vs {want:e}");
+        }
+        let x = s.simulate(1000, 7).unwrap();
+        assert_eq!(x, s.simulate(1000, 7).unwrap());
         assert!(s.simulate(0, 7).is_err());
-        assert_eq!(
-            s.model_text(),
-            "AR1(phi=0.9990005, sigma2=1.414585e-11)+WN(sigma2=6.94e-7)+RW(gamma2=3.9e-14)"
-        );
-        let bad = DemoSensor { ar1_phi: 1.0, ..s };
-        assert!(bad.simulate(10, 1).is_err());
     }
 }

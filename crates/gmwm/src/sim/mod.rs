@@ -1,12 +1,15 @@
 //! Seeded simulation (METHODS §10).
 //!
 //! [`Simulator`] streams any sum of the processes of METHODS §10.1 over plain, per-sample
-//! parameters ([`Generator`]); [`DemoSensor`] is the small known truth behind `gmwm demo`.
+//! parameters ([`Generator`]); [`simulate_model`] and [`Simulator::for_model`] simulate a [`Model`](crate::model::Model);
+//! [`DemoSensor`] is the known truth behind `gmwm demo`.
 
 pub mod demo;
 pub mod generator;
+pub mod model;
 
-pub use demo::DemoSensor;
+pub use demo::{DemoSensor, DEMO_FREQ_HZ, DEMO_MODEL};
+pub use model::simulate_model;
 pub use generator::{
     ar_is_stationary, quantisation_noise, replicate_seed, simulate, Generator, Simulator, StartMode,
 };

@@ -1,0 +1,193 @@
+//! From a fully specified model to numbers: its latent processes (METHODS §0.2, §4.3), its
+//! implied Haar wavelet variance and the derivatives with respect to theta (§4.1–§4.6).
+
+use super::{Component, Model, ProcessKind};
+use crate::error::{Error, ParamError};
+use crate::process::{Ar1, Arma, Arma11, Dr, Gm, LatentProcess, Ma1, Process, Qn, Rw, Wn};
+use serde::Serialize;
+use std::fmt;
+
+impl Component {
+    /// The latent process of a fully specified component; `freq_hz` converts GM to its AR1
+    /// (METHODS §4.3) and is otherwise unused.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming the first missing value, or the process constructor's error for an
+    /// invalid one (e.g. a non-stationary AR polynomial).
+    pub fn process(&self, freq_hz: f64) -> Result<Process, Error> {
+        let names = self.kind.param_names();
+        let v: Vec<f64> = self
+            .values
+            .iter()
+            .zip(&names)
+            .map(|(v, name)| {
+                v.ok_or_else(|| {
+                    ParamError::new(
+                        "model",
+                        format!("{} without a value for {name}", self.kind.name()),
+                        "a fully specified model, e.g. \"AR1(phi=0.9, sigma2=1)+WN(sigma2=0.5)\"",
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(match self.kind {
+            ProcessKind::Wn => Wn::new(v[0])?.into(),
+            ProcessKind::Qn => Qn::new(v[0])?.into(),
+            ProcessKind::Rw => Rw::new(v[0])?.into(),
+            ProcessKind::Dr => Dr::new(v[0])?.into(),
+            ProcessKind::Ar1 => Ar1::new(v[0], v[1])?.into(),
+            ProcessKind::Gm => Gm::new(v[0], v[1], freq_hz)?.into(),
+            ProcessKind::Ma1 => Ma1::new(v[0], v[1])?.into(),
+            ProcessKind::Arma11 => Arma11::new(v[0], v[1], v[2])?.into(),
+            ProcessKind::Ar(p) => Arma::new(v[..p].to_vec(), Vec::new(), v[p])?.into(),
+            ProcessKind::Ma(q) => Arma::new(Vec::new(), v[..q].to_vec(), v[q])?.into(),
+            ProcessKind::Arma(p, q) => {
+                Arma::new(v[..p].to_vec(), v[p..p + q].to_vec(), v[p + q])?.into()
+            }
+        })
+    }
+}
+
+impl Model {
+    /// The latent processes of a fully specified model, in model order.
+    ///
+    /// # Errors
+    /// As [`Component::process`].
+    pub fn processes(&self, freq_hz: f64) -> Result<Vec<Process>, Error> {
+        check_freq(freq_hz)?;
+        self.components()
+            .iter()
+            .map(|c| c.process(freq_hz))
+            .collect()
+    }
+
+    /// Implied Haar WV of the model and of each component at `tau_j = 2^j`, `j = 1..=levels`
+    /// (METHODS §4.1–§4.4; a sum of independent processes has the sum of their WVs).
+    ///
+    /// # Errors
+    /// As [`Model::processes`]; `levels` must be in 1..=60.
+    pub fn implied_wv(&self, levels: usize, freq_hz: f64) -> Result<ImpliedWv, Error> {
+        check_levels(levels)?;
+        let processes = self.processes(freq_hz)?;
+        let per: Vec<ComponentWv> = self
+            .components()
+            .iter()
+            .zip(&processes)
+            .map(|(c, p)| ComponentWv {
+                process: c.to_string(),
+                wv: p.wv(levels),
+            })
+            .collect();
+        let wv = (0..levels)
+            .map(|j| per.iter().map(|c| c.wv[j]).sum())
+            .collect();
+        let tau: Vec<f64> = (1..=levels).map(|j| (j as f64).exp2()).collect();
+        Ok(ImpliedWv {
+            model: self.to_string(),
+            freq_hz,
+            tau_s: tau.iter().map(|t| t / freq_hz).collect(),
+            tau,
+            wv,
+            processes: per,
+        })
+    }
+
+    /// Jacobian of the implied WV with respect to theta (model order, original
+    /// parametrisation: GM in (beta, sigma2_gm)), `[level][param]` (METHODS §4.5).
+    ///
+    /// # Errors
+    /// As [`Model::implied_wv`].
+    pub fn jacobian(&self, levels: usize, freq_hz: f64) -> Result<Vec<Vec<f64>>, Error> {
+        check_levels(levels)?;
+        let blocks: Vec<Vec<Vec<f64>>> = self
+            .processes(freq_hz)?
+            .iter()
+            .map(|p| p.jacobian(levels))
+            .collect();
+        Ok((0..levels)
+            .map(|j| blocks.iter().flat_map(|b| b[j].iter().copied()).collect())
+            .collect())
+    }
+}
+
+fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
+    if freq_hz.is_finite() && freq_hz > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(
+            "freq",
+            freq_hz,
+            "must be a positive number of hertz",
+        ))
+    }
+}
+
+fn check_levels(levels: usize) -> Result<(), ParamError> {
+    if (1..=crate::wavelet::MAX_LEVELS).contains(&levels) {
+        Ok(())
+    } else {
+        Err(ParamError::new(
+            "levels",
+            levels,
+            format!("must be in 1..={}", crate::wavelet::MAX_LEVELS),
+        ))
+    }
+}
+
+/// Implied wavelet variance of a model and of each of its components.
+///
+/// Wire format: `model` (canonical text), `freq_hz`, equal-length `tau` (samples), `tau_s`,
+/// `wv` (the model), and `processes`: one `{process, wv}` per component in model order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImpliedWv {
+    /// Canonical model text.
+    pub model: String,
+    /// Sampling rate in Hz.
+    pub freq_hz: f64,
+    /// Scales `2^j` in samples.
+    pub tau: Vec<f64>,
+    /// Scales in seconds.
+    pub tau_s: Vec<f64>,
+    /// Implied WV of the whole model.
+    pub wv: Vec<f64>,
+    /// Implied WV of each component.
+    pub processes: Vec<ComponentWv>,
+}
+
+/// Implied WV of one component.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComponentWv {
+    /// Canonical text of the component.
+    pub process: String,
+    /// Its implied WV.
+    pub wv: Vec<f64>,
+}
+
+impl fmt::Display for ImpliedWv {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "implied wavelet variance of {} at {} Hz", self.model, self.freq_hz)?;
+        write!(f, "{:>5} {:>10} {:>12} {:>13}", "level", "tau", "tau_s", "model")?;
+        for (i, _) in self.processes.iter().enumerate() {
+            write!(f, " {:>13}", format!("[{}]", i + 1))?;
+        }
+        writeln!(f)?;
+        for j in 0..self.wv.len() {
+            write!(
+                f,
+                "{:>5} {:>10} {:>12.6} {:>13.6e}",
+                j + 1,
+                self.tau[j],
+                self.tau_s[j],
+                self.wv[j]
+            )?;
+            for p in &self.processes {
+                write!(f, " {:>13.6e}", p.wv[j])?;
+            }
+            writeln!(f)?;
+        }
+        for (i, p) in self.processes.iter().enumerate() {
+            writeln!(f, "[{}] {}", i + 1, p.process)?;
+        }
+        Ok(())
+    }
+}
