@@ -22,6 +22,7 @@
 pub mod error;
 pub mod imu;
 pub mod math;
+pub mod process;
 pub mod sim;
 pub mod variance;
 pub mod wavelet;
