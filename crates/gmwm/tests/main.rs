@@ -5,6 +5,7 @@
 
 mod allan;
 mod common;
+mod process;
 mod read;
 mod robust;
 mod wavelet;

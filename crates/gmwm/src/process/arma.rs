@@ -41,7 +41,7 @@ impl Arma {
         }
         check_positive("sigma2", sigma2)?;
         let min_modulus = min_root_modulus(&ar, -1.0);
-        if min_modulus <= 1.0 || !min_modulus.is_finite() {
+        if !(min_modulus > 1.0) {
             return Err(ParamError::new(
                 "ar",
                 min_modulus,

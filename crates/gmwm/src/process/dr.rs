@@ -42,13 +42,19 @@ impl LatentProcess for Dr {
         vec![self.omega]
     }
     fn wv(&self, levels: usize) -> Vec<f64> {
-        half_widths(levels).map(|m| self.omega * self.omega * unit_wv(m)).collect()
+        half_widths(levels)
+            .map(|m| self.omega * self.omega * unit_wv(m))
+            .collect()
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
-        half_widths(levels).map(|m| vec![2.0 * self.omega * unit_wv(m)]).collect()
+        half_widths(levels)
+            .map(|m| vec![2.0 * self.omega * unit_wv(m)])
+            .collect()
     }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
-        half_widths(levels).map(|m| vec![vec![2.0 * unit_wv(m)]]).collect()
+        half_widths(levels)
+            .map(|m| vec![vec![2.0 * unit_wv(m)]])
+            .collect()
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let _ = f;

@@ -40,7 +40,9 @@ impl LatentProcess for Rw {
         vec![self.gamma2]
     }
     fn wv(&self, levels: usize) -> Vec<f64> {
-        half_widths(levels).map(|m| self.gamma2 * unit_wv(m)).collect()
+        half_widths(levels)
+            .map(|m| self.gamma2 * unit_wv(m))
+            .collect()
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         half_widths(levels).map(|m| vec![unit_wv(m)]).collect()

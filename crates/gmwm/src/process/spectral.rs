@@ -16,10 +16,14 @@ use super::LatentProcess;
 
 /// Gauss–Legendre order.
 const GL_N: usize = 20;
-/// Local relative agreement required between a piece and its two halves.
-const REL_TOL: f64 = 1e-14;
-/// Maximum bisection depth of a piece (`2^-40` of a lobe is far below the finest feature).
-const MAX_DEPTH: usize = 40;
+/// Local relative agreement required between a piece and its two halves: 100 times the
+/// rounding noise of a 20-term sum, so that noise never drives the bisection.
+const REL_TOL: f64 = 1e-13;
+/// Absolute agreement, relative to a first estimate of the whole level, below which a piece is
+/// accepted whatever its own size (negligible pieces).
+const ABS_TOL: f64 = 1e-17;
+/// Maximum bisection depth of a piece (the geometric cuts already resolve the finest feature).
+const MAX_DEPTH: usize = 24;
 /// Geometric cuts towards the ends of the interval (`2^-60` of a lobe).
 const GRADING_CUTS: i32 = 60;
 
@@ -67,20 +71,24 @@ impl Rule {
             .sum::<f64>()
     }
 
-    fn adaptive(&self, g: &dyn Fn(f64) -> f64, a: f64, b: f64, whole: f64, depth: usize) -> f64 {
+    fn adaptive(
+        &self,
+        g: &dyn Fn(f64) -> f64,
+        piece: [f64; 2],
+        whole: f64,
+        abs: f64,
+        depth: usize,
+    ) -> f64 {
+        let [a, b] = piece;
         let mid = 0.5 * (a + b);
         let (l, r) = (self.apply(g, a, mid), self.apply(g, mid, b));
         let halves = l + r;
-        if (halves - whole).abs() <= REL_TOL * halves.abs() || depth >= MAX_DEPTH {
+        if (halves - whole).abs() <= (REL_TOL * halves.abs()).max(abs) || depth >= MAX_DEPTH {
             halves
         } else {
-            self.adaptive(g, a, mid, l, depth + 1) + self.adaptive(g, mid, b, r, depth + 1)
+            self.adaptive(g, [a, mid], l, abs, depth + 1)
+                + self.adaptive(g, [mid, b], r, abs, depth + 1)
         }
-    }
-
-    fn integrate(&self, g: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-        let whole = self.apply(g, a, b);
-        self.adaptive(g, a, b, whole, 0)
     }
 }
 
@@ -97,30 +105,38 @@ pub fn spectral_wv_level(density: &dyn Fn(f64) -> f64, j: usize) -> f64 {
     let m = 2f64.powi(j as i32 - 1);
     // lobes k = 0.. with s in [0, s_max(k)], f = (k + s)/m <= 1/2
     let n_lobes = (m / 2.0).ceil().max(1.0) as usize;
+    // pass 0: plain rule on every piece (the scale of the absolute tolerance); pass 1: adaptive
+    let mut crude = 0.0;
     let mut total = 0.0;
-    for k in 0..n_lobes {
-        let kf = k as f64;
-        let s_max = (m / 2.0 - kf).min(1.0);
-        let g = move |s: f64| {
-            let f = (kf + s) / m;
-            let ss = (std::f64::consts::PI * s).sin();
-            let sf = (std::f64::consts::PI * f).sin();
-            let gain = ss * ss * ss * ss / (m * m * sf * sf);
-            gain * density(f) / m
-        };
-        let mut cuts = vec![0.0, s_max];
-        if k == 0 {
-            cuts.extend((1..=GRADING_CUTS).map(|i| s_max * 2f64.powi(-i)));
+    for pass in 0..2 {
+        for k in 0..n_lobes {
+            let kf = k as f64;
+            let s_max = (m / 2.0 - kf).min(1.0);
+            let g = move |s: f64| {
+                let f = (kf + s) / m;
+                let ss = (std::f64::consts::PI * s).sin();
+                let sf = (std::f64::consts::PI * f).sin();
+                let gain = ss * ss * ss * ss / (m * m * sf * sf);
+                gain * density(f) / m
+            };
+            let mut cuts = vec![0.0, s_max];
+            if k == 0 {
+                cuts.extend((1..=GRADING_CUTS).map(|i| s_max * 2f64.powi(-i)));
+            }
+            if k + 1 == n_lobes {
+                cuts.extend((1..=GRADING_CUTS).map(|i| s_max * (1.0 - 2f64.powi(-i))));
+            }
+            cuts.sort_by(f64::total_cmp);
+            cuts.dedup();
+            for p in cuts.windows(2) {
+                let whole = rule.apply(&g, p[0], p[1]);
+                if pass == 0 {
+                    crude += whole;
+                } else {
+                    total += rule.adaptive(&g, [p[0], p[1]], whole, ABS_TOL * crude.abs(), 0);
+                }
+            }
         }
-        if k + 1 == n_lobes {
-            cuts.extend((1..=GRADING_CUTS).map(|i| s_max * (1.0 - 2f64.powi(-i))));
-        }
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup();
-        total += cuts
-            .windows(2)
-            .map(|p| rule.integrate(&g, p[0], p[1]))
-            .sum::<f64>();
     }
     2.0 * total
 }
