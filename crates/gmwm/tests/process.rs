@@ -20,6 +20,9 @@ const ORACLE: f64 = 1e-8;
 const ACF_SUM: f64 = 1e-10;
 /// Analytic derivatives versus Richardson central differences of the stable WV.
 const FD: f64 = 1e-6;
+/// Generic ARMA: numeric (§4.7) Jacobian and its differences (Hessian) versus differences of
+/// the WV: both sides carry O(h^4) truncation and ~1e-11/h noise.
+const FD_NUMERIC: f64 = 1e-5;
 /// Levels of the oracle comparison (brief: 1..20).
 const ORACLE_LEVELS: usize = 20;
 
@@ -387,14 +390,20 @@ fn with_param(p: &Process, k: usize, v: f64) -> Process {
     }
 }
 
-/// Step for parameter `k`: relative 1e-3, but never across the validity boundary at `|.| = 1`.
-fn fd_step(p: &Process, k: usize) -> f64 {
+/// Step for parameter `k` at `levels`: relative 1e-3, but small against every scale on which the
+/// WV varies: `1 - |phi|` near the unit circle and `1/m` (through `phi^m`) at half-width `m`
+/// (for GM `freq/m` in `beta`), so that the O(h^4) Richardson error stays below 1e-7.
+fn fd_step(p: &Process, k: usize, levels: usize) -> f64 {
     let v = p.params()[k];
+    let m_max = 2f64.powi(levels as i32 - 1);
     let mut h = 1e-3 * v.abs().max(0.01);
-    if matches!(p, Process::Ar1(_) | Process::Ma1(_) | Process::Arma11(_))
-        && k + 1 < p.params().len()
-    {
-        h = h.min(0.25 * (1.0 - v.abs()));
+    let coefficient = k + 1 < p.params().len();
+    match p {
+        Process::Ar1(_) | Process::Ma1(_) | Process::Arma11(_) | Process::Arma(_) if coefficient => {
+            h = h.min(0.02 * (1.0 - v.abs())).min(0.02 / m_max);
+        }
+        Process::Gm(g) if k == 0 => h = h.min(0.02 * g.freq_hz / m_max),
+        _ => {}
     }
     h
 }
@@ -403,10 +412,11 @@ fn check_derivatives(p: &Process, levels: usize) {
     let jac = p.jacobian(levels);
     let hes = p.hessian(levels);
     let np = p.params().len();
+    let tol = if p.name() == "ARMA" { FD_NUMERIC } else { FD };
     let scale: Vec<f64> = p.wv(levels).iter().map(|v| v.abs()).collect();
     for k in 0..np {
         let x = p.params()[k];
-        let h = fd_step(p, k);
+        let h = fd_step(p, k, levels);
         let fd = richardson(&|v| with_param(p, k, v).wv(levels), x, h);
         for j in 0..levels {
             // derivative scale: nu2 / |theta_k| (with a floor) so that a zero crossing passes
@@ -414,7 +424,7 @@ fn check_derivatives(p: &Process, levels: usize) {
             check_close_abs(
                 jac[j][k],
                 fd[j],
-                FD,
+                tol,
                 s,
                 &format!("{} {:?} d/dp{k} level {}", p.name(), p.params(), j + 1),
             );
@@ -436,7 +446,7 @@ fn check_derivatives(p: &Process, levels: usize) {
                 check_close_abs(
                     hes[j][a][k],
                     fdh[j],
-                    FD,
+                    tol,
                     s,
                     &format!(
                         "{} {:?} d2/dp{a}dp{k} level {}",

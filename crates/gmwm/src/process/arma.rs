@@ -248,9 +248,9 @@ fn arma_wv(ar: &[f64], ma: &[f64], sigma2: f64, levels: usize) -> Vec<f64> {
     autocovariance_wv(&autocovariance(ar, ma, sigma2, max_lag), levels)
 }
 
-/// `zero_tol = sqrt(eps / 7e-7)` of METHODS §4.7 (numDeriv's default).
-fn zero_tol() -> f64 {
-    (f64::EPSILON / 7e-7).sqrt()
+/// Largest half-width `m = 2^{levels-1}` (1 for no levels).
+fn max_half_width(levels: usize) -> f64 {
+    2f64.powi(levels.clamp(1, 1000) as i32 - 1)
 }
 
 /// Richardson rounds of METHODS §4.7.
@@ -268,10 +268,12 @@ impl Arma {
     }
 
     /// METHODS §4.7: Richardson-extrapolated central differences with respect to the
-    /// coefficient `k` of `c` (numDeriv style: step `|1e-4 c_k| + 1e-4 [|c_k| < zero_tol]`,
-    /// four rounds halving the step).
+    /// coefficient `k` of `c`, four rounds halving the step. The initial step is
+    /// `1e-3 max(|c_k|, 0.1)`, at most `0.05 / m_max` (the WV varies through `phi^m`), instead of
+    /// numDeriv's `|1e-4 c_k| + 1e-4 [|c_k| < zero_tol]`, whose step for a small non-zero
+    /// coefficient (e.g. `1e-4`, step `1e-8`) leaves only ~7 digits.
     fn d_coef(&self, c: &[f64], k: usize, levels: usize) -> Vec<f64> {
-        let mut h = (1e-4 * c[k]).abs() + if c[k].abs() < zero_tol() { 1e-4 } else { 0.0 };
+        let mut h = (1e-3 * c[k].abs().max(0.1)).min(0.05 / max_half_width(levels));
         let mut rounds: Vec<Vec<f64>> = Vec::with_capacity(RICHARDSON_ROUNDS);
         for _ in 0..RICHARDSON_ROUNDS {
             let mut up = c.to_vec();
@@ -316,9 +318,9 @@ impl Arma {
     }
 }
 
-/// Relative step of the central differences of the Jacobian used for the generic ARMA Hessian:
-/// the §4.7 Jacobian is accurate to ~1e-11, so a 1e-3 step keeps the noise near 1e-8 and the
-/// truncation error near 1e-6 relative.
+/// Relative step of the Richardson-extrapolated central differences of the Jacobian used for the
+/// generic ARMA Hessian: the §4.7 Jacobian is accurate to ~1e-11, so a 1e-3 step keeps the noise
+/// near 1e-7 and the O(h^4) truncation error below it.
 const HESSIAN_STEP: f64 = 1e-3;
 
 impl LatentProcess for Arma {
@@ -351,7 +353,7 @@ impl LatentProcess for Arma {
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         self.jacobian_at(&self.coefs(), levels)
     }
-    /// Central differences of the §4.7 Jacobian for coefficient pairs; `(sigma2, sigma2) = 0`
+    /// Richardson-extrapolated central differences of the §4.7 Jacobian for coefficient pairs; `(sigma2, sigma2) = 0`
     /// and `(c, sigma2) = (d nu2 / d c) / sigma2` exactly.
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
         let c = self.coefs();
@@ -360,15 +362,26 @@ impl LatentProcess for Arma {
         let nl = base.len();
         let mut h = vec![vec![vec![0.0; n + 1]; n + 1]; nl];
         for b in 0..n {
-            let step = HESSIAN_STEP * c[b].abs().max(0.1);
-            let mut up = c.clone();
-            up[b] += step;
-            let mut dn = c.clone();
-            dn[b] -= step;
-            let (ju, jd) = (self.jacobian_at(&up, levels), self.jacobian_at(&dn, levels));
+            let step = (HESSIAN_STEP * c[b].abs().max(0.1)).min(0.05 / max_half_width(levels));
+            let central = |step: f64| {
+                let mut up = c.clone();
+                up[b] += step;
+                let mut dn = c.clone();
+                dn[b] -= step;
+                let (ju, jd) = (self.jacobian_at(&up, levels), self.jacobian_at(&dn, levels));
+                (0..nl)
+                    .map(|j| {
+                        (0..n)
+                            .map(|a| (ju[j][a] - jd[j][a]) / (2.0 * step))
+                            .collect::<Vec<f64>>()
+                    })
+                    .collect::<Vec<_>>()
+            };
+            // one Richardson step: (4 D(h/2) - D(h)) / 3, error O(h^4)
+            let (d1, d2) = (central(step), central(step / 2.0));
             for j in 0..nl {
                 for a in 0..n {
-                    h[j][a][b] = (ju[j][a] - jd[j][a]) / (2.0 * step);
+                    h[j][a][b] = (4.0 * d2[j][a] - d1[j][a]) / 3.0;
                 }
             }
         }
