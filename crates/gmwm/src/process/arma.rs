@@ -41,7 +41,7 @@ impl Arma {
         }
         check_positive("sigma2", sigma2)?;
         let min_modulus = min_root_modulus(&ar, -1.0);
-        if !(min_modulus > 1.0) {
+        if min_modulus.is_nan() || min_modulus <= 1.0 {
             return Err(ParamError::new(
                 "ar",
                 min_modulus,
@@ -214,6 +214,8 @@ fn autocovariance(ar: &[f64], ma: &[f64], sigma2: f64, max_lag: usize) -> Vec<f6
 }
 
 /// Gaussian elimination with partial pivoting; `None` when singular.
+// Row operations read two rows of one matrix by index; iterators would obscure that.
+#[allow(clippy::needless_range_loop)]
 fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     let n = b.len();
     for col in 0..n {
@@ -355,6 +357,8 @@ impl LatentProcess for Arma {
     }
     /// Richardson-extrapolated central differences of the §4.7 Jacobian for coefficient pairs; `(sigma2, sigma2) = 0`
     /// and `(c, sigma2) = (d nu2 / d c) / sigma2` exactly.
+    // symmetric [level][a][b] fills read both triangles by index
+    #[allow(clippy::needless_range_loop)]
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
         let c = self.coefs();
         let n = c.len();
