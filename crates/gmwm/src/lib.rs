@@ -23,6 +23,7 @@ pub mod error;
 pub mod imu;
 pub mod math;
 pub mod model;
+pub mod process;
 pub mod sim;
 pub mod variance;
 pub mod wavelet;

@@ -6,6 +6,7 @@
 mod allan;
 mod common;
 mod model;
+mod process;
 mod read;
 mod robust;
 mod sim;

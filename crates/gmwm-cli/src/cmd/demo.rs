@@ -65,7 +65,10 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
 
 fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     let (wv, implied) = (r.empirical, r.implied);
-    writeln!(out, "demo sensor (NavChip gyroscope, paper Table I), simulated with known truth")?;
+    writeln!(
+        out,
+        "demo sensor (NavChip gyroscope, paper Table I), simulated with known truth"
+    )?;
     writeln!(out, "  truth: {}", r.truth)?;
     writeln!(out, "  {} Hz, N = {}, seed {}", r.freq_hz, r.n, r.seed)?;
     writeln!(out)?;

@@ -66,10 +66,7 @@ pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
     if let Some(path) = &args.output {
         let sidecar = Sidecar {
             name: path.file_name().map(|f| f.to_string_lossy().into_owned()),
-            sensor: Some(format!(
-                "simulated by gmwm: {} (seed {})",
-                model, args.seed
-            )),
+            sensor: Some(format!("simulated by gmwm: {} (seed {})", model, args.seed)),
             sampling_frequency_hz: Some(args.freq),
             n_rows: Some(args.n as u64),
             columns: names

@@ -35,7 +35,10 @@ pub fn create(path: &Path) -> Result<Box<dyn Write>, ReadError> {
 /// If the columns have different lengths (an internal invariant of the callers).
 pub fn write_csv_rows(out: &mut dyn Write, columns: &[&[f64]]) -> io::Result<()> {
     let n = columns.first().map_or(0, |c| c.len());
-    assert!(columns.iter().all(|c| c.len() == n), "columns of equal length");
+    assert!(
+        columns.iter().all(|c| c.len() == n),
+        "columns of equal length"
+    );
     let mut line = String::with_capacity(32 * columns.len());
     for t in 0..n {
         line.clear();

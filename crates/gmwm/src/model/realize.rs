@@ -165,8 +165,16 @@ pub struct ComponentWv {
 
 impl fmt::Display for ImpliedWv {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "implied wavelet variance of {} at {} Hz", self.model, self.freq_hz)?;
-        write!(f, "{:>5} {:>10} {:>12} {:>13}", "level", "tau", "tau_s", "model")?;
+        writeln!(
+            f,
+            "implied wavelet variance of {} at {} Hz",
+            self.model, self.freq_hz
+        )?;
+        write!(
+            f,
+            "{:>5} {:>10} {:>12} {:>13}",
+            "level", "tau", "tau_s", "model"
+        )?;
         for (i, _) in self.processes.iter().enumerate() {
             write!(f, " {:>13}", format!("[{}]", i + 1))?;
         }

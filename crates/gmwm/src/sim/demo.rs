@@ -56,7 +56,10 @@ mod tests {
         let wv = s.model.implied_wv(21, s.freq_hz).unwrap();
         for (j, want) in [(1, 3.782112e-6), (10, 1.927074e-9), (21, 7.281275e-9)] {
             let got = wv.wv[j - 1];
-            assert!((got / want - 1.0).abs() < 5e-7, "tau 2^{j}: {got:e} vs {want:e}");
+            assert!(
+                (got / want - 1.0).abs() < 5e-7,
+                "tau 2^{j}: {got:e} vs {want:e}"
+            );
         }
         let x = s.simulate(1000, 7).unwrap();
         assert_eq!(x, s.simulate(1000, 7).unwrap());

@@ -9,7 +9,7 @@ pub mod generator;
 pub mod model;
 
 pub use demo::{DemoSensor, DEMO_FREQ_HZ, DEMO_MODEL};
-pub use model::simulate_model;
 pub use generator::{
     ar_is_stationary, quantisation_noise, replicate_seed, simulate, Generator, Simulator, StartMode,
 };
+pub use model::simulate_model;

@@ -1,0 +1,273 @@
+//! AR1 and Gauss–Markov processes (METHODS §0.2, §4.2, §4.3, §4.5, §4.6).
+//!
+//! # Numerically stable evaluation
+//! The closed form of §4.2, written with `m = tau/2`, is
+//! `nu2 = sigma2 B / (2 m^2 (1-phi)^3 (1+phi))`, `B = m (1-phi^2) - phi (1-a)(3-a)`, `a = phi^m`.
+//! `B` vanishes like `(1-phi)^3`: for `phi` near 1 its two terms cancel. With `L = -ln phi > 0`
+//! and `x = m L`, expanding every exponential gives the convergent series
+//! `B = sum_{k>=3} (-1)^k L^k p_k(m) / k!`, `p_k(m) = 4 (1+m)^k - (1+2m)^k - 2^k m - 3`
+//! (the terms `k = 0, 1, 2` vanish identically), so
+//! `nu2 = sigma2 G(L) R(L) / (2 m^2)` with `G = B / L^3 = sum_{k>=3} (-1)^k p_k(m) L^{k-3} / k!`
+//! and `R = (L / (1 - e^{-L}))^3 / (1 + e^{-L})`. Used when `x < 1/2`; otherwise the closed form
+//! is evaluated with `exp_m1` (its condition number there is below ~12). Derivatives are exact
+//! derivatives of this evaluation (forward-mode jets), so they inherit its accuracy.
+
+use serde::{Deserialize, Serialize};
+
+use super::{
+    check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
+    LatentProcess,
+};
+use crate::error::ParamError;
+
+/// Below this `x = m L = -m ln(phi)` the series of the module doc is used: there the closed form
+/// loses about `-2 log10(x)` digits, the series (terms bounded by `1.5^k/k!`) none.
+const SERIES_BELOW_X: f64 = 0.5;
+/// Series terms of `G`: at `t = (1+2m) L <= 1.5` the omitted term is below `1.5^40/40! ~ 1e-41`.
+const G_TERMS: usize = 40;
+/// Series terms of `(1 - e^{-L})/L` for `L < 0.5`: omitted term below `0.5^20/21! ~ 2e-26`.
+const E_TERMS: usize = 20;
+
+/// First-order autoregression `x_t = phi x_{t-1} + w_t`, `Var w_t = sigma2`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Ar1 {
+    /// Autoregressive coefficient, `|phi| < 1`.
+    pub phi: f64,
+    /// Innovation variance per sample.
+    pub sigma2: f64,
+}
+
+/// Gauss–Markov process: an AR1 parametrised by its inverse correlation time `beta` (1/s) and
+/// stationary variance `sigma2_gm` at sampling rate `freq_hz` (METHODS §4.3).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Gm {
+    /// Inverse correlation time in 1/s, `> 0`.
+    pub beta: f64,
+    /// Stationary variance, `> 0`.
+    pub sigma2_gm: f64,
+    /// Sampling rate in Hz, `> 0`.
+    pub freq_hz: f64,
+}
+
+impl Ar1 {
+    /// Builds an AR1.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `phi` unless `|phi| < 1` (stationarity), or `sigma2` unless finite
+    /// and `> 0`.
+    pub fn new(phi: f64, sigma2: f64) -> Result<Self, ParamError> {
+        check_unit("phi", phi, "|phi| < 1 for a stationary AR1")?;
+        check_positive("sigma2", sigma2)?;
+        Ok(Self { phi, sigma2 })
+    }
+
+    /// METHODS §4.3: the Gauss–Markov parametrisation at `freq_hz`:
+    /// `beta = -ln(phi) freq`, `sigma2_gm = sigma2 / (1 - phi^2)`.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `phi` unless `0 < phi < 1` (a GM has positive correlation), or
+    /// `freq_hz` unless finite and `> 0`.
+    pub fn to_gm(&self, freq_hz: f64) -> Result<Gm, ParamError> {
+        check_positive("freq_hz", freq_hz)?;
+        if !(self.phi > 0.0 && self.phi < 1.0) {
+            return Err(ParamError::new(
+                "phi",
+                self.phi,
+                "0 < phi < 1 for a Gauss-Markov process",
+            ));
+        }
+        let beta = -self.phi.ln() * freq_hz;
+        let sigma2_gm = self.sigma2 / ((1.0 - self.phi) * (1.0 + self.phi));
+        Gm::new(beta, sigma2_gm, freq_hz)
+    }
+}
+
+impl Gm {
+    /// Builds a Gauss–Markov process.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `beta`, `sigma2_gm` or `freq_hz` unless each is finite and `> 0`.
+    pub fn new(beta: f64, sigma2_gm: f64, freq_hz: f64) -> Result<Self, ParamError> {
+        check_positive("beta", beta)?;
+        check_positive("sigma2_gm", sigma2_gm)?;
+        check_positive("freq_hz", freq_hz)?;
+        Ok(Self {
+            beta,
+            sigma2_gm,
+            freq_hz,
+        })
+    }
+
+    /// METHODS §4.3: the equivalent per-sample AR1: `phi = exp(-beta dt)`,
+    /// `sigma2 = sigma2_gm (1 - exp(-2 beta dt))`, `dt = 1/freq_hz`.
+    pub fn to_ar1(&self) -> Ar1 {
+        let l = self.beta / self.freq_hz;
+        Ar1 {
+            phi: (-l).exp(),
+            sigma2: self.sigma2_gm * -(-2.0 * l).exp_m1(),
+        }
+    }
+}
+
+/// METHODS §4.2 (AR1 row), stable form of the module doc, at half-width `m`.
+///
+/// `lag` is `L = -ln(phi)` when known exactly (GM); otherwise it is computed from `phi` when
+/// `phi > 0`. For `phi <= 0` the closed form has no cancellation and is used as written.
+pub(crate) fn ar1_wv_jet<const N: usize>(
+    phi: Jet<N>,
+    lag: Option<Jet<N>>,
+    sigma2: Jet<N>,
+    m: f64,
+) -> Jet<N> {
+    let lag = match lag {
+        Some(l) => Some(l),
+        None if phi.v > 0.0 => Some(-phi.ln()),
+        None => None,
+    };
+    let Some(l) = lag else {
+        // phi <= 0: B = m (1 - phi^2) - phi (1 - a)(3 - a), all in phi.
+        let a = phi.powi(m as i32);
+        let b = one_minus(phi * phi) * m - phi * one_minus(a) * (-a + 3.0);
+        let d = one_minus(phi).powi(3) * (phi + 1.0) * (2.0 * m * m);
+        return sigma2 * b / d;
+    };
+    let x = m * l.v;
+    if x < SERIES_BELOW_X {
+        sigma2 * series_g(l, m) * series_r(l) / (2.0 * m * m)
+    } else {
+        let one_m_phi = -(-l).exp_m1();
+        let phi_e = (-l).exp();
+        let one_m_a = -(-l * m).exp_m1();
+        let one_m_phi2 = -(-l * 2.0).exp_m1();
+        let b = one_m_phi2 * m - phi_e * one_m_a * (one_m_a + 2.0);
+        let d = one_m_phi.powi(3) * (phi_e + 1.0) * (2.0 * m * m);
+        sigma2 * b / d
+    }
+}
+
+/// `G(L) = B / L^3` as the series of the module doc, evaluated in `t = (1+2m) L` so that no
+/// power overflows: `G = sum_k d_k t^{k-3}`,
+/// `d_k = (-1)^k (1+2m)^3 / k! * (4 r1^k - 1 - m r2^k - 3 r0^k)` with `r1 = (1+m)/(1+2m)`,
+/// `r2 = 2/(1+2m)`, `r0 = 1/(1+2m)`.
+fn series_g<const N: usize>(l: Jet<N>, m: f64) -> Jet<N> {
+    let q = 1.0 + 2.0 * m;
+    let (r0, r1, r2) = (1.0 / q, (1.0 + m) / q, 2.0 / q);
+    let mut d = [0.0; G_TERMS];
+    let mut fact = 1.0;
+    let (mut p0, mut p1, mut p2) = (1.0, 1.0, 1.0);
+    for k in 1..G_TERMS + 3 {
+        fact *= k as f64;
+        p0 *= r0;
+        p1 *= r1;
+        p2 *= r2;
+        if k >= 3 {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            d[k - 3] = sign * q * q * q / fact * (4.0 * p1 - 1.0 - m * p2 - 3.0 * p0);
+        }
+    }
+    let t = l * q;
+    // Horner from the highest term.
+    let mut acc = Jet::c(d[G_TERMS - 1]);
+    for k in (0..G_TERMS - 1).rev() {
+        acc = acc * t + d[k];
+    }
+    acc
+}
+
+/// `R(L) = 1 / (E(L)^3 (1 + e^{-L}))`, `E(L) = (1 - e^{-L})/L = sum_k (-L)^k/(k+1)!`.
+fn series_r<const N: usize>(l: Jet<N>) -> Jet<N> {
+    let mut coef = [0.0; E_TERMS];
+    let mut fact = 1.0;
+    for (k, c) in coef.iter_mut().enumerate() {
+        fact *= (k + 1) as f64;
+        *c = if k % 2 == 0 { 1.0 } else { -1.0 } / fact;
+    }
+    let mut e = Jet::c(coef[E_TERMS - 1]);
+    for k in (0..E_TERMS - 1).rev() {
+        e = e * l + coef[k];
+    }
+    (e.powi(3) * ((-l).exp() + 1.0)).recip()
+}
+
+/// AR1 spectral density `sigma2 / ((1-phi)^2 + 4 phi sin^2(pi f))` (METHODS §1.9), the same as
+/// `sigma2 / (1 - 2 phi cos 2 pi f + phi^2)` without its cancellation at `f = 0`.
+pub(crate) fn ar1_spectrum(one_m_phi: f64, phi: f64, sigma2: f64, f: f64) -> f64 {
+    let s = (std::f64::consts::PI * f).sin();
+    sigma2 / (one_m_phi * one_m_phi + 4.0 * phi * s * s)
+}
+
+impl Ar1 {
+    fn jets(&self, levels: usize) -> Vec<Jet<2>> {
+        jet_levels([self.phi, self.sigma2], levels, |v, m| {
+            ar1_wv_jet(v[0], None, v[1], m)
+        })
+    }
+}
+
+impl LatentProcess for Ar1 {
+    fn name(&self) -> &'static str {
+        "AR1"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        vec!["phi", "sigma2"]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.phi, self.sigma2]
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        jet_levels::<0>([], levels, |_, m| {
+            ar1_wv_jet(Jet::c(self.phi), None, Jet::c(self.sigma2), m)
+        })
+        .iter()
+        .map(|j| j.v)
+        .collect()
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        jets_jacobian(&self.jets(levels))
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        jets_hessian(&self.jets(levels))
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        Some(ar1_spectrum(1.0 - self.phi, self.phi, self.sigma2, f))
+    }
+}
+
+impl Gm {
+    /// Jets in `(beta, sigma2_gm)` through the exact conversion of §4.3 (chain rule included).
+    fn jets(&self, levels: usize) -> Vec<Jet<2>> {
+        let dt = 1.0 / self.freq_hz;
+        jet_levels([self.beta, self.sigma2_gm], levels, |v, m| {
+            let l = v[0] * dt;
+            let phi = (-l).exp();
+            let sigma2 = v[1] * -(-l * 2.0).exp_m1();
+            ar1_wv_jet(phi, Some(l), sigma2, m)
+        })
+    }
+}
+
+impl LatentProcess for Gm {
+    fn name(&self) -> &'static str {
+        "GM"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        vec!["beta", "sigma2_gm"]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.beta, self.sigma2_gm]
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        self.jets(levels).iter().map(|j| j.v).collect()
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        jets_jacobian(&self.jets(levels))
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        jets_hessian(&self.jets(levels))
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        let l = self.beta / self.freq_hz;
+        let ar = self.to_ar1();
+        Some(ar1_spectrum(-(-l).exp_m1(), ar.phi, ar.sigma2, f))
+    }
+}

@@ -1,0 +1,419 @@
+//! General ARMA(p, q) (METHODS §0.2, §4.4, §4.7), with AR(p) (`ma` empty) and MA(q) (`ar` empty)
+//! as special cases. R sign convention: AR polynomial `1 - sum ar_i B^i`, MA polynomial
+//! `1 + sum ma_i B^i`.
+
+use serde::{Deserialize, Serialize};
+
+use super::{autocovariance_wv, check_positive, LatentProcess};
+use crate::error::ParamError;
+
+/// General ARMA(p, q): `x_t = sum ar_i x_{t-i} + w_t + sum ma_i w_{t-i}`, `Var w_t = sigma2`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Arma {
+    /// Autoregressive coefficients `ar_1..ar_p`.
+    pub ar: Vec<f64>,
+    /// Moving-average coefficients `ma_1..ma_q`.
+    pub ma: Vec<f64>,
+    /// Innovation variance per sample.
+    pub sigma2: f64,
+}
+
+/// Durand–Kerner iterations for the polynomial roots (quadratic convergence once close; the
+/// loop also stops as soon as no root moves by more than `ROOT_TOL`).
+const ROOT_ITERATIONS: usize = 2000;
+/// Relative movement below which the root iteration stops.
+const ROOT_TOL: f64 = 1e-15;
+
+impl Arma {
+    /// Builds an ARMA(p, q). Non-invertible MA parts are valid processes (accepted) but are not
+    /// identifiable from second moments; see [`Arma::is_invertible`].
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `ar`/`ma` for a non-finite coefficient, `ar` when the AR polynomial
+    /// has a root on or inside the unit circle (the value reported is that root's modulus), or
+    /// `sigma2` unless finite and `> 0`.
+    pub fn new(ar: Vec<f64>, ma: Vec<f64>, sigma2: f64) -> Result<Self, ParamError> {
+        if let Some(v) = ar.iter().find(|v| !v.is_finite()) {
+            return Err(ParamError::new("ar", v, "finite AR coefficients"));
+        }
+        if let Some(v) = ma.iter().find(|v| !v.is_finite()) {
+            return Err(ParamError::new("ma", v, "finite MA coefficients"));
+        }
+        check_positive("sigma2", sigma2)?;
+        let min_modulus = min_root_modulus(&ar, -1.0);
+        if min_modulus.is_nan() || min_modulus <= 1.0 {
+            return Err(ParamError::new(
+                "ar",
+                min_modulus,
+                "every root of the AR polynomial 1 - sum ar_i z^i outside the unit circle \
+                 (stationarity); the value is the smallest root modulus",
+            ));
+        }
+        Ok(Self { ar, ma, sigma2 })
+    }
+
+    /// Whether every root of the MA polynomial `1 + sum ma_i z^i` lies outside the unit circle.
+    pub fn is_invertible(&self) -> bool {
+        let m = min_root_modulus(&self.ma, 1.0);
+        m > 1.0
+    }
+
+    /// MA(inf) weights `psi_0 = 1, psi_1, ...` (METHODS §4.4).
+    pub fn psi_weights(&self, n: usize) -> Vec<f64> {
+        psi(&self.ar, &self.ma, n)
+    }
+
+    /// METHODS §4.4: autocovariances `gamma_0..gamma_{max_lag}` from the exact
+    /// `(r+1) x (r+1)` linear system (`r = max(p, q+1)`), then the AR recursion; `gamma_0` is
+    /// exact, not the package's 1000-term MA(inf) truncation (§13.12). Values are NaN only if
+    /// the system were singular, which stationarity (checked by [`Arma::new`]) excludes.
+    pub fn autocovariance(&self, max_lag: usize) -> Vec<f64> {
+        autocovariance(&self.ar, &self.ma, self.sigma2, max_lag)
+    }
+}
+
+/// Smallest modulus of the roots of `1 + s * sum c_i z^i` (`s = -1` for AR, `+1` for MA);
+/// infinity when the polynomial is constant. The roots are the reciprocals of those of the
+/// monic `w^n + s c_1 w^{n-1} + ... + s c_n` (trailing zero coefficients dropped).
+fn min_root_modulus(c: &[f64], s: f64) -> f64 {
+    let n = c.iter().rposition(|v| *v != 0.0).map_or(0, |i| i + 1);
+    if n == 0 {
+        return f64::INFINITY;
+    }
+    let coef: Vec<f64> = c[..n].iter().map(|v| s * v).collect();
+    let roots = monic_roots(&coef);
+    roots
+        .iter()
+        .map(|r| 1.0 / r.abs())
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[derive(Debug, Clone, Copy)]
+struct C64 {
+    re: f64,
+    im: f64,
+}
+
+impl C64 {
+    fn mul(self, o: C64) -> C64 {
+        C64 {
+            re: self.re * o.re - self.im * o.im,
+            im: self.re * o.im + self.im * o.re,
+        }
+    }
+    fn sub(self, o: C64) -> C64 {
+        C64 {
+            re: self.re - o.re,
+            im: self.im - o.im,
+        }
+    }
+    fn div(self, o: C64) -> C64 {
+        let d = o.re * o.re + o.im * o.im;
+        C64 {
+            re: (self.re * o.re + self.im * o.im) / d,
+            im: (self.im * o.re - self.re * o.im) / d,
+        }
+    }
+    fn abs(self) -> f64 {
+        self.re.hypot(self.im)
+    }
+}
+
+/// Roots of `w^n + a_1 w^{n-1} + ... + a_n` by Durand–Kerner (Weierstrass) iteration.
+fn monic_roots(a: &[f64]) -> Vec<C64> {
+    let n = a.len();
+    // start on a circle of the Cauchy bound radius, at non-symmetric angles
+    let radius = 1.0 + a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut z: Vec<C64> = (0..n)
+        .map(|k| {
+            let ang = 2.0 * std::f64::consts::PI * k as f64 / n as f64 + 0.4;
+            C64 {
+                re: radius * ang.cos(),
+                im: radius * ang.sin(),
+            }
+        })
+        .collect();
+    let eval = |w: C64| {
+        let mut acc = C64 { re: 1.0, im: 0.0 };
+        for &c in a {
+            acc = acc.mul(w);
+            acc.re += c;
+        }
+        acc
+    };
+    for _ in 0..ROOT_ITERATIONS {
+        let mut moved = 0.0f64;
+        for i in 0..n {
+            let mut den = C64 { re: 1.0, im: 0.0 };
+            for k in 0..n {
+                if k != i {
+                    den = den.mul(z[i].sub(z[k]));
+                }
+            }
+            if den.abs() == 0.0 {
+                continue;
+            }
+            let step = eval(z[i]).div(den);
+            z[i] = z[i].sub(step);
+            moved = moved.max(step.abs() / z[i].abs().max(1e-300));
+        }
+        if moved < ROOT_TOL {
+            break;
+        }
+    }
+    z
+}
+
+/// METHODS §4.4: `psi_i = ma_i (0 if i > q) + sum_{l=1}^{min(i,p)} ar_l psi_{i-l}`, `psi_0 = 1`.
+fn psi(ar: &[f64], ma: &[f64], n: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n.max(1)];
+    out[0] = 1.0;
+    for i in 1..n {
+        let mut v = if i <= ma.len() { ma[i - 1] } else { 0.0 };
+        for l in 1..=i.min(ar.len()) {
+            v += ar[l - 1] * out[i - l];
+        }
+        out[i] = v;
+    }
+    out.truncate(n);
+    out
+}
+
+/// METHODS §4.4 linear system plus recursion; see [`Arma::autocovariance`].
+fn autocovariance(ar: &[f64], ma: &[f64], sigma2: f64, max_lag: usize) -> Vec<f64> {
+    let (p, q) = (ar.len(), ma.len());
+    let r = p.max(q + 1);
+    let phi: Vec<f64> = (0..r).map(|i| ar.get(i).copied().unwrap_or(0.0)).collect();
+    let ps = psi(ar, ma, q + 1);
+    let ma0 = |l: usize| if l == 0 { 1.0 } else { ma[l - 1] };
+    // A gamma = rhs, unknowns gamma_0..gamma_r
+    let n = r + 1;
+    let mut a = vec![vec![0.0; n]; n];
+    let mut rhs = vec![0.0; n];
+    for k in 0..n {
+        a[k][k] += 1.0;
+        for i in 1..=r {
+            a[k][k.abs_diff(i)] -= phi[i - 1];
+        }
+        rhs[k] = if k <= q {
+            sigma2 * (k..=q).map(|l| ma0(l) * ps[l - k]).sum::<f64>()
+        } else {
+            0.0
+        };
+    }
+    let Some(g) = solve(a, rhs) else {
+        return vec![f64::NAN; max_lag + 1];
+    };
+    let mut gamma = g;
+    gamma.resize(max_lag.max(r) + 1, 0.0);
+    for h in r + 1..=max_lag {
+        gamma[h] = (1..=r).map(|i| phi[i - 1] * gamma[h - i]).sum();
+    }
+    gamma.truncate(max_lag + 1);
+    gamma
+}
+
+/// Gaussian elimination with partial pivoting; `None` when singular.
+// Row operations read two rows of one matrix by index; iterators would obscure that.
+#[allow(clippy::needless_range_loop)]
+fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let n = b.len();
+    for col in 0..n {
+        let piv = (col..n).max_by(|&i, &k| a[i][col].abs().total_cmp(&a[k][col].abs()))?;
+        if a[piv][col] == 0.0 || !a[piv][col].is_finite() {
+            return None;
+        }
+        a.swap(col, piv);
+        b.swap(col, piv);
+        for row in col + 1..n {
+            let f = a[row][col] / a[col][col];
+            for k in col..n {
+                a[row][k] -= f * a[col][k];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for row in (0..n).rev() {
+        let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    Some(x)
+}
+
+/// METHODS §4.4: WV through §4.1 from the exact autocovariances (no validation).
+fn arma_wv(ar: &[f64], ma: &[f64], sigma2: f64, levels: usize) -> Vec<f64> {
+    if levels == 0 {
+        return Vec::new();
+    }
+    let max_lag = (1usize << levels.min(40)) - 1;
+    autocovariance_wv(&autocovariance(ar, ma, sigma2, max_lag), levels)
+}
+
+/// Largest half-width `m = 2^{levels-1}` (1 for no levels).
+fn max_half_width(levels: usize) -> f64 {
+    2f64.powi(levels.clamp(1, 1000) as i32 - 1)
+}
+
+/// Richardson rounds of METHODS §4.7.
+const RICHARDSON_ROUNDS: usize = 4;
+
+impl Arma {
+    /// The coefficients `ar ++ ma` with `sigma2` last, as in [`LatentProcess::params`].
+    fn coefs(&self) -> Vec<f64> {
+        self.ar.iter().chain(&self.ma).copied().collect()
+    }
+
+    fn wv_at(&self, c: &[f64], levels: usize) -> Vec<f64> {
+        let p = self.ar.len();
+        arma_wv(&c[..p], &c[p..], self.sigma2, levels)
+    }
+
+    /// METHODS §4.7: Richardson-extrapolated central differences with respect to the
+    /// coefficient `k` of `c`, four rounds halving the step. The initial step is
+    /// `1e-3 max(|c_k|, 0.1)`, at most `0.05 / m_max` (the WV varies through `phi^m`), instead of
+    /// numDeriv's `|1e-4 c_k| + 1e-4 [|c_k| < zero_tol]`, whose step for a small non-zero
+    /// coefficient (e.g. `1e-4`, step `1e-8`) leaves only ~7 digits.
+    fn d_coef(&self, c: &[f64], k: usize, levels: usize) -> Vec<f64> {
+        let mut h = (1e-3 * c[k].abs().max(0.1)).min(0.05 / max_half_width(levels));
+        let mut rounds: Vec<Vec<f64>> = Vec::with_capacity(RICHARDSON_ROUNDS);
+        for _ in 0..RICHARDSON_ROUNDS {
+            let mut up = c.to_vec();
+            up[k] += h;
+            let mut dn = c.to_vec();
+            dn[k] -= h;
+            let (wu, wd) = (self.wv_at(&up, levels), self.wv_at(&dn, levels));
+            rounds.push(
+                wu.iter()
+                    .zip(&wd)
+                    .map(|(a, b)| (a - b) / (2.0 * h))
+                    .collect(),
+            );
+            h /= 2.0;
+        }
+        for m in 1..RICHARDSON_ROUNDS {
+            let w = 4f64.powi(m as i32);
+            rounds = rounds
+                .windows(2)
+                .map(|pair| {
+                    pair[1]
+                        .iter()
+                        .zip(&pair[0])
+                        .map(|(d1, d0)| (w * d1 - d0) / (w - 1.0))
+                        .collect()
+                })
+                .collect();
+        }
+        rounds.pop().unwrap_or_default()
+    }
+
+    fn jacobian_at(&self, c: &[f64], levels: usize) -> Vec<Vec<f64>> {
+        let cols: Vec<Vec<f64>> = (0..c.len()).map(|k| self.d_coef(c, k, levels)).collect();
+        let nu = self.wv_at(c, levels);
+        (0..nu.len())
+            .map(|j| {
+                let mut row: Vec<f64> = cols.iter().map(|col| col[j]).collect();
+                row.push(nu[j] / self.sigma2);
+                row
+            })
+            .collect()
+    }
+}
+
+/// Relative step of the Richardson-extrapolated central differences of the Jacobian used for the
+/// generic ARMA Hessian: the §4.7 Jacobian is accurate to ~1e-11, so a 1e-3 step keeps the noise
+/// near 1e-7 and the O(h^4) truncation error below it.
+const HESSIAN_STEP: f64 = 1e-3;
+
+impl LatentProcess for Arma {
+    fn name(&self) -> &'static str {
+        "ARMA"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        const AR: [&str; 12] = [
+            "ar1", "ar2", "ar3", "ar4", "ar5", "ar6", "ar7", "ar8", "ar9", "ar10", "ar11", "ar12",
+        ];
+        const MA: [&str; 12] = [
+            "ma1", "ma2", "ma3", "ma4", "ma5", "ma6", "ma7", "ma8", "ma9", "ma10", "ma11", "ma12",
+        ];
+        let mut v: Vec<&'static str> = (0..self.ar.len())
+            .map(|i| AR.get(i).copied().unwrap_or("ar"))
+            .collect();
+        v.extend((0..self.ma.len()).map(|i| MA.get(i).copied().unwrap_or("ma")));
+        v.push("sigma2");
+        v
+    }
+    fn params(&self) -> Vec<f64> {
+        let mut v = self.coefs();
+        v.push(self.sigma2);
+        v
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        arma_wv(&self.ar, &self.ma, self.sigma2, levels)
+    }
+    /// METHODS §4.7 for the coefficients; `nu2 / sigma2` (§4.5) for `sigma2`.
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        self.jacobian_at(&self.coefs(), levels)
+    }
+    /// Richardson-extrapolated central differences of the §4.7 Jacobian for coefficient pairs; `(sigma2, sigma2) = 0`
+    /// and `(c, sigma2) = (d nu2 / d c) / sigma2` exactly.
+    // symmetric [level][a][b] fills read both triangles by index
+    #[allow(clippy::needless_range_loop)]
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        let c = self.coefs();
+        let n = c.len();
+        let base = self.jacobian_at(&c, levels);
+        let nl = base.len();
+        let mut h = vec![vec![vec![0.0; n + 1]; n + 1]; nl];
+        for b in 0..n {
+            let step = (HESSIAN_STEP * c[b].abs().max(0.1)).min(0.05 / max_half_width(levels));
+            let central = |step: f64| {
+                let mut up = c.clone();
+                up[b] += step;
+                let mut dn = c.clone();
+                dn[b] -= step;
+                let (ju, jd) = (self.jacobian_at(&up, levels), self.jacobian_at(&dn, levels));
+                (0..nl)
+                    .map(|j| {
+                        (0..n)
+                            .map(|a| (ju[j][a] - jd[j][a]) / (2.0 * step))
+                            .collect::<Vec<f64>>()
+                    })
+                    .collect::<Vec<_>>()
+            };
+            // one Richardson step: (4 D(h/2) - D(h)) / 3, error O(h^4)
+            let (d1, d2) = (central(step), central(step / 2.0));
+            for j in 0..nl {
+                for a in 0..n {
+                    h[j][a][b] = (4.0 * d2[j][a] - d1[j][a]) / 3.0;
+                }
+            }
+        }
+        for j in 0..nl {
+            for a in 0..n {
+                for b in 0..a {
+                    let s = 0.5 * (h[j][a][b] + h[j][b][a]);
+                    h[j][a][b] = s;
+                    h[j][b][a] = s;
+                }
+                h[j][a][n] = base[j][a] / self.sigma2;
+                h[j][n][a] = base[j][a] / self.sigma2;
+            }
+        }
+        h
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        let w = 2.0 * std::f64::consts::PI * f;
+        // |1 + sum c_k e^{-i k w}|^2 with sign s
+        let gain = |c: &[f64], s: f64| {
+            let (mut re, mut im) = (1.0, 0.0);
+            for (k, v) in c.iter().enumerate() {
+                let a = w * (k + 1) as f64;
+                re += s * v * a.cos();
+                im -= s * v * a.sin();
+            }
+            re * re + im * im
+        };
+        Some(self.sigma2 * gain(&self.ma, 1.0) / gain(&self.ar, -1.0))
+    }
+}

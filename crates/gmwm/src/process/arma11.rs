@@ -1,0 +1,106 @@
+//! ARMA(1,1) (METHODS §0.2, §4.2, §4.5, §4.6).
+//!
+//! Near `phi = 1` the closed form cancels like the AR1 one. Its autocovariance is
+//! `gamma_0 = sigma2 (1 + 2 theta phi + theta^2)/(1 - phi^2)`,
+//! `gamma_h = sigma2 (1 + theta phi)(phi + theta) phi^{h-1}/(1 - phi^2)` (h >= 1), i.e. white
+//! noise of variance `-sigma2 theta / phi` plus an AR1 with innovation variance
+//! `sigma2 (1 + theta phi)(phi + theta)/phi`; by linearity of §4.1 the WV is the sum of theirs,
+//! and the AR1 part uses the stable evaluation of [`super::ar1`]. This is used for
+//! `phi > 1/2`; below, the closed form is used as written.
+
+use serde::{Deserialize, Serialize};
+
+use super::ar1::ar1_wv_jet;
+use super::{
+    check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
+    LatentProcess,
+};
+use crate::error::ParamError;
+
+/// From this `phi` on, the WN + AR1 decomposition of the module doc is used (it divides by
+/// `phi`, so it is not used near 0, where the closed form has no cancellation).
+const DECOMPOSE_FROM_PHI: f64 = 0.5;
+
+/// ARMA(1,1) `x_t = phi x_{t-1} + w_t + theta w_{t-1}`, `Var w_t = sigma2`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Arma11 {
+    /// Autoregressive coefficient, `|phi| < 1`.
+    pub phi: f64,
+    /// Moving-average coefficient, `|theta| < 1`.
+    pub theta: f64,
+    /// Innovation variance per sample.
+    pub sigma2: f64,
+}
+
+impl Arma11 {
+    /// Builds an ARMA(1,1).
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `phi` unless `|phi| < 1` (stationarity), `theta` unless
+    /// `|theta| < 1` (invertibility), or `sigma2` unless finite and `> 0`.
+    pub fn new(phi: f64, theta: f64, sigma2: f64) -> Result<Self, ParamError> {
+        check_unit("phi", phi, "|phi| < 1 for a stationary ARMA11")?;
+        check_unit("theta", theta, "|theta| < 1 for an invertible ARMA11")?;
+        check_positive("sigma2", sigma2)?;
+        Ok(Self { phi, theta, sigma2 })
+    }
+
+    fn jets(&self, levels: usize) -> Vec<Jet<3>> {
+        jet_levels([self.phi, self.theta, self.sigma2], levels, |v, m| {
+            arma11_wv_jet(v[0], v[1], v[2], m)
+        })
+    }
+}
+
+/// METHODS §4.2 (ARMA11 row):
+/// `nu2 = sigma2 [(1+theta)^2 (1-phi^2) tau - 2 (theta+phi)(1+theta phi) K] / [tau^2 (1-phi)^3 (1+phi)]`,
+/// `K = 3 - 4 phi^{tau/2} + phi^tau`; for `phi > 1/2` through the decomposition of the module doc.
+pub(crate) fn arma11_wv_jet<const N: usize>(
+    phi: Jet<N>,
+    theta: Jet<N>,
+    sigma2: Jet<N>,
+    m: f64,
+) -> Jet<N> {
+    let tau = 2.0 * m;
+    if phi.v > DECOMPOSE_FROM_PHI {
+        let wn = -(sigma2 * theta / phi) / tau;
+        let s_ar = sigma2 * (theta * phi + 1.0) * (phi + theta) / phi;
+        wn + ar1_wv_jet(phi, None, s_ar, m)
+    } else {
+        let a = phi.powi(m as i32);
+        let k = -a * 4.0 + a * a + 3.0;
+        let n = (theta + 1.0).powi(2) * one_minus(phi * phi) * tau
+            - (theta + phi) * (theta * phi + 1.0) * k * 2.0;
+        let d = one_minus(phi).powi(3) * (phi + 1.0) * (tau * tau);
+        sigma2 * n / d
+    }
+}
+
+impl LatentProcess for Arma11 {
+    fn name(&self) -> &'static str {
+        "ARMA11"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        vec!["phi", "theta", "sigma2"]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.phi, self.theta, self.sigma2]
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        self.jets(levels).iter().map(|j| j.v).collect()
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        jets_jacobian(&self.jets(levels))
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        jets_hessian(&self.jets(levels))
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        let s = (std::f64::consts::PI * f).sin();
+        let s2 = s * s;
+        let (p, t) = (self.phi, self.theta);
+        let num = (1.0 + t) * (1.0 + t) - 4.0 * t * s2;
+        let den = (1.0 - p) * (1.0 - p) + 4.0 * p * s2;
+        Some(self.sigma2 * num / den)
+    }
+}

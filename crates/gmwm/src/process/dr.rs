@@ -1,0 +1,63 @@
+//! Deterministic drift (METHODS §0.2, §4.2).
+
+use serde::{Deserialize, Serialize};
+
+use super::{half_widths, LatentProcess};
+use crate::error::ParamError;
+
+/// Deterministic drift: the ramp `x_t = omega (t + 1)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Dr {
+    /// Slope per sample (any sign).
+    pub omega: f64,
+}
+
+impl Dr {
+    /// Builds the process.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `omega` unless it is finite.
+    pub fn new(omega: f64) -> Result<Self, ParamError> {
+        if !omega.is_finite() {
+            return Err(ParamError::new("omega", omega, "a finite number"));
+        }
+        Ok(Self { omega })
+    }
+}
+
+/// METHODS §4.2: `nu2 = omega^2 tau^2 / 16`, `tau = 2m`.
+fn unit_wv(m: f64) -> f64 {
+    let tau = 2.0 * m;
+    tau * tau / 16.0
+}
+
+impl LatentProcess for Dr {
+    fn name(&self) -> &'static str {
+        "DR"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        vec!["omega"]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.omega]
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        half_widths(levels)
+            .map(|m| self.omega * self.omega * unit_wv(m))
+            .collect()
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        half_widths(levels)
+            .map(|m| vec![2.0 * self.omega * unit_wv(m)])
+            .collect()
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        half_widths(levels)
+            .map(|m| vec![vec![2.0 * unit_wv(m)]])
+            .collect()
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        let _ = f;
+        None
+    }
+}

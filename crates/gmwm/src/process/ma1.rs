@@ -1,0 +1,68 @@
+//! First-order moving average (METHODS §0.2, §4.2, §4.5, §4.6).
+
+use serde::{Deserialize, Serialize};
+
+use super::{
+    check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, Jet, LatentProcess,
+};
+use crate::error::ParamError;
+
+/// First-order moving average `x_t = w_t + theta w_{t-1}`, `Var w_t = sigma2`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Ma1 {
+    /// Moving-average coefficient, `|theta| < 1` (invertible, hence identifiable).
+    pub theta: f64,
+    /// Innovation variance per sample.
+    pub sigma2: f64,
+}
+
+impl Ma1 {
+    /// Builds an MA1. Every finite `theta` gives a valid process, but `theta` and `1/theta` give
+    /// the same autocovariances up to scale; only the invertible `|theta| < 1` is accepted.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `theta` unless `|theta| < 1`, or `sigma2` unless finite and `> 0`.
+    pub fn new(theta: f64, sigma2: f64) -> Result<Self, ParamError> {
+        check_unit("theta", theta, "|theta| < 1 for an invertible MA1")?;
+        check_positive("sigma2", sigma2)?;
+        Ok(Self { theta, sigma2 })
+    }
+
+    fn jets(&self, levels: usize) -> Vec<Jet<2>> {
+        jet_levels([self.theta, self.sigma2], levels, |v, m| {
+            ma1_wv_jet(v[0], v[1], m)
+        })
+    }
+}
+
+/// METHODS §4.2 (MA1 row): `nu2 = sigma2 [(1 + theta)^2 tau - 6 theta] / tau^2`, `tau = 2m`.
+pub(crate) fn ma1_wv_jet<const N: usize>(theta: Jet<N>, sigma2: Jet<N>, m: f64) -> Jet<N> {
+    let tau = 2.0 * m;
+    sigma2 * ((theta + 1.0).powi(2) * tau - theta * 6.0) / (tau * tau)
+}
+
+impl LatentProcess for Ma1 {
+    fn name(&self) -> &'static str {
+        "MA1"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        vec!["theta", "sigma2"]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.theta, self.sigma2]
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        self.jets(levels).iter().map(|j| j.v).collect()
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        jets_jacobian(&self.jets(levels))
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        jets_hessian(&self.jets(levels))
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        let s = (std::f64::consts::PI * f).sin();
+        let t = self.theta;
+        Some(self.sigma2 * ((1.0 + t) * (1.0 + t) - 4.0 * t * s * s))
+    }
+}

@@ -1,0 +1,373 @@
+//! Latent processes of an IMU error model and their implied (theoretical) Haar wavelet variance,
+//! with first and second derivatives (METHODS §4).
+//!
+//! Every process implements [`LatentProcess`]; [`Process`] is the closed set of them. Levels are
+//! `j = 1..=levels` at scales `tau_j = 2^j` samples, parameters are per sample (METHODS §0.1);
+//! only [`Gm`] carries a sampling rate (§4.3).
+//!
+//! Derivatives of the closed forms are exact (forward-mode automatic differentiation of the
+//! numerically stable evaluation, see [`ar1`]), so they stay accurate where the textbook quotient
+//! of §4.5 cancels (AR1/GM with `phi` near 1). The generic [`Arma`] is differentiated numerically
+//! (§4.7). [`spectral`] holds the slow quadrature oracle of §1.9.
+
+use serde::{Deserialize, Serialize};
+
+pub mod ar1;
+pub mod arma;
+pub mod arma11;
+pub mod dr;
+pub mod ma1;
+pub mod qn;
+pub mod rw;
+pub mod spectral;
+pub mod wn;
+
+pub use ar1::{Ar1, Gm};
+pub use arma::Arma;
+pub use arma11::Arma11;
+pub use dr::Dr;
+pub use ma1::Ma1;
+pub use qn::Qn;
+pub use rw::Rw;
+pub use wn::Wn;
+
+use crate::error::ParamError;
+
+/// A latent process with an implied Haar wavelet variance (METHODS §4). Object safe.
+pub trait LatentProcess {
+    /// Component name as in METHODS §0.2: "WN", "QN", "RW", "DR", "AR1", "GM", "MA1", "ARMA11",
+    /// "ARMA".
+    fn name(&self) -> &'static str;
+    /// Parameter names in METHODS §0.2 order.
+    fn param_names(&self) -> Vec<&'static str>;
+    /// Parameter values in the order of [`LatentProcess::param_names`].
+    fn params(&self) -> Vec<f64>;
+    /// METHODS §4.2: implied Haar WV at `tau_j = 2^j` samples, `j = 1..=levels`.
+    fn wv(&self, levels: usize) -> Vec<f64>;
+    /// METHODS §4.5: Jacobian `d nu2_j / d theta_k`, indexed `[level][param]`.
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>>;
+    /// METHODS §4.6: second derivatives, indexed `[level][param][param]` (symmetric).
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>>;
+    /// METHODS §1.9: spectral density `S(f)` on `|f| <= 1/2` (cycles per sample); the RW
+    /// pseudo-spectrum for RW; `None` for the deterministic drift.
+    fn spectral_density(&self, f: f64) -> Option<f64>;
+}
+
+/// One latent process of a model (METHODS §0.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Process {
+    /// White noise.
+    Wn(Wn),
+    /// Quantisation noise.
+    Qn(Qn),
+    /// Random walk.
+    Rw(Rw),
+    /// Deterministic drift.
+    Dr(Dr),
+    /// First-order autoregression.
+    Ar1(Ar1),
+    /// Gauss–Markov (AR1 at a sampling rate).
+    Gm(Gm),
+    /// First-order moving average.
+    Ma1(Ma1),
+    /// ARMA(1,1).
+    Arma11(Arma11),
+    /// General ARMA(p, q).
+    Arma(Arma),
+}
+
+impl Process {
+    fn inner(&self) -> &dyn LatentProcess {
+        match self {
+            Process::Wn(p) => p,
+            Process::Qn(p) => p,
+            Process::Rw(p) => p,
+            Process::Dr(p) => p,
+            Process::Ar1(p) => p,
+            Process::Gm(p) => p,
+            Process::Ma1(p) => p,
+            Process::Arma11(p) => p,
+            Process::Arma(p) => p,
+        }
+    }
+}
+
+impl LatentProcess for Process {
+    fn name(&self) -> &'static str {
+        self.inner().name()
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        self.inner().param_names()
+    }
+    fn params(&self) -> Vec<f64> {
+        self.inner().params()
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        self.inner().wv(levels)
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        self.inner().jacobian(levels)
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        self.inner().hessian(levels)
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        self.inner().spectral_density(f)
+    }
+}
+
+macro_rules! impl_from_process {
+    ($($v:ident),*) => {
+        $(impl From<$v> for Process {
+            fn from(p: $v) -> Self {
+                Process::$v(p)
+            }
+        })*
+    };
+}
+impl_from_process!(Wn, Qn, Rw, Dr, Ar1, Gm, Ma1, Arma11, Arma);
+
+/// METHODS §4.1: Haar WV at `tau_j = 2^j`, `j = 1..=levels`, from autocovariances
+/// `gamma_0, gamma_1, ...`:
+/// `nu2(tau) = [m (gamma_0 - gamma_m) + sum_{i=1}^{m-1} i (2 gamma_{m-i} - gamma_i - gamma_{2m-i})] / (2 m^2)`
+/// with `m = tau / 2`. Level `j` needs `gamma_0 .. gamma_{2^j - 1}`; levels whose lags are not
+/// all given are left out, so the result may be shorter than `levels`.
+///
+/// Cost: `O(2^levels)`.
+pub fn autocovariance_wv(gamma: &[f64], levels: usize) -> Vec<f64> {
+    let mut out = Vec::with_capacity(levels);
+    for j in 1..=levels.min(62) {
+        let m = 1usize << (j - 1);
+        if 2 * m > gamma.len() {
+            break;
+        }
+        let mut s = m as f64 * (gamma[0] - gamma[m]);
+        for i in 1..m {
+            s += i as f64 * (2.0 * gamma[m - i] - gamma[i] - gamma[2 * m - i]);
+        }
+        let mf = m as f64;
+        out.push(s / (2.0 * mf * mf));
+    }
+    out
+}
+
+/// Half-widths `m_j = 2^{j-1}` for `j = 1..=levels` (METHODS §0.1), as `f64`.
+pub(crate) fn half_widths(levels: usize) -> impl Iterator<Item = f64> {
+    (1..=levels).map(|j| 2f64.powi(j as i32 - 1))
+}
+
+/// Checks a variance-like parameter: finite and `> 0`.
+pub(crate) fn check_positive(name: &'static str, v: f64) -> Result<(), ParamError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, v, "a finite number > 0"))
+    }
+}
+
+/// Checks a coefficient with `|v| < 1`.
+pub(crate) fn check_unit(name: &'static str, v: f64, expected: &str) -> Result<(), ParamError> {
+    if v.is_finite() && v.abs() < 1.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, v, expected))
+    }
+}
+
+/// Evaluates a function of `N` parameters in jets and splits value, gradient and Hessian per
+/// level. `f(params, m)` returns the level's jet.
+pub(crate) fn jet_levels<const N: usize>(
+    params: [f64; N],
+    levels: usize,
+    f: impl Fn(&[Jet<N>; N], f64) -> Jet<N>,
+) -> Vec<Jet<N>> {
+    let vars: [Jet<N>; N] = std::array::from_fn(|k| Jet::var(params[k], k));
+    half_widths(levels).map(|m| f(&vars, m)).collect()
+}
+
+/// Jacobian rows from jets.
+pub(crate) fn jets_jacobian<const N: usize>(jets: &[Jet<N>]) -> Vec<Vec<f64>> {
+    jets.iter().map(|j| j.g.to_vec()).collect()
+}
+
+/// Hessian blocks from jets.
+pub(crate) fn jets_hessian<const N: usize>(jets: &[Jet<N>]) -> Vec<Vec<Vec<f64>>> {
+    jets.iter()
+        .map(|j| j.h.iter().map(|r| r.to_vec()).collect())
+        .collect()
+}
+
+/// A second-order forward-mode jet: value, gradient and Hessian with respect to `N` parameters.
+/// Arithmetic on jets gives exact derivatives of whatever formula is evaluated (no differencing).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Jet<const N: usize> {
+    /// Value.
+    pub v: f64,
+    /// Gradient.
+    pub g: [f64; N],
+    /// Hessian.
+    pub h: [[f64; N]; N],
+}
+
+impl<const N: usize> Jet<N> {
+    /// A constant.
+    pub fn c(v: f64) -> Self {
+        Self {
+            v,
+            g: [0.0; N],
+            h: [[0.0; N]; N],
+        }
+    }
+    /// The `k`-th independent variable at value `v`.
+    pub fn var(v: f64, k: usize) -> Self {
+        let mut s = Self::c(v);
+        if k < N {
+            s.g[k] = 1.0;
+        }
+        s
+    }
+    /// `f(self)` given `f`, `f'`, `f''` at `self.v`.
+    pub fn chain(self, f0: f64, f1: f64, f2: f64) -> Self {
+        let mut out = Self::c(f0);
+        for a in 0..N {
+            out.g[a] = f1 * self.g[a];
+            for b in 0..N {
+                out.h[a][b] = f1 * self.h[a][b] + f2 * self.g[a] * self.g[b];
+            }
+        }
+        out
+    }
+    /// `exp`.
+    pub fn exp(self) -> Self {
+        let e = self.v.exp();
+        self.chain(e, e, e)
+    }
+    /// `exp(x) - 1`, accurate near 0.
+    pub fn exp_m1(self) -> Self {
+        let e = self.v.exp();
+        self.chain(self.v.exp_m1(), e, e)
+    }
+    /// Natural logarithm.
+    pub fn ln(self) -> Self {
+        let v = self.v;
+        self.chain(v.ln(), 1.0 / v, -1.0 / (v * v))
+    }
+    /// Integer power.
+    pub fn powi(self, n: i32) -> Self {
+        let v = self.v;
+        let nf = f64::from(n);
+        let d1 = if n == 0 { 0.0 } else { nf * v.powi(n - 1) };
+        let d2 = if n <= 1 {
+            0.0
+        } else {
+            nf * (nf - 1.0) * v.powi(n - 2)
+        };
+        self.chain(v.powi(n), d1, d2)
+    }
+    /// `1 / x`.
+    pub fn recip(self) -> Self {
+        let v = self.v;
+        self.chain(1.0 / v, -1.0 / (v * v), 2.0 / (v * v * v))
+    }
+    /// Multiplies by a constant.
+    pub fn scale(self, s: f64) -> Self {
+        let mut out = self;
+        out.v *= s;
+        for a in 0..N {
+            out.g[a] *= s;
+            for b in 0..N {
+                out.h[a][b] *= s;
+            }
+        }
+        out
+    }
+}
+
+impl<const N: usize> std::ops::Add for Jet<N> {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        let mut out = self;
+        out.v += o.v;
+        for a in 0..N {
+            out.g[a] += o.g[a];
+            for b in 0..N {
+                out.h[a][b] += o.h[a][b];
+            }
+        }
+        out
+    }
+}
+
+impl<const N: usize> std::ops::Add<f64> for Jet<N> {
+    type Output = Self;
+    fn add(self, o: f64) -> Self {
+        let mut out = self;
+        out.v += o;
+        out
+    }
+}
+
+impl<const N: usize> std::ops::Neg for Jet<N> {
+    type Output = Self;
+    fn neg(self) -> Self {
+        self.scale(-1.0)
+    }
+}
+
+impl<const N: usize> std::ops::Sub for Jet<N> {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        self + (-o)
+    }
+}
+
+impl<const N: usize> std::ops::Sub<f64> for Jet<N> {
+    type Output = Self;
+    fn sub(self, o: f64) -> Self {
+        self + (-o)
+    }
+}
+
+impl<const N: usize> std::ops::Mul for Jet<N> {
+    type Output = Self;
+    fn mul(self, o: Self) -> Self {
+        let mut out = Self::c(self.v * o.v);
+        for a in 0..N {
+            out.g[a] = self.g[a] * o.v + self.v * o.g[a];
+            for b in 0..N {
+                out.h[a][b] = self.h[a][b] * o.v
+                    + self.v * o.h[a][b]
+                    + self.g[a] * o.g[b]
+                    + self.g[b] * o.g[a];
+            }
+        }
+        out
+    }
+}
+
+impl<const N: usize> std::ops::Mul<f64> for Jet<N> {
+    type Output = Self;
+    fn mul(self, o: f64) -> Self {
+        self.scale(o)
+    }
+}
+
+impl<const N: usize> std::ops::Div for Jet<N> {
+    type Output = Self;
+    #[allow(clippy::suspicious_arithmetic_impl)]
+    fn div(self, o: Self) -> Self {
+        self * o.recip()
+    }
+}
+
+impl<const N: usize> std::ops::Div<f64> for Jet<N> {
+    type Output = Self;
+    fn div(self, o: f64) -> Self {
+        self.scale(1.0 / o)
+    }
+}
+
+/// `1 - x` for a jet.
+pub(crate) fn one_minus<const N: usize>(x: Jet<N>) -> Jet<N> {
+    -x + 1.0
+}

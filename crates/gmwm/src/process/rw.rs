@@ -1,0 +1,57 @@
+//! Random walk (METHODS §0.2, §4.2).
+
+use serde::{Deserialize, Serialize};
+
+use super::{check_positive, half_widths, LatentProcess};
+use crate::error::ParamError;
+
+/// Random walk: cumulative sum of white noise with increment variance `gamma2`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Rw {
+    /// Increment variance.
+    pub gamma2: f64,
+}
+
+impl Rw {
+    /// Builds the process.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `gamma2` unless it is finite and > 0.
+    pub fn new(gamma2: f64) -> Result<Self, ParamError> {
+        check_positive("gamma2", gamma2)?;
+        Ok(Self { gamma2 })
+    }
+}
+
+/// METHODS §4.2: `nu2 = gamma2 (tau^2 + 2) / (12 tau)`, `tau = 2m`.
+fn unit_wv(m: f64) -> f64 {
+    let tau = 2.0 * m;
+    (tau * tau + 2.0) / (12.0 * tau)
+}
+
+impl LatentProcess for Rw {
+    fn name(&self) -> &'static str {
+        "RW"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        vec!["gamma2"]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.gamma2]
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        half_widths(levels)
+            .map(|m| self.gamma2 * unit_wv(m))
+            .collect()
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        half_widths(levels).map(|m| vec![unit_wv(m)]).collect()
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        half_widths(levels).map(|_| vec![vec![0.0]]).collect()
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        let s = (std::f64::consts::PI * f).sin();
+        Some(self.gamma2 / (4.0 * s * s))
+    }
+}

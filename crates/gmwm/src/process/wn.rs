@@ -1,0 +1,57 @@
+//! White noise (METHODS §0.2, §4.2).
+
+use serde::{Deserialize, Serialize};
+
+use super::{check_positive, half_widths, LatentProcess};
+use crate::error::ParamError;
+
+/// White noise: independent samples of variance `sigma2`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Wn {
+    /// Variance per sample.
+    pub sigma2: f64,
+}
+
+impl Wn {
+    /// Builds the process.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `sigma2` unless it is finite and > 0.
+    pub fn new(sigma2: f64) -> Result<Self, ParamError> {
+        check_positive("sigma2", sigma2)?;
+        Ok(Self { sigma2 })
+    }
+}
+
+/// METHODS §4.2: `nu2 = sigma2 / tau`, `tau = 2m`.
+fn unit_wv(m: f64) -> f64 {
+    let tau = 2.0 * m;
+    1.0 / tau
+}
+
+impl LatentProcess for Wn {
+    fn name(&self) -> &'static str {
+        "WN"
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        vec!["sigma2"]
+    }
+    fn params(&self) -> Vec<f64> {
+        vec![self.sigma2]
+    }
+    fn wv(&self, levels: usize) -> Vec<f64> {
+        half_widths(levels)
+            .map(|m| self.sigma2 * unit_wv(m))
+            .collect()
+    }
+    fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
+        half_widths(levels).map(|m| vec![unit_wv(m)]).collect()
+    }
+    fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
+        half_widths(levels).map(|_| vec![vec![0.0]]).collect()
+    }
+    fn spectral_density(&self, f: f64) -> Option<f64> {
+        let _ = f;
+        Some(self.sigma2)
+    }
+}
