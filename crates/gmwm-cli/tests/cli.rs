@@ -126,15 +126,27 @@ fn wv_table_and_csv_render() {
 }
 
 #[test]
-fn demo_runs_and_prints_its_truth() {
+fn demo_runs_and_compares_with_the_truth() {
     gmwm()
-        .args(["demo", "--n", "4096"])
+        .args(["demo", "--n", "65536"])
         .assert()
         .success()
         .stdout(
-            predicate::str::contains("demo sensor: AR1(phi=")
-                .and(predicate::str::contains("wavelet variance")),
+            predicate::str::contains("truth: GM(beta=0.25, sigma2_gm=7.08e-9)+")
+                .and(predicate::str::contains("implied WV"))
+                .and(predicate::str::contains(
+                    "the implied WV of the truth lies inside",
+                )),
         );
+    let out = gmwm()
+        .args(["demo", "--n", "8192", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let levels = doc["empirical"]["wv"].as_array().unwrap().len();
+    assert_eq!(doc["implied"]["wv"].as_array().unwrap().len(), levels);
+    assert_eq!(doc["implied"]["processes"].as_array().unwrap().len(), 6);
 }
 
 #[test]
@@ -361,5 +373,181 @@ fn robust_levels_without_a_scale_are_warned_and_null() {
     assert!(
         wv.iter().any(|v| v.is_null()),
         "missing levels are null, never numbers"
+    );
+}
+
+#[test]
+fn simulate_to_stdout_is_seeded_csv() {
+    let run = |seed: &str| {
+        gmwm()
+            .args([
+                "simulate",
+                "--model",
+                "AR1(phi=0.9, sigma2=1)+WN(sigma2=0.5)",
+                "--n",
+                "100",
+                "--seed",
+                seed,
+            ])
+            .output()
+            .unwrap()
+    };
+    let (a, b, c) = (run("1"), run("1"), run("2"));
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    assert_eq!(a.stdout, b.stdout, "same seed, same bits");
+    assert_ne!(a.stdout, c.stdout);
+    let text = String::from_utf8(a.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("x"));
+    let values: Vec<f64> = lines.map(|l| l.parse().unwrap()).collect();
+    assert_eq!(values.len(), 100);
+}
+
+#[test]
+fn simulate_to_gz_file_writes_a_sidecar_that_wv_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sim.csv.gz");
+    gmwm()
+        .args([
+            "simulate",
+            "--model",
+            "GM(beta=2, sigma2_gm=1)+WN(sigma2=0.01)",
+            "--n",
+            "5000",
+            "--freq",
+            "250",
+            "--components",
+            "-o",
+        ])
+        .arg(&path)
+        .assert()
+        .success()
+        .stdout("");
+    assert!(
+        dir.path().join("sim.json").is_file(),
+        "sidecar beside the data"
+    );
+    let out = gmwm()
+        .args(["wv", "--json", "--columns", "x"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        doc["series"][0]["freq_hz"], 250.0,
+        "rate taken from the sidecar"
+    );
+    assert_eq!(doc["series"][0]["n"], 5000);
+    // the components add up to x
+    let all = gmwm().args(["avar", "--csv"]).arg(&path).output().unwrap();
+    assert!(all.status.success());
+    let names: std::collections::BTreeSet<String> = String::from_utf8(all.stdout)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().to_string())
+        .collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+}
+
+#[test]
+fn implied_json_has_model_and_process_wv() {
+    let out = gmwm()
+        .args([
+            "implied",
+            "--model",
+            "AR1(phi=0.5, sigma2=1)+WN(sigma2=1)",
+            "--levels",
+            "3",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["tau"], serde_json::json!([2.0, 4.0, 8.0]));
+    let wv: Vec<f64> = doc["wv"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    // METHODS §4 test values: AR1(0.5, 1) 1/3, 0.3125, 0.2705078125; WN(1) 0.5, 0.25, 0.125
+    for (got, want) in wv
+        .iter()
+        .zip([1.0 / 3.0 + 0.5, 0.3125 + 0.25, 0.2705078125 + 0.125])
+    {
+        assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+    }
+    let procs = doc["processes"].as_array().unwrap();
+    assert_eq!(procs.len(), 2);
+    assert_eq!(procs[1]["process"], "WN(sigma2=1)");
+    assert_eq!(procs[1]["wv"].as_array().unwrap().len(), 3);
+    gmwm()
+        .args([
+            "implied",
+            "--model",
+            "3*GM(beta=1, sigma2_gm=1)+WN(sigma2=2)",
+            "--levels",
+            "4",
+            "--freq",
+            "100",
+        ])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("implied wavelet variance of"));
+}
+
+#[test]
+fn bad_models_are_one_line_errors() {
+    assert_one_line_error(
+        &[
+            "implied",
+            "--model",
+            "AR1(phi=0.9,, sigma2=1)",
+            "--levels",
+            "3",
+        ],
+        &["column 13", "parameter name"],
+    );
+    assert_one_line_error(&["implied", "--model", "GN()", "--levels", "3"], &["GM"]);
+    assert_one_line_error(
+        &["implied", "--model", "AR1()+WN()", "--levels", "3"],
+        &["fully specified"],
+    );
+    assert_one_line_error(
+        &["simulate", "--model", "AR1(phi=1.5, sigma2=1)", "--n", "10"],
+        &["phi"],
+    );
+    assert_one_line_error(
+        &[
+            "simulate",
+            "--model",
+            "WN(sigma2=1)+WN(sigma2=2)",
+            "--n",
+            "10",
+        ],
+        &["WN"],
+    );
+    assert_one_line_error(
+        &[
+            "simulate",
+            "--model",
+            "WN(sigma2=1)",
+            "--n",
+            "10",
+            "-o",
+            "/nonexistent/dir/x.csv",
+        ],
+        &["/nonexistent/dir/x.csv"],
     );
 }
