@@ -78,14 +78,13 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     };
     writeln!(
         out,
-        "{:>5} {:>12} {:>13} {:>13} {:>13} {:>13}  {}",
+        "{:>5} {:>12} {:>13} {:>13} {:>13} {:>13}  truth in CI",
         "level",
         "tau_s",
         format!("empirical {kind}"),
         "ci_low",
         "ci_high",
         "implied WV",
-        "truth in CI"
     )?;
     let mut inside = 0;
     for j in 0..wv.levels() {
