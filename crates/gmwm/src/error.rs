@@ -112,6 +112,22 @@ pub fn check_series(x: &[f64]) -> Result<(), SeriesError> {
     Ok(())
 }
 
+/// Checks a sampling rate: finite and positive (hertz).
+///
+/// # Errors
+/// [`ParamError`] named `freq` (the CLI flag).
+pub fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
+    if freq_hz.is_finite() && freq_hz > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(
+            "freq",
+            freq_hz,
+            "must be a positive number of hertz",
+        ))
+    }
+}
+
 /// Checks that every value is finite (an empty slice passes).
 ///
 /// # Errors

@@ -202,7 +202,7 @@ fn read_bad_options() {
     };
     assert_eq!(
         err(&p, &o),
-        "invalid freq_hz = -1: a positive finite number of Hz"
+        "invalid freq = -1: must be a positive number of hertz"
     );
 }
 

@@ -1,9 +1,9 @@
 //! The [`Imu`] object of METHODS §9.1: sensor columns with their sensor type, axis, unit and a
 //! common sampling rate.
 
-use super::read::{check_freq, Column, ImuRecordType, Table};
+use super::read::{Column, ImuRecordType, Table};
 use super::ReadError;
-use crate::error::{Error, ParamError};
+use crate::error::{check_freq, Error, ParamError};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 

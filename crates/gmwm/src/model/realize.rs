@@ -2,7 +2,7 @@
 //! implied Haar wavelet variance and the derivatives with respect to theta (§4.1–§4.6).
 
 use super::{Component, Model, ProcessKind};
-use crate::error::{Error, ParamError};
+use crate::error::{check_freq, Error, ParamError};
 use crate::process::{Ar1, Arma, Arma11, Dr, Gm, LatentProcess, Ma1, Process, Qn, Rw, Wn};
 use serde::Serialize;
 use std::fmt;
@@ -107,18 +107,6 @@ impl Model {
         Ok((0..levels)
             .map(|j| blocks.iter().flat_map(|b| b[j].iter().copied()).collect())
             .collect())
-    }
-}
-
-fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
-    if freq_hz.is_finite() && freq_hz > 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::new(
-            "freq",
-            freq_hz,
-            "must be a positive number of hertz",
-        ))
     }
 }
 

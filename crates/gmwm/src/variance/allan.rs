@@ -322,9 +322,7 @@ pub fn allan_variance(
     opts: &AllanOptions,
 ) -> Result<AllanVariance, Error> {
     check_series(x)?;
-    if !(freq_hz.is_finite() && freq_hz > 0.0) {
-        return Err(ParamError::new("freq", freq_hz, "must be a finite number > 0 (Hz)").into());
-    }
+    crate::error::check_freq(freq_hz)?;
     check_alpha(opts.alpha)?;
     let n = x.len();
     let method = Method::of(opts.kind, opts.convention);

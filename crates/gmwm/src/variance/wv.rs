@@ -5,7 +5,7 @@
 //! [`HaarWvAccumulator`], a streaming O(N·J) pass that never stores the coefficients and can
 //! consume its input in chunks.
 
-use crate::error::{check_finite, check_series, Error, ParamError, SeriesError};
+use crate::error::{check_finite, check_freq, check_series, Error, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
 use crate::variance::robust::{robust_ci, robust_scale, tuning_constant, RobustOptions};
@@ -377,18 +377,6 @@ pub fn wavelet_variance(
     let mut result = WaveletVariance::assemble(n, freq_hz, opts, &classical, robust, counts, eta);
     result.warnings = warnings;
     Ok(result)
-}
-
-fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
-    if freq_hz.is_finite() && freq_hz > 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::new(
-            "freq",
-            freq_hz,
-            "must be a positive number of hertz",
-        ))
-    }
 }
 
 /// Compensated mean.

@@ -11,7 +11,7 @@ pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordTy
 
 use super::sidecar::{find_sidecar, Sidecar};
 use super::ReadError;
-use crate::error::ParamError;
+use crate::error::{check_freq, ParamError};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -250,19 +250,6 @@ pub(crate) fn freq_from_times(t: &[f64]) -> Option<f64> {
     let span = last - first;
     let f = (t.len() - 1) as f64 / span;
     (t.len() >= 2 && span > 0.0 && f.is_finite()).then_some(f)
-}
-
-/// A sampling frequency must be a positive finite number.
-pub(crate) fn check_freq(f: f64) -> Result<(), ParamError> {
-    if f.is_finite() && f > 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::new(
-            "freq_hz",
-            f,
-            "a positive finite number of Hz",
-        ))
-    }
 }
 
 /// Resolved column selection: 0-based indices of the time column and the data columns.
