@@ -13,6 +13,7 @@ pub mod transform;
 pub mod weights;
 
 pub use objective::Objective;
+pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason};
 
 pub use transform::{ParamTransform, Parametrisation, PhiOrder, TransformPreset};
 pub use weights::{Weighting, Weights};

@@ -114,6 +114,15 @@ impl Objective {
         &self.nu_hat
     }
 
+    /// `sum_j omega_j nu2_hat_j^2`, the objective at a zero implied WV: the scale of `Q`.
+    pub fn scale(&self) -> f64 {
+        self.nu_hat
+            .iter()
+            .zip(&self.sqrt_omega)
+            .map(|(h, s)| (h * s).powi(2))
+            .sum()
+    }
+
     /// Sampling rate in Hz.
     pub fn freq_hz(&self) -> f64 {
         self.freq_hz
