@@ -222,11 +222,17 @@ fn minimize_on_simulated_ar1_wn_rw_lands_near_the_truth() {
     .unwrap();
     assert!(fit.convergence.converged, "{}", fit.convergence);
     assert!(fit.objective <= obj.value_at_theta(&theta0).unwrap());
-    // a few standard errors at N = 1e5 (loose; Monte Carlo belongs to a later suite)
+    // A few standard errors at N = 1e5 (loose; Monte Carlo belongs to a later suite). Over
+    // seeds 0..8, 1 - phi, sigma2 and WN stayed within 10% of the truth.
     const LOOSE: f64 = 0.25;
+    // RW is identified by the last ~4 of 16 levels only (few coefficients): over seeds 0..8
+    // its estimate ranged from 0.47 to 1.5 times the truth, so allow a factor 3.
+    const RW_FACTOR: f64 = 3.0;
     let t = &fit.theta;
     assert!(rel(1.0 - t[0], 1.0 - theta0[0]) < LOOSE, "phi {t:?}");
-    for i in 1..4 {
+    for i in 1..3 {
         assert!(rel(t[i], theta0[i]) < LOOSE, "theta[{i}]: {t:?}");
     }
+    let ratio = t[3] / theta0[3];
+    assert!((1.0 / RW_FACTOR..RW_FACTOR).contains(&ratio), "RW: {t:?}");
 }
