@@ -236,3 +236,84 @@ fn minimize_on_simulated_ar1_wn_rw_lands_near_the_truth() {
     let ratio = t[3] / theta0[3];
     assert!((1.0 / RW_FACTOR..RW_FACTOR).contains(&ratio), "RW: {t:?}");
 }
+
+#[test]
+fn gmwm_fits_simulated_data_with_both_weightings() {
+    use gmwm::fit::{Gmwm, GmwmFit, Weighting};
+    let truth = model("AR1(phi=0.99, sigma2=0.01)+WN(sigma2=1)");
+    let x = simulate_model(&truth, 50_000, 1.0, 5).unwrap();
+    let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+    let est = Gmwm::new(model("AR1()+WN()"));
+    let start = [0.9, 0.1, 0.5];
+    let fast = est.fit_wv(&wv, 1.0, &start).unwrap();
+    let fast2 = est
+        .fit_series(&x, 1.0, &WvOptions::default(), &start)
+        .unwrap();
+    assert_eq!(fast, fast2);
+    // The plug-in diag V of the coarsest levels (few coefficients) is itself very noisy and
+    // can be far too small (seed 5: level 15 gets a standard deviation 1/3 of its nu2_hat),
+    // which lets one level dominate; stop at 12 levels, where each V_jj rests on >= 12k
+    // coefficients.
+    let twelve = WvOptions {
+        levels: Some(12),
+        ..WvOptions::default()
+    };
+    let diag = est
+        .clone()
+        .with_weighting(Weighting::Diag)
+        .fit_series(&x, 1.0, &twelve, &start)
+        .unwrap();
+    for fit in [&fast, &diag] {
+        assert!(fit.convergence.converged, "{}", fit.convergence);
+        assert!(rel(1.0 - fit.theta[0], 0.01) < 0.25, "{fit}");
+        assert!(rel(fit.theta[2], 1.0) < 0.1, "{fit}");
+        assert_eq!(
+            fit.param_names,
+            ["AR1[0].phi", "AR1[0].sigma2", "WN[1].sigma2"]
+        );
+        assert_eq!(fit.implied_wv.wv.len(), fit.nu_hat.len());
+    }
+    assert_ne!(fast.weights, diag.weights);
+    let text = fast.to_string();
+    assert!(
+        text.contains("AR1[0].phi") && text.contains("objective Q"),
+        "{text}"
+    );
+    let json = serde_json::to_value(&fast).unwrap();
+    assert_eq!(json["convergence"]["converged"], true);
+    assert!(json["model"].as_str().unwrap().starts_with("AR1(phi="));
+    // diag weights need the series
+    let e = est
+        .clone()
+        .with_weighting(Weighting::Diag)
+        .fit_wv(&wv, 1.0, &start)
+        .unwrap_err();
+    assert!(matches!(e, FitError::Length { what: "series", .. }), "{e}");
+    let e = est.fit_wv(&wv, 1.0, &start[..2]).unwrap_err();
+    assert!(matches!(e, FitError::Length { what: "theta", .. }), "{e}");
+    let e = est.fit_wv(&wv, 1.0, &[1.5, 0.1, 0.5]).unwrap_err();
+    assert!(matches!(e, FitError::OutOfDomain { index: 0, .. }), "{e}");
+    fn contracts<T: Send + Sync + Clone>() {}
+    contracts::<Gmwm>();
+    contracts::<GmwmFit>();
+}
+
+#[test]
+fn gmwm_orders_ar1_components_by_phi() {
+    use gmwm::fit::Gmwm;
+    let text = "AR1(phi=0.999, sigma2=1e-4)+AR1(phi=0.9, sigma2=1e-2)+WN(sigma2=1)";
+    let truth = model(text);
+    let (nu, w) = exact_problem(&truth, 1 << 16, 1.0, 9);
+    // start given in the wrong order: both parametrisations report phi decreasing
+    let start = [0.8, 3e-2, 0.99, 3e-4, 0.5];
+    for order in [PhiOrder::Ordered, PhiOrder::Free] {
+        let fit = Gmwm::new(truth.clone())
+            .with_phi_order(order)
+            .fit_weighted(&nu, w.clone(), 1.0, &start)
+            .unwrap();
+        assert!(fit.convergence.converged, "{order:?}: {fit}");
+        assert!(rel(fit.theta[0], 0.999) < RECOVERY_TOL, "{order:?}: {fit}");
+        assert!(rel(fit.theta[2], 0.9) < RECOVERY_TOL, "{order:?}: {fit}");
+        assert_eq!(fit.start[0], 0.99);
+    }
+}

@@ -4,14 +4,16 @@
 //! The optimiser works on unconstrained parameters `u`; [`Parametrisation`] maps them to the
 //! model's `theta` (original parametrisation, GM in `(beta, sigma2_gm)`), [`Weights`] holds the
 //! diagonal of Omega, [`Objective`] evaluates `Q(u)` and its whitened residuals, and
-//! [`minimize`] runs the optimiser from a caller-given start. Non-convergence is reported in
+//! [`minimize`] runs the optimiser from a caller-given start; [`Gmwm`] ties them together. Non-convergence is reported in
 //! [`Convergence`], never hidden.
 
+pub mod gmwm;
 pub mod objective;
 pub mod optimize;
 pub mod transform;
 pub mod weights;
 
+pub use gmwm::{Gmwm, GmwmFit};
 pub use objective::Objective;
 pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason};
 
