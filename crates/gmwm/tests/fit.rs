@@ -317,3 +317,43 @@ fn gmwm_orders_ar1_components_by_phi() {
         assert_eq!(fit.start[0], 0.99);
     }
 }
+
+#[test]
+fn minimize_recovers_the_methods_5_10_navchip_model() {
+    // METHODS §5.10: 3*GM()+WN()+QN()+RW() at 250 Hz, ~3.1e6 samples, 21 levels. Weights: the
+    // chi-square proxy V_j = nu2_j^2 * 2 / eta_j with eta_j = M_j / 2^j (METHODS §1.7), so no
+    // simulation is needed.
+    let text = "GM(beta=6.28e-3, sigma2_gm=1.28e-8)+GM(beta=0.25, sigma2_gm=7.08e-9)\
+                +GM(beta=8.48, sigma2_gm=6.48e-9)+WN(sigma2=6.94e-7)+QN(q2=2.29e-6)\
+                +RW(gamma2=3.9e-14)";
+    let truth = model(text);
+    let (n, levels, freq) = (3_100_000f64, 21, 250.0);
+    let nu = truth.implied_wv(levels, freq).unwrap().wv;
+    let v: Vec<f64> = nu
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let tau = 2f64.powi(i as i32 + 1);
+            let eta = ((n - tau + 1.0) / tau).max(1.0);
+            x * x * 2.0 / eta
+        })
+        .collect();
+    let w = Weights::from_variances(v).unwrap();
+    let obj = objective(&truth, &nu, &w, freq, PhiOrder::Ordered);
+    let start = [1e-2, 2e-8, 0.15, 1e-8, 5.0, 1e-8, 1e-6, 1e-6, 1e-13];
+    let fit = minimize(
+        &obj,
+        &obj.parametrisation().to_u(&start).unwrap(),
+        &LmOptions::default(),
+    )
+    .unwrap();
+    assert!(fit.convergence.converged, "{}", fit.convergence);
+    let theta0: Vec<f64> = truth.values().into_iter().map(Option::unwrap).collect();
+    for (i, (a, b)) in fit.theta.iter().zip(&theta0).enumerate() {
+        assert!(
+            rel(*a, *b) < RECOVERY_TOL,
+            "theta[{i}] = {a} vs {b} ({})",
+            fit.convergence
+        );
+    }
+}
