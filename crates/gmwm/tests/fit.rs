@@ -293,6 +293,23 @@ fn gmwm_fits_simulated_data_with_both_weightings() {
     assert!(matches!(e, FitError::Length { what: "theta", .. }), "{e}");
     let e = est.fit_wv(&wv, 1.0, &[1.5, 0.1, 0.5]).unwrap_err();
     assert!(matches!(e, FitError::OutOfDomain { index: 0, .. }), "{e}");
+    // robust: parameters + 1 <= J (METHODS §5.7)
+    let robust3 = WvOptions {
+        levels: Some(3),
+        robust: Some(gmwm::RobustOptions::default()),
+        ..WvOptions::default()
+    };
+    let e = est.fit_series(&x, 1.0, &robust3, &start).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            FitError::TooFewLevels {
+                params: 4,
+                levels: 3
+            }
+        ),
+        "{e}"
+    );
     fn contracts<T: Send + Sync + Clone>() {}
     contracts::<Gmwm>();
     contracts::<GmwmFit>();
@@ -355,5 +372,34 @@ fn minimize_recovers_the_methods_5_10_navchip_model() {
             "theta[{i}] = {a} vs {b} ({})",
             fit.convergence
         );
+    }
+}
+
+#[test]
+fn gradient_matches_finite_differences_for_arma_family_and_drift() {
+    for (text, preset, start) in [
+        (
+            "ARMA11(phi=0.6, theta=0.3, sigma2=1)+WN(sigma2=0.5)+DR(omega=1e-3)",
+            TransformPreset::Ssm,
+            vec![0.4, -0.2, 2.0, 0.3, -2e-3],
+        ),
+        (
+            "MA1(theta=0.4, sigma2=1)+RW(gamma2=1e-3)",
+            TransformPreset::Imu,
+            vec![0.6, 0.5, 3e-3],
+        ),
+        (
+            "ARMA(2,1)(ar1=0.5, ar2=-0.3, ma1=0.2, sigma2=1)+WN(sigma2=0.5)",
+            TransformPreset::Ssm,
+            vec![0.4, -0.1, 0.3, 1.5, 0.2],
+        ),
+    ] {
+        let truth = model(text);
+        let nu = truth.implied_wv(10, 1.0).unwrap().wv;
+        let w = Weights::from_variances(nu.iter().map(|v| v * v * 0.01).collect()).unwrap();
+        let t = truth.without_values();
+        let p = Parametrisation::new(&t, preset, PhiOrder::Ordered, 1.0).unwrap();
+        let obj = Objective::new(&t, p, &nu, &w, 1.0).unwrap();
+        check_gradient(&obj, &obj.parametrisation().to_u(&start).unwrap());
     }
 }

@@ -84,7 +84,9 @@ impl Gmwm {
     /// # Errors
     /// [`FitError::Length`] for a wrong-length start or [`Weighting::Diag`]; errors of
     /// [`Weights::fast`], [`Parametrisation::to_u`] (a start outside its domain) and
-    /// [`Objective::new`]; [`FitError::BadStart`] when the start is not a valid model.
+    /// [`Objective::new`] (more parameters than levels; a robust WV needs one level more,
+    /// §5.7, reported with `params` counting that extra one); [`FitError::BadStart`] when the
+    /// start is not a valid model.
     pub fn fit_wv(
         &self,
         wv: &WaveletVariance,
@@ -92,7 +94,20 @@ impl Gmwm {
         start: &[f64],
     ) -> Result<GmwmFit, FitError> {
         let weights = Weights::new(self.weighting, wv, None)?;
+        self.check_robust_levels(wv)?;
         self.fit_weighted(&wv.wv, weights, freq_hz, start)
+    }
+
+    /// METHODS §5.7: a robust fit needs parameters + 1 <= J.
+    fn check_robust_levels(&self, wv: &WaveletVariance) -> Result<(), FitError> {
+        let params = self.model.n_params();
+        if wv.robust.is_some() && params + 1 > wv.levels() {
+            return Err(FitError::TooFewLevels {
+                params: params + 1,
+                levels: wv.levels(),
+            });
+        }
+        Ok(())
     }
 
     /// Computes the WV of `x` (METHODS §5.5 step 3, with `wv_options`) and the weights, then
@@ -109,6 +124,7 @@ impl Gmwm {
     ) -> Result<GmwmFit, FitError> {
         let wv = wavelet_variance(x, freq_hz, wv_options)?;
         let weights = Weights::new(self.weighting, &wv, Some(x))?;
+        self.check_robust_levels(&wv)?;
         self.fit_weighted(&wv.wv, weights, freq_hz, start)
     }
 
