@@ -59,6 +59,11 @@ fn objective_matches_methods_5_9() {
     assert!(rel(q, 0.01167277) < METHODS_TOL, "Q = {q}");
     let u = obj.parametrisation().to_u(&theta).unwrap();
     assert!(rel(obj.value(&u).unwrap(), q) < 1e-14);
+    // flattening objective F = 3 (1 - 1/1.1)^2 = 0.02479339 (METHODS §5.9)
+    let flat = Weights::flattening(&nu_hat).unwrap();
+    let obj = objective(&truth, &nu_hat, &flat, 1.0, PhiOrder::Ordered);
+    let f = obj.value_at_theta(&theta).unwrap();
+    assert!(rel(f, 0.02479339) < METHODS_TOL, "F = {f}");
 }
 
 #[test]

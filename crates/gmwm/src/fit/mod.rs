@@ -15,7 +15,7 @@ pub mod weights;
 
 pub use gmwm::{Gmwm, GmwmFit};
 pub use objective::Objective;
-pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason};
+pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason, STALL_COSINE};
 
 pub use transform::{ParamTransform, Parametrisation, PhiOrder, TransformPreset};
 pub use weights::{Weighting, Weights};

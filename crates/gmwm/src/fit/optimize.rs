@@ -30,12 +30,19 @@ pub enum StopReason {
     MaxIterations,
     /// The evaluation limit was reached first: **not converged**.
     MaxEvaluations,
+    /// Trial steps kept failing (no reduction of `Q`, or an invalid model) until the damping
+    /// made them vanish, away from a stationary point (gradient cosine above
+    /// [`STALL_COSINE`]): **not converged**.
+    Stalled,
 }
 
 impl StopReason {
     /// Whether this reason means convergence.
     pub fn is_converged(self) -> bool {
-        !matches!(self, StopReason::MaxIterations | StopReason::MaxEvaluations)
+        !matches!(
+            self,
+            StopReason::MaxIterations | StopReason::MaxEvaluations | StopReason::Stalled
+        )
     }
 }
 
@@ -48,6 +55,7 @@ impl fmt::Display for StopReason {
             StopReason::FunctionTolerance => "objective reduction below tolerance",
             StopReason::MaxIterations => "iteration limit reached (not converged)",
             StopReason::MaxEvaluations => "evaluation limit reached (not converged)",
+            StopReason::Stalled => "steps vanished away from a stationary point (not converged)",
         })
     }
 }
@@ -113,6 +121,11 @@ const INITIAL_DAMPING: f64 = 1e-3;
 /// Floor of Marquardt's scaling relative to the largest diagonal of `J'J`, so that a parameter
 /// without influence (zero column) still gets a damped, finite step.
 const SCALE_FLOOR: f64 = 1e-20;
+
+/// Gradient cosine above which a step-tolerance stop that followed rejected trials counts as
+/// [`StopReason::Stalled`]. At a true minimum the cosine is rounding noise (below ~1e-7 in the
+/// tests, where `Q` is known to ~1e-16 relative); 1e-4 leaves three decades of margin.
+pub const STALL_COSINE: f64 = 1e-4;
 
 /// The minimiser found by [`minimize`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -265,6 +278,7 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
             mu = INITIAL_DAMPING;
         }
         // inner loop: raise the damping until a step reduces Q
+        let mut rejected = false;
         loop {
             if evaluations >= opts.max_evaluations {
                 return Ok(finish(
@@ -289,14 +303,12 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
             let h_norm = sum_sq(&h).sqrt();
             let u_norm = sum_sq(&u).sqrt();
             if h_norm <= opts.step_tolerance * (u_norm + opts.step_tolerance) {
-                return Ok(finish(
-                    StopReason::StepTolerance,
-                    u,
-                    &cur,
-                    q,
-                    iterations,
-                    evaluations,
-                ));
+                let reason = if rejected && cosine > STALL_COSINE {
+                    StopReason::Stalled
+                } else {
+                    StopReason::StepTolerance
+                };
+                return Ok(finish(reason, u, &cur, q, iterations, evaluations));
             }
             for k in 0..p {
                 u_new[k] = u[k] + h[k];
@@ -330,6 +342,7 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
                 }
                 break;
             }
+            rejected = true;
             mu *= nu;
             nu *= 2.0;
         }

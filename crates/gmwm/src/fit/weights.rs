@@ -85,6 +85,18 @@ impl Weights {
         Self::from_v(v, "diag variance")
     }
 
+    /// METHODS §5.4 stage 1: the flattening objective `F = sum_j (1 - nu2_j / nu2_hat_j)^2` is
+    /// `Q` with `omega_j = 1 / nu2_hat_j^2` (`V_jj = nu2_hat_j^2`).
+    ///
+    /// # Errors
+    /// [`FitError::BadWeight`] for a zero or non-finite `nu2_hat_j`.
+    pub fn flattening(nu_hat: &[f64]) -> Result<Self, FitError> {
+        Self::from_v(
+            nu_hat.iter().map(|v| v * v).collect(),
+            "squared wavelet variance",
+        )
+    }
+
     /// Omega = I (every level weighted 1), for tests and comparisons.
     pub fn unit(levels: usize) -> Self {
         Self {
