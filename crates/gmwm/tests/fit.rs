@@ -101,6 +101,13 @@ fn objective_rejects_bad_input() {
         minimize(&obj, &[0.0], &LmOptions::default()),
         Err(FitError::Length { .. })
     ));
+    // an overflowing start is refused, naming the first level that overflows
+    let t = model("WN()+RW()");
+    let p = Parametrisation::new(&t, TransformPreset::Imu, PhiOrder::Ordered, 1.0).unwrap();
+    let obj = Objective::new(&t, p, &[1.0; 10], &Weights::unit(10), 1.0).unwrap();
+    let u0 = obj.parametrisation().to_u(&[1.0, 1e308]).unwrap();
+    let e = minimize(&obj, &u0, &LmOptions::default()).unwrap_err();
+    assert!(matches!(e, FitError::NonFiniteStart { .. }), "{e}");
 }
 
 /// Central differences of `Q(u)` with step `h` in u: truncation ~h^2 Q''' and rounding

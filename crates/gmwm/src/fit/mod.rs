@@ -97,6 +97,14 @@ pub enum FitError {
     /// The implied WV cannot be evaluated at the start.
     #[error("the starting values cannot be evaluated: {0}")]
     BadStart(#[source] Box<crate::Error>),
+    /// The implied WV at the start is not finite (e.g. an enormous variance overflowed).
+    #[error("level {level}: the implied wavelet variance at the start is {value}; choose a smaller start")]
+    NonFiniteStart {
+        /// 1-based level.
+        level: usize,
+        /// The implied WV there.
+        value: f64,
+    },
     /// An engine computation the fit relies on failed (e.g. the diag covariance of a bad series).
     #[error(transparent)]
     Engine(Box<crate::Error>),

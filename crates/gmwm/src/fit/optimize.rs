@@ -184,8 +184,8 @@ fn sum_sq(r: &[f64]) -> f64 {
 /// counts as a failed step. The result always says how it ended ([`Convergence`]).
 ///
 /// # Errors
-/// [`FitError::Length`] if `u0` has the wrong length; [`FitError::BadStart`] if the objective
-/// cannot be evaluated at `u0`.
+/// [`FitError::Length`] if `u0` has the wrong length; [`FitError::BadStart`] if theta(u0) is not
+/// a valid model; [`FitError::NonFiniteStart`] if its implied WV overflows.
 pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<Minimum, FitError> {
     let p = objective.n_params();
     let levels = objective.levels();
@@ -202,10 +202,11 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
     objective
         .evaluate(&u, &mut cur, true)
         .map_err(|e| FitError::BadStart(Box::new(e)))?;
-    if !cur.r.iter().all(|v| v.is_finite()) {
-        return Err(FitError::BadStart(Box::new(
-            crate::ParamError::new("start", "non-finite implied WV", "finite implied WV").into(),
-        )));
+    if let Some(j) = cur.r.iter().position(|v| !v.is_finite()) {
+        return Err(FitError::NonFiniteStart {
+            level: j + 1,
+            value: cur.nu[j],
+        });
     }
     let mut evaluations = 1;
     let mut iterations = 0;
