@@ -149,7 +149,8 @@ impl Parametrisation {
     /// [`TransformPreset::Imu`] AR1/GM `phi` logit (0, 1), GM `beta` log, MA1 `theta` logit,
     /// ARMA11 and ARMA coefficients pseudo-logit; with [`TransformPreset::Ssm`] AR1 `phi` and MA1
     /// `theta` pseudo-logit, ARMA coefficients of polynomial order 1 pseudo-logit and of
-    /// higher order logit2; in both every variance log and the DR slope `ln |omega|`. Two or more AR1/GM
+    /// higher order logit2; in both GM `beta` log (a GM has `phi` in (0, 1)), every variance
+    /// log and the DR slope `ln |omega|`. Two or more AR1/GM
     /// components with [`PhiOrder::Ordered`] share the ordered chain of the module doc.
     ///
     /// # Errors
@@ -298,7 +299,7 @@ impl Parametrisation {
             let domain = match slot {
                 Slot::Phi if self.width > 1.0 => "phi in (-1, 1)",
                 Slot::Phi => "phi in (0, 1)",
-                Slot::Beta(_) => "beta > 0",
+                Slot::Beta(_) => "beta > 0 with exp(-beta / freq) not rounding to 0 or 1",
             };
             if !(c.is_finite() && c > 0.0 && c < self.width) {
                 return Err(self.out_of_domain(i, v, domain));
