@@ -20,6 +20,7 @@
 #![deny(missing_docs)]
 
 pub mod error;
+pub mod fit;
 pub mod imu;
 pub mod math;
 pub mod model;

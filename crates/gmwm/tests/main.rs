@@ -5,6 +5,7 @@
 
 mod allan;
 mod common;
+mod fit;
 mod model;
 mod process;
 mod read;

@@ -1,0 +1,117 @@
+//! GMWM estimation (METHODS §5): parameter transforms (§5.3), weighting matrices (§5.2), the
+//! objective with its analytic gradient (§5.1, §5.4) and a Levenberg–Marquardt optimiser.
+//!
+//! The optimiser works on unconstrained parameters `u`; [`Parametrisation`] maps them to the
+//! model's `theta` (original parametrisation, GM in `(beta, sigma2_gm)`), [`Weights`] holds the
+//! diagonal of Omega, [`Objective`] evaluates `Q(u)` and its whitened residuals, and
+//! [`minimize`] runs the optimiser from a caller-given start; [`Gmwm`] ties them together. Non-convergence is reported in
+//! [`Convergence`], never hidden.
+
+pub mod gmwm;
+pub mod objective;
+pub mod optimize;
+pub mod transform;
+pub mod weights;
+
+pub use gmwm::{Gmwm, GmwmFit};
+pub use objective::Objective;
+pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason, STALL_COSINE};
+
+pub use transform::{ParamTransform, Parametrisation, PhiOrder, TransformPreset};
+pub use weights::{Weighting, Weights};
+
+use thiserror::Error;
+
+/// Why a fit could not be set up or evaluated.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum FitError {
+    /// A parameter value lies outside the domain of its transform (METHODS §5.3).
+    #[error("parameter {index} ({name}) = {value} is outside the domain of its transform: expected {expected}")]
+    OutOfDomain {
+        /// 0-based index in theta.
+        index: usize,
+        /// Parameter label, e.g. `GM[0].beta` (component index in brackets).
+        name: String,
+        /// The value given.
+        value: f64,
+        /// The valid domain.
+        expected: &'static str,
+    },
+    /// With ordered AR1/GM components the phis must be strictly decreasing in model order.
+    #[error(
+        "AR1/GM components {first} and {second} (0-based) are not in strictly decreasing phi \
+         order (phi {phi_first} then {phi_second}); sort them with \
+         Parametrisation::canonical_order or use PhiOrder::Free"
+    )]
+    PhiNotOrdered {
+        /// Component index of the earlier term.
+        first: usize,
+        /// Component index of the later term.
+        second: usize,
+        /// phi of the earlier term.
+        phi_first: f64,
+        /// phi of the later term.
+        phi_second: f64,
+    },
+    /// A vector has the wrong length.
+    #[error("{what} has {found} values; expected {expected}")]
+    Length {
+        /// Which vector (e.g. "theta", "u", "weights").
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Length given.
+        found: usize,
+    },
+    /// A level's weight cannot be formed: its CI width or variance is zero or not finite
+    /// (e.g. a robust level without a scale, or the last level of a power-of-two series).
+    #[error(
+        "level {level}: {what} = {value} gives no usable weight (it must be finite and > 0); \
+         drop this level by fitting fewer levels"
+    )]
+    BadWeight {
+        /// 1-based level.
+        level: usize,
+        /// What was inverted ("CI width", "diag variance").
+        what: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// An empirical wavelet variance is missing or not finite.
+    #[error("level {level}: the empirical wavelet variance {value} is not a finite number > 0; fit fewer levels")]
+    BadWv {
+        /// 1-based level.
+        level: usize,
+        /// The value.
+        value: f64,
+    },
+    /// More parameters than levels: the model is not identified (METHODS §5.7).
+    #[error("the model has {params} parameters but only {levels} levels are fitted; use a smaller model or more levels")]
+    TooFewLevels {
+        /// Number of parameters.
+        params: usize,
+        /// Number of levels.
+        levels: usize,
+    },
+    /// The implied WV cannot be evaluated at the start.
+    #[error("the starting values cannot be evaluated: {0}")]
+    BadStart(#[source] Box<crate::Error>),
+    /// The implied WV at the start is not finite (e.g. an enormous variance overflowed).
+    #[error("level {level}: the implied wavelet variance at the start is {value}; choose a smaller start")]
+    NonFiniteStart {
+        /// 1-based level.
+        level: usize,
+        /// The implied WV there.
+        value: f64,
+    },
+    /// An engine computation the fit relies on failed (e.g. the diag covariance of a bad series).
+    #[error(transparent)]
+    Engine(Box<crate::Error>),
+}
+
+impl From<crate::Error> for FitError {
+    fn from(e: crate::Error) -> Self {
+        FitError::Engine(Box::new(e))
+    }
+}

@@ -1,0 +1,276 @@
+//! The GMWM objective on the unconstrained parameters (METHODS §5.1, §5.4).
+//!
+//! `Q(u) = sum_j omega_j (nu2_hat_j - nu2_j(theta(u)))^2 = sum_j r_j^2` with whitened residuals
+//! `r_j = sqrt(omega_j) (nu2_hat_j - nu2_j)`. Wavelet variances span many decades (1e-6 to 1e-14
+//! for an IMU), but with the fast or diag weights `sqrt(omega_j)` is about `1 / nu2_j` times a
+//! level constant, so the whitened residuals are relative errors of order one and the
+//! least-squares problem is well scaled; the transforms of §5.3 put every variance on a log scale.
+
+use super::{FitError, Parametrisation, Weights};
+use crate::model::Model;
+use crate::process::LatentProcess;
+
+/// The objective of one fit: a model template, the target WV, the weights and the transforms.
+#[derive(Debug, Clone)]
+pub struct Objective {
+    model: Model,
+    param: Parametrisation,
+    nu_hat: Vec<f64>,
+    sqrt_omega: Vec<f64>,
+    freq_hz: f64,
+}
+
+/// Residuals and their Jacobian at one `u` (reused buffers).
+#[derive(Debug, Clone)]
+pub(crate) struct Eval {
+    /// theta(u).
+    pub theta: Vec<f64>,
+    /// d theta / d u, row-major p x p.
+    pub dtheta: Vec<f64>,
+    /// Whitened residuals, J.
+    pub r: Vec<f64>,
+    /// d r / d u, row-major J x p.
+    pub jac: Vec<f64>,
+    /// Implied WV nu2(theta), J.
+    pub nu: Vec<f64>,
+}
+
+impl Objective {
+    /// The objective of `model` (values ignored) against `nu2_hat` with weights `weights` at
+    /// `freq_hz` (used by GM terms, METHODS §4.3).
+    ///
+    /// # Errors
+    /// [`FitError::Length`] when the weights, WV or parametrisation disagree in size;
+    /// [`FitError::BadWv`] for a non-finite or non-positive `nu2_hat_j`;
+    /// [`FitError::TooFewLevels`] when the model has more parameters than levels (§5.7).
+    pub fn new(
+        model: &Model,
+        param: Parametrisation,
+        nu_hat: &[f64],
+        weights: &Weights,
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        if weights.levels() != nu_hat.len() {
+            return Err(FitError::Length {
+                what: "weights",
+                expected: nu_hat.len(),
+                found: weights.levels(),
+            });
+        }
+        if param.n_params() != model.n_params() {
+            return Err(FitError::Length {
+                what: "parametrisation",
+                expected: model.n_params(),
+                found: param.n_params(),
+            });
+        }
+        if let Some((j, &value)) = nu_hat
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+        {
+            return Err(FitError::BadWv {
+                level: j + 1,
+                value,
+            });
+        }
+        if model.n_params() > nu_hat.len() {
+            return Err(FitError::TooFewLevels {
+                params: model.n_params(),
+                levels: nu_hat.len(),
+            });
+        }
+        Ok(Self {
+            model: model.without_values(),
+            param,
+            nu_hat: nu_hat.to_vec(),
+            sqrt_omega: weights.omega.iter().map(|w| w.sqrt()).collect(),
+            freq_hz,
+        })
+    }
+
+    /// Number of levels J.
+    pub fn levels(&self) -> usize {
+        self.nu_hat.len()
+    }
+
+    /// Number of parameters p.
+    pub fn n_params(&self) -> usize {
+        self.param.n_params()
+    }
+
+    /// The transforms.
+    pub fn parametrisation(&self) -> &Parametrisation {
+        &self.param
+    }
+
+    /// The model template (no values).
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The target WV `nu2_hat`.
+    pub fn nu_hat(&self) -> &[f64] {
+        &self.nu_hat
+    }
+
+    /// `sum_j omega_j nu2_hat_j^2`, the objective at a zero implied WV: the scale of `Q`.
+    pub fn scale(&self) -> f64 {
+        self.nu_hat
+            .iter()
+            .zip(&self.sqrt_omega)
+            .map(|(h, s)| (h * s).powi(2))
+            .sum()
+    }
+
+    /// Sampling rate in Hz.
+    pub fn freq_hz(&self) -> f64 {
+        self.freq_hz
+    }
+
+    /// Implied WV `nu2(theta)` and, if asked, its Jacobian `A` (row-major J x p, METHODS §4.5,
+    /// original parametrisation) into the given buffers.
+    fn implied(
+        &self,
+        theta: &[f64],
+        nu: &mut [f64],
+        a: Option<&mut [f64]>,
+    ) -> Result<(), crate::Error> {
+        let levels = self.levels();
+        let processes = self.model.with_values(theta)?.processes(self.freq_hz)?;
+        nu.fill(0.0);
+        for p in &processes {
+            for (n, w) in nu.iter_mut().zip(p.wv(levels)) {
+                *n += w;
+            }
+        }
+        if let Some(a) = a {
+            let np = self.n_params();
+            let mut col = 0;
+            for p in &processes {
+                let block = p.jacobian(levels);
+                for (j, row) in block.iter().enumerate() {
+                    a[j * np + col..j * np + col + row.len()].copy_from_slice(row);
+                }
+                col += block.first().map_or(0, Vec::len);
+            }
+        }
+        Ok(())
+    }
+
+    /// A fresh evaluation buffer.
+    pub(crate) fn buffer(&self) -> Eval {
+        let (j, p) = (self.levels(), self.n_params());
+        Eval {
+            theta: vec![0.0; p],
+            dtheta: vec![0.0; p * p],
+            r: vec![0.0; j],
+            jac: vec![0.0; j * p],
+            nu: vec![0.0; j],
+        }
+    }
+
+    /// Whitened residuals at `u` (and their Jacobian when `with_jacobian`) into `ev`.
+    /// `u` has length p (caller's invariant).
+    ///
+    /// `d r_j / d u_k = -sqrt(omega_j) sum_i A_ji d theta_i / d u_k` (METHODS §5.4).
+    pub(crate) fn evaluate(
+        &self,
+        u: &[f64],
+        ev: &mut Eval,
+        with_jacobian: bool,
+    ) -> Result<(), crate::Error> {
+        let p = self.n_params();
+        self.param.eval(
+            u,
+            &mut ev.theta,
+            with_jacobian.then_some(&mut ev.dtheta[..]),
+        );
+        if with_jacobian {
+            // A goes into jac first, then is multiplied by dtheta/du in place, row by row.
+            self.implied(&ev.theta, &mut ev.nu, Some(&mut ev.jac))?;
+            let mut row = vec![0.0; p];
+            for j in 0..self.levels() {
+                let a = &mut ev.jac[j * p..(j + 1) * p];
+                for (k, out) in row.iter_mut().enumerate() {
+                    *out = -self.sqrt_omega[j]
+                        * (0..p).map(|i| a[i] * ev.dtheta[i * p + k]).sum::<f64>();
+                }
+                a.copy_from_slice(&row);
+            }
+        } else {
+            self.implied(&ev.theta, &mut ev.nu, None)?;
+        }
+        for (j, r) in ev.r.iter_mut().enumerate() {
+            *r = self.sqrt_omega[j] * (self.nu_hat[j] - ev.nu[j]);
+        }
+        Ok(())
+    }
+
+    fn check_u(&self, u: &[f64]) -> Result<(), FitError> {
+        if u.len() == self.n_params() {
+            Ok(())
+        } else {
+            Err(FitError::Length {
+                what: "u",
+                expected: self.n_params(),
+                found: u.len(),
+            })
+        }
+    }
+
+    /// METHODS §5.1, paper eq. (3): `Q = sum_j omega_j (nu2_hat_j - nu2_j(theta))^2` at theta
+    /// (original parametrisation). No factor N.
+    ///
+    /// # Errors
+    /// [`FitError::Length`]; [`FitError::Engine`] when theta is not a valid model.
+    pub fn value_at_theta(&self, theta: &[f64]) -> Result<f64, FitError> {
+        if theta.len() != self.n_params() {
+            return Err(FitError::Length {
+                what: "theta",
+                expected: self.n_params(),
+                found: theta.len(),
+            });
+        }
+        let mut nu = vec![0.0; self.levels()];
+        self.implied(theta, &mut nu, None)?;
+        Ok(nu
+            .iter()
+            .zip(&self.nu_hat)
+            .zip(&self.sqrt_omega)
+            .map(|((n, h), s)| (s * (h - n)).powi(2))
+            .sum())
+    }
+
+    /// METHODS §5.1: `Q(theta(u))`.
+    ///
+    /// # Errors
+    /// [`FitError::Length`]; [`FitError::Engine`] when theta(u) is not a valid model (e.g. a
+    /// transformed variance that underflowed to 0).
+    pub fn value(&self, u: &[f64]) -> Result<f64, FitError> {
+        self.check_u(u)?;
+        let mut ev = self.buffer();
+        self.evaluate(u, &mut ev, false)?;
+        Ok(ev.r.iter().map(|r| r * r).sum())
+    }
+
+    /// METHODS §5.4: `grad_u Q = -2 sum_j omega_j r_j (A(theta) d theta / d u)_j` with the
+    /// analytic A of §4.5 (GM with respect to `beta`, `sigma2_gm` at the rate).
+    ///
+    /// # Errors
+    /// As [`Objective::value`].
+    pub fn gradient(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.check_u(u)?;
+        let p = self.n_params();
+        let mut ev = self.buffer();
+        self.evaluate(u, &mut ev, true)?;
+        // with whitened r and J = dr/du: grad = 2 J' r
+        Ok((0..p)
+            .map(|k| {
+                2.0 * (0..self.levels())
+                    .map(|j| ev.jac[j * p + k] * ev.r[j])
+                    .sum::<f64>()
+            })
+            .collect())
+    }
+}

@@ -1,0 +1,634 @@
+//! Parameter transforms: the optimiser works on unconstrained `u`, the model on `theta`
+//! (METHODS §5.3).
+//!
+//! # Ordered AR1/GM components (deviation from the package, documented)
+//! With [`PhiOrder::Ordered`] and two or more AR1 (or GM) components, their `phi`s are
+//! parametrised jointly so that they are strictly decreasing in model order (largest `phi` first,
+//! the order §5.6 intends): with `c = 1 - phi`, lower bound `lo` (0 for GM and for AR1 in the IMU
+//! preset, -1 for AR1 in the SSM preset) and the AR1/GM slots `s = 0..k` in model order,
+//! `c_{k-1} = (1 - lo) logistic(-u_{k-1})` and `c_s = c_{s+1} logistic(-u_s)`. This is the chain
+//! `phi_{i+1} = phi_i + (1 - phi_i) logistic(u_{i+1})` of §5.3 written from the smallest `phi`
+//! upwards and in `1 - phi`, which keeps full relative precision for `phi` near 1. A GM slot holds
+//! `beta = -freq ln(1 - c)`. Label switching then cannot happen and §5.6 needs no reordering.
+
+use super::FitError;
+use crate::model::{Model, ProcessKind};
+use serde::{Deserialize, Serialize};
+
+/// Logistic function `1 / (1 + e^{-u})`, evaluated without overflow for either sign of `u`.
+pub fn logistic(u: f64) -> f64 {
+    if u >= 0.0 {
+        1.0 / (1.0 + (-u).exp())
+    } else {
+        let e = u.exp();
+        e / (1.0 + e)
+    }
+}
+
+/// One scalar transform `theta = g(u)` (METHODS §5.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ParamTransform {
+    /// `u = theta`.
+    Identity,
+    /// `u = ln theta`, theta in (0, inf): variances, GM beta.
+    Log,
+    /// `u = ln(theta / (1 - theta))`, theta in (0, 1).
+    Logit,
+    /// Pseudo-logit `u = ln((1 + theta) / (1 - theta))`, theta in (-1, 1); inverse
+    /// `2 / (1 + e^{-u}) - 1`.
+    PseudoLogit,
+    /// Logit2 `u = ln((theta + 2) / (2 - theta))`, theta in (-2, 2); inverse `4 / (1 + e^{-u}) - 2`.
+    Logit2,
+    /// `u = ln |theta|`, inverse `e^u`: the DR slope, whose sign is lost (the estimate is >= 0).
+    LogAbs,
+}
+
+impl ParamTransform {
+    /// The open domain of theta, in words (for error messages).
+    pub fn domain(self) -> &'static str {
+        match self {
+            ParamTransform::Identity => "a finite number",
+            ParamTransform::Log => "a finite number > 0",
+            ParamTransform::Logit => "a number in (0, 1)",
+            ParamTransform::PseudoLogit => "a number in (-1, 1)",
+            ParamTransform::Logit2 => "a number in (-2, 2)",
+            ParamTransform::LogAbs => "a finite non-zero number",
+        }
+    }
+
+    /// METHODS §5.3: `u = g^{-1}(theta)`; `None` when theta is outside the open domain.
+    pub fn to_u(self, theta: f64) -> Option<f64> {
+        if !theta.is_finite() {
+            return None;
+        }
+        let u = match self {
+            ParamTransform::Identity => theta,
+            ParamTransform::Log if theta > 0.0 => theta.ln(),
+            ParamTransform::Logit if theta > 0.0 && theta < 1.0 => (theta / (1.0 - theta)).ln(),
+            ParamTransform::PseudoLogit if theta.abs() < 1.0 => 2.0 * theta.atanh(),
+            ParamTransform::Logit2 if theta.abs() < 2.0 => ((theta + 2.0) / (2.0 - theta)).ln(),
+            ParamTransform::LogAbs if theta != 0.0 => theta.abs().ln(),
+            _ => return None,
+        };
+        u.is_finite().then_some(u)
+    }
+
+    /// METHODS §5.3: `theta = g(u)`.
+    pub fn from_u(self, u: f64) -> f64 {
+        match self {
+            ParamTransform::Identity => u,
+            ParamTransform::Log | ParamTransform::LogAbs => u.exp(),
+            ParamTransform::Logit => logistic(u),
+            // 2 logistic(u) - 1 = tanh(u / 2), without the cancellation near u = 0
+            ParamTransform::PseudoLogit => (0.5 * u).tanh(),
+            ParamTransform::Logit2 => 2.0 * (0.5 * u).tanh(),
+        }
+    }
+
+    /// `d theta / d u` at `u`.
+    pub fn dtheta_du(self, u: f64) -> f64 {
+        let s = || logistic(u) * logistic(-u);
+        match self {
+            ParamTransform::Identity => 1.0,
+            ParamTransform::Log | ParamTransform::LogAbs => u.exp(),
+            ParamTransform::Logit => s(),
+            ParamTransform::PseudoLogit => 2.0 * s(),
+            ParamTransform::Logit2 => 4.0 * s(),
+        }
+    }
+}
+
+/// Which table of METHODS §5.3 to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TransformPreset {
+    /// model.type "imu" (the package default since 2020, §5.7): AR1/GM `phi` in (0, 1).
+    #[default]
+    Imu,
+    /// model.type "ssm": AR1 `phi` in (-1, 1); ARMA coefficients of order > 1 in (-2, 2).
+    Ssm,
+}
+
+/// How several AR1/GM components are parametrised (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PhiOrder {
+    /// Jointly, with strictly decreasing `phi` in model order (the §5.3 port suggestion;
+    /// default because it makes the output order well defined).
+    #[default]
+    Ordered,
+    /// Each `phi` (GM: `beta`) on its own, as the package (no ordering constraint).
+    Free,
+}
+
+/// What an ordered slot holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Slot {
+    /// AR1 `phi`.
+    Phi,
+    /// GM `beta` at this rate (Hz).
+    Beta(f64),
+}
+
+/// The map `u -> theta` of a whole model (METHODS §5.3).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parametrisation {
+    /// Per parameter: its scalar transform, `None` for the ordered slots.
+    single: Vec<Option<ParamTransform>>,
+    /// Ordered slots in model order: (theta index, component index, what it holds).
+    ordered: Vec<(usize, usize, Slot)>,
+    /// `1 - lo` of the ordered chain.
+    width: f64,
+    /// Parameter labels such as `GM[0].beta`.
+    names: Vec<String>,
+}
+
+impl Parametrisation {
+    /// The transforms of METHODS §5.3 for `model` (values are ignored): with
+    /// [`TransformPreset::Imu`] AR1/GM `phi` logit (0, 1), GM `beta` log, MA1 `theta` logit,
+    /// ARMA11 and ARMA coefficients pseudo-logit; with [`TransformPreset::Ssm`] AR1 `phi` and MA1
+    /// `theta` pseudo-logit, ARMA coefficients of polynomial order 1 pseudo-logit and of
+    /// higher order logit2; in both GM `beta` log (a GM has `phi` in (0, 1)), every variance
+    /// log and the DR slope `ln |omega|`. Two or more AR1/GM
+    /// components with [`PhiOrder::Ordered`] share the ordered chain of the module doc.
+    ///
+    /// # Errors
+    /// [`FitError::BadStart`] if `freq_hz` is not a positive finite number and the model has GM
+    /// terms.
+    pub fn new(
+        model: &Model,
+        preset: TransformPreset,
+        order: PhiOrder,
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        use ParamTransform as T;
+        let ssm = preset == TransformPreset::Ssm;
+        let n_ordered = model.count(ProcessKind::Ar1) + model.count(ProcessKind::Gm);
+        let chain = order == PhiOrder::Ordered && n_ordered >= 2;
+        if model.uses_gm() && !(freq_hz.is_finite() && freq_hz > 0.0) {
+            return Err(FitError::BadStart(Box::new(
+                crate::ParamError::new("freq", freq_hz, "must be a positive number of hertz")
+                    .into(),
+            )));
+        }
+        let mut single = Vec::with_capacity(model.n_params());
+        let mut ordered = Vec::new();
+        let mut names = Vec::with_capacity(model.n_params());
+        for (ci, c) in model.components().iter().enumerate() {
+            let kind = c.kind;
+            for name in kind.param_names() {
+                names.push(format!("{}[{ci}].{name}", kind.base_name()));
+            }
+            let coef = |order: usize| {
+                if ssm && order > 1 {
+                    T::Logit2
+                } else {
+                    T::PseudoLogit
+                }
+            };
+            let unit = if ssm { T::PseudoLogit } else { T::Logit };
+            let at = single.len();
+            match kind {
+                ProcessKind::Wn | ProcessKind::Qn | ProcessKind::Rw => single.push(Some(T::Log)),
+                ProcessKind::Dr => single.push(Some(T::LogAbs)),
+                ProcessKind::Ar1 | ProcessKind::Gm => {
+                    if chain {
+                        let slot = if kind == ProcessKind::Gm {
+                            Slot::Beta(freq_hz)
+                        } else {
+                            Slot::Phi
+                        };
+                        ordered.push((at, ci, slot));
+                        single.push(None);
+                    } else if kind == ProcessKind::Gm {
+                        single.push(Some(T::Log));
+                    } else {
+                        single.push(Some(unit));
+                    }
+                    single.push(Some(T::Log));
+                }
+                ProcessKind::Ma1 => single.extend([Some(unit), Some(T::Log)]),
+                ProcessKind::Arma11 => {
+                    single.extend([Some(T::PseudoLogit), Some(T::PseudoLogit), Some(T::Log)])
+                }
+                ProcessKind::Ar(_) | ProcessKind::Ma(_) | ProcessKind::Arma(..) => {
+                    let (p, q) = kind.orders();
+                    let (tp, tq) = if ssm {
+                        (coef(p), coef(q))
+                    } else {
+                        (T::PseudoLogit, T::PseudoLogit)
+                    };
+                    single.extend(std::iter::repeat(Some(tp)).take(p));
+                    single.extend(std::iter::repeat(Some(tq)).take(q));
+                    single.push(Some(T::Log));
+                }
+            }
+        }
+        // GM phis lie in (0, 1) whatever the preset; AR1 follows the preset.
+        let width = if ssm && !model.uses_gm() { 2.0 } else { 1.0 };
+        Ok(Self {
+            single,
+            ordered,
+            width,
+            names,
+        })
+    }
+
+    /// Number of parameters.
+    pub fn n_params(&self) -> usize {
+        self.single.len()
+    }
+
+    /// Parameter labels, `KIND[component].name` (e.g. `GM[0].beta`).
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The scalar transform of each parameter; `None` for a `phi`/`beta` of the ordered chain.
+    pub fn transforms(&self) -> &[Option<ParamTransform>] {
+        &self.single
+    }
+
+    /// Whether the AR1/GM components are parametrised by the ordered chain.
+    pub fn is_ordered(&self) -> bool {
+        !self.ordered.is_empty()
+    }
+
+    fn check_len(&self, what: &'static str, found: usize) -> Result<(), FitError> {
+        if found == self.n_params() {
+            Ok(())
+        } else {
+            Err(FitError::Length {
+                what,
+                expected: self.n_params(),
+                found,
+            })
+        }
+    }
+
+    /// `1 - phi` of an ordered slot holding `v` (exact for GM: `-expm1(-beta / freq)`).
+    fn complement(slot: Slot, v: f64) -> f64 {
+        match slot {
+            Slot::Phi => 1.0 - v,
+            Slot::Beta(freq) => -(-v / freq).exp_m1(),
+        }
+    }
+
+    /// METHODS §5.3 (and the ordered chain of the module doc): `u` from `theta`.
+    ///
+    /// # Errors
+    /// [`FitError::Length`]; [`FitError::OutOfDomain`] naming the parameter; with the ordered
+    /// chain, [`FitError::PhiNotOrdered`] unless the phis strictly decrease in model order.
+    pub fn to_u(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.check_len("theta", theta.len())?;
+        let mut u = vec![0.0; theta.len()];
+        for (i, (t, &v)) in self.single.iter().zip(theta).enumerate() {
+            if let Some(t) = t {
+                u[i] = t
+                    .to_u(v)
+                    .ok_or_else(|| self.out_of_domain(i, v, t.domain()))?;
+            }
+        }
+        let k = self.ordered.len();
+        let mut upper = self.width; // c of the next slot (or 1 - lo for the last one)
+        for s in (0..k).rev() {
+            let (i, ci, slot) = self.ordered[s];
+            let v = theta[i];
+            let c = Self::complement(slot, v);
+            let domain = match slot {
+                Slot::Phi if self.width > 1.0 => "phi in (-1, 1)",
+                Slot::Phi => "phi in (0, 1)",
+                Slot::Beta(_) => "beta > 0 with exp(-beta / freq) not rounding to 0 or 1",
+            };
+            if !(c.is_finite() && c > 0.0 && c < self.width) {
+                return Err(self.out_of_domain(i, v, domain));
+            }
+            if c >= upper {
+                let (j, cj, slot_j) = self.ordered[s + 1];
+                let phi = |slot: Slot, v: f64| match slot {
+                    Slot::Phi => v,
+                    Slot::Beta(freq) => (-v / freq).exp(),
+                };
+                return Err(FitError::PhiNotOrdered {
+                    first: ci,
+                    second: cj,
+                    phi_first: phi(slot, v),
+                    phi_second: phi(slot_j, theta[j]),
+                });
+            }
+            // c = upper * logistic(-u)  =>  u = ln((upper - c) / c)
+            u[i] = ((upper - c) / c).ln();
+            upper = c;
+        }
+        Ok(u)
+    }
+
+    fn out_of_domain(&self, index: usize, value: f64, expected: &'static str) -> FitError {
+        FitError::OutOfDomain {
+            index,
+            name: self.names.get(index).cloned().unwrap_or_default(),
+            value,
+            expected,
+        }
+    }
+
+    /// METHODS §5.3: `theta` from `u`.
+    ///
+    /// # Errors
+    /// [`FitError::Length`].
+    pub fn from_u(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.check_len("u", u.len())?;
+        let mut theta = vec![0.0; u.len()];
+        self.eval(u, &mut theta, None);
+        Ok(theta)
+    }
+
+    /// `d theta_i / d u_k`, indexed `[i][k]` (diagonal except inside the ordered chain, which
+    /// is triangular).
+    ///
+    /// # Errors
+    /// [`FitError::Length`].
+    pub fn jacobian(&self, u: &[f64]) -> Result<Vec<Vec<f64>>, FitError> {
+        self.check_len("u", u.len())?;
+        let p = u.len();
+        let mut theta = vec![0.0; p];
+        let mut jac = vec![0.0; p * p];
+        self.eval(u, &mut theta, Some(&mut jac));
+        Ok(jac.chunks(p).map(<[f64]>::to_vec).collect())
+    }
+
+    /// `theta = g(u)` into `theta` and, if given, `d theta / d u` into `jac` (row-major p x p,
+    /// fully overwritten). Lengths are the caller's invariant.
+    pub(crate) fn eval(&self, u: &[f64], theta: &mut [f64], mut jac: Option<&mut [f64]>) {
+        let p = self.n_params();
+        if let Some(j) = jac.as_deref_mut() {
+            j.fill(0.0);
+        }
+        for (i, t) in self.single.iter().enumerate() {
+            if let Some(t) = t {
+                theta[i] = t.from_u(u[i]);
+                if let Some(j) = jac.as_deref_mut() {
+                    j[i * p + i] = t.dtheta_du(u[i]);
+                }
+            }
+        }
+        // c_s = width * prod_{r >= s} logistic(-u_r); d c_s / d u_r = -c_s logistic(u_r).
+        let k = self.ordered.len();
+        let mut c = self.width;
+        for s in (0..k).rev() {
+            let (i, _, slot) = self.ordered[s];
+            c *= logistic(-u[i]);
+            let (value, dvalue_dc) = match slot {
+                Slot::Phi => (1.0 - c, -1.0),
+                Slot::Beta(freq) => (-freq * (-c).ln_1p(), freq / (1.0 - c)),
+            };
+            theta[i] = value;
+            if let Some(j) = jac.as_deref_mut() {
+                for &(r, _, _) in &self.ordered[s..] {
+                    j[i * p + r] = -dvalue_dc * c * logistic(u[r]);
+                }
+            }
+        }
+    }
+
+    /// METHODS §5.6 (port): theta with the AR1/GM blocks `(phi, sigma2)` / `(beta, sigma2_gm)`
+    /// stably sorted by `phi` decreasing (GM: `beta` increasing), wherever they appear; other
+    /// parameters stay in place. Use it on a start before [`Parametrisation::to_u`] with the
+    /// ordered chain, and on a [`PhiOrder::Free`] result.
+    ///
+    /// # Errors
+    /// [`FitError::Length`].
+    pub fn canonical_order(model: &Model, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+        if theta.len() != model.n_params() {
+            return Err(FitError::Length {
+                what: "theta",
+                expected: model.n_params(),
+                found: theta.len(),
+            });
+        }
+        let mut starts = Vec::new();
+        let mut at = 0;
+        for c in model.components() {
+            if matches!(c.kind, ProcessKind::Ar1 | ProcessKind::Gm) {
+                starts.push((at, c.kind == ProcessKind::Gm));
+            }
+            at += c.kind.n_params();
+        }
+        // sort key: phi decreasing == (for GM) beta increasing; NaN keys keep their place last
+        let key = |&(i, gm): &(usize, bool)| if gm { -theta[i] } else { theta[i] };
+        let mut sorted = starts.clone();
+        sorted.sort_by(|a, b| key(b).total_cmp(&key(a)));
+        let mut out = theta.to_vec();
+        for (&(dst, _), &(src, _)) in starts.iter().zip(&sorted) {
+            out[dst] = theta[src];
+            out[dst + 1] = theta[src + 1];
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// METHODS §5.9 test values carry 7 significant digits.
+    const METHODS_TOL: f64 = 5e-7;
+
+    #[test]
+    #[allow(clippy::approx_constant)] // the METHODS §5.9 value, as printed
+    fn to_u_matches_methods_5_9() {
+        let close = |a: f64, b: f64| (a / b - 1.0).abs() < METHODS_TOL;
+        assert!(close(ParamTransform::Logit.to_u(0.9).unwrap(), 2.1972246));
+        assert!(close(ParamTransform::Log.to_u(2.0).unwrap(), 0.6931472));
+        assert!(close(ParamTransform::LogAbs.to_u(0.5).unwrap(), -0.6931472));
+        assert!(close(
+            ParamTransform::PseudoLogit.to_u(-0.9).unwrap(),
+            -2.944439
+        ));
+        assert_eq!(ParamTransform::Logit.to_u(1.0), None);
+        assert_eq!(ParamTransform::Log.to_u(0.0), None);
+        assert_eq!(ParamTransform::LogAbs.to_u(0.0), None);
+        assert_eq!(ParamTransform::Logit2.to_u(-2.0), None);
+        assert_eq!(ParamTransform::Identity.to_u(f64::NAN), None);
+    }
+
+    #[test]
+    fn logistic_is_stable() {
+        assert_eq!(logistic(-800.0), 0.0);
+        assert_eq!(logistic(800.0), 1.0);
+        assert!((logistic(0.0) - 0.5).abs() < 1e-16);
+    }
+
+    /// Central differences with step `FD_STEP` have truncation error ~h^2 |theta'''| ~ 1e-8 and
+    /// rounding error ~eps/h ~ 1e-11 on these O(1) functions.
+    const FD_STEP: f64 = 1e-4;
+    /// Tolerance of the central-difference comparisons (see `FD_STEP`).
+    const FD_TOL: f64 = 1e-7;
+
+    const ALL: [ParamTransform; 6] = [
+        ParamTransform::Identity,
+        ParamTransform::Log,
+        ParamTransform::Logit,
+        ParamTransform::PseudoLogit,
+        ParamTransform::Logit2,
+        ParamTransform::LogAbs,
+    ];
+
+    #[test]
+    fn param_transform_round_trips_and_differentiates() {
+        for t in ALL {
+            for u in [-7.0, -1.3, 0.0, 0.4, 2.5, 9.0] {
+                let theta = t.from_u(u);
+                let back = t.to_u(theta).unwrap();
+                assert!(
+                    (back - u).abs() < 1e-9 * (1.0 + u.abs()),
+                    "{t:?} {u} {back}"
+                );
+                let fd = (t.from_u(u + FD_STEP) - t.from_u(u - FD_STEP)) / (2.0 * FD_STEP);
+                let d = t.dtheta_du(u);
+                assert!(
+                    (fd - d).abs() < FD_TOL * (1.0 + d.abs()),
+                    "{t:?} {u}: {fd} vs {d}"
+                );
+            }
+        }
+        assert_eq!(
+            ParamTransform::LogAbs.from_u(ParamTransform::LogAbs.to_u(-0.5).unwrap()),
+            0.5
+        );
+    }
+
+    fn model(text: &str) -> Model {
+        Model::parse(text).unwrap()
+    }
+
+    fn check_jacobian(p: &Parametrisation, u: &[f64]) {
+        let jac = p.jacobian(u).unwrap();
+        for k in 0..u.len() {
+            let mut up = u.to_vec();
+            let mut dn = u.to_vec();
+            // absolute step: every map has derivatives of order theta itself in u
+            let h = FD_STEP;
+            up[k] += h;
+            dn[k] -= h;
+            let (tp, td) = (p.from_u(&up).unwrap(), p.from_u(&dn).unwrap());
+            for i in 0..u.len() {
+                let fd = (tp[i] - td[i]) / (2.0 * h);
+                let scale = jac[i][k].abs().max(jac[i][i].abs()).max(1e-300);
+                assert!(
+                    (fd - jac[i][k]).abs() <= 1e-6 * scale,
+                    "d theta_{i} / d u_{k}: fd {fd} vs {}",
+                    jac[i][k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn parametrisation_round_trips_imu_presets() {
+        let m = model("3*GM()+WN()+QN()+RW()+DR()");
+        let p = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Ordered, 250.0).unwrap();
+        assert!(p.is_ordered());
+        assert_eq!(p.names()[0], "GM[0].beta");
+        // METHODS §5.10 truth, betas increasing = phis decreasing
+        let theta = [
+            6.28e-3, 1.28e-8, 0.25, 7.08e-9, 8.48, 6.48e-9, 6.94e-7, 2.29e-6, 3.9e-14, 1e-6,
+        ];
+        let u = p.to_u(&theta).unwrap();
+        let back = p.from_u(&u).unwrap();
+        for (a, b) in theta.iter().zip(&back) {
+            assert!((a / b - 1.0).abs() < 1e-12, "{a} {b}");
+        }
+        check_jacobian(&p, &u);
+        // not ordered: named error; canonical order fixes it
+        let swapped = [
+            0.25, 7.08e-9, 6.28e-3, 1.28e-8, 8.48, 6.48e-9, 6.94e-7, 2.29e-6, 3.9e-14, 1e-6,
+        ];
+        let e = p.to_u(&swapped).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                FitError::PhiNotOrdered {
+                    first: 0,
+                    second: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert_eq!(
+            Parametrisation::canonical_order(&m, &swapped).unwrap(),
+            theta
+        );
+        // free order: each parameter on its own
+        let free = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Free, 250.0).unwrap();
+        assert!(!free.is_ordered());
+        assert_eq!(free.transforms()[0], Some(ParamTransform::Log));
+        let u = free.to_u(&swapped).unwrap();
+        check_jacobian(&free, &u);
+    }
+
+    #[test]
+    fn parametrisation_ar1_chain_in_both_presets() {
+        let m = model("3*AR1()+WN()");
+        for (preset, phis) in [
+            (TransformPreset::Imu, [0.9999, 0.99, 0.3]),
+            (TransformPreset::Ssm, [0.9, 0.2, -0.7]),
+        ] {
+            let p = Parametrisation::new(&m, preset, PhiOrder::Ordered, 1.0).unwrap();
+            let theta = [phis[0], 1e-3, phis[1], 2.0, phis[2], 0.5, 1.0];
+            let u = p.to_u(&theta).unwrap();
+            let back = p.from_u(&u).unwrap();
+            for (a, b) in theta.iter().zip(&back) {
+                assert!(
+                    (a - b).abs() < 1e-12 * a.abs().max(1.0),
+                    "{preset:?} {a} {b}"
+                );
+            }
+            check_jacobian(&p, &u);
+        }
+        // imu: a negative phi is outside (0, 1)
+        let p = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Ordered, 1.0).unwrap();
+        let e = p.to_u(&[0.9, 1.0, 0.5, 1.0, -0.1, 1.0, 1.0]).unwrap_err();
+        assert!(matches!(e, FitError::OutOfDomain { index: 4, .. }), "{e}");
+        // any u maps to ordered phis
+        let theta = p.from_u(&[-30.0, 0.0, 30.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        assert!(theta[0] >= theta[2] && theta[2] >= theta[4]);
+    }
+
+    #[test]
+    fn parametrisation_arma_presets_follow_methods_5_3() {
+        use ParamTransform as T;
+        let m = model("ARMA(2,1)+WN()");
+        let imu = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Ordered, 1.0).unwrap();
+        let ssm = Parametrisation::new(&m, TransformPreset::Ssm, PhiOrder::Ordered, 1.0).unwrap();
+        let l = Some(T::Log);
+        assert_eq!(
+            imu.transforms(),
+            [
+                Some(T::PseudoLogit),
+                Some(T::PseudoLogit),
+                Some(T::PseudoLogit),
+                l,
+                l
+            ]
+        );
+        assert_eq!(
+            ssm.transforms(),
+            [Some(T::Logit2), Some(T::Logit2), Some(T::PseudoLogit), l, l]
+        );
+        let ma1 = model("MA1()+AR1()");
+        let imu = Parametrisation::new(&ma1, TransformPreset::Imu, PhiOrder::Ordered, 1.0).unwrap();
+        assert_eq!(imu.transforms(), [Some(T::Logit), l, Some(T::Logit), l]);
+        let e = imu.to_u(&[0.5, 1.0]).unwrap_err();
+        assert!(matches!(
+            e,
+            FitError::Length {
+                expected: 4,
+                found: 2,
+                ..
+            }
+        ));
+    }
+}

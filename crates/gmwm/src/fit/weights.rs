@@ -1,0 +1,182 @@
+//! The weighting matrix Omega of the GMWM objective (METHODS §5.2), diagonal in every supported
+//! option.
+//!
+//! Levels whose weight cannot be formed (a zero or non-finite CI width or variance, e.g. a robust
+//! level without a scale or the coefficient-less last level of a power-of-two series, §5.9) are
+//! **rejected** with [`FitError::BadWeight`] naming the level, never dropped silently: the caller
+//! decides to fit fewer levels.
+
+use super::FitError;
+use crate::variance::cov::{wv_diag_covariance, DiagDivisor};
+use crate::variance::wv::WaveletVariance;
+use serde::{Deserialize, Serialize};
+
+/// Which V (and Omega = V^{-1}) to use (METHODS §5.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Weighting {
+    /// `V = diag((hi_j - lo_j)^2)` from the WV confidence interval (robust CI if robust); the
+    /// package default (`compute.v = "fast"`, used by `gmwm.imu`).
+    #[default]
+    Fast,
+    /// Percival's asymptotic diagonal (METHODS §1.10) with the per-level divisor, `/ eff` if
+    /// robust; needs the series.
+    Diag,
+}
+
+/// Diagonal weights `omega_j = 1 / V_jj` (METHODS §5.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Weights {
+    /// `V_jj`, the (proxy) variance of `nu2_hat_j` (the package's `orgV` diagonal).
+    pub v: Vec<f64>,
+    /// `omega_j = 1 / V_jj`.
+    pub omega: Vec<f64>,
+}
+
+impl Weights {
+    /// Weights from the diagonal of V; `what` names it in errors.
+    fn from_v(v: Vec<f64>, what: &'static str) -> Result<Self, FitError> {
+        for (j, &x) in v.iter().enumerate() {
+            let omega = 1.0 / x;
+            if !(x.is_finite() && x > 0.0 && omega.is_finite()) {
+                return Err(FitError::BadWeight {
+                    level: j + 1,
+                    what,
+                    value: x,
+                });
+            }
+        }
+        let omega = v.iter().map(|x| 1.0 / x).collect();
+        Ok(Self { v, omega })
+    }
+
+    /// METHODS §5.2 "fast": `V_jj = (ci_high_j - ci_low_j)^2`, Omega = V^{-1}.
+    ///
+    /// # Errors
+    /// [`FitError::BadWeight`] for a level whose CI width is zero or not finite.
+    pub fn fast(wv: &WaveletVariance) -> Result<Self, FitError> {
+        let mut v = Vec::with_capacity(wv.levels());
+        for (j, (&lo, &hi)) in wv.ci_low.iter().zip(&wv.ci_high).enumerate() {
+            let width = hi - lo;
+            if !(width.is_finite() && width > 0.0) {
+                return Err(FitError::BadWeight {
+                    level: j + 1,
+                    what: "CI width",
+                    value: width,
+                });
+            }
+            v.push(width * width);
+        }
+        Self::from_v(v, "squared CI width")
+    }
+
+    /// METHODS §5.2 "diag": `V_jj` from [`wv_diag_covariance`] of the series `x` at the levels
+    /// and filter of `wv` (per-level divisor), divided by `eff` when `wv` is robust.
+    ///
+    /// Cost: one MODWT of `x` and one FFT per level.
+    ///
+    /// # Errors
+    /// [`FitError::Engine`] wrapping the error of [`wv_diag_covariance`]; [`FitError::BadWeight`] for a zero or non-finite `V_jj`.
+    pub fn diag(x: &[f64], wv: &WaveletVariance) -> Result<Self, FitError> {
+        let mut v = wv_diag_covariance(x, wv.filter, wv.levels(), DiagDivisor::Level)?;
+        if let Some(r) = wv.robust {
+            v.iter_mut().for_each(|x| *x /= r.eff);
+        }
+        Self::from_v(v, "diag variance")
+    }
+
+    /// METHODS §5.4 stage 1: the flattening objective `F = sum_j (1 - nu2_j / nu2_hat_j)^2` is
+    /// `Q` with `omega_j = 1 / nu2_hat_j^2` (`V_jj = nu2_hat_j^2`).
+    ///
+    /// # Errors
+    /// [`FitError::BadWeight`] for a zero or non-finite `nu2_hat_j`.
+    pub fn flattening(nu_hat: &[f64]) -> Result<Self, FitError> {
+        Self::from_v(
+            nu_hat.iter().map(|v| v * v).collect(),
+            "squared wavelet variance",
+        )
+    }
+
+    /// Omega = I (every level weighted 1), for tests and comparisons.
+    pub fn unit(levels: usize) -> Self {
+        Self {
+            v: vec![1.0; levels],
+            omega: vec![1.0; levels],
+        }
+    }
+
+    /// Weights from a caller's diagonal of V.
+    ///
+    /// # Errors
+    /// [`FitError::BadWeight`] for a zero or non-finite value.
+    pub fn from_variances(v: Vec<f64>) -> Result<Self, FitError> {
+        Self::from_v(v, "variance")
+    }
+
+    /// Weights of the given kind; `x` is needed only by [`Weighting::Diag`].
+    ///
+    /// # Errors
+    /// As [`Weights::fast`] / [`Weights::diag`]; [`FitError::Length`] (what = "series") when
+    /// `Diag` is asked without a series.
+    pub fn new(
+        weighting: Weighting,
+        wv: &WaveletVariance,
+        x: Option<&[f64]>,
+    ) -> Result<Self, FitError> {
+        match (weighting, x) {
+            (Weighting::Fast, _) => Self::fast(wv),
+            (Weighting::Diag, Some(x)) => Self::diag(x, wv),
+            (Weighting::Diag, None) => Err(FitError::Length {
+                what: "series",
+                expected: wv.n,
+                found: 0,
+            }),
+        }
+    }
+
+    /// Number of levels.
+    pub fn levels(&self) -> usize {
+        self.omega.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{wavelet_variance, WvOptions};
+
+    #[test]
+    fn fast_weights_are_inverse_squared_ci_widths() {
+        let x: Vec<f64> = (0..1000).map(|i| ((i * 7919) % 101) as f64).collect();
+        let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+        let w = Weights::fast(&wv).unwrap();
+        for j in 0..wv.levels() {
+            let width = wv.ci_high[j] - wv.ci_low[j];
+            assert!((w.omega[j] * width * width - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn fast_v_matches_methods_5_9() {
+        // CI bounds (2.19972535, 2.6215535): V = 0.42182815^2 = 0.1779390 (METHODS §5.9)
+        let x: Vec<f64> = (0..64).map(|i| ((i * 37) % 11) as f64).collect();
+        let mut wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+        wv.ci_low[0] = 2.19972535;
+        wv.ci_high[0] = 2.6215535;
+        let w = Weights::fast(&wv).unwrap();
+        assert!((w.v[0] / 0.1779390 - 1.0).abs() < 5e-7);
+    }
+
+    #[test]
+    fn bad_levels_are_named() {
+        let x: Vec<f64> = (0..64).map(|i| ((i * 37) % 11) as f64).collect();
+        let mut wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+        wv.ci_low[2] = f64::NAN;
+        let e = Weights::fast(&wv).unwrap_err();
+        assert!(matches!(e, FitError::BadWeight { level: 3, .. }), "{e}");
+        assert!(e.to_string().starts_with("level 3:"));
+        assert!(Weights::from_variances(vec![1.0, 0.0]).is_err());
+        let d = Weights::diag(&x, &wv).unwrap();
+        assert_eq!(d.levels(), wv.levels());
+    }
+}
