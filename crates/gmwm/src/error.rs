@@ -22,6 +22,9 @@ pub enum Error {
     /// A model breaks a rule of METHODS §0.2 or has an invalid value.
     #[error(transparent)]
     Model(#[from] crate::model::ModelError),
+    /// A GMWM fit could not be set up or evaluated (METHODS §5).
+    #[error(transparent)]
+    Fit(#[from] crate::fit::FitError),
 }
 
 /// A series that cannot be analysed.

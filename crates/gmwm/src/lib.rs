@@ -30,6 +30,7 @@ pub mod variance;
 pub mod wavelet;
 
 pub use error::{Error, ParamError, SeriesError};
+pub use fit::{FitError, Gmwm, GmwmFit, Weighting, Weights};
 pub use variance::allan::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
 pub use variance::robust::{RobustConvention, RobustOptions};
 pub use variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};
