@@ -564,10 +564,9 @@ impl HaarWvAccumulator {
             return Ok(());
         };
         let offset = *self.offset.get_or_insert(head);
-        let first = *self.first.get_or_insert(head);
+        self.first.get_or_insert(head);
         let mut input = std::mem::take(&mut self.scratch_in);
         let mut output = std::mem::take(&mut self.scratch_out);
-        let _ = first;
         if let Err(e) = check_finite(block) {
             self.scratch_in = input;
             self.scratch_out = output;
