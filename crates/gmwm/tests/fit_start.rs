@@ -43,7 +43,7 @@ fn condition_phi_ranges() {
         let p1 = condition1_phi(u);
         assert!((0.0..=0.2 + 1e-15).contains(&p1), "{p1}");
         let p3 = condition3_phi(u, 0.9);
-        assert!(p3 >= 0.9 && p3 <= PHI_MAX, "{p3}");
+        assert!((0.9..=PHI_MAX).contains(&p3), "{p3}");
     }
     assert!((condition3_phi(0.0, 0.9) - PHI_MAX).abs() < 1e-15);
     assert!((condition3_phi(1.0 / 3.0, 0.9) - 0.9).abs() < 1e-15);
@@ -188,4 +188,40 @@ fn reference_ar1_wn_rw_vs_r() {
     );
     assert!(fit.objective <= r_exact * R_FACTOR);
     assert!(fit.objective <= r_guess);
+}
+
+#[test]
+fn fit_from_precomputed_wv() {
+    let (x, wv) = ar1_wn_rw_wv(10_000, 8);
+    let g = Gmwm::new(model("AR1()+WN()+RW()"))
+        .with_seed(3)
+        .with_draws(2000);
+    let from_wv = g.fit_from_wv(&wv, StartInputs::from_wv(&wv)).unwrap();
+    let from_x = g.fit(&x, 1.0, &WvOptions::default()).unwrap();
+    // the range R only feeds DR draws (none here), so both searches are identical
+    assert_eq!(from_wv.start, from_x.start);
+    assert_eq!(from_wv.objective, from_x.objective);
+    assert_eq!(StartInputs::from_wv(&wv).range, 0.0);
+    // the diag weighting needs the series: an error, not a panic
+    let diag = Gmwm::new(model("AR1()+WN()+RW()")).with_weighting(gmwm::fit::Weighting::Diag);
+    assert!(diag.fit_from_wv(&wv, StartInputs::from_wv(&wv)).is_err());
+}
+
+#[test]
+fn early_stop_and_default_draws() {
+    let (x, wv) = ar1_wn_rw_wv(10_000, 9);
+    let s = starting_values(
+        &model("AR1()+WN()+RW()"),
+        &wv,
+        &StartInputs::from_series(&x),
+        &StartOptions::default(),
+    )
+    .unwrap();
+    assert!(
+        s.draws >= gmwm::fit::start::MIN_DRAWS && s.draws <= 20_000,
+        "{}",
+        s.draws
+    );
+    assert_eq!(gmwm::fit::start::default_draws(10_000), 20_000);
+    assert_eq!(gmwm::fit::start::default_draws(10_001), 100_000);
 }

@@ -1,5 +1,6 @@
-//! A minimal GMWM fit from caller-given starting values (METHODS §5.5 steps 3, 4, 6, 10–12; the
-//! starting-value search of §6 and the bootstrap V are not here yet).
+//! The GMWM estimator settings and the fit from caller-given starting values (METHODS §5.5
+//! steps 3, 4, 6, 10–12); the fit with generated starting values (§6) is in [`super::auto`],
+//! the bootstrap V is not here yet.
 
 use super::{
     minimize, Convergence, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StartOptions,
