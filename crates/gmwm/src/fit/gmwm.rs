@@ -1,8 +1,9 @@
-//! A minimal GMWM fit from caller-given starting values (METHODS §5.5 steps 3, 4, 6, 10–12; the
-//! starting-value search of §6 and the bootstrap V are not here yet).
+//! The GMWM estimator settings and the fit from caller-given starting values (METHODS §5.5
+//! steps 3, 4, 6, 10–12); the fit with generated starting values (§6) is in [`super::auto`],
+//! the bootstrap V is not here yet.
 
 use super::{
-    minimize, Convergence, FitError, LmOptions, Objective, Parametrisation, PhiOrder,
+    minimize, Convergence, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StartOptions,
     TransformPreset, Weighting, Weights,
 };
 use crate::model::{format_value, ImpliedWv, Model};
@@ -33,13 +34,21 @@ pub struct Gmwm {
     preset: TransformPreset,
     phi_order: PhiOrder,
     options: LmOptions,
+    /// The values the user gave (kept in the §6 draws; all `Some`: the fit's start).
+    pub(crate) given: Vec<Option<f64>>,
+    /// Starting-value search settings (METHODS §6).
+    pub(crate) start_options: StartOptions,
 }
 
 impl Gmwm {
-    /// An estimator of `model` (its values, if any, are ignored: starts are given to the fit)
-    /// with the IMU defaults: fast weights, IMU transforms, ordered AR1/GM components.
+    /// An estimator of `model` with the IMU defaults: fast weights, IMU transforms, ordered
+    /// AR1/GM components. Its values are ignored by the explicit-start fits
+    /// ([`Gmwm::fit_wv`], ...) and used by [`Gmwm::fit`] / [`Gmwm::fit_from_wv`]: all given
+    /// means the start, some given means kept in the starting-value draws (METHODS §6).
     pub fn new(model: Model) -> Self {
         Self {
+            given: model.values(),
+            start_options: StartOptions::default(),
             model: model.without_values(),
             weighting: Weighting::Fast,
             preset: TransformPreset::Imu,
@@ -70,6 +79,23 @@ impl Gmwm {
     pub fn with_options(mut self, options: LmOptions) -> Self {
         self.options = options;
         self
+    }
+
+    /// Sets the seed of the starting-value search (METHODS §5.7; default 1337).
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.start_options.seed = seed;
+        self
+    }
+
+    /// Sets the number of starting-value draws G (default [`super::start::default_draws`]).
+    pub fn with_draws(mut self, draws: usize) -> Self {
+        self.start_options.draws = Some(draws);
+        self
+    }
+
+    /// The weighting (METHODS §5.2).
+    pub fn weighting(&self) -> Weighting {
+        self.weighting
     }
 
     /// The model template.

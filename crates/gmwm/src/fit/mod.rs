@@ -4,18 +4,22 @@
 //! The optimiser works on unconstrained parameters `u`; [`Parametrisation`] maps them to the
 //! model's `theta` (original parametrisation, GM in `(beta, sigma2_gm)`), [`Weights`] holds the
 //! diagonal of Omega, [`Objective`] evaluates `Q(u)` and its whitened residuals, and
-//! [`minimize`] runs the optimiser from a caller-given start; [`Gmwm`] ties them together. Non-convergence is reported in
+//! [`minimize`] runs the optimiser from a caller-given start; [`Gmwm`] ties them together,
+//! and [`Gmwm::fit`] runs the two-stage pipeline from generated starting values ([`start`], §6). Non-convergence is reported in
 //! [`Convergence`], never hidden.
 
+pub mod auto;
 pub mod gmwm;
 pub mod objective;
 pub mod optimize;
+pub mod start;
 pub mod transform;
 pub mod weights;
 
 pub use gmwm::{Gmwm, GmwmFit};
 pub use objective::Objective;
 pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason, STALL_COSINE};
+pub use start::{starting_values, Dominance, StartInputs, StartOptions, StartValues};
 
 pub use transform::{ParamTransform, Parametrisation, PhiOrder, TransformPreset};
 pub use weights::{Weighting, Weights};
