@@ -48,6 +48,48 @@ pub enum Command {
         after_long_help = "Examples:\n  gmwm implied --model \"3*AR1(phi=0.9, sigma2=1)+WN(sigma2=2)\" --levels 10\n  gmwm implied --model \"GM(beta=0.25, sigma2_gm=7.08e-9)+RW(gamma2=3.9e-14)\" --levels 20 --freq 250 --json"
     )]
     Implied(ImpliedArgs),
+    /// Estimate a latent error model by GMWM on each selected column (METHODS §5).
+    #[command(
+        after_long_help = "Examples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7"
+    )]
+    Fit(FitArgs),
+}
+
+/// `gmwm fit`.
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    /// Input.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Model to estimate: guess mode ("3*GM()+WN()") or with starting values
+    /// ("AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)").
+    #[arg(long, value_name = "MODEL")]
+    pub model: String,
+    /// Wavelet-variance settings of the estimate.
+    #[command(flatten)]
+    pub estimator: WvEstimatorArgs,
+    /// Weighting matrix Omega (METHODS §5.2): CI-width ("fast", the IMU default) or the
+    /// Percival asymptotic diagonal.
+    #[arg(long, value_enum, default_value_t = WeightsArg::Fast)]
+    pub weights: WeightsArg,
+    /// Number of starting-value draws [default: 20000 for N <= 1e4, else 100000, with early stop].
+    #[arg(long = "G", value_name = "N")]
+    pub draws: Option<usize>,
+    /// Seed of the starting-value search.
+    #[arg(long, value_name = "S", default_value_t = 1337)]
+    pub seed: u64,
+    /// Output format.
+    #[command(flatten)]
+    pub output: OutputArgs,
+}
+
+/// `--weights`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum WeightsArg {
+    /// Inverse squared CI widths (package "fast").
+    Fast,
+    /// Inverse of the Percival asymptotic diagonal covariance (METHODS §1.10).
+    Diag,
 }
 
 /// `gmwm simulate`.

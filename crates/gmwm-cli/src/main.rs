@@ -22,6 +22,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Command::Avar(a) => cmd::avar::run(a, &mut out)?,
         Command::Simulate(a) => cmd::simulate::run(a, &mut out)?,
         Command::Implied(a) => cmd::implied::run(a, &mut out)?,
+        Command::Fit(a) => cmd::fit::run(a, &mut out)?,
     }
     out.flush()?;
     Ok(())

@@ -551,3 +551,56 @@ fn bad_models_are_one_line_errors() {
         &["/nonexistent/dir/x.csv"],
     );
 }
+
+#[test]
+fn fit_json_has_the_documented_shape() {
+    let out = gmwm()
+        .args(["fit", "--model", "AR1()+WN()+RW()", "--freq", "1", "--json"])
+        .arg(data("sim/ar1_wn_rw_N10000.csv.gz"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let fit = &doc["fits"][0];
+    assert_eq!(fit["column"], "x");
+    assert!(fit["model"].as_str().unwrap().starts_with("AR1(phi="));
+    assert!(fit["objective"].as_f64().unwrap() >= 0.0);
+    assert!(fit["converged"].is_boolean());
+    let params = fit["parameters"].as_array().unwrap();
+    let names: Vec<(&str, u64, &str)> = params
+        .iter()
+        .map(|p| {
+            (
+                p["process"].as_str().unwrap(),
+                p["index"].as_u64().unwrap(),
+                p["name"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        names,
+        vec![
+            ("AR1", 0, "phi"),
+            ("AR1", 0, "sigma2"),
+            ("WN", 1, "sigma2"),
+            ("RW", 2, "gamma2")
+        ]
+    );
+    let phi = params[0]["value"].as_f64().unwrap();
+    assert!((0.95..1.0).contains(&phi), "phi {phi} (truth 0.99)");
+    assert_one_line_error(
+        &[
+            "fit",
+            "--model",
+            "AR1()+GM()",
+            "--freq",
+            "1",
+            data("sim/ar1_wn_rw_N1000.csv.gz").to_str().unwrap(),
+        ],
+        &["GM"],
+    );
+}

@@ -2,6 +2,7 @@
 
 pub mod avar;
 pub mod demo;
+pub mod fit;
 pub mod implied;
 pub mod simulate;
 pub mod wv;
