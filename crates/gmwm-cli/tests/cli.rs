@@ -604,3 +604,37 @@ fn fit_json_has_the_documented_shape() {
         &["GM"],
     );
 }
+
+#[test]
+fn review_findings_are_errors_not_panics_or_silent_numbers() {
+    let mut big = String::from("x\n");
+    for i in 0..1000 {
+        big.push_str(if i % 2 == 0 { "1e200\n" } else { "0\n" });
+    }
+    let f = temp_file(".csv", big.as_bytes());
+    let p = f.path().to_str().unwrap();
+    assert_one_line_error(&["wv", "--freq", "1", p], &["not finite", "rescale"]);
+    assert_one_line_error(&["avar", "--freq", "1", p], &["not finite"]);
+    assert_one_line_error(&["demo", "--filter", "la8"], &["Haar"]);
+    assert_one_line_error(&["demo", "--n", "100000000000"], &["memory"]);
+    let b = temp_file(".bin", &1.0f64.to_le_bytes());
+    assert_one_line_error(
+        &[
+            "wv",
+            "--format",
+            "f64",
+            "--ncols",
+            "0",
+            "--freq",
+            "1",
+            b.path().to_str().unwrap(),
+        ],
+        &["ncols"],
+    );
+    let ok = temp_file(".csv", b"x\n1\n3\n2\n5\n4\n6\n8\n7\n");
+    gmwm()
+        .args(["wv", "--freq", "1", "--alpha", "1e-300"])
+        .arg(ok.path())
+        .assert()
+        .success();
+}

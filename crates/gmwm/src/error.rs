@@ -64,6 +64,15 @@ pub enum SeriesError {
         /// Tuning constant.
         c: f64,
     },
+    /// A computed variance overflowed although every sample is finite.
+    #[error(
+        "the {what} is not finite although every sample is: squares of the data overflow \
+         double precision (|x| near 1e154 or more); rescale the series"
+    )]
+    Overflow {
+        /// Which quantity overflowed.
+        what: String,
+    },
     /// Every sample has the same value: all variances are zero and nothing can be estimated.
     #[error("series is constant (every sample equals {value}); its variances are all zero")]
     Constant {

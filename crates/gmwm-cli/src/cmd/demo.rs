@@ -25,6 +25,10 @@ struct DemoReport<'a> {
 /// Runs the subcommand.
 pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
     let opts = options(&args.estimator)?;
+    anyhow::ensure!(
+        opts.filter == gmwm::WaveletFilter::Haar && opts.transform == gmwm::Transform::Modwt,
+        "gmwm demo compares with the implied WV of METHODS §4, which exists for the Haar MODWT only; drop --filter/--transform"
+    );
     let sensor = DemoSensor::default();
     let x = sensor.simulate(args.n, args.seed)?;
     let wv = wavelet_variance(&x, sensor.freq_hz, &opts)?;

@@ -144,6 +144,12 @@ pub fn run(args: &WvArgs, out: &mut impl Write) -> Result<()> {
             "invalid --freq {f}: must be a positive number of hertz"
         );
     }
+    if let Some(k) = args.input.ncols {
+        anyhow::ensure!(
+            k >= 1,
+            "invalid --ncols 0: a binary file has at least one column"
+        );
+    }
     if streamable(args, &opts) {
         return run_streaming(args, &opts, out);
     }

@@ -69,7 +69,16 @@ pub fn simulate_model(model: &Model, n: usize, freq_hz: f64, seed: u64) -> Resul
         return Err(crate::error::ParamError::new("n", n, "must be at least 1").into());
     }
     let mut sim = Simulator::for_model(model, freq_hz, seed)?;
-    let mut x = vec![0.0; n];
+    let mut x = Vec::new();
+    if x.try_reserve_exact(n).is_err() {
+        return Err(crate::error::ParamError::new(
+            "n",
+            n,
+            "too many samples to hold in memory (stream with `gmwm simulate -o FILE` instead)",
+        )
+        .into());
+    }
+    x.resize(n, 0.0);
     sim.fill(&mut x);
     Ok(x)
 }

@@ -375,6 +375,7 @@ pub fn allan_variance(
         out.terms.push(row.terms);
         out.error.push(package_error(n, m));
     }
+    crate::variance::wv::check_finite_result(&out.avar, "variance")?;
     Ok(out)
 }
 

@@ -31,8 +31,9 @@ pub fn eta3(kept: usize, j: usize) -> f64 {
 ///
 /// `alpha` must already be valid ([`check_alpha`]) and `eta >= 1`.
 pub fn chi_square_interval(estimate: f64, eta: f64, alpha: f64) -> (f64, f64) {
-    let upper_q = chi_square_quantile(1.0 - alpha / 2.0, eta);
-    let lower_q = chi_square_quantile(alpha / 2.0, eta);
+    // Solve each tail directly: 1 - alpha/2 rounds to 1 for alpha < ~2e-16.
+    let upper_q = quantile_from_tail(alpha / 2.0, true, eta);
+    let lower_q = quantile_from_tail(alpha / 2.0, false, eta);
     (eta * estimate / upper_q, eta * estimate / lower_q)
 }
 
@@ -47,24 +48,37 @@ pub fn chi_square_interval(estimate: f64, eta: f64, alpha: f64) -> (f64, f64) {
 /// # Panics
 /// Never for `df > 0` and `p` in (0, 1); callers validate both.
 pub fn chi_square_quantile(p: f64, df: f64) -> f64 {
+    if p > 0.5 {
+        quantile_from_tail(1.0 - p, true, df)
+    } else {
+        quantile_from_tail(p, false, df)
+    }
+}
+
+/// The chi-square quantile whose lower tail (`upper = false`) or upper tail (`upper = true`)
+/// has probability `tail` in (0, 1/2].
+fn quantile_from_tail(tail: f64, upper: bool, df: f64) -> f64 {
     let k = df / 2.0;
-    let upper = p > 0.5;
-    // residual r(x) = F(x) - p, computed from the tail that is accurate
+    // residual r(x), increasing in x, computed from the tail that is accurate
     let residual = |x: f64| -> f64 {
         if upper {
-            (1.0 - p) - gamma_ur(k, x / 2.0)
+            tail - gamma_ur(k, x / 2.0)
         } else {
-            gamma_lr(k, x / 2.0) - p
+            gamma_lr(k, x / 2.0) - tail
         }
     };
     let chi = ChiSquared::new(df).expect("df > 0 is a valid chi-square df");
-    let z = Normal::standard().inverse_cdf(p);
+    let z_lower = Normal::standard().inverse_cdf(tail);
+    let z = if upper { -z_lower } else { z_lower };
     let c = 2.0 / (9.0 * df);
     let wh = df * (1.0 - c + z * c.sqrt()).powi(3);
     let mut x = if wh > 0.0 { wh } else { df.min(1.0) * 1e-3 };
     // bracket [lo, hi] with r(lo) < 0 < r(hi)
     let (mut lo, mut hi) = (0.0, x.max(1.0));
     while residual(hi) < 0.0 {
+        if hi > f64::MAX / 4.0 {
+            return f64::INFINITY;
+        }
         lo = hi;
         hi *= 2.0;
     }
@@ -146,6 +160,18 @@ mod tests {
         // (statrs' inverse_cdf returns NaN for the latter)
         assert!((chi_square_quantile(0.975, 1.0) - 5.023886187314888).abs() < 1e-13);
         assert!((chi_square_quantile(0.025, 1.0) / 0.000982069117175 - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn tiny_alpha_gives_finite_wide_intervals() {
+        // 1 - 1e-16 / 2 rounds to 1: the tails must be solved directly (review finding)
+        for alpha in [1e-16, 1e-300] {
+            let (lo, hi) = chi_square_interval(1.0, 50.0, alpha);
+            assert!(
+                lo > 0.0 && lo < 0.7 && hi > 1.5 && hi.is_finite(),
+                "{alpha}: {lo} {hi}"
+            );
+        }
     }
 
     #[test]

@@ -445,20 +445,18 @@ fn median_abs(y: &[f64]) -> f64 {
 
 fn scale_exact(y: &[f64], c: f64, a: f64) -> Result<f64, Error> {
     let mad = median_abs(y);
-    if mad == 0.0 {
-        let zeros = y.iter().filter(|&&v| v == 0.0).count();
-        if zeros == y.len() {
-            return Err(SeriesError::Constant { value: 0.0 }.into());
+    // Quantised sensors give many exactly-zero coefficients at fine levels: with more than half
+    // of them zero the MAD is 0 and only serves as no start; the root-mean-square then starts
+    // the iteration instead (the estimating equation is unchanged). All zero: the scale is 0.
+    let s0 = if mad > 0.0 {
+        mad / MAD_CONSISTENCY
+    } else {
+        let rms = (y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64).sqrt();
+        if rms == 0.0 {
+            return Ok(0.0);
         }
-        return Err(ParamError::new(
-            "coefficients",
-            format!("{zeros} of {} exactly zero", y.len()),
-            "at most half of them exactly zero: with more than half the coefficients exactly \
-             zero the median |y| is 0, so a robust scale is undefined",
-        )
-        .into());
-    }
-    let s0 = mad / MAD_CONSISTENCY;
+        rms
+    };
     let mut s2 = s0 * s0;
     let mut next_polish = POLISH_FROM;
     for _ in 0..FIXED_POINT_MAX_ITER {

@@ -96,7 +96,8 @@ impl fmt::Display for WvWarning {
         match self {
             WvWarning::NoRobustScale { level } => write!(
                 f,
-                "level {level}: the robust scale is undefined (too many contaminated coefficients); \
+                "level {level}: the robust scale is undefined (the biweight scale equation has no root: \
+                 too many contaminated or exactly-zero coefficients, or an efficiency too low); \
                  its wavelet variance is left missing — try the classical estimator or fewer levels"
             ),
         }
@@ -357,6 +358,7 @@ pub fn wavelet_variance(
         })
         .collect::<Result<_, Error>>()?;
     let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
+    check_finite_result(&classical, "wavelet variance")?;
     let robust: Vec<f64> = per_level.iter().filter_map(|l| l.1).collect();
     let warnings = robust
         .iter()
@@ -377,6 +379,15 @@ pub fn wavelet_variance(
     let mut result = WaveletVariance::assemble(n, freq_hz, opts, &classical, robust, counts, eta);
     result.warnings = warnings;
     Ok(result)
+}
+
+/// Refuses non-finite estimates from finite data (overflowing squares): never silent numbers.
+pub(crate) fn check_finite_result(values: &[f64], what: &str) -> Result<(), SeriesError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SeriesError::Overflow { what: what.into() })
+    }
 }
 
 /// Compensated mean.
@@ -630,6 +641,7 @@ impl HaarWvAccumulator {
             counts.push(kept);
             eta.push(eta3(kept, j));
         }
+        check_finite_result(&wv, "wavelet variance")?;
         Ok(WaveletVariance::assemble(
             n, freq_hz, &opts, &wv, None, counts, eta,
         ))

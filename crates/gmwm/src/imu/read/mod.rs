@@ -227,8 +227,12 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
     let freq_hz = opts
         .freq_hz
         .or(freq_from_time)
-        .or_else(|| sidecar.as_ref().and_then(|s| s.sampling_frequency_hz))
-        .filter(|f| f.is_finite() && *f > 0.0);
+        .or_else(|| sidecar.as_ref().and_then(|s| s.sampling_frequency_hz));
+    if let Some(f) = freq_hz {
+        // a rate from the options, the time column or the sidecar must be usable: never
+        // silently replaced by a default
+        check_freq(f)?;
+    }
     Ok(Table {
         path: path.to_path_buf(),
         columns: raw.columns,
