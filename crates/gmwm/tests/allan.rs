@@ -47,19 +47,9 @@ fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
 // ------------------------------------------------------------------------------------------
 // Slow, obviously correct oracles: direct double loops with compensated sums.
 
-/// Neumaier-compensated sum.
+/// Neumaier-compensated sum (the library's, itself unit-tested in `math::sum`).
 fn csum(values: impl IntoIterator<Item = f64>) -> f64 {
-    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
-    for v in values {
-        let t = sum + v;
-        comp += if sum.abs() >= v.abs() {
-            (sum - t) + v
-        } else {
-            (v - t) + sum
-        };
-        sum = t;
-    }
-    sum + comp
+    gmwm::math::sum::NeumaierSum::of(values)
 }
 
 /// `sum_i w_i * mean(x_{s_i} .. x_{s_i + m - 1})` for windows `(s_i, w_i)`, summed as one

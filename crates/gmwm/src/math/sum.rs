@@ -21,6 +21,13 @@ impl NeumaierSum {
         self.sum = t;
     }
 
+    /// Compensated sum of all `values`.
+    pub fn of(values: impl IntoIterator<Item = f64>) -> f64 {
+        let mut s = Self::default();
+        values.into_iter().for_each(|v| s.add(v));
+        s.total()
+    }
+
     /// The compensated total.
     #[inline]
     pub fn total(&self) -> f64 {

@@ -28,6 +28,7 @@
 //! AV), O(N log N) for all octaves; cluster lengths are computed in parallel with rayon.
 
 use crate::error::{check_series, Error, ParamError, SeriesError};
+use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, chi_square_interval};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -599,39 +600,17 @@ fn package_levels(
 /// with Neumaier-compensated summation and rounded once (METHODS §3 numerics).
 fn centred_prefix_sums(x: &[f64]) -> Vec<f64> {
     let n = x.len() as f64;
-    let mean = compensated_sum(x.iter().copied()) / n;
+    let mean = NeumaierSum::of(x.iter().copied()) / n;
     // second pass removes the rounding left in the first mean
-    let mean = mean + compensated_sum(x.iter().map(|&v| v - mean)) / n;
+    let mean = mean + NeumaierSum::of(x.iter().map(|&v| v - mean)) / n;
     let mut s = Vec::with_capacity(x.len() + 1);
     s.push(0.0);
-    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
+    let mut sum = NeumaierSum::default();
     for &v in x {
-        let v = v - mean;
-        let t = sum + v;
-        comp += if sum.abs() >= v.abs() {
-            (sum - t) + v
-        } else {
-            (v - t) + sum
-        };
-        sum = t;
-        s.push(sum + comp);
+        sum.add(v - mean);
+        s.push(sum.total());
     }
     s
-}
-
-/// Neumaier-compensated sum.
-fn compensated_sum(values: impl Iterator<Item = f64>) -> f64 {
-    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
-    for v in values {
-        let t = sum + v;
-        comp += if sum.abs() >= v.abs() {
-            (sum - t) + v
-        } else {
-            (v - t) + sum
-        };
-        sum = t;
-    }
-    sum + comp
 }
 
 /// Block of the blocked summation: partial sums of this many terms are added together, so the
@@ -722,17 +701,10 @@ fn modified_sum(s: &[f64], m: usize, terms: usize) -> f64 {
     let nd = terms + m - 1;
     let mut q = Vec::with_capacity(nd + 1);
     q.push(0.0);
-    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
+    let mut sum = NeumaierSum::default();
     for i in 0..nd {
-        let v = (s[i + 2 * m] - s[i + m]) - (s[i + m] - s[i]);
-        let t = sum + v;
-        comp += if sum.abs() >= v.abs() {
-            (sum - t) + v
-        } else {
-            (v - t) + sum
-        };
-        sum = t;
-        q.push(sum + comp);
+        sum.add((s[i + 2 * m] - s[i + m]) - (s[i + m] - s[i]));
+        q.push(sum.total());
     }
     blocked_sum(terms, |j| {
         let w = q[j + m] - q[j];
