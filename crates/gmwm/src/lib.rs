@@ -22,6 +22,7 @@
 pub mod error;
 pub mod fit;
 pub mod imu;
+pub mod inference;
 pub mod math;
 pub mod model;
 pub mod process;

@@ -1,0 +1,7 @@
+//! Inference on a GMWM fit (METHODS §7): the parametric bootstrap of the wavelet variance
+//! ([`bootstrap`], §7.4), on which the bootstrap weighting (§5.2), the bootstrap covariance
+//! of the estimates and the WIC optimism (§8) rest.
+
+pub mod bootstrap;
+
+pub use bootstrap::{map_replicates, wv_bootstrap, WvBootstrap};
