@@ -48,9 +48,10 @@ pub enum Command {
         after_long_help = "Examples:\n  gmwm implied --model \"3*AR1(phi=0.9, sigma2=1)+WN(sigma2=2)\" --levels 10\n  gmwm implied --model \"GM(beta=0.25, sigma2_gm=7.08e-9)+RW(gamma2=3.9e-14)\" --levels 20 --freq 250 --json"
     )]
     Implied(ImpliedArgs),
-    /// Estimate a latent error model by GMWM on each selected column (METHODS §5).
+    /// Estimate a latent error model by GMWM on each selected column (METHODS §5), from a
+    /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
-        after_long_help = "Examples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7"
+        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap"
     )]
     Fit(FitArgs),
 }
@@ -68,8 +69,9 @@ pub struct FitArgs {
     /// Wavelet-variance settings of the estimate.
     #[command(flatten)]
     pub estimator: WvEstimatorArgs,
-    /// Weighting matrix Omega (METHODS §5.2): CI-width ("fast", the IMU default) or the
-    /// Percival asymptotic diagonal.
+    /// Weighting matrix Omega (METHODS §5.2): CI-width ("fast", the IMU default), the
+    /// Percival asymptotic diagonal, or a parametric bootstrap of the WV variances at the
+    /// first fit (100 replicates of the series length, then a refit).
     #[arg(long, value_enum, default_value_t = WeightsArg::Fast)]
     pub weights: WeightsArg,
     /// Number of starting-value draws [default: 20000 for N <= 1e4, else 100000, with early stop].
@@ -90,6 +92,8 @@ pub enum WeightsArg {
     Fast,
     /// Inverse of the Percival asymptotic diagonal covariance (METHODS §1.10).
     Diag,
+    /// Inverse of the parametric-bootstrap WV variances at the fast fit, then refit (§5.2).
+    Bootstrap,
 }
 
 /// `gmwm simulate`.

@@ -1,27 +1,17 @@
 //! `gmwm fit`: GMWM estimation of a latent error model on each selected column (METHODS §5).
 
-use crate::args::{FitArgs, WeightsArg};
+use crate::args::{FitArgs, TransformArg, WeightsArg};
 use crate::cmd::wv::options;
-use crate::input::{analyse_columns, load};
+use crate::input::{analyse_columns, column_context, load};
 use crate::render::Style;
 use anyhow::Result;
+use gmwm::fit::{Ar1GmForms, NavParameter, ParameterEstimate, StartInputs};
+use gmwm::imu::{is_wv_json, read_wv_json};
 use gmwm::model::Model;
-use gmwm::{Gmwm, GmwmFit, Weighting};
+use gmwm::{Gmwm, GmwmFit, WaveletVariance, Weighting};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::io::Write;
-
-/// One estimated parameter in the JSON output, in model order.
-#[derive(Serialize)]
-struct Parameter {
-    /// Process kind of the component (`GM`, `WN`, ...).
-    process: String,
-    /// 0-based position of the component in the model.
-    index: usize,
-    /// Parameter name (METHODS §0.2).
-    name: String,
-    /// Estimate.
-    value: f64,
-}
 
 /// One column's fit in the JSON output.
 #[derive(Serialize)]
@@ -30,7 +20,12 @@ struct FitReport<'a> {
     model: String,
     objective: f64,
     converged: bool,
-    parameters: Vec<Parameter>,
+    /// `{process, index, name, value, start}` in model order.
+    parameters: Vec<ParameterEstimate>,
+    /// AR1/GM components in both forms.
+    ar1_gm: Vec<Ar1GmForms>,
+    /// Physical units (u = the data unit).
+    navigation: Vec<NavParameter>,
     fit: &'a GmwmFit,
 }
 
@@ -39,21 +34,78 @@ struct FitsDoc<'a> {
     fits: Vec<FitReport<'a>>,
 }
 
-fn parameters(model: &Model, theta: &[f64]) -> Vec<Parameter> {
-    let mut out = Vec::with_capacity(theta.len());
-    let mut k = 0;
-    for (index, c) in model.components().iter().enumerate() {
-        for name in c.kind.param_names() {
-            out.push(Parameter {
-                process: c.kind.name(),
-                index,
-                name,
-                value: theta[k],
-            });
-            k += 1;
+/// Keeps the first `j` levels of a WV.
+fn truncate_levels(wv: &mut WaveletVariance, j: usize) {
+    wv.tau.truncate(j);
+    wv.tau_s.truncate(j);
+    wv.wv.truncate(j);
+    wv.ci_low.truncate(j);
+    wv.ci_high.truncate(j);
+    wv.n_coefficients.truncate(j);
+    wv.eta.truncate(j);
+}
+
+/// Fits every series of a WV JSON file (`gmwm wv --json`) selected by `--columns` (names).
+fn fit_wv_file(args: &FitArgs, gmwm: &Gmwm) -> Result<Vec<(String, GmwmFit)>> {
+    let file = &args.input.file;
+    let e = &args.estimator;
+    anyhow::ensure!(
+        !e.robust,
+        "{}: --robust needs the series; a wavelet-variance file is fitted as it is (robust if it says so)",
+        file.display()
+    );
+    anyhow::ensure!(
+        e.filter == "haar" && e.transform == TransformArg::Modwt,
+        "{}: --filter/--transform apply to a recording; a wavelet-variance file is fitted as it is",
+        file.display()
+    );
+    anyhow::ensure!(
+        args.weights != WeightsArg::Diag,
+        "{}: --weights diag needs the series; use fast or bootstrap with a wavelet-variance file",
+        file.display()
+    );
+    let mut series = read_wv_json(file, args.input.freq)?;
+    if !args.input.columns.is_empty() {
+        let available: Vec<String> = series.iter().map(|(n, _)| n.clone()).collect();
+        let mut kept = Vec::new();
+        for c in &args.input.columns {
+            let pos = series.iter().position(|(n, _)| n == c).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{}: no series named \"{c}\"; available: {}",
+                    file.display(),
+                    available.join(", ")
+                )
+            })?;
+            kept.push(series[pos].clone());
+        }
+        series = kept;
+    }
+    if let Some(j) = e.levels {
+        for (name, wv) in &mut series {
+            anyhow::ensure!(
+                j >= 1 && j <= wv.levels(),
+                "{}: series {name}: --levels {j} is outside 1..={}",
+                file.display(),
+                wv.levels()
+            );
+            truncate_levels(wv, j);
         }
     }
-    out
+    let wvs: Vec<&WaveletVariance> = series.iter().map(|(_, w)| w).collect();
+    let fits: Vec<_> = wvs
+        .par_iter()
+        .map(|wv| gmwm.fit_from_wv(wv, StartInputs::from_wv(wv)))
+        .collect();
+    series
+        .iter()
+        .zip(fits)
+        .map(|((name, _), r)| {
+            Ok((
+                name.clone(),
+                column_context(r.map_err(gmwm::Error::from), file, name)?,
+            ))
+        })
+        .collect()
 }
 
 /// Runs the subcommand.
@@ -63,17 +115,22 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
     let mut gmwm = Gmwm::new(model).with_weighting(match args.weights {
         WeightsArg::Fast => Weighting::Fast,
         WeightsArg::Diag => Weighting::Diag,
+        WeightsArg::Bootstrap => Weighting::Bootstrap,
     });
     gmwm = gmwm.with_seed(args.seed);
     if let Some(g) = args.draws {
         anyhow::ensure!(g >= 1, "invalid --G 0: at least one starting-value draw");
         gmwm = gmwm.with_draws(g);
     }
-    let loaded = load(&args.input)?;
-    let fits = analyse_columns(&loaded, &args.input.file, |x| {
-        gmwm.fit(x, loaded.freq_hz, &wv_opts)
-            .map_err(gmwm::Error::from)
-    })?;
+    let fits = if is_wv_json(&args.input.file) {
+        fit_wv_file(args, &gmwm)?
+    } else {
+        let loaded = load(&args.input)?;
+        analyse_columns(&loaded, &args.input.file, |x| {
+            gmwm.fit(x, loaded.freq_hz, &wv_opts)
+                .map_err(gmwm::Error::from)
+        })?
+    };
     for (name, fit) in &fits {
         if !fit.convergence.converged {
             eprintln!(
@@ -93,7 +150,9 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                         model: fit.model.to_string(),
                         objective: fit.objective,
                         converged: fit.convergence.converged,
-                        parameters: parameters(&fit.model, &fit.theta),
+                        parameters: fit.parameters(),
+                        ar1_gm: fit.ar1_gm_forms(),
+                        navigation: fit.navigation(None),
                         fit,
                     })
                     .collect(),
@@ -104,7 +163,7 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
         Style::Csv => {
             writeln!(out, "column,process,index,name,value")?;
             for (column, fit) in &fits {
-                for p in parameters(&fit.model, &fit.theta) {
+                for p in fit.parameters() {
                     writeln!(
                         out,
                         "{column},{},{},{},{:e}",

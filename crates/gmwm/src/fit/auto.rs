@@ -22,12 +22,14 @@ impl Gmwm {
     pub fn fit(&self, x: &[f64], freq_hz: f64, wv_opts: &WvOptions) -> Result<GmwmFit, FitError> {
         let wv = wavelet_variance(x, freq_hz, wv_opts)?;
         let weights = Weights::new(self.weighting(), &wv, Some(x))?;
-        self.fit_auto(&wv, weights, StartInputs::from_series(x))
+        let inputs = StartInputs::from_series(x);
+        let fit = self.fit_auto(&wv, weights, inputs)?;
+        self.finish(fit, &wv, inputs)
     }
 
     /// Fits a precomputed WV (its `freq_hz` is used), generating starting values unless the
     /// model is fully specified; `inputs` supplies N and R (e.g. [`StartInputs::from_wv`]).
-    /// Needs a weighting that does not need the series (not `Diag`).
+    /// Needs a weighting that does not need the series (fast or bootstrap, not diag).
     ///
     /// # Errors
     /// As [`Gmwm::fit`] ([`FitError::Length`] for the diag weighting).
@@ -37,7 +39,8 @@ impl Gmwm {
         inputs: StartInputs,
     ) -> Result<GmwmFit, FitError> {
         let weights = Weights::new(self.weighting(), wv, None)?;
-        self.fit_auto(wv, weights, inputs)
+        let fit = self.fit_auto(wv, weights, inputs)?;
+        self.finish(fit, wv, inputs)
     }
 
     /// The model template carrying the user's (partial) values.
@@ -57,7 +60,8 @@ impl Gmwm {
         Ok(Model::new(comps).map_err(crate::Error::from)?)
     }
 
-    fn fit_auto(
+    /// The search and two-stage fit on given weights (no bootstrap rounds, nothing attached).
+    pub(crate) fn fit_auto(
         &self,
         wv: &WaveletVariance,
         weights: Weights,

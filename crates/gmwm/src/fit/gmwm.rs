@@ -1,15 +1,20 @@
 //! The GMWM estimator settings and the fit from caller-given starting values (METHODS §5.5
-//! steps 3, 4, 6, 10–12); the fit with generated starting values (§6) is in [`super::auto`],
-//! the bootstrap V is not here yet.
+//! steps 3, 4, 6, 8, 10–12), the bootstrap weighting (§5.2) and the refit of another model on
+//! a fit's WV (`update`, §5.9); the fit with generated starting values (§6) is in
+//! [`super::auto`].
 
 use super::{
-    minimize, Convergence, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StartOptions,
-    TransformPreset, Weighting, Weights,
+    minimize, Convergence, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StartInputs,
+    StartOptions, TransformPreset, Weighting, Weights,
 };
-use crate::model::{format_value, ImpliedWv, Model};
+use crate::error::ParamError;
+use crate::inference::wv_bootstrap;
+use crate::model::{ImpliedWv, Model};
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use serde::Serialize;
-use std::fmt;
+
+/// Default number of bootstrap replicates H behind [`Weighting::Bootstrap`] (METHODS §5.7).
+pub const DEFAULT_BOOTSTRAP_REPLICATES: usize = 100;
 
 /// GMWM estimator settings (METHODS §5): the model and how to fit it. Build with
 /// [`Gmwm::new`] and the `with_*` setters, then call [`Gmwm::fit_wv`] or [`Gmwm::fit_series`].
@@ -38,6 +43,9 @@ pub struct Gmwm {
     pub(crate) given: Vec<Option<f64>>,
     /// Starting-value search settings (METHODS §6).
     pub(crate) start_options: StartOptions,
+    /// Bootstrap weighting: replicates H and rounds K (METHODS §5.2, §5.5 step 8).
+    bootstrap_replicates: usize,
+    bootstrap_rounds: usize,
 }
 
 impl Gmwm {
@@ -54,7 +62,42 @@ impl Gmwm {
             preset: TransformPreset::Imu,
             phi_order: PhiOrder::Ordered,
             options: LmOptions::default(),
+            bootstrap_replicates: DEFAULT_BOOTSTRAP_REPLICATES,
+            bootstrap_rounds: 1,
         }
+    }
+
+    /// Model text or model, parsed: `Gmwm::parse("3*GM()+WN()")`.
+    ///
+    /// # Errors
+    /// The model's parse error, as [`crate::Error::ModelParse`].
+    pub fn parse(text: &str) -> Result<Self, crate::Error> {
+        Ok(Self::new(Model::parse(text)?))
+    }
+
+    /// Sets the replicates H and rounds K of [`Weighting::Bootstrap`] (METHODS §5.2; defaults
+    /// 100 and 1).
+    ///
+    /// # Errors
+    /// [`ParamError`] for `replicates < 2` (no covariance) or `rounds == 0`.
+    pub fn with_bootstrap(mut self, replicates: usize, rounds: usize) -> Result<Self, ParamError> {
+        if replicates < 2 {
+            return Err(ParamError::new(
+                "bootstrap replicates",
+                replicates,
+                "must be at least 2 (a variance needs two replicates)",
+            ));
+        }
+        if rounds == 0 {
+            return Err(ParamError::new(
+                "bootstrap rounds",
+                rounds,
+                "must be at least 1",
+            ));
+        }
+        self.bootstrap_replicates = replicates;
+        self.bootstrap_rounds = rounds;
+        Ok(self)
     }
 
     /// Sets the weighting (METHODS §5.2); default [`Weighting::Fast`].
@@ -104,8 +147,8 @@ impl Gmwm {
     }
 
     /// Fits the model to an empirical WV (METHODS §5.5) from `start` (theta in model order,
-    /// original parametrisation). Needs [`Weighting::Fast`]: the diag weights need the series
-    /// ([`Gmwm::fit_series`]).
+    /// original parametrisation). Works with the fast and bootstrap weightings; the diag weights
+    /// need the series ([`Gmwm::fit_series`]).
     ///
     /// # Errors
     /// [`FitError::Length`] for a wrong-length start or [`Weighting::Diag`]; errors of
@@ -121,7 +164,8 @@ impl Gmwm {
     ) -> Result<GmwmFit, FitError> {
         let weights = Weights::new(self.weighting, wv, None)?;
         self.check_robust_levels(wv)?;
-        self.fit_weighted(&wv.wv, weights, freq_hz, start)
+        let fit = self.fit_weighted(&wv.wv, weights, freq_hz, start)?;
+        self.finish(fit, wv, StartInputs::from_wv(wv))
     }
 
     /// METHODS §5.7: a robust fit needs parameters + 1 <= J.
@@ -151,7 +195,83 @@ impl Gmwm {
         let wv = wavelet_variance(x, freq_hz, wv_options)?;
         let weights = Weights::new(self.weighting, &wv, Some(x))?;
         self.check_robust_levels(&wv)?;
-        self.fit_weighted(&wv.wv, weights, freq_hz, start)
+        let fit = self.fit_weighted(&wv.wv, weights, freq_hz, start)?;
+        self.finish(fit, &wv, StartInputs::from_series(x))
+    }
+
+    /// METHODS §5.5 step 8 and §5.9: the bootstrap rounds when asked, then the empirical WV
+    /// and the search inputs are attached to the fit (for `update` and reporting).
+    pub(crate) fn finish(
+        &self,
+        mut fit: GmwmFit,
+        wv: &WaveletVariance,
+        inputs: StartInputs,
+    ) -> Result<GmwmFit, FitError> {
+        if self.weighting == Weighting::Bootstrap {
+            let org_v = fit.weights.v.clone();
+            let opts = WvOptions {
+                transform: wv.transform,
+                filter: wv.filter,
+                levels: Some(wv.levels()),
+                alpha: wv.alpha,
+                robust: wv.robust,
+            };
+            for round in 0..self.bootstrap_rounds {
+                let seed = self.start_options.seed.wrapping_add(1 + round as u64);
+                let boot = wv_bootstrap(
+                    &fit.model,
+                    wv.n,
+                    fit.freq_hz,
+                    &opts,
+                    self.bootstrap_replicates,
+                    seed,
+                )?;
+                let weights = Weights::from_v(boot.variances(), "bootstrap variance")?;
+                let start = fit.theta.clone();
+                let keep = fit.start.clone();
+                fit = self.fit_weighted(&wv.wv, weights, fit.freq_hz, &start)?;
+                fit.start = keep;
+            }
+            fit.org_v = Some(org_v);
+            fit.bootstrap_replicates = Some(self.bootstrap_replicates);
+        }
+        fit.empirical = Some(wv.clone());
+        fit.inputs = Some(inputs);
+        Ok(fit)
+    }
+
+    /// The package's `update` (METHODS §5.9): fits this estimator's model to the WV stored in
+    /// `fit` with `fit`'s original (fast or diag) weights, without recomputing the WV. Values
+    /// in this model are starting values as in [`Gmwm::fit`]; the starting-value search uses
+    /// this estimator's seed and G and the stored N and range.
+    ///
+    /// ```
+    /// use gmwm::{fit::Gmwm, model::Model, sim::simulate_model, WvOptions};
+    /// let truth = Model::parse("AR1(phi=0.99, sigma2=0.01)+WN(sigma2=1)").unwrap();
+    /// let x = simulate_model(&truth, 20_000, 1.0, 3).unwrap();
+    /// let full = Gmwm::parse("AR1()+WN()+RW()").unwrap().with_draws(2000);
+    /// let fit = full.fit(&x, 1.0, &WvOptions::default()).unwrap();
+    /// let small = Gmwm::parse("AR1()+WN()").unwrap().with_draws(2000).update(&fit).unwrap();
+    /// assert_eq!(small.empirical, fit.empirical);
+    /// ```
+    ///
+    /// # Errors
+    /// [`FitError::Length`] (what = "stored WV") when `fit` carries no empirical WV (a fit made
+    /// by [`Gmwm::fit_weighted`] alone); as [`Gmwm::fit_from_wv`].
+    pub fn update(&self, fit: &GmwmFit) -> Result<GmwmFit, FitError> {
+        let (Some(wv), Some(inputs)) = (&fit.empirical, fit.inputs) else {
+            return Err(FitError::Length {
+                what: "stored WV",
+                expected: fit.nu_hat.len(),
+                found: 0,
+            });
+        };
+        let weights = match &fit.org_v {
+            Some(v) => Weights::from_v(v.clone(), "stored variance")?,
+            None => fit.weights.clone(),
+        };
+        let refit = self.fit_auto(wv, weights, inputs)?;
+        self.finish(refit, wv, inputs)
     }
 
     /// Fits the model to `nu_hat` with the given weights from `start`.
@@ -174,9 +294,24 @@ impl Gmwm {
         // METHODS §5.6 (port): stable sort of the AR1/GM blocks, phi decreasing (a no-op for
         // the ordered chain)
         let theta = Parametrisation::canonical_order(&self.model, &min.theta)?;
+        // the §5.6 sort moves values between AR1/GM blocks unchanged: find each collapsed one
+        let collapsed = min
+            .collapsed
+            .iter()
+            .filter_map(|&k| {
+                let pos = theta.iter().position(|&v| v == min.theta[k]).unwrap_or(k);
+                param_names.get(pos).cloned()
+            })
+            .collect();
         let fitted = self.model.with_values(&theta).map_err(crate::Error::from)?;
         let implied_wv = fitted.implied_wv(nu_hat.len(), freq_hz)?;
         Ok(GmwmFit {
+            weighting: self.weighting,
+            org_v: None,
+            bootstrap_replicates: None,
+            empirical: None,
+            inputs: None,
+            collapsed,
             model: fitted,
             theta,
             param_names,
@@ -193,12 +328,16 @@ impl Gmwm {
     }
 }
 
-/// The result of a GMWM fit (METHODS §5.9, the fields implemented so far).
+/// The result of a GMWM fit (METHODS §5.9).
 ///
 /// Wire format: `model` (text with the estimates), `theta` and `param_names` (model order,
 /// original parametrisation, GM as `beta`, `sigma2_gm`), `start`, `objective` (`Q`, §5.1),
 /// `convergence` (`iterations`, `evaluations`, `reason`, `converged`), `nu_hat`, `implied_wv`
-/// (model and per component), `weights` (`v`, `omega`), `freq_hz`, `preset`, `phi_order`.
+/// (model and per component), `weights` (`v`, `omega`: the final weights), `weighting`,
+/// `org_v` (bootstrap weighting only: the fast V of the first fit), `bootstrap_replicates`,
+/// `empirical` (the WV with its CI), `inputs` (`n`, `range`), `freq_hz`, `preset`,
+/// `phi_order`. [`GmwmFit::parameters`] and [`GmwmFit::navigation`] give the per-parameter
+/// and physical-unit views.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GmwmFit {
     /// The model with the estimates.
@@ -225,21 +364,19 @@ pub struct GmwmFit {
     pub preset: TransformPreset,
     /// AR1/GM parametrisation used.
     pub phi_order: PhiOrder,
-}
-
-impl fmt::Display for GmwmFit {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "GMWM fit of {} at {} Hz", self.model, self.freq_hz)?;
-        writeln!(f, "{:<20} {:>14} {:>14}", "parameter", "estimate", "start")?;
-        for ((name, t), s) in self.param_names.iter().zip(&self.theta).zip(&self.start) {
-            writeln!(
-                f,
-                "{name:<20} {:>14} {:>14}",
-                format_value(*t),
-                format_value(*s)
-            )?;
-        }
-        writeln!(f, "objective Q = {:e}", self.objective)?;
-        write!(f, "optimiser: {}", self.convergence)
-    }
+    /// Which weighting produced `weights` (METHODS §5.2).
+    pub weighting: Weighting,
+    /// The fast V of the first fit when the bootstrap weighting replaced it (the package's
+    /// `orgV`); `None` otherwise (then `weights.v` is `orgV`).
+    pub org_v: Option<Vec<f64>>,
+    /// Replicates H of the bootstrap weighting, when used.
+    pub bootstrap_replicates: Option<usize>,
+    /// The empirical WV fitted, with its CI (`None` only for a bare [`Gmwm::fit_weighted`]).
+    pub empirical: Option<WaveletVariance>,
+    /// Series length and range behind the starting values (METHODS §6.1), kept for `update`.
+    pub inputs: Option<StartInputs>,
+    /// Labels of parameters that collapsed onto zero (their component has no measurable
+    /// share of the WV; the fit is a boundary point, [`super::optimize::COLLAPSE_INFLUENCE`]):
+    /// a hint that a smaller model fits as well.
+    pub collapsed: Vec<String>,
 }

@@ -12,13 +12,15 @@ pub mod auto;
 pub mod gmwm;
 pub mod objective;
 pub mod optimize;
+pub mod report;
 pub mod start;
 pub mod transform;
 pub mod weights;
 
-pub use gmwm::{Gmwm, GmwmFit};
+pub use gmwm::{Gmwm, GmwmFit, DEFAULT_BOOTSTRAP_REPLICATES};
 pub use objective::Objective;
 pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason, STALL_COSINE};
+pub use report::{Ar1GmForms, NavParameter, ParameterEstimate};
 pub use start::{starting_values, Dominance, StartInputs, StartOptions, StartValues};
 
 pub use transform::{ParamTransform, Parametrisation, PhiOrder, TransformPreset};

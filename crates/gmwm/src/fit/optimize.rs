@@ -8,7 +8,7 @@
 //! converges quadratically on small-residual fits and robustly elsewhere.
 
 use super::objective::Eval;
-use super::{FitError, Objective};
+use super::{FitError, Objective, ParamTransform};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -122,10 +122,42 @@ const INITIAL_DAMPING: f64 = 1e-3;
 /// without influence (zero column) still gets a damped, finite step.
 const SCALE_FLOOR: f64 = 1e-20;
 
+/// Restarts of the scaling and damping allowed when the steps vanish away from a stationary
+/// point, before the fit is reported [`StopReason::Stalled`].
+const MAX_RESTARTS: usize = 3;
+
 /// Gradient cosine above which a step-tolerance stop that followed rejected trials counts as
 /// [`StopReason::Stalled`]. At a true minimum the cosine is rounding noise (below ~1e-7 in the
 /// tests, where `Q` is known to ~1e-16 relative); 1e-4 leaves three decades of margin.
 pub const STALL_COSINE: f64 = 1e-4;
+
+/// Influence below which a log-scale parameter whose descent direction points to zero counts
+/// as collapsed onto its boundary (theta -> 0, u -> -inf): its whitened Jacobian column
+/// `sqrt(omega) theta dnu2/dtheta` (for a variance, the component's whole whitened WV) is at
+/// most this fraction of the residual norm, so removing the component entirely changes `Q` by
+/// at most `2e-9` relative. Such a minimum is a boundary (KKT) point: the gradient there is not
+/// zero, so the first-order test runs over the other parameters, and the fit lists the
+/// collapsed ones ([`Minimum::collapsed`]).
+pub const COLLAPSE_INFLUENCE: f64 = 1e-9;
+
+/// Indices of the collapsed parameters (see [`COLLAPSE_INFLUENCE`]) at `ev`.
+fn collapsed_params(ev: &Eval, levels: usize, p: usize, log_scale: &[bool]) -> Vec<usize> {
+    let r_norm = sum_sq(&ev.r[..levels]).sqrt();
+    (0..p)
+        .filter(|&k| {
+            if !log_scale[k] {
+                return false;
+            }
+            let (mut col, mut g) = (0.0, 0.0);
+            for j in 0..levels {
+                let v = ev.jac[j * p + k];
+                col += v * v;
+                g += v * ev.r[j];
+            }
+            g >= 0.0 && col.sqrt() <= COLLAPSE_INFLUENCE * r_norm
+        })
+        .collect()
+}
 
 /// The minimiser found by [`minimize`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -140,6 +172,9 @@ pub struct Minimum {
     pub implied_wv: Vec<f64>,
     /// How it ended.
     pub convergence: Convergence,
+    /// Parameters (indices) that collapsed onto zero: the data do not support their
+    /// component (see [`COLLAPSE_INFLUENCE`]).
+    pub collapsed: Vec<usize>,
 }
 
 /// Cholesky solve of the symmetric positive definite `m x = b` (row-major n x n), in place in
@@ -221,6 +256,13 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
     let mut u_new = vec![0.0; p];
     let mut mu = f64::NAN;
     let mut nu = 2.0;
+    let mut restarts = 0;
+    let log_scale: Vec<bool> = objective
+        .parametrisation()
+        .transforms()
+        .iter()
+        .map(|t| matches!(t, Some(ParamTransform::Log | ParamTransform::LogAbs)))
+        .collect();
     let finish =
         |reason: StopReason, u: Vec<f64>, ev: &Eval, q: f64, it: usize, evals: usize| Minimum {
             u,
@@ -233,6 +275,7 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
                 reason,
                 converged: reason.is_converged(),
             },
+            collapsed: collapsed_params(ev, levels, p, &log_scale),
         };
     loop {
         if q <= opts.zero_tolerance * scale_q {
@@ -247,8 +290,9 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
         }
         normal_equations(&cur, levels, p, &mut a, &mut g);
         let r_norm = q.sqrt();
+        let collapsed = collapsed_params(&cur, levels, p, &log_scale);
         let cosine = (0..p)
-            .filter(|&k| a[k * p + k] > 0.0)
+            .filter(|&k| a[k * p + k] > 0.0 && !collapsed.contains(&k))
             .map(|k| g[k].abs() / (a[k * p + k].sqrt() * r_norm))
             .fold(0.0, f64::max);
         if cosine <= opts.gradient_tolerance {
@@ -304,7 +348,21 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
             let h_norm = sum_sq(&h).sqrt();
             let u_norm = sum_sq(&u).sqrt();
             if h_norm <= opts.step_tolerance * (u_norm + opts.step_tolerance) {
-                let reason = if rejected && cosine > STALL_COSINE {
+                let stalled = rejected && cosine > STALL_COSINE;
+                if stalled && restarts < MAX_RESTARTS {
+                    // Marquardt's scaling keeps the largest curvature seen; a parameter whose
+                    // column has since shrunk by decades (a component fading towards zero)
+                    // is then damped to a standstill. Restart the scaling and the damping.
+                    restarts += 1;
+                    for k in 0..p {
+                        d[k] = a[k * p + k].max(SCALE_FLOOR * a_max);
+                    }
+                    mu = INITIAL_DAMPING;
+                    nu = 2.0;
+                    rejected = false;
+                    continue;
+                }
+                let reason = if stalled {
                     StopReason::Stalled
                 } else {
                     StopReason::StepTolerance

@@ -45,7 +45,7 @@ const ARMA_TRIES: usize = 1000;
 const PSI_TERMS: usize = 1000;
 
 /// The non-WV inputs of the search (METHODS §6.1).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StartInputs {
     /// Series length N (RW draws scale with `1 / N`).
     pub n: usize,

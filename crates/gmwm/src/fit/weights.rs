@@ -22,6 +22,11 @@ pub enum Weighting {
     /// Percival's asymptotic diagonal (METHODS §1.10) with the per-level divisor, `/ eff` if
     /// robust; needs the series.
     Diag,
+    /// METHODS §5.2 `bootstrap`: fit with the fast weights, then (K rounds, default 1) take
+    /// `V_jj` from a parametric bootstrap of the WV at the current estimate (H replicates of the
+    /// observed length, default 100, §7.4) and refit stage 2 from the estimate with
+    /// `Omega = diag(V)^{-1}` (the package ignores the off-diagonals; so do we).
+    Bootstrap,
 }
 
 /// Diagonal weights `omega_j = 1 / V_jj` (METHODS §5.2).
@@ -35,7 +40,7 @@ pub struct Weights {
 
 impl Weights {
     /// Weights from the diagonal of V; `what` names it in errors.
-    fn from_v(v: Vec<f64>, what: &'static str) -> Result<Self, FitError> {
+    pub(crate) fn from_v(v: Vec<f64>, what: &'static str) -> Result<Self, FitError> {
         for (j, &x) in v.iter().enumerate() {
             let omega = 1.0 / x;
             if !(x.is_finite() && x > 0.0 && omega.is_finite()) {
@@ -113,7 +118,8 @@ impl Weights {
         Self::from_v(v, "variance")
     }
 
-    /// Weights of the given kind; `x` is needed only by [`Weighting::Diag`].
+    /// Weights of the given kind; `x` is needed only by [`Weighting::Diag`]. For
+    /// [`Weighting::Bootstrap`] these are the fast weights of the first fit.
     ///
     /// # Errors
     /// As [`Weights::fast`] / [`Weights::diag`]; [`FitError::Length`] (what = "series") when
@@ -124,7 +130,7 @@ impl Weights {
         x: Option<&[f64]>,
     ) -> Result<Self, FitError> {
         match (weighting, x) {
-            (Weighting::Fast, _) => Self::fast(wv),
+            (Weighting::Fast | Weighting::Bootstrap, _) => Self::fast(wv),
             (Weighting::Diag, Some(x)) => Self::diag(x, wv),
             (Weighting::Diag, None) => Err(FitError::Length {
                 what: "series",

@@ -176,6 +176,14 @@ pub enum ReadError {
         /// Why (e.g. "fewer than 2 epochs"); a fixed phrase, not formatted data.
         reason: &'static str,
     },
+    /// A wavelet-variance JSON file is not usable (what is wrong, naming the series and field).
+    #[error("{}: not a usable wavelet-variance JSON: {reason}", .path.display())]
+    WvJson {
+        /// File.
+        path: PathBuf,
+        /// What is wrong, e.g. `series[0] (gyro_x): tau[2] = 12, expected 8`.
+        reason: String,
+    },
     /// An option has an impossible value (e.g. `ncols = 0`, `freq_hz = -1`).
     #[error(transparent)]
     InvalidOption(#[from] ParamError),

@@ -4,6 +4,7 @@
 //!   [`Table`] of named columns, with the JSON [`Sidecar`] and the sampling rate;
 //! - [`BinaryChunks`] / [`for_each_chunk`]: one column of a huge binary file in bounded memory;
 //! - [`read_imu_record_file`]: the binary IMU epoch records of METHODS §9.2–9.3;
+//! - [`read_wv_json`]: a wavelet variance computed elsewhere (`gmwm wv --json`), to fit again;
 //! - [`Imu`]: gyroscope/accelerometer axes with a common rate (METHODS §9.1).
 //!
 //! This module knows no statistics; every error is a [`ReadError`] (or a
@@ -26,6 +27,7 @@ pub mod read;
 mod sensor;
 pub mod sidecar;
 pub mod write;
+pub mod wv_file;
 
 pub use error::ReadError;
 pub use read::{
@@ -34,3 +36,4 @@ pub use read::{
 };
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
 pub use sidecar::{find_sidecar, ColumnSummary, Sidecar, SidecarColumn, SidecarUnits};
+pub use wv_file::{is_wv_json, read_wv_json};
