@@ -86,10 +86,11 @@ impl fmt::Display for Convergence {
 /// Options of [`minimize`]; the defaults suit the GMWM problem (a few to ~20 parameters).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LmOptions {
-    /// Maximum accepted steps; default 500 (LM typically needs 10–100 here; the package's CG
+    /// Maximum accepted steps; default 2000 (LM typically needs 10–200 here, more when a
+    /// component slowly fades to zero; the package's CG
     /// stops at 100).
     pub max_iterations: usize,
-    /// Maximum evaluations; default 5000 (ten trials per step leave the damping exhausted).
+    /// Maximum evaluations; default 20000 (ten trials per step leave the damping exhausted).
     pub max_evaluations: usize,
     /// Gradient cosine tolerance; default 1e-10 (MINPACK's `gtol` measure, scale-free).
     pub gradient_tolerance: f64,
@@ -105,8 +106,8 @@ pub struct LmOptions {
 impl Default for LmOptions {
     fn default() -> Self {
         Self {
-            max_iterations: 500,
-            max_evaluations: 5000,
+            max_iterations: 2000,
+            max_evaluations: 20000,
             gradient_tolerance: 1e-10,
             step_tolerance: 1e-12,
             function_tolerance: 1e-15,
@@ -122,6 +123,11 @@ const INITIAL_DAMPING: f64 = 1e-3;
 /// without influence (zero column) still gets a damped, finite step.
 const SCALE_FLOOR: f64 = 1e-20;
 
+/// Accepted steps between refreshes of Marquardt's scaling (the running maximum of the
+/// curvature goes stale when a component fades by decades, and the steps crawl) and of the
+/// damping.
+const REFRESH_EVERY: usize = 50;
+
 /// Restarts of the scaling and damping allowed when the steps vanish away from a stationary
 /// point, before the fit is reported [`StopReason::Stalled`].
 const MAX_RESTARTS: usize = 3;
@@ -135,10 +141,12 @@ pub const STALL_COSINE: f64 = 1e-4;
 /// as collapsed onto its boundary (theta -> 0, u -> -inf): its whitened Jacobian column
 /// `sqrt(omega) theta dnu2/dtheta` (for a variance, the component's whole whitened WV) is at
 /// most this fraction of the residual norm, so removing the component entirely changes `Q` by
-/// at most `2e-9` relative. Such a minimum is a boundary (KKT) point: the gradient there is not
-/// zero, so the first-order test runs over the other parameters, and the fit lists the
-/// collapsed ones ([`Minimum::collapsed`]).
-pub const COLLAPSE_INFLUENCE: f64 = 1e-9;
+/// at most `2e-7` relative. Such a minimum is a boundary (KKT) point: the gradient there is
+/// not zero and the parameter would crawl towards zero for thousands of steps, so while it
+/// stays collapsed it is held fixed, the first-order test runs over the other parameters, and
+/// the fit lists it ([`Minimum::collapsed`]). It is released as soon as the gradient asks it
+/// to grow.
+pub const COLLAPSE_INFLUENCE: f64 = 1e-7;
 
 /// Indices of the collapsed parameters (see [`COLLAPSE_INFLUENCE`]) at `ev`.
 fn collapsed_params(ev: &Eval, levels: usize, p: usize, log_scale: &[bool]) -> Vec<usize> {
@@ -291,6 +299,13 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
         normal_equations(&cur, levels, p, &mut a, &mut g);
         let r_norm = q.sqrt();
         let collapsed = collapsed_params(&cur, levels, p, &log_scale);
+        for &k in &collapsed {
+            for l in 0..p {
+                a[k * p + l] = 0.0;
+                a[l * p + k] = 0.0;
+            }
+            g[k] = 0.0;
+        }
         let cosine = (0..p)
             .filter(|&k| a[k * p + k] > 0.0 && !collapsed.contains(&k))
             .map(|k| g[k].abs() / (a[k * p + k].sqrt() * r_norm))
@@ -316,8 +331,14 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
             ));
         }
         let a_max = (0..p).map(|k| a[k * p + k]).fold(0.0, f64::max);
+        let refresh = iterations > 0 && iterations % REFRESH_EVERY == 0;
         for k in 0..p {
-            d[k] = d[k].max(a[k * p + k]).max(SCALE_FLOOR * a_max);
+            let kept = if refresh { 0.0 } else { d[k] };
+            d[k] = kept.max(a[k * p + k]).max(SCALE_FLOOR * a_max);
+        }
+        if refresh {
+            mu = INITIAL_DAMPING;
+            nu = 2.0;
         }
         if mu.is_nan() {
             mu = INITIAL_DAMPING;
