@@ -253,7 +253,7 @@ fn section_5_7_refusals_and_power_of_two() {
             1.0,
             &WvOptions {
                 robust: Some(RobustOptions::default()),
-                ..opts.clone()
+                ..opts
             },
         )
         .unwrap_err();
