@@ -136,7 +136,9 @@ fn demo_runs_and_compares_with_the_truth() {
                 .and(predicate::str::contains("implied WV"))
                 .and(predicate::str::contains(
                     "the implied WV of the truth lies inside",
-                )),
+                ))
+                .and(predicate::str::contains("truth against estimate"))
+                .and(predicate::str::contains("GM[0].beta")),
         );
     let out = gmwm()
         .args(["demo", "--n", "8192", "--json"])
@@ -147,6 +149,14 @@ fn demo_runs_and_compares_with_the_truth() {
     let levels = doc["empirical"]["wv"].as_array().unwrap().len();
     assert_eq!(doc["implied"]["wv"].as_array().unwrap().len(), levels);
     assert_eq!(doc["implied"]["processes"].as_array().unwrap().len(), 6);
+    let params = doc["parameters"].as_array().unwrap();
+    assert_eq!(params.len(), 9);
+    // the WN and QN dominate the first levels: recovered within 10% even at N = 8192
+    for p in &params[6..8] {
+        let (t, e) = (p["truth"].as_f64().unwrap(), p["estimate"].as_f64().unwrap());
+        assert!((e / t - 1.0).abs() < 0.1, "{p}");
+    }
+    assert!(doc["fit"]["convergence"]["converged"].as_bool().unwrap());
 }
 
 #[test]
@@ -637,4 +647,79 @@ fn review_findings_are_errors_not_panics_or_silent_numbers() {
         .arg(ok.path())
         .assert()
         .success();
+}
+
+/// `gmwm fit` on the JSON of `gmwm wv --json` gives the fit of the recording itself, and the
+/// JSON output carries the fields; `--weights bootstrap` runs and says so.
+#[test]
+fn fit_accepts_a_wv_json_and_bootstrap_weights() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("sim.csv");
+    gmwm()
+        .args([
+            "simulate",
+            "--model",
+            "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)",
+            "--n",
+            "20000",
+            "--freq",
+            "10",
+            "--seed",
+            "3",
+            "-o",
+        ])
+        .arg(&csv)
+        .assert()
+        .success();
+    let wv = gmwm().arg("wv").arg(&csv).arg("--json").output().unwrap();
+    assert!(wv.status.success());
+    let wv_file = dir.path().join("wv.json");
+    std::fs::write(&wv_file, &wv.stdout).unwrap();
+    let fit_json = |file: &std::path::Path, extra: &[&str]| -> serde_json::Value {
+        let out = gmwm()
+            .arg("fit")
+            .arg(file)
+            .args(["--model", "AR1()+WN()", "--G", "2000", "--json"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let from_wv = fit_json(&wv_file, &[]);
+    let from_csv = fit_json(&csv, &[]);
+    let f = &from_wv["fits"][0];
+    assert_eq!(f["column"], "x");
+    assert_eq!(f["parameters"], from_csv["fits"][0]["parameters"]);
+    let names: Vec<&str> = f["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["phi", "sigma2", "sigma2"]);
+    assert_eq!(f["parameters"][2]["process"], "WN");
+    assert_eq!(f["parameters"][2]["index"], 1);
+    assert!(f["objective"].as_f64().unwrap() >= 0.0);
+    assert_eq!(f["converged"], true);
+    // GM form at 10 Hz: beta = -10 ln(phi)
+    let phi = f["parameters"][0]["value"].as_f64().unwrap();
+    let beta = f["ar1_gm"][0]["beta"].as_f64().unwrap();
+    assert!((beta / (-10.0 * phi.ln()) - 1.0).abs() < 1e-12);
+    let boot = fit_json(&wv_file, &["--weights", "bootstrap"]);
+    assert_eq!(boot["fits"][0]["fit"]["weighting"], "bootstrap");
+    assert_eq!(boot["fits"][0]["fit"]["bootstrap_replicates"], 100);
+    // refusals on a WV file
+    assert_one_line_error(
+        &["fit", wv_file.to_str().unwrap(), "--model", "WN()", "--robust"],
+        &["needs the series"],
+    );
+    assert_one_line_error(
+        &["fit", wv_file.to_str().unwrap(), "--model", "WN()", "--weights", "diag"],
+        &["needs the series"],
+    );
+    assert_one_line_error(
+        &["fit", wv_file.to_str().unwrap(), "--model", "WN()", "--columns", "y"],
+        &["no series named \"y\""],
+    );
 }

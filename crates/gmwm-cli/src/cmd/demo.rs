@@ -1,5 +1,6 @@
 //! `gmwm demo`: the main job on a built-in default — simulate a sensor with known truth
-//! (METHODS §5.10) and show its empirical wavelet variance against the truth's implied WV.
+//! (METHODS §5.10), compute its wavelet variance, fit the truth's model structure
+//! `3*GM()+WN()+QN()+RW()` by GMWM in guess mode, and show truth against estimate.
 
 use crate::args::DemoArgs;
 use crate::cmd::wv::options;
@@ -7,7 +8,7 @@ use crate::render::Style;
 use anyhow::Result;
 use gmwm::model::ImpliedWv;
 use gmwm::sim::DemoSensor;
-use gmwm::{wavelet_variance, WaveletVariance};
+use gmwm::{wavelet_variance, Gmwm, GmwmFit, WaveletVariance};
 use serde::Serialize;
 use std::io::Write;
 
@@ -20,6 +21,17 @@ struct DemoReport<'a> {
     seed: u64,
     empirical: &'a WaveletVariance,
     implied: &'a ImpliedWv,
+    /// Truth against estimate, in model order.
+    parameters: Vec<TruthVsEstimate>,
+    fit: &'a GmwmFit,
+}
+
+/// One parameter of the demo: the truth and the GMWM estimate.
+#[derive(Serialize)]
+struct TruthVsEstimate {
+    name: String,
+    truth: f64,
+    estimate: f64,
 }
 
 /// Runs the subcommand.
@@ -33,6 +45,26 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
     let x = sensor.simulate(args.n, args.seed)?;
     let wv = wavelet_variance(&x, sensor.freq_hz, &opts)?;
     let implied = sensor.model.implied_wv(wv.levels(), sensor.freq_hz)?;
+    let started = std::time::Instant::now();
+    let fit = Gmwm::new(sensor.model.without_values()).fit_from_wv(
+        &wv,
+        gmwm::fit::StartInputs::from_series(&x),
+    )?;
+    let fit_time = started.elapsed();
+    // the fit lists AR1/GM blocks by phi descending (METHODS §5.6): order the truth alike
+    let truth: Vec<f64> = sensor.model.values().into_iter().flatten().collect();
+    let truth = gmwm::fit::Parametrisation::canonical_order(&sensor.model, &truth)?;
+    let parameters = fit
+        .param_names
+        .iter()
+        .zip(&truth)
+        .zip(&fit.theta)
+        .map(|((name, t), e)| TruthVsEstimate {
+            name: name.clone(),
+            truth: *t,
+            estimate: *e,
+        })
+        .collect();
     let report = DemoReport {
         truth: sensor.model.to_string(),
         freq_hz: sensor.freq_hz,
@@ -40,6 +72,8 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
         seed: args.seed,
         empirical: &wv,
         implied: &implied,
+        parameters,
+        fit: &fit,
     };
     match Style::from(&args.output) {
         Style::Json => {
@@ -47,22 +81,30 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
             writeln!(out)?;
         }
         Style::Csv => {
-            writeln!(out, "level,tau,tau_s,wv,ci_low,ci_high,implied_wv")?;
+            writeln!(out, "level,tau,tau_s,wv,ci_low,ci_high,implied_wv,fitted_wv")?;
             for j in 0..wv.levels() {
                 writeln!(
                     out,
-                    "{},{},{:e},{:e},{:e},{:e},{:e}",
+                    "{},{},{:e},{:e},{:e},{:e},{:e},{:e}",
                     j + 1,
                     wv.tau[j],
                     wv.tau_s[j],
                     wv.wv[j],
                     wv.ci_low[j],
                     wv.ci_high[j],
-                    implied.wv[j]
+                    implied.wv[j],
+                    fit.implied_wv.wv[j]
                 )?;
             }
         }
-        Style::Table => table(out, &report)?,
+        Style::Table => {
+            table(out, &report)?;
+            writeln!(
+                out,
+                "(fit: {:.0} ms on this machine; the WV and fit of a 1e6-sample column take well under a second)",
+                fit_time.as_secs_f64() * 1e3
+            )?;
+        }
     }
     Ok(())
 }
@@ -111,6 +153,43 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
         "\nthe implied WV of the truth lies inside the {:.0}% CI at {inside} of {} levels",
         100.0 * (1.0 - wv.alpha),
         wv.levels()
+    )?;
+    writeln!(out)?;
+    writeln!(
+        out,
+        "GMWM fit of {} (guess mode, seed 1337): truth against estimate",
+        r.fit.model.without_values()
+    )?;
+    writeln!(
+        out,
+        "{:<18} {:>13} {:>13} {:>10}",
+        "parameter", "truth", "estimate", "ratio"
+    )?;
+    for p in &r.parameters {
+        writeln!(
+            out,
+            "{:<18} {:>13.4e} {:>13.4e} {:>10.3}",
+            p.name,
+            p.truth,
+            p.estimate,
+            p.estimate / p.truth
+        )?;
+    }
+    writeln!(
+        out,
+        "objective Q = {:.6e}; optimiser: {}",
+        r.fit.objective, r.fit.convergence
+    )?;
+    if !r.fit.collapsed.is_empty() {
+        writeln!(
+            out,
+            "collapsed to zero (not supported by the data): {}",
+            r.fit.collapsed.join(", ")
+        )?;
+    }
+    writeln!(
+        out,
+        "(GM beta in 1/s; `gmwm fit --json` gives the AR1 forms and the navigation-filter units)"
     )?;
     Ok(())
 }
