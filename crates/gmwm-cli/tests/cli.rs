@@ -153,7 +153,10 @@ fn demo_runs_and_compares_with_the_truth() {
     assert_eq!(params.len(), 9);
     // the WN and QN dominate the first levels: recovered within 10% even at N = 8192
     for p in &params[6..8] {
-        let (t, e) = (p["truth"].as_f64().unwrap(), p["estimate"].as_f64().unwrap());
+        let (t, e) = (
+            p["truth"].as_f64().unwrap(),
+            p["estimate"].as_f64().unwrap(),
+        );
         assert!((e / t - 1.0).abs() < 0.1, "{p}");
     }
     assert!(doc["fit"]["convergence"]["converged"].as_bool().unwrap());
@@ -683,7 +686,11 @@ fn fit_accepts_a_wv_json_and_bootstrap_weights() {
             .args(extra)
             .output()
             .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         serde_json::from_slice(&out.stdout).unwrap()
     };
     let from_wv = fit_json(&wv_file, &[]);
@@ -711,15 +718,35 @@ fn fit_accepts_a_wv_json_and_bootstrap_weights() {
     assert_eq!(boot["fits"][0]["fit"]["bootstrap_replicates"], 100);
     // refusals on a WV file
     assert_one_line_error(
-        &["fit", wv_file.to_str().unwrap(), "--model", "WN()", "--robust"],
+        &[
+            "fit",
+            wv_file.to_str().unwrap(),
+            "--model",
+            "WN()",
+            "--robust",
+        ],
         &["needs the series"],
     );
     assert_one_line_error(
-        &["fit", wv_file.to_str().unwrap(), "--model", "WN()", "--weights", "diag"],
+        &[
+            "fit",
+            wv_file.to_str().unwrap(),
+            "--model",
+            "WN()",
+            "--weights",
+            "diag",
+        ],
         &["needs the series"],
     );
     assert_one_line_error(
-        &["fit", wv_file.to_str().unwrap(), "--model", "WN()", "--columns", "y"],
+        &[
+            "fit",
+            wv_file.to_str().unwrap(),
+            "--model",
+            "WN()",
+            "--columns",
+            "y",
+        ],
         &["no series named \"y\""],
     );
 }

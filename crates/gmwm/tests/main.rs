@@ -6,6 +6,7 @@
 mod allan;
 mod common;
 mod fit;
+mod fit_mc;
 mod fit_ref;
 mod fit_start;
 mod model;

@@ -46,10 +46,8 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
     let wv = wavelet_variance(&x, sensor.freq_hz, &opts)?;
     let implied = sensor.model.implied_wv(wv.levels(), sensor.freq_hz)?;
     let started = std::time::Instant::now();
-    let fit = Gmwm::new(sensor.model.without_values()).fit_from_wv(
-        &wv,
-        gmwm::fit::StartInputs::from_series(&x),
-    )?;
+    let fit = Gmwm::new(sensor.model.without_values())
+        .fit_from_wv(&wv, gmwm::fit::StartInputs::from_series(&x))?;
     let fit_time = started.elapsed();
     // the fit lists AR1/GM blocks by phi descending (METHODS §5.6): order the truth alike
     let truth: Vec<f64> = sensor.model.values().into_iter().flatten().collect();
@@ -81,7 +79,10 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
             writeln!(out)?;
         }
         Style::Csv => {
-            writeln!(out, "level,tau,tau_s,wv,ci_low,ci_high,implied_wv,fitted_wv")?;
+            writeln!(
+                out,
+                "level,tau,tau_s,wv,ci_low,ci_high,implied_wv,fitted_wv"
+            )?;
             for j in 0..wv.levels() {
                 writeln!(
                     out,
