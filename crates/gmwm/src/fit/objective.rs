@@ -140,9 +140,7 @@ impl Objective {
         let processes = self.model.with_values(theta)?.processes(self.freq_hz)?;
         nu.fill(0.0);
         for p in &processes {
-            for (n, w) in nu.iter_mut().zip(p.wv(levels)) {
-                *n += w;
-            }
+            p.add_wv(nu);
         }
         if let Some(a) = a {
             let np = self.n_params();

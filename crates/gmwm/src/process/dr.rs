@@ -46,6 +46,12 @@ impl LatentProcess for Dr {
             .map(|m| self.omega * self.omega * unit_wv(m))
             .collect()
     }
+    fn add_wv(&self, out: &mut [f64]) {
+        let scale = self.omega * self.omega;
+        for (o, m) in out.iter_mut().zip(half_widths(usize::MAX)) {
+            *o += scale * unit_wv(m);
+        }
+    }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         half_widths(levels)
             .map(|m| vec![2.0 * self.omega * unit_wv(m)])

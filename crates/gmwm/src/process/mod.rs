@@ -44,6 +44,14 @@ pub trait LatentProcess {
     fn params(&self) -> Vec<f64>;
     /// METHODS §4.2: implied Haar WV at `tau_j = 2^j` samples, `j = 1..=levels`.
     fn wv(&self, levels: usize) -> Vec<f64>;
+    /// Adds the implied WV at levels `1..=out.len()` to `out` (the objective's and the
+    /// starting-value search's hot path: no allocation where a process overrides it).
+    fn add_wv(&self, out: &mut [f64]) {
+        let wv = self.wv(out.len());
+        for (o, w) in out.iter_mut().zip(wv) {
+            *o += w;
+        }
+    }
     /// METHODS §4.5: Jacobian `d nu2_j / d theta_k`, indexed `[level][param]`.
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>>;
     /// METHODS §4.6: second derivatives, indexed `[level][param][param]` (symmetric).
@@ -104,6 +112,9 @@ impl LatentProcess for Process {
     }
     fn wv(&self, levels: usize) -> Vec<f64> {
         self.inner().wv(levels)
+    }
+    fn add_wv(&self, out: &mut [f64]) {
+        self.inner().add_wv(out)
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         self.inner().jacobian(levels)

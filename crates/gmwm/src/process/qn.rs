@@ -42,6 +42,12 @@ impl LatentProcess for Qn {
     fn wv(&self, levels: usize) -> Vec<f64> {
         half_widths(levels).map(|m| self.q2 * unit_wv(m)).collect()
     }
+    fn add_wv(&self, out: &mut [f64]) {
+        let scale = self.q2;
+        for (o, m) in out.iter_mut().zip(half_widths(usize::MAX)) {
+            *o += scale * unit_wv(m);
+        }
+    }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         half_widths(levels).map(|m| vec![unit_wv(m)]).collect()
     }

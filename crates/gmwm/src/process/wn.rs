@@ -44,6 +44,12 @@ impl LatentProcess for Wn {
             .map(|m| self.sigma2 * unit_wv(m))
             .collect()
     }
+    fn add_wv(&self, out: &mut [f64]) {
+        let scale = self.sigma2;
+        for (o, m) in out.iter_mut().zip(half_widths(usize::MAX)) {
+            *o += scale * unit_wv(m);
+        }
+    }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         half_widths(levels).map(|m| vec![unit_wv(m)]).collect()
     }
