@@ -7,6 +7,7 @@ mod allan;
 mod common;
 mod fit;
 mod fit_start;
+mod inference;
 mod model;
 mod process;
 mod read;
