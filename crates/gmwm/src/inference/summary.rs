@@ -191,7 +191,7 @@ impl fmt::Display for InferenceWarning {
 pub struct Inference {
     /// Asymptotic or bootstrap.
     pub method: InferenceMethod,
-    /// Intervals are `1 - alpha` (two-sided convention) .
+    /// The `alpha` of the intervals (`1 - alpha` two-sided, `1 - 2 alpha` with the package z).
     pub alpha: f64,
     /// The normal quantile used.
     pub z: f64,
