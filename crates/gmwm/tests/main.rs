@@ -9,6 +9,7 @@ mod fit;
 mod fit_mc;
 mod fit_ref;
 mod fit_start;
+mod inference;
 mod model;
 mod process;
 mod read;

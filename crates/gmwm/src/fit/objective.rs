@@ -5,7 +5,12 @@
 //! for an IMU), but with the fast or diag weights `sqrt(omega_j)` is about `1 / nu2_j` times a
 //! level constant, so the whitened residuals are relative errors of order one and the
 //! least-squares problem is well scaled; the transforms of §5.3 put every variance on a log scale.
+//!
+//! A full weighting `Omega = V^{-1}` ([`FullWeights`], e.g. the efficient weights of the J-test,
+//! §7.3) whitens by a lower-triangular matrix instead: `r = W (nu2_hat - nu2)`, `W'W = Omega`.
+//! The diagonal path is unchanged.
 
+use super::weights::FullWeights;
 use super::{FitError, Parametrisation, Weights};
 use crate::model::Model;
 use crate::process::LatentProcess;
@@ -17,6 +22,9 @@ pub struct Objective {
     param: Parametrisation,
     nu_hat: Vec<f64>,
     sqrt_omega: Vec<f64>,
+    /// Row-major J x J lower-triangular whitening matrix of a full weighting; `sqrt_omega` is
+    /// then unused.
+    whitening: Option<Vec<f64>>,
     freq_hz: f64,
 }
 
@@ -50,11 +58,42 @@ impl Objective {
         weights: &Weights,
         freq_hz: f64,
     ) -> Result<Self, FitError> {
-        if weights.levels() != nu_hat.len() {
+        let sqrt_omega = weights.omega.iter().map(|w| w.sqrt()).collect();
+        Self::build(model, param, nu_hat, sqrt_omega, None, freq_hz)
+    }
+
+    /// The objective with a full weighting `Omega = V^{-1}` (METHODS §5.1 with a non-diagonal
+    /// Omega, e.g. the efficient weights of §7.3): `Q = (nu2_hat - nu2)' Omega (nu2_hat - nu2)`,
+    /// minimised through the whitened residuals `W (nu2_hat - nu2)`.
+    ///
+    /// # Errors
+    /// As [`Objective::new`].
+    pub fn with_full_weights(
+        model: &Model,
+        param: Parametrisation,
+        nu_hat: &[f64],
+        weights: &FullWeights,
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        let w = weights.whitening();
+        let n = w.nrows();
+        let whitening = (0..n * n).map(|k| w[(k / n, k % n)]).collect();
+        Self::build(model, param, nu_hat, vec![1.0; n], Some(whitening), freq_hz)
+    }
+
+    fn build(
+        model: &Model,
+        param: Parametrisation,
+        nu_hat: &[f64],
+        sqrt_omega: Vec<f64>,
+        whitening: Option<Vec<f64>>,
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        if sqrt_omega.len() != nu_hat.len() {
             return Err(FitError::Length {
                 what: "weights",
                 expected: nu_hat.len(),
-                found: weights.levels(),
+                found: sqrt_omega.len(),
             });
         }
         if param.n_params() != model.n_params() {
@@ -84,7 +123,8 @@ impl Objective {
             model: model.without_values(),
             param,
             nu_hat: nu_hat.to_vec(),
-            sqrt_omega: weights.omega.iter().map(|w| w.sqrt()).collect(),
+            sqrt_omega,
+            whitening,
             freq_hz,
         })
     }
@@ -116,11 +156,29 @@ impl Objective {
 
     /// `sum_j omega_j nu2_hat_j^2`, the objective at a zero implied WV: the scale of `Q`.
     pub fn scale(&self) -> f64 {
+        if self.whitening.is_some() {
+            let mut r = vec![0.0; self.levels()];
+            self.whiten(&self.nu_hat, &mut r);
+            return r.iter().map(|v| v * v).sum();
+        }
         self.nu_hat
             .iter()
             .zip(&self.sqrt_omega)
             .map(|(h, s)| (h * s).powi(2))
             .sum()
+    }
+
+    /// `out = W e` for the full weighting (lower-triangular `W`); `out = e` otherwise.
+    fn whiten(&self, e: &[f64], out: &mut [f64]) {
+        let n = e.len();
+        match &self.whitening {
+            Some(w) => {
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = (0..=i).map(|k| w[i * n + k] * e[k]).sum();
+                }
+            }
+            None => out.copy_from_slice(e),
+        }
     }
 
     /// Sampling rate in Hz.
@@ -196,8 +254,26 @@ impl Objective {
                 }
                 a.copy_from_slice(&row);
             }
+            if let Some(w) = &self.whitening {
+                // full weighting: jac <- W jac (sqrt_omega is all ones), column by column
+                let levels = self.levels();
+                let mut col = vec![0.0; levels];
+                for k in 0..p {
+                    for (i, c) in col.iter_mut().enumerate() {
+                        *c = (0..=i).map(|m| w[i * levels + m] * ev.jac[m * p + k]).sum();
+                    }
+                    for (i, c) in col.iter().enumerate() {
+                        ev.jac[i * p + k] = *c;
+                    }
+                }
+            }
         } else {
             self.implied(&ev.theta, &mut ev.nu, None)?;
+        }
+        if self.whitening.is_some() {
+            let e: Vec<f64> = self.nu_hat.iter().zip(&ev.nu).map(|(h, n)| h - n).collect();
+            self.whiten(&e, &mut ev.r);
+            return Ok(());
         }
         for (j, r) in ev.r.iter_mut().enumerate() {
             *r = self.sqrt_omega[j] * (self.nu_hat[j] - ev.nu[j]);
@@ -217,7 +293,8 @@ impl Objective {
         }
     }
 
-    /// METHODS §5.1, paper eq. (3): `Q = sum_j omega_j (nu2_hat_j - nu2_j(theta))^2` at theta
+    /// METHODS §5.1, paper eq. (3): `Q = sum_j omega_j (nu2_hat_j - nu2_j(theta))^2` (with a full
+    /// weighting `(nu2_hat - nu2)' Omega (nu2_hat - nu2)`) at theta
     /// (original parametrisation). No factor N.
     ///
     /// # Errors
@@ -232,6 +309,12 @@ impl Objective {
         }
         let mut nu = vec![0.0; self.levels()];
         self.implied(theta, &mut nu, None)?;
+        if self.whitening.is_some() {
+            let e: Vec<f64> = self.nu_hat.iter().zip(&nu).map(|(h, n)| h - n).collect();
+            let mut r = vec![0.0; self.levels()];
+            self.whiten(&e, &mut r);
+            return Ok(r.iter().map(|v| v * v).sum());
+        }
         Ok(nu
             .iter()
             .zip(&self.nu_hat)

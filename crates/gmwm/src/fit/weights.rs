@@ -9,6 +9,7 @@
 use super::FitError;
 use crate::variance::cov::{wv_diag_covariance, DiagDivisor};
 use crate::variance::wv::WaveletVariance;
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Which V (and Omega = V^{-1}) to use (METHODS §5.2).
@@ -146,6 +147,119 @@ impl Weights {
     }
 }
 
+/// A full (non-diagonal) weighting `Omega = V^{-1}` given by a covariance `V` of the WV vector
+/// (METHODS §5.2 "full", §7.3 efficient weights), applied through a whitening matrix `W` with
+/// `W' W = V^{-1}`: the objective's residuals become `W (nu2_hat - nu2(theta))`
+/// ([`super::Objective::with_full_weights`]).
+///
+/// `W = L^{-1}` for the Cholesky factor `V = L L'`. WV levels span many decades, so the
+/// factorisation runs on the correlation matrix `C = D^{-1} V D^{-1}`, `D = diag(sqrt V_jj)`:
+/// `W = L_C^{-1} D^{-1}`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FullWeights {
+    v: DMatrix<f64>,
+    whitening: DMatrix<f64>,
+}
+
+impl FullWeights {
+    /// Weights `Omega = V^{-1}` from a symmetric positive definite `V` (J x J).
+    ///
+    /// Cost: O(J^3) once.
+    ///
+    /// # Errors
+    /// [`FitError::Length`] when `V` is not square; [`FitError::BadWeight`] for a zero or
+    /// non-finite variance `V_jj`, a non-finite entry, or a non-positive Cholesky pivot of the
+    /// correlation matrix (`V` not numerically positive definite), naming the level.
+    pub fn from_covariance(v: &DMatrix<f64>) -> Result<Self, FitError> {
+        let n = v.nrows();
+        if v.ncols() != n {
+            return Err(FitError::Length {
+                what: "covariance columns",
+                expected: n,
+                found: v.ncols(),
+            });
+        }
+        let mut d = Vec::with_capacity(n);
+        for j in 0..n {
+            let x = v[(j, j)];
+            let s = x.sqrt();
+            if !(x.is_finite() && x > 0.0 && (1.0 / s).is_finite()) {
+                return Err(FitError::BadWeight {
+                    level: j + 1,
+                    what: "covariance diagonal",
+                    value: x,
+                });
+            }
+            d.push(s);
+        }
+        // Cholesky of the correlation matrix, lower triangle (row-major in a DMatrix).
+        let mut l = DMatrix::<f64>::zeros(n, n);
+        for i in 0..n {
+            for j in 0..=i {
+                let c = 0.5 * (v[(i, j)] + v[(j, i)]) / (d[i] * d[j]);
+                if !c.is_finite() {
+                    return Err(FitError::BadWeight {
+                        level: i + 1,
+                        what: "covariance entry",
+                        value: v[(i, j)],
+                    });
+                }
+                let s = c - (0..j).map(|k| l[(i, k)] * l[(j, k)]).sum::<f64>();
+                if i == j {
+                    if !(s > 0.0 && s.is_finite()) {
+                        return Err(FitError::BadWeight {
+                            level: i + 1,
+                            what: "Cholesky pivot of the correlation matrix (V is not positive definite)",
+                            value: s,
+                        });
+                    }
+                    l[(i, i)] = s.sqrt();
+                } else {
+                    l[(i, j)] = s / l[(j, j)];
+                }
+            }
+        }
+        // W = L_C^{-1} D^{-1}: forward substitution column by column.
+        let mut w = DMatrix::<f64>::zeros(n, n);
+        for col in 0..n {
+            for i in col..n {
+                let rhs = if i == col { 1.0 } else { 0.0 };
+                let s = rhs - (col..i).map(|k| l[(i, k)] * w[(k, col)]).sum::<f64>();
+                w[(i, col)] = s / l[(i, i)];
+            }
+        }
+        for col in 0..n {
+            for i in col..n {
+                w[(i, col)] /= d[col];
+            }
+        }
+        Ok(Self {
+            v: v.clone(),
+            whitening: w,
+        })
+    }
+
+    /// The covariance `V`.
+    pub fn v(&self) -> &DMatrix<f64> {
+        &self.v
+    }
+
+    /// The lower-triangular whitening matrix `W`, `W' W = V^{-1}`.
+    pub fn whitening(&self) -> &DMatrix<f64> {
+        &self.whitening
+    }
+
+    /// `Omega = V^{-1} = W' W`.
+    pub fn omega(&self) -> DMatrix<f64> {
+        self.whitening.transpose() * &self.whitening
+    }
+
+    /// Number of levels.
+    pub fn levels(&self) -> usize {
+        self.v.nrows()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,6 +285,39 @@ mod tests {
         wv.ci_high[0] = 2.6215535;
         let w = Weights::fast(&wv).unwrap();
         assert!((w.v[0] / 0.1779390 - 1.0).abs() < 5e-7);
+    }
+
+    #[test]
+    fn full_weights_whiten_to_the_inverse() {
+        // V with decades-apart variances and strong correlation: W'W V = I
+        let sd = [1e-3, 1e-6, 1e-9];
+        let rho = [[1.0, 0.9, 0.5], [0.9, 1.0, 0.8], [0.5, 0.8, 1.0]];
+        let v = DMatrix::from_fn(3, 3, |i, j| rho[i][j] * sd[i] * sd[j]);
+        let w = FullWeights::from_covariance(&v).unwrap();
+        let ident = w.omega() * &v;
+        for i in 0..3 {
+            for j in 0..3 {
+                let want = if i == j { 1.0 } else { 0.0 };
+                // compared in correlation units (D Omega V D^{-1} = C^{-1} C, scale-free): the condition
+                // number of the correlation matrix is ~60, so 1e-12 leaves ample room
+                let scaled = ident[(i, j)] * sd[i] / sd[j];
+                assert!((scaled - want).abs() < 1e-12, "{ident}");
+            }
+        }
+        assert_eq!(w.whitening()[(0, 1)], 0.0);
+        // diagonal V: W = diag(1/sqrt(V_jj))
+        let d = FullWeights::from_covariance(&DMatrix::from_diagonal(
+            &nalgebra::DVector::from_vec(vec![4.0, 0.25]),
+        ))
+        .unwrap();
+        assert!((d.whitening()[(0, 0)] - 0.5).abs() < 1e-15);
+        assert!((d.whitening()[(1, 1)] - 2.0).abs() < 1e-15);
+        // not positive definite: named level
+        let bad = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        let e = FullWeights::from_covariance(&bad).unwrap_err();
+        assert!(matches!(e, FitError::BadWeight { level: 2, .. }), "{e}");
+        assert!(FullWeights::from_covariance(&DMatrix::zeros(2, 3)).is_err());
+        assert!(FullWeights::from_covariance(&DMatrix::from_row_slice(1, 1, &[0.0])).is_err());
     }
 
     #[test]

@@ -6,13 +6,16 @@
 //! thread count or on the order in which rayon runs the replicates. Each worker thread reuses
 //! one series buffer: memory is `threads x N` samples plus what the caller keeps per replicate.
 
+use super::progress::Progress;
 use crate::error::{Error, ParamError};
+use crate::fit::{FitError, Gmwm, GmwmFit, StartInputs, Weighting, Weights};
 use crate::model::Model;
 use crate::sim::{replicate_seed, Simulator};
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Runs `f` on `replicates` parametric-bootstrap replicates of `model` (length `n`, rate
 /// `freq_hz`, WV computed with `wv_opts`) in parallel, and returns the results in replicate
@@ -144,6 +147,201 @@ pub fn wv_bootstrap(
         Ok::<_, Error>(wv.wv.clone())
     })?;
     WvBootstrap::from_samples(&samples)
+}
+
+/// The parametric bootstrap of a fit (the package's `all_bootstrapper`, METHODS §7.4): per
+/// replicate the refit from `theta_hat` and, optionally, the objective of a fresh two-stage fit.
+///
+/// Wire format: `replicates`, `theta_hat`, `estimates` (B x p, replicate order), `mean`, `sd`,
+/// `v` (J x J), `cross_cov` (J x J), `objectives` (B values or null), `not_converged`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitBootstrap {
+    /// Number of replicates B.
+    pub replicates: usize,
+    /// The estimate the replicates were simulated from (model order).
+    pub theta_hat: Vec<f64>,
+    /// Replicate estimates `theta*_b` (refit from `theta_hat`, stage 2 only), B x p.
+    pub estimates: Vec<Vec<f64>>,
+    /// Mean of the replicate estimates.
+    pub mean: Vec<f64>,
+    /// Standard deviation of the replicate estimates (divisor B - 1).
+    pub sd: Vec<f64>,
+    /// `V = Cov(nu2_hat*)` (J x J, divisor B - 1).
+    pub v: DMatrix<f64>,
+    /// `C = Cov(nu2_hat*, nu2(theta*))` (J x J, divisor B - 1; row index the empirical WV
+    /// level, column the implied one), the input of the WIC bootstrap optimism `2 tr(C Omega)`
+    /// (METHODS §8.3).
+    pub cross_cov: DMatrix<f64>,
+    /// Final objective of a fresh two-stage fit per replicate (the bootstrap GoF input), when
+    /// asked.
+    pub objectives: Option<Vec<f64>>,
+    /// Replicate refits whose optimiser did not report convergence (kept in the summaries).
+    pub not_converged: usize,
+}
+
+/// One replicate's kept numbers.
+struct ReplicateFit {
+    theta: Vec<f64>,
+    nu_hat: Vec<f64>,
+    implied: Vec<f64>,
+    objective: Option<f64>,
+    converged: bool,
+}
+
+/// The weighting the replicates use: the fit's when it can be formed from one replicate
+/// (`Diag`), else the fast weights (METHODS §7.4: "its (classical or robust) WV, CI and fast
+/// Omega"; a bootstrap weighting would nest a bootstrap in every replicate).
+pub(crate) fn replicate_weighting(gmwm: &Gmwm) -> Weighting {
+    if gmwm.weighting() == Weighting::Diag {
+        Weighting::Diag
+    } else {
+        Weighting::Fast
+    }
+}
+
+/// Settings of [`fit_bootstrap`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct FitBootstrapOptions {
+    /// Replicates B (at least 2).
+    pub replicates: usize,
+    /// Master seed of the replicates.
+    pub seed: u64,
+    /// `Some(G)`: also fit each replicate from a fresh search with G draws (bootstrap GoF).
+    pub gof_draws: Option<usize>,
+}
+
+/// METHODS §7.4 `all_bootstrapper(B)`: simulates `replicates` series of length `n` from
+/// `fit.model` (rate `fit.freq_hz`), computes each one's WV with `wv_opts` (its `levels` is set
+/// to the fit's J) and weights, and refits from `fit.theta` (stage 2 only); with
+/// `gof_draws = Some(G)` each replicate is also fitted from a fresh starting-value search with
+/// G draws (METHODS §6, seeded per replicate) and its final objective kept.
+///
+/// Replicate `r` simulates with [`replicate_seed`]`(seed, r)` and searches starting values with
+/// `replicate_seed(seed + 1, r)`: results do not depend on the thread count. Memory: one series
+/// buffer per thread plus `p + 2J + 1` numbers per replicate. `progress` hears of every finished
+/// replicate.
+///
+/// Cost: B x (simulation + WV + one stage-2 fit [+ G draws and a two-stage fit]).
+///
+/// # Errors
+/// [`FitError::Engine`] with a [`ParamError`] for fewer than 2 replicates or `n == 0`; errors of
+/// the simulation, the WV, the weights and the replicate fits (the first one met).
+pub fn fit_bootstrap(
+    gmwm: &Gmwm,
+    fit: &GmwmFit,
+    n: usize,
+    wv_opts: &WvOptions,
+    settings: &FitBootstrapOptions,
+    progress: &dyn Progress,
+) -> Result<FitBootstrap, FitError> {
+    let FitBootstrapOptions {
+        replicates,
+        seed,
+        gof_draws,
+    } = *settings;
+    if replicates < 2 {
+        return Err(Error::from(ParamError::new(
+            "replicates",
+            replicates,
+            "must be at least 2 for a bootstrap covariance",
+        ))
+        .into());
+    }
+    let levels = fit.nu_hat.len();
+    let opts = WvOptions {
+        levels: Some(levels),
+        ..*wv_opts
+    };
+    let weighting = replicate_weighting(gmwm);
+    let refitter = gmwm.clone().with_weighting(weighting);
+    let mut searcher = refitter.clone();
+    if let Some(g) = gof_draws {
+        searcher = searcher.with_draws(g);
+    }
+    searcher.given = vec![None; fit.theta.len()];
+    let done = AtomicUsize::new(0);
+    progress.start(replicates);
+    let reps = map_replicates(
+        &fit.model,
+        n,
+        fit.freq_hz,
+        &opts,
+        replicates,
+        seed,
+        |r, wv, x| -> Result<ReplicateFit, FitError> {
+            let weights = Weights::new(weighting, wv, Some(x))?;
+            let refit = refitter.fit_weighted(&wv.wv, weights, fit.freq_hz, &fit.theta)?;
+            let objective = match gof_draws {
+                Some(_) => {
+                    let s = searcher
+                        .clone()
+                        .with_seed(replicate_seed(seed.wrapping_add(1), r as u64));
+                    let f = if weighting == Weighting::Diag {
+                        s.fit(x, fit.freq_hz, &opts)?
+                    } else {
+                        s.fit_from_wv(wv, StartInputs::from_series(x))?
+                    };
+                    Some(f.objective)
+                }
+                None => None,
+            };
+            progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
+            Ok(ReplicateFit {
+                converged: refit.convergence.converged,
+                theta: refit.theta,
+                nu_hat: wv.wv.clone(),
+                implied: refit.implied_wv.wv,
+                objective,
+            })
+        },
+    )?;
+    let b = reps.len();
+    let p = fit.theta.len();
+    let mean: Vec<f64> = (0..p)
+        .map(|k| reps.iter().map(|r| r.theta[k]).sum::<f64>() / b as f64)
+        .collect();
+    let sd = (0..p)
+        .map(|k| {
+            let ss: f64 = reps.iter().map(|r| (r.theta[k] - mean[k]).powi(2)).sum();
+            (ss / (b - 1) as f64).sqrt()
+        })
+        .collect();
+    let mean_hat = column_means(reps.iter().map(|r| &r.nu_hat[..]), levels, b);
+    let mean_imp = column_means(reps.iter().map(|r| &r.implied[..]), levels, b);
+    let mut v = DMatrix::zeros(levels, levels);
+    let mut cross = DMatrix::zeros(levels, levels);
+    for r in &reps {
+        let dh = DVector::from_column_slice(&r.nu_hat) - &mean_hat;
+        let di = DVector::from_column_slice(&r.implied) - &mean_imp;
+        v.ger(1.0, &dh, &dh, 1.0);
+        cross.ger(1.0, &dh, &di, 1.0);
+    }
+    v /= (b - 1) as f64;
+    cross /= (b - 1) as f64;
+    let objectives = gof_draws.map(|_| reps.iter().filter_map(|r| r.objective).collect());
+    Ok(FitBootstrap {
+        replicates: b,
+        theta_hat: fit.theta.clone(),
+        not_converged: reps.iter().filter(|r| !r.converged).count(),
+        estimates: reps.into_iter().map(|r| r.theta).collect(),
+        mean,
+        sd,
+        v,
+        cross_cov: cross,
+        objectives,
+    })
+}
+
+fn column_means<'a>(
+    rows: impl Iterator<Item = &'a [f64]>,
+    levels: usize,
+    b: usize,
+) -> DVector<f64> {
+    let mut m = DVector::zeros(levels);
+    for r in rows {
+        m += DVector::from_column_slice(r);
+    }
+    m / b as f64
 }
 
 #[cfg(test)]

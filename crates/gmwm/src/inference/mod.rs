@@ -1,7 +1,22 @@
-//! Inference on a GMWM fit (METHODS §7): the parametric bootstrap of the wavelet variance
-//! ([`bootstrap`], §7.4), on which the bootstrap weighting (§5.2), the bootstrap covariance
-//! of the estimates and the WIC optimism (§8) rest.
+//! Inference on a GMWM fit (METHODS §7): the parametric bootstrap of the wavelet variance and
+//! of the fit ([`bootstrap`], §7.4), on which the bootstrap weighting (§5.2), the bootstrap
+//! covariance of the estimates and the WIC optimism (§8) rest; the sandwich covariance and
+//! intervals ([`asymptotic`], §7.1, §7.2, §7.6); the J-test ([`gof`], §7.3); and one entry
+//! point, [`infer`] ([`summary`], §7.5).
 
+pub mod asymptotic;
 pub mod bootstrap;
+pub mod gof;
+pub mod progress;
+pub mod summary;
 
-pub use bootstrap::{map_replicates, wv_bootstrap, WvBootstrap};
+pub use asymptotic::{sandwich, wald_interval, z_value, IntervalScale, Sandwich, ZConvention};
+pub use bootstrap::{
+    fit_bootstrap, map_replicates, wv_bootstrap, FitBootstrap, FitBootstrapOptions, WvBootstrap,
+};
+pub use gof::{j_test, JTest};
+pub use progress::{NoProgress, Progress};
+pub use summary::{
+    infer, infer_with_progress, BootstrapGof, Inference, InferenceMethod, InferenceOptions,
+    InferenceWarning, ParameterInference, VShape,
+};
