@@ -12,6 +12,7 @@ mod model;
 mod process;
 mod read;
 mod robust;
+mod selection;
 mod sim;
 mod wavelet;
 mod wv;
