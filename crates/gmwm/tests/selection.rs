@@ -56,10 +56,7 @@ fn check_hessian(text: &str, levels: usize, freq: f64) {
     for j in 0..levels {
         // scale of the level's block: second differences of a smooth function with a relative
         // step of 1e-5 carry a relative error of about 1e-9 of the largest entry
-        let scale = h[j]
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = h[j].iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
         for k in 0..p {
             for l in 0..p {
                 assert!(
@@ -144,7 +141,14 @@ fn optimism_matches_methods_8_test_values() {
     assert!(close(package, 10.61682, METHODS_TOL), "{package}");
     assert!(close(corrected, 10.36262, METHODS_TOL), "{corrected}");
     // wrong sizes are errors, not panics
-    assert!(asymptotic_optimism(&a, &d, &omega, &DMatrix::identity(2, 2), OptimismConvention::Corrected).is_err());
+    assert!(asymptotic_optimism(
+        &a,
+        &d,
+        &omega,
+        &DMatrix::identity(2, 2),
+        OptimismConvention::Corrected
+    )
+    .is_err());
 }
 
 #[test]
@@ -152,7 +156,11 @@ fn d_matrix_matches_methods_8_test_value() {
     // AR1(0.5, 1) + DR(0.2), tau = 2, 4, 8, Omega = I, nu_hat = nu x (1.1, 0.9, 1.05)
     let m = model("AR1(phi=0.5, sigma2=1)+DR(omega=0.2)");
     let nu = m.implied_wv(3, 1.0).unwrap().wv;
-    let nu_hat: Vec<f64> = nu.iter().zip([1.1, 0.9, 1.05]).map(|(a, b)| a * b).collect();
+    let nu_hat: Vec<f64> = nu
+        .iter()
+        .zip([1.1, 0.9, 1.05])
+        .map(|(a, b)| a * b)
+        .collect();
     let d = d_matrix(
         &m.hessian(3, 1.0).unwrap(),
         &DMatrix::identity(3, 3),
@@ -239,7 +247,10 @@ fn optimism_derivative_uses_b_plus_d() {
             miss = miss.max((fd - minus[(k, j)]).abs() / scale);
         }
     }
-    assert!(miss > 1e-3, "(B - D)^-1 A' Omega should differ visibly: {miss}");
+    assert!(
+        miss > 1e-3,
+        "(B - D)^-1 A' Omega should differ visibly: {miss}"
+    );
 }
 
 /// Random fully specified models of the selection family (distinct AR1 phis keep A of full rank).
@@ -305,7 +316,10 @@ fn nested_candidates_match_methods_8_4() {
     assert_eq!(&t[..3], ["AR1", "AR1 AR1", "AR1 AR1 AR1"]);
     assert_eq!(t.last().unwrap(), "WN RW QN DR");
     // byte order of the term lists, no duplicates, all in guess mode
-    let lists: Vec<Vec<String>> = t.iter().map(|s| s.split(' ').map(String::from).collect()).collect();
+    let lists: Vec<Vec<String>> = t
+        .iter()
+        .map(|s| s.split(' ').map(String::from).collect())
+        .collect();
     assert!(lists.windows(2).all(|w| w[0] < w[1]));
     assert!(c.iter().all(Model::is_guess_mode));
     // the R reference's 31 candidates of 3*AR1()+WN()+RW()+QN()
@@ -326,7 +340,11 @@ fn nested_candidates_match_methods_8_4() {
 
 #[test]
 fn common_denominator_matches_methods_8_5() {
-    let list = [model("AR1()+WN()"), model("2*AR1()+RW()"), model("QN()+DR()")];
+    let list = [
+        model("AR1()+WN()"),
+        model("2*AR1()+RW()"),
+        model("QN()+DR()"),
+    ];
     let d = common_denominator(&list).unwrap();
     assert_eq!(terms(&d), "AR1 AR1 WN QN RW DR");
     // added as an extra candidate when absent, and the full model
@@ -335,7 +353,8 @@ fn common_denominator_matches_methods_8_5() {
     assert_eq!(wic.full_model(), &d);
     assert_eq!(wic.candidates()[3], d);
     // a given model with the same terms (any order) plays the full model; duplicates merge
-    let wic = Wic::parse_list(&["AR1()+WN()", "WN()+2*AR1()", "AR1(phi=0.5, sigma2=1)+WN()"]).unwrap();
+    let wic =
+        Wic::parse_list(&["AR1()+WN()", "WN()+2*AR1()", "AR1(phi=0.5, sigma2=1)+WN()"]).unwrap();
     assert_eq!(wic.candidates().len(), 2);
     assert_eq!(wic.full_model().to_string(), "WN()+2*AR1()");
     // GM lists count GM
@@ -352,16 +371,25 @@ fn selection_refuses_unsupported_candidates_by_name() {
     assert!(e.to_string().contains("candidate ARMA(1,1)+WN()"), "{e}");
     for full in ["AR1()+MA1()", "ARMA11()", "AR(2)+WN()"] {
         let e = Wic::nested(model(full)).unwrap_err();
-        assert!(e.to_string().contains("not supported in model selection"), "{e}");
+        assert!(
+            e.to_string().contains("not supported in model selection"),
+            "{e}"
+        );
     }
     let e = Wic::parse_list(&["GM()+WN()", "AR1()+RW()"]).unwrap_err();
     assert!(matches!(e, SelectionError::GmAr1Mixed { .. }), "{e}");
     // duplicated WN: refused by the model rules, reported with the candidate's position
     let e = Wic::parse_list(&["AR1()+WN()", "WN()+RW()+WN()"]).unwrap_err();
     let msg = e.to_string();
-    assert!(msg.starts_with("candidate 2 (\"WN()+RW()+WN()\"):"), "{msg}");
+    assert!(
+        msg.starts_with("candidate 2 (\"WN()+RW()+WN()\"):"),
+        "{msg}"
+    );
     assert!(msg.contains("found WN 2 times"), "{msg}");
-    assert!(matches!(Wic::parse_list::<&str>(&[]), Err(SelectionError::NoCandidates)));
+    assert!(matches!(
+        Wic::parse_list::<&str>(&[]),
+        Err(SelectionError::NoCandidates)
+    ));
     // settings
     let x = simulate_model(&model("WN(sigma2=1)"), 512, 1.0, 1).unwrap();
     let wic = Wic::nested(model("WN()+RW()")).unwrap();

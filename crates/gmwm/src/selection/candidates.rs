@@ -165,14 +165,23 @@ mod tests {
         let c = nested_candidates(&m("AR1()+WN()+AR1()")).unwrap();
         let t: Vec<String> = c.iter().map(terms).collect();
         // "AR1 WN" (first AR1 + WN) and "WN AR1" (WN + second AR1) are different lists
-        assert_eq!(t, ["AR1", "AR1 AR1", "AR1 WN", "AR1 WN AR1", "WN", "WN AR1"]);
+        assert_eq!(
+            t,
+            ["AR1", "AR1 AR1", "AR1 WN", "AR1 WN AR1", "WN", "WN AR1"]
+        );
     }
 
     #[test]
     fn refusals_name_the_candidate() {
         let e = nested_candidates(&m("AR1()+MA1()")).unwrap_err();
         assert!(
-            matches!(e, SelectionError::ArmaNotSupported { kind: ProcessKind::Ma1, .. }),
+            matches!(
+                e,
+                SelectionError::ArmaNotSupported {
+                    kind: ProcessKind::Ma1,
+                    ..
+                }
+            ),
             "{e}"
         );
         assert!(e.to_string().contains("AR1()+MA1()"), "{e}");
@@ -195,7 +204,10 @@ mod tests {
 
     #[test]
     fn same_terms_ignores_order() {
-        assert!(same_terms(&m("WN()+AR1()"), &m("AR1(phi=0.5, sigma2=1)+WN()")));
+        assert!(same_terms(
+            &m("WN()+AR1()"),
+            &m("AR1(phi=0.5, sigma2=1)+WN()")
+        ));
         assert!(!same_terms(&m("WN()+AR1()"), &m("2*AR1()+WN()")));
     }
 }

@@ -416,11 +416,7 @@ impl Context<'_> {
     /// for `C = Cov(nu2_hat*, nu2(theta*))`, and fitted afresh (guess mode, G =
     /// `bootstrap_draws`) for an objective value; the p-value is the share of those strictly
     /// above the observed objective.
-    fn bootstrap(
-        &self,
-        candidate: &Model,
-        fit: &GmwmFit,
-    ) -> Result<(f64, Option<f64>), FitError> {
+    fn bootstrap(&self, candidate: &Model, fit: &GmwmFit) -> Result<(f64, Option<f64>), FitError> {
         let stage2 = self.wic.estimator(candidate);
         let freq_hz = self.wv.freq_hz;
         let seed = self.wic.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET);
