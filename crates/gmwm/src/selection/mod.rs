@@ -23,7 +23,8 @@
 //!     .with_bootstrap(20);
 //! let s = wic.select(&x, 1.0).unwrap();
 //! assert_eq!(s.candidates.len(), 7);
-//! assert!(s.candidates.windows(2).all(|w| w[0].wic <= w[1].wic));
+//! assert_eq!(s.selected, s.candidates[0].model);
+//! assert!(s.candidates.iter().all(|c| c.wic >= s.candidates[0].wic * (1.0 - 1e-9)));
 //! ```
 
 pub mod candidates;
