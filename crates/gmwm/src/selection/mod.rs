@@ -24,7 +24,7 @@
 //! let s = wic.select(&x, 1.0).unwrap();
 //! assert_eq!(s.candidates.len(), 7);
 //! assert_eq!(s.selected, s.candidates[0].model);
-//! assert!(s.candidates.iter().all(|c| c.wic >= s.candidates[0].wic * (1.0 - 1e-9)));
+//! assert!(s.candidates.iter().all(|c| c.wic >= s.candidates[0].wic * (1.0 - 1e-6)));
 //! ```
 
 pub mod candidates;
