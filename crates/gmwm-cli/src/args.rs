@@ -10,7 +10,8 @@ Examples:
   gmwm wv imu.csv.gz                          wavelet variance of every column
   gmwm wv imu.csv.gz --columns gyro_x,3 --robust --eff 0.6 --json
   gmwm avar imu.csv.gz --kind modified --csv
-  gmwm wv log.bin --format f64 --ncols 6 --columns 1 --freq 400";
+  gmwm wv log.bin --format f64 --ncols 6 --columns 1 --freq 400
+  gmwm select imu.csv.gz --model \"3*AR1()+WN()+RW()+QN()+DR()\"";
 
 /// Stochastic error calibration of inertial sensors with the Generalized Method of Wavelet
 /// Moments: wavelet, Allan and Hadamard variances of IMU recordings.
@@ -54,6 +55,79 @@ pub enum Command {
         after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap"
     )]
     Fit(FitArgs),
+    /// Select a model by the Wavelet Information Criterion on each selected column (METHODS §8).
+    #[command(after_long_help = SELECT_EXAMPLES)]
+    Select(SelectArgs),
+}
+
+const SELECT_EXAMPLES: &str = "\
+Examples:
+  gmwm select imu.csv.gz --model \"3*AR1()+WN()+RW()+QN()+DR()\"
+      every sub-model of the full model (63 candidates), on every column
+  gmwm select imu.csv.gz --columns gyro_x --model \"3*AR1()+WN()+RW()+QN()\" --json
+  gmwm select sim.csv.gz --candidates \"AR1()+WN()+RW();2*AR1()+WN()+RW();3*AR1()+WN()+QN()+RW()\"
+      a list of candidates; their common denominator is added and plays the full model
+  gmwm select imu.csv.gz --model \"2*GM()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7";
+
+/// `gmwm select`.
+#[derive(Debug, Args)]
+pub struct SelectArgs {
+    /// Input.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Full model: every non-empty sub-model of it is a candidate (METHODS §8.4); values in it
+    /// are ignored. With --candidates it is one more candidate of the list.
+    #[arg(long, value_name = "MODEL", required_unless_present = "candidates")]
+    pub model: Option<String>,
+    /// Candidate models separated by ';' instead of the sub-models of --model; their common
+    /// denominator is added if absent and plays the full model (METHODS §8.5).
+    #[arg(long, value_name = "M1;M2;...")]
+    pub candidates: Option<String>,
+    /// Bootstrap replicates B: of the covariance V of the WV, simulated from the full model's
+    /// estimate (asymptotic optimism), or per candidate (--optimism bootstrap).
+    #[arg(long, value_name = "B", default_value_t = 50)]
+    pub bootstrap: usize,
+    /// Optimism estimator (METHODS §8.2, §8.3).
+    #[arg(long, value_enum, default_value_t = OptimismArg::Asymptotic)]
+    pub optimism: OptimismArg,
+    /// Asymptotic optimism formula: the corrected derivative and trace order, or the R
+    /// package's (METHODS §13.15).
+    #[arg(long, value_enum, default_value_t = OptimismConventionArg::Corrected)]
+    pub convention: OptimismConventionArg,
+    /// Use the robust (Tukey biweight) wavelet variance.
+    #[arg(long)]
+    pub robust: bool,
+    /// Gaussian efficiency of the robust estimator, in (0, 0.99].
+    #[arg(long, value_name = "E", default_value_t = 0.6)]
+    pub eff: f64,
+    /// Number of starting-value draws of every fit [default: 20000 for N <= 1e4, else 100000,
+    /// with early stop].
+    #[arg(long = "G", value_name = "N")]
+    pub draws: Option<usize>,
+    /// Seed of the starting-value searches and of the bootstrap.
+    #[arg(long, value_name = "S", default_value_t = 1337)]
+    pub seed: u64,
+    /// Print JSON (machine-readable, full precision) instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `--optimism`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OptimismArg {
+    /// Closed form with the full model's bootstrap V (the package default).
+    Asymptotic,
+    /// Parametric bootstrap per candidate (about K times slower for K candidates).
+    Bootstrap,
+}
+
+/// `--convention` of `gmwm select`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OptimismConventionArg {
+    /// (B + D)^+ A' Omega and tr(Omega A dTheta V).
+    Corrected,
+    /// The R package's formula.
+    Package,
 }
 
 /// `gmwm fit`.

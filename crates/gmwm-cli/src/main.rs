@@ -23,6 +23,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Command::Simulate(a) => cmd::simulate::run(a, &mut out)?,
         Command::Implied(a) => cmd::implied::run(a, &mut out)?,
         Command::Fit(a) => cmd::fit::run(a, &mut out)?,
+        Command::Select(a) => cmd::select::run(a, &mut out)?,
     }
     out.flush()?;
     Ok(())

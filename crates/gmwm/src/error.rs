@@ -25,6 +25,9 @@ pub enum Error {
     /// A GMWM fit could not be set up or evaluated (METHODS §5).
     #[error(transparent)]
     Fit(#[from] crate::fit::FitError),
+    /// A WIC model selection could not be set up or run (METHODS §8).
+    #[error(transparent)]
+    Selection(#[from] crate::selection::SelectionError),
 }
 
 /// A series that cannot be analysed.

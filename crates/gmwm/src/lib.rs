@@ -26,12 +26,14 @@ pub mod inference;
 pub mod math;
 pub mod model;
 pub mod process;
+pub mod selection;
 pub mod sim;
 pub mod variance;
 pub mod wavelet;
 
 pub use error::{Error, ParamError, SeriesError};
 pub use fit::{FitError, Gmwm, GmwmFit, Weighting, Weights};
+pub use selection::{auto_imu, ModelSelection, SelectionError, Wic};
 pub use variance::allan::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
 pub use variance::robust::{RobustConvention, RobustOptions};
 pub use variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};

@@ -14,6 +14,7 @@ mod model;
 mod process;
 mod read;
 mod robust;
+mod selection;
 mod sim;
 mod wavelet;
 mod wv;

@@ -4,5 +4,6 @@ pub mod avar;
 pub mod demo;
 pub mod fit;
 pub mod implied;
+pub mod select;
 pub mod simulate;
 pub mod wv;

@@ -108,6 +108,34 @@ impl Model {
             .map(|j| blocks.iter().flat_map(|b| b[j].iter().copied()).collect())
             .collect())
     }
+
+    /// METHODS §4.6: second derivatives of the implied WV with respect to theta (model order,
+    /// original parametrisation as [`Model::jacobian`]), `[level][param][param]`, symmetric.
+    ///
+    /// Block diagonal: the WV of a sum is the sum of the components' WVs, so a cross-component
+    /// second derivative is zero. Each block is its process's [`LatentProcess::hessian`]; GM
+    /// blocks are in `(beta, sigma2_gm)` (the process differentiates through the AR1
+    /// conversion of §4.3, chain rule included).
+    ///
+    /// # Errors
+    /// As [`Model::implied_wv`].
+    pub fn hessian(&self, levels: usize, freq_hz: f64) -> Result<Vec<Vec<Vec<f64>>>, Error> {
+        check_levels(levels)?;
+        let p = self.n_params();
+        let mut out = vec![vec![vec![0.0; p]; p]; levels];
+        let mut at = 0;
+        for process in self.processes(freq_hz)? {
+            let block = process.hessian(levels);
+            let k = process.params().len();
+            for (h, b) in out.iter_mut().zip(&block) {
+                for r in 0..k {
+                    h[at + r][at..at + k].copy_from_slice(&b[r][..k]);
+                }
+            }
+            at += k;
+        }
+        Ok(out)
+    }
 }
 
 fn check_levels(levels: usize) -> Result<(), ParamError> {

@@ -1,0 +1,191 @@
+//! End-to-end tests of `gmwm select` (METHODS §8): the JSON shape, the table, determinism and
+//! one test per bad-input class.
+
+use assert_cmd::Command;
+use std::path::Path;
+
+fn gmwm() -> Command {
+    Command::cargo_bin("gmwm").expect("binary built")
+}
+
+/// A seeded AR1 + WN + RW series (5000 samples, 100 Hz, with its sidecar) in `dir`.
+fn simulated(dir: &Path) -> std::path::PathBuf {
+    let path = dir.join("sim.csv");
+    let out = gmwm()
+        .args([
+            "simulate",
+            "--model",
+            "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)",
+            "--n",
+            "5000",
+            "--freq",
+            "100",
+            "--seed",
+            "3",
+            "-o",
+        ])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    path
+}
+
+fn select_json(file: &Path, extra: &[&str]) -> serde_json::Value {
+    let out = gmwm()
+        .arg("select")
+        .arg(file)
+        .args(["--G", "500", "--bootstrap", "20", "--json"])
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn select_json_has_the_documented_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = simulated(dir.path());
+    let doc = select_json(&file, &["--model", "AR1()+WN()+RW()"]);
+    let sel = doc["selections"].as_array().unwrap();
+    assert_eq!(sel.len(), 1);
+    assert_eq!(sel[0]["column"], "x");
+    let cands = sel[0]["candidates"].as_array().unwrap();
+    // 2^3 - 1 sub-models of AR1 + WN + RW
+    assert_eq!(cands.len(), 7);
+    let mut keys: Vec<&str> = cands[0]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    keys.sort();
+    assert_eq!(
+        keys,
+        ["gof_p_value", "model", "objective", "optimism", "wic"]
+    );
+    let wic: Vec<f64> = cands.iter().map(|c| c["wic"].as_f64().unwrap()).collect();
+    // sorted by wic (ties within 1e-6 relative go to the smaller model)
+    assert!(
+        wic.windows(2).all(|w| w[0] <= w[1] * (1.0 + 1e-6)),
+        "sorted by wic: {wic:?}"
+    );
+    for c in cands {
+        let (o, p, w) = (
+            c["objective"].as_f64().unwrap(),
+            c["optimism"].as_f64().unwrap(),
+            c["wic"].as_f64().unwrap(),
+        );
+        // wic = objective + optimism exactly as computed (one rounding)
+        assert!((o + p - w).abs() <= 1e-15 * w.abs(), "{c}");
+        assert!(o >= 0.0 && p > 0.0, "{c}");
+    }
+    assert_eq!(sel[0]["selected"], cands[0]["model"]);
+    // the true structure has the smallest WIC on this seed; the model missing RW is far worse
+    assert_eq!(sel[0]["selected"], "AR1()+WN()+RW()");
+    // the same seed gives the same bits
+    assert_eq!(select_json(&file, &["--model", "AR1()+WN()+RW()"]), doc);
+}
+
+#[test]
+fn select_candidate_list_adds_the_common_denominator() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = simulated(dir.path());
+    let doc = select_json(&file, &["--candidates", "AR1()+WN(); 2*AR1()+RW()"]);
+    let mut models: Vec<String> = doc["selections"][0]["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["model"].as_str().unwrap().to_string())
+        .collect();
+    models.sort();
+    assert_eq!(models, ["2*AR1()+RW()", "2*AR1()+WN()+RW()", "AR1()+WN()"]);
+}
+
+#[test]
+fn select_table_names_the_column_and_the_selected_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = simulated(dir.path());
+    let out = gmwm()
+        .arg("select")
+        .arg(&file)
+        .args(["--model", "AR1()+WN()", "--G", "300", "--bootstrap", "10"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.starts_with("x\nWIC model selection: full model AR1()+WN()"),
+        "{text}"
+    );
+    assert!(text.contains("selected: "), "{text}");
+    assert!(text.contains("GoF p-value"), "{text}");
+}
+
+/// Exit code 1 and one error line containing every needle.
+fn assert_error(file: &Path, args: &[&str], needles: &[&str]) {
+    let out = gmwm().arg("select").arg(file).args(args).output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {out:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("warning:")).collect();
+    assert_eq!(lines.len(), 1, "one line expected, got {stderr:?}");
+    assert!(lines[0].starts_with("gmwm: error: "), "{stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "{n:?} not in {stderr:?}");
+    }
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn select_bad_inputs_are_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = simulated(dir.path());
+    assert_error(
+        &file,
+        &["--model", "AR1()+ARMA(1,1)"],
+        &[
+            "candidate AR1()+ARMA(1,1)",
+            "not supported in model selection",
+        ],
+    );
+    assert_error(
+        &file,
+        &["--candidates", "GM()+WN();AR1()+RW()"],
+        &["candidate GM()+WN() uses GM but candidate AR1()+RW() uses AR1"],
+    );
+    assert_error(
+        &file,
+        &["--candidates", "AR1()+WN();WN()+RW()+WN()"],
+        &["candidate 2", "WN()+RW()+WN()", "found WN 2 times"],
+    );
+    assert_error(
+        &file,
+        &["--model", "AR1()+WN()", "--bootstrap", "1"],
+        &["--bootstrap 1"],
+    );
+    assert_error(&file, &["--model", "AR1()+WN()", "--G", "0"], &["--G 0"]);
+    assert_error(&file, &["--candidates", " ; "], &["--candidates"]);
+    assert_error(
+        &file,
+        &["--model", "AR1()+WN()", "--robust", "--eff", "1.5"],
+        &["1.5"],
+    );
+    assert_error(&file, &["--model", "AR1(", "--G", "10"], &["AR1("]);
+    // usage errors exit 2
+    let out = gmwm().arg("select").arg(&file).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+}
+
+#[test]
+fn select_help_shows_examples() {
+    let out = gmwm().args(["select", "--help"]).output().unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("Examples:"), "{text}");
+    assert!(text.contains("--candidates"), "{text}");
+    assert!(text.contains("[default: 50]"), "{text}");
+}
