@@ -52,7 +52,7 @@ pub enum Command {
     /// Estimate a latent error model by GMWM on each selected column (METHODS §5), from a
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
-        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap"
+        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200"
     )]
     Fit(FitArgs),
     /// Select a model by the Wavelet Information Criterion on each selected column (METHODS §8).
@@ -154,6 +154,14 @@ pub struct FitArgs {
     /// Seed of the starting-value search.
     #[arg(long, value_name = "S", default_value_t = 1337)]
     pub seed: u64,
+    /// Add inference (METHODS §7): standard errors, 1 - alpha intervals and the J-test
+    /// goodness of fit, from the sandwich with a parametric-bootstrap V (100 replicates).
+    #[arg(long)]
+    pub inference: bool,
+    /// With --inference: parametric-bootstrap inference with B replicates instead of the
+    /// sandwich (bootstrap SE/CI and the bootstrap goodness-of-fit p-value).
+    #[arg(long, value_name = "B", requires = "inference")]
+    pub bootstrap: Option<usize>,
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,

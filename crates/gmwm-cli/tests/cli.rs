@@ -750,3 +750,66 @@ fn fit_accepts_a_wv_json_and_bootstrap_weights() {
         &["no series named \"y\""],
     );
 }
+
+/// `gmwm fit --inference` adds `se`, `ci_low`, `ci_high` per parameter and
+/// `gof: {statistic, df, p_value}` per fit; `--bootstrap B` switches to bootstrap inference.
+#[test]
+fn fit_inference_fields() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("sim.csv");
+    gmwm()
+        .args([
+            "simulate",
+            "--model",
+            "AR1(phi=0.9, sigma2=0.5)+WN(sigma2=1)",
+            "--n",
+            "4096",
+            "--seed",
+            "8",
+            "-o",
+        ])
+        .arg(&csv)
+        .assert()
+        .success();
+    for extra in [&[][..], &["--bootstrap", "20"][..]] {
+        let out = gmwm()
+            .arg("fit")
+            .arg(&csv)
+            .args([
+                "--model",
+                "AR1()+WN()",
+                "--G",
+                "2000",
+                "--inference",
+                "--json",
+            ])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let f = &doc["fits"][0];
+        for p in f["parameters"].as_array().unwrap() {
+            let (v, se) = (p["value"].as_f64().unwrap(), p["se"].as_f64().unwrap());
+            let (lo, hi) = (
+                p["ci_low"].as_f64().unwrap(),
+                p["ci_high"].as_f64().unwrap(),
+            );
+            assert!(se > 0.0 && lo < v && v < hi, "{p}");
+        }
+        assert_eq!(f["gof"]["df"], 11 - 3, "{}", f["gof"]);
+        let pv = f["gof"]["p_value"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&pv));
+    }
+    // --bootstrap needs --inference
+    gmwm()
+        .arg("fit")
+        .arg(&csv)
+        .args(["--model", "WN()", "--bootstrap", "10"])
+        .assert()
+        .code(2);
+}

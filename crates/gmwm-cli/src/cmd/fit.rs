@@ -7,11 +7,26 @@ use crate::render::Style;
 use anyhow::Result;
 use gmwm::fit::{Ar1GmForms, NavParameter, ParameterEstimate, StartInputs};
 use gmwm::imu::{is_wv_json, read_wv_json};
+use gmwm::inference::{infer_with_progress, Inference, InferenceOptions, JTest};
 use gmwm::model::Model;
+use gmwm::WvOptions;
 use gmwm::{Gmwm, GmwmFit, WaveletVariance, Weighting};
 use rayon::prelude::*;
 use serde::Serialize;
-use std::io::Write;
+use std::io::{IsTerminal, Write};
+
+/// One parameter in the JSON output: the estimate, plus its inference when asked.
+#[derive(Serialize)]
+struct ParameterReport {
+    #[serde(flatten)]
+    estimate: ParameterEstimate,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    se: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ci_low: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ci_high: Option<f64>,
+}
 
 /// One column's fit in the JSON output.
 #[derive(Serialize)]
@@ -20,8 +35,14 @@ struct FitReport<'a> {
     model: String,
     objective: f64,
     converged: bool,
-    /// `{process, index, name, value, start}` in model order.
-    parameters: Vec<ParameterEstimate>,
+    /// `{process, index, name, value, start[, se, ci_low, ci_high]}` in model order.
+    parameters: Vec<ParameterReport>,
+    /// The J-test `{statistic, df, p_value}` (with --inference; null when it cannot be formed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gof: Option<Option<JTest>>,
+    /// The whole inference (with --inference).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    inference: Option<&'a Inference>,
     /// AR1/GM components in both forms.
     ar1_gm: Vec<Ar1GmForms>,
     /// Physical units (u = the data unit).
@@ -108,6 +129,55 @@ fn fit_wv_file(args: &FitArgs, gmwm: &Gmwm) -> Result<Vec<(String, GmwmFit)>> {
         .collect()
 }
 
+/// The WV settings behind a fit (for the bootstrap replicates).
+fn wv_options_of(fit: &GmwmFit) -> Result<(usize, WvOptions)> {
+    let wv = fit
+        .empirical
+        .as_ref()
+        .ok_or_else(|| anyhow::anyhow!("the fit carries no wavelet variance"))?;
+    Ok((
+        wv.n,
+        WvOptions {
+            transform: wv.transform,
+            filter: wv.filter,
+            levels: Some(wv.levels()),
+            alpha: wv.alpha,
+            robust: wv.robust,
+        },
+    ))
+}
+
+/// METHODS §7 on one column's fit, with a progress bar on a terminal.
+fn inference(args: &FitArgs, gmwm: &Gmwm, column: &str, fit: &GmwmFit) -> Result<Inference> {
+    if let Some(b) = args.bootstrap {
+        anyhow::ensure!(b >= 2, "invalid --bootstrap {b}: at least 2 replicates");
+    }
+    let (n, wv_opts) = wv_options_of(fit)?;
+    let opts = InferenceOptions {
+        alpha: args.estimator.alpha,
+        bootstrap: args.bootstrap,
+        ..InferenceOptions::default()
+    };
+    let total = args.bootstrap.unwrap_or(opts.v_replicates) as u64;
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(total);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} [{bar:30}] {pos}/{len} replicates, {elapsed} (eta {eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_message(format!("inference on {column}"));
+        bar
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let progress = |done: usize| bar.set_position(done as u64);
+    let result = infer_with_progress(gmwm, fit, n, &wv_opts, &opts, &progress);
+    bar.finish_and_clear();
+    column_context(result.map_err(gmwm::Error::from), &args.input.file, column)
+}
+
 /// Runs the subcommand.
 pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
     let model: Model = args.model.parse()?;
@@ -140,17 +210,40 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
             );
         }
     }
+    let inferences: Vec<Option<Inference>> = if args.inference {
+        fits.iter()
+            .map(|(column, fit)| inference(args, &gmwm, column, fit).map(Some))
+            .collect::<Result<_>>()?
+    } else {
+        fits.iter().map(|_| None).collect()
+    };
     match Style::from(&args.output) {
         Style::Json => {
             let doc = FitsDoc {
                 fits: fits
                     .iter()
-                    .map(|(column, fit)| FitReport {
+                    .zip(&inferences)
+                    .map(|((column, fit), inf)| FitReport {
                         column,
                         model: fit.model.to_string(),
                         objective: fit.objective,
                         converged: fit.convergence.converged,
-                        parameters: fit.parameters(),
+                        parameters: fit
+                            .parameters()
+                            .into_iter()
+                            .enumerate()
+                            .map(|(k, estimate)| {
+                                let p = inf.as_ref().map(|i| &i.parameters[k]);
+                                ParameterReport {
+                                    estimate,
+                                    se: p.map(|p| p.se),
+                                    ci_low: p.map(|p| p.ci_low),
+                                    ci_high: p.map(|p| p.ci_high),
+                                }
+                            })
+                            .collect(),
+                        gof: inf.as_ref().map(|i| i.gof.clone()),
+                        inference: inf.as_ref(),
                         ar1_gm: fit.ar1_gm_forms(),
                         navigation: fit.navigation(None),
                         fit,
@@ -161,24 +254,38 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
             writeln!(out)?;
         }
         Style::Csv => {
-            writeln!(out, "column,process,index,name,value")?;
-            for (column, fit) in &fits {
-                for p in fit.parameters() {
+            writeln!(out, "column,process,index,name,value,se,ci_low,ci_high")?;
+            for ((column, fit), inf) in fits.iter().zip(&inferences) {
+                for (k, p) in fit.parameters().into_iter().enumerate() {
+                    let (se, lo, hi) = match inf {
+                        Some(i) => {
+                            let q = &i.parameters[k];
+                            (
+                                format!("{:e}", q.se),
+                                format!("{:e}", q.ci_low),
+                                format!("{:e}", q.ci_high),
+                            )
+                        }
+                        None => Default::default(),
+                    };
                     writeln!(
                         out,
-                        "{column},{},{},{},{:e}",
+                        "{column},{},{},{},{:e},{se},{lo},{hi}",
                         p.process, p.index, p.name, p.value
                     )?;
                 }
             }
         }
         Style::Table => {
-            for (i, (column, fit)) in fits.iter().enumerate() {
+            for (i, ((column, fit), inf)) in fits.iter().zip(&inferences).enumerate() {
                 if i > 0 {
                     writeln!(out)?;
                 }
                 writeln!(out, "{column}")?;
                 writeln!(out, "{fit}")?;
+                if let Some(inf) = inf {
+                    writeln!(out, "{inf}")?;
+                }
             }
         }
     }

@@ -28,7 +28,6 @@ use super::gof::{hartlap_factor, j_test, JTest};
 use super::progress::{NoProgress, Progress};
 use crate::error::{Error, ParamError};
 use crate::fit::{FitError, Gmwm, GmwmFit};
-use crate::model::format_value;
 use crate::variance::wv::WvOptions;
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
@@ -464,12 +463,8 @@ impl fmt::Display for Inference {
         for p in &self.parameters {
             writeln!(
                 f,
-                "{:<20} {:>14} {:>14} {:>14} {:>14}",
-                p.name,
-                format_value(p.estimate),
-                format_value(p.se),
-                format_value(p.ci_low),
-                format_value(p.ci_high)
+                "{:<20} {:>14.5e} {:>14.5e} {:>14.5e} {:>14.5e}",
+                p.name, p.estimate, p.se, p.ci_low, p.ci_high
             )?;
         }
         write!(f, "objective Q = {:e}", self.objective)?;
