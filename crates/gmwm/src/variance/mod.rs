@@ -4,6 +4,7 @@
 pub mod allan;
 pub mod ci;
 pub mod cov;
+pub(crate) mod haar;
 pub mod robust;
 pub mod wv;
 
