@@ -160,10 +160,17 @@ fn stage_a(
             // a block lies within one row (BLOCK divides 2^L, parts start on rows)
             let k = (t - t0) / stride;
             let r = (t - t0) % stride;
-            for (i, piece) in cur[..b].chunks(TILE).enumerate() {
-                let g = (r / TILE) + i;
-                let at = (g * rows + k) * TILE;
-                region[at..at + piece.len()].copy_from_slice(piece);
+            let mut pieces = cur[..b].chunks_exact(TILE);
+            for (i, piece) in (&mut pieces).enumerate() {
+                let at = ((r / TILE + i) * rows + k) * TILE;
+                let dst: &mut [f64; TILE] =
+                    (&mut region[at..at + TILE]).try_into().expect("a tile row");
+                *dst = piece.try_into().expect("a tile row");
+            }
+            let rest = pieces.remainder();
+            if !rest.is_empty() {
+                let at = ((r + b) / TILE * rows + k) * TILE;
+                region[at..at + rest.len()].copy_from_slice(rest);
             }
         }
         t += b;
@@ -221,6 +228,63 @@ fn stage_b(regions: &[&[f64]], n: usize, g: usize, low: usize, levels: usize) ->
         sums.push(main + tail);
     }
     sums
+}
+
+/// Calls `f(j, w_j)` for `j = 1..=levels`, in order, with the boundary-free Haar MODWT wavelet
+/// coefficients `w_j = (W_{j,t})_{t >= 2^j - 1}` of `x - offset` (METHODS §1.2, §1.3), and
+/// returns the results in level order.
+///
+/// Level by level over the whole series (the pyramid of [`haar_square_sums`], same roundings),
+/// keeping `V_{j-1}`, `V_j` and two coefficient buffers (4 N values in all); the coefficients of
+/// level `j + 1` are computed while `f` runs on level `j` (`rayon::join`), so a costly `f` (the
+/// robust scale) overlaps the transform.
+pub(crate) fn for_each_haar_level<R: Send>(
+    x: &[f64],
+    levels: usize,
+    offset: f64,
+    f: impl Fn(usize, &[f64]) -> R + Sync,
+) -> Vec<R> {
+    let n = x.len();
+    let mut v_prev: Vec<f64> = x.iter().map(|v| v - offset).collect();
+    let mut v_next = vec![0.0f64; n];
+    let mut w_cur = Vec::with_capacity(n);
+    let mut w_next = Vec::with_capacity(n);
+    haar_step(&v_prev, &mut v_next, &mut w_cur, 1, levels > 1);
+    std::mem::swap(&mut v_prev, &mut v_next);
+    let mut results = Vec::with_capacity(levels);
+    for j in 2..=levels {
+        let (_, r) = rayon::join(
+            || haar_step(&v_prev, &mut v_next, &mut w_next, j, j < levels),
+            || f(j - 1, &w_cur),
+        );
+        results.push(r);
+        std::mem::swap(&mut v_prev, &mut v_next);
+        std::mem::swap(&mut w_cur, &mut w_next);
+    }
+    results.push(f(levels, &w_cur));
+    results
+}
+
+/// One level of the whole-series pyramid: `w = (V_{j-1,t} - V_{j-1,t-h}) 2^-j` for
+/// `t >= 2^j - 1` and, with `with_v`, `v_next = V_j` (window sums; zero before the start).
+fn haar_step(v_prev: &[f64], v_next: &mut [f64], w: &mut Vec<f64>, j: usize, with_v: bool) {
+    let n = v_prev.len();
+    let h = 1usize << (j - 1);
+    let first = (1usize << j) - 1;
+    let scale = (-(j as f64)).exp2();
+    w.clear();
+    w.extend(
+        v_prev[first..]
+            .iter()
+            .zip(&v_prev[first - h..n - h])
+            .map(|(&a, &b)| (a - b) * scale),
+    );
+    if with_v {
+        v_next[..h].copy_from_slice(&v_prev[..h]);
+        for ((o, &a), &b) in v_next[h..].iter_mut().zip(&v_prev[h..]).zip(&v_prev[..n - h]) {
+            *o = a + b;
+        }
+    }
 }
 
 /// Rows `lo..hi` of a stage-B tile at one level, newest first, in place: row `k` becomes

@@ -7,9 +7,11 @@
 
 use crate::error::{check_finite, check_freq, check_series, Error, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
-use crate::variance::haar::haar_square_sums;
+use crate::variance::haar::{for_each_haar_level, haar_square_sums};
 use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
-use crate::variance::robust::{robust_ci, robust_scale, tuning_constant, RobustOptions};
+use crate::variance::robust::{
+    robust_ci, robust_scale, robust_scale_long, tuning_constant, RobustConvention, RobustOptions,
+};
 use crate::wavelet::{
     dwt_boundary, modwt_boundary, Dwt, Modwt, Transform, WaveletFilter, MAX_LEVELS,
 };
@@ -341,6 +343,14 @@ pub fn wavelet_variance(
     }
     check_series(x)?;
 
+    if let (Some(r), Transform::Modwt, WaveletFilter::Haar) =
+        (opts.robust, opts.transform, opts.filter)
+    {
+        if r.convention == RobustConvention::Exact {
+            return haar_robust_in_memory(x, levels, freq_hz, opts);
+        }
+    }
+
     let coefs = match opts.transform {
         Transform::Modwt => Modwt::new(opts.filter, levels)?.transform(x)?,
         Transform::Dwt => Dwt::new(opts.filter, levels)?.transform(x)?,
@@ -391,6 +401,48 @@ pub fn wavelet_variance(
         .collect();
     let robust = opts.robust.map(|_| robust.as_slice());
     let mut result = WaveletVariance::assemble(n, freq_hz, opts, &classical, robust, counts, eta);
+    result.warnings = warnings;
+    Ok(result)
+}
+
+/// Robust (Exact convention) Haar MODWT WV of an in-memory series (METHODS §2, §2.5): the
+/// coefficients level by level ([`for_each_haar_level`], the pyramid of the classical pass with
+/// the mean of the first block removed) and the robust scale of each by [`robust_scale_long`],
+/// the next level's transform overlapping the current level's solve. `x` has been checked.
+fn haar_robust_in_memory(
+    x: &[f64],
+    levels: usize,
+    freq_hz: f64,
+    opts: &WvOptions,
+) -> Result<WaveletVariance, Error> {
+    let n = x.len();
+    let r = opts.robust.expect("robust options");
+    let c = tuning_constant(r.eff, r.convention)?;
+    let head = &x[..n.min(crate::variance::haar::BLOCK)];
+    let offset = head.iter().sum::<f64>() / head.len() as f64;
+    let per_level = for_each_haar_level(x, levels, offset, |_, w| {
+        let robust = match robust_scale_long(w, c) {
+            Ok(s2) => s2,
+            Err(Error::Series(SeriesError::NoRobustScale { .. })) => f64::NAN,
+            Err(e) => return Err(e),
+        };
+        Ok((mean_square(w), robust, w.len()))
+    })
+    .into_iter()
+    .collect::<Result<Vec<_>, Error>>()?;
+    let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
+    check_finite_result(&classical, "wavelet variance")?;
+    let robust: Vec<f64> = per_level.iter().map(|l| l.1).collect();
+    let warnings = robust
+        .iter()
+        .zip(1..)
+        .filter(|(v, _)| v.is_nan())
+        .map(|(_, level)| WvWarning::NoRobustScale { level })
+        .collect();
+    let counts: Vec<usize> = per_level.iter().map(|l| l.2).collect();
+    let eta = counts.iter().zip(1..).map(|(&kept, j)| eta3(kept, j)).collect();
+    let mut result =
+        WaveletVariance::assemble(n, freq_hz, opts, &classical, Some(&robust), counts, eta);
     result.warnings = warnings;
     Ok(result)
 }
