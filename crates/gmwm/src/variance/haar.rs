@@ -52,8 +52,60 @@ const PART: usize = 1 << 16;
 /// Phases per tile of stage B: 16 doubles, two cache lines per row.
 const TILE: usize = 16;
 
+/// What the pyramid of [`haar_pass`] does with the boundary-free coefficients of each level.
+///
+/// The coefficients handed over are unscaled: `2^j W_{j,t}` (exact powers of two away from the
+/// MODWT's). A pass creates one sink per part and per tile and merges them in a fixed order.
+pub(crate) trait LevelSink: Send {
+    /// With `true` the kernels hand over the coefficients ([`push`](Self::push)), otherwise
+    /// only the sum of their squares per block ([`add_square_sum`](Self::add_square_sum)).
+    const COEFFICIENTS: bool;
+    /// Sum of squared unscaled coefficients of a block of level `j` (1-based).
+    fn add_square_sum(&mut self, j: usize, sum: f64);
+    /// Unscaled coefficients of level `j` (1-based).
+    fn push(&mut self, j: usize, w: &[f64]);
+    /// Appends a sink of a later part of the pass.
+    fn merge(&mut self, later: &Self);
+}
+
+/// Per-level compensated sums of squared unscaled coefficients: the classical WV.
+pub(crate) struct SquareSums(Vec<NeumaierSum>);
+
+impl LevelSink for SquareSums {
+    const COEFFICIENTS: bool = false;
+    fn add_square_sum(&mut self, j: usize, sum: f64) {
+        self.0[j - 1].add(sum);
+    }
+    fn push(&mut self, j: usize, w: &[f64]) {
+        self.0[j - 1].add(w.iter().map(|v| v * v).sum());
+    }
+    fn merge(&mut self, later: &Self) {
+        for (a, b) in self.0.iter_mut().zip(&later.0) {
+            a.add(b.total());
+        }
+    }
+}
+
 /// Per-level sums of squared Haar MODWT wavelet coefficients `sum_t W_{j,t}^2` over the
-/// boundary-free `t >= 2^j - 1` (METHODS §1.3, §1.5), `j = 1..=levels`, of `x - offset`.
+/// boundary-free `t >= 2^j - 1` (METHODS §1.3, §1.5), `j = 1..=levels`, of `x - offset`, by
+/// [`haar_pass`].
+///
+/// Non-finite sums (window sums or squares overflowing for data near `f64::MAX`, or a
+/// non-finite sample) are returned as they are; the caller checks.
+pub(crate) fn haar_square_sums(x: &[f64], levels: usize, offset: f64) -> Vec<f64> {
+    let sums = haar_pass(x, levels, offset, || {
+        SquareSums(vec![NeumaierSum::default(); levels])
+    });
+    sums.0
+        .iter()
+        .zip(1..)
+        // the kernels square 2^j W: scale by 4^-j (exact)
+        .map(|(s, j)| s.total() * (-2.0 * j as f64).exp2())
+        .collect()
+}
+
+/// The Haar MODWT pyramid of `x - offset` (METHODS §1.2), levels `1..=levels`, feeding every
+/// level's boundary-free coefficients (METHODS §1.3) to sinks made by `make`.
 ///
 /// Stage A runs levels `1..=L` ([`low_levels`]) as a pyramid over blocks of [`BLOCK`] samples,
 /// in parts of [`PART`] samples; each part first runs the pyramid, without counting, over the
@@ -62,59 +114,66 @@ const TILE: usize = 16;
 /// the series splits into `2^L` independent phases `r` (samples `r, r + 2^L, ...`), each a Haar
 /// pyramid with lags `1, 2, 4, ...` on a short sub-series; tiles of [`TILE`] adjacent phases run
 /// vectorised across phases. Every coefficient is the one of a single sequential pyramid; the
-/// sums are added in a fixed order (parts, then tiles), so the result does not depend on the
+/// sinks are merged in a fixed order (parts, then tiles), so the result does not depend on the
 /// thread count.
-///
-/// Non-finite sums (window sums or squares overflowing for data near `f64::MAX`, or a
-/// non-finite sample) are returned as they are; the caller checks.
-pub(crate) fn haar_square_sums(x: &[f64], levels: usize, offset: f64) -> Vec<f64> {
+pub(crate) fn haar_pass<S: LevelSink>(
+    x: &[f64],
+    levels: usize,
+    offset: f64,
+    make: impl Fn() -> S + Sync,
+) -> S {
     use rayon::prelude::*;
     let n = x.len();
     let low = levels.min(low_levels(n));
     let stage_b_levels = levels > low;
     let part_len = PART.max(1usize << low);
-    let parts: Vec<(Vec<NeumaierSum>, Vec<f64>)> = (0..n.div_ceil(part_len))
+    let parts: Vec<(S, Vec<f64>)> = (0..n.div_ceil(part_len))
         .into_par_iter()
-        .map(|p| stage_a(x, p * part_len, part_len, low, offset, stage_b_levels))
+        .map(|p| {
+            stage_a(
+                x,
+                p * part_len,
+                part_len,
+                low,
+                offset,
+                stage_b_levels,
+                make(),
+            )
+        })
         .collect();
-    let mut totals = vec![NeumaierSum::default(); levels];
-    for (part, _) in &parts {
-        for (t, s) in totals.iter_mut().zip(part) {
-            t.add(s.total());
-        }
+    let mut parts = parts.into_iter();
+    let (mut total, first_region) = parts.next().expect("a non-empty series");
+    let mut regions = vec![first_region];
+    for (sink, region) in parts {
+        total.merge(&sink);
+        regions.push(region);
     }
     if stage_b_levels {
-        let regions: Vec<&[f64]> = parts.iter().map(|p| p.1.as_slice()).collect();
-        let tiles: Vec<Vec<f64>> = (0..(1usize << low) / TILE)
+        let regions: Vec<&[f64]> = regions.iter().map(Vec::as_slice).collect();
+        let tiles: Vec<S> = (0..(1usize << low) / TILE)
             .into_par_iter()
-            .map(|g| stage_b(&regions, n, g, low, levels))
+            .map(|g| stage_b(&regions, n, g, low, levels, make()))
             .collect();
         for tile in &tiles {
-            for (t, &s) in totals[low..].iter_mut().zip(tile) {
-                t.add(s);
-            }
+            total.merge(tile);
         }
     }
-    totals
-        .iter()
-        .zip(1..)
-        // the kernels square 2^j W: scale by 4^-j (exact)
-        .map(|(s, j)| s.total() * (-2.0 * j as f64).exp2())
-        .collect()
+    total
 }
 
 /// Stage A on the part starting at `t0` (`part_len` samples, or what is left): levels
-/// `1..=levels`, sums of squared unscaled coefficients per level. With `keep`, also returns
-/// `V_levels` of the part in stage B's layout: the part's rows `k` (samples `k 2^L + r`) tile by
-/// tile, `region[g][k][lane]` with phase `r = g TILE + lane`.
-fn stage_a(
+/// `1..=levels` into `sink`. With `keep`, also returns `V_levels` of the part in stage B's
+/// layout: the part's rows `k` (samples `k 2^L + r`) tile by tile, `region[g][k][lane]` with
+/// phase `r = g TILE + lane`.
+fn stage_a<S: LevelSink>(
     x: &[f64],
     t0: usize,
     part_len: usize,
     levels: usize,
     offset: f64,
     keep: bool,
-) -> (Vec<NeumaierSum>, Vec<f64>) {
+    mut sink: S,
+) -> (S, Vec<f64>) {
     let t1 = (t0 + part_len).min(x.len());
     let stride = 1usize << levels;
     let rows = (t1 - t0).div_ceil(stride);
@@ -125,15 +184,21 @@ fn stage_a(
     };
     let mut rings: Vec<Vec<f64>> = (1..=levels).map(|j| vec![0.0; 1usize << (j - 1)]).collect();
     let mut pos = vec![0usize; levels];
-    let mut sums = vec![NeumaierSum::default(); levels];
     let mut cur = vec![0.0f64; BLOCK];
     let mut next = vec![0.0f64; BLOCK];
+    let mut diff = if S::COEFFICIENTS {
+        vec![0.0f64; BLOCK]
+    } else {
+        Vec::new()
+    };
     // warm-up: the pyramid over the 2^L samples before the part fills the rings exactly as a
     // single pass from t = 0 would (rings start at zero = the pyramid's pre-start values)
     let warm = t0.saturating_sub(stride);
     let mut t = warm;
     while t < t1 {
-        let b = BLOCK.min(t1 - t).min(if t < t0 { t0 - t } else { usize::MAX });
+        let b = BLOCK
+            .min(t1 - t)
+            .min(if t < t0 { t0 - t } else { usize::MAX });
         for (c, &v) in cur[..b].iter_mut().zip(&x[t..t + b]) {
             *c = v - offset;
         }
@@ -144,15 +209,30 @@ fn stage_a(
             } else {
                 ((1usize << j) - 1).saturating_sub(t).min(b)
             };
-            let ss = level_block(
-                &cur[..b],
-                &mut next[..b],
-                &mut rings[j - 1],
-                &mut pos[j - 1],
-                skip,
-            );
-            if skip < b {
-                sums[j - 1].add(ss);
+            if S::COEFFICIENTS {
+                level_block::<true>(
+                    &cur[..b],
+                    &mut next[..b],
+                    &mut rings[j - 1],
+                    &mut pos[j - 1],
+                    skip,
+                    &mut diff[..b],
+                );
+                if skip < b {
+                    sink.push(j, &diff[skip..b]);
+                }
+            } else {
+                let ss = level_block::<false>(
+                    &cur[..b],
+                    &mut next[..b],
+                    &mut rings[j - 1],
+                    &mut pos[j - 1],
+                    skip,
+                    &mut [],
+                );
+                if skip < b {
+                    sink.add_square_sum(j, ss);
+                }
             }
             std::mem::swap(&mut cur, &mut next);
         }
@@ -175,12 +255,19 @@ fn stage_a(
         }
         t += b;
     }
-    (sums, region)
+    (sink, region)
 }
 
 /// Stage B on tile `g` (phases `g TILE .. (g + 1) TILE`) of `V_low`, given as the parts' regions
-/// of [`stage_a`]: levels `low+1..=levels`, sums of squared unscaled coefficients per level.
-fn stage_b(regions: &[&[f64]], n: usize, g: usize, low: usize, levels: usize) -> Vec<f64> {
+/// of [`stage_a`]: levels `low+1..=levels` into `sink`.
+fn stage_b<S: LevelSink>(
+    regions: &[&[f64]],
+    n: usize,
+    g: usize,
+    low: usize,
+    levels: usize,
+    mut sink: S,
+) -> S {
     let stride = 1usize << low;
     let r0 = g * TILE;
     // rows valid for every phase of the tile, and the rows of the longest phase
@@ -192,13 +279,14 @@ fn stage_b(regions: &[&[f64]], n: usize, g: usize, low: usize, levels: usize) ->
         tile.extend_from_slice(&region[g * part_rows * TILE..(g + 1) * part_rows * TILE]);
     }
     tile.truncate(rows * TILE);
-    let mut sums = Vec::with_capacity(levels - low);
+    let mut diff = Vec::new();
     for j in low + 1..=levels {
         let lag = 1usize << (j - 1 - low);
         // rows before first_row hold boundary coefficients (METHODS §1.3): t = r + k 2^low is
         // kept iff k >= 2^{j-low}, or k = 2^{j-low} - 1 for the last phase r = 2^low - 1
         let first_row = 1usize << (j - low);
         let mut tail = 0.0;
+        diff.clear();
         // the partially valid last row (phases past the end of the series are ignored)
         if rows > rows_full {
             let k = rows - 1;
@@ -207,12 +295,17 @@ fn stage_b(regions: &[&[f64]], n: usize, g: usize, low: usize, levels: usize) ->
                     let (a, b) = (tile[k * TILE + lane], tile[(k - lag) * TILE + lane]);
                     if k >= first_row || (k + 1 == first_row && r0 + lane + 1 == stride) {
                         tail += (a - b) * (a - b);
+                        diff.push(a - b);
                     }
                     tile[k * TILE + lane] = a + b;
                 }
             }
         }
-        let main = tile_rows(&mut tile, lag, first_row, rows_full);
+        let main = if S::COEFFICIENTS {
+            tile_rows::<true>(&mut tile, lag, first_row, rows_full, &mut diff)
+        } else {
+            tile_rows::<false>(&mut tile, lag, first_row, rows_full, &mut diff)
+        };
         // boundary rows: update the scaling coefficients, count nothing (but the last phase's
         // first kept row)
         for k in (lag..first_row.min(rows_full)).rev() {
@@ -221,78 +314,33 @@ fn stage_b(regions: &[&[f64]], n: usize, g: usize, low: usize, levels: usize) ->
                 let old = older[(k - lag) * TILE + lane];
                 if k + 1 == first_row && r0 + lane + 1 == stride {
                     tail += (newer[lane] - old) * (newer[lane] - old);
+                    diff.push(newer[lane] - old);
                 }
                 newer[lane] += old;
             }
         }
-        sums.push(main + tail);
-    }
-    sums
-}
-
-/// Calls `f(j, w_j)` for `j = 1..=levels`, in order, with the boundary-free Haar MODWT wavelet
-/// coefficients `w_j = (W_{j,t})_{t >= 2^j - 1}` of `x - offset` (METHODS §1.2, §1.3), and
-/// returns the results in level order.
-///
-/// Level by level over the whole series (the pyramid of [`haar_square_sums`], same roundings),
-/// keeping `V_{j-1}`, `V_j` and two coefficient buffers (4 N values in all); the coefficients of
-/// level `j + 1` are computed while `f` runs on level `j` (`rayon::join`), so a costly `f` (the
-/// robust scale) overlaps the transform.
-pub(crate) fn for_each_haar_level<R: Send>(
-    x: &[f64],
-    levels: usize,
-    offset: f64,
-    f: impl Fn(usize, &[f64]) -> R + Sync,
-) -> Vec<R> {
-    let n = x.len();
-    let mut v_prev: Vec<f64> = x.iter().map(|v| v - offset).collect();
-    let mut v_next = vec![0.0f64; n];
-    let mut w_cur = Vec::with_capacity(n);
-    let mut w_next = Vec::with_capacity(n);
-    haar_step(&v_prev, &mut v_next, &mut w_cur, 1, levels > 1);
-    std::mem::swap(&mut v_prev, &mut v_next);
-    let mut results = Vec::with_capacity(levels);
-    for j in 2..=levels {
-        let (_, r) = rayon::join(
-            || haar_step(&v_prev, &mut v_next, &mut w_next, j, j < levels),
-            || f(j - 1, &w_cur),
-        );
-        results.push(r);
-        std::mem::swap(&mut v_prev, &mut v_next);
-        std::mem::swap(&mut w_cur, &mut w_next);
-    }
-    results.push(f(levels, &w_cur));
-    results
-}
-
-/// One level of the whole-series pyramid: `w = (V_{j-1,t} - V_{j-1,t-h}) 2^-j` for
-/// `t >= 2^j - 1` and, with `with_v`, `v_next = V_j` (window sums; zero before the start).
-fn haar_step(v_prev: &[f64], v_next: &mut [f64], w: &mut Vec<f64>, j: usize, with_v: bool) {
-    let n = v_prev.len();
-    let h = 1usize << (j - 1);
-    let first = (1usize << j) - 1;
-    let scale = (-(j as f64)).exp2();
-    w.clear();
-    w.extend(
-        v_prev[first..]
-            .iter()
-            .zip(&v_prev[first - h..n - h])
-            .map(|(&a, &b)| (a - b) * scale),
-    );
-    if with_v {
-        v_next[..h].copy_from_slice(&v_prev[..h]);
-        for ((o, &a), &b) in v_next[h..].iter_mut().zip(&v_prev[h..]).zip(&v_prev[..n - h]) {
-            *o = a + b;
+        if S::COEFFICIENTS {
+            sink.push(j, &diff);
+        } else {
+            sink.add_square_sum(j, main + tail);
         }
     }
+    sink
 }
 
 /// Rows `lo..hi` of a stage-B tile at one level, newest first, in place: row `k` becomes
-/// `row k + row k - lag` (the scaling coefficients of the level); returns the sum of the squared
-/// differences `row k - row k - lag` (the unscaled wavelet coefficients). Row `k - lag` is read
-/// before it is overwritten. `lo >= lag`.
+/// `row k + row k - lag` (the scaling coefficients of the level). Returns the sum of the squared
+/// differences `row k - row k - lag` (the unscaled wavelet coefficients), or with `D` appends the
+/// differences to `diff` (and returns 0). Row `k - lag` is read before it is overwritten;
+/// `lo >= lag`.
 #[inline(never)]
-fn tile_rows(tile: &mut [f64], lag: usize, lo: usize, hi: usize) -> f64 {
+fn tile_rows<const D: bool>(
+    tile: &mut [f64],
+    lag: usize,
+    lo: usize,
+    hi: usize,
+    diff: &mut Vec<f64>,
+) -> f64 {
     let mut acc = [0.0f64; TILE];
     for k in (lo..hi).rev() {
         let (older, newer) = tile.split_at_mut(k * TILE);
@@ -300,10 +348,19 @@ fn tile_rows(tile: &mut [f64], lag: usize, lo: usize, hi: usize) -> f64 {
         let old: &[f64; TILE] = older[(k - lag) * TILE..(k - lag + 1) * TILE]
             .try_into()
             .expect("a full tile row");
-        for g in 0..TILE {
-            let w = new[g] - old[g];
-            acc[g] += w * w;
-            new[g] += old[g];
+        if D {
+            let mut w = [0.0f64; TILE];
+            for g in 0..TILE {
+                w[g] = new[g] - old[g];
+                new[g] += old[g];
+            }
+            diff.extend_from_slice(&w);
+        } else {
+            for g in 0..TILE {
+                let w = new[g] - old[g];
+                acc[g] += w * w;
+                new[g] += old[g];
+            }
         }
     }
     // even and odd lanes apart: the two-wide register order (see `lane_total`)
@@ -318,9 +375,17 @@ fn tile_rows(tile: &mut [f64], lag: usize, lo: usize, hi: usize) -> f64 {
 
 /// One pyramid level over a block: `out = V_j` from `cur = V_{j-1}`, the lags `V_{j-1,t-h}`
 /// taken from the ring (length `h`, oldest at `*pos`) for the first `h` samples and from `cur`
-/// after; updates the ring; returns the sum of squared differences from index `skip` on.
+/// after; updates the ring. Returns the sum of squared differences `V_{j-1,t} - V_{j-1,t-h}`
+/// from index `skip` on, or with `D` writes every difference to `diff` instead (and returns 0).
 #[inline]
-fn level_block(cur: &[f64], out: &mut [f64], ring: &mut [f64], pos: &mut usize, skip: usize) -> f64 {
+fn level_block<const D: bool>(
+    cur: &[f64],
+    out: &mut [f64],
+    ring: &mut [f64],
+    pos: &mut usize,
+    skip: usize,
+    diff: &mut [f64],
+) -> f64 {
     let h = ring.len();
     let b = cur.len();
     if h >= b {
@@ -331,11 +396,17 @@ fn level_block(cur: &[f64], out: &mut [f64], ring: &mut [f64], pos: &mut usize, 
         while i < b {
             let run = (h - *pos).min(b - i);
             let seg = &mut ring[*pos..*pos + run];
-            ss += swap_span(
+            let d = if D {
+                &mut diff[i..i + run]
+            } else {
+                &mut [][..]
+            };
+            ss += swap_span::<D>(
                 &cur[i..i + run],
                 seg,
                 &mut out[i..i + run],
                 skip.saturating_sub(i),
+                d,
             );
             i += run;
             *pos = (*pos + run) % h;
@@ -347,18 +418,42 @@ fn level_block(cur: &[f64], out: &mut [f64], ring: &mut [f64], pos: &mut usize, 
             ring.rotate_left(*pos);
             *pos = 0;
         }
-        let mut ss = span(&cur[..h], ring, &mut out[..h], skip);
-        let (head, body) = out.split_at_mut(h);
-        let _ = head;
-        ss += span(&cur[h..], &cur[..b - h], body, skip.saturating_sub(h));
+        let (d_head, d_body) = if D {
+            diff[..b].split_at_mut(h)
+        } else {
+            (&mut [][..], &mut [][..])
+        };
+        let mut ss = span::<D>(&cur[..h], ring, &mut out[..h], skip, d_head);
+        let (_, body) = out.split_at_mut(h);
+        ss += span::<D>(
+            &cur[h..],
+            &cur[..b - h],
+            body,
+            skip.saturating_sub(h),
+            d_body,
+        );
         ring.copy_from_slice(&cur[b - h..]);
         ss
     }
 }
 
-/// `out = new + old`; returns `sum (new - old)^2` over indices `>= skip`.
+/// `out = new + old`; returns `sum (new - old)^2` over indices `>= skip`, or with `D` writes
+/// `diff = new - old` (all indices) and returns 0.
 #[inline(always)]
-fn span(new: &[f64], old: &[f64], out: &mut [f64], skip: usize) -> f64 {
+fn span<const D: bool>(
+    new: &[f64],
+    old: &[f64],
+    out: &mut [f64],
+    skip: usize,
+    diff: &mut [f64],
+) -> f64 {
+    if D {
+        for (((o, d), &v), &u) in out.iter_mut().zip(diff.iter_mut()).zip(new).zip(old) {
+            *o = v + u;
+            *d = v - u;
+        }
+        return 0.0;
+    }
     let skip = skip.min(new.len());
     for ((o, &v), &u) in out[..skip].iter_mut().zip(&new[..skip]).zip(&old[..skip]) {
         *o = v + u;
@@ -390,7 +485,27 @@ fn span(new: &[f64], old: &[f64], out: &mut [f64], skip: usize) -> f64 {
 
 /// As [`span`] with the lags in `ring`, which then receives `new` (a FIFO step).
 #[inline(always)]
-fn swap_span(new: &[f64], ring: &mut [f64], out: &mut [f64], skip: usize) -> f64 {
+fn swap_span<const D: bool>(
+    new: &[f64],
+    ring: &mut [f64],
+    out: &mut [f64],
+    skip: usize,
+    diff: &mut [f64],
+) -> f64 {
+    if D {
+        for (((o, d), &v), r) in out
+            .iter_mut()
+            .zip(diff.iter_mut())
+            .zip(new)
+            .zip(ring.iter_mut())
+        {
+            let u = *r;
+            *o = v + u;
+            *d = v - u;
+            *r = v;
+        }
+        return 0.0;
+    }
     let skip = skip.min(new.len());
     for ((o, &v), r) in out[..skip]
         .iter_mut()

@@ -486,11 +486,11 @@ pub const LONG_MIN: usize = 1 << 15;
 /// Target size of the strided subsample that locates the root for [`robust_scale_long`]: its
 /// root is within about 1% of the full one for Gaussian-like levels (sd of the eff-0.6 scale
 /// estimate from 8 Ki values, ~0.9%), well inside [`WINDOW`].
-const SUBSAMPLE: usize = 1 << 13;
+pub(crate) const SUBSAMPLE: usize = 1 << 13;
 /// Half-width factor of the search window in `s` around the subsample's root: `[s/W, s W]`.
 const WINDOW: f64 = 1.1;
 /// Windows tried (each one pass over the data) before the direct iteration takes over.
-const WINDOW_SLIDES: usize = 3;
+pub(crate) const WINDOW_SLIDES: usize = 3;
 /// Largest `u = (y / (c s))^2` summed through power sums in [`PowerWindow`]: there
 /// `|u - 4u^2 + 6u^3 - 4u^4 + u^5| / u (1 - u)^4`, the cancellation of the expanded biweight,
 /// is at most 20, so `mean psi_c^2` keeps ~14 digits.
@@ -534,25 +534,31 @@ pub fn robust_scale_long(y: &[f64], c: f64) -> Result<f64, Error> {
         Ok(s2) if s2 > 0.0 && s2.is_finite() => s2.sqrt(),
         _ => return robust_scale(y, c, RobustConvention::Exact),
     };
-    let (mut lo, mut hi) = (s_sub / WINDOW, s_sub * WINDOW);
+    let (mut lo, mut hi) = window_around(s_sub);
     for _ in 0..WINDOW_SLIDES {
         let Some(window) = PowerWindow::new(y, c, lo, hi) else {
             break; // a non-finite square: let the direct route report or handle it
         };
-        let h = |s: f64| window.mean_psi2(s) - a;
-        let (h_lo, h_hi) = (h(lo), h(hi));
-        if h_lo > 0.0 && h_hi <= 0.0 {
-            let root = find_root(h, lo, hi, (S_ROOT_RTOL * lo).max(f64::MIN_POSITIVE))?;
-            return Ok(root.x * root.x);
-        }
-        // slide towards the root in the direction the fixed point moves (METHODS §2.4)
-        if h_lo <= 0.0 {
-            (lo, hi) = (lo / (WINDOW * WINDOW), lo);
-        } else {
-            (lo, hi) = (hi, hi * WINDOW * WINDOW);
+        match window.solve(a, lo, hi)? {
+            WindowOutcome::Root(s2) => return Ok(s2),
+            WindowOutcome::Slide(l, h) => (lo, hi) = (l, h),
         }
     }
     robust_scale(y, c, RobustConvention::Exact)
+}
+
+/// The first search window of [`robust_scale_long`] around a located root `s`.
+pub(crate) fn window_around(s: f64) -> (f64, f64) {
+    (s / WINDOW, s * WINDOW)
+}
+
+/// Result of [`PowerWindow::solve`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum WindowOutcome {
+    /// The robust variance `s^2`.
+    Root(f64),
+    /// No down-crossing on the window: the next window to try.
+    Slide(f64, f64),
 }
 
 /// `mean(psi_c(y/s)^2)` for every `s` in a window `[s_lo, s_hi]`, from one pass over `y`
@@ -572,82 +578,189 @@ pub struct PowerWindow {
     sum_squares: f64,
 }
 
-/// Values per block of the [`PowerWindow`] pass before the lane sums enter the compensated totals.
-const POWER_BLOCK: usize = 4096;
+/// The pass behind [`PowerWindow`], fed in pieces (e.g. by the blocks of a pyramid) and merged
+/// in a fixed order (METHODS §2.1; see [`robust_scale_long`]).
+#[derive(Debug, Clone)]
+pub struct PowerAccumulator {
+    c: f64,
+    n: usize,
+    below: f64,
+    inv_below: f64,
+    above: f64,
+    scale2: f64,
+    totals: [NeumaierSum; 6],
+    outside: usize,
+    kept: Vec<f64>,
+    probe: f64,
+}
+
+impl PowerAccumulator {
+    /// An empty pass for the window `[s_lo, s_hi]` on values `y = scale2.sqrt() v` given as `v`
+    /// (`scale2` multiplies the squares; a power of 4 keeps them exact).
+    pub fn new(c: f64, s_lo: f64, s_hi: f64, scale2: f64) -> Self {
+        let below = U_POWER_MAX * (c * s_lo) * (c * s_lo);
+        Self {
+            c,
+            n: 0,
+            below,
+            inv_below: 1.0 / below,
+            above: (c * s_hi) * (c * s_hi),
+            scale2,
+            totals: [NeumaierSum::default(); 6],
+            outside: 0,
+            kept: Vec::new(),
+            probe: 0.0,
+        }
+    }
+
+    /// Adds values (see [`new`](Self::new) for their scale).
+    pub fn push(&mut self, v: &[f64]) {
+        let (above, inv_below, scale2) = (self.above, self.inv_below, self.scale2);
+        let mut scratch = [0.0f64; POWER_BLOCK];
+        for block in v.chunks(POWER_BLOCK) {
+            // p = min(q / L, 1): the values that may cross |r| = c get p = 1 and are counted
+            // out again below (branch-free, vectorised sums)
+            let p = &mut scratch[..block.len()];
+            for (p, &vi) in p.iter_mut().zip(block) {
+                *p = (vi * vi * scale2 * inv_below).min(1.0);
+            }
+            let p: &[f64] = p;
+            let powers = power_sums(p);
+            let sums = [
+                powers[0],
+                powers[1],
+                powers[2],
+                powers[3],
+                powers[4],
+                lane_sum(block, |v| v * v * scale2),
+            ];
+            // the values with p = 1 (`min` maps NaN to 1 too), found eight at a time
+            let mut outside = 0usize;
+            for (p8, v8) in p.chunks(8).zip(block.chunks(8)) {
+                let top = p8.iter().fold(0.0f64, |m, &x| if x > m { x } else { m });
+                if top < 1.0 {
+                    continue;
+                }
+                for (&pi, &vi) in p8.iter().zip(v8) {
+                    if pi >= 1.0 {
+                        outside += 1;
+                        let q = vi * vi * scale2;
+                        if q <= above {
+                            self.kept.push(q);
+                        }
+                    }
+                }
+            }
+            for (t, s) in self.totals.iter_mut().zip(sums) {
+                t.add(s);
+            }
+            self.outside += outside;
+            // NaN iff some square is not finite
+            self.probe += sums[5] * 0.0;
+        }
+        self.n += v.len();
+    }
+
+    /// Appends `other` (a later piece of the same series and window).
+    pub fn merge(&mut self, other: &Self) {
+        for (t, o) in self.totals.iter_mut().zip(&other.totals) {
+            t.add(o.total());
+        }
+        self.kept.extend_from_slice(&other.kept);
+        self.probe += other.probe;
+        self.outside += other.outside;
+        self.n += other.n;
+    }
+
+    /// The window, `None` if some square was not finite or nothing was pushed.
+    pub fn finish(self) -> Option<PowerWindow> {
+        let sum_squares = self.totals[5].total();
+        if self.n == 0 || !self.probe.is_finite() || !sum_squares.is_finite() {
+            return None;
+        }
+        // every value outside [0, L) entered each power sum as 1
+        let mut powers = [0.0; 5];
+        for (p, t) in powers.iter_mut().zip(&self.totals) {
+            let mut t = *t;
+            t.add(-(self.outside as f64));
+            *p = t.total();
+        }
+        Some(PowerWindow {
+            c: self.c,
+            n: self.n as f64,
+            below: self.below,
+            powers,
+            kept: self.kept,
+            sum_squares,
+        })
+    }
+}
+
+/// Values per block of the [`PowerWindow`] pass before the lane sums enter the compensated
+/// totals (16 KiB of scratch on the stack).
+const POWER_BLOCK: usize = 2048;
+
+/// `sum p^m` for `m = 1..=5` over `p`, in one pass with four lanes per power (vectorised).
+#[inline(always)]
+fn power_sums(p: &[f64]) -> [f64; 5] {
+    let mut a1 = [0.0f64; 4];
+    let mut a2 = [0.0f64; 4];
+    let mut a3 = [0.0f64; 4];
+    let mut a4 = [0.0f64; 4];
+    let mut a5 = [0.0f64; 4];
+    let mut c4 = p.chunks_exact(4);
+    for x in &mut c4 {
+        for k in 0..4 {
+            let p1 = x[k];
+            let p2 = p1 * p1;
+            let p4 = p2 * p2;
+            a1[k] += p1;
+            a2[k] += p2;
+            a3[k] += p2 * p1;
+            a4[k] += p4;
+            a5[k] += p4 * p1;
+        }
+    }
+    for &p1 in c4.remainder() {
+        let p2 = p1 * p1;
+        let p4 = p2 * p2;
+        a1[0] += p1;
+        a2[0] += p2;
+        a3[0] += p2 * p1;
+        a4[0] += p4;
+        a5[0] += p4 * p1;
+    }
+    let total = |a: [f64; 4]| (a[0] + a[2]) + (a[1] + a[3]);
+    [total(a1), total(a2), total(a3), total(a4), total(a5)]
+}
+
+/// `sum f(v)` over `v` with eight lanes (vectorised; even and odd lanes are added apart, the
+/// order of two-wide registers).
+#[inline(always)]
+fn lane_sum(v: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+    let mut acc = [0.0f64; 8];
+    let mut c8 = v.chunks_exact(8);
+    for x in &mut c8 {
+        for k in 0..8 {
+            acc[k] += f(x[k]);
+        }
+    }
+    let mut tail = 0.0;
+    for &x in c8.remainder() {
+        tail += f(x);
+    }
+    let even = (acc[0] + acc[2]) + (acc[4] + acc[6]);
+    let odd = (acc[1] + acc[3]) + (acc[5] + acc[7]);
+    even + odd + tail
+}
 
 impl PowerWindow {
     /// One pass over `y` for the window `[s_lo, s_hi]` (`0 < s_lo < s_hi`); `None` if some
     /// `y^2` is not finite.
     pub fn new(y: &[f64], c: f64, s_lo: f64, s_hi: f64) -> Option<Self> {
-        let below = U_POWER_MAX * (c * s_lo) * (c * s_lo);
-        let above = (c * s_hi) * (c * s_hi);
-        let inv_below = 1.0 / below;
-        let mut totals = [NeumaierSum::default(); 6];
-        let mut kept = Vec::new();
-        let mut probe = 0.0;
-        for block in y.chunks(POWER_BLOCK) {
-            // lanes: [p, p^2, p^3, p^4, p^5, q] x 4, p = q / L on values below L, else 0
-            let mut acc = [[0.0f64; 4]; 6];
-            let mut quads = block.chunks_exact(4);
-            for v in &mut quads {
-                let mut outside = false;
-                for k in 0..4 {
-                    let q = v[k] * v[k];
-                    let inside = q < below;
-                    outside |= !inside;
-                    let p = if inside { q * inv_below } else { 0.0 };
-                    let p2 = p * p;
-                    let p4 = p2 * p2;
-                    acc[0][k] += p;
-                    acc[1][k] += p2;
-                    acc[2][k] += p2 * p;
-                    acc[3][k] += p4;
-                    acc[4][k] += p4 * p;
-                    acc[5][k] += q;
-                }
-                if outside {
-                    for &yi in v {
-                        let q = yi * yi;
-                        if q >= below && q <= above {
-                            kept.push(q);
-                        }
-                    }
-                }
-            }
-            for &yi in quads.remainder() {
-                let q = yi * yi;
-                if q < below {
-                    let p = q * inv_below;
-                    let mut pm = p;
-                    for lane in acc.iter_mut().take(5) {
-                        lane[0] += pm;
-                        pm *= p;
-                    }
-                } else if q <= above {
-                    kept.push(q);
-                }
-                acc[5][0] += q;
-            }
-            for (t, lane) in totals.iter_mut().zip(&acc) {
-                t.add((lane[0] + lane[2]) + (lane[1] + lane[3]));
-            }
-            probe += acc[5].iter().sum::<f64>() * 0.0;
-        }
-        if !probe.is_finite() || !totals[5].total().is_finite() {
-            return None;
-        }
-        let mut powers = [0.0; 5];
-        for (p, t) in powers.iter_mut().zip(&totals) {
-            *p = t.total();
-        }
-        Some(Self {
-            c,
-            n: y.len() as f64,
-            below,
-            powers,
-            kept,
-            sum_squares: totals[5].total(),
-        })
+        let mut acc = PowerAccumulator::new(c, s_lo, s_hi, 1.0);
+        acc.push(y);
+        acc.finish()
     }
 
     /// `mean(psi_c(y/s)^2)` at `s` in the window (METHODS §2.1).
@@ -680,6 +793,24 @@ impl PowerWindow {
         }
         let kept = (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail;
         self.c * self.c * (below + kept) / self.n
+    }
+
+    /// The down-crossing of `h(s) = mean(psi_c(y/s)^2) - a` on the window `[lo, hi]` by
+    /// Brent–Dekker to 1e-14 relative in `s` (METHODS §2.4), or, when `h` does not go from `+`
+    /// to `-` across it, the next window towards the root in the direction the fixed point
+    /// moves (down where `h(lo) <= 0`, up otherwise), twice as wide.
+    pub(crate) fn solve(&self, a: f64, lo: f64, hi: f64) -> Result<WindowOutcome, Error> {
+        let h = |s: f64| self.mean_psi2(s) - a;
+        let (h_lo, h_hi) = (h(lo), h(hi));
+        if h_lo > 0.0 && h_hi <= 0.0 {
+            let root = find_root(h, lo, hi, (S_ROOT_RTOL * lo).max(f64::MIN_POSITIVE))?;
+            return Ok(WindowOutcome::Root(root.x * root.x));
+        }
+        Ok(if h_lo <= 0.0 {
+            WindowOutcome::Slide(lo / (WINDOW * WINDOW), lo)
+        } else {
+            WindowOutcome::Slide(hi, hi * WINDOW * WINDOW)
+        })
     }
 
     /// Mean of `y^2` over the whole pass (the classical WV of the level, METHODS §1.5).

@@ -7,10 +7,11 @@
 
 use crate::error::{check_finite, check_freq, check_series, Error, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
-use crate::variance::haar::{for_each_haar_level, haar_square_sums};
 use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
+use crate::variance::haar::haar_square_sums;
+use crate::variance::haar_robust::haar_robust_levels;
 use crate::variance::robust::{
-    robust_ci, robust_scale, robust_scale_long, tuning_constant, RobustConvention, RobustOptions,
+    robust_ci, robust_scale, tuning_constant, RobustConvention, RobustOptions,
 };
 use crate::wavelet::{
     dwt_boundary, modwt_boundary, Dwt, Modwt, Transform, WaveletFilter, MAX_LEVELS,
@@ -420,16 +421,17 @@ fn haar_robust_in_memory(
     let c = tuning_constant(r.eff, r.convention)?;
     let head = &x[..n.min(crate::variance::haar::BLOCK)];
     let offset = head.iter().sum::<f64>() / head.len() as f64;
-    let per_level = for_each_haar_level(x, levels, offset, |_, w| {
-        let robust = match robust_scale_long(w, c) {
-            Ok(s2) => s2,
-            Err(Error::Series(SeriesError::NoRobustScale { .. })) => f64::NAN,
-            Err(e) => return Err(e),
-        };
-        Ok((mean_square(w), robust, w.len()))
-    })
-    .into_iter()
-    .collect::<Result<Vec<_>, Error>>()?;
+    let per_level = haar_robust_levels(x, levels, offset, c)
+        .into_iter()
+        .map(|(classical, robust, kept)| {
+            let robust = match robust {
+                Ok(s2) => s2,
+                Err(Error::Series(SeriesError::NoRobustScale { .. })) => f64::NAN,
+                Err(e) => return Err(e),
+            };
+            Ok((classical, robust, kept))
+        })
+        .collect::<Result<Vec<_>, Error>>()?;
     let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
     check_finite_result(&classical, "wavelet variance")?;
     let robust: Vec<f64> = per_level.iter().map(|l| l.1).collect();
@@ -440,7 +442,11 @@ fn haar_robust_in_memory(
         .map(|(_, level)| WvWarning::NoRobustScale { level })
         .collect();
     let counts: Vec<usize> = per_level.iter().map(|l| l.2).collect();
-    let eta = counts.iter().zip(1..).map(|(&kept, j)| eta3(kept, j)).collect();
+    let eta = counts
+        .iter()
+        .zip(1..)
+        .map(|(&kept, j)| eta3(kept, j))
+        .collect();
     let mut result =
         WaveletVariance::assemble(n, freq_hz, opts, &classical, Some(&robust), counts, eta);
     result.warnings = warnings;
