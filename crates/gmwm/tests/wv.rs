@@ -291,6 +291,15 @@ proptest! {
 /// differences summed in i128, so the only rounding is the final division. This is the
 /// numerical-care check of issue 2 (a biased signal, long accumulations).
 fn check_streaming_exact(n: usize) {
+    check_exact(n, false);
+}
+
+/// As [`check_streaming_exact`] through [`wavelet_variance`] (the in-memory kernel).
+fn check_in_memory_exact(n: usize) {
+    check_exact(n, true);
+}
+
+fn check_exact(n: usize, in_memory: bool) {
     let mut state = 0x9E37_79B9_7F4A_7C15u64;
     let mut next = move || {
         state ^= state << 13;
@@ -311,14 +320,20 @@ fn check_streaming_exact(n: usize) {
         .collect();
     let levels =
         gmwm::variance::default_levels(n, gmwm::Transform::Modwt, gmwm::WaveletFilter::Haar);
-    let mut acc = HaarWvAccumulator::new(levels).unwrap();
-    let mut chunk = Vec::with_capacity(1 << 20);
-    for block in k.chunks(1 << 20) {
-        chunk.clear();
-        chunk.extend(block.iter().map(|&v| -1000.0 + v as f64 / 64.0));
-        acc.push(&chunk).unwrap();
-    }
-    let wv = acc.finish(1.0, 0.05).unwrap();
+    let wv = if in_memory {
+        let x: Vec<f64> = k.iter().map(|&v| -1000.0 + v as f64 / 64.0).collect();
+        wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap()
+    } else {
+        let mut acc = HaarWvAccumulator::new(levels).unwrap();
+        let mut chunk = Vec::with_capacity(1 << 20);
+        for block in k.chunks(1 << 20) {
+            chunk.clear();
+            chunk.extend(block.iter().map(|&v| -1000.0 + v as f64 / 64.0));
+            acc.push(&chunk).unwrap();
+        }
+        acc.finish(1.0, 0.05).unwrap()
+    };
+    assert_eq!(wv.levels(), levels);
     let mut prefix = Vec::with_capacity(n + 1);
     prefix.push(0i64);
     for &v in &k {
@@ -354,4 +369,108 @@ fn streaming_wv_is_exact_to_1e_9_at_30_million_samples() {
 #[ignore = "10^9 samples: ~3 min and 12 GB; run with `cargo test --release -p gmwm --test integration -- --ignored streaming_wv_is_exact_to_1e_9_at_a_billion`"]
 fn streaming_wv_is_exact_to_1e_9_at_a_billion_samples() {
     check_streaming_exact(1_000_000_001);
+}
+
+/// The in-memory robust route (one pyramid pass, windowed power sums, METHODS §2.4 "Port")
+/// against the direct route: [`robust_scale`] (exact MAD start, fixed point, Brent polish) on
+/// the MODWT coefficients of every level. Both solve to ~1e-14 in `s`; the coefficients differ
+/// by the offset removed before the pyramid (rounding only), so 1e-10 relative is the bound.
+fn check_robust_matches_direct_route(x: &[f64], what: &str) {
+    use gmwm::variance::robust::robust_scale;
+    use gmwm::wavelet::{Modwt, WaveletFilter};
+    let opts = WvOptions {
+        robust: Some(RobustOptions::default()),
+        ..WvOptions::default()
+    };
+    let fast = wavelet_variance(x, 1.0, &opts).unwrap();
+    let c = RobustOptions::default().tuning_constant().unwrap();
+    let coefs = Modwt::new(WaveletFilter::Haar, fast.levels())
+        .unwrap()
+        .transform(x)
+        .unwrap();
+    for j in 1..=fast.levels() {
+        let direct = match robust_scale(coefs.kept(j), c, RobustConvention::Exact) {
+            Ok(s2) => s2,
+            Err(gmwm::Error::Series(gmwm::SeriesError::NoRobustScale { .. })) => f64::NAN,
+            Err(e) => panic!("{what} level {j}: {e}"),
+        };
+        let ours = fast.wv[j - 1];
+        if direct.is_nan() {
+            assert!(ours.is_nan(), "{what} level {j}: {ours:e} vs no root");
+            continue;
+        }
+        let d = rel_diff(ours, direct);
+        assert!(
+            d < 1e-10,
+            "{what} level {j}: {ours:e} vs direct {direct:e} ({d:e})"
+        );
+    }
+}
+
+#[test]
+fn robust_wv_matches_the_direct_route_on_real_data() {
+    let table = read_dataset("adis_16405_imu1");
+    for name in ["gyro_x", "accel_z"] {
+        let col = table.columns.iter().find(|c| c.name == name).unwrap();
+        check_robust_matches_direct_route(&col.values, name);
+    }
+    let cont = read_dataset("cont_imu1");
+    check_robust_matches_direct_route(&cont.columns[0].values, "cont_imu1");
+}
+
+#[test]
+fn robust_wv_matches_the_direct_route_on_contaminated_data() {
+    // 1% gross outliers (the robust levels lose their root from level ~5 on: NaN on both
+    // routes), a level shift, and a heavy-tailed mixture where the MAD start and the biweight
+    // root are far apart
+    let n = 300_000;
+    let mut outliers = white_noise(n, 1.0, 21);
+    for i in (0..n).step_by(100) {
+        outliers[i] += 1e3;
+    }
+    check_robust_matches_direct_route(&outliers, "1% outliers");
+    let mut shifted = white_noise(n, 1.0, 22);
+    for v in &mut shifted[n / 3..] {
+        *v += 5e4;
+    }
+    check_robust_matches_direct_route(&shifted, "level shift");
+    let a = white_noise(n, 1.0, 23);
+    let b = white_noise(n, 100.0, 24);
+    let mixture: Vec<f64> = a
+        .iter()
+        .zip(&b)
+        .enumerate()
+        .map(|(i, (u, v))| if i % 7 == 0 { *v } else { *u })
+        .collect();
+    check_robust_matches_direct_route(&mixture, "scale mixture");
+}
+
+#[test]
+fn robust_wv_does_not_depend_on_the_thread_count() {
+    let mut x = white_noise(200_003, 1.0, 31);
+    for i in (0..x.len()).step_by(997) {
+        x[i] -= 40.0;
+    }
+    let opts = WvOptions {
+        robust: Some(RobustOptions::default()),
+        ..WvOptions::default()
+    };
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| wavelet_variance(&x, 1.0, &opts).unwrap())
+    };
+    let one = run(1);
+    for threads in [2, 3] {
+        assert_eq!(run(threads), one, "{threads} threads");
+    }
+}
+
+#[test]
+fn in_memory_wv_is_exact_to_1e_9_on_a_biased_random_walk() {
+    // the exact-oracle series of `check_streaming_exact` through `wavelet_variance` (the
+    // in-memory kernel) at a length with several parts, partial blocks and stage-B levels
+    check_in_memory_exact(3_000_001);
 }

@@ -4,6 +4,8 @@
 pub mod allan;
 pub mod ci;
 pub mod cov;
+pub(crate) mod haar;
+pub(crate) mod haar_robust;
 pub mod robust;
 pub mod wv;
 

@@ -8,7 +8,11 @@
 use crate::error::{check_finite, check_freq, check_series, Error, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
-use crate::variance::robust::{robust_ci, robust_scale, tuning_constant, RobustOptions};
+use crate::variance::haar::haar_square_sums;
+use crate::variance::haar_robust::haar_robust_levels;
+use crate::variance::robust::{
+    robust_ci, robust_scale, tuning_constant, RobustConvention, RobustOptions,
+};
 use crate::wavelet::{
     dwt_boundary, modwt_boundary, Dwt, Modwt, Transform, WaveletFilter, MAX_LEVELS,
 };
@@ -306,25 +310,46 @@ pub fn wavelet_variance(
         }
         .into());
     }
-    check_series(x)?;
-    check_alpha(opts.alpha)?;
-    check_freq(freq_hz)?;
     let n = x.len();
-    // With no level keeping two coefficients, ask for one so that check_levels reports the
-    // precise reason.
-    let levels = opts
-        .levels
-        .unwrap_or_else(|| default_levels(n, opts.transform, opts.filter).max(1));
-    check_levels(n, levels, opts)?;
-    if let Some(r) = opts.robust {
-        RobustOptions::new(r.eff, r.convention)?;
-    }
+    // Checks that do not read the data first; a series error still takes precedence over them.
+    let params = (|| -> Result<usize, Error> {
+        check_alpha(opts.alpha)?;
+        check_freq(freq_hz)?;
+        // With no level keeping two coefficients, ask for one so that check_levels reports the
+        // precise reason.
+        let levels = opts
+            .levels
+            .unwrap_or_else(|| default_levels(n, opts.transform, opts.filter).max(1));
+        check_levels(n, levels, opts)?;
+        if let Some(r) = opts.robust {
+            RobustOptions::new(r.eff, r.convention)?;
+        }
+        Ok(levels)
+    })();
+    let levels = match params {
+        Ok(levels) => levels,
+        Err(e) => {
+            check_series(x)?;
+            return Err(e);
+        }
+    };
 
     if opts.robust.is_none()
         && opts.transform == Transform::Modwt
         && opts.filter == WaveletFilter::Haar
     {
-        return haar_wv_parallel(x, levels, freq_hz, opts.alpha);
+        // The data are checked inside the pass (a non-finite sample makes the sums NaN), so
+        // the series is read once.
+        return haar_wv_in_memory(x, levels, freq_hz, opts.alpha);
+    }
+    check_series(x)?;
+
+    if let (Some(r), Transform::Modwt, WaveletFilter::Haar) =
+        (opts.robust, opts.transform, opts.filter)
+    {
+        if r.convention == RobustConvention::Exact {
+            return haar_robust_in_memory(x, levels, freq_hz, opts);
+        }
     }
 
     let coefs = match opts.transform {
@@ -377,6 +402,53 @@ pub fn wavelet_variance(
         .collect();
     let robust = opts.robust.map(|_| robust.as_slice());
     let mut result = WaveletVariance::assemble(n, freq_hz, opts, &classical, robust, counts, eta);
+    result.warnings = warnings;
+    Ok(result)
+}
+
+/// Robust (Exact convention) Haar MODWT WV of an in-memory series (METHODS §2, §2.5): the
+/// coefficients level by level ([`for_each_haar_level`], the pyramid of the classical pass with
+/// the mean of the first block removed) and the robust scale of each by [`robust_scale_long`],
+/// the next level's transform overlapping the current level's solve. `x` has been checked.
+fn haar_robust_in_memory(
+    x: &[f64],
+    levels: usize,
+    freq_hz: f64,
+    opts: &WvOptions,
+) -> Result<WaveletVariance, Error> {
+    let n = x.len();
+    let r = opts.robust.expect("robust options");
+    let c = tuning_constant(r.eff, r.convention)?;
+    let head = &x[..n.min(crate::variance::haar::BLOCK)];
+    let offset = head.iter().sum::<f64>() / head.len() as f64;
+    let per_level = haar_robust_levels(x, levels, offset, c)
+        .into_iter()
+        .map(|(classical, robust, kept)| {
+            let robust = match robust {
+                Ok(s2) => s2,
+                Err(Error::Series(SeriesError::NoRobustScale { .. })) => f64::NAN,
+                Err(e) => return Err(e),
+            };
+            Ok((classical, robust, kept))
+        })
+        .collect::<Result<Vec<_>, Error>>()?;
+    let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
+    check_finite_result(&classical, "wavelet variance")?;
+    let robust: Vec<f64> = per_level.iter().map(|l| l.1).collect();
+    let warnings = robust
+        .iter()
+        .zip(1..)
+        .filter(|(v, _)| v.is_nan())
+        .map(|(_, level)| WvWarning::NoRobustScale { level })
+        .collect();
+    let counts: Vec<usize> = per_level.iter().map(|l| l.2).collect();
+    let eta = counts
+        .iter()
+        .zip(1..)
+        .map(|(&kept, j)| eta3(kept, j))
+        .collect();
+    let mut result =
+        WaveletVariance::assemble(n, freq_hz, opts, &classical, Some(&robust), counts, eta);
     result.warnings = warnings;
     Ok(result)
 }
@@ -646,6 +718,56 @@ impl HaarWvAccumulator {
             n, freq_hz, &opts, &wv, None, counts, eta,
         ))
     }
+}
+
+/// Haar MODWT WV of an in-memory series ([`haar_square_sums`]: the pyramid of
+/// [`HaarWvAccumulator`] with the same roundings, blocked and split in time and phase), for
+/// valid parameters and `x.len() >= 2`.
+///
+/// The data checks of [`check_series`] are folded in: a constant series is found by a scan that
+/// stops at the first differing sample, a non-finite sample turns the sums into NaN and
+/// [`check_series`] then names it. The offset removed before the pyramid (METHODS §1.5 is
+/// unchanged by any constant offset) is the mean of the first [`BLOCK`](crate::variance::haar::BLOCK)
+/// samples, the series' level where it starts, so no extra pass over the data is needed. Falls
+/// back to the streaming pass when the kernel's window sums or squares overflow (data near
+/// `f64::MAX`), so that edge keeps the accumulator's behaviour.
+fn haar_wv_in_memory(
+    x: &[f64],
+    levels: usize,
+    freq_hz: f64,
+    alpha: f64,
+) -> Result<WaveletVariance, Error> {
+    let first = x[0];
+    if first.is_finite() && x.iter().all(|&v| v == first) {
+        return Err(SeriesError::Constant { value: first }.into());
+    }
+    let head = &x[..x.len().min(crate::variance::haar::BLOCK)];
+    let offset = head.iter().sum::<f64>() / head.len() as f64;
+    let sums = haar_square_sums(x, levels, offset);
+    if !sums.iter().all(|s| s.is_finite()) {
+        check_series(x)?;
+        return haar_wv_parallel(x, levels, freq_hz, alpha);
+    }
+    let n = x.len();
+    let opts = WvOptions {
+        levels: Some(levels),
+        alpha,
+        ..WvOptions::default()
+    };
+    check_levels(n, levels, &opts)?;
+    let mut wv = Vec::with_capacity(levels);
+    let mut counts = Vec::with_capacity(levels);
+    let mut eta = Vec::with_capacity(levels);
+    for (j, sum) in (1..=levels).zip(&sums) {
+        let kept = n + 1 - (1usize << j);
+        wv.push(sum / kept as f64);
+        counts.push(kept);
+        eta.push(eta3(kept, j));
+    }
+    check_finite_result(&wv, "wavelet variance")?;
+    Ok(WaveletVariance::assemble(
+        n, freq_hz, &opts, &wv, None, counts, eta,
+    ))
 }
 
 /// Series shorter than this run on one thread: below it the split does not pay.
