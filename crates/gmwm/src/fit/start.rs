@@ -56,12 +56,33 @@ pub struct StartInputs {
 impl StartInputs {
     /// N and R of a series (non-finite values are ignored in the range).
     pub fn from_series(x: &[f64]) -> Self {
-        let (lo, hi) = x
+        // eight independent lanes of compare-and-select vectorise (a NaN never wins a
+        // comparison); an infinity falls back to the filtered pass
+        let (mut lo8, mut hi8) = ([f64::INFINITY; 8], [f64::NEG_INFINITY; 8]);
+        let chunks = x.chunks_exact(8);
+        let rest = chunks.remainder();
+        for c in chunks {
+            for i in 0..8 {
+                lo8[i] = if c[i] < lo8[i] { c[i] } else { lo8[i] };
+                hi8[i] = if c[i] > hi8[i] { c[i] } else { hi8[i] };
+            }
+        }
+        let mut lo = rest
             .iter()
-            .filter(|v| v.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            });
+            .chain(&lo8)
+            .fold(f64::INFINITY, |a, &v| if v < a { v } else { a });
+        let mut hi = rest
+            .iter()
+            .chain(&hi8)
+            .fold(f64::NEG_INFINITY, |a, &v| if v > a { v } else { a });
+        if lo == f64::NEG_INFINITY || hi == f64::INFINITY {
+            (lo, hi) = x
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                });
+        }
         let range = if x.is_empty() || hi < lo {
             0.0
         } else {
@@ -426,6 +447,30 @@ pub fn starting_values(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn range_ignores_non_finite_values() {
+        let naive = |x: &[f64]| {
+            let f: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+            let lo = f.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = f.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            if f.is_empty() {
+                0.0
+            } else {
+                (hi - lo) / x.len() as f64
+            }
+        };
+        let mut x: Vec<f64> = (0..37).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
+        assert_eq!(StartInputs::from_series(&x).range, naive(&x));
+        x[3] = f64::NAN;
+        x[30] = 1e9;
+        assert_eq!(StartInputs::from_series(&x).range, naive(&x));
+        x[11] = f64::INFINITY;
+        x[35] = f64::NEG_INFINITY;
+        assert_eq!(StartInputs::from_series(&x).range, naive(&x));
+        assert_eq!(StartInputs::from_series(&[]).range, 0.0);
+        assert_eq!(StartInputs::from_series(&[f64::NAN; 9]).range, 0.0);
+    }
 
     #[test]
     fn stationarity_check() {
