@@ -10,7 +10,7 @@ use crate::error::check_freq;
 use crate::fit::{FitError, Gmwm, GmwmFit, StartInputs, Weights};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{map_replicates, wv_bootstrap};
-use crate::model::{format_value, Model};
+use crate::model::Model;
 use crate::sim::replicate_seed;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use nalgebra::{DMatrix, DVector};
@@ -549,7 +549,9 @@ impl fmt::Display for ModelSelection {
             "model", "objective", "optimism", "WIC", "GoF p-value"
         )?;
         for c in &self.candidates {
-            let p = c.gof_p_value.map_or_else(|| "-".to_string(), format_value);
+            let p = c
+                .gof_p_value
+                .map_or_else(|| "-".to_string(), |p| format!("{p:.4e}"));
             let mark = if c.converged { "" } else { " (not converged)" };
             writeln!(
                 f,
