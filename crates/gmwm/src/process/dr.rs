@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{half_widths, LatentProcess};
+use super::{add_scaled, half_widths, LatentProcess};
 use crate::error::ParamError;
 
 /// Deterministic drift: the ramp `x_t = omega (t + 1)`.
@@ -47,10 +47,7 @@ impl LatentProcess for Dr {
             .collect()
     }
     fn add_wv(&self, out: &mut [f64]) {
-        let scale = self.omega * self.omega;
-        for (o, m) in out.iter_mut().zip(half_widths(usize::MAX)) {
-            *o += scale * unit_wv(m);
-        }
+        add_scaled(out, self.omega * self.omega, unit_wv);
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         half_widths(levels)

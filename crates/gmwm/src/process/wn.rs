@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{check_positive, half_widths, LatentProcess};
+use super::{add_scaled, check_positive, half_widths, LatentProcess};
 use crate::error::ParamError;
 
 /// White noise: independent samples of variance `sigma2`.
@@ -45,10 +45,7 @@ impl LatentProcess for Wn {
             .collect()
     }
     fn add_wv(&self, out: &mut [f64]) {
-        let scale = self.sigma2;
-        for (o, m) in out.iter_mut().zip(half_widths(usize::MAX)) {
-            *o += scale * unit_wv(m);
-        }
+        add_scaled(out, self.sigma2, unit_wv);
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         half_widths(levels).map(|m| vec![unit_wv(m)]).collect()
