@@ -394,13 +394,17 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
                 u_new[k] = u[k] + h[k];
             }
             evaluations += 1;
-            let ok = objective.evaluate(&u_new, &mut trial, true).is_ok();
+            // a trial needs only the residuals; the Jacobian is formed at accepted points
+            let ok = objective.evaluate(&u_new, &mut trial, false).is_ok();
             let q_new = if ok { sum_sq(&trial.r) } else { f64::INFINITY };
             // predicted reduction of Q by the linear model: h'(mu D h - g)
             let predicted: f64 = (0..p).map(|k| h[k] * (mu * d[k] * h[k] - g[k])).sum();
             let actual = q - q_new;
             let rho = actual / predicted;
-            if q_new.is_finite() && rho > 0.0 {
+            if q_new.is_finite()
+                && rho > 0.0
+                && objective.evaluate(&u_new, &mut trial, true).is_ok()
+            {
                 std::mem::swap(&mut cur, &mut trial);
                 std::mem::swap(&mut u, &mut u_new);
                 let old_q = q;
