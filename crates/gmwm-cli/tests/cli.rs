@@ -1,14 +1,12 @@
 //! End-to-end tests of the `gmwm` binary: outputs on real data, and one test per bad-input
 //! class checking the exit code and the one-line error (STYLE §6.8).
 
-use assert_cmd::Command;
+mod common;
+
+use common::{gmwm, run_json, simulate};
 use predicates::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
-
-fn gmwm() -> Command {
-    Command::cargo_bin("gmwm").expect("binary built")
-}
 
 fn data(name: &str) -> PathBuf {
     let dir = std::env::var_os("GMWM_DATA_DIR")
@@ -28,16 +26,7 @@ fn temp_file(suffix: &str, bytes: &[u8]) -> tempfile::NamedTempFile {
 
 /// Runs `gmwm ARGS FILE` on a text file and checks a one-line error containing `needles`.
 fn assert_one_line_error(args: &[&str], needles: &[&str]) {
-    let out = gmwm().args(args).output().expect("runs");
-    assert_eq!(out.status.code(), Some(1), "args {args:?}: {out:?}");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("warning:")).collect();
-    assert_eq!(lines.len(), 1, "one line expected, got {stderr:?}");
-    assert!(lines[0].starts_with("gmwm: error: "), "{stderr}");
-    for n in needles {
-        assert!(lines[0].contains(n), "{n:?} not in {stderr:?}");
-    }
-    assert!(out.stdout.is_empty(), "no partial results on stdout");
+    common::assert_one_line_error(gmwm().args(args), needles);
 }
 
 #[test]
@@ -657,41 +646,20 @@ fn review_findings_are_errors_not_panics_or_silent_numbers() {
 #[test]
 fn fit_accepts_a_wv_json_and_bootstrap_weights() {
     let dir = tempfile::tempdir().unwrap();
-    let csv = dir.path().join("sim.csv");
-    gmwm()
-        .args([
-            "simulate",
-            "--model",
-            "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)",
-            "--n",
-            "20000",
-            "--freq",
-            "10",
-            "--seed",
-            "3",
-            "-o",
-        ])
-        .arg(&csv)
-        .assert()
-        .success();
+    let model = "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)";
+    let csv = simulate(dir.path(), "sim.csv", model, 20_000, 10.0, 3);
     let wv = gmwm().arg("wv").arg(&csv).arg("--json").output().unwrap();
     assert!(wv.status.success());
     let wv_file = dir.path().join("wv.json");
     std::fs::write(&wv_file, &wv.stdout).unwrap();
-    let fit_json = |file: &std::path::Path, extra: &[&str]| -> serde_json::Value {
-        let out = gmwm()
-            .arg("fit")
-            .arg(file)
-            .args(["--model", "AR1()+WN()", "--G", "2000", "--json"])
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice(&out.stdout).unwrap()
+    let fit_json = |file: &std::path::Path, extra: &[&str]| {
+        run_json(
+            gmwm()
+                .arg("fit")
+                .arg(file)
+                .args(["--model", "AR1()+WN()", "--G", "2000", "--json"])
+                .args(extra),
+        )
     };
     let from_wv = fit_json(&wv_file, &[]);
     let from_csv = fit_json(&csv, &[]);
@@ -756,21 +724,8 @@ fn fit_accepts_a_wv_json_and_bootstrap_weights() {
 #[test]
 fn fit_inference_fields() {
     let dir = tempfile::tempdir().unwrap();
-    let csv = dir.path().join("sim.csv");
-    gmwm()
-        .args([
-            "simulate",
-            "--model",
-            "AR1(phi=0.9, sigma2=0.5)+WN(sigma2=1)",
-            "--n",
-            "4096",
-            "--seed",
-            "8",
-            "-o",
-        ])
-        .arg(&csv)
-        .assert()
-        .success();
+    let model = "AR1(phi=0.9, sigma2=0.5)+WN(sigma2=1)";
+    let csv = simulate(dir.path(), "sim.csv", model, 4096, 1.0, 8);
     for extra in [&[][..], &["--bootstrap", "20"][..]] {
         let out = gmwm()
             .arg("fit")

@@ -1,50 +1,25 @@
 //! End-to-end tests of `gmwm select` (METHODS §8): the JSON shape, the table, determinism and
 //! one test per bad-input class.
 
-use assert_cmd::Command;
-use std::path::Path;
+mod common;
 
-fn gmwm() -> Command {
-    Command::cargo_bin("gmwm").expect("binary built")
-}
+use common::{gmwm, run_json, simulate};
+use std::path::Path;
 
 /// A seeded AR1 + WN + RW series (5000 samples, 100 Hz, with its sidecar) in `dir`.
 fn simulated(dir: &Path) -> std::path::PathBuf {
-    let path = dir.join("sim.csv");
-    let out = gmwm()
-        .args([
-            "simulate",
-            "--model",
-            "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)",
-            "--n",
-            "5000",
-            "--freq",
-            "100",
-            "--seed",
-            "3",
-            "-o",
-        ])
-        .arg(&path)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{out:?}");
-    path
+    let model = "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)";
+    simulate(dir, "sim.csv", model, 5000, 100.0, 3)
 }
 
 fn select_json(file: &Path, extra: &[&str]) -> serde_json::Value {
-    let out = gmwm()
-        .arg("select")
-        .arg(file)
-        .args(["--G", "500", "--bootstrap", "20", "--json"])
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+    run_json(
+        gmwm()
+            .arg("select")
+            .arg(file)
+            .args(["--G", "500", "--bootstrap", "20", "--json"])
+            .args(extra),
+    )
 }
 
 #[test]
@@ -129,16 +104,7 @@ fn select_table_names_the_column_and_the_selected_model() {
 
 /// Exit code 1 and one error line containing every needle.
 fn assert_error(file: &Path, args: &[&str], needles: &[&str]) {
-    let out = gmwm().arg("select").arg(file).args(args).output().unwrap();
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {out:?}");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("warning:")).collect();
-    assert_eq!(lines.len(), 1, "one line expected, got {stderr:?}");
-    assert!(lines[0].starts_with("gmwm: error: "), "{stderr}");
-    for n in needles {
-        assert!(lines[0].contains(n), "{n:?} not in {stderr:?}");
-    }
-    assert!(out.stdout.is_empty());
+    common::assert_one_line_error(gmwm().arg("select").arg(file).args(args), needles);
 }
 
 #[test]

@@ -151,19 +151,9 @@ pub(crate) fn ar1_wv_jet<const N: usize>(
 /// `r2 = 2/(1+2m)`, `r0 = 1/(1+2m)`.
 fn series_g<const N: usize>(l: Jet<N>, m: f64) -> Jet<N> {
     let q = 1.0 + 2.0 * m;
-    let (r0, r1, r2) = (1.0 / q, (1.0 + m) / q, 2.0 / q);
     let mut d = [0.0; G_TERMS];
-    let mut fact = 1.0;
-    let (mut p0, mut p1, mut p2) = (1.0, 1.0, 1.0);
-    for k in 1..G_TERMS + 3 {
-        fact *= k as f64;
-        p0 *= r0;
-        p1 *= r1;
-        p2 *= r2;
-        if k >= 3 {
-            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-            d[k - 3] = sign * q * q * q / fact * (4.0 * p1 - 1.0 - m * p2 - 3.0 * p0);
-        }
+    for (dk, c) in d.iter_mut().zip(g_coefficients(m)) {
+        *dk = c;
     }
     let t = l * q;
     // Truncate where the terms, divided by t^2, fall below 1e-17 of the leading one: the value,
@@ -185,6 +175,24 @@ fn series_g<const N: usize>(l: Jet<N>, m: f64) -> Jet<N> {
         acc = acc * t + d[k];
     }
     acc
+}
+
+/// The coefficients `d_0, d_1, ...` ([`G_TERMS`] of them) of the series of [`series_g`].
+fn g_coefficients(m: f64) -> impl Iterator<Item = f64> {
+    let q = 1.0 + 2.0 * m;
+    let (r0, r1, r2) = (1.0 / q, (1.0 + m) / q, 2.0 / q);
+    let q3 = q * q * q;
+    let (mut fact, mut p0, mut p1, mut p2) = (1.0, 1.0, 1.0, 1.0);
+    (1..G_TERMS + 3).filter_map(move |k| {
+        fact *= k as f64;
+        p0 *= r0;
+        p1 *= r1;
+        p2 *= r2;
+        (k >= 3).then(|| {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            sign * q3 / fact * (4.0 * p1 - 1.0 - m * p2 - 3.0 * p0)
+        })
+    })
 }
 
 /// `R(L) = 1 / (E(L)^3 (1 + e^{-L}))`, `E(L) = (1 - e^{-L})/L = sum_k (-L)^k/(k+1)!`.
@@ -235,28 +243,16 @@ pub(crate) fn ar1_add_wv(phi: f64, lag: Option<f64>, sigma2: f64, out: &mut [f64
 /// [`series_g`] in plain `f64`, summed forward and stopped at the first term below `1e-17` of
 /// the sum (at most [`G_TERMS`] terms).
 fn series_g_f64(l: f64, m: f64) -> f64 {
-    let q = 1.0 + 2.0 * m;
-    let (r0, r1, r2) = (1.0 / q, (1.0 + m) / q, 2.0 / q);
-    let t = l * q;
-    let q3 = q * q * q;
-    let mut fact = 1.0;
-    let (mut p0, mut p1, mut p2) = (1.0, 1.0, 1.0);
+    let t = l * (1.0 + 2.0 * m);
     let mut tp = 1.0;
     let mut acc = 0.0;
-    for k in 1..G_TERMS + 3 {
-        fact *= k as f64;
-        p0 *= r0;
-        p1 *= r1;
-        p2 *= r2;
-        if k >= 3 {
-            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-            let term = sign * q3 / fact * (4.0 * p1 - 1.0 - m * p2 - 3.0 * p0) * tp;
-            acc += term;
-            if k > 5 && term.abs() <= 1e-17 * acc.abs() {
-                break;
-            }
-            tp *= t;
+    for (k, d) in g_coefficients(m).enumerate() {
+        let term = d * tp;
+        acc += term;
+        if k > 2 && term.abs() <= 1e-17 * acc.abs() {
+            break;
         }
+        tp *= t;
     }
     acc
 }

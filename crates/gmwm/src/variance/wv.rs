@@ -382,6 +382,18 @@ pub fn wavelet_variance(
             Ok((mean_square(kept) / scale, robust, kept.len()))
         })
         .collect::<Result<_, Error>>()?;
+    from_levels(n, freq_hz, opts, &per_level)
+}
+
+/// The result from per-level `(classical, robust, kept)` estimates: refuses a non-finite
+/// classical value, turns NaN robust levels into [`WvWarning::NoRobustScale`], and sets the
+/// degrees of freedom (eta3 for the MODWT, the kept count for the DWT).
+fn from_levels(
+    n: usize,
+    freq_hz: f64,
+    opts: &WvOptions,
+    per_level: &[(f64, Option<f64>, usize)],
+) -> Result<WaveletVariance, Error> {
     let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
     check_finite_result(&classical, "wavelet variance")?;
     let robust: Vec<f64> = per_level.iter().filter_map(|l| l.1).collect();
@@ -429,28 +441,10 @@ fn haar_robust_in_memory(
                 Err(Error::Series(SeriesError::NoRobustScale { .. })) => f64::NAN,
                 Err(e) => return Err(e),
             };
-            Ok((classical, robust, kept))
+            Ok((classical, Some(robust), kept))
         })
         .collect::<Result<Vec<_>, Error>>()?;
-    let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
-    check_finite_result(&classical, "wavelet variance")?;
-    let robust: Vec<f64> = per_level.iter().map(|l| l.1).collect();
-    let warnings = robust
-        .iter()
-        .zip(1..)
-        .filter(|(v, _)| v.is_nan())
-        .map(|(_, level)| WvWarning::NoRobustScale { level })
-        .collect();
-    let counts: Vec<usize> = per_level.iter().map(|l| l.2).collect();
-    let eta = counts
-        .iter()
-        .zip(1..)
-        .map(|(&kept, j)| eta3(kept, j))
-        .collect();
-    let mut result =
-        WaveletVariance::assemble(n, freq_hz, opts, &classical, Some(&robust), counts, eta);
-    result.warnings = warnings;
-    Ok(result)
+    from_levels(n, freq_hz, opts, &per_level)
 }
 
 /// Refuses non-finite estimates from finite data (overflowing squares): never silent numbers.

@@ -1,0 +1,50 @@
+//! Helpers shared by the CLI test binaries (each binary uses a subset).
+#![allow(dead_code)]
+
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+/// The `gmwm` binary under test.
+pub fn gmwm() -> Command {
+    Command::cargo_bin("gmwm").expect("binary built")
+}
+
+/// `gmwm simulate --model MODEL --n N --freq F --seed S -o DIR/NAME` (with its sidecar).
+pub fn simulate(dir: &Path, name: &str, model: &str, n: usize, freq: f64, seed: u64) -> PathBuf {
+    let path = dir.join(name);
+    let out = gmwm()
+        .args(["simulate", "--model", model])
+        .args(["--n", &n.to_string(), "--freq", &freq.to_string()])
+        .args(["--seed", &seed.to_string(), "-o"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    path
+}
+
+/// Runs `gmwm ARGS`, asserts success and parses stdout as JSON.
+pub fn run_json(cmd: &mut Command) -> serde_json::Value {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Exit code 1, exactly one `gmwm: error: ` line on stderr (warnings aside) containing every
+/// needle, and nothing on stdout.
+pub fn assert_one_line_error(cmd: &mut Command, needles: &[&str]) {
+    let out = cmd.output().expect("runs");
+    assert_eq!(out.status.code(), Some(1), "{cmd:?}: {out:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("warning:")).collect();
+    assert_eq!(lines.len(), 1, "one line expected, got {stderr:?}");
+    assert!(lines[0].starts_with("gmwm: error: "), "{stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "{n:?} not in {stderr:?}");
+    }
+    assert!(out.stdout.is_empty(), "no partial results on stdout");
+}
