@@ -760,6 +760,32 @@ fn fit_inference_fields() {
         let pv = f["gof"]["p_value"].as_f64().unwrap();
         assert!((0.0..=1.0).contains(&pv));
     }
+    // a drift fitted to a driftless series sits at omega = 0 (seed 6 at these settings):
+    // inference still runs; the drift's se and interval are null, the others are numbers
+    let csv = simulate(
+        dir.path(),
+        "s6.csv",
+        "AR1(phi=0.9, sigma2=1)+WN(sigma2=2)",
+        4000,
+        1.0,
+        6,
+    );
+    let doc = run_json(gmwm().arg("fit").arg(&csv).args([
+        "--model",
+        "AR1()+WN()+DR()",
+        "--G",
+        "300",
+        "--inference",
+        "--json",
+    ]));
+    let params = doc["fits"][0]["parameters"].as_array().unwrap();
+    let dr = &params[3];
+    assert_eq!(dr["name"], "omega");
+    assert_eq!(dr["value"], 0.0);
+    for key in ["se", "ci_low", "ci_high"] {
+        assert!(dr[key].is_null(), "{dr}");
+        assert!(params[0][key].is_f64(), "{}", params[0]);
+    }
     // --bootstrap needs --inference
     gmwm()
         .arg("fit")

@@ -273,7 +273,8 @@ fn coverage(
     for inf in &runs {
         assert_eq!(inf.method, InferenceMethod::Asymptotic);
         for (k, p) in inf.parameters.iter().enumerate() {
-            if p.ci_low <= theta0[k] && theta0[k] <= p.ci_high {
+            let (lo, hi) = (p.ci_low.unwrap(), p.ci_high.unwrap());
+            if lo <= theta0[k] && theta0[k] <= hi {
                 covered[k] += 1;
             }
         }
@@ -402,10 +403,8 @@ fn bootstrap_gof_p_value_lies_in_its_interval() {
     // the J-test uses the V of the 40 replicates (40 > J + 2 = 10)
     assert_eq!(inf.gof.as_ref().unwrap().df, 5);
     for p in &inf.parameters {
-        assert!(
-            p.se > 0.0 && p.ci_low < p.estimate && p.estimate < p.ci_high,
-            "{p:?}"
-        );
+        let (se, lo, hi) = (p.se.unwrap(), p.ci_low.unwrap(), p.ci_high.unwrap());
+        assert!(se > 0.0 && lo < p.estimate && p.estimate < hi, "{p:?}");
     }
     let json = serde_json::to_value(&inf).unwrap();
     for key in ["se", "ci_low", "ci_high", "name", "estimate"] {
@@ -459,8 +458,9 @@ fn bootstrap_se_agrees_with_the_sandwich() {
     assert!(boot.bootstrap_gof.is_none());
     let tol = 3.0 * (1.0 / 598.0 + 1.0 / 798.0f64).sqrt();
     for (b, a) in boot.parameters.iter().zip(&asym.parameters) {
-        eprintln!("{}: bootstrap SE {} sandwich SE {}", b.name, b.se, a.se);
-        assert!(rel(b.se, a.se) < tol, "{}: {} vs {}", b.name, b.se, a.se);
+        let (bs, asy) = (b.se.unwrap(), a.se.unwrap());
+        eprintln!("{}: bootstrap SE {bs} sandwich SE {asy}", b.name);
+        assert!(rel(bs, asy) < tol, "{}: {bs} vs {asy}", b.name);
     }
 }
 
@@ -516,15 +516,61 @@ fn gm_inference_is_in_gm_units() {
         // the two fits agree to the optimiser tolerance; the simulated V is identical (same
         // seed and fitted model): 1e-5 relative
         assert!(
-            rel(inf.parameters[k].se, mapped[(k, k)].sqrt()) < 1e-5,
+            rel(inf.parameters[k].se.unwrap(), mapped[(k, k)].sqrt()) < 1e-5,
             "{k}"
         );
     }
     // transformed intervals stay positive and bracket the estimate
     for p in &inf.parameters {
-        assert!(
-            p.ci_low > 0.0 && p.ci_low < p.estimate && p.estimate < p.ci_high,
-            "{p:?}"
-        );
+        let (lo, hi) = (p.ci_low.unwrap(), p.ci_high.unwrap());
+        assert!(lo > 0.0 && lo < p.estimate && p.estimate < hi, "{p:?}");
+    }
+}
+
+#[test]
+fn a_component_at_the_boundary_gets_no_se_and_leaves_the_others_unchanged() {
+    use gmwm::fit::StartInputs;
+    use gmwm::inference::InferenceWarning;
+    // seed 6: the drift of AR1()+WN()+DR() fitted to a driftless series is exactly 0, the
+    // boundary of its domain (this used to fail: "DR[2].omega has no influence on the implied
+    // WV" in the sandwich, "outside the domain of its transform" in the bootstrap refits)
+    let x = simulate_model(&model("AR1(phi=0.9, sigma2=1)+WN(sigma2=2)"), 4000, 1.0, 6).unwrap();
+    let opts = WvOptions::default();
+    let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
+    let fit_of = |text: &str| {
+        let g = Gmwm::parse(text).unwrap().with_draws(300);
+        let f = g.fit_from_wv(&wv, StartInputs::from_series(&x)).unwrap();
+        (g, f)
+    };
+    let (g3, f3) = fit_of("AR1()+WN()+DR()");
+    let (g2, f2) = fit_of("AR1()+WN()");
+    assert_eq!(f3.theta[3], 0.0, "the case needs a drift of exactly 0");
+    assert_eq!(f3.active_parameters(), vec![0, 1, 2]);
+    for bootstrap in [None, Some(20)] {
+        let o = InferenceOptions {
+            bootstrap,
+            ..InferenceOptions::default()
+        };
+        let i3 = infer(&g3, &f3, x.len(), &opts, &o).unwrap();
+        let i2 = infer(&g2, &f2, x.len(), &opts, &o).unwrap();
+        let dr = &i3.parameters[3];
+        assert_eq!((dr.se, dr.ci_low, dr.ci_high), (None, None, None));
+        assert!(i3.covariance[3].iter().all(|c| c.is_nan()));
+        assert!(i3.warnings.contains(&InferenceWarning::AtBoundary {
+            parameters: vec!["DR[2].omega".into()]
+        }));
+        // the other parameters: the inference of the model without the drift (V simulated
+        // from the same fitted process with the same seed; fits equal to the optimiser
+        // tolerance, 1e-6 relative)
+        for (a, b) in i3.parameters.iter().zip(&i2.parameters) {
+            assert!(
+                rel(a.se.unwrap(), b.se.unwrap()) < 1e-6,
+                "{bootstrap:?} {a:?} {b:?}"
+            );
+            assert!(rel(a.ci_low.unwrap(), b.ci_low.unwrap()) < 1e-6);
+        }
+        let (j3, j2) = (i3.gof.unwrap(), i2.gof.unwrap());
+        assert_eq!(j3.df, j2.df);
+        assert!(rel(j3.statistic, j2.statistic) < 1e-6);
     }
 }

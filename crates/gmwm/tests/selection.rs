@@ -505,6 +505,39 @@ fn bootstrap_optimism_agrees_with_the_asymptotic_one() {
     assert_eq!((p * 200.0).round() / 200.0, p);
 }
 
+#[test]
+fn bootstrap_optimism_refits_a_candidate_whose_drift_collapsed() {
+    // A drift fitted to a driftless series goes to omega = 0, the boundary of its transform:
+    // the replicates' refits start from the active sub-model instead (they used to fail with
+    // "DR[2].omega = 0 is outside the domain of its transform").
+    let truth = model("AR1(phi=0.9, sigma2=1)+WN(sigma2=2)");
+    // seed 6: the drift's estimate is exactly 0 (seeds 17 and 26 too; most seeds stop at
+    // omega ~ 1e-7, which the transforms accept)
+    let x = simulate_model(&truth, 4000, 1.0, 6).unwrap();
+    let s = Wic::parse_list(&["AR1()+WN()", "AR1()+WN()+DR()"])
+        .unwrap()
+        .with_draws(300)
+        .with_bootstrap(20)
+        .with_optimism(OptimismMethod::Bootstrap)
+        .with_bootstrap_draws(100)
+        .select(&x, 1.0)
+        .unwrap();
+    let with_dr = s
+        .candidates
+        .iter()
+        .find(|c| c.model.n_components() == 3)
+        .unwrap();
+    let without = s
+        .candidates
+        .iter()
+        .find(|c| c.model.n_components() == 2)
+        .unwrap();
+    // the drift is inactive: same objective as the sub-model (optimiser tolerance)
+    assert!(close(with_dr.objective, without.objective, 1e-6));
+    assert!(with_dr.optimism.is_finite() && with_dr.optimism > 0.0);
+    assert_eq!(s.selected.to_string(), "AR1()+WN()");
+}
+
 /// The expected excess of the out-of-sample loss over the in-sample loss, by Monte Carlo:
 /// `R` fits of `candidate` to series from `truth`, each scored against the WV of an independent
 /// series with the fit's own weights; returns (mean excess, its standard error, mean

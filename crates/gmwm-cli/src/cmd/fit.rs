@@ -20,11 +20,15 @@ use std::io::{IsTerminal, Write};
 struct ParameterReport {
     #[serde(flatten)]
     estimate: ParameterEstimate,
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// With --inference: `se`, `ci_low`, `ci_high` (null for a parameter at the boundary).
+    #[serde(flatten)]
+    inference: Option<ParameterInterval>,
+}
+
+#[derive(Serialize)]
+struct ParameterInterval {
     se: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
     ci_low: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
     ci_high: Option<f64>,
 }
 
@@ -236,9 +240,11 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                                 let p = inf.as_ref().map(|i| &i.parameters[k]);
                                 ParameterReport {
                                     estimate,
-                                    se: p.map(|p| p.se),
-                                    ci_low: p.map(|p| p.ci_low),
-                                    ci_high: p.map(|p| p.ci_high),
+                                    inference: p.map(|p| ParameterInterval {
+                                        se: p.se,
+                                        ci_low: p.ci_low,
+                                        ci_high: p.ci_high,
+                                    }),
                                 }
                             })
                             .collect(),
@@ -260,11 +266,9 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                     let (se, lo, hi) = match inf {
                         Some(i) => {
                             let q = &i.parameters[k];
-                            (
-                                format!("{:e}", q.se),
-                                format!("{:e}", q.ci_low),
-                                format!("{:e}", q.ci_high),
-                            )
+                            let cell =
+                                |x: Option<f64>| x.map(|x| format!("{x:e}")).unwrap_or_default();
+                            (cell(q.se), cell(q.ci_low), cell(q.ci_high))
                         }
                         None => Default::default(),
                     };

@@ -146,6 +146,15 @@ impl Gmwm {
         &self.model
     }
 
+    /// This estimator's settings (weighting, transforms, phi order, optimiser, search) for
+    /// another model, in guess mode.
+    pub fn for_model(&self, model: Model) -> Gmwm {
+        let mut g = self.clone();
+        g.given = vec![None; model.n_params()];
+        g.model = model.without_values();
+        g
+    }
+
     /// Fits the model to an empirical WV (METHODS §5.5) from `start` (theta in model order,
     /// original parametrisation). Works with the fast and bootstrap weightings; the diag weights
     /// need the series ([`Gmwm::fit_series`]).

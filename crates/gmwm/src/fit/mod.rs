@@ -8,6 +8,7 @@
 //! and [`Gmwm::fit`] runs the two-stage pipeline from generated starting values ([`start`], §6). Non-convergence is reported in
 //! [`Convergence`], never hidden.
 
+pub mod active;
 pub mod auto;
 pub mod gmwm;
 pub mod objective;
@@ -17,6 +18,7 @@ pub mod start;
 pub mod transform;
 pub mod weights;
 
+pub use active::{SubModel, NEGLIGIBLE_WV_SHARE};
 pub use gmwm::{Gmwm, GmwmFit, DEFAULT_BOOTSTRAP_REPLICATES};
 pub use objective::Objective;
 pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason, STALL_COSINE};

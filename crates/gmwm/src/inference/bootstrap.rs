@@ -212,8 +212,9 @@ pub struct FitBootstrapOptions {
 
 /// METHODS §7.4 `all_bootstrapper(B)`: simulates `replicates` series of length `n` from
 /// `fit.model` (rate `fit.freq_hz`), computes each one's WV with `wv_opts` (its `levels` is set
-/// to the fit's J) and weights, and refits from `fit.theta` (stage 2 only); with
-/// `gof_draws = Some(G)` each replicate is also fitted from a fresh starting-value search with
+/// to the fit's J) and weights, and refits from `fit.theta` (stage 2 only; components the fit
+/// drove to the boundary are held there and the active sub-model is refitted,
+/// [`GmwmFit::active_sub_model`]); with `gof_draws = Some(G)` each replicate is also fitted from a fresh starting-value search with
 /// G draws (METHODS §6, seeded per replicate) and its final objective kept.
 ///
 /// Replicate `r` simulates with [`replicate_seed`]`(seed, r)` and searches starting values with
@@ -253,8 +254,14 @@ pub fn fit_bootstrap(
         ..*wv_opts
     };
     let weighting = replicate_weighting(gmwm);
-    let refitter = gmwm.clone().with_weighting(weighting);
-    let mut searcher = refitter.clone();
+    // components at the boundary are held there: refit the active sub-model (crate::fit::active)
+    let sub = fit.active_sub_model()?;
+    let (refitter, start) = match &sub {
+        Some(s) => (gmwm.for_model(s.model.clone()), s.start.clone()),
+        None => (gmwm.clone(), fit.theta.clone()),
+    };
+    let refitter = refitter.with_weighting(weighting);
+    let mut searcher = gmwm.clone().with_weighting(weighting);
     if let Some(g) = gof_draws {
         searcher = searcher.with_draws(g);
     }
@@ -270,7 +277,7 @@ pub fn fit_bootstrap(
         seed,
         |r, wv, x| -> Result<ReplicateFit, FitError> {
             let weights = Weights::new(weighting, wv, Some(x))?;
-            let refit = refitter.fit_weighted(&wv.wv, weights, fit.freq_hz, &fit.theta)?;
+            let refit = refitter.fit_weighted(&wv.wv, weights, fit.freq_hz, &start)?;
             let objective = match gof_draws {
                 Some(_) => {
                     let s = searcher
@@ -288,7 +295,10 @@ pub fn fit_bootstrap(
             progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
             Ok(ReplicateFit {
                 converged: refit.convergence.converged,
-                theta: refit.theta,
+                theta: match &sub {
+                    Some(s) => s.expand(&refit.theta, &fit.theta),
+                    None => refit.theta,
+                },
                 nu_hat: wv.wv.clone(),
                 implied: refit.implied_wv.wv,
                 objective,

@@ -62,7 +62,9 @@ pub fn hartlap_factor(replicates: usize, levels: usize) -> Option<f64> {
 /// caller should debias with [`hartlap_factor`] since the statistic uses its inverse).
 ///
 /// Re-minimises the objective from `fit.theta` (stage 2 only, default [`LmOptions`]) with
-/// `Omega = V^{-1}`, `T = Q` at that minimum, `df = J - p`, `p = 1 - F_chi2(T; df)`.
+/// `Omega = V^{-1}`, `T = Q` at that minimum, `df = J - p`, `p = 1 - F_chi2(T; df)`. Components
+/// the fit drove to the boundary ([`GmwmFit::active_sub_model`]) are left out: the test is that
+/// of the active sub-model, with `p` its parameter count.
 ///
 /// Cost: one Cholesky of V and one stage-2 fit.
 ///
@@ -73,7 +75,13 @@ pub fn hartlap_factor(replicates: usize, levels: usize) -> Option<f64> {
 /// and optimiser.
 pub fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, FitError> {
     let levels = fit.nu_hat.len();
-    let p = fit.theta.len();
+    // components at the boundary stay there: test the active sub-model (crate::fit::active)
+    let sub = fit.active_sub_model()?;
+    let (model, theta) = match &sub {
+        Some(s) => (s.model.clone(), &s.start[..]),
+        None => (gmwm.model().clone(), &fit.theta[..]),
+    };
+    let p = theta.len();
     if v.nrows() != levels {
         return Err(FitError::Length {
             what: "covariance rows",
@@ -90,10 +98,10 @@ pub fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, Fit
         .into());
     }
     let weights = FullWeights::from_covariance(v)?;
-    let param = Parametrisation::new(gmwm.model(), fit.preset, fit.phi_order, fit.freq_hz)?;
-    let u0 = param.to_u(&fit.theta)?;
+    let param = Parametrisation::new(&model, fit.preset, fit.phi_order, fit.freq_hz)?;
+    let u0 = param.to_u(theta)?;
     let objective =
-        Objective::with_full_weights(gmwm.model(), param, &fit.nu_hat, &weights, fit.freq_hz)?;
+        Objective::with_full_weights(&model, param, &fit.nu_hat, &weights, fit.freq_hz)?;
     let min = minimize(&objective, &u0, &LmOptions::default())?;
     let df = levels - p;
     Ok(JTest {

@@ -103,12 +103,13 @@ pub struct ParameterInference {
     pub name: String,
     /// The estimate.
     pub estimate: f64,
-    /// Standard error (natural units).
-    pub se: f64,
-    /// Lower interval end.
-    pub ci_low: f64,
-    /// Upper interval end.
-    pub ci_high: f64,
+    /// Standard error (natural units); `None` for a parameter at the boundary
+    /// ([`InferenceWarning::AtBoundary`]).
+    pub se: Option<f64>,
+    /// Lower interval end (`None` with `se`).
+    pub ci_low: Option<f64>,
+    /// Upper interval end (`None` with `se`).
+    pub ci_high: Option<f64>,
 }
 
 /// The bootstrap goodness-of-fit test (METHODS §7.4).
@@ -144,6 +145,13 @@ pub enum InferenceWarning {
         /// How many.
         replicates: usize,
     },
+    /// Components the fit drove to the boundary of the parameter space (a variance or drift
+    /// of 0, `crate::fit::active`): their parameters get no standard error, and the others
+    /// are inferred on the sub-model without them (same implied WV and objective).
+    AtBoundary {
+        /// The boundary parameters' labels.
+        parameters: Vec<String>,
+    },
     /// No J-test: no degrees of freedom or too few replicates for a usable `V^{-1}`.
     NoJTest {
         /// Levels J.
@@ -166,6 +174,13 @@ impl fmt::Display for InferenceWarning {
             InferenceWarning::NotConverged { replicates } => {
                 write!(f, "{replicates} bootstrap refits did not converge (kept)")
             }
+            InferenceWarning::AtBoundary { parameters } => write!(
+                f,
+                "{} at the boundary (fitted to nothing): no standard error; the other \
+                 parameters are inferred without {}",
+                parameters.join(", "),
+                if parameters.len() == 1 { "it" } else { "them" }
+            ),
             InferenceWarning::NoJTest {
                 levels,
                 params,
@@ -260,6 +275,21 @@ pub fn infer_with_progress(
     };
     let g = scales(&fit.model, opts.scale);
     let mut warnings = Vec::new();
+    // parameters of components at the boundary get no SE (crate::fit::active)
+    let sub = fit.active_sub_model()?;
+    let keep: Vec<usize> = match &sub {
+        Some(s) => {
+            warnings.push(InferenceWarning::AtBoundary {
+                parameters: (0..p)
+                    .filter(|k| !s.keep.contains(k))
+                    .map(|k| fit.param_names[k].clone())
+                    .collect(),
+            });
+            s.keep.clone()
+        }
+        None => (0..p).collect(),
+    };
+    let q = keep.len();
     let (method, v, v_replicates, covariance, se, se_g, bootstrap_gof) = match opts.bootstrap {
         None => {
             let h = opts.v_replicates;
@@ -291,20 +321,21 @@ pub fn infer_with_progress(
                 VShape::Diagonal => DMatrix::from_diagonal(&v.diagonal()),
             };
             let a = fit.model.jacobian(levels, fit.freq_hz)?;
-            let a = DMatrix::from_fn(levels, p, |i, k| a[i][k]);
+            let a = DMatrix::from_fn(levels, q, |i, k| a[i][keep[k]]);
             let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&fit.weights.omega));
             let s = sandwich(&a, &omega, &v_sand)?;
-            if s.rank < p {
+            if s.rank < q {
                 warnings.push(InferenceWarning::RankDeficient {
                     rank: s.rank,
-                    params: p,
+                    params: q,
                 });
             }
-            let se: Vec<f64> = (0..p).map(|k| s.psi[(k, k)].max(0.0).sqrt()).collect();
+            let psi = expand(&s.psi, &keep, p);
+            let se: Vec<f64> = (0..p).map(|k| psi[(k, k)].max(0.0).sqrt()).collect();
             let se_g: Vec<f64> = (0..p)
                 .map(|k| se[k] * g[k].derivative(fit.theta[k]).abs())
                 .collect();
-            let cov = rows(&s.psi);
+            let cov = rows(&psi);
             (InferenceMethod::Asymptotic, v, h, cov, se, se_g, None)
         }
         Some(b) => {
@@ -325,13 +356,15 @@ pub fn infer_with_progress(
                     replicates: fb.not_converged,
                 });
             }
-            let cov = DMatrix::from_fn(p, p, |i, k| {
+            let cov = DMatrix::from_fn(q, q, |i, k| {
+                let (i, k) = (keep[i], keep[k]);
                 fb.estimates
                     .iter()
                     .map(|t| (t[i] - fb.mean[i]) * (t[k] - fb.mean[k]))
                     .sum::<f64>()
                     / (b - 1) as f64
             });
+            let cov = expand(&cov, &keep, p);
             let se_g = (0..p)
                 .map(|k| {
                     let ys: Vec<f64> = fb.estimates.iter().map(|t| g[k].forward(t[k])).collect();
@@ -354,11 +387,11 @@ pub fn infer_with_progress(
         }
     };
     let gof = match hartlap_factor(v_replicates, levels) {
-        Some(f) if levels > p => Some(j_test(gmwm, fit, &(&v / f))?),
+        Some(f) if levels > q => Some(j_test(gmwm, fit, &(&v / f))?),
         _ => {
             warnings.push(InferenceWarning::NoJTest {
                 levels,
-                params: p,
+                params: q,
                 replicates: v_replicates,
             });
             None
@@ -366,13 +399,14 @@ pub fn infer_with_progress(
     };
     let parameters = (0..p)
         .map(|k| {
+            let active = keep.contains(&k);
             let (ci_low, ci_high) = g[k].interval(fit.theta[k], se_g[k], z);
             ParameterInference {
                 name: fit.param_names[k].clone(),
                 estimate: fit.theta[k],
-                se: se[k],
-                ci_low,
-                ci_high,
+                se: active.then_some(se[k]),
+                ci_low: active.then_some(ci_low),
+                ci_high: active.then_some(ci_high),
             }
         })
         .collect();
@@ -391,6 +425,18 @@ pub fn infer_with_progress(
         bootstrap_gof,
         warnings,
     })
+}
+
+/// The p x p matrix with `m` (q x q) at the `keep` rows and columns and NaN (JSON null)
+/// elsewhere.
+fn expand(m: &DMatrix<f64>, keep: &[usize], p: usize) -> DMatrix<f64> {
+    let mut out = DMatrix::from_element(p, p, f64::NAN);
+    for (i, &ki) in keep.iter().enumerate() {
+        for (k, &kk) in keep.iter().enumerate() {
+            out[(ki, kk)] = m[(i, k)];
+        }
+    }
+    out
 }
 
 fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
@@ -460,11 +506,16 @@ impl fmt::Display for Inference {
             "{:<20} {:>14} {:>14} {:>14} {:>14}",
             "parameter", "estimate", "se", "ci_low", "ci_high"
         )?;
+        let cell = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |x| format!("{x:.5e}"));
         for p in &self.parameters {
             writeln!(
                 f,
-                "{:<20} {:>14.5e} {:>14.5e} {:>14.5e} {:>14.5e}",
-                p.name, p.estimate, p.se, p.ci_low, p.ci_high
+                "{:<20} {:>14.5e} {:>14} {:>14} {:>14}",
+                p.name,
+                p.estimate,
+                cell(p.se),
+                cell(p.ci_low),
+                cell(p.ci_high)
             )?;
         }
         write!(f, "objective Q = {:e}", self.objective)?;

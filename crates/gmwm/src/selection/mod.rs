@@ -37,7 +37,7 @@ pub use imu::{auto_imu, AxisSelection, ImuSelection};
 pub use optimism::{
     asymptotic_optimism, bootstrap_optimism, d_matrix, OptimismConvention, OptimismMethod,
 };
-pub use wic::{active_parameters, CandidateScore, ModelSelection, Wic};
+pub use wic::{CandidateScore, ModelSelection, Wic};
 
 use crate::fit::FitError;
 use crate::model::ProcessKind;

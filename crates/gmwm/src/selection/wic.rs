@@ -370,10 +370,10 @@ impl Context<'_> {
     }
 
     /// METHODS §8.2 at the candidate's estimate, over the parameters of its active
-    /// components ([`active_parameters`]).
+    /// components ([`GmwmFit::active_parameters`], `crate::fit::active`).
     fn asymptotic(&self, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<f64, FitError> {
         let levels = fit.nu_hat.len();
-        let keep = active_parameters(fit);
+        let keep = fit.active_parameters();
         let jac = fit.model.jacobian(levels, fit.freq_hz)?;
         let a = DMatrix::from_fn(levels, keep.len(), |j, k| jac[j][keep[k]]);
         let h = fit.model.hessian(levels, fit.freq_hz)?;
@@ -418,8 +418,17 @@ impl Context<'_> {
     /// for `C = Cov(nu2_hat*, nu2(theta*))`, and fitted afresh (guess mode, G =
     /// `bootstrap_draws`) for an objective value; the p-value is the share of those strictly
     /// above the observed objective.
+    ///
+    /// A component the fit drove to zero ([`GmwmFit::active_sub_model`]) is left out of the refits:
+    /// it generates nothing in the replicates, and its boundary value (a drift of exactly 0)
+    /// is no starting point for the transforms; the optimism is then that of the sub-model,
+    /// as in the asymptotic form.
     fn bootstrap(&self, candidate: &Model, fit: &GmwmFit) -> Result<(f64, Option<f64>), FitError> {
-        let stage2 = self.wic.estimator(candidate);
+        let (active, start) = match fit.active_sub_model()? {
+            Some(sub) => (sub.model, sub.start),
+            None => (candidate.clone(), fit.theta.clone()),
+        };
+        let stage2 = self.wic.estimator(&active);
         let freq_hz = self.wv.freq_hz;
         let seed = self.wic.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET);
         let reps = map_replicates(
@@ -431,7 +440,7 @@ impl Context<'_> {
             seed,
             |r, wv, x| {
                 let weights = Weights::fast(wv)?;
-                let refit = stage2.fit_weighted(&wv.wv, weights, freq_hz, &fit.theta)?;
+                let refit = stage2.fit_weighted(&wv.wv, weights, freq_hz, &start)?;
                 let fresh = Gmwm::new(candidate.clone())
                     .with_seed(replicate_seed(seed, r as u64))
                     .with_draws(self.wic.bootstrap_draws)
@@ -449,37 +458,6 @@ impl Context<'_> {
         let optimism = bootstrap_optimism(&nu_hat, &nu_theta, self.omega)?;
         Ok((optimism, Some(above as f64 / self.wic.bootstrap as f64)))
     }
-}
-
-/// A component whose implied WV is below this share of the model's at every level counts as
-/// fitted to nothing (see [`active_parameters`]); its effect on the objective is of the order
-/// of this share, far below what separates candidates.
-pub const NEGLIGIBLE_WV_SHARE: f64 = 1e-6;
-
-/// Indices (into theta) of the parameters of the components that contribute to the fit.
-///
-/// Port: a fit may drive a term to its boundary (a variance to 0, a drift to omega = 0); the
-/// estimate then stays there under small changes of `nu2_hat`, so its derivative
-/// `d theta_hat / d nu2_hat'` is zero and the first-order condition behind §8.2 does not hold
-/// for it. Such a component (implied WV below [`NEGLIGIBLE_WV_SHARE`] of the model's at every
-/// level) is left out of the optimism, which then equals that of the sub-model without it.
-pub fn active_parameters(fit: &GmwmFit) -> Vec<usize> {
-    let total = &fit.implied_wv.wv;
-    let mut keep = Vec::with_capacity(fit.theta.len());
-    let mut at = 0;
-    for (c, wv) in fit.model.components().iter().zip(&fit.implied_wv.processes) {
-        let k = c.kind.n_params();
-        let active = wv
-            .wv
-            .iter()
-            .zip(total)
-            .any(|(x, t)| x.abs() > NEGLIGIBLE_WV_SHARE * t.abs());
-        if active {
-            keep.extend(at..at + k);
-        }
-        at += k;
-    }
-    keep
 }
 
 /// One candidate's row of the selection table (METHODS §8.6).
