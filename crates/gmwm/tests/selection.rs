@@ -606,14 +606,21 @@ fn asymptotic_optimism_estimates_the_out_of_sample_excess_loss() {
     }
 }
 
-/// Seeded Monte Carlo of METHODS §8.6 selection: `reps` series of length `n` from the truth,
-/// nested candidates of `2*AR1()+WN()+RW()+QN()+DR()`; returns (true model selected, a strict
-/// sub-model of the truth selected) counts.
-fn selection_mc(truth: &Model, n: usize, reps: usize, draws: usize) -> (usize, usize) {
-    let wic = Wic::nested(model("2*AR1()+WN()+RW()+QN()+DR()"))
+/// Seeded Monte Carlo of METHODS §8.6 selection: `reps` series of length `n` at 100 Hz from
+/// the truth, the nested candidates of `full`, G = `draws`, B = `replicates` for V; returns
+/// (true model selected, a strict sub-model of the truth selected) counts.
+fn selection_mc(
+    truth: &Model,
+    full: &str,
+    n: usize,
+    reps: usize,
+    draws: usize,
+    replicates: usize,
+) -> (usize, usize) {
+    let wic = Wic::nested(model(full))
         .unwrap()
         .with_draws(draws)
-        .with_bootstrap(20);
+        .with_bootstrap(replicates);
     let kinds = truth.kinds();
     let (mut hits, mut under) = (0, 0);
     for r in 0..reps {
@@ -631,21 +638,45 @@ fn selection_mc(truth: &Model, n: usize, reps: usize, draws: usize) -> (usize, u
 
 /// The truth of the selection Monte Carlo: AR1, WN and RW each dominate a band of scales
 /// (WN below tau ~ 8, the AR1 bump around tau ~ 40, RW above tau ~ 200).
-const MC_TRUTH: &str = "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)";
+const MC_TRUTH: &str = "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-3)";
 
 #[test]
 fn wic_selects_the_true_model_among_nested_candidates() {
-    // N = 1e4, 40 replicates, G = 1000, B = 20 (seconds). WIC is an AIC-type criterion: a
-    // superfluous term lowers the objective by more than its optimism with a fixed probability
-    // (about 16% per free parameter for a chi-square(1) gain), whatever N, so with seven
-    // supersets of the truth among the 47 candidates the true model wins in about 70% of
-    // replicates (70/100 measured at these settings, 31/40 at N = 1e5). Bounds: 3 binomial
-    // standard deviations below 0.7 with 40 replicates is 0.48; an underfit (a strict
-    // sub-model of the truth) must essentially never win because each term dominates a band of
-    // scales (0/100 measured).
+    // The must-show at its size: N = 1e5, 100 replicates, the package's B = 50, G =
+    // 2000 (about 20 s on 2 cores). Every term of the full model AR1+WN+RW+QN+DR is identified
+    // when present, so the only errors an AIC-type criterion makes are the superfluous QN
+    // or DR (about 8% each, see the selection module docs): 94/100 measured (183/200 with
+    // seeds 1000..1199). Bound: 0.9 less 3 binomial standard errors at 100 replicates (0.81);
+    // a true rate of 0.7 passes it with probability 0.5%. An underfit (a strict sub-model of the
+    // truth) must not happen: each term dominates a band of scales.
     let truth = model(MC_TRUTH);
+    let reps = 100;
+    let (hits, under) = selection_mc(&truth, "AR1()+WN()+RW()+QN()+DR()", 100_000, reps, 2000, 50);
+    assert!(hits >= 82, "true model selected in {hits}/{reps}");
+    assert_eq!(
+        under, 0,
+        "a sub-model of the truth selected in {under}/{reps}"
+    );
+}
+
+#[test]
+fn wic_with_a_second_ar1_in_the_full_model_still_never_underfits() {
+    // The example of a full model, 2*AR1+WN+RW+QN+DR, at N = 1e4 (seconds): a second
+    // AR1 is not identified when its variance is 0 (its phi is free) and can stand in for the
+    // RW (phi -> 1) or the WN (phi -> 0), so the true model wins less often: 70/100 measured at
+    // N = 1e4 and 135/200 at N = 1e5 with the RW of MC_TRUTH (the rate does not grow with N: WIC is loss efficient,
+    // not consistent). Bounds: 3 binomial standard errors below 0.7 at 40 replicates is 0.48;
+    // never an underfit. At N = 1e4 the RW needs gamma2 = 1e-2 to dominate the coarse scales.
+    let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)");
     let reps = 40;
-    let (hits, under) = selection_mc(&truth, 10_000, reps, 1000);
+    let (hits, under) = selection_mc(
+        &truth,
+        "2*AR1()+WN()+RW()+QN()+DR()",
+        10_000,
+        reps,
+        1000,
+        20,
+    );
     assert!(hits >= 20, "true model selected in {hits}/{reps}");
     assert!(
         under <= 1,
@@ -654,18 +685,24 @@ fn wic_selects_the_true_model_among_nested_candidates() {
 }
 
 #[test]
-#[ignore = "about 3 minutes in release on 2 cores; run with cargo test --release -p gmwm --test integration wic_selects_the_true_model_full_size -- --ignored"]
-fn wic_selects_the_true_model_full_size() {
-    // The size N = 1e5, 100 replicates (31/40 measured in a first run).
-    let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-3)");
-    let reps = 100;
-    let (hits, under) = selection_mc(&truth, 100_000, reps, 2000);
-    eprintln!("true model selected in {hits}/{reps}, a sub-model in {under}/{reps}");
-    assert!(hits >= 60, "true model selected in {hits}/{reps}");
-    assert!(
-        under <= 2,
-        "a sub-model of the truth selected in {under}/{reps}"
+#[ignore = "about 90 s in release on 2 cores; run with cargo test --release -p gmwm --test integration wic_second_ar1_full_size -- --ignored --nocapture"]
+fn wic_second_ar1_full_size() {
+    // The figure quoted above for the example at its size: N = 1e5, 200 replicates,
+    // full model 2*AR1+WN+RW+QN+DR, B = 50 (135/200 measured; misses: a second AR1 standing in
+    // for the RW 24, for the WN 8, added to the truth 16; a superfluous QN or DR 17).
+    let truth = model(MC_TRUTH);
+    let reps = 200;
+    let (hits, under) = selection_mc(
+        &truth,
+        "2*AR1()+WN()+RW()+QN()+DR()",
+        100_000,
+        reps,
+        2000,
+        50,
     );
+    eprintln!("true model selected in {hits}/{reps}, a sub-model in {under}/{reps}");
+    assert!(hits >= 120, "true model selected in {hits}/{reps}");
+    assert_eq!(under, 0);
 }
 
 #[test]
