@@ -3,6 +3,7 @@
 //! a fit's WV (`update`, §5.9); the fit with generated starting values (§6) is in
 //! [`super::auto`].
 
+use super::revive::{revival_start, MAX_REVIVALS};
 use super::{
     minimize, Convergence, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StartInputs,
     StartOptions, TransformPreset, Weighting, Weights,
@@ -298,8 +299,40 @@ impl Gmwm {
         let start = Parametrisation::canonical_order(&self.model, start)?;
         let u0 = param.to_u(&start)?;
         let param_names = param.names().to_vec();
-        let objective = Objective::new(&self.model, param, nu_hat, &weights, freq_hz)?;
-        let min = minimize(&objective, &u0, &self.options)?;
+        let objective = Objective::new(&self.model, param.clone(), nu_hat, &weights, freq_hz)?;
+        let mut min = minimize(&objective, &u0, &self.options)?;
+        // leave a false boundary point (components fitted to nothing that the data want back)
+        for _ in 0..MAX_REVIVALS {
+            let fitted = self
+                .model
+                .with_values(&min.theta)
+                .map_err(crate::Error::from)?;
+            let Some(revived) = revival_start(
+                &fitted,
+                &min.theta,
+                nu_hat,
+                &weights.omega,
+                freq_hz,
+                min.objective,
+            )?
+            else {
+                break;
+            };
+            // a start the transforms refuse (e.g. two AR1s with equal phi) is no revival
+            let Ok(u) = Parametrisation::canonical_order(&self.model, &revived)
+                .and_then(|t| param.to_u(&t))
+            else {
+                break;
+            };
+            let next = minimize(&objective, &u, &self.options)?;
+            if next.objective >= min.objective {
+                break;
+            }
+            let (it, ev) = (min.convergence.iterations, min.convergence.evaluations);
+            min = next;
+            min.convergence.iterations += it;
+            min.convergence.evaluations += ev;
+        }
         // METHODS §5.6 (port): stable sort of the AR1/GM blocks, phi decreasing (a no-op for
         // the ordered chain)
         let theta = Parametrisation::canonical_order(&self.model, &min.theta)?;

@@ -14,6 +14,7 @@ pub mod gmwm;
 pub mod objective;
 pub mod optimize;
 pub mod report;
+pub mod revive;
 pub mod start;
 pub mod transform;
 pub mod weights;
