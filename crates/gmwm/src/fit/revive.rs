@@ -71,7 +71,7 @@ pub(crate) fn revival_start(
                     continue;
                 }
                 let gain = sr * sr / ss;
-                if gain > REVIVAL_MIN_GAIN * q && best.as_ref().is_none_or(|b| gain > b.0) {
+                if gain > REVIVAL_MIN_GAIN * q && best.as_ref().map_or(true, |b| gain > b.0) {
                     let t = -sr / ss;
                     let mut values = unit.clone();
                     values[k - 1] = scale(t);
@@ -88,9 +88,12 @@ pub(crate) fn revival_start(
     }))
 }
 
-/// Unit-scale parameter vectors of a component kind (scale parameter last) with the map from
-/// the WV multiplier `t` to the scale parameter; empty for kinds without a linear scale.
-fn unit_shapes(kind: ProcessKind, levels: usize, freq_hz: f64) -> Vec<(Vec<f64>, fn(f64) -> f64)> {
+/// A unit-scale parameter vector (scale parameter last) and the map from the WV multiplier
+/// `t` to the scale parameter.
+type UnitShape = (Vec<f64>, fn(f64) -> f64);
+
+/// The unit shapes of a component kind; empty for kinds without a linear scale.
+fn unit_shapes(kind: ProcessKind, levels: usize, freq_hz: f64) -> Vec<UnitShape> {
     let identity: fn(f64) -> f64 = |t| t;
     match kind {
         ProcessKind::Wn | ProcessKind::Qn | ProcessKind::Rw => vec![(vec![1.0], identity)],
