@@ -593,9 +593,14 @@ fn excess_loss(truth: &Model, candidate: &str, n: usize, reps: usize) -> (f64, f
 #[test]
 fn asymptotic_optimism_estimates_the_out_of_sample_excess_loss() {
     // METHODS §8.1: optimism = E[loss on new data] - E[apparent loss], checked against its
-    // definition by Monte Carlo for the true model and for an over-fitted one.
+    // definition by Monte Carlo for the true model and two over-fitted ones (a superfluous QN
+    // and DR; a second AR1, whose phi is not identified at the truth).
     let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)");
-    for candidate in ["AR1()+WN()+RW()", "AR1()+WN()+RW()+QN()+DR()"] {
+    for candidate in [
+        "AR1()+WN()+RW()",
+        "AR1()+WN()+RW()+QN()+DR()",
+        "2*AR1()+WN()+RW()",
+    ] {
         let (excess, se, opt) = excess_loss(&truth, candidate, 10_000, 200);
         // 4 standard errors of the Monte Carlo mean plus 10% for the asymptotic
         // approximation and the estimated V
