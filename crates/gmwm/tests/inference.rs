@@ -510,7 +510,7 @@ fn gm_inference_is_in_gm_units() {
             1.0 / (1.0 - phi * phi),
         ],
     );
-    let c = DMatrix::from_fn(2, 2, |i, k| ar_inf.covariance[i][k]);
+    let c = DMatrix::from_fn(2, 2, |i, k| ar_inf.covariance[i][k].unwrap());
     let mapped = &jac * c * jac.transpose();
     for k in 0..2 {
         // the two fits agree to the optimiser tolerance; the simulated V is identical (same
@@ -527,14 +527,19 @@ fn gm_inference_is_in_gm_units() {
     }
 }
 
-#[test]
-fn a_component_at_the_boundary_gets_no_se_and_leaves_the_others_unchanged() {
+/// Inference on `big` fitted to a seeded AR1+WN series, where the fit drives the components
+/// named by `boundary` to zero, against inference on `small` (the model without them): the
+/// boundary parameters get no SE, interval or covariance, the others equal the small model's.
+fn check_boundary_inference(seed: u64, big: &str, small: &str, boundary: &[&str]) {
     use gmwm::fit::StartInputs;
     use gmwm::inference::InferenceWarning;
-    // seed 6: the drift of AR1()+WN()+DR() fitted to a driftless series is exactly 0, the
-    // boundary of its domain (this used to fail: "DR[2].omega has no influence on the implied
-    // WV" in the sandwich, "outside the domain of its transform" in the bootstrap refits)
-    let x = simulate_model(&model("AR1(phi=0.9, sigma2=1)+WN(sigma2=2)"), 4000, 1.0, 6).unwrap();
+    let x = simulate_model(
+        &model("AR1(phi=0.9, sigma2=1)+WN(sigma2=2)"),
+        4000,
+        1.0,
+        seed,
+    )
+    .unwrap();
     let opts = WvOptions::default();
     let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
     let fit_of = |text: &str| {
@@ -542,35 +547,96 @@ fn a_component_at_the_boundary_gets_no_se_and_leaves_the_others_unchanged() {
         let f = g.fit_from_wv(&wv, StartInputs::from_series(&x)).unwrap();
         (g, f)
     };
-    let (g3, f3) = fit_of("AR1()+WN()+DR()");
-    let (g2, f2) = fit_of("AR1()+WN()");
-    assert_eq!(f3.theta[3], 0.0, "the case needs a drift of exactly 0");
-    assert_eq!(f3.active_parameters(), vec![0, 1, 2]);
+    let (gb, fb) = fit_of(big);
+    let (gs, fs) = fit_of(small);
+    assert_eq!(
+        fb.collapsed, boundary,
+        "the case needs these components at 0"
+    );
+    let at: Vec<usize> = boundary
+        .iter()
+        .map(|b| fb.param_names.iter().position(|n| n == b).unwrap())
+        .collect();
+    assert_eq!(fb.active_parameters().len(), fs.theta.len());
     for bootstrap in [None, Some(20)] {
         let o = InferenceOptions {
             bootstrap,
             ..InferenceOptions::default()
         };
-        let i3 = infer(&g3, &f3, x.len(), &opts, &o).unwrap();
-        let i2 = infer(&g2, &f2, x.len(), &opts, &o).unwrap();
-        let dr = &i3.parameters[3];
-        assert_eq!((dr.se, dr.ci_low, dr.ci_high), (None, None, None));
-        assert!(i3.covariance[3].iter().all(|c| c.is_nan()));
-        assert!(i3.warnings.contains(&InferenceWarning::AtBoundary {
-            parameters: vec!["DR[2].omega".into()]
+        let ib = infer(&gb, &fb, x.len(), &opts, &o).unwrap();
+        let is = infer(&gs, &fs, x.len(), &opts, &o).unwrap();
+        for &k in &at {
+            let p = &ib.parameters[k];
+            assert_eq!((p.se, p.ci_low, p.ci_high), (None, None, None));
+            assert!(ib.covariance[k].iter().all(Option::is_none));
+        }
+        assert!(ib.warnings.contains(&InferenceWarning::AtBoundary {
+            parameters: boundary.iter().map(|b| b.to_string()).collect()
         }));
-        // the other parameters: the inference of the model without the drift (V simulated
-        // from the same fitted process with the same seed; fits equal to the optimiser
-        // tolerance, 1e-6 relative)
-        for (a, b) in i3.parameters.iter().zip(&i2.parameters) {
+        // the other parameters: the inference of the small model (V simulated from the same
+        // fitted process with the same seed; fits equal to the optimiser tolerance, 1e-6)
+        let kept = ib
+            .parameters
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| !at.contains(k));
+        for ((_, a), b) in kept.zip(&is.parameters) {
             assert!(
                 rel(a.se.unwrap(), b.se.unwrap()) < 1e-6,
                 "{bootstrap:?} {a:?} {b:?}"
             );
             assert!(rel(a.ci_low.unwrap(), b.ci_low.unwrap()) < 1e-6);
         }
-        let (j3, j2) = (i3.gof.unwrap(), i2.gof.unwrap());
-        assert_eq!(j3.df, j2.df);
-        assert!(rel(j3.statistic, j2.statistic) < 1e-6);
+        let (jb, js) = (ib.gof.unwrap(), is.gof.unwrap());
+        assert_eq!(jb.df, js.df);
+        assert!(rel(jb.statistic, js.statistic) < 1e-6);
+    }
+}
+
+#[test]
+fn a_component_at_the_boundary_gets_no_se_and_leaves_the_others_unchanged() {
+    // seed 6: the drift of AR1()+WN()+DR() fitted to a driftless series is exactly 0, the
+    // boundary of its domain (this used to fail: "DR[2].omega has no influence on the implied
+    // WV" in the sandwich, "outside the domain of its transform" in the bootstrap refits)
+    check_boundary_inference(6, "AR1()+WN()+DR()", "AR1()+WN()", &["DR[2].omega"]);
+    // seed 15: the first of two AR1s is fitted to nothing (phi ~ 1, sigma2 ~ 1e-159), so
+    // the active parameters are not the leading ones; the bootstraps simulate the active
+    // model, whose random stream is that of AR1()+WN()
+    check_boundary_inference(
+        15,
+        "2*AR1()+WN()",
+        "AR1()+WN()",
+        &["AR1[0].phi", "AR1[0].sigma2"],
+    );
+}
+
+#[test]
+fn inference_restarts_from_a_phi_rounded_onto_its_edge() {
+    // 2*AR1()+WN()+RW()+DR() on AR1+WN+RW data (N = 2e4 at 100 Hz, G = 500, seed 1): the
+    // second AR1 stands in for part of the WN with phi exactly 0 (its u ran off to -inf), an
+    // edge of the IMU domain (0, 1); the J-test and the bootstrap refits restart from just
+    // inside (Parametrisation::to_u_restart) instead of failing
+    use gmwm::fit::StartInputs;
+    let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-3)");
+    let x = simulate_model(&truth, 20_000, 100.0, 1).unwrap();
+    let opts = WvOptions::default();
+    let wv = wavelet_variance(&x, 100.0, &opts).unwrap();
+    let g = Gmwm::parse("2*AR1()+WN()+RW()+DR()")
+        .unwrap()
+        .with_draws(500);
+    let f = g.fit_from_wv(&wv, StartInputs::from_series(&x)).unwrap();
+    assert_eq!(
+        f.theta[2], 0.0,
+        "the case needs a phi of exactly 0: {:?}",
+        f.theta
+    );
+    for bootstrap in [None, Some(20)] {
+        let o = InferenceOptions {
+            bootstrap,
+            ..InferenceOptions::default()
+        };
+        let i = infer(&g, &f, x.len(), &opts, &o).unwrap();
+        assert!(i.gof.is_some());
+        assert!(i.parameters[3].se.unwrap() > 0.0);
     }
 }

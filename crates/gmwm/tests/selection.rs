@@ -514,6 +514,14 @@ fn bootstrap_optimism_refits_a_candidate_whose_drift_collapsed() {
     // seed 6: the drift's estimate is exactly 0 (seeds 17 and 26 too; most seeds stop at
     // omega ~ 1e-7, which the transforms accept)
     let x = simulate_model(&truth, 4000, 1.0, 6).unwrap();
+    // the candidate's fit as the selection makes it (seed 1337, G = 300) has omega exactly 0
+    let dr_fit = gmwm::Gmwm::parse("AR1()+WN()+DR()")
+        .unwrap()
+        .with_seed(1337)
+        .with_draws(300)
+        .fit(&x, 1.0, &gmwm::WvOptions::default())
+        .unwrap();
+    assert_eq!(dr_fit.theta[3], 0.0);
     let s = Wic::parse_list(&["AR1()+WN()", "AR1()+WN()+DR()"])
         .unwrap()
         .with_draws(300)
@@ -657,7 +665,7 @@ fn wic_selects_the_true_model_among_nested_candidates() {
     let truth = model(MC_TRUTH);
     let reps = 100;
     let (hits, under) = selection_mc(&truth, "AR1()+WN()+RW()+QN()+DR()", 100_000, reps, 2000, 50);
-    assert!(hits >= 82, "true model selected in {hits}/{reps}");
+    assert!(hits >= 81, "true model selected in {hits}/{reps}");
     assert_eq!(
         under, 0,
         "a sub-model of the truth selected in {under}/{reps}"
@@ -671,7 +679,7 @@ fn wic_with_a_second_ar1_in_the_full_model_still_never_underfits() {
     // RW (phi -> 1) or the WN (phi -> 0), so the true model wins less often: 77/100 measured
     // at N = 1e4 and 134/200 at N = 1e5 with the RW of MC_TRUTH (the rate does not grow with
     // N: WIC is loss efficient, not consistent). Bounds: 3 binomial standard errors below 0.7
-    // at 40 replicates is 0.48; never an underfit. At N = 1e4 the RW needs gamma2 = 1e-2 to dominate the coarse scales.
+    // at 40 replicates is 0.48; at most one underfit (none measured). At N = 1e4 the RW needs gamma2 = 1e-2 to dominate the coarse scales.
     let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)");
     let reps = 40;
     let (hits, under) = selection_mc(

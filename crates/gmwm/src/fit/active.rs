@@ -68,6 +68,22 @@ impl GmwmFit {
         keep
     }
 
+    /// The fitted model without its inactive components (with their estimates): what the
+    /// parametric bootstraps simulate, so that a component at the boundary does not shift
+    /// their random streams. The whole fitted model when all are active.
+    ///
+    /// # Errors
+    /// As [`GmwmFit::active_sub_model`].
+    pub fn active_model(&self) -> Result<Model, FitError> {
+        match self.active_sub_model()? {
+            Some(sub) => Ok(sub
+                .model
+                .with_values(&sub.start)
+                .map_err(crate::Error::from)?),
+            None => Ok(self.model.clone()),
+        }
+    }
+
     /// The sub-model of the active components, or `None` when every component is active (or
     /// none is: a model fitted to nothing is kept whole).
     ///

@@ -284,7 +284,9 @@ impl Gmwm {
         self.finish(refit, wv, inputs)
     }
 
-    /// Fits the model to `nu_hat` with the given weights from `start`.
+    /// Fits the model to `nu_hat` with the given weights from `start` (a value exactly on the
+    /// edge of its domain, as an earlier estimate can be, starts just inside:
+    /// [`Parametrisation::to_u_restart`]).
     ///
     /// # Errors
     /// As [`Gmwm::fit_wv`].
@@ -297,7 +299,7 @@ impl Gmwm {
     ) -> Result<GmwmFit, FitError> {
         let param = Parametrisation::new(&self.model, self.preset, self.phi_order, freq_hz)?;
         let start = Parametrisation::canonical_order(&self.model, start)?;
-        let u0 = param.to_u(&start)?;
+        let u0 = param.to_u_restart(&start)?;
         let param_names = param.names().to_vec();
         let objective = Objective::new(&self.model, param.clone(), nu_hat, &weights, freq_hz)?;
         let mut min = minimize(&objective, &u0, &self.options)?;
@@ -320,7 +322,7 @@ impl Gmwm {
             };
             // a start the transforms refuse (e.g. two AR1s with equal phi) is no revival
             let Ok(u) = Parametrisation::canonical_order(&self.model, &revived)
-                .and_then(|t| param.to_u(&t))
+                .and_then(|t| param.to_u_restart(&t))
             else {
                 break;
             };
@@ -336,24 +338,15 @@ impl Gmwm {
         // METHODS §5.6 (port): stable sort of the AR1/GM blocks, phi decreasing (a no-op for
         // the ordered chain)
         let theta = Parametrisation::canonical_order(&self.model, &min.theta)?;
-        // the §5.6 sort moves values between AR1/GM blocks unchanged: find each collapsed one
-        let collapsed = min
-            .collapsed
-            .iter()
-            .filter_map(|&k| {
-                let pos = theta.iter().position(|&v| v == min.theta[k]).unwrap_or(k);
-                param_names.get(pos).cloned()
-            })
-            .collect();
         let fitted = self.model.with_values(&theta).map_err(crate::Error::from)?;
         let implied_wv = fitted.implied_wv(nu_hat.len(), freq_hz)?;
-        Ok(GmwmFit {
+        let mut fit = GmwmFit {
             weighting: self.weighting,
             org_v: None,
             bootstrap_replicates: None,
             empirical: None,
             inputs: None,
-            collapsed,
+            collapsed: Vec::new(),
             model: fitted,
             theta,
             param_names,
@@ -366,7 +359,13 @@ impl Gmwm {
             freq_hz,
             preset: self.preset,
             phi_order: self.phi_order,
-        })
+        };
+        let active = fit.active_parameters();
+        fit.collapsed = (0..fit.theta.len())
+            .filter(|k| !active.contains(k))
+            .map(|k| fit.param_names[k].clone())
+            .collect();
+        Ok(fit)
     }
 }
 
@@ -417,8 +416,9 @@ pub struct GmwmFit {
     pub empirical: Option<WaveletVariance>,
     /// Series length and range behind the starting values (METHODS §6.1), kept for `update`.
     pub inputs: Option<StartInputs>,
-    /// Labels of parameters that collapsed onto zero (their component has no measurable
-    /// share of the WV; the fit is a boundary point, [`super::optimize::COLLAPSE_INFLUENCE`]):
-    /// a hint that a smaller model fits as well.
+    /// Labels of the parameters of the components fitted to nothing (implied WV below
+    /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level, [`GmwmFit::active_parameters`]):
+    /// the fit is a boundary point and a smaller model fits as well. Inference reports these
+    /// parameters without a standard error.
     pub collapsed: Vec<String>,
 }

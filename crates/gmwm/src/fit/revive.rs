@@ -14,10 +14,12 @@
 //! WV is linear in the scale parameter (WN `sigma2`, QN `q2`, RW `gamma2`, DR `omega^2`, AR1
 //! `sigma2` and GM `sigma2_gm` at a fixed phi or beta), so with `s` the component's WV at unit
 //! scale and `r = nu2(theta) - nu2_hat`, the best size is `t = -s' Omega r / s' Omega s` and
-//! the objective falls by `(s' Omega r)^2 / s' Omega s` when `s' Omega r < 0`. AR1/GM shapes
-//! are tried on a grid of correlation lengths `2^(m/2)` samples that covers every level. The
-//! largest fall above [`REVIVAL_MIN_GAIN`] of `Q` gives the start of a new minimisation,
-//! which can only end lower; at most [`MAX_REVIVALS`] times per fit.
+//! the objective falls by about `(s' Omega r)^2 / s' Omega s` when `s' Omega r < 0` (exactly
+//! so but for the component's own negligible WV, which `r` still contains). AR1/GM shapes are
+//! tried on a grid of correlation lengths `2^((m - 2) / 2)` samples, m = 0 ..= 2J + 4 (0.5 to
+//! `2^(J + 1)`), which covers every level; the ARMA family is not revived. The largest fall
+//! above [`REVIVAL_MIN_GAIN`] of `Q` gives the start of a new minimisation, kept only if it
+//! ends lower; at most [`MAX_REVIVALS`] times per fit.
 
 use super::active::NEGLIGIBLE_WV_SHARE;
 use super::FitError;
@@ -92,7 +94,7 @@ pub(crate) fn revival_start(
 /// `t` to the scale parameter.
 type UnitShape = (Vec<f64>, fn(f64) -> f64);
 
-/// The unit shapes of a component kind; empty for kinds without a linear scale.
+/// The unit shapes of a component kind; empty for the ARMA family (not revived).
 fn unit_shapes(kind: ProcessKind, levels: usize, freq_hz: f64) -> Vec<UnitShape> {
     let identity: fn(f64) -> f64 = |t| t;
     match kind {

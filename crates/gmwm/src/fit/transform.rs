@@ -74,6 +74,21 @@ impl ParamTransform {
         u.is_finite().then_some(u)
     }
 
+    /// `theta` moved just inside the domain when it lies exactly on its closed edge (an
+    /// estimate whose `u` ran off to +-inf rounds onto it: a variance or drift of 0, a phi of
+    /// 0 or 1); other values unchanged. See [`Parametrisation::to_u_restart`].
+    pub fn inside(self, theta: f64) -> f64 {
+        let e = RESTART_EDGE;
+        match self {
+            ParamTransform::Log | ParamTransform::LogAbs if theta == 0.0 => f64::MIN_POSITIVE,
+            ParamTransform::Logit if theta == 0.0 => e,
+            ParamTransform::Logit if theta == 1.0 => 1.0 - e,
+            ParamTransform::PseudoLogit if theta.abs() == 1.0 => theta * (1.0 - e),
+            ParamTransform::Logit2 if theta.abs() == 2.0 => theta * (1.0 - e),
+            _ => theta,
+        }
+    }
+
     /// METHODS §5.3: `theta = g(u)`.
     pub fn from_u(self, u: f64) -> f64 {
         match self {
@@ -98,6 +113,10 @@ impl ParamTransform {
         }
     }
 }
+
+/// Relative distance from the edge of its domain at which an estimate on the edge restarts
+/// ([`Parametrisation::to_u_restart`]): a phi of 0 restarts at 1e-9, of 1 at 1 - 1e-9.
+pub const RESTART_EDGE: f64 = 1e-9;
 
 /// Which table of METHODS §5.3 to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -281,10 +300,26 @@ impl Parametrisation {
     /// [`FitError::Length`]; [`FitError::OutOfDomain`] naming the parameter; with the ordered
     /// chain, [`FitError::PhiNotOrdered`] unless the phis strictly decrease in model order.
     pub fn to_u(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.to_u_with(theta, false)
+    }
+
+    /// [`Parametrisation::to_u`] of an estimate to restart an optimisation from: values on
+    /// the closed edge of their domain ([`ParamTransform::inside`]) and, in the ordered chain,
+    /// a `1 - phi` at 0, at its upper bound or tied with its neighbour are moved inside by
+    /// [`RESTART_EDGE`] (relative). Values outside the closed domain are still refused.
+    ///
+    /// # Errors
+    /// As [`Parametrisation::to_u`].
+    pub fn to_u_restart(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.to_u_with(theta, true)
+    }
+
+    fn to_u_with(&self, theta: &[f64], restart: bool) -> Result<Vec<f64>, FitError> {
         self.check_len("theta", theta.len())?;
         let mut u = vec![0.0; theta.len()];
         for (i, (t, &v)) in self.single.iter().zip(theta).enumerate() {
             if let Some(t) = t {
+                let v = if restart { t.inside(v) } else { v };
                 u[i] = t
                     .to_u(v)
                     .ok_or_else(|| self.out_of_domain(i, v, t.domain()))?;
@@ -295,7 +330,10 @@ impl Parametrisation {
         for s in (0..k).rev() {
             let (i, ci, slot) = self.ordered[s];
             let v = theta[i];
-            let c = Self::complement(slot, v);
+            let mut c = Self::complement(slot, v);
+            if restart && c.is_finite() && (0.0..=upper).contains(&c) {
+                c = c.clamp(upper * RESTART_EDGE, upper * (1.0 - RESTART_EDGE));
+            }
             let domain = match slot {
                 Slot::Phi if self.width > 1.0 => "phi in (-1, 1)",
                 Slot::Phi => "phi in (0, 1)",
@@ -630,5 +668,30 @@ mod tests {
                 ..
             }
         ));
+    }
+    #[test]
+    fn restart_moves_edge_values_inside_and_refuses_outside_ones() {
+        let m = model("2*AR1()+WN()+DR()");
+        let p = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Ordered, 1.0).unwrap();
+        // a phi of 0 and a drift of 0 (edges), then a phi of 1 and two equal phis
+        for theta in [
+            [0.9, 1.0, 0.0, 1.0, 2.0, 0.0],
+            [1.0, 1.0, 0.5, 1.0, 2.0, 0.1],
+            [0.7, 1.0, 0.7, 1.0, 2.0, 0.1],
+        ] {
+            assert!(p.to_u(&theta).is_err(), "{theta:?}");
+            let u = p.to_u_restart(&theta).unwrap();
+            let back = p.from_u(&u).unwrap();
+            for (a, b) in back.iter().zip(&theta) {
+                assert!((a - b).abs() < 1e-8, "{theta:?} -> {back:?}");
+            }
+            assert!(
+                back[0] > back[2] && back[2] > 0.0 && back[0] < 1.0,
+                "{back:?}"
+            );
+        }
+        // outside the closed domain: still refused
+        assert!(p.to_u_restart(&[1.5, 1.0, 0.5, 1.0, 2.0, 0.1]).is_err());
+        assert!(p.to_u_restart(&[0.9, -1.0, 0.5, 1.0, 2.0, 0.1]).is_err());
     }
 }

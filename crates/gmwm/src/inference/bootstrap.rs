@@ -269,7 +269,7 @@ pub fn fit_bootstrap(
     let done = AtomicUsize::new(0);
     progress.start(replicates);
     let reps = map_replicates(
-        &fit.model,
+        &fit.active_model()?,
         n,
         fit.freq_hz,
         &opts,

@@ -99,7 +99,7 @@ pub fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, Fit
     }
     let weights = FullWeights::from_covariance(v)?;
     let param = Parametrisation::new(&model, fit.preset, fit.phi_order, fit.freq_hz)?;
-    let u0 = param.to_u(theta)?;
+    let u0 = param.to_u_restart(theta)?;
     let objective =
         Objective::with_full_weights(&model, param, &fit.nu_hat, &weights, fit.freq_hz)?;
     let min = minimize(&objective, &u0, &LmOptions::default())?;

@@ -198,9 +198,10 @@ impl fmt::Display for InferenceWarning {
 ///
 /// Wire format: `method` ("asymptotic" | "bootstrap"), `alpha`, `z`, `z_convention`, `scale`,
 /// `v_replicates` (replicates behind V), `bootstrap_replicates` (B or null), `parameters`
-/// (per parameter `name`, `estimate`, `se`, `ci_low`, `ci_high`), `covariance` (p x p rows),
-/// `objective`, `gof` (`statistic`, `df`, `p_value`, or null), `bootstrap_gof` (`objective`,
-/// `p_value`, `ci_low`, `ci_high`, `replicates`, or null), `warnings`.
+/// (per parameter `name`, `estimate`, `se`, `ci_low`, `ci_high`), `covariance` (p x p rows;
+/// null for a parameter at the boundary), `objective`, `gof` (`statistic`, `df`, `p_value`,
+/// or null), `bootstrap_gof` (`objective`, `p_value`, `ci_low`, `ci_high`, `replicates`, or
+/// null), `warnings`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Inference {
     /// Asymptotic or bootstrap.
@@ -219,8 +220,9 @@ pub struct Inference {
     pub bootstrap_replicates: Option<usize>,
     /// Per parameter, model order.
     pub parameters: Vec<ParameterInference>,
-    /// Covariance of the estimates (sandwich `Psi` or bootstrap), rows.
-    pub covariance: Vec<Vec<f64>>,
+    /// Covariance of the estimates (sandwich `Psi` or bootstrap), rows; `None` in the rows and
+    /// columns of a parameter at the boundary.
+    pub covariance: Vec<Vec<Option<f64>>>,
     /// `Q(theta_hat)` of the fit.
     pub objective: f64,
     /// The J-test (METHODS §7.3).
@@ -304,7 +306,7 @@ pub fn infer_with_progress(
             let done = AtomicUsize::new(0);
             progress.start(h);
             let samples = map_replicates(
-                &fit.model,
+                &fit.active_model()?,
                 n,
                 fit.freq_hz,
                 &wv_opts,
@@ -427,8 +429,7 @@ pub fn infer_with_progress(
     })
 }
 
-/// The p x p matrix with `m` (q x q) at the `keep` rows and columns and NaN (JSON null)
-/// elsewhere.
+/// The p x p matrix with `m` (q x q) at the `keep` rows and columns and NaN elsewhere.
 fn expand(m: &DMatrix<f64>, keep: &[usize], p: usize) -> DMatrix<f64> {
     let mut out = DMatrix::from_element(p, p, f64::NAN);
     for (i, &ki) in keep.iter().enumerate() {
@@ -439,9 +440,15 @@ fn expand(m: &DMatrix<f64>, keep: &[usize], p: usize) -> DMatrix<f64> {
     out
 }
 
-fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+/// Rows of `m`, NaN (a parameter at the boundary, see [`expand`]) as `None`.
+fn rows(m: &DMatrix<f64>) -> Vec<Vec<Option<f64>>> {
     (0..m.nrows())
-        .map(|i| m.row(i).iter().copied().collect())
+        .map(|i| {
+            m.row(i)
+                .iter()
+                .map(|&x| (!x.is_nan()).then_some(x))
+                .collect()
+        })
         .collect()
 }
 

@@ -255,7 +255,7 @@ impl Wic {
         let v = match self.method {
             OptimismMethod::Asymptotic => Some(
                 wv_bootstrap(
-                    &full_fit.model,
+                    &full_fit.active_model().map_err(fit_error(&self.full))?,
                     x.len(),
                     freq_hz,
                     &replicate_opts,
@@ -396,7 +396,7 @@ impl Context<'_> {
         let Some(factor) = hartlap_factor(self.wic.bootstrap, levels) else {
             return Ok(None);
         };
-        if levels <= fit.theta.len() {
+        if levels <= fit.active_parameters().len() {
             return Ok(None);
         }
         match j_test(&self.wic.estimator(candidate), fit, &(v / factor)) {
@@ -432,7 +432,7 @@ impl Context<'_> {
         let freq_hz = self.wv.freq_hz;
         let seed = self.wic.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET);
         let reps = map_replicates(
-            &fit.model,
+            &fit.active_model()?,
             self.inputs.n,
             freq_hz,
             self.replicate_opts,
