@@ -138,22 +138,37 @@ const MAX_RESTARTS: usize = 3;
 pub const STALL_COSINE: f64 = 1e-4;
 
 /// Influence below which a log-scale parameter whose descent direction points to zero counts
-/// as collapsed onto its boundary (theta -> 0, u -> -inf): its whitened Jacobian column
-/// `sqrt(omega) theta dnu2/dtheta` (for a variance, the component's whole whitened WV) is at
-/// most this fraction of the residual norm, so removing the component entirely changes `Q` by
-/// at most `2e-7` relative. Such a minimum is a boundary (KKT) point: the gradient there is
-/// not zero and the parameter would crawl towards zero for thousands of steps, so while it
-/// stays collapsed it is held fixed, the first-order test runs over the other parameters, and
-/// the fit lists it ([`Minimum::collapsed`]). It is released as soon as the gradient asks it
-/// to grow.
+/// as collapsed onto its boundary (theta -> 0, u -> -inf); likewise a bounded coefficient
+/// (logit-type transform or a link of the ordered phi chain) whose descent pushes `u` on
+/// towards either infinity (phi -> 0 or phi -> 1, where `dtheta/du` vanishes). Its whitened
+/// Jacobian column in `u` (for a variance `sqrt(omega) theta dnu2/dtheta`, the component's
+/// whole whitened WV) is at most this fraction of the residual norm, so moving it on to the
+/// edge changes `Q` by at most `2e-7` relative. Such a minimum is a boundary (KKT) point: the
+/// gradient there is not zero and the parameter would crawl towards its edge for thousands
+/// of steps, so while it stays collapsed it is held fixed, the first-order test runs over the
+/// other parameters, and the optimiser lists it ([`Minimum::collapsed`]). It is released as
+/// soon as the gradient points back inside.
 pub const COLLAPSE_INFLUENCE: f64 = 1e-7;
 
-/// Indices of the collapsed parameters (see [`COLLAPSE_INFLUENCE`]) at `ev`.
-fn collapsed_params(ev: &Eval, levels: usize, p: usize, log_scale: &[bool]) -> Vec<usize> {
+/// Where a parameter's boundary lies in `u` (see [`COLLAPSE_INFLUENCE`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Edge {
+    /// Unbounded (identity transform): never collapses.
+    Free,
+    /// Log scale: the boundary theta = 0 is u -> -inf.
+    Zero,
+    /// A bounded coefficient (logit-type, or a link of the ordered phi chain): u -> -inf and
+    /// u -> +inf are both edges (e.g. phi -> 0 and phi -> 1).
+    Both,
+}
+
+/// Indices of the collapsed parameters (see [`COLLAPSE_INFLUENCE`]) at `ev` (`u` its point):
+/// negligible influence and a descent direction that pushes `u` on towards its edge.
+fn collapsed_params(ev: &Eval, u: &[f64], levels: usize, p: usize, edge: &[Edge]) -> Vec<usize> {
     let r_norm = sum_sq(&ev.r[..levels]).sqrt();
     (0..p)
         .filter(|&k| {
-            if !log_scale[k] {
+            if edge[k] == Edge::Free {
                 return false;
             }
             let (mut col, mut g) = (0.0, 0.0);
@@ -162,7 +177,11 @@ fn collapsed_params(ev: &Eval, levels: usize, p: usize, log_scale: &[bool]) -> V
                 col += v * v;
                 g += v * ev.r[j];
             }
-            g >= 0.0 && col.sqrt() <= COLLAPSE_INFLUENCE * r_norm
+            let outwards = match edge[k] {
+                Edge::Zero => g >= 0.0,
+                _ => g * u[k] <= 0.0,
+            };
+            outwards && col.sqrt() <= COLLAPSE_INFLUENCE * r_norm
         })
         .collect()
 }
@@ -265,14 +284,20 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
     let mut mu = f64::NAN;
     let mut nu = 2.0;
     let mut restarts = 0;
-    let log_scale: Vec<bool> = objective
+    let edge: Vec<Edge> = objective
         .parametrisation()
         .transforms()
         .iter()
-        .map(|t| matches!(t, Some(ParamTransform::Log | ParamTransform::LogAbs)))
+        .map(|t| match t {
+            Some(ParamTransform::Log | ParamTransform::LogAbs) => Edge::Zero,
+            Some(ParamTransform::Identity) => Edge::Free,
+            // logit-type transforms, and None: a link of the ordered phi chain
+            _ => Edge::Both,
+        })
         .collect();
     let finish =
         |reason: StopReason, u: Vec<f64>, ev: &Eval, q: f64, it: usize, evals: usize| Minimum {
+            collapsed: collapsed_params(ev, &u, levels, p, &edge),
             u,
             theta: ev.theta.clone(),
             objective: q,
@@ -283,7 +308,6 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
                 reason,
                 converged: reason.is_converged(),
             },
-            collapsed: collapsed_params(ev, levels, p, &log_scale),
         };
     loop {
         if q <= opts.zero_tolerance * scale_q {
@@ -298,7 +322,7 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
         }
         normal_equations(&cur, levels, p, &mut a, &mut g);
         let r_norm = q.sqrt();
-        let collapsed = collapsed_params(&cur, levels, p, &log_scale);
+        let collapsed = collapsed_params(&cur, &u, levels, p, &edge);
         for &k in &collapsed {
             for l in 0..p {
                 a[k * p + l] = 0.0;
