@@ -20,7 +20,7 @@
 //! more for a second AR1, whose phi is not identified when its variance is 0 and which can
 //! also stand in for a random walk (phi -> 1) or a white noise (phi -> 0). Measured at
 //! N = 1e5, truth `AR1+WN+RW` (tests/selection.rs): the true model is picked in 94/100
-//! replicates among the nested candidates of `AR1()+WN()+RW()+QN()+DR()` and in 134/200 among
+//! replicates among the nested candidates of `AR1()+WN()+RW()+QN()+DR()` and in 138/200 among
 //! those of `2*AR1()+WN()+RW()+QN()+DR()`, never an underfit.
 //!
 //! ```
