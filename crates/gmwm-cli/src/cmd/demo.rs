@@ -184,7 +184,7 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     if !r.fit.collapsed.is_empty() {
         writeln!(
             out,
-            "collapsed to zero (not supported by the data): {}",
+            "at the boundary, fitted to nothing (not supported by the data): {}",
             r.fit.collapsed.join(", ")
         )?;
     }

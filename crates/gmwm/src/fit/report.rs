@@ -259,7 +259,7 @@ impl fmt::Display for GmwmFit {
         if !self.collapsed.is_empty() {
             writeln!(
                 f,
-                "collapsed to zero (not supported by the data): {}",
+                "at the boundary, fitted to nothing (not supported by the data): {}",
                 self.collapsed.join(", ")
             )?;
         }
