@@ -685,38 +685,15 @@ fn fit_accepts_a_wv_json_and_bootstrap_weights() {
     assert_eq!(boot["fits"][0]["fit"]["weighting"], "bootstrap");
     assert_eq!(boot["fits"][0]["fit"]["bootstrap_replicates"], 100);
     // refusals on a WV file
-    assert_one_line_error(
-        &[
-            "fit",
-            wv_file.to_str().unwrap(),
-            "--model",
-            "WN()",
-            "--robust",
-        ],
-        &["needs the series"],
-    );
-    assert_one_line_error(
-        &[
-            "fit",
-            wv_file.to_str().unwrap(),
-            "--model",
-            "WN()",
-            "--weights",
-            "diag",
-        ],
-        &["needs the series"],
-    );
-    assert_one_line_error(
-        &[
-            "fit",
-            wv_file.to_str().unwrap(),
-            "--model",
-            "WN()",
-            "--columns",
-            "y",
-        ],
-        &["no series named \"y\""],
-    );
+    for (extra, needle) in [
+        (&["--robust"][..], "needs the series"),
+        (&["--weights", "diag"][..], "needs the series"),
+        (&["--columns", "y"][..], "no series named \"y\""),
+    ] {
+        let mut args = vec!["fit", wv_file.to_str().unwrap(), "--model", "WN()"];
+        args.extend_from_slice(extra);
+        assert_one_line_error(&args, &[needle]);
+    }
 }
 
 /// `gmwm fit --inference` adds `se`, `ci_low`, `ci_high` per parameter and

@@ -69,13 +69,16 @@ fn bootstrap_weighting_refits_with_bootstrap_variances() {
         .unwrap()
         .fit_series(&x, 1.0, &opts, &start)
         .unwrap();
-    let boot = Gmwm::parse("AR1()+WN()")
-        .unwrap()
-        .with_weighting(Weighting::Bootstrap)
-        .with_bootstrap(60, 1)
-        .unwrap()
-        .fit_series(&x, 1.0, &opts, &start)
-        .unwrap();
+    let bootstrap_fit = || {
+        Gmwm::parse("AR1()+WN()")
+            .unwrap()
+            .with_weighting(Weighting::Bootstrap)
+            .with_bootstrap(60, 1)
+            .unwrap()
+            .fit_series(&x, 1.0, &opts, &start)
+            .unwrap()
+    };
+    let boot = bootstrap_fit();
     assert!(boot.convergence.converged, "{boot}");
     assert_eq!(boot.weighting, Weighting::Bootstrap);
     assert_eq!(boot.bootstrap_replicates, Some(60));
@@ -98,13 +101,7 @@ fn bootstrap_weighting_refits_with_bootstrap_variances() {
         "fast / bootstrap V at level 1: {ratio}"
     );
     // same seed, same answer
-    let again = Gmwm::parse("AR1()+WN()")
-        .unwrap()
-        .with_weighting(Weighting::Bootstrap)
-        .with_bootstrap(60, 1)
-        .unwrap()
-        .fit_series(&x, 1.0, &opts, &start)
-        .unwrap();
+    let again = bootstrap_fit();
     assert_eq!(again.theta, boot.theta);
     assert!(Gmwm::parse("WN()").unwrap().with_bootstrap(1, 1).is_err());
     assert!(Gmwm::parse("WN()").unwrap().with_bootstrap(10, 0).is_err());

@@ -10,12 +10,26 @@
 //! the boundary parameters are reported without a standard error.
 
 use super::{FitError, GmwmFit};
-use crate::model::{Component, Model};
+use crate::model::{Component, ImpliedWv, Model};
 
 /// A component whose implied WV is below this share of the model's at every level counts as
 /// fitted to nothing; its effect on the objective is of the order of this share, far below
 /// what separates candidate models or moves an estimate.
 pub const NEGLIGIBLE_WV_SHARE: f64 = 1e-6;
+
+/// Per component of `implied`, whether it contributes: its implied WV exceeds
+/// [`NEGLIGIBLE_WV_SHARE`] of the model's at some level.
+pub(crate) fn active_components(implied: &ImpliedWv) -> Vec<bool> {
+    implied
+        .processes
+        .iter()
+        .map(|c| {
+            c.wv.iter()
+                .zip(&implied.wv)
+                .any(|(x, t)| x.abs() > NEGLIGIBLE_WV_SHARE * t.abs())
+        })
+        .collect()
+}
 
 /// The active components of a fit as a guess-mode model (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -45,21 +59,11 @@ impl GmwmFit {
     /// all but those whose implied WV is below [`NEGLIGIBLE_WV_SHARE`] of the model's at every
     /// level (see the module docs).
     pub fn active_parameters(&self) -> Vec<usize> {
-        let total = &self.implied_wv.wv;
         let mut keep = Vec::with_capacity(self.theta.len());
         let mut at = 0;
-        for (c, wv) in self
-            .model
-            .components()
-            .iter()
-            .zip(&self.implied_wv.processes)
-        {
+        let active = active_components(&self.implied_wv);
+        for (c, active) in self.model.components().iter().zip(active) {
             let k = c.kind.n_params();
-            let active = wv
-                .wv
-                .iter()
-                .zip(total)
-                .any(|(x, t)| x.abs() > NEGLIGIBLE_WV_SHARE * t.abs());
             if active {
                 keep.extend(at..at + k);
             }

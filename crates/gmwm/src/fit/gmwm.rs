@@ -303,43 +303,47 @@ impl Gmwm {
         let param_names = param.names().to_vec();
         let objective = Objective::new(&self.model, param.clone(), nu_hat, &weights, freq_hz)?;
         let mut min = minimize(&objective, &u0, &self.options)?;
-        // leave a false boundary point (components fitted to nothing that the data want back)
-        for _ in 0..MAX_REVIVALS {
-            let fitted = self
-                .model
-                .with_values(&min.theta)
-                .map_err(crate::Error::from)?;
-            let Some(revived) = revival_start(
-                &fitted,
-                &min.theta,
-                nu_hat,
-                &weights.omega,
-                freq_hz,
-                min.objective,
-            )?
-            else {
-                break;
+        // METHODS §5.6 (port): stable sort of the AR1/GM blocks, phi decreasing (a no-op for
+        // the ordered chain); then leave a false boundary point (components fitted to nothing
+        // that the data want back, fit::revive), at most MAX_REVIVALS times
+        let mut revivals = 0;
+        let (theta, fitted, implied_wv) = loop {
+            let theta = Parametrisation::canonical_order(&self.model, &min.theta)?;
+            let fitted = self.model.with_values(&theta).map_err(crate::Error::from)?;
+            let implied = fitted.implied_wv(nu_hat.len(), freq_hz)?;
+            let revived = if revivals < MAX_REVIVALS {
+                revival_start(
+                    &fitted,
+                    &theta,
+                    &implied,
+                    nu_hat,
+                    &weights.omega,
+                    freq_hz,
+                    min.objective,
+                )?
+            } else {
+                None
             };
             // a start the transforms refuse (e.g. two AR1s with equal phi) is no revival
-            let Ok(u) = Parametrisation::canonical_order(&self.model, &revived)
-                .and_then(|t| param.to_u_restart(&t))
-            else {
-                break;
-            };
-            let next = minimize(&objective, &u, &self.options)?;
-            if next.objective >= min.objective {
-                break;
+            let next = revived
+                .and_then(|r| {
+                    Parametrisation::canonical_order(&self.model, &r)
+                        .and_then(|t| param.to_u_restart(&t))
+                        .ok()
+                })
+                .map(|u| minimize(&objective, &u, &self.options))
+                .transpose()?;
+            match next {
+                Some(next) if next.objective < min.objective => {
+                    let (it, ev) = (min.convergence.iterations, min.convergence.evaluations);
+                    min = next;
+                    min.convergence.iterations += it;
+                    min.convergence.evaluations += ev;
+                    revivals += 1;
+                }
+                _ => break (theta, fitted, implied),
             }
-            let (it, ev) = (min.convergence.iterations, min.convergence.evaluations);
-            min = next;
-            min.convergence.iterations += it;
-            min.convergence.evaluations += ev;
-        }
-        // METHODS §5.6 (port): stable sort of the AR1/GM blocks, phi decreasing (a no-op for
-        // the ordered chain)
-        let theta = Parametrisation::canonical_order(&self.model, &min.theta)?;
-        let fitted = self.model.with_values(&theta).map_err(crate::Error::from)?;
-        let implied_wv = fitted.implied_wv(nu_hat.len(), freq_hz)?;
+        };
         let mut fit = GmwmFit {
             weighting: self.weighting,
             org_v: None,
@@ -417,8 +421,8 @@ pub struct GmwmFit {
     /// Series length and range behind the starting values (METHODS §6.1), kept for `update`.
     pub inputs: Option<StartInputs>,
     /// Labels of the parameters of the components fitted to nothing (implied WV below
-    /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level, [`GmwmFit::active_parameters`]):
-    /// the fit is a boundary point and a smaller model fits as well. Inference reports these
-    /// parameters without a standard error.
+    /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level,
+    /// [`GmwmFit::active_parameters`]): the fit is a boundary point and a smaller model fits as
+    /// well. Inference reports these parameters without a standard error.
     pub collapsed: Vec<String>,
 }

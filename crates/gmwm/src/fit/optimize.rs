@@ -146,7 +146,7 @@ pub const STALL_COSINE: f64 = 1e-4;
 /// edge changes `Q` by at most `2e-7` relative. Such a minimum is a boundary (KKT) point: the
 /// gradient there is not zero and the parameter would crawl towards its edge for thousands
 /// of steps, so while it stays collapsed it is held fixed, the first-order test runs over the
-/// other parameters, and the optimiser lists it ([`Minimum::collapsed`]). It is released as
+/// other parameters (the fit reports its component, `GmwmFit::collapsed`). It is released as
 /// soon as the gradient points back inside.
 pub const COLLAPSE_INFLUENCE: f64 = 1e-7;
 
@@ -199,9 +199,6 @@ pub struct Minimum {
     pub implied_wv: Vec<f64>,
     /// How it ended.
     pub convergence: Convergence,
-    /// Parameters (indices) that collapsed onto zero: the data do not support their
-    /// component (see [`COLLAPSE_INFLUENCE`]).
-    pub collapsed: Vec<usize>,
 }
 
 /// Cholesky solve of the symmetric positive definite `m x = b` (row-major n x n), in place in
@@ -297,7 +294,6 @@ pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<M
         .collect();
     let finish =
         |reason: StopReason, u: Vec<f64>, ev: &Eval, q: f64, it: usize, evals: usize| Minimum {
-            collapsed: collapsed_params(ev, &u, levels, p, &edge),
             u,
             theta: ev.theta.clone(),
             objective: q,

@@ -21,9 +21,9 @@
 //! above [`REVIVAL_MIN_GAIN`] of `Q` gives the start of a new minimisation, kept only if it
 //! ends lower; at most [`MAX_REVIVALS`] times per fit.
 
-use super::active::NEGLIGIBLE_WV_SHARE;
+use super::active::active_components;
 use super::FitError;
-use crate::model::{Component, Model, ProcessKind};
+use crate::model::{Component, ImpliedWv, Model, ProcessKind};
 
 /// Revivals per fit at most (each one a further minimisation).
 pub const MAX_REVIVALS: usize = 3;
@@ -34,28 +34,25 @@ pub const REVIVAL_MIN_GAIN: f64 = 1e-6;
 
 /// A start with the inactive component of `fitted` whose return lowers the objective most
 /// (see the module docs), or `None` when none lowers it by more than [`REVIVAL_MIN_GAIN`] of
-/// `q`. `theta` is in `fitted`'s order; `omega` the diagonal weights.
+/// `q`. `theta` is in `fitted`'s order and `implied` its implied WV; `omega` the diagonal
+/// weights.
 pub(crate) fn revival_start(
     fitted: &Model,
     theta: &[f64],
+    implied: &ImpliedWv,
     nu_hat: &[f64],
     omega: &[f64],
     freq_hz: f64,
     q: f64,
 ) -> Result<Option<Vec<f64>>, FitError> {
     let levels = nu_hat.len();
-    let implied = fitted.implied_wv(levels, freq_hz)?;
     let r: Vec<f64> = implied.wv.iter().zip(nu_hat).map(|(a, b)| a - b).collect();
     let mut best: Option<(f64, usize, Vec<f64>)> = None;
     let mut at = 0;
-    for (c, cw) in fitted.components().iter().zip(&implied.processes) {
+    let active = active_components(implied);
+    for (c, active) in fitted.components().iter().zip(active) {
         let k = c.kind.n_params();
-        let inactive = cw
-            .wv
-            .iter()
-            .zip(&implied.wv)
-            .all(|(x, t)| x.abs() <= NEGLIGIBLE_WV_SHARE * t.abs());
-        if inactive {
+        if !active {
             for (unit, scale) in unit_shapes(c.kind, levels, freq_hz) {
                 let one = Model::new(vec![Component::new(
                     c.kind,
@@ -137,9 +134,17 @@ mod tests {
         let lost = model("WN(sigma2=1)+RW(gamma2=1e-30)");
         let omega: Vec<f64> = nu_hat.iter().map(|v| 1.0 / (v * v)).collect();
         let q: f64 = 1.0;
-        let start = revival_start(&lost, &[1.0, 1e-30], &nu_hat, &omega, 1.0, q)
-            .unwrap()
-            .unwrap();
+        let start = revival_start(
+            &lost,
+            &[1.0, 1e-30],
+            &lost.implied_wv(levels, 1.0).unwrap(),
+            &nu_hat,
+            &omega,
+            1.0,
+            q,
+        )
+        .unwrap()
+        .unwrap();
         assert_eq!(start[0], 1.0);
         assert!((start[1] / 1e-3 - 1.0).abs() < 1e-12, "{start:?}");
     }
@@ -157,9 +162,17 @@ mod tests {
         let nu_hat = truth.implied_wv(levels, 1.0).unwrap().wv;
         let omega = vec![1.0; levels];
         let lost = model("AR1(phi=0.3, sigma2=1e-40)+WN(sigma2=1)");
-        let start = revival_start(&lost, &[0.3, 1e-40, 1.0], &nu_hat, &omega, 1.0, 1.0)
-            .unwrap()
-            .unwrap();
+        let start = revival_start(
+            &lost,
+            &[0.3, 1e-40, 1.0],
+            &lost.implied_wv(levels, 1.0).unwrap(),
+            &nu_hat,
+            &omega,
+            1.0,
+            1.0,
+        )
+        .unwrap()
+        .unwrap();
         assert!((start[0] / phi - 1.0).abs() < 1e-12, "{start:?}");
         assert!((start[1] / 0.5 - 1.0).abs() < 1e-9, "{start:?}");
         // at the truth with a superfluous RW at 1e-30: nothing to revive (the residual is 0)
@@ -169,8 +182,16 @@ mod tests {
             Component::new(ProcessKind::Rw, vec![Some(1e-30)]).unwrap(),
         ])
         .unwrap();
-        let none =
-            revival_start(&sup, &[phi, 0.5, 1.0, 1e-30], &nu_hat, &omega, 1.0, 1e-20).unwrap();
+        let none = revival_start(
+            &sup,
+            &[phi, 0.5, 1.0, 1e-30],
+            &sup.implied_wv(levels, 1.0).unwrap(),
+            &nu_hat,
+            &omega,
+            1.0,
+            1e-20,
+        )
+        .unwrap();
         assert!(none.is_none());
     }
 }

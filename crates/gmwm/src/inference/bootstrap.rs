@@ -210,12 +210,13 @@ pub struct FitBootstrapOptions {
     pub gof_draws: Option<usize>,
 }
 
-/// METHODS §7.4 `all_bootstrapper(B)`: simulates `replicates` series of length `n` from
-/// `fit.model` (rate `fit.freq_hz`), computes each one's WV with `wv_opts` (its `levels` is set
-/// to the fit's J) and weights, and refits from `fit.theta` (stage 2 only; components the fit
-/// drove to the boundary are held there and the active sub-model is refitted,
-/// [`GmwmFit::active_sub_model`]); with `gof_draws = Some(G)` each replicate is also fitted from a fresh starting-value search with
-/// G draws (METHODS §6, seeded per replicate) and its final objective kept.
+/// METHODS §7.4 `all_bootstrapper(B)`: simulates `replicates` series of length `n` from the
+/// fitted model (rate `fit.freq_hz`), computes each one's WV with `wv_opts` (its `levels` is
+/// set to the fit's J) and weights, and refits from `fit.theta` (stage 2 only). Components the
+/// fit drove to the boundary are left out of the simulation and held there: the active
+/// sub-model is refitted ([`GmwmFit::active_sub_model`]). With `gof_draws = Some(G)` each
+/// replicate is also fitted from a fresh starting-value search with G draws (METHODS §6,
+/// seeded per replicate) and its final objective kept.
 ///
 /// Replicate `r` simulates with [`replicate_seed`]`(seed, r)` and searches starting values with
 /// `replicate_seed(seed + 1, r)`: results do not depend on the thread count. Memory: one series
