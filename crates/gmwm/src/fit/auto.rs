@@ -20,6 +20,7 @@ impl Gmwm {
     /// As [`wavelet_variance`] (in [`FitError::Engine`]), [`Weights::new`],
     /// [`starting_values`] and [`Gmwm::fit_weighted`].
     pub fn fit(&self, x: &[f64], freq_hz: f64, wv_opts: &WvOptions) -> Result<GmwmFit, FitError> {
+        super::check_haar(wv_opts.filter)?;
         let wv = wavelet_variance(x, freq_hz, wv_opts)?;
         let weights = Weights::new(self.weighting(), &wv, Some(x))?;
         let inputs = StartInputs::from_series(x);
@@ -38,6 +39,7 @@ impl Gmwm {
         wv: &WaveletVariance,
         inputs: StartInputs,
     ) -> Result<GmwmFit, FitError> {
+        super::check_haar(wv.filter)?;
         let weights = Weights::new(self.weighting(), wv, None)?;
         let fit = self.fit_auto(wv, weights, inputs)?;
         self.finish(fit, wv, inputs)

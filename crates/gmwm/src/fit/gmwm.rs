@@ -172,6 +172,7 @@ impl Gmwm {
         freq_hz: f64,
         start: &[f64],
     ) -> Result<GmwmFit, FitError> {
+        super::check_haar(wv.filter)?;
         let weights = Weights::new(self.weighting, wv, None)?;
         self.check_robust_levels(wv)?;
         let fit = self.fit_weighted(&wv.wv, weights, freq_hz, start)?;
@@ -202,6 +203,7 @@ impl Gmwm {
         wv_options: &WvOptions,
         start: &[f64],
     ) -> Result<GmwmFit, FitError> {
+        super::check_haar(wv_options.filter)?;
         let wv = wavelet_variance(x, freq_hz, wv_options)?;
         let weights = Weights::new(self.weighting, &wv, Some(x))?;
         self.check_robust_levels(&wv)?;
@@ -276,6 +278,7 @@ impl Gmwm {
                 found: 0,
             });
         };
+        super::check_haar(wv.filter)?;
         let weights = match &fit.org_v {
             Some(v) => Weights::from_v(v.clone(), "stored variance")?,
             None => fit.weights.clone(),

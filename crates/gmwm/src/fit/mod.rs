@@ -10,6 +10,7 @@
 
 pub mod active;
 pub mod auto;
+pub mod canonical;
 pub mod gmwm;
 pub mod objective;
 pub mod optimize;
@@ -20,6 +21,7 @@ pub mod transform;
 pub mod weights;
 
 pub use active::{SubModel, NEGLIGIBLE_WV_SHARE};
+pub use canonical::{CanonicalModel, CanonicalTerm, Reading, SEPARATION_LIMIT};
 pub use gmwm::{Gmwm, GmwmFit, DEFAULT_BOOTSTRAP_REPLICATES};
 pub use objective::Objective;
 pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason, STALL_COSINE};
@@ -29,6 +31,7 @@ pub use start::{starting_values, Dominance, StartInputs, StartOptions, StartValu
 pub use transform::{ParamTransform, Parametrisation, PhiOrder, TransformPreset};
 pub use weights::{Weighting, Weights};
 
+use crate::wavelet::WaveletFilter;
 use thiserror::Error;
 
 /// Why a fit could not be set up or evaluated.
@@ -114,9 +117,33 @@ pub enum FitError {
         /// The implied WV there.
         value: f64,
     },
+    /// The wavelet variance was computed with another filter than Haar: every implied WV of
+    /// METHODS §4 is the Haar WV (§1.8), so a fit, a selection or an inference on it would
+    /// silently be wrong.
+    #[error(
+        "the wavelet variance uses the {filter} filter, but every model's implied wavelet \
+         variance is the Haar one (METHODS §1.8, §4): fit, select and infer on a Haar wavelet \
+         variance (other filters are for display only)"
+    )]
+    NotHaar {
+        /// The filter of the WV.
+        filter: WaveletFilter,
+    },
     /// An engine computation the fit relies on failed (e.g. the diag covariance of a bad series).
     #[error(transparent)]
     Engine(Box<crate::Error>),
+}
+
+/// Refuses a wavelet variance with another filter than Haar ([`FitError::NotHaar`]).
+///
+/// # Errors
+/// [`FitError::NotHaar`].
+pub(crate) fn check_haar(filter: WaveletFilter) -> Result<(), FitError> {
+    if filter == WaveletFilter::Haar {
+        Ok(())
+    } else {
+        Err(FitError::NotHaar { filter })
+    }
 }
 
 impl From<crate::Error> for FitError {

@@ -94,44 +94,18 @@ impl GmwmFit {
 
     /// Every AR1/GM component in both the per-sample AR1 and the rate-aware GM form.
     pub fn ar1_gm_forms(&self) -> Vec<Ar1GmForms> {
-        let dt = 1.0 / self.freq_hz;
         let mut out = Vec::new();
         let mut k = 0;
         for (index, c) in self.model.components().iter().enumerate() {
-            let (a, b) = (
-                self.theta.get(k).copied().unwrap_or(f64::NAN),
-                self.theta.get(k + 1).copied().unwrap_or(f64::NAN),
-            );
-            let forms = match c.kind {
-                ProcessKind::Ar1 => {
-                    let (phi, sigma2) = (a, b);
-                    let beta = -phi.ln() / dt;
-                    Some((phi, sigma2, beta, sigma2 / (1.0 - phi * phi)))
-                }
-                ProcessKind::Gm => {
-                    let (beta, sigma2_gm) = (a, b);
-                    let phi = (-beta * dt).exp();
-                    Some((
-                        phi,
-                        -sigma2_gm * (-2.0 * beta * dt).exp_m1(),
-                        beta,
-                        sigma2_gm,
-                    ))
-                }
-                _ => None,
-            };
-            if let Some((phi, sigma2, beta, sigma2_gm)) = forms {
-                out.push(Ar1GmForms {
-                    process: c.kind.name(),
-                    index,
-                    phi,
-                    sigma2,
-                    beta,
-                    sigma2_gm,
-                    correlation_time_s: 1.0 / beta,
-                });
+            let n = c.kind.n_params();
+            if let Some(forms) = self
+                .theta
+                .get(k..k + n)
+                .and_then(|theta| Ar1GmForms::of(c.kind, index, theta, self.freq_hz))
+            {
+                out.push(forms);
             }
-            k += c.kind.n_params();
+            k += n;
         }
         out
     }
@@ -139,51 +113,103 @@ impl GmwmFit {
     /// The parameters in physical units (module table), `unit` naming the data unit (`"u"`
     /// when `None`). MA/ARMA terms have no physical form and are left out.
     pub fn navigation(&self, unit: Option<&str>) -> Vec<NavParameter> {
-        let u = unit.unwrap_or("u");
-        let f = self.freq_hz;
-        let forms = self.ar1_gm_forms();
         let mut out = Vec::new();
         let mut k = 0;
         for (index, c) in self.model.components().iter().enumerate() {
-            let v = self.theta.get(k).copied().unwrap_or(f64::NAN);
-            let mut push = |name, value, unit: String| {
-                out.push(NavParameter {
-                    process: c.kind.name(),
+            let n = c.kind.n_params();
+            if let Some(theta) = self.theta.get(k..k + n) {
+                out.extend(physical_parameters(
+                    c.kind,
                     index,
-                    name,
-                    value,
+                    theta,
+                    self.freq_hz,
                     unit,
-                })
-            };
-            match c.kind {
-                ProcessKind::Wn => push(
-                    "white_noise_density",
-                    (v / f).sqrt(),
-                    format!("{u}/sqrt(Hz)"),
-                ),
-                ProcessKind::Qn => push("quantization_coefficient", v.sqrt() / f, format!("{u}*s")),
-                ProcessKind::Rw => push(
-                    "rate_random_walk_density",
-                    (v * f).sqrt(),
-                    format!("{u}*sqrt(Hz)"),
-                ),
-                ProcessKind::Dr => push("drift_rate", v * f, format!("{u}/s")),
-                ProcessKind::Ar1 | ProcessKind::Gm => {
-                    if let Some(g) = forms.iter().find(|g| g.index == index) {
-                        push("correlation_time", g.correlation_time_s, "s".to_string());
-                        push("gm_std", g.sigma2_gm.sqrt(), u.to_string());
-                        push(
-                            "driving_noise_density",
-                            (2.0 * g.beta * g.sigma2_gm).sqrt(),
-                            format!("{u}*sqrt(Hz)"),
-                        );
-                    }
-                }
-                _ => {}
+                ));
             }
-            k += c.kind.n_params();
+            k += n;
         }
         out
+    }
+}
+
+impl Ar1GmForms {
+    /// Both forms of an AR1 (`theta = [phi, sigma2]`) or GM (`[beta, sigma2_gm]`) component
+    /// at `freq_hz` (METHODS §4.3); `None` for other kinds.
+    pub(crate) fn of(
+        kind: ProcessKind,
+        index: usize,
+        theta: &[f64],
+        freq_hz: f64,
+    ) -> Option<Ar1GmForms> {
+        let dt = 1.0 / freq_hz;
+        let (a, b) = (*theta.first()?, *theta.get(1)?);
+        let (phi, sigma2, beta, sigma2_gm) = match kind {
+            ProcessKind::Ar1 => (a, b, -a.ln() / dt, b / (1.0 - a * a)),
+            ProcessKind::Gm => ((-a * dt).exp(), -b * (-2.0 * a * dt).exp_m1(), a, b),
+            _ => return None,
+        };
+        Some(Ar1GmForms {
+            process: kind.name(),
+            index,
+            phi,
+            sigma2,
+            beta,
+            sigma2_gm,
+            correlation_time_s: 1.0 / beta,
+        })
+    }
+}
+
+/// The physical parameters of one component (module table) with parameters `theta` (METHODS
+/// §0.2 order) at `freq_hz`; `unit` names the data unit (`"u"` when `None`); empty for the MA
+/// and ARMA kinds. `index` is the component's position, copied into each entry.
+pub(crate) fn physical_parameters(
+    kind: ProcessKind,
+    index: usize,
+    theta: &[f64],
+    freq_hz: f64,
+    unit: Option<&str>,
+) -> Vec<NavParameter> {
+    let u = unit.unwrap_or("u");
+    let f = freq_hz;
+    let v = theta.first().copied().unwrap_or(f64::NAN);
+    let entry = |name, value, unit: String| NavParameter {
+        process: kind.name(),
+        index,
+        name,
+        value,
+        unit,
+    };
+    match kind {
+        ProcessKind::Wn => vec![entry(
+            "white_noise_density",
+            (v / f).sqrt(),
+            format!("{u}/sqrt(Hz)"),
+        )],
+        ProcessKind::Qn => vec![entry(
+            "quantization_coefficient",
+            v.sqrt() / f,
+            format!("{u}*s"),
+        )],
+        ProcessKind::Rw => vec![entry(
+            "rate_random_walk_density",
+            (v * f).sqrt(),
+            format!("{u}*sqrt(Hz)"),
+        )],
+        ProcessKind::Dr => vec![entry("drift_rate", v * f, format!("{u}/s"))],
+        ProcessKind::Ar1 | ProcessKind::Gm => match Ar1GmForms::of(kind, index, theta, f) {
+            Some(g) => vec![
+                entry("correlation_time", g.correlation_time_s, "s".to_string()),
+                entry("gm_std", g.sigma2_gm.sqrt(), u.to_string()),
+                entry(
+                    "driving_noise_density",
+                    (2.0 * g.beta * g.sigma2_gm).sqrt(),
+                    format!("{u}*sqrt(Hz)"),
+                ),
+            ],
+            None => Vec::new(),
+        },
+        _ => Vec::new(),
     }
 }
 

@@ -268,6 +268,7 @@ pub fn infer_with_progress(
     opts: &InferenceOptions,
     progress: &dyn Progress,
 ) -> Result<Inference, FitError> {
+    crate::fit::check_haar(wv_opts.filter)?;
     let z = z_value(opts.alpha, opts.z).map_err(Error::from)?;
     let levels = fit.nu_hat.len();
     let p = fit.theta.len();

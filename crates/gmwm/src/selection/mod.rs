@@ -49,7 +49,9 @@ pub use imu::{auto_imu, AxisSelection, ImuSelection};
 pub use optimism::{
     asymptotic_optimism, bootstrap_optimism, d_matrix, OptimismConvention, OptimismMethod,
 };
-pub use wic::{CandidateScore, ModelSelection, Wic};
+pub use wic::{
+    CandidateScore, ModelSelection, RowStatus, SelectionRow, SelectionRule, SelectionTable, Wic,
+};
 
 use crate::fit::FitError;
 use crate::model::ProcessKind;

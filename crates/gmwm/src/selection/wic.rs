@@ -7,16 +7,17 @@ use super::optimism::{
 };
 use super::SelectionError;
 use crate::error::check_freq;
-use crate::fit::{FitError, Gmwm, GmwmFit, StartInputs, Weights};
+use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
 use crate::inference::gof::{hartlap_factor, j_test};
-use crate::inference::{map_replicates, wv_bootstrap};
-use crate::model::Model;
+use crate::inference::{map_replicates, wv_bootstrap, NoProgress, Progress};
+use crate::model::{Model, ProcessKind};
 use crate::sim::replicate_seed;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::fmt;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Default number of bootstrap replicates B (the package's `B = 50`).
 pub const DEFAULT_BOOTSTRAP: usize = 50;
@@ -43,6 +44,42 @@ pub struct Wic {
     draws: Option<usize>,
     bootstrap_draws: usize,
     wv_options: WvOptions,
+    rule: SelectionRule,
+    separation_limit: f64,
+}
+
+/// How the selected row is chosen among the rows of canonical models (module docs of
+/// [`super`]): every rule ranks the rows by WIC; they differ in what they do with the rows
+/// whose WIC exceeds the minimum by at most one standard error of that difference
+/// ([`WIC_EQUIVALENCE_SE`], [`wic_difference_se`]): the criterion cannot tell those apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SelectionRule {
+    /// The row with the smallest WIC (the package's rule, applied to canonical models).
+    WicMinimum,
+    /// Among the rows within one standard error of the WIC minimum, the canonical model with
+    /// the fewest parameters (then the smaller WIC): the "equivalent models" rule of the R
+    /// follow-up `mgmwm` (the least complex candidate whose criterion lies within the best
+    /// one's interval), Breiman's one-standard-error rule.
+    Parsimonious,
+    /// Among the rows within one standard error of the WIC minimum, the canonical model with
+    /// the most of the two terms every navigation filter carries, white noise and random walk,
+    /// then the fewest parameters, then the smaller WIC (default): a bias random walk the
+    /// criterion cannot exclude is kept (dropping it makes a filter overconfident), a drift is
+    /// never preferred to a random walk the criterion cannot tell from it, and any other term
+    /// the criterion cannot confirm is left out.
+    #[default]
+    Navigation,
+}
+
+impl fmt::Display for SelectionRule {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SelectionRule::WicMinimum => "wic-minimum",
+            SelectionRule::Parsimonious => "parsimonious",
+            SelectionRule::Navigation => "navigation",
+        })
+    }
 }
 
 impl Wic {
@@ -57,6 +94,8 @@ impl Wic {
             draws: None,
             bootstrap_draws: DEFAULT_BOOTSTRAP_DRAWS,
             wv_options: WvOptions::default(),
+            rule: SelectionRule::default(),
+            separation_limit: SEPARATION_LIMIT,
         }
     }
 
@@ -163,6 +202,20 @@ impl Wic {
         self
     }
 
+    /// Sets how the selected row is chosen ([`SelectionRule`]; default
+    /// [`SelectionRule::Navigation`]).
+    pub fn with_rule(mut self, rule: SelectionRule) -> Self {
+        self.rule = rule;
+        self
+    }
+
+    /// Sets the separation below which a candidate's fit and its canonical reduction are not
+    /// told apart ([`crate::fit::canonical`]; default [`SEPARATION_LIMIT`]).
+    pub fn with_separation_limit(mut self, limit: f64) -> Self {
+        self.separation_limit = limit;
+        self
+    }
+
     /// The full model (guess mode).
     pub fn full_model(&self) -> &Model {
         &self.full
@@ -218,63 +271,84 @@ impl Wic {
     /// 3. every candidate (in parallel; each search seeded with `seed`) fitted in guess mode
     ///    against the same WV and weights; objective, optimism, WIC, GoF p-value (the J-test of
     ///    §7.3 with `V`, or with the bootstrap optimism the bootstrap p-value of §7.4);
-    /// 4. candidates sorted by WIC (a NaN WIC last; ties within [`WIC_TIE_REL`] go to the
-    ///    model with fewer parameters); the first is selected.
+    /// 4. each candidate's fit read as its canonical model
+    ///    ([`GmwmFit::canonical`](crate::fit::GmwmFit::canonical)); candidates with the same
+    ///    canonical model are one row, scored by its smallest member (fewest parameters, then
+    ///    smallest WIC), so a superset whose extra terms collapsed or stand in for others never
+    ///    wins on the noise of its optimism;
+    /// 5. rows sorted by WIC (a NaN WIC last; ties within [`WIC_TIE_REL`] go to the model with
+    ///    fewer parameters); the selected row is chosen by the [`SelectionRule`] among the rows
+    ///    whose fits the data cannot separate from the WIC minimum's.
     ///
     /// Not reproduced from the package: after scoring, its asymptotic mode replaces the
     /// optimism of a bigger model with a higher objective but lower WIC than a smaller one by
     /// the smaller one's optimism plus a random `|N(0, obj/10)|` draw; here every optimism is
     /// the formula's.
     ///
-    /// Cost: one WV of `x`, B simulations and WVs of length N, one fit per candidate (with the
-    /// bootstrap optimism, B simulations, WVs and two fits per candidate on top).
+    /// Cost: one WV of `x`, B simulations and WVs of length N, one fit per candidate plus the
+    /// refits of its canonical reading (with the bootstrap optimism, B simulations, WVs and two
+    /// fits per candidate on top).
     ///
     /// # Errors
     /// [`SelectionError::Setting`] for B < 2 or G = 0; [`SelectionError::Engine`] for an
-    /// unusable series or rate; [`SelectionError::Fit`] naming the candidate whose fit,
-    /// optimism or GoF failed.
+    /// unusable series or rate, or a non-Haar wavelet filter; [`SelectionError::Fit`] naming
+    /// the candidate whose fit, optimism or GoF failed.
     pub fn select(&self, x: &[f64], freq_hz: f64) -> Result<ModelSelection, SelectionError> {
+        self.select_with_progress(x, freq_hz, &NoProgress)
+    }
+
+    /// [`Wic::select`] reporting each scored candidate to `progress` (`start` with the number
+    /// of candidates, then one `advance` per finished candidate, in completion order).
+    ///
+    /// # Errors
+    /// As [`Wic::select`].
+    pub fn select_with_progress(
+        &self,
+        x: &[f64],
+        freq_hz: f64,
+        progress: &dyn Progress,
+    ) -> Result<ModelSelection, SelectionError> {
         self.check_settings()?;
         check_freq(freq_hz).map_err(crate::Error::from)?;
+        crate::fit::check_haar(self.wv_options.filter).map_err(crate::Error::from)?;
         let wv = wavelet_variance(x, freq_hz, &self.wv_options)?;
         let inputs = StartInputs::from_series(x);
         let fit_error = |m: &Model| {
             let candidate = m.to_string();
             move |source| SelectionError::Fit { candidate, source }
         };
+        progress.start(self.candidates.len());
         let full_fit = self
             .estimator(&self.full)
             .fit_from_wv(&wv, inputs)
             .map_err(fit_error(&self.full))?;
         let levels = wv.levels();
-        let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&full_fit.weights.omega));
         let replicate_opts = WvOptions {
             levels: Some(levels),
             ..self.wv_options
         };
-        let v = match self.method {
-            OptimismMethod::Asymptotic => Some(
-                wv_bootstrap(
-                    &full_fit.active_model().map_err(fit_error(&self.full))?,
-                    x.len(),
-                    freq_hz,
-                    &replicate_opts,
-                    self.bootstrap,
-                    self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET),
-                )?
-                .cov,
-            ),
-            OptimismMethod::Bootstrap => None,
-        };
+        // V of the full model: the asymptotic optimism's, and with either optimism the
+        // sampling covariance behind the WIC differences' standard errors (step 5)
+        let v = wv_bootstrap(
+            &full_fit.active_model().map_err(fit_error(&self.full))?,
+            x.len(),
+            freq_hz,
+            &replicate_opts,
+            self.bootstrap,
+            self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET),
+        )?
+        .cov;
+        let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&full_fit.weights.omega));
         let context = Context {
             wic: self,
             wv: &wv,
             inputs,
             omega: &omega,
-            v: v.as_ref(),
+            v: (self.method == OptimismMethod::Asymptotic).then_some(&v),
             replicate_opts: &replicate_opts,
         };
-        let scored: Vec<(CandidateScore, GmwmFit)> = self
+        let done = AtomicUsize::new(0);
+        let scored: Vec<Scored> = self
             .candidates
             .par_iter()
             .map(|c| {
@@ -284,29 +358,164 @@ impl Wic {
                     self.estimator(c).fit_from_wv(&wv, inputs)?
                 };
                 let score = context.score(c, &fit)?;
-                Ok((score, fit))
+                let canonical = fit.canonical_with(self.separation_limit)?;
+                progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
+                Ok(Scored {
+                    score,
+                    fit,
+                    canonical,
+                })
             })
             .map(|r: Result<_, FitError>| r)
             .zip(self.candidates.par_iter())
             .map(|(r, c)| r.map_err(fit_error(c)))
             .collect::<Result<_, _>>()?;
-        let wics: Vec<f64> = scored.iter().map(|s| s.0.wic).collect();
-        let params: Vec<usize> = scored.iter().map(|s| s.0.model.n_params()).collect();
+        Ok(self.assemble(scored, &full_fit.weights.omega, &v))
+    }
+
+    /// Steps 4 and 5 of [`Wic::select`]: folds the scored candidates into rows of canonical
+    /// models and chooses the selected row.
+    fn assemble(&self, scored: Vec<Scored>, omega: &[f64], v: &DMatrix<f64>) -> ModelSelection {
+        // step 4: rows of equal canonical models, in order of first appearance
+        let mut keys: Vec<String> = Vec::new();
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        for (i, s) in scored.iter().enumerate() {
+            let key = s.canonical.model.to_string();
+            match keys.iter().position(|k| *k == key) {
+                Some(r) => members[r].push(i),
+                None => {
+                    keys.push(key);
+                    members.push(vec![i]);
+                }
+            }
+        }
+        let mut rows: Vec<(usize, Vec<usize>)> = members
+            .into_iter()
+            .map(|m| {
+                let rep = *m
+                    .iter()
+                    .min_by(|&&a, &&b| {
+                        let (a, b) = (&scored[a], &scored[b]);
+                        a.score
+                            .model
+                            .n_params()
+                            .cmp(&b.score.model.n_params())
+                            .then(a.score.wic.total_cmp(&b.score.wic))
+                    })
+                    .unwrap_or(&m[0]);
+                (rep, m)
+            })
+            .collect();
+        // step 5: WIC order, then the rule among the rows not separable from the minimum
+        let wics: Vec<f64> = rows.iter().map(|r| scored[r.0].score.wic).collect();
+        let params: Vec<usize> = rows
+            .iter()
+            .map(|r| scored[r.0].canonical.model.n_params())
+            .collect();
         let order = rank(&wics, &params);
-        let best = order[0];
-        let selected = scored[best].0.model.clone();
-        let fit = scored[best].1.clone();
-        let candidates = order.iter().map(|&i| scored[i].0.clone()).collect();
-        Ok(ModelSelection {
+        rows = order.iter().map(|&i| rows[i].clone()).collect();
+        let best = &scored[rows[0].0];
+        let delta_wic: Vec<f64> = rows
+            .iter()
+            .map(|r| scored[r.0].score.wic - best.score.wic)
+            .collect();
+        let delta_wic_se: Vec<f64> = rows
+            .iter()
+            .map(|r| {
+                let s = &scored[r.0];
+                wic_difference_se(
+                    (
+                        &s.fit.implied_wv.wv,
+                        s.score.optimism,
+                        s.canonical.model.n_params(),
+                    ),
+                    (
+                        &best.fit.implied_wv.wv,
+                        best.score.optimism,
+                        best.canonical.model.n_params(),
+                    ),
+                    omega,
+                    v,
+                )
+            })
+            .collect();
+        let equivalent: Vec<usize> = (0..rows.len())
+            .filter(|&r| r == 0 || delta_wic[r] <= WIC_EQUIVALENCE_SE * delta_wic_se[r])
+            .collect();
+        let navigation_terms = |r: usize| {
+            let m = &scored[rows[r].0].canonical.model;
+            usize::from(m.count(ProcessKind::Wn) > 0) + usize::from(m.count(ProcessKind::Rw) > 0)
+        };
+        let chosen = match self.rule {
+            SelectionRule::WicMinimum => 0,
+            SelectionRule::Parsimonious => *equivalent
+                .iter()
+                .min_by_key(|&&r| (params[order[r]], r))
+                .unwrap_or(&0),
+            SelectionRule::Navigation => *equivalent
+                .iter()
+                .min_by_key(|&&r| (std::cmp::Reverse(navigation_terms(r)), params[order[r]], r))
+                .unwrap_or(&0),
+        };
+        let table: Vec<SelectionRow> = rows
+            .iter()
+            .enumerate()
+            .map(|(r, (rep, m))| {
+                let s = &scored[*rep];
+                SelectionRow {
+                    canonical_model: s.canonical.model.clone(),
+                    candidate: s.score.model.clone(),
+                    members: m.iter().map(|&i| scored[i].score.model.clone()).collect(),
+                    objective: s.score.objective,
+                    optimism: s.score.optimism,
+                    wic: s.score.wic,
+                    gof_p_value: s.score.gof_p_value,
+                    gof_p_value_upper_bound: s.score.gof_p_value_upper_bound,
+                    converged: s.score.converged,
+                    delta_wic: delta_wic[r],
+                    delta_wic_se: delta_wic_se[r],
+                    status: if r == chosen {
+                        RowStatus::Selected
+                    } else if equivalent.contains(&r) {
+                        RowStatus::Equivalent
+                    } else {
+                        RowStatus::Separable
+                    },
+                }
+            })
+            .collect();
+        let chosen_rep = rows[chosen].0;
+        let cand_wics: Vec<f64> = scored.iter().map(|s| s.score.wic).collect();
+        let cand_params: Vec<usize> = scored.iter().map(|s| s.score.model.n_params()).collect();
+        let candidates = rank(&cand_wics, &cand_params)
+            .into_iter()
+            .map(|i| CandidateScore {
+                canonical_model: scored[i].canonical.model.clone(),
+                ..scored[i].score.clone()
+            })
+            .collect();
+        let chosen = &scored[chosen_rep];
+        ModelSelection {
             full_model: self.full.clone(),
             method: self.method,
             convention: self.convention,
             bootstrap: self.bootstrap,
+            rule: self.rule,
+            separation_limit: self.separation_limit,
+            rows: table,
             candidates,
-            selected,
-            fit,
-        })
+            selected: chosen.score.model.clone(),
+            selected_canonical: chosen.canonical.clone(),
+            fit: chosen.fit.clone(),
+        }
     }
+}
+
+/// One candidate's fit, score and canonical reading.
+struct Scored {
+    score: CandidateScore,
+    fit: GmwmFit,
+    canonical: CanonicalModel,
 }
 
 /// Two WICs closer than this (relative) are a tie. A term that a fit drives to zero (a
@@ -315,6 +524,45 @@ impl Wic {
 /// gyro_x of adis_16405_imu1); the tie then goes to the sub-model. Differences this small are
 /// far below the bootstrap noise of the optimism (about 10% with B = 50).
 pub const WIC_TIE_REL: f64 = 1e-6;
+
+/// Rows whose WIC exceeds the minimum by at most this many standard errors of the difference
+/// are equivalent (the one-standard-error rule).
+pub const WIC_EQUIVALENCE_SE: f64 = 1.0;
+
+/// Standard error of the difference of two candidates' WICs under the sampling noise of the
+/// empirical WV (Vuong 1989, for fitted criteria): a first-order term, from the derivative of
+/// a fitted objective with respect to `nu2_hat`, `2 Omega (nu2_hat - nu2(theta_hat))`
+/// (envelope theorem), and a second-order term, the spread of the chi-square-like drop in
+/// objective that extra parameters buy on noise alone, which dominates when the two fits
+/// nearly coincide (nested candidates):
+///
+/// ```text
+/// se^2 = 4 d' Omega V Omega d  +  (opt_a - opt_b)^2 / (2 max(1, |p_a - p_b|))
+/// ```
+///
+/// with `d = nu_a - nu_b` (the two fits' implied WVs), `V` the covariance of the WV (the full
+/// model's bootstrap) and `opt` the optimisms: with `k` extra parameters the drop is about
+/// `s chi2_k` with mean `s k` = half the optimism difference (the AIC identity), so its
+/// variance is `2 k s^2`. The optimisms' own estimation noise is not included.
+pub fn wic_difference_se(
+    a: (&[f64], f64, usize),
+    b: (&[f64], f64, usize),
+    omega: &[f64],
+    v: &DMatrix<f64>,
+) -> f64 {
+    let ((nu_a, opt_a, p_a), (nu_b, opt_b, p_b)) = (a, b);
+    let g = DVector::from_iterator(
+        omega.len(),
+        omega
+            .iter()
+            .zip(nu_a.iter().zip(nu_b))
+            .map(|(w, (x, y))| w * (x - y)),
+    );
+    let first = 4.0 * (g.transpose() * v * &g)[(0, 0)].max(0.0);
+    let k = p_a.abs_diff(p_b).max(1) as f64;
+    let second = (opt_a - opt_b).powi(2) / (2.0 * k);
+    (first + second).sqrt()
+}
 
 /// Candidate order: WIC ascending (NaN last); runs of ties ([`WIC_TIE_REL`] of the run's first
 /// WIC) ordered by parameter count, then by processing order (port: the package keeps the
@@ -352,19 +600,21 @@ struct Context<'a> {
 
 impl Context<'_> {
     fn score(&self, candidate: &Model, fit: &GmwmFit) -> Result<CandidateScore, FitError> {
-        let (optimism, gof_p_value) = match self.v {
+        let (optimism, gof_p_value, gof_p_value_upper_bound) = match self.v {
             Some(v) => {
                 let o = self.asymptotic(fit, v)?;
-                (o, self.j_test_p_value(candidate, fit, v)?)
+                (o, self.j_test_p_value(candidate, fit, v)?, false)
             }
             None => self.bootstrap(candidate, fit)?,
         };
         Ok(CandidateScore {
             model: candidate.clone(),
+            canonical_model: candidate.clone(),
             objective: fit.objective,
             optimism,
             wic: fit.objective + optimism,
             gof_p_value,
+            gof_p_value_upper_bound,
             converged: fit.convergence.converged,
         })
     }
@@ -423,7 +673,11 @@ impl Context<'_> {
     /// it generates nothing in the replicates, and its boundary value (a drift of exactly 0)
     /// is no starting point for the transforms; the optimism is then that of the sub-model,
     /// as in the asymptotic form.
-    fn bootstrap(&self, candidate: &Model, fit: &GmwmFit) -> Result<(f64, Option<f64>), FitError> {
+    fn bootstrap(
+        &self,
+        candidate: &Model,
+        fit: &GmwmFit,
+    ) -> Result<(f64, Option<f64>, bool), FitError> {
         let (active, start) = match fit.active_sub_model()? {
             Some(sub) => (sub.model, sub.start),
             None => (candidate.clone(), fit.theta.clone()),
@@ -456,21 +710,33 @@ impl Context<'_> {
             above += usize::from(obj > fit.objective);
         }
         let optimism = bootstrap_optimism(&nu_hat, &nu_theta, self.omega)?;
-        Ok((optimism, Some(above as f64 / self.wic.bootstrap as f64)))
+        // no replicate above: the p-value is below 1 / (B + 1) (the smallest value the
+        // Monte Carlo p-value (1 + above) / (B + 1) takes), reported as that bound
+        let b = self.wic.bootstrap as f64;
+        Ok(if above == 0 {
+            (optimism, Some(1.0 / (b + 1.0)), true)
+        } else {
+            (optimism, Some(above as f64 / b), false)
+        })
     }
 }
 
-/// One candidate's row of the selection table (METHODS §8.6).
+/// One candidate of the selection (METHODS §8.6).
 ///
-/// Wire format: `model` (canonical text, guess mode), `objective` (`Q(theta_hat)`, §5.1),
+/// Wire format: `model` (canonical text, guess mode), `canonical_model` (its fit read as a
+/// canonical model, [`crate::fit::canonical`]), `objective` (`Q(theta_hat)`, §5.1),
 /// `optimism`, `wic` (= objective + optimism), `gof_p_value` (null when undefined: J <= p,
 /// B <= J + 2 bootstrap replicates (too few to invert V), V not positive definite or an
-/// estimate on the boundary of its transform domain),
-/// `converged` (of the candidate's optimiser).
+/// estimate on the boundary of its transform domain), `gof_p_value_upper_bound` (true when
+/// the bootstrap p-value is a bound: no replicate exceeded the observed objective, so the
+/// p-value is below `1 / (B + 1)`, the value given), `converged` (of the candidate's
+/// optimiser).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CandidateScore {
     /// The candidate (guess mode).
     pub model: Model,
+    /// Its fit's canonical model (guess mode).
+    pub canonical_model: Model,
     /// Its GMWM objective at the estimate, against the data's WV and fast weights.
     pub objective: f64,
     /// The optimism (§8.2 or §8.3).
@@ -479,16 +745,69 @@ pub struct CandidateScore {
     pub wic: f64,
     /// Goodness-of-fit p-value (§7.3 J-test with V, or the bootstrap one of §7.4).
     pub gof_p_value: Option<f64>,
+    /// Whether `gof_p_value` is an upper bound (bootstrap p-value with no replicate above).
+    pub gof_p_value_upper_bound: bool,
     /// Whether the candidate's optimiser converged.
     pub converged: bool,
+}
+
+/// Where a row stands in the selection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RowStatus {
+    /// The selected row.
+    Selected,
+    /// Within one standard error of the WIC minimum, not selected.
+    Equivalent,
+    /// Further from the WIC minimum.
+    Separable,
+}
+
+/// One row of the selection table: a canonical model and the candidates that read as it.
+///
+/// Wire format: `canonical_model`, `candidate` (the member whose scores the row shows: fewest
+/// parameters, then smallest WIC), `members` (every candidate with this canonical model),
+/// `objective`, `optimism`, `wic`, `gof_p_value`, `gof_p_value_upper_bound`, `converged` (of
+/// `candidate`), `delta_wic` (its WIC less the minimum's), `delta_wic_se` (the standard error
+/// of that difference, [`wic_difference_se`]), `status` (`selected`, `equivalent`,
+/// `separable`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SelectionRow {
+    /// The canonical model (guess mode).
+    pub canonical_model: Model,
+    /// The member whose scores the row shows.
+    pub candidate: Model,
+    /// Every candidate with this canonical model.
+    pub members: Vec<Model>,
+    /// `candidate`'s objective.
+    pub objective: f64,
+    /// `candidate`'s optimism.
+    pub optimism: f64,
+    /// `candidate`'s WIC.
+    pub wic: f64,
+    /// `candidate`'s GoF p-value.
+    pub gof_p_value: Option<f64>,
+    /// Whether that p-value is an upper bound.
+    pub gof_p_value_upper_bound: bool,
+    /// Whether `candidate`'s optimiser converged.
+    pub converged: bool,
+    /// WIC less the minimum's.
+    pub delta_wic: f64,
+    /// Standard error of `delta_wic` ([`wic_difference_se`]).
+    pub delta_wic_se: f64,
+    /// Selected, equivalent or separable.
+    pub status: RowStatus,
 }
 
 /// The result of a WIC selection (METHODS §8.6).
 ///
 /// Wire format: `full_model`, `method` (`asymptotic`/`bootstrap`), `convention`
-/// (`corrected`/`package`, used by the asymptotic optimism), `bootstrap` (B), `candidates`
-/// ([`CandidateScore`], sorted by `wic` ascending), `selected` (the first candidate's text) and
-/// `fit` (its [`GmwmFit`]).
+/// (`corrected`/`package`, used by the asymptotic optimism), `bootstrap` (B), `rule`
+/// ([`SelectionRule`]), `separation_limit` (of the canonical readings), `rows`
+/// ([`SelectionRow`], one per canonical model,
+/// sorted by `wic`), `candidates` ([`CandidateScore`], every candidate, sorted by `wic`
+/// ascending), `selected` (the selected row's candidate, as fitted), `selected_canonical`
+/// ([`CanonicalModel`]) and `fit` (the selected candidate's [`GmwmFit`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelSelection {
     /// The full model (guess mode).
@@ -499,49 +818,183 @@ pub struct ModelSelection {
     pub convention: OptimismConvention,
     /// Bootstrap replicates B.
     pub bootstrap: usize,
-    /// Candidates sorted by WIC ascending.
+    /// How the selected row was chosen.
+    pub rule: SelectionRule,
+    /// Separation below which a fit and its canonical reduction are not told apart.
+    pub separation_limit: f64,
+    /// One row per canonical model, sorted by WIC.
+    pub rows: Vec<SelectionRow>,
+    /// Every candidate, sorted by WIC ascending.
     pub candidates: Vec<CandidateScore>,
-    /// The selected model (smallest WIC), guess mode.
+    /// The selected candidate (guess mode, as fitted).
     pub selected: Model,
-    /// The selected model's fit.
+    /// Its canonical model.
+    pub selected_canonical: CanonicalModel,
+    /// The selected candidate's fit.
     pub fit: GmwmFit,
+}
+
+impl ModelSelection {
+    /// The selected row.
+    pub fn selected_row(&self) -> &SelectionRow {
+        self.rows
+            .iter()
+            .find(|r| r.status == RowStatus::Selected)
+            .unwrap_or(&self.rows[0])
+    }
+
+    /// The table with at most `top` rows (0 for all); the selected and equivalent rows are
+    /// always shown.
+    pub fn table(&self, top: usize) -> SelectionTable<'_> {
+        SelectionTable {
+            selection: self,
+            top,
+        }
+    }
+
+    /// Why the selected row was chosen, in one sentence.
+    pub fn reason(&self) -> String {
+        let sel = self.selected_row();
+        if std::ptr::eq(sel, &self.rows[0]) {
+            return format!("{} has the smallest WIC", sel.canonical_model);
+        }
+        let best = &self.rows[0];
+        let why = match self.rule {
+            SelectionRule::Navigation => {
+                let nav = |m: &Model| {
+                    usize::from(m.count(ProcessKind::Wn) > 0)
+                        + usize::from(m.count(ProcessKind::Rw) > 0)
+                };
+                if nav(&sel.canonical_model) > nav(&best.canonical_model) {
+                    "it keeps the white noise and random walk a navigation filter carries"
+                } else {
+                    "it has fewer parameters"
+                }
+            }
+            _ => "it has fewer parameters",
+        };
+        format!(
+            "{} has the smallest WIC, but {}'s exceeds it by {:.3e}, within one standard error \
+             ({:.3e}) of the difference, and {why}",
+            best.canonical_model, sel.canonical_model, sel.delta_wic, sel.delta_wic_se
+        )
+    }
+}
+
+/// A view of a [`ModelSelection`] with at most a number of rows ([`ModelSelection::table`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SelectionTable<'a> {
+    selection: &'a ModelSelection,
+    top: usize,
+}
+
+/// The WIC difference in units of its standard error (`0` for the minimum itself, `inf` when
+/// the fits coincide but the WICs do not).
+fn se_ratio(delta: f64, se: f64) -> String {
+    if delta == 0.0 {
+        "0".to_string()
+    } else if se > 0.0 {
+        format!("{:.2}", delta / se)
+    } else {
+        "inf".to_string()
+    }
+}
+
+/// A p-value cell: `<x` for an upper bound, `-` when undefined.
+fn p_cell(p: Option<f64>, bound: bool) -> String {
+    match p {
+        None => "-".to_string(),
+        Some(p) if bound => format!("<{p:.2e}"),
+        Some(p) => format!("{p:.2e}"),
+    }
+}
+
+impl fmt::Display for SelectionTable<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = self.selection;
+        writeln!(
+            f,
+            "WIC model selection: full model {}, {} candidates in {} canonical models, {} optimism, \
+             B = {}, rule {}",
+            s.full_model,
+            s.candidates.len(),
+            s.rows.len(),
+            s.method,
+            s.bootstrap,
+            s.rule
+        )?;
+        let shown: Vec<usize> = (0..s.rows.len())
+            .filter(|&r| self.top == 0 || r < self.top || s.rows[r].status != RowStatus::Separable)
+            .collect();
+        let width = shown
+            .iter()
+            .map(|&r| s.rows[r].canonical_model.to_string().len())
+            .max()
+            .unwrap_or(5)
+            .max(15);
+        writeln!(
+            f,
+            "  {:>3} {:<width$} {:>11} {:>11} {:>11} {:>10} {:>10}  {}",
+            "#",
+            "canonical model",
+            "objective",
+            "optimism",
+            "WIC",
+            "dWIC / se",
+            "GoF p",
+            "fitted as"
+        )?;
+        for &r in &shown {
+            let row = &s.rows[r];
+            let mark = match row.status {
+                RowStatus::Selected => "*",
+                RowStatus::Equivalent => "=",
+                RowStatus::Separable => " ",
+            };
+            let mut fitted: Vec<String> = vec![row.candidate.to_string()];
+            let others = row.members.len() - 1;
+            if others > 0 {
+                fitted.push(format!("(+{others} more)"));
+            }
+            let conv = if row.converged {
+                ""
+            } else {
+                " (not converged)"
+            };
+            writeln!(
+                f,
+                "{mark} {:>3} {:<width$} {:>11.5e} {:>11.5e} {:>11.5e} {:>10} {:>10}  {}{conv}",
+                r + 1,
+                row.canonical_model.to_string(),
+                row.objective,
+                row.optimism,
+                row.wic,
+                se_ratio(row.delta_wic, row.delta_wic_se),
+                p_cell(row.gof_p_value, row.gof_p_value_upper_bound),
+                fitted.join(" ")
+            )?;
+        }
+        let hidden = s.rows.len() - shown.len();
+        if hidden > 0 {
+            writeln!(f, "  ... {hidden} more rows (--top 0 shows all)")?;
+        }
+        writeln!(
+            f,
+            "  * selected, = equivalent: WIC within one standard error of the minimum (dWIC / se <= \
+             {WIC_EQUIVALENCE_SE})"
+        )?;
+        writeln!(
+            f,
+            "selected: {} ({})",
+            s.selected_row().canonical_model,
+            s.reason()
+        )?;
+        write!(f, "{}", s.selected_canonical)
+    }
 }
 
 impl fmt::Display for ModelSelection {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(
-            f,
-            "WIC model selection: full model {}, {} optimism, B = {}",
-            self.full_model, self.method, self.bootstrap
-        )?;
-        let width = self
-            .candidates
-            .iter()
-            .map(|c| c.model.to_string().len())
-            .max()
-            .unwrap_or(5)
-            .max(5);
-        writeln!(
-            f,
-            "{:<width$} {:>14} {:>14} {:>14} {:>12}",
-            "model", "objective", "optimism", "WIC", "GoF p-value"
-        )?;
-        for c in &self.candidates {
-            let p = c
-                .gof_p_value
-                .map_or_else(|| "-".to_string(), |p| format!("{p:.4e}"));
-            let mark = if c.converged { "" } else { " (not converged)" };
-            writeln!(
-                f,
-                "{:<width$} {:>14.6e} {:>14.6e} {:>14.6e} {:>12}{mark}",
-                c.model.to_string(),
-                c.objective,
-                c.optimism,
-                c.wic,
-                p
-            )?;
-        }
-        writeln!(f, "selected: {}", self.selected)?;
-        write!(f, "{}", self.fit)
+        write!(f, "{}", self.table(0))
     }
 }

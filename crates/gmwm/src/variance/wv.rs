@@ -6,6 +6,7 @@
 //! consume its input in chunks.
 
 use crate::error::{check_finite, check_freq, check_series, Error, ParamError, SeriesError};
+use crate::math::special::trigamma;
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
 use crate::variance::haar::haar_square_sums;
@@ -112,6 +113,33 @@ impl WaveletVariance {
     /// Number of levels J.
     pub fn levels(&self) -> usize {
         self.wv.len()
+    }
+
+    /// The variance of `ln nu2_hat_j` at each level: the noise of each estimate on the log
+    /// scale of its plot, whatever the level's size.
+    ///
+    /// # Formula
+    /// For the classical estimator `eta_j nu2_hat_j / nu2_j` is approximately chi-square with
+    /// `eta_j` degrees of freedom (the approximation behind the intervals, METHODS §1.7), and
+    /// the log of a chi-square variable with `eta` degrees of freedom has variance
+    /// `psi'(eta / 2)` (trigamma, [`trigamma`]): `2 / eta` for large `eta`, 1.64 at
+    /// `eta = 2`, 4.93 at `eta = 1`. The robust estimator's is `1 / eff` times larger (the
+    /// factor by which its intervals widen, METHODS §2.5).
+    ///
+    /// ```
+    /// use gmwm::{wavelet_variance, WvOptions};
+    /// let x: Vec<f64> = (0..4096).map(|t| ((t * 7919) % 101) as f64).collect();
+    /// let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+    /// let v = wv.log_variance();
+    /// // level 1 keeps 4095 coefficients, eta = 2047.5: about 2 / eta
+    /// assert!((v[0] * wv.eta[0] / 2.0 - 1.0).abs() < 1e-3);
+    /// ```
+    pub fn log_variance(&self) -> Vec<f64> {
+        let widen = self.robust.map_or(1.0, |r| 1.0 / r.eff);
+        self.eta
+            .iter()
+            .map(|&e| trigamma(e / 2.0) * widen)
+            .collect()
     }
 
     /// Assembles the result from per-level estimates and counts: scales, chi-square intervals
