@@ -27,36 +27,44 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Simulate the built-in sensor (known truth) and print its wavelet variance.
-    #[command(after_long_help = "Examples:\n  gmwm demo\n  gmwm demo --n 100000 --seed 7 --json")]
+    #[command(
+        allow_negative_numbers = true,
+        after_long_help = "Examples:\n  gmwm demo\n  gmwm demo --n 100000 --seed 7 --json"
+    )]
     Demo(DemoArgs),
     /// Wavelet variance (classical or robust) with confidence intervals, per column.
     #[command(
+        allow_negative_numbers = true,
         after_long_help = "Examples:\n  gmwm wv imu.csv.gz\n  gmwm wv imu.csv.gz --columns gyro_x --robust --eff 0.6\n  gmwm wv imu.csv.gz --transform dwt --filter la8 --levels 6 --csv\n  gmwm wv log.f64 --format f64 --ncols 3 --freq 200 --json"
     )]
     Wv(WvArgs),
     /// Allan, modified Allan or Hadamard variance with confidence intervals, per column.
     #[command(
+        allow_negative_numbers = true,
         after_long_help = "Examples:\n  gmwm avar imu.csv.gz\n  gmwm avar imu.csv.gz --kind non-overlapping --columns accel_z\n  gmwm avar imu.csv.gz --kind hadamard --json"
     )]
     Avar(AvarArgs),
     /// Simulate a fully specified error model (seeded; CSV on stdout or to a file).
     #[command(
+        allow_negative_numbers = true,
         after_long_help = "Examples:\n  gmwm simulate --model \"AR1(phi=0.99, sigma2=0.01)+WN(sigma2=1)\" --n 100000 --seed 1 -o sim.csv.gz\n  gmwm simulate --model \"GM(beta=0.25, sigma2_gm=7e-9)+WN(sigma2=7e-7)\" --freq 250 --n 1000 --components"
     )]
     Simulate(SimulateArgs),
     /// Implied (theoretical) wavelet variance of a fully specified model and of each process.
     #[command(
+        allow_negative_numbers = true,
         after_long_help = "Examples:\n  gmwm implied --model \"3*AR1(phi=0.9, sigma2=1)+WN(sigma2=2)\" --levels 10\n  gmwm implied --model \"GM(beta=0.25, sigma2_gm=7.08e-9)+RW(gamma2=3.9e-14)\" --levels 20 --freq 250 --json"
     )]
     Implied(ImpliedArgs),
     /// Estimate a latent error model by GMWM on each selected column (METHODS §5), from a
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
+        allow_negative_numbers = true,
         after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200"
     )]
     Fit(FitArgs),
     /// Select a model by the Wavelet Information Criterion on each selected column (METHODS §8).
-    #[command(after_long_help = SELECT_EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_long_help = SELECT_EXAMPLES)]
     Select(SelectArgs),
 }
 
@@ -84,8 +92,9 @@ pub struct SelectArgs {
     #[arg(long, value_name = "M1;M2;...")]
     pub candidates: Option<String>,
     /// Bootstrap replicates B: of the covariance V of the WV, simulated from the full model's
-    /// estimate (asymptotic optimism), or per candidate (--optimism bootstrap).
-    #[arg(long, value_name = "B", default_value_t = 50)]
+    /// estimate (asymptotic optimism, standard errors of WIC differences), and per candidate
+    /// with --optimism bootstrap.
+    #[arg(long, value_name = "B", default_value_t = 50, value_parser = at_least_2)]
     pub bootstrap: usize,
     /// Optimism estimator (METHODS §8.2, §8.3).
     #[arg(long, value_enum, default_value_t = OptimismArg::Asymptotic)]
@@ -94,22 +103,44 @@ pub struct SelectArgs {
     /// package's (METHODS §13.15).
     #[arg(long, value_enum, default_value_t = OptimismConventionArg::Corrected)]
     pub convention: OptimismConventionArg,
-    /// Use the robust (Tukey biweight) wavelet variance.
-    #[arg(long)]
-    pub robust: bool,
-    /// Gaussian efficiency of the robust estimator, in (0, 0.99].
-    #[arg(long, value_name = "E", default_value_t = 0.6)]
-    pub eff: f64,
+    /// How the selected model is chosen among the canonical models whose WIC is within one
+    /// standard error of the minimum.
+    #[arg(long, value_enum, default_value_t = RuleArg::Navigation)]
+    pub rule: RuleArg,
+    /// Weighting matrix Omega of every candidate's objective (METHODS §5.2): CI widths (the
+    /// package's), Percival's asymptotic variances of the WV, or the diagonal of the full
+    /// model's bootstrap V.
+    #[arg(long, value_enum, default_value_t = WeightsArg::Fast)]
+    pub weights: WeightsArg,
+    /// Wavelet-variance settings of the estimate.
+    #[command(flatten)]
+    pub estimator: WvEstimatorArgs,
     /// Number of starting-value draws of every fit [default: 20000 for N <= 1e4, else 100000,
     /// with early stop].
-    #[arg(long = "G", value_name = "N")]
+    #[arg(long = "G", value_name = "N", value_parser = at_least_1)]
     pub draws: Option<usize>,
     /// Seed of the starting-value searches and of the bootstrap.
-    #[arg(long, value_name = "S", default_value_t = 1337)]
+    #[arg(long, value_name = "S", default_value_t = 1337, value_parser = seed)]
     pub seed: u64,
-    /// Print JSON (machine-readable, full precision) instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// Rows of the table per column (0: all); the selected and equivalent rows are always
+    /// shown. JSON and CSV hold every row.
+    #[arg(long, value_name = "K", default_value_t = 10, value_parser = whole)]
+    pub top: usize,
+    /// Output format.
+    #[command(flatten)]
+    pub output: OutputArgs,
+}
+
+/// `--rule` of `gmwm select`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RuleArg {
+    /// The most of white noise and random walk (the terms a navigation filter carries), then
+    /// the fewest parameters.
+    Navigation,
+    /// The fewest parameters (the one-standard-error rule).
+    Parsimonious,
+    /// The smallest WIC (the package's rule, on canonical models).
+    WicMinimum,
 }
 
 /// `--optimism`.
@@ -149,10 +180,10 @@ pub struct FitArgs {
     #[arg(long, value_enum, default_value_t = WeightsArg::Fast)]
     pub weights: WeightsArg,
     /// Number of starting-value draws [default: 20000 for N <= 1e4, else 100000, with early stop].
-    #[arg(long = "G", value_name = "N")]
+    #[arg(long = "G", value_name = "N", value_parser = at_least_1)]
     pub draws: Option<usize>,
     /// Seed of the starting-value search.
-    #[arg(long, value_name = "S", default_value_t = 1337)]
+    #[arg(long, value_name = "S", default_value_t = 1337, value_parser = seed)]
     pub seed: u64,
     /// Add inference (METHODS §7): standard errors, 1 - alpha intervals and the J-test
     /// goodness of fit, from the sandwich with a parametric-bootstrap V (100 replicates).
@@ -160,7 +191,7 @@ pub struct FitArgs {
     pub inference: bool,
     /// With --inference: parametric-bootstrap inference with B replicates instead of the
     /// sandwich (bootstrap SE/CI and the bootstrap goodness-of-fit p-value).
-    #[arg(long, value_name = "B", requires = "inference")]
+    #[arg(long, value_name = "B", requires = "inference", value_parser = at_least_2)]
     pub bootstrap: Option<usize>,
     /// Output format.
     #[command(flatten)]
@@ -185,13 +216,13 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "MODEL")]
     pub model: String,
     /// Number of samples.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = at_least_1)]
     pub n: usize,
     /// Sampling rate in Hz (converts GM parameters; written to the sidecar).
-    #[arg(long, value_name = "HZ", default_value_t = 1.0)]
+    #[arg(long, value_name = "HZ", default_value_t = 1.0, value_parser = positive_hz)]
     pub freq: f64,
     /// Seed of the simulation (same seed, same bits).
-    #[arg(long, value_name = "S", default_value_t = 0)]
+    #[arg(long, value_name = "S", default_value_t = 0, value_parser = seed)]
     pub seed: u64,
     /// Output file (.csv or .csv.gz) with a JSON sidecar beside it [default: CSV on stdout].
     #[arg(short = 'o', long, value_name = "FILE")]
@@ -208,10 +239,10 @@ pub struct ImpliedArgs {
     #[arg(long, value_name = "MODEL")]
     pub model: String,
     /// Number of levels J (scales 2^1 .. 2^J samples).
-    #[arg(long, value_name = "J")]
+    #[arg(long, value_name = "J", value_parser = at_least_1)]
     pub levels: usize,
     /// Sampling rate in Hz (converts GM parameters; labels tau_s).
-    #[arg(long, value_name = "HZ", default_value_t = 1.0)]
+    #[arg(long, value_name = "HZ", default_value_t = 1.0, value_parser = positive_hz)]
     pub freq: f64,
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -228,13 +259,13 @@ pub struct InputArgs {
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub columns: Vec<String>,
     /// Sampling rate in Hz [default: from a time column or the JSON sidecar beside FILE].
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, value_name = "HZ", value_parser = positive_hz)]
     pub freq: Option<f64>,
     /// Input format.
     #[arg(long, value_enum, default_value_t = FormatArg::Auto)]
     pub format: FormatArg,
     /// Number of interleaved columns of a binary file.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", value_parser = at_least_1)]
     pub ncols: Option<usize>,
     /// Whether the first row of a text file is a header.
     #[arg(long, value_enum, default_value_t = HeaderArg::Auto)]
@@ -262,7 +293,7 @@ pub struct WvEstimatorArgs {
     #[arg(long)]
     pub robust: bool,
     /// Gaussian efficiency of the robust estimator, in (0, 0.99].
-    #[arg(long, value_name = "E", default_value_t = 0.6)]
+    #[arg(long, value_name = "E", default_value_t = 0.6, value_parser = efficiency)]
     pub eff: f64,
     /// Robust tuning constant and solver: the correct formula, or the R package's.
     #[arg(long, value_enum, default_value_t = RobustConventionArg::Exact)]
@@ -275,10 +306,10 @@ pub struct WvEstimatorArgs {
     #[arg(long, value_enum, default_value_t = TransformArg::Modwt)]
     pub transform: TransformArg,
     /// Number of levels J [default: floor(log2 N), one fewer if the last would keep < 2 coefficients].
-    #[arg(long, value_name = "J")]
+    #[arg(long, value_name = "J", value_parser = at_least_1)]
     pub levels: Option<usize>,
     /// Confidence level of the intervals (0.05 gives 95% intervals).
-    #[arg(long, value_name = "A", default_value_t = 0.05)]
+    #[arg(long, value_name = "A", default_value_t = 0.05, value_parser = alpha)]
     pub alpha: f64,
 }
 
@@ -286,10 +317,10 @@ pub struct WvEstimatorArgs {
 #[derive(Debug, Args)]
 pub struct DemoArgs {
     /// Number of samples to simulate [default: 2^22, about 4.7 hours at 250 Hz, as the paper's 3.1e6].
-    #[arg(long, value_name = "N", default_value_t = 1 << 22)]
+    #[arg(long, value_name = "N", default_value_t = 1 << 22, value_parser = at_least_1)]
     pub n: usize,
     /// Seed of the simulation.
-    #[arg(long, value_name = "S", default_value_t = 2018)]
+    #[arg(long, value_name = "S", default_value_t = 2018, value_parser = seed)]
     pub seed: u64,
     /// Estimator settings.
     #[command(flatten)]
@@ -326,7 +357,7 @@ pub struct AvarArgs {
     #[arg(long, value_enum, default_value_t = ConventionArg::Textbook)]
     pub convention: ConventionArg,
     /// Confidence level of the intervals (0.05 gives 95% intervals).
-    #[arg(long, value_name = "A", default_value_t = 0.05)]
+    #[arg(long, value_name = "A", default_value_t = 0.05, value_parser = alpha)]
     pub alpha: f64,
     /// Output format.
     #[command(flatten)]
@@ -399,6 +430,60 @@ pub enum ConventionArg {
     Textbook,
     /// The R package's estimators.
     Package,
+}
+
+/// `--freq`: a positive finite number of hertz.
+pub fn positive_hz(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err("must be a positive number of hertz, e.g. 100".into()),
+    }
+}
+
+/// `--eff`: a Gaussian efficiency in (0, 0.99].
+pub fn efficiency(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 0.99 => Ok(v),
+        _ => Err("must be a Gaussian efficiency in (0, 0.99], e.g. 0.6".into()),
+    }
+}
+
+/// `--alpha`: a level in (0, 1).
+pub fn alpha(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err("must be in (0, 1): 0.05 gives 95% intervals".into()),
+    }
+}
+
+/// A count of at least `min`.
+fn count_at_least(s: &str, min: usize) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(v) if v >= min => Ok(v),
+        _ => Err(format!("must be a whole number >= {min}")),
+    }
+}
+
+/// A whole number >= 1 (`--G`, `--levels`, `--ncols`, `--n`).
+pub fn at_least_1(s: &str) -> Result<usize, String> {
+    count_at_least(s, 1)
+}
+
+/// A whole number >= 2 (`--bootstrap`: a covariance needs two replicates).
+pub fn at_least_2(s: &str) -> Result<usize, String> {
+    count_at_least(s, 2).map_err(|e| format!("{e} (a covariance needs two replicates)"))
+}
+
+/// A whole number >= 0 (`--top`).
+pub fn whole(s: &str) -> Result<usize, String> {
+    count_at_least(s, 0)
+}
+
+/// A seed: a whole number from 0 to 2^64 - 1.
+pub fn seed(s: &str) -> Result<u64, String> {
+    s.trim()
+        .parse::<u64>()
+        .map_err(|_| "must be a whole number from 0 to 18446744073709551615".into())
 }
 
 #[cfg(test)]

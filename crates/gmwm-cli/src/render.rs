@@ -134,3 +134,25 @@ fn csv_field(s: &str) -> String {
         s.to_string()
     }
 }
+
+/// A reading of a canonical model with its sentence, for JSON.
+#[derive(Serialize)]
+pub struct CanonicalNote<'a> {
+    /// The reading's fields (`kind`, components, times, separation).
+    #[serde(flatten)]
+    pub reading: &'a gmwm::fit::Reading,
+    /// The reading in words.
+    pub message: String,
+}
+
+/// The readings of `canonical` with their sentences.
+pub fn canonical_notes(canonical: &gmwm::fit::CanonicalModel) -> Vec<CanonicalNote<'_>> {
+    canonical
+        .readings
+        .iter()
+        .map(|reading| CanonicalNote {
+            reading,
+            message: reading.to_string(),
+        })
+        .collect()
+}

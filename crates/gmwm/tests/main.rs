@@ -4,6 +4,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod allan;
+mod canonical;
 mod common;
 mod fit;
 mod fit_mc;

@@ -865,3 +865,300 @@ fn auto_imu_adis_six_axes() {
         ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]
     );
 }
+
+// ---------------------------------------------------------------- canonical rows (issue 10)
+
+#[test]
+fn selection_rows_fold_the_candidates_by_canonical_model() {
+    use gmwm::selection::RowStatus;
+    let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-3)");
+    let x = simulate_model(&truth, 20_000, 100.0, 31).unwrap();
+    let s = Wic::nested(model("2*AR1()+WN()+RW()+QN()+DR()"))
+        .unwrap()
+        .with_draws(500)
+        .with_bootstrap(30)
+        .select(&x, 100.0)
+        .unwrap();
+    // one row per canonical model; the rows' members partition the candidates
+    let keys: Vec<String> = s
+        .rows
+        .iter()
+        .map(|r| r.canonical_model.to_string())
+        .collect();
+    let mut unique = keys.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), keys.len(), "{keys:?}");
+    let mut members: Vec<String> = s
+        .rows
+        .iter()
+        .flat_map(|r| r.members.iter().map(Model::to_string))
+        .collect();
+    members.sort();
+    let mut all: Vec<String> = s.candidates.iter().map(|c| c.model.to_string()).collect();
+    all.sort();
+    assert_eq!(members, all);
+    for row in &s.rows {
+        // the row shows its smallest member's scores, and each member reads as the row
+        let min = row.members.iter().map(Model::n_params).min().unwrap();
+        assert_eq!(row.candidate.n_params(), min, "{}", row.canonical_model);
+        for m in &row.members {
+            let c = s.candidates.iter().find(|c| &c.model == m).unwrap();
+            assert_eq!(c.canonical_model, row.canonical_model);
+            let f = s.candidate_fit(m).unwrap();
+            assert_eq!(f.canonical().unwrap().model, row.canonical_model);
+        }
+        let c = s
+            .candidates
+            .iter()
+            .find(|c| c.model == row.candidate)
+            .unwrap();
+        assert_eq!((c.objective, c.wic), (row.objective, row.wic));
+        assert!(row.delta_wic_se >= 0.0 && row.delta_wic >= -1e-12 * row.wic.abs());
+    }
+    // sorted by WIC; the first row is the minimum, exactly one row is selected, and it is
+    // the minimum or within one standard error of it
+    assert!(s
+        .rows
+        .windows(2)
+        .all(|w| w[0].wic <= w[1].wic * (1.0 + WIC_TIE_REL)));
+    assert_eq!(s.rows[0].delta_wic, 0.0);
+    let selected: Vec<_> = s
+        .rows
+        .iter()
+        .filter(|r| r.status == RowStatus::Selected)
+        .collect();
+    assert_eq!(selected.len(), 1);
+    let sel = selected[0];
+    assert!(sel.delta_wic <= sel.delta_wic_se, "{sel:?}");
+    assert_eq!(sel.canonical_model, s.selected_canonical.model);
+    assert_eq!(sel.candidate, s.selected);
+    assert_eq!(s.fit.model.without_values(), s.selected);
+    assert_eq!(
+        s.selected_canonical.model.to_string(),
+        "AR1()+WN()+RW()",
+        "{s}"
+    );
+}
+
+#[test]
+fn wic_difference_se_matches_its_formula() {
+    use gmwm::selection::wic::wic_difference_se;
+    // one level, Omega = V = 1, fits 1 apart, equal optimisms: 2 |d| = 2
+    let v = DMatrix::identity(1, 1);
+    let se = wic_difference_se((&[2.0], 0.5, 3), (&[1.0], 0.5, 3), &[1.0], &v);
+    assert!(close(se, 2.0, 1e-15), "{se}");
+    // plus the second-order term of one extra parameter: (opt_a - opt_b)^2 / 2
+    let se = wic_difference_se((&[2.0], 2.5, 4), (&[1.0], 0.5, 3), &[1.0], &v);
+    assert!(close(se, (4.0f64 + 2.0).sqrt(), 1e-15), "{se}");
+    // two levels with a correlated V: 4 g' V g with g = Omega d
+    let v = DMatrix::from_row_slice(2, 2, &[2.0, 0.5, 0.5, 1.0]);
+    let se = wic_difference_se(
+        (&[1.0, 3.0], 1.0, 2),
+        (&[0.0, 1.0], 1.0, 2),
+        &[3.0, 0.5],
+        &v,
+    );
+    // g = (3, 1): g' V g = 18 + 3 + 1 = 22
+    assert!(close(se, (4.0f64 * 22.0).sqrt(), 1e-15), "{se}");
+}
+
+#[test]
+fn estimation_refuses_a_non_haar_wavelet_variance() {
+    use gmwm::fit::FitError;
+    use gmwm::{WaveletFilter, WvOptions};
+    let x = simulate_model(&model("AR1(phi=0.9, sigma2=1)+WN(sigma2=1)"), 4000, 1.0, 2).unwrap();
+    let la8 = WvOptions {
+        filter: WaveletFilter::La8,
+        ..WvOptions::default()
+    };
+    let g = gmwm::Gmwm::parse("AR1()+WN()").unwrap().with_draws(100);
+    for r in [
+        g.fit(&x, 1.0, &la8),
+        g.fit_series(&x, 1.0, &la8, &[0.9, 1.0, 1.0]),
+        g.fit_from_wv(
+            &gmwm::wavelet_variance(&x, 1.0, &la8).unwrap(),
+            gmwm::fit::StartInputs::from_series(&x),
+        ),
+    ] {
+        let e = r.unwrap_err();
+        assert!(matches!(e, FitError::NotHaar { .. }), "{e}");
+        assert!(e.to_string().contains("la8"), "{e}");
+    }
+    let e = Wic::nested(model("AR1()+WN()"))
+        .unwrap()
+        .with_draws(100)
+        .with_wv_options(la8)
+        .select(&x, 1.0)
+        .unwrap_err();
+    assert!(e.to_string().contains("Haar"), "{e}");
+    let fit = g.fit(&x, 1.0, &WvOptions::default()).unwrap();
+    let e = gmwm::inference::infer(&g, &fit, x.len(), &la8, &Default::default()).unwrap_err();
+    assert!(matches!(e, FitError::NotHaar { .. }), "{e}");
+}
+
+#[test]
+fn bootstrap_gof_p_value_is_a_bound_when_no_replicate_exceeds() {
+    // white noise alone on AR1 + WN data: every fresh fit of a replicate lies far below the
+    // observed objective, so the p-value is reported as below 1 / (B + 1)
+    let x = simulate_model(
+        &model("AR1(phi=0.99, sigma2=0.1)+WN(sigma2=1)"),
+        4000,
+        1.0,
+        7,
+    )
+    .unwrap();
+    let b = 20;
+    let s = Wic::parse_list(&["WN()", "AR1()+WN()"])
+        .unwrap()
+        .with_draws(200)
+        .with_bootstrap(b)
+        .with_optimism(OptimismMethod::Bootstrap)
+        .with_bootstrap_draws(100)
+        .select(&x, 1.0)
+        .unwrap();
+    let wn = s
+        .candidates
+        .iter()
+        .find(|c| terms(&c.model) == "WN")
+        .unwrap();
+    assert!(wn.gof_p_value_upper_bound, "{wn:?}");
+    assert_eq!(wn.gof_p_value, Some(1.0 / (b as f64 + 1.0)));
+    let row = s.rows.iter().find(|r| r.candidate == wn.model).unwrap();
+    assert!(row.gof_p_value_upper_bound);
+    assert!(
+        s.to_string()
+            .contains(&format!("<{:.2e}", 1.0 / (b as f64 + 1.0))),
+        "{s}"
+    );
+}
+
+/// The issue 10 Monte Carlo (figures of one replicate set): per replicate, the selected
+/// canonical model against the truth `AR1(phi=0.99, sigma2=1e-3) + WN(1) + RW(1e-6)` at N =
+/// 1e5 (the random walk shows only at the last three or four scales), and the white-noise and
+/// random-walk densities of the selected canonical model against those of the true model
+/// fitted to the same replicate (read the same way).
+struct Issue10 {
+    reps: usize,
+    /// Exactly one AR1, a WN and a RW (any QN or DR allowed).
+    core: usize,
+    /// Exactly AR1()+WN()+RW().
+    exact: usize,
+    /// WN density within 10% and RW density within 50% of the true model's fit.
+    densities: usize,
+    /// Replicates where the true model's own fit has no random walk.
+    truth_without_rw: usize,
+    /// Superfluous QN or DR in the selected canonical model.
+    superfluous: usize,
+    /// How often each canonical model was selected.
+    selected: std::collections::BTreeMap<String, usize>,
+}
+
+fn issue_10_mc(full: &str, reps: usize, weighting: gmwm::Weighting) -> Issue10 {
+    use gmwm::model::ProcessKind;
+    use rayon::prelude::*;
+    let truth = model("AR1(phi=0.99, sigma2=1e-3)+WN(sigma2=1)+RW(gamma2=1e-6)");
+    let true_model = model("AR1()+WN()+RW()");
+    let wic = Wic::nested(model(full))
+        .unwrap()
+        .with_draws(2000)
+        .with_bootstrap(50)
+        .with_weighting(weighting);
+    let rows: Vec<([bool; 5], String)> = (0..reps)
+        .into_par_iter()
+        .map(|r| {
+            let x = simulate_model(&truth, 100_000, 100.0, 1000 + r as u64).unwrap();
+            let s = wic.select(&x, 100.0).unwrap();
+            let c = &s.selected_canonical;
+            let t = s.candidate_fit(&true_model).unwrap().canonical().unwrap();
+            let density =
+                |m: &gmwm::fit::CanonicalModel, k, name| m.physical(k, name).unwrap_or(0.0);
+            let (n, n0) = (
+                density(c, ProcessKind::Wn, "white_noise_density"),
+                density(&t, ProcessKind::Wn, "white_noise_density"),
+            );
+            let (k, k0) = (
+                density(c, ProcessKind::Rw, "rate_random_walk_density"),
+                density(&t, ProcessKind::Rw, "rate_random_walk_density"),
+            );
+            let flags = [
+                c.correlated_terms() == 1
+                    && c.model.count(ProcessKind::Wn) == 1
+                    && c.model.count(ProcessKind::Rw) == 1,
+                c.model.to_string() == "AR1()+WN()+RW()",
+                (n - n0).abs() <= 0.1 * n0 && (k - k0).abs() <= 0.5 * k0,
+                k0 == 0.0,
+                c.model.count(ProcessKind::Qn) + c.model.count(ProcessKind::Dr) > 0,
+            ];
+            (flags, c.model.to_string())
+        })
+        .collect();
+    let count = |i: usize| rows.iter().filter(|r| r.0[i]).count();
+    let mut selected = std::collections::BTreeMap::new();
+    for (_, name) in &rows {
+        *selected.entry(name.clone()).or_insert(0) += 1;
+    }
+    Issue10 {
+        reps,
+        core: count(0),
+        exact: count(1),
+        densities: count(2),
+        truth_without_rw: count(3),
+        superfluous: count(4),
+        selected,
+    }
+}
+
+impl std::fmt::Display for Issue10 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} replicates: one AR1 + WN + RW {}, exactly AR1()+WN()+RW() {}, densities within \
+             10% / 50% of the true model's fit {}, true model's fit without RW {}, superfluous \
+             QN or DR {}; selected {:?}",
+            self.reps,
+            self.core,
+            self.exact,
+            self.densities,
+            self.truth_without_rw,
+            self.superfluous,
+            self.selected
+        )
+    }
+}
+
+#[test]
+fn issue_10_selection_reports_the_canonical_truth() {
+    // CI size of the issue's Monte Carlo (the full one, 200 replicates per full model, is the
+    // ignored test below): 40 replicates of N = 1e5 with the 2*AR1 full model, B = 50, G = 2000
+    // (about 20 s on 2 cores). Measured at 200 replicates (module docs of gmwm::selection):
+    // one AR1 + WN + RW 183/200, exactly AR1+WN+RW 182/200, densities 193/200. Bounds: the
+    // measured rate less 3 binomial standard errors at 40 replicates. Before this issue the
+    // selected model was AR1+WN+RW (as fitted) in 1 of 20 replicates (a drift in 11, no RW in 5).
+    let mc = issue_10_mc("2*AR1()+WN()+RW()+QN()+DR()", 40, gmwm::Weighting::Fast);
+    eprintln!("{mc}");
+    assert!(mc.core >= 31, "{mc}");
+    assert!(mc.exact >= 31, "{mc}");
+    assert!(mc.densities >= 35, "{mc}");
+}
+
+#[test]
+#[ignore = "the issue's full Monte Carlo: 200 replicates of N = 1e5 for both full models and \
+            the diag weighting, about 8 minutes on 2 cores; run with cargo test --release -p gmwm \
+            --test integration issue_10_selection_full_size -- --ignored --nocapture"]
+fn issue_10_selection_full_size() {
+    for (full, weighting) in [
+        ("2*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Fast),
+        ("3*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Fast),
+        ("2*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Diag),
+        ("3*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Diag),
+    ] {
+        let mc = issue_10_mc(full, 200, weighting);
+        eprintln!("{full} ({weighting:?} weights): {mc}");
+        // the issue's bars: exactly AR1+WN+RW in 85% (2*AR1) / 80% (3*AR1), densities in 95%;
+        // one AR1 + WN + RW in 95% is out of reach with the fast weights (module docs)
+        let exact_bar = if full.starts_with('2') { 170 } else { 160 };
+        assert!(mc.exact >= exact_bar, "{mc}");
+        assert!(mc.densities >= 190, "{mc}");
+    }
+}

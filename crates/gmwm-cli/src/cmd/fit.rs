@@ -3,17 +3,20 @@
 use crate::args::{FitArgs, TransformArg, WeightsArg};
 use crate::cmd::wv::options;
 use crate::input::{analyse_columns, column_context, load};
-use crate::render::Style;
+use crate::progress::bar;
+use crate::render::{canonical_notes, CanonicalNote, Style};
+use crate::UsageError;
 use anyhow::Result;
-use gmwm::fit::{Ar1GmForms, NavParameter, ParameterEstimate, StartInputs};
+use gmwm::fit::{
+    Ar1GmForms, CanonicalModel, CanonicalTerm, NavParameter, ParameterEstimate, StartInputs,
+};
 use gmwm::imu::{is_wv_json, read_wv_json};
 use gmwm::inference::{infer_with_progress, Inference, InferenceOptions, JTest};
 use gmwm::model::Model;
-use gmwm::WvOptions;
-use gmwm::{Gmwm, GmwmFit, WaveletVariance, Weighting};
+use gmwm::{Gmwm, GmwmFit, WaveletFilter, WaveletVariance, Weighting, WvOptions};
 use rayon::prelude::*;
 use serde::Serialize;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 
 /// One parameter in the JSON output: the estimate, plus its inference when asked.
 #[derive(Serialize)]
@@ -51,6 +54,12 @@ struct FitReport<'a> {
     ar1_gm: Vec<Ar1GmForms>,
     /// Physical units (u = the data unit).
     navigation: Vec<NavParameter>,
+    /// The canonical model (text): what the fitted components are at the observed scales.
+    canonical_model: String,
+    /// Its terms with their physical read-off.
+    canonical: &'a [CanonicalTerm],
+    /// What the canonical model reads differently from the fit, and why.
+    canonical_notes: Vec<CanonicalNote<'a>>,
     fit: &'a GmwmFit,
 }
 
@@ -163,29 +172,32 @@ fn inference(args: &FitArgs, gmwm: &Gmwm, column: &str, fit: &GmwmFit) -> Result
         ..InferenceOptions::default()
     };
     let total = args.bootstrap.unwrap_or(opts.v_replicates) as u64;
-    let bar = if std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(total);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{msg} [{bar:30}] {pos}/{len} replicates, {elapsed} (eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar.set_message(format!("inference on {column}"));
-        bar
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = bar(total, &format!("inference on {column}"), "replicates");
     let progress = |done: usize| bar.set_position(done as u64);
     let result = infer_with_progress(gmwm, fit, n, &wv_opts, &opts, &progress);
     bar.finish_and_clear();
     column_context(result.map_err(gmwm::Error::from), &args.input.file, column)
 }
 
+/// Refuses a non-Haar `--filter` for the estimation commands (fit, select): every model's
+/// implied WV is the Haar one (METHODS §1.8, §4); the engine refuses it too.
+pub fn check_haar_flag(name: &str, opts: &WvOptions) -> Result<()> {
+    if opts.filter != WaveletFilter::Haar {
+        return Err(UsageError(format!(
+            "invalid --filter {name}: every model's implied wavelet variance is the Haar one \
+             (METHODS §1.8, §4), so fits and selections use --filter haar (the default); other \
+             filters are for gmwm wv"
+        ))
+        .into());
+    }
+    Ok(())
+}
+
 /// Runs the subcommand.
 pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
     let model: Model = args.model.parse()?;
     let wv_opts = options(&args.estimator)?;
+    check_haar_flag(&args.estimator.filter, &wv_opts)?;
     let mut gmwm = Gmwm::new(model).with_weighting(match args.weights {
         WeightsArg::Fast => Weighting::Fast,
         WeightsArg::Diag => Weighting::Diag,
@@ -214,6 +226,16 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
             );
         }
     }
+    let canonicals: Vec<CanonicalModel> = fits
+        .par_iter()
+        .map(|(column, fit)| {
+            column_context(
+                fit.canonical().map_err(gmwm::Error::from),
+                &args.input.file,
+                column,
+            )
+        })
+        .collect::<Result<_>>()?;
     let inferences: Vec<Option<Inference>> = if args.inference {
         fits.iter()
             .map(|(column, fit)| inference(args, &gmwm, column, fit).map(Some))
@@ -227,7 +249,8 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                 fits: fits
                     .iter()
                     .zip(&inferences)
-                    .map(|((column, fit), inf)| FitReport {
+                    .zip(&canonicals)
+                    .map(|(((column, fit), inf), canonical)| FitReport {
                         column,
                         model: fit.model.to_string(),
                         objective: fit.objective,
@@ -252,6 +275,9 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                         inference: inf.as_ref(),
                         ar1_gm: fit.ar1_gm_forms(),
                         navigation: fit.navigation(None),
+                        canonical_model: canonical.model.to_string(),
+                        canonical: &canonical.terms,
+                        canonical_notes: canonical_notes(canonical),
                         fit,
                     })
                     .collect(),
@@ -281,7 +307,9 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
             }
         }
         Style::Table => {
-            for (i, ((column, fit), inf)) in fits.iter().zip(&inferences).enumerate() {
+            for (i, (((column, fit), inf), canonical)) in
+                fits.iter().zip(&inferences).zip(&canonicals).enumerate()
+            {
                 if i > 0 {
                     writeln!(out)?;
                 }
@@ -289,6 +317,14 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                 writeln!(out, "{fit}")?;
                 if let Some(inf) = inf {
                     writeln!(out, "{inf}")?;
+                }
+                writeln!(out, "{canonical}")?;
+                if !canonical.is_as_fitted() {
+                    writeln!(
+                        out,
+                        "  (fit {} for its own estimates and intervals)",
+                        canonical.model
+                    )?;
                 }
             }
         }

@@ -1,12 +1,16 @@
 //! `gmwm select`: model selection by the Wavelet Information Criterion on each selected column
-//! (METHODS §8).
+//! (METHODS §8), the candidates folded by canonical model.
 
-use crate::args::{OptimismArg, OptimismConventionArg, SelectArgs};
+use crate::args::{OptimismArg, OptimismConventionArg, RuleArg, SelectArgs, WeightsArg};
+use crate::cmd::wv::options;
 use crate::input::{analyse_columns, load};
+use crate::progress::{bar, Ticks};
+use crate::render::{canonical_notes, CanonicalNote, Style};
 use anyhow::Result;
+use gmwm::fit::CanonicalTerm;
 use gmwm::model::Model;
-use gmwm::selection::{OptimismConvention, OptimismMethod};
-use gmwm::{ModelSelection, RobustConvention, RobustOptions, Wic, WvOptions};
+use gmwm::selection::{OptimismConvention, OptimismMethod, RowStatus, SelectionRow, SelectionRule};
+use gmwm::{ModelSelection, Weighting, Wic};
 use serde::Serialize;
 use std::io::Write;
 
@@ -14,17 +18,33 @@ use std::io::Write;
 #[derive(Serialize)]
 struct CandidateRow {
     model: String,
+    canonical_model: String,
     objective: f64,
     optimism: f64,
     wic: f64,
     gof_p_value: Option<f64>,
+    gof_p_value_upper_bound: bool,
 }
 
-/// One column's selection in the JSON output; candidates sorted by `wic`.
+/// One column's selection in the JSON output.
 #[derive(Serialize)]
 struct SelectionReport<'a> {
     column: &'a str,
+    /// The selected candidate, as fitted.
     selected: String,
+    /// Its canonical model (text).
+    selected_canonical: String,
+    /// The canonical model's terms with their physical read-off.
+    canonical: &'a [CanonicalTerm],
+    /// What the canonical model reads differently from the fit, and why.
+    canonical_notes: Vec<CanonicalNote<'a>>,
+    /// Why the selected row was chosen.
+    reason: String,
+    rule: SelectionRule,
+    weighting: Weighting,
+    /// One row per canonical model, sorted by WIC.
+    rows: &'a [SelectionRow],
+    /// Every candidate, sorted by WIC.
     candidates: Vec<CandidateRow>,
 }
 
@@ -61,11 +81,8 @@ fn wic(args: &SelectArgs) -> Result<Wic> {
             Wic::nested(model)?
         }
     };
-    anyhow::ensure!(
-        args.bootstrap >= 2,
-        "invalid --bootstrap {}: at least 2 replicates (a covariance needs two)",
-        args.bootstrap
-    );
+    let wv_options = options(&args.estimator)?;
+    crate::cmd::fit::check_haar_flag(&args.estimator.filter, &wv_options)?;
     wic = wic
         .with_bootstrap(args.bootstrap)
         .with_seed(args.seed)
@@ -76,29 +93,77 @@ fn wic(args: &SelectArgs) -> Result<Wic> {
         .with_convention(match args.convention {
             OptimismConventionArg::Corrected => OptimismConvention::Corrected,
             OptimismConventionArg::Package => OptimismConvention::Package,
-        });
+        })
+        .with_rule(match args.rule {
+            RuleArg::Navigation => SelectionRule::Navigation,
+            RuleArg::Parsimonious => SelectionRule::Parsimonious,
+            RuleArg::WicMinimum => SelectionRule::WicMinimum,
+        })
+        .with_weighting(match args.weights {
+            WeightsArg::Fast => Weighting::Fast,
+            WeightsArg::Diag => Weighting::Diag,
+            WeightsArg::Bootstrap => Weighting::Bootstrap,
+        })
+        .with_wv_options(wv_options);
     if let Some(g) = args.draws {
-        anyhow::ensure!(g >= 1, "invalid --G 0: at least one starting-value draw");
         wic = wic.with_draws(g);
     }
-    let robust = if args.robust {
-        Some(RobustOptions::new(args.eff, RobustConvention::Exact)?)
-    } else {
-        None
-    };
-    Ok(wic.with_wv_options(WvOptions {
-        robust,
-        ..WvOptions::default()
-    }))
+    Ok(wic)
+}
+
+/// CSV: one line per row of each column's table.
+const CSV_HEADER: &str = "column,rank,canonical_model,candidate,members,objective,optimism,wic,\
+delta_wic,delta_wic_se,gof_p_value,gof_p_value_upper_bound,status";
+
+fn write_csv(results: &[(String, ModelSelection)], out: &mut impl Write) -> Result<()> {
+    writeln!(out, "{CSV_HEADER}")?;
+    let cell = |x: Option<f64>| x.map(|x| format!("{x:e}")).unwrap_or_default();
+    for (column, s) in results {
+        for (r, row) in s.rows.iter().enumerate() {
+            let members: Vec<String> = row.members.iter().map(Model::to_string).collect();
+            let status = match row.status {
+                RowStatus::Selected => "selected",
+                RowStatus::Equivalent => "equivalent",
+                RowStatus::Separable => "separable",
+            };
+            writeln!(
+                out,
+                "{column},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{},{},{status}",
+                r + 1,
+                row.canonical_model,
+                row.candidate,
+                members.join(";"),
+                row.objective,
+                row.optimism,
+                row.wic,
+                row.delta_wic,
+                row.delta_wic_se,
+                cell(row.gof_p_value),
+                row.gof_p_value_upper_bound
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// Runs the subcommand.
 pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
     let wic = wic(args)?;
     let loaded = load(&args.input)?;
-    let results: Vec<(String, ModelSelection)> = analyse_columns(&loaded, &args.input.file, |x| {
-        wic.select(x, loaded.freq_hz).map_err(gmwm::Error::from)
-    })?;
+    let columns = loaded.table.columns.len();
+    let progress = bar(
+        (columns * wic.candidates().len()) as u64,
+        "WIC selection",
+        "candidates",
+    );
+    let ticks = Ticks(&progress);
+    let results: Result<Vec<(String, ModelSelection)>> =
+        analyse_columns(&loaded, &args.input.file, |x| {
+            wic.select_with_progress(x, loaded.freq_hz, &ticks)
+                .map_err(gmwm::Error::from)
+        });
+    progress.finish_and_clear();
+    let results = results?;
     for (name, s) in &results {
         if !s.fit.convergence.converged {
             eprintln!(
@@ -109,36 +174,49 @@ pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
             );
         }
     }
-    if args.json {
-        let doc = SelectionsDoc {
-            selections: results
-                .iter()
-                .map(|(column, s)| SelectionReport {
-                    column,
-                    selected: s.selected.to_string(),
-                    candidates: s
-                        .candidates
-                        .iter()
-                        .map(|c| CandidateRow {
-                            model: c.model.to_string(),
-                            objective: c.objective,
-                            optimism: c.optimism,
-                            wic: c.wic,
-                            gof_p_value: c.gof_p_value,
-                        })
-                        .collect(),
-                })
-                .collect(),
-        };
-        serde_json::to_writer_pretty(&mut *out, &doc)?;
-        writeln!(out)?;
-    } else {
-        for (i, (column, s)) in results.iter().enumerate() {
-            if i > 0 {
-                writeln!(out)?;
+    match Style::from(&args.output) {
+        Style::Json => {
+            let doc = SelectionsDoc {
+                selections: results
+                    .iter()
+                    .map(|(column, s)| SelectionReport {
+                        column,
+                        selected: s.selected.to_string(),
+                        selected_canonical: s.selected_canonical.model.to_string(),
+                        canonical: &s.selected_canonical.terms,
+                        canonical_notes: canonical_notes(&s.selected_canonical),
+                        reason: s.reason(),
+                        rule: s.rule,
+                        weighting: s.weighting,
+                        rows: &s.rows,
+                        candidates: s
+                            .candidates
+                            .iter()
+                            .map(|c| CandidateRow {
+                                model: c.model.to_string(),
+                                canonical_model: c.canonical_model.to_string(),
+                                objective: c.objective,
+                                optimism: c.optimism,
+                                wic: c.wic,
+                                gof_p_value: c.gof_p_value,
+                                gof_p_value_upper_bound: c.gof_p_value_upper_bound,
+                            })
+                            .collect(),
+                    })
+                    .collect(),
+            };
+            serde_json::to_writer_pretty(&mut *out, &doc)?;
+            writeln!(out)?;
+        }
+        Style::Csv => write_csv(&results, out)?,
+        Style::Table => {
+            for (i, (column, s)) in results.iter().enumerate() {
+                if i > 0 {
+                    writeln!(out)?;
+                }
+                writeln!(out, "{column}")?;
+                writeln!(out, "{}", s.table(args.top))?;
             }
-            writeln!(out, "{column}")?;
-            writeln!(out, "{s}")?;
         }
     }
     Ok(())

@@ -59,6 +59,11 @@
 //!
 //!    An AR1/GM that rises over every observed scale but is separable from a random walk is kept,
 //!    with a note that its correlation time lies beyond the recording and is poorly determined.
+//!    In practice that does not happen: such an AR1 bends only over the last octaves, where
+//!    the WV has a few degrees of freedom (`eta_j ~ N / 2^j`), so even its noise-free WV is
+//!    about one standard error from the best random walk's (a 2^15-sample recording and a
+//!    correlation length of 5000 samples: tests/canonical.rs). A correlation time beyond the
+//!    recording is not measured by it.
 //!
 //! The result, [`CanonicalModel`], lists the canonical terms in a fixed order (AR1/GM by
 //! decreasing correlation time, then WN, QN, RW, DR, then any ARMA-family term as fitted), each
@@ -828,8 +833,8 @@ impl GmwmFit {
                 .filter(|(j, _)| *j != i && *j != k)
                 .map(|(_, p)| p.clone())
                 .collect();
+            let components = part.from.clone();
             next.push(part);
-            let components = vec![parts[i].from[0], parts[k].from[0]];
             let times = vec![correlation_time(a, f), correlation_time(b, f)];
             let process = parts[i].kind().name();
             out.push(Reduction {

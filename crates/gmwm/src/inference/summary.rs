@@ -152,6 +152,14 @@ pub enum InferenceWarning {
         /// The boundary parameters' labels.
         parameters: Vec<String>,
     },
+    /// Parameters without influence on the implied WV at the estimate (the edge of their
+    /// domain, e.g. a GM `beta` so large that `phi` underflowed to 0, which makes the GM a
+    /// white noise): no standard error; the canonical model ([`crate::fit::canonical`]) names
+    /// what the component is.
+    NoInfluence {
+        /// The parameters' labels.
+        parameters: Vec<String>,
+    },
     /// No J-test: no degrees of freedom or too few replicates for a usable `V^{-1}`.
     NoJTest {
         /// Levels J.
@@ -181,6 +189,15 @@ impl fmt::Display for InferenceWarning {
                 parameters.join(", "),
                 if parameters.len() == 1 { "it" } else { "them" }
             ),
+            InferenceWarning::NoInfluence { parameters } => {
+                write!(
+                f,
+                "{} no influence on the implied WV at the estimate (the edge of {} domain): no \
+                 standard error; fit the canonical model for identified intervals",
+                parameters.join(", ") + if parameters.len() == 1 { " has" } else { " have" },
+                if parameters.len() == 1 { "its" } else { "their" }
+            )
+            }
             InferenceWarning::NoJTest {
                 levels,
                 params,
@@ -292,6 +309,33 @@ pub fn infer_with_progress(
         }
         None => (0..p).collect(),
     };
+    // a parameter without influence on the implied WV at the estimate sits on the edge of
+    // its domain (a GM beta so large that phi underflowed to 0: the GM is white noise); it
+    // has no standard error either
+    let jacobian = fit.model.jacobian(levels, fit.freq_hz)?;
+    let no_influence: Vec<usize> = keep
+        .iter()
+        .copied()
+        .filter(|&k| {
+            let norm: f64 = (0..levels)
+                .map(|j| fit.weights.omega[j] * jacobian[j][k] * jacobian[j][k])
+                .sum();
+            !(norm.is_finite() && norm > 0.0)
+        })
+        .collect();
+    let keep: Vec<usize> = if no_influence.is_empty() {
+        keep
+    } else {
+        warnings.push(InferenceWarning::NoInfluence {
+            parameters: no_influence
+                .iter()
+                .map(|&k| fit.param_names[k].clone())
+                .collect(),
+        });
+        keep.into_iter()
+            .filter(|k| !no_influence.contains(k))
+            .collect()
+    };
     let q = keep.len();
     let (method, v, v_replicates, covariance, se, se_g, bootstrap_gof) = match opts.bootstrap {
         None => {
@@ -323,8 +367,7 @@ pub fn infer_with_progress(
                 VShape::Full => v.clone(),
                 VShape::Diagonal => DMatrix::from_diagonal(&v.diagonal()),
             };
-            let a = fit.model.jacobian(levels, fit.freq_hz)?;
-            let a = DMatrix::from_fn(levels, q, |i, k| a[i][keep[k]]);
+            let a = DMatrix::from_fn(levels, q, |i, k| jacobian[i][keep[k]]);
             let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&fit.weights.omega));
             let s = sandwich(&a, &omega, &v_sand)?;
             if s.rank < q {

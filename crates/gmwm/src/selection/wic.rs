@@ -7,7 +7,9 @@ use super::optimism::{
 };
 use super::SelectionError;
 use crate::error::check_freq;
-use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
+use crate::fit::{
+    CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weighting, Weights, SEPARATION_LIMIT,
+};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{map_replicates, wv_bootstrap, NoProgress, Progress};
 use crate::model::{Model, ProcessKind};
@@ -46,6 +48,7 @@ pub struct Wic {
     wv_options: WvOptions,
     rule: SelectionRule,
     separation_limit: f64,
+    weighting: Weighting,
 }
 
 /// How the selected row is chosen among the rows of canonical models (module docs of
@@ -96,6 +99,7 @@ impl Wic {
             wv_options: WvOptions::default(),
             rule: SelectionRule::default(),
             separation_limit: SEPARATION_LIMIT,
+            weighting: Weighting::Fast,
         }
     }
 
@@ -216,6 +220,18 @@ impl Wic {
         self
     }
 
+    /// Sets the weights of every candidate's objective (METHODS §5.2); default
+    /// [`Weighting::Fast`], the package's. [`Weighting::Diag`] uses Percival's asymptotic
+    /// variances of the series' WV; [`Weighting::Bootstrap`] the diagonal of the full model's
+    /// bootstrap covariance V (the one behind the asymptotic optimism), the same for every
+    /// candidate. Both weigh each level by its actual variance, where the fast weights (squared
+    /// interval widths) discount the coarsest levels, whose chi-square intervals are far wider
+    /// than their standard errors.
+    pub fn with_weighting(mut self, weighting: Weighting) -> Self {
+        self.weighting = weighting;
+        self
+    }
+
     /// The full model (guess mode).
     pub fn full_model(&self) -> &Model {
         &self.full
@@ -318,10 +334,16 @@ impl Wic {
             move |source| SelectionError::Fit { candidate, source }
         };
         progress.start(self.candidates.len());
-        let full_fit = self
-            .estimator(&self.full)
-            .fit_from_wv(&wv, inputs)
-            .map_err(fit_error(&self.full))?;
+        let weights = match self.weighting {
+            Weighting::Diag => Weights::diag(x, &wv),
+            _ => Weights::fast(&wv),
+        }
+        .map_err(fit_error(&self.full))?;
+        let fit_with = |m: &Model, w: &Weights| -> Result<GmwmFit, FitError> {
+            let g = self.estimator(m);
+            g.finish(g.fit_auto(&wv, w.clone(), inputs)?, &wv, inputs)
+        };
+        let full_fit = fit_with(&self.full, &weights).map_err(fit_error(&self.full))?;
         let levels = wv.levels();
         let replicate_opts = WvOptions {
             levels: Some(levels),
@@ -338,11 +360,19 @@ impl Wic {
             self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET),
         )?
         .cov;
-        let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&full_fit.weights.omega));
+        let (full_fit, weights) = if self.weighting == Weighting::Bootstrap {
+            let w = Weights::from_variances(v.diagonal().iter().copied().collect())
+                .map_err(fit_error(&self.full))?;
+            (fit_with(&self.full, &w).map_err(fit_error(&self.full))?, w)
+        } else {
+            (full_fit, weights)
+        };
+        let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&weights.omega));
         let context = Context {
             wic: self,
             wv: &wv,
             inputs,
+            weights: &weights,
             omega: &omega,
             v: (self.method == OptimismMethod::Asymptotic).then_some(&v),
             replicate_opts: &replicate_opts,
@@ -355,7 +385,7 @@ impl Wic {
                 let fit = if c.kinds() == self.full.kinds() {
                     full_fit.clone()
                 } else {
-                    self.estimator(c).fit_from_wv(&wv, inputs)?
+                    fit_with(c, &weights)?
                 };
                 let score = context.score(c, &fit)?;
                 let canonical = fit.canonical_with(self.separation_limit)?;
@@ -370,7 +400,7 @@ impl Wic {
             .zip(self.candidates.par_iter())
             .map(|(r, c)| r.map_err(fit_error(c)))
             .collect::<Result<_, _>>()?;
-        Ok(self.assemble(scored, &full_fit.weights.omega, &v))
+        Ok(self.assemble(scored, &weights.omega, &v))
     }
 
     /// Steps 4 and 5 of [`Wic::select`]: folds the scored candidates into rows of canonical
@@ -487,13 +517,15 @@ impl Wic {
         let chosen_rep = rows[chosen].0;
         let cand_wics: Vec<f64> = scored.iter().map(|s| s.score.wic).collect();
         let cand_params: Vec<usize> = scored.iter().map(|s| s.score.model.n_params()).collect();
-        let candidates = rank(&cand_wics, &cand_params)
-            .into_iter()
-            .map(|i| CandidateScore {
+        let cand_order = rank(&cand_wics, &cand_params);
+        let candidates = cand_order
+            .iter()
+            .map(|&i| CandidateScore {
                 canonical_model: scored[i].canonical.model.clone(),
                 ..scored[i].score.clone()
             })
             .collect();
+        let candidate_fits = cand_order.iter().map(|&i| scored[i].fit.clone()).collect();
         let chosen = &scored[chosen_rep];
         ModelSelection {
             full_model: self.full.clone(),
@@ -507,6 +539,8 @@ impl Wic {
             selected: chosen.score.model.clone(),
             selected_canonical: chosen.canonical.clone(),
             fit: chosen.fit.clone(),
+            weighting: self.weighting,
+            candidate_fits,
         }
     }
 }
@@ -593,12 +627,23 @@ struct Context<'a> {
     wic: &'a Wic,
     wv: &'a WaveletVariance,
     inputs: StartInputs,
+    weights: &'a Weights,
     omega: &'a DMatrix<f64>,
     v: Option<&'a DMatrix<f64>>,
     replicate_opts: &'a WvOptions,
 }
 
 impl Context<'_> {
+    /// The weights of a replicate's fits, of the selection's kind (METHODS §5.2): its own fast
+    /// or diag weights, or the full model's bootstrap weights of the data.
+    fn replicate_weights(&self, wv: &WaveletVariance, x: &[f64]) -> Result<Weights, FitError> {
+        match self.wic.weighting {
+            Weighting::Fast => Weights::fast(wv),
+            Weighting::Diag => Weights::diag(x, wv),
+            Weighting::Bootstrap => Ok(self.weights.clone()),
+        }
+    }
+
     fn score(&self, candidate: &Model, fit: &GmwmFit) -> Result<CandidateScore, FitError> {
         let (optimism, gof_p_value, gof_p_value_upper_bound) = match self.v {
             Some(v) => {
@@ -693,12 +738,12 @@ impl Context<'_> {
             self.wic.bootstrap,
             seed,
             |r, wv, x| {
-                let weights = Weights::fast(wv)?;
-                let refit = stage2.fit_weighted(&wv.wv, weights, freq_hz, &start)?;
+                let weights = self.replicate_weights(wv, x)?;
+                let refit = stage2.fit_weighted(&wv.wv, weights.clone(), freq_hz, &start)?;
                 let fresh = Gmwm::new(candidate.clone())
                     .with_seed(replicate_seed(seed, r as u64))
                     .with_draws(self.wic.bootstrap_draws)
-                    .fit_from_wv(wv, StartInputs::from_series(x))?;
+                    .fit_auto(wv, weights, StartInputs::from_series(x))?;
                 Ok::<_, FitError>((wv.wv.clone(), refit.implied_wv.wv, fresh.objective))
             },
         )?;
@@ -807,7 +852,7 @@ pub struct SelectionRow {
 /// ([`SelectionRow`], one per canonical model,
 /// sorted by `wic`), `candidates` ([`CandidateScore`], every candidate, sorted by `wic`
 /// ascending), `selected` (the selected row's candidate, as fitted), `selected_canonical`
-/// ([`CanonicalModel`]) and `fit` (the selected candidate's [`GmwmFit`]).
+/// ([`CanonicalModel`]), `fit` (the selected candidate's [`GmwmFit`]) and `weighting`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelSelection {
     /// The full model (guess mode).
@@ -832,9 +877,22 @@ pub struct ModelSelection {
     pub selected_canonical: CanonicalModel,
     /// The selected candidate's fit.
     pub fit: GmwmFit,
+    /// The weights every candidate was fitted with (METHODS §5.2).
+    pub weighting: Weighting,
+    /// Every candidate's fit, in the order of `candidates` (not serialised).
+    #[serde(skip)]
+    pub candidate_fits: Vec<GmwmFit>,
 }
 
 impl ModelSelection {
+    /// The fit of the candidate `model` (guess mode, as listed in `candidates`).
+    pub fn candidate_fit(&self, model: &Model) -> Option<&GmwmFit> {
+        self.candidates
+            .iter()
+            .position(|c| &c.model == model)
+            .and_then(|i| self.candidate_fits.get(i))
+    }
+
     /// The selected row.
     pub fn selected_row(&self) -> &SelectionRow {
         self.rows
