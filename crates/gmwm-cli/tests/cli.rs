@@ -29,6 +29,10 @@ fn assert_one_line_error(args: &[&str], needles: &[&str]) {
     common::assert_one_line_error(gmwm().args(args), needles);
 }
 
+fn assert_usage_error(args: &[&str], needles: &[&str]) {
+    common::assert_usage_error(gmwm().args(args), needles);
+}
+
 #[test]
 fn wv_json_on_real_data_has_the_documented_shape() {
     let out = gmwm()
@@ -252,13 +256,16 @@ fn truncated_binary_is_an_error() {
 fn impossible_parameters_are_errors() {
     let f = temp_file(".csv", b"x\n1\n3\n2\n5\n4\n6\n8\n7\n");
     let p = f.path().to_str().unwrap();
-    assert_one_line_error(&["wv", "--robust", "--eff", "1.5", p], &["eff"]);
+    assert_usage_error(
+        &["wv", "--robust", "--eff", "1.5", p],
+        &["--eff", "(0, 0.99]"],
+    );
     assert_one_line_error(&["wv", "--filter", "db99", p], &["db99"]);
-    assert_one_line_error(&["wv", "--alpha", "2", p], &["alpha"]);
+    assert_usage_error(&["wv", "--alpha", "2", p], &["--alpha", "(0, 1)"]);
     assert_one_line_error(&["wv", "--levels", "9", p], &["level"]);
-    assert_one_line_error(&["wv", "--freq=-3", p], &["freq"]);
-    assert_one_line_error(&["wv", "--freq", "0", p], &["freq"]);
-    assert_one_line_error(&["avar", "--alpha", "0", p], &["alpha"]);
+    assert_usage_error(&["wv", "--levels", "0", p], &["--levels", ">= 1"]);
+    assert_usage_error(&["wv", "--freq=-3", p], &["--freq", "positive"]);
+    assert_usage_error(&["avar", "--alpha", "0", p], &["--alpha"]);
     assert_one_line_error(
         &[
             "wv",
@@ -272,6 +279,89 @@ fn impossible_parameters_are_errors() {
         ],
         &["/nonexistent/file.csv"],
     );
+}
+
+#[test]
+fn issue_10_numeric_flags_outside_their_domain_are_one_line_usage_errors() {
+    // `gmwm wv FILE --freq -5` used to answer "unexpected argument '-5' found ... use '-- -5'"
+    let f = temp_file(".csv", b"x\n1\n3\n2\n5\n4\n6\n8\n7\n");
+    let p = f.path().to_str().unwrap();
+    for cmd in [
+        &["wv"][..],
+        &["avar"],
+        &["fit", "--model", "WN()"],
+        &["select", "--model", "WN()"],
+    ] {
+        for freq in ["-5", "0", "nan", "inf", "abc"] {
+            let mut args = cmd.to_vec();
+            args.extend(["--freq", freq, p]);
+            assert_usage_error(&args, &["--freq", "must be a positive number of hertz"]);
+        }
+    }
+    for (flag, value, domain) in [
+        ("--G", "-3", ">= 1"),
+        ("--G", "0", ">= 1"),
+        ("--seed", "-1", "whole number"),
+        ("--levels", "-2", ">= 1"),
+        ("--eff", "-0.5", "(0, 0.99]"),
+        ("--alpha", "-0.05", "(0, 1)"),
+    ] {
+        assert_usage_error(&["fit", "--model", "WN()", flag, value, p], &[flag, domain]);
+    }
+    assert_usage_error(
+        &[
+            "fit",
+            "--model",
+            "WN()",
+            "--inference",
+            "--bootstrap",
+            "1",
+            p,
+        ],
+        &["--bootstrap", ">= 2"],
+    );
+    assert_usage_error(&["select", "--model", "WN()", "--top", "-1", p], &["--top"]);
+    assert_usage_error(
+        &["simulate", "--model", "WN(sigma2=1)", "--n", "0"],
+        &["--n", ">= 1"],
+    );
+    assert_usage_error(
+        &[
+            "simulate",
+            "--model",
+            "WN(sigma2=1)",
+            "--n",
+            "10",
+            "--freq",
+            "-1",
+        ],
+        &["--freq"],
+    );
+    assert_usage_error(
+        &["implied", "--model", "WN(sigma2=1)", "--levels", "0"],
+        &["--levels"],
+    );
+    assert_usage_error(&["demo", "--n", "-1"], &["--n"]);
+}
+
+#[test]
+fn issue_10_fit_and_select_refuse_a_non_haar_filter() {
+    // `gmwm fit FILE --filter la8` used to exit 0 with estimates fitted to the wrong WV
+    let csv = data("sim/ar1_wn_rw_N10000.csv.gz");
+    let p = csv.to_str().unwrap();
+    for cmd in ["fit", "select"] {
+        assert_usage_error(
+            &[cmd, "--model", "AR1()+WN()", "--filter", "la8", p],
+            &["--filter la8", "Haar"],
+        );
+    }
+    // Haar stays accepted by name
+    gmwm()
+        .args([
+            "fit", "--model", "WN()", "--filter", "haar", "--G", "100", p,
+        ])
+        .assert()
+        .success();
 }
 
 #[test]
@@ -620,7 +710,7 @@ fn review_findings_are_errors_not_panics_or_silent_numbers() {
     assert_one_line_error(&["demo", "--filter", "la8"], &["Haar"]);
     assert_one_line_error(&["demo", "--n", "100000000000"], &["memory"]);
     let b = temp_file(".bin", &1.0f64.to_le_bytes());
-    assert_one_line_error(
+    assert_usage_error(
         &[
             "wv",
             "--format",
@@ -631,7 +721,7 @@ fn review_findings_are_errors_not_panics_or_silent_numbers() {
             "1",
             b.path().to_str().unwrap(),
         ],
-        &["ncols"],
+        &["--ncols", ">= 1"],
     );
     let ok = temp_file(".csv", b"x\n1\n3\n2\n5\n4\n6\n8\n7\n");
     gmwm()
@@ -770,4 +860,38 @@ fn fit_inference_fields() {
         .args(["--model", "WN()", "--bootstrap", "10"])
         .assert()
         .code(2);
+}
+
+/// Issue 10: `gmwm fit adis_16405_imu1 --columns gyro_x --model "2*AR1()"` returned an AR1 at
+/// phi = 0.16 (5.5 ms at 10 ms sampling) as its only fast term; the canonical model names it
+/// white noise, in the table and the JSON.
+#[test]
+fn issue_10_fit_reports_the_canonical_model() {
+    let file = data("adis_16405_imu1.csv.gz");
+    let args = ["--columns", "gyro_x", "--model", "2*AR1()"];
+    let doc = run_json(gmwm().arg("fit").arg(&file).args(args).arg("--json"));
+    let fit = &doc["fits"][0];
+    assert_eq!(fit["model"].as_str().unwrap().matches("AR1(").count(), 2);
+    assert_eq!(fit["canonical_model"], "AR1()+WN()");
+    let terms = fit["canonical"].as_array().unwrap();
+    assert_eq!(terms[1]["process"], "WN");
+    assert_eq!(terms[1]["from"], serde_json::json!([1]));
+    let n = &terms[1]["physical"][0];
+    assert_eq!(n["name"], "white_noise_density");
+    // deg/s/sqrt(Hz) at 100 Hz: about 0.041 (2.5 deg/sqrt(h)), the Allan read-off at 1 s
+    let value = n["value"].as_f64().unwrap();
+    assert!((value - 0.0412).abs() < 0.001, "{value}");
+    let note = &fit["canonical_notes"][0];
+    assert_eq!(note["kind"], "white-at-sampling-rate");
+    assert!(note["message"]
+        .as_str()
+        .unwrap()
+        .contains("below the sampling interval"));
+    let out = gmwm().arg("fit").arg(&file).args(args).output().unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("canonical model: AR1()+WN()"), "{text}");
+    assert!(
+        text.contains("fit AR1()+WN() for its own estimates and intervals"),
+        "{text}"
+    );
 }

@@ -30,6 +30,28 @@ fn select_json_has_the_documented_shape() {
     let sel = doc["selections"].as_array().unwrap();
     assert_eq!(sel.len(), 1);
     assert_eq!(sel[0]["column"], "x");
+    let mut top: Vec<&str> = sel[0]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    top.sort();
+    assert_eq!(
+        top,
+        [
+            "candidates",
+            "canonical",
+            "canonical_notes",
+            "column",
+            "reason",
+            "rows",
+            "rule",
+            "selected",
+            "selected_canonical",
+            "weighting"
+        ]
+    );
     let cands = sel[0]["candidates"].as_array().unwrap();
     // 2^3 - 1 sub-models of AR1 + WN + RW
     assert_eq!(cands.len(), 7);
@@ -42,7 +64,15 @@ fn select_json_has_the_documented_shape() {
     keys.sort();
     assert_eq!(
         keys,
-        ["gof_p_value", "model", "objective", "optimism", "wic"]
+        [
+            "canonical_model",
+            "gof_p_value",
+            "gof_p_value_upper_bound",
+            "model",
+            "objective",
+            "optimism",
+            "wic"
+        ]
     );
     let wic: Vec<f64> = cands.iter().map(|c| c["wic"].as_f64().unwrap()).collect();
     // sorted by wic (ties within 1e-6 relative go to the smaller model)
@@ -60,11 +90,96 @@ fn select_json_has_the_documented_shape() {
         assert!((o + p - w).abs() <= 1e-15 * w.abs(), "{c}");
         assert!(o >= 0.0 && p > 0.0, "{c}");
     }
-    assert_eq!(sel[0]["selected"], cands[0]["model"]);
-    // the true structure has the smallest WIC on this seed; the model missing RW is far worse
-    assert_eq!(sel[0]["selected"], "AR1()+WN()+RW()");
+    // the rows: one per canonical model, the selected one marked, its canonical model named
+    let rows = sel[0]["rows"].as_array().unwrap();
+    let selected: Vec<&serde_json::Value> =
+        rows.iter().filter(|r| r["status"] == "selected").collect();
+    assert_eq!(selected.len(), 1);
+    assert_eq!(sel[0]["selected_canonical"], selected[0]["canonical_model"]);
+    assert_eq!(sel[0]["selected"], selected[0]["candidate"]);
+    // the true structure is selected on this seed, and its terms carry the read-off
+    assert_eq!(sel[0]["selected_canonical"], "AR1()+WN()+RW()");
+    let terms: Vec<&str> = sel[0]["canonical"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["process"].as_str().unwrap())
+        .collect();
+    assert_eq!(terms, ["AR1", "WN", "RW"]);
+    let wn = &sel[0]["canonical"][1]["physical"][0];
+    assert_eq!(wn["name"], "white_noise_density");
+    assert!(wn["value"].as_f64().unwrap() > 0.0);
+    // every candidate names its canonical model, and each canonical model has one row
+    for c in cands {
+        let cm = c["canonical_model"].as_str().unwrap();
+        assert_eq!(
+            rows.iter().filter(|r| r["canonical_model"] == cm).count(),
+            1,
+            "{cm}"
+        );
+    }
     // the same seed gives the same bits
     assert_eq!(select_json(&file, &["--model", "AR1()+WN()+RW()"]), doc);
+}
+
+#[test]
+fn select_csv_and_top_fold_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = simulated(dir.path());
+    let args = [
+        "--model",
+        "2*AR1()+WN()+RW()+QN()",
+        "--G",
+        "300",
+        "--bootstrap",
+        "20",
+    ];
+    let csv = gmwm()
+        .arg("select")
+        .arg(&file)
+        .args(args)
+        .arg("--csv")
+        .output()
+        .unwrap();
+    assert!(csv.status.success(), "{csv:?}");
+    let text = String::from_utf8(csv.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "column,rank,canonical_model,candidate,members,objective,optimism,wic,delta_wic,\
+         delta_wic_se,gof_p_value,gof_p_value_upper_bound,status"
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert!(rows.iter().all(|r| r.len() == 13), "{text}");
+    assert_eq!(
+        rows.iter().filter(|r| r[12] == "selected").count(),
+        1,
+        "{text}"
+    );
+    // 23 candidates fold into fewer rows, each canonical model once
+    let mut models: Vec<&str> = rows.iter().map(|r| r[2]).collect();
+    let n = models.len();
+    models.sort();
+    models.dedup();
+    assert_eq!(models.len(), n, "{text}");
+    let members: usize = rows.iter().map(|r| r[4].split(';').count()).sum();
+    assert_eq!(members, 23, "{text}");
+    assert!(n < 23);
+    // --top 2: two rows (plus any selected or equivalent one) and a line saying how many more
+    let out = gmwm()
+        .arg("select")
+        .arg(&file)
+        .args(args)
+        .args(["--top", "2"])
+        .output()
+        .unwrap();
+    let table = String::from_utf8(out.stdout).unwrap();
+    assert!(table.contains("more rows (--top 0 shows all)"), "{table}");
+    let shown = table
+        .lines()
+        .filter(|l| l.contains("e-") && l.contains("()"))
+        .count();
+    assert!(shown >= 2 && shown < n, "{table}");
 }
 
 #[test]
@@ -99,7 +214,8 @@ fn select_table_names_the_column_and_the_selected_model() {
         "{text}"
     );
     assert!(text.contains("selected: "), "{text}");
-    assert!(text.contains("GoF p-value"), "{text}");
+    assert!(text.contains("GoF p"), "{text}");
+    assert!(text.contains("canonical model: "), "{text}");
 }
 
 /// Exit code 1 and one error line containing every needle.
@@ -129,17 +245,18 @@ fn select_bad_inputs_are_one_line_errors() {
         &["--candidates", "AR1()+WN();WN()+RW()+WN()"],
         &["candidate 2", "WN()+RW()+WN()", "found WN 2 times"],
     );
-    assert_error(
-        &file,
+    let usage = |args: &[&str], needles: &[&str]| {
+        common::assert_usage_error(gmwm().arg("select").arg(&file).args(args), needles)
+    };
+    usage(
         &["--model", "AR1()+WN()", "--bootstrap", "1"],
-        &["--bootstrap 1"],
+        &["--bootstrap", "'1'"],
     );
-    assert_error(&file, &["--model", "AR1()+WN()", "--G", "0"], &["--G 0"]);
+    usage(&["--model", "AR1()+WN()", "--G", "0"], &["--G", "'0'"]);
     assert_error(&file, &["--candidates", " ; "], &["--candidates"]);
-    assert_error(
-        &file,
+    usage(
         &["--model", "AR1()+WN()", "--robust", "--eff", "1.5"],
-        &["1.5"],
+        &["'1.5'", "--eff"],
     );
     assert_error(&file, &["--model", "AR1(", "--G", "10"], &["AR1("]);
     // usage errors exit 2

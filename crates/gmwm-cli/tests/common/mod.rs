@@ -37,8 +37,18 @@ pub fn run_json(cmd: &mut Command) -> serde_json::Value {
 /// Exit code 1, exactly one `gmwm: error: ` line on stderr (warnings aside) containing every
 /// needle, and nothing on stdout.
 pub fn assert_one_line_error(cmd: &mut Command, needles: &[&str]) {
+    assert_one_line_exit(cmd, 1, needles);
+}
+
+/// A flag value outside its domain: exit code 2 (a usage error), one `gmwm: error: ` line
+/// containing every needle, nothing on stdout.
+pub fn assert_usage_error(cmd: &mut Command, needles: &[&str]) {
+    assert_one_line_exit(cmd, 2, needles);
+}
+
+fn assert_one_line_exit(cmd: &mut Command, code: i32, needles: &[&str]) {
     let out = cmd.output().expect("runs");
-    assert_eq!(out.status.code(), Some(1), "{cmd:?}: {out:?}");
+    assert_eq!(out.status.code(), Some(code), "{cmd:?}: {out:?}");
     let stderr = String::from_utf8_lossy(&out.stderr);
     let lines: Vec<&str> = stderr.lines().filter(|l| !l.contains("warning:")).collect();
     assert_eq!(lines.len(), 1, "one line expected, got {stderr:?}");

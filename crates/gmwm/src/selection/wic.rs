@@ -992,15 +992,8 @@ impl fmt::Display for SelectionTable<'_> {
             .max(15);
         writeln!(
             f,
-            "  {:>3} {:<width$} {:>11} {:>11} {:>11} {:>10} {:>10}  {}",
-            "#",
-            "canonical model",
-            "objective",
-            "optimism",
-            "WIC",
-            "dWIC / se",
-            "GoF p",
-            "fitted as"
+            "  {:>3} {:<width$} {:>11} {:>11} {:>11} {:>10} {:>10}  fitted as",
+            "#", "canonical model", "objective", "optimism", "WIC", "dWIC / se", "GoF p",
         )?;
         for &r in &shown {
             let row = &s.rows[r];
