@@ -107,11 +107,6 @@ pub struct SelectArgs {
     /// standard error of the minimum.
     #[arg(long, value_enum, default_value_t = RuleArg::Navigation)]
     pub rule: RuleArg,
-    /// Weighting matrix Omega of every candidate's objective (METHODS §5.2): CI widths (the
-    /// package's), Percival's asymptotic variances of the WV, or the diagonal of the full
-    /// model's bootstrap V.
-    #[arg(long, value_enum, default_value_t = WeightsArg::Fast)]
-    pub weights: WeightsArg,
     /// Wavelet-variance settings of the estimate.
     #[command(flatten)]
     pub estimator: WvEstimatorArgs,

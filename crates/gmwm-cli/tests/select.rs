@@ -48,8 +48,7 @@ fn select_json_has_the_documented_shape() {
             "rows",
             "rule",
             "selected",
-            "selected_canonical",
-            "weighting"
+            "selected_canonical"
         ]
     );
     let cands = sel[0]["candidates"].as_array().unwrap();

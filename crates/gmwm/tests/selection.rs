@@ -1054,7 +1054,7 @@ struct Issue10 {
     selected: std::collections::BTreeMap<String, usize>,
 }
 
-fn issue_10_mc(full: &str, reps: usize, weighting: gmwm::Weighting) -> Issue10 {
+fn issue_10_mc(full: &str, reps: usize) -> Issue10 {
     use gmwm::model::ProcessKind;
     use rayon::prelude::*;
     let truth = model("AR1(phi=0.99, sigma2=1e-3)+WN(sigma2=1)+RW(gamma2=1e-6)");
@@ -1062,8 +1062,7 @@ fn issue_10_mc(full: &str, reps: usize, weighting: gmwm::Weighting) -> Issue10 {
     let wic = Wic::nested(model(full))
         .unwrap()
         .with_draws(2000)
-        .with_bootstrap(50)
-        .with_weighting(weighting);
+        .with_bootstrap(50);
     let rows: Vec<([bool; 5], String)> = (0..reps)
         .into_par_iter()
         .map(|r| {
@@ -1135,7 +1134,7 @@ fn issue_10_selection_reports_the_canonical_truth() {
     // one AR1 + WN + RW 183/200, exactly AR1+WN+RW 182/200, densities 193/200. Bounds: the
     // measured rate less 3 binomial standard errors at 40 replicates. Before this issue the
     // selected model was AR1+WN+RW (as fitted) in 1 of 20 replicates (a drift in 11, no RW in 5).
-    let mc = issue_10_mc("2*AR1()+WN()+RW()+QN()+DR()", 40, gmwm::Weighting::Fast);
+    let mc = issue_10_mc("2*AR1()+WN()+RW()+QN()+DR()", 40);
     eprintln!("{mc}");
     assert!(mc.core >= 31, "{mc}");
     assert!(mc.exact >= 31, "{mc}");
@@ -1143,22 +1142,97 @@ fn issue_10_selection_reports_the_canonical_truth() {
 }
 
 #[test]
-#[ignore = "the issue's full Monte Carlo: 200 replicates of N = 1e5 for both full models and \
-            the diag weighting, about 8 minutes on 2 cores; run with cargo test --release -p gmwm \
-            --test integration issue_10_selection_full_size -- --ignored --nocapture"]
+#[ignore = "the issue's full Monte Carlo: 200 replicates of N = 1e5 for both full models, about \
+            90 s on 2 cores; run with cargo test --release -p gmwm --test integration \
+            issue_10_selection_full_size -- --ignored --nocapture"]
 fn issue_10_selection_full_size() {
-    for (full, weighting) in [
-        ("2*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Fast),
-        ("3*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Fast),
-        ("2*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Diag),
-        ("3*AR1()+WN()+RW()+QN()+DR()", gmwm::Weighting::Diag),
-    ] {
-        let mc = issue_10_mc(full, 200, weighting);
-        eprintln!("{full} ({weighting:?} weights): {mc}");
+    for full in ["2*AR1()+WN()+RW()+QN()+DR()", "3*AR1()+WN()+RW()+QN()+DR()"] {
+        let mc = issue_10_mc(full, 200);
+        eprintln!("{full}: {mc}");
         // the issue's bars: exactly AR1+WN+RW in 85% (2*AR1) / 80% (3*AR1), densities in 95%;
-        // one AR1 + WN + RW in 95% is out of reach with the fast weights (module docs)
+        // one AR1 + WN + RW in 95% is out of reach with the package's fast weights (module docs
+        // of gmwm::selection): 183/200 measured, and in 12 of the 17 misses the true model's
+        // own fit has no random walk
         let exact_bar = if full.starts_with('2') { 170 } else { 160 };
         assert!(mc.exact >= exact_bar, "{mc}");
         assert!(mc.densities >= 190, "{mc}");
+        assert!(mc.core >= 175, "{mc}");
     }
+}
+
+#[test]
+fn asymptotic_optimism_is_calibrated_for_the_fast_weights_only() {
+    // Why the selection keeps the package's fast weights: the WIC's optimism estimates the
+    // excess of the out-of-sample loss over the apparent one for weights that do not follow
+    // each level's own noise. The fast weights (squared CI widths) all but ignore the coarsest
+    // levels, whose chi-square intervals are far wider than their standard errors; weights
+    // from each level's own variance (Percival's diag) give those near-empty levels a weight
+    // that moves with their noise (~ 1 / nu2_hat^2), the loss becomes heavy-tailed and the
+    // optimism stops describing it. Measured, 200 fits of AR1+WN+RW at N = 1e4: fast, optimism
+    // 0.47 vs excess loss 0.43 +- 0.03 (median 0.35); diag, optimism 6682 vs excess loss 1892 +-
+    // 884 with a median of 19.
+    use gmwm::fit::{Gmwm, StartInputs, Weights};
+    use gmwm::inference::wv_bootstrap;
+    use gmwm::{wavelet_variance, Weighting, WvOptions};
+    use rayon::prelude::*;
+    let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)");
+    let (n, freq, reps) = (10_000, 100.0, 200);
+    let x0 = simulate_model(&truth, n, freq, 1).unwrap();
+    let levels = wavelet_variance(&x0, freq, &WvOptions::default())
+        .unwrap()
+        .levels();
+    let fixed = WvOptions {
+        levels: Some(levels),
+        ..WvOptions::default()
+    };
+    let v = wv_bootstrap(&truth, n, freq, &fixed, 400, 77).unwrap().cov;
+    let cand = model("AR1()+WN()+RW()");
+    let study = |w: Weighting| {
+        let res: Vec<(f64, f64)> = (0..reps)
+            .into_par_iter()
+            .map(|r| {
+                let x = simulate_model(&truth, n, freq, 10_000 + r as u64).unwrap();
+                let y = simulate_model(&truth, n, freq, 90_000 + r as u64).unwrap();
+                let wv = wavelet_variance(&x, freq, &fixed).unwrap();
+                let wv_new = wavelet_variance(&y, freq, &fixed).unwrap();
+                let g = Gmwm::new(cand.clone()).with_draws(2000);
+                let start = g.fit_from_wv(&wv, StartInputs::from_series(&x)).unwrap();
+                let weights = Weights::new(w, &wv, Some(&x)).unwrap();
+                let f = g.fit_weighted(&wv.wv, weights, freq, &start.theta).unwrap();
+                let om = &f.weights.omega;
+                let q_new: f64 = (0..levels)
+                    .map(|j| om[j] * (wv_new.wv[j] - f.implied_wv.wv[j]).powi(2))
+                    .sum();
+                let jac = f.model.jacobian(levels, freq).unwrap();
+                let a = DMatrix::from_fn(levels, f.theta.len(), |j, k| jac[j][k]);
+                let omega = DMatrix::from_diagonal(&DVector::from_column_slice(om));
+                let h = f.model.hessian(levels, freq).unwrap();
+                let d = d_matrix(&h, &omega, &f.implied_wv.wv, &f.nu_hat).unwrap();
+                let o =
+                    asymptotic_optimism(&a, &d, &omega, &v, OptimismConvention::Corrected).unwrap();
+                (q_new - f.objective, o)
+            })
+            .collect();
+        let k = reps as f64;
+        let excess = res.iter().map(|r| r.0).sum::<f64>() / k;
+        let sd = (res.iter().map(|r| (r.0 - excess).powi(2)).sum::<f64>() / (k - 1.0)).sqrt();
+        let optimism = res.iter().map(|r| r.1).sum::<f64>() / k;
+        let mut sorted: Vec<f64> = res.iter().map(|r| r.0).collect();
+        sorted.sort_by(f64::total_cmp);
+        (optimism, excess, sd / k.sqrt(), sorted[reps / 2])
+    };
+    let (o, e, se, median) = study(Weighting::Fast);
+    // 4 Monte Carlo standard errors plus 10% for the asymptotics and the estimated V; a
+    // light-tailed loss (mean within a factor 2 of the median)
+    assert!(
+        (o - e).abs() <= 4.0 * se + 0.1 * e,
+        "fast: {o} vs {e} +- {se}"
+    );
+    assert!(e < 2.0 * median, "fast: mean {e}, median {median}");
+    let (o, e, se, median) = study(Weighting::Diag);
+    // heavy-tailed (mean over 20 times the median) and the optimism far from both
+    assert!(
+        e > 20.0 * median && o > 50.0 * median,
+        "diag: {o} vs {e} +- {se}, median {median}"
+    );
 }

@@ -1,7 +1,7 @@
 //! `gmwm select`: model selection by the Wavelet Information Criterion on each selected column
 //! (METHODS §8), the candidates folded by canonical model.
 
-use crate::args::{OptimismArg, OptimismConventionArg, RuleArg, SelectArgs, WeightsArg};
+use crate::args::{OptimismArg, OptimismConventionArg, RuleArg, SelectArgs};
 use crate::cmd::wv::options;
 use crate::input::{analyse_columns, load};
 use crate::progress::{bar, Ticks};
@@ -10,7 +10,7 @@ use anyhow::Result;
 use gmwm::fit::CanonicalTerm;
 use gmwm::model::Model;
 use gmwm::selection::{OptimismConvention, OptimismMethod, RowStatus, SelectionRow, SelectionRule};
-use gmwm::{ModelSelection, Weighting, Wic};
+use gmwm::{ModelSelection, Wic};
 use serde::Serialize;
 use std::io::Write;
 
@@ -41,7 +41,6 @@ struct SelectionReport<'a> {
     /// Why the selected row was chosen.
     reason: String,
     rule: SelectionRule,
-    weighting: Weighting,
     /// One row per canonical model, sorted by WIC.
     rows: &'a [SelectionRow],
     /// Every candidate, sorted by WIC.
@@ -98,11 +97,6 @@ fn wic(args: &SelectArgs) -> Result<Wic> {
             RuleArg::Navigation => SelectionRule::Navigation,
             RuleArg::Parsimonious => SelectionRule::Parsimonious,
             RuleArg::WicMinimum => SelectionRule::WicMinimum,
-        })
-        .with_weighting(match args.weights {
-            WeightsArg::Fast => Weighting::Fast,
-            WeightsArg::Diag => Weighting::Diag,
-            WeightsArg::Bootstrap => Weighting::Bootstrap,
         })
         .with_wv_options(wv_options);
     if let Some(g) = args.draws {
@@ -187,7 +181,6 @@ pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
                         canonical_notes: canonical_notes(&s.selected_canonical),
                         reason: s.reason(),
                         rule: s.rule,
-                        weighting: s.weighting,
                         rows: &s.rows,
                         candidates: s
                             .candidates

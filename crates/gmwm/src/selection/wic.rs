@@ -7,9 +7,7 @@ use super::optimism::{
 };
 use super::SelectionError;
 use crate::error::check_freq;
-use crate::fit::{
-    CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weighting, Weights, SEPARATION_LIMIT,
-};
+use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{map_replicates, wv_bootstrap, NoProgress, Progress};
 use crate::model::{Model, ProcessKind};
@@ -48,7 +46,6 @@ pub struct Wic {
     wv_options: WvOptions,
     rule: SelectionRule,
     separation_limit: f64,
-    weighting: Weighting,
 }
 
 /// How the selected row is chosen among the rows of canonical models (module docs of
@@ -99,7 +96,6 @@ impl Wic {
             wv_options: WvOptions::default(),
             rule: SelectionRule::default(),
             separation_limit: SEPARATION_LIMIT,
-            weighting: Weighting::Fast,
         }
     }
 
@@ -220,18 +216,6 @@ impl Wic {
         self
     }
 
-    /// Sets the weights of every candidate's objective (METHODS §5.2); default
-    /// [`Weighting::Fast`], the package's. [`Weighting::Diag`] uses Percival's asymptotic
-    /// variances of the series' WV; [`Weighting::Bootstrap`] the diagonal of the full model's
-    /// bootstrap covariance V (the one behind the asymptotic optimism), the same for every
-    /// candidate. Both weigh each level by its actual variance, where the fast weights (squared
-    /// interval widths) discount the coarsest levels, whose chi-square intervals are far wider
-    /// than their standard errors.
-    pub fn with_weighting(mut self, weighting: Weighting) -> Self {
-        self.weighting = weighting;
-        self
-    }
-
     /// The full model (guess mode).
     pub fn full_model(&self) -> &Model {
         &self.full
@@ -334,11 +318,9 @@ impl Wic {
             move |source| SelectionError::Fit { candidate, source }
         };
         progress.start(self.candidates.len());
-        let weights = match self.weighting {
-            Weighting::Diag => Weights::diag(x, &wv),
-            _ => Weights::fast(&wv),
-        }
-        .map_err(fit_error(&self.full))?;
+        // the fast weights of the package (METHODS §5.2, §8.6): the asymptotic optimism is
+        // calibrated for them (selection module docs)
+        let weights = Weights::fast(&wv).map_err(fit_error(&self.full))?;
         let fit_with = |m: &Model, w: &Weights| -> Result<GmwmFit, FitError> {
             let g = self.estimator(m);
             g.finish(g.fit_auto(&wv, w.clone(), inputs)?, &wv, inputs)
@@ -360,19 +342,11 @@ impl Wic {
             self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET),
         )?
         .cov;
-        let (full_fit, weights) = if self.weighting == Weighting::Bootstrap {
-            let w = Weights::from_variances(v.diagonal().iter().copied().collect())
-                .map_err(fit_error(&self.full))?;
-            (fit_with(&self.full, &w).map_err(fit_error(&self.full))?, w)
-        } else {
-            (full_fit, weights)
-        };
         let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&weights.omega));
         let context = Context {
             wic: self,
             wv: &wv,
             inputs,
-            weights: &weights,
             omega: &omega,
             v: (self.method == OptimismMethod::Asymptotic).then_some(&v),
             replicate_opts: &replicate_opts,
@@ -539,7 +513,6 @@ impl Wic {
             selected: chosen.score.model.clone(),
             selected_canonical: chosen.canonical.clone(),
             fit: chosen.fit.clone(),
-            weighting: self.weighting,
             candidate_fits,
         }
     }
@@ -627,23 +600,12 @@ struct Context<'a> {
     wic: &'a Wic,
     wv: &'a WaveletVariance,
     inputs: StartInputs,
-    weights: &'a Weights,
     omega: &'a DMatrix<f64>,
     v: Option<&'a DMatrix<f64>>,
     replicate_opts: &'a WvOptions,
 }
 
 impl Context<'_> {
-    /// The weights of a replicate's fits, of the selection's kind (METHODS §5.2): its own fast
-    /// or diag weights, or the full model's bootstrap weights of the data.
-    fn replicate_weights(&self, wv: &WaveletVariance, x: &[f64]) -> Result<Weights, FitError> {
-        match self.wic.weighting {
-            Weighting::Fast => Weights::fast(wv),
-            Weighting::Diag => Weights::diag(x, wv),
-            Weighting::Bootstrap => Ok(self.weights.clone()),
-        }
-    }
-
     fn score(&self, candidate: &Model, fit: &GmwmFit) -> Result<CandidateScore, FitError> {
         let (optimism, gof_p_value, gof_p_value_upper_bound) = match self.v {
             Some(v) => {
@@ -738,7 +700,7 @@ impl Context<'_> {
             self.wic.bootstrap,
             seed,
             |r, wv, x| {
-                let weights = self.replicate_weights(wv, x)?;
+                let weights = Weights::fast(wv)?;
                 let refit = stage2.fit_weighted(&wv.wv, weights.clone(), freq_hz, &start)?;
                 let fresh = Gmwm::new(candidate.clone())
                     .with_seed(replicate_seed(seed, r as u64))
@@ -852,7 +814,7 @@ pub struct SelectionRow {
 /// ([`SelectionRow`], one per canonical model,
 /// sorted by `wic`), `candidates` ([`CandidateScore`], every candidate, sorted by `wic`
 /// ascending), `selected` (the selected row's candidate, as fitted), `selected_canonical`
-/// ([`CanonicalModel`]), `fit` (the selected candidate's [`GmwmFit`]) and `weighting`.
+/// ([`CanonicalModel`]) and `fit` (the selected candidate's [`GmwmFit`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelSelection {
     /// The full model (guess mode).
@@ -877,8 +839,6 @@ pub struct ModelSelection {
     pub selected_canonical: CanonicalModel,
     /// The selected candidate's fit.
     pub fit: GmwmFit,
-    /// The weights every candidate was fitted with (METHODS §5.2).
-    pub weighting: Weighting,
     /// Every candidate's fit, in the order of `candidates` (not serialised).
     #[serde(skip)]
     pub candidate_fits: Vec<GmwmFit>,
