@@ -69,13 +69,22 @@ pub enum Command {
 }
 
 const SELECT_EXAMPLES: &str = "\
+Each candidate's fit is read as its canonical model (an AR1 below the sampling interval is white
+noise, one rising over every observed scale a random walk, two the WV cannot separate are one, a
+drift the WV cannot tell from a random walk is the random walk); candidates with the same
+canonical model are one row of the table. The selected row is the WIC minimum or, within one
+standard error of it, the one --rule prefers.
+
 Examples:
   gmwm select imu.csv.gz --model \"3*AR1()+WN()+RW()+QN()+DR()\"
       every sub-model of the full model (63 candidates), on every column
   gmwm select imu.csv.gz --columns gyro_x --model \"3*AR1()+WN()+RW()+QN()\" --json
+  gmwm select imu.csv.gz --columns gyro_x --model \"2*AR1()+WN()+RW()+QN()+DR()\" --top 0 --csv
+      every row of the table, as CSV
   gmwm select sim.csv.gz --candidates \"AR1()+WN()+RW();2*AR1()+WN()+RW();3*AR1()+WN()+QN()+RW()\"
       a list of candidates; their common denominator is added and plays the full model
-  gmwm select imu.csv.gz --model \"2*GM()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7";
+  gmwm select imu.csv.gz --model \"2*GM()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7
+  gmwm select imu.csv.gz --model \"2*AR1()+WN()+RW()\" --rule parsimonious";
 
 /// `gmwm select`.
 #[derive(Debug, Args)]
@@ -276,7 +285,8 @@ pub struct OutputArgs {
     /// Print JSON (machine-readable, full precision) instead of a table.
     #[arg(long, conflicts_with = "csv")]
     pub json: bool,
-    /// Print CSV (one row per series and scale) instead of a table.
+    /// Print CSV instead of a table (one line per record: per series and scale for variances,
+    /// per parameter for fits, per table row for selections).
     #[arg(long)]
     pub csv: bool,
 }

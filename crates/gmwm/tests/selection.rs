@@ -646,6 +646,7 @@ fn selection_mc(
             under += 1;
         }
     }
+    eprintln!("{full}: true model {hits}/{reps}, a sub-model {under}/{reps}");
     (hits, under)
 }
 
@@ -655,17 +656,18 @@ const MC_TRUTH: &str = "AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-3)";
 
 #[test]
 fn wic_selects_the_true_model_among_nested_candidates() {
-    // The issue's must-show at its size: N = 1e5, 100 replicates, the package's B = 50, G =
+    // Issue 5's must-show at its size: N = 1e5, 100 replicates, the package's B = 50, G =
     // 2000 (about 20 s on 2 cores). Every term of the full model AR1+WN+RW+QN+DR is identified
     // when present, so the only errors an AIC-type criterion makes are the superfluous QN
-    // or DR (about 8% each, see the selection module docs): 94/100 measured (184/200 with
-    // seeds 1000..1199). Bound: 0.9 less 3 binomial standard errors at 100 replicates (0.81);
-    // a true rate of 0.7 passes it with probability 0.5%. An underfit (a strict sub-model of the
-    // truth) must not happen: each term dominates a band of scales.
+    // or DR (about 8% each, see the selection module docs): 94/100 measured with the WIC
+    // minimum alone; 100/100 since the choice among the rows within one standard error of it
+    // (issue 10). Bound: issue 10's 0.9 (0.97 less 3 binomial standard errors at 100
+    // replicates is 0.92). An underfit (a strict sub-model of the truth) must not happen: each
+    // term dominates a band of scales.
     let truth = model(MC_TRUTH);
     let reps = 100;
     let (hits, under) = selection_mc(&truth, "AR1()+WN()+RW()+QN()+DR()", 100_000, reps, 2000, 50);
-    assert!(hits >= 81, "true model selected in {hits}/{reps}");
+    assert!(hits >= 90, "true model selected in {hits}/{reps}");
     assert_eq!(
         under, 0,
         "a sub-model of the truth selected in {under}/{reps}"
@@ -674,12 +676,14 @@ fn wic_selects_the_true_model_among_nested_candidates() {
 
 #[test]
 fn wic_with_a_second_ar1_in_the_full_model_still_never_underfits() {
-    // The issue's example of a full model, 2*AR1+WN+RW+QN+DR, at N = 1e4 (seconds): a second
+    // Issue 5's example of a full model, 2*AR1+WN+RW+QN+DR, at N = 1e4 (seconds): a second
     // AR1 is not identified when its variance is 0 (its phi is free) and can stand in for the
-    // RW (phi -> 1) or the WN (phi -> 0), so the true model wins less often: 74/100 measured
-    // at N = 1e4 and 138/200 at N = 1e5 with the RW of MC_TRUTH (the rate does not grow with
-    // N: WIC is loss efficient, not consistent). Bounds: 3 binomial standard errors below 0.7
-    // at 40 replicates is 0.48; at most one underfit (none measured). At N = 1e4 the RW needs gamma2 = 1e-2 to dominate the coarse scales.
+    // RW (phi -> 1) or the WN (phi -> 0); with the WIC minimum alone the true model won 74/100
+    // at N = 1e4 and 138/200 at N = 1e5 with the RW of MC_TRUTH. Since the canonical rows and
+    // the choice within one standard error (issue 10): 39/40 here, 190/200 at N = 1e5 (the
+    // ignored test below). Bounds: 0.9 less 3 binomial standard errors at 40 replicates is
+    // 0.76; at most one underfit (none measured). At N = 1e4 the RW needs gamma2 = 1e-2 to
+    // dominate the coarse scales.
     let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)");
     let reps = 40;
     let (hits, under) = selection_mc(
@@ -690,7 +694,7 @@ fn wic_with_a_second_ar1_in_the_full_model_still_never_underfits() {
         1000,
         20,
     );
-    assert!(hits >= 20, "true model selected in {hits}/{reps}");
+    assert!(hits >= 30, "true model selected in {hits}/{reps}");
     assert!(
         under <= 1,
         "a sub-model of the truth selected in {under}/{reps}"
@@ -700,9 +704,10 @@ fn wic_with_a_second_ar1_in_the_full_model_still_never_underfits() {
 #[test]
 #[ignore = "about 90 s in release on 2 cores; run with cargo test --release -p gmwm --test integration wic_second_ar1_full_size -- --ignored --nocapture"]
 fn wic_second_ar1_full_size() {
-    // The figure quoted above for the issue's example at its size: N = 1e5, 200 replicates,
-    // full model 2*AR1+WN+RW+QN+DR, B = 50 (138/200 measured; misses: a second AR1 standing in
-    // for the RW 25, for the WN 9, added to the truth 12; a superfluous QN or DR 16).
+    // The figure quoted above for issue 5's example at its size: N = 1e5, 200 replicates,
+    // full model 2*AR1+WN+RW+QN+DR, B = 50: 190/200 measured (138/200 with the WIC minimum
+    // alone, whose misses were a second AR1 standing in for the RW 25, for the WN 9, added to
+    // the truth 12, and a superfluous QN or DR 16).
     let truth = model(MC_TRUTH);
     let reps = 200;
     let (hits, under) = selection_mc(
@@ -714,7 +719,7 @@ fn wic_second_ar1_full_size() {
         50,
     );
     eprintln!("true model selected in {hits}/{reps}, a sub-model in {under}/{reps}");
-    assert!(hits >= 120, "true model selected in {hits}/{reps}");
+    assert!(hits >= 175, "true model selected in {hits}/{reps}");
     assert_eq!(under, 0);
 }
 
@@ -1235,4 +1240,26 @@ fn asymptotic_optimism_is_calibrated_for_the_fast_weights_only() {
         e > 20.0 * median && o > 50.0 * median,
         "diag: {o} vs {e} +- {se}, median {median}"
     );
+}
+
+#[test]
+fn issue_10_candidates_with_one_fit_have_one_gof_p_value() {
+    // adis_16405_imu1 gyro_y: candidates with the same objective had J-test p-values of
+    // 7.29e-127 and 5.20e-126
+    let x = read_column("adis_16405_imu1", "gyro_y");
+    let s = Wic::nested(model("2*AR1()+WN()+RW()+QN()+DR()"))
+        .unwrap()
+        .select(&x, 100.0)
+        .unwrap();
+    // B = 50 > J + 2: every candidate has a J-test
+    assert!(s.candidates.iter().all(|c| c.gof_p_value.is_some()));
+    for a in &s.candidates {
+        for b in &s.candidates {
+            if a.canonical_model == b.canonical_model
+                && (a.objective - b.objective).abs() <= 1e-9 * a.objective
+            {
+                assert_eq!(a.gof_p_value, b.gof_p_value, "{} vs {}", a.model, b.model);
+            }
+        }
+    }
 }

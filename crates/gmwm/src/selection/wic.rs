@@ -492,10 +492,30 @@ impl Wic {
         let cand_wics: Vec<f64> = scored.iter().map(|s| s.score.wic).collect();
         let cand_params: Vec<usize> = scored.iter().map(|s| s.score.model.n_params()).collect();
         let cand_order = rank(&cand_wics, &cand_params);
+        // candidates with one canonical model and one objective (within WIC_TIE_REL) are one
+        // fit up to terms fitted to nothing: one goodness-of-fit p-value, the smallest one's
+        let gof: Vec<(Option<f64>, bool)> = (0..scored.len())
+            .map(|i| {
+                let same = |j: &usize| {
+                    let (a, b) = (&scored[i], &scored[*j]);
+                    a.canonical.model == b.canonical.model
+                        && (a.score.objective - b.score.objective).abs()
+                            <= WIC_TIE_REL * a.score.objective.abs()
+                };
+                let first = (0..scored.len())
+                    .filter(same)
+                    .min_by_key(|&j| (scored[j].score.model.n_params(), j))
+                    .unwrap_or(i);
+                let s = &scored[first].score;
+                (s.gof_p_value, s.gof_p_value_upper_bound)
+            })
+            .collect();
         let candidates = cand_order
             .iter()
             .map(|&i| CandidateScore {
                 canonical_model: scored[i].canonical.model.clone(),
+                gof_p_value: gof[i].0,
+                gof_p_value_upper_bound: gof[i].1,
                 ..scored[i].score.clone()
             })
             .collect();
@@ -737,7 +757,9 @@ impl Context<'_> {
 /// estimate on the boundary of its transform domain), `gof_p_value_upper_bound` (true when
 /// the bootstrap p-value is a bound: no replicate exceeded the observed objective, so the
 /// p-value is below `1 / (B + 1)`, the value given), `converged` (of the candidate's
-/// optimiser).
+/// optimiser). Candidates with one canonical model and one objective (within [`WIC_TIE_REL`])
+/// are one fit up to terms fitted to nothing, and report the p-value of the one with the
+/// fewest parameters.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CandidateScore {
     /// The candidate (guess mode).
