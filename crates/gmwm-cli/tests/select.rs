@@ -95,7 +95,7 @@ fn select_json_has_the_documented_shape() {
         rows.iter().filter(|r| r["status"] == "selected").collect();
     assert_eq!(selected.len(), 1);
     assert_eq!(sel[0]["selected_canonical"], selected[0]["canonical_model"]);
-    assert_eq!(sel[0]["selected"], selected[0]["candidate"]);
+    assert_eq!(sel[0]["selected"], selected[0]["model"]);
     // the true structure is selected on this seed, and its terms carry the read-off
     assert_eq!(sel[0]["selected_canonical"], "AR1()+WN()+RW()");
     let terms: Vec<&str> = sel[0]["canonical"]

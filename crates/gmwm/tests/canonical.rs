@@ -21,6 +21,13 @@ fn fit(text: &str, x: &[f64], freq: f64) -> GmwmFit {
         .unwrap_or_else(|e| panic!("{text}: {e}"))
 }
 
+/// `text` fitted to a precomputed WV (guess mode).
+fn fit_wv(text: &str, wv: &gmwm::WaveletVariance) -> GmwmFit {
+    Gmwm::new(model(text))
+        .fit_from_wv(wv, StartInputs::from_wv(wv))
+        .unwrap_or_else(|e| panic!("{text}: {e}"))
+}
+
 fn has_reading(c: &CanonicalModel, f: impl Fn(&Reading) -> bool) -> bool {
     c.readings.iter().any(f)
 }
@@ -125,10 +132,7 @@ fn canonical_reads_a_slow_ar1_as_the_random_walk_it_stands_for() {
     // the AR1 runs to phi -> 1 and rises over every observed scale
     let truth = model("WN(sigma2=1)+RW(gamma2=1e-3)");
     let wv = exact_wv(&truth, 1 << 15, 10.0);
-    let f = Gmwm::parse("AR1()+WN()")
-        .unwrap()
-        .fit_from_wv(&wv, StartInputs::from_wv(&wv))
-        .unwrap();
+    let f = fit_wv("AR1()+WN()", &wv);
     let c = f.canonical().unwrap();
     assert_eq!(c.model.to_string(), "WN()+RW()", "{f}\n{c}");
     assert!(
@@ -172,10 +176,7 @@ fn canonical_rising_ar1s_are_random_walks_and_peaked_ones_stay() {
     let phi = (-1.0f64 / 5000.0).exp();
     let truth = model(&format!("AR1(phi={phi}, sigma2=1e-3)+WN(sigma2=1e-2)"));
     let wv = exact_wv(&truth, 1 << 15, 1.0);
-    let f = Gmwm::parse("AR1()+WN()")
-        .unwrap()
-        .fit_from_wv(&wv, StartInputs::from_wv(&wv))
-        .unwrap();
+    let f = fit_wv("AR1()+WN()", &wv);
     let own = &f.implied_wv.processes[0].wv;
     let j = own.len();
     assert!(
@@ -188,10 +189,7 @@ fn canonical_rising_ar1s_are_random_walks_and_peaked_ones_stay() {
     // length has), the bend would show: the AR1 stays, and the note says it rises everywhere
     let mut precise = wv.clone();
     precise.eta.iter_mut().for_each(|e| *e *= 1000.0);
-    let f = Gmwm::parse("AR1()+WN()")
-        .unwrap()
-        .fit_from_wv(&precise, StartInputs::from_wv(&precise))
-        .unwrap();
+    let f = fit_wv("AR1()+WN()", &precise);
     let c = f.canonical().unwrap();
     assert_eq!(c.model.to_string(), "AR1()+WN()", "{f}\n{c}");
     assert!(
@@ -205,10 +203,7 @@ fn canonical_rising_ar1s_are_random_walks_and_peaked_ones_stay() {
     let phi = (-1.0f64 / 500.0).exp();
     let truth = model(&format!("AR1(phi={phi}, sigma2=1e-3)+WN(sigma2=1e-2)"));
     let wv = exact_wv(&truth, 1 << 15, 1.0);
-    let f = Gmwm::parse("AR1()+WN()")
-        .unwrap()
-        .fit_from_wv(&wv, StartInputs::from_wv(&wv))
-        .unwrap();
+    let f = fit_wv("AR1()+WN()", &wv);
     let c = f.canonical().unwrap();
     assert_eq!(c.model.to_string(), "AR1()+WN()", "{f}\n{c}");
     assert!(c.is_as_fitted(), "{c}");
@@ -280,10 +275,7 @@ fn issue_10_kvh1750_gm_at_infinite_beta_is_white_noise() {
     // gmwm fit kvh1750_wv.json --columns gyro_x --model "GM()+WN()+RW()" printed beta =
     // 1.29e181 (phi = 0), nothing at the boundary, and --inference failed
     let wv = kvh_gyro_x();
-    let f = Gmwm::parse("GM()+WN()+RW()")
-        .unwrap()
-        .fit_from_wv(&wv, StartInputs::from_wv(&wv))
-        .unwrap();
+    let f = fit_wv("GM()+WN()+RW()", &wv);
     let c = f.canonical().unwrap();
     // the RW of this fit is negligible (a random-walk density of 1e-8 against the coarse
     // levels' noise): fitted to nothing
@@ -328,10 +320,7 @@ fn issue_10_kvh1750_gm_at_infinite_beta_is_white_noise() {
 fn issue_10_kvh1750_three_gms_at_one_beta_are_one() {
     // 3*GM()+WN()+QN()+RW() gave three GMs at beta 408-415 and flagged one
     let wv = kvh_gyro_x();
-    let f = Gmwm::parse("3*GM()+WN()+QN()+RW()")
-        .unwrap()
-        .fit_from_wv(&wv, StartInputs::from_wv(&wv))
-        .unwrap();
+    let f = fit_wv("3*GM()+WN()+QN()+RW()", &wv);
     let c = f.canonical().unwrap();
     assert!(c.correlated_terms() <= 1, "{f}\n{c}");
     // no two GMs of the canonical model within a factor 2 of correlation time (a bound far

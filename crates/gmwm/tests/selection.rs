@@ -888,7 +888,7 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
     let keys: Vec<String> = s
         .rows
         .iter()
-        .map(|r| r.canonical_model.to_string())
+        .map(|r| r.score.canonical_model.to_string())
         .collect();
     let mut unique = keys.clone();
     unique.sort();
@@ -906,27 +906,32 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
     for row in &s.rows {
         // the row shows its smallest member's scores, and each member reads as the row
         let min = row.members.iter().map(Model::n_params).min().unwrap();
-        assert_eq!(row.candidate.n_params(), min, "{}", row.canonical_model);
+        assert_eq!(
+            row.score.model.n_params(),
+            min,
+            "{}",
+            row.score.canonical_model
+        );
         for m in &row.members {
             let c = s.candidates.iter().find(|c| &c.model == m).unwrap();
-            assert_eq!(c.canonical_model, row.canonical_model);
+            assert_eq!(c.canonical_model, row.score.canonical_model);
             let f = s.candidate_fit(m).unwrap();
-            assert_eq!(f.canonical().unwrap().model, row.canonical_model);
+            assert_eq!(f.canonical().unwrap().model, row.score.canonical_model);
         }
         let c = s
             .candidates
             .iter()
-            .find(|c| c.model == row.candidate)
+            .find(|c| c.model == row.score.model)
             .unwrap();
-        assert_eq!((c.objective, c.wic), (row.objective, row.wic));
-        assert!(row.delta_wic_se >= 0.0 && row.delta_wic >= -1e-12 * row.wic.abs());
+        assert_eq!(c, &row.score);
+        assert!(row.delta_wic_se >= 0.0 && row.delta_wic >= -1e-12 * row.score.wic.abs());
     }
     // sorted by WIC; the first row is the minimum, exactly one row is selected, and it is
     // the minimum or within one standard error of it
     assert!(s
         .rows
         .windows(2)
-        .all(|w| w[0].wic <= w[1].wic * (1.0 + WIC_TIE_REL)));
+        .all(|w| w[0].score.wic <= w[1].score.wic * (1.0 + WIC_TIE_REL)));
     assert_eq!(s.rows[0].delta_wic, 0.0);
     let selected: Vec<_> = s
         .rows
@@ -936,8 +941,8 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
     assert_eq!(selected.len(), 1);
     let sel = selected[0];
     assert!(sel.delta_wic <= sel.delta_wic_se, "{sel:?}");
-    assert_eq!(sel.canonical_model, s.selected_canonical.model);
-    assert_eq!(sel.candidate, s.selected);
+    assert_eq!(sel.score.canonical_model, s.selected_canonical.model);
+    assert_eq!(sel.score.model, s.selected);
     assert_eq!(s.fit.model.without_values(), s.selected);
     assert_eq!(
         s.selected_canonical.model.to_string(),
@@ -1029,8 +1034,8 @@ fn bootstrap_gof_p_value_is_a_bound_when_no_replicate_exceeds() {
         .unwrap();
     assert!(wn.gof_p_value_upper_bound, "{wn:?}");
     assert_eq!(wn.gof_p_value, Some(1.0 / (b as f64 + 1.0)));
-    let row = s.rows.iter().find(|r| r.candidate == wn.model).unwrap();
-    assert!(row.gof_p_value_upper_bound);
+    let row = s.rows.iter().find(|r| r.score.model == wn.model).unwrap();
+    assert!(row.score.gof_p_value_upper_bound);
     assert!(
         s.to_string()
             .contains(&format!("<{:.2e}", 1.0 / (b as f64 + 1.0))),

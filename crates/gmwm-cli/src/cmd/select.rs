@@ -124,16 +124,16 @@ fn write_csv(results: &[(String, ModelSelection)], out: &mut impl Write) -> Resu
                 out,
                 "{column},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{},{},{status}",
                 r + 1,
-                row.canonical_model,
-                row.candidate,
+                row.score.canonical_model,
+                row.score.model,
                 members.join(";"),
-                row.objective,
-                row.optimism,
-                row.wic,
+                row.score.objective,
+                row.score.optimism,
+                row.score.wic,
                 row.delta_wic,
                 row.delta_wic_se,
-                cell(row.gof_p_value),
-                row.gof_p_value_upper_bound
+                cell(row.score.gof_p_value),
+                row.score.gof_p_value_upper_bound
             )?;
         }
     }

@@ -88,7 +88,7 @@
 //! ```
 
 use super::active::active_components;
-use super::report::{physical_parameters, NavParameter};
+use super::report::{physical_parameters, significant, NavParameter};
 use super::{FitError, Gmwm, GmwmFit, PhiOrder};
 use crate::model::{Component, ImpliedWv, Model, ProcessKind};
 use crate::process::{Ar1, Gm};
@@ -360,14 +360,9 @@ impl fmt::Display for Reading {
     }
 }
 
-/// Six significant digits, scientific outside [1e-3, 1e5).
+/// Four significant digits ([`significant`]).
 fn short(v: f64) -> String {
-    let a = v.abs();
-    if a != 0.0 && !(1e-3..1e5).contains(&a) {
-        format!("{v:.3e}")
-    } else {
-        format!("{v:.4}")
-    }
+    significant(v, 4)
 }
 
 /// The canonical model of a fit (module doc).

@@ -215,11 +215,18 @@ pub(crate) fn physical_parameters(
 
 /// Six significant digits, scientific outside [1e-3, 1e5).
 fn short(v: f64) -> String {
+    significant(v, 6)
+}
+
+/// The display of a value in the engine's tables and notes: `digits` significant digits in
+/// scientific notation outside [1e-3, 1e5), `digits` decimals inside (`digits` 2 to 17).
+pub(crate) fn significant(v: f64, digits: usize) -> String {
+    let digits = digits.clamp(2, 17);
     let a = v.abs();
     if a != 0.0 && !(1e-3..1e5).contains(&a) {
-        format!("{v:.5e}")
+        format!("{v:.*e}", digits - 1)
     } else {
-        format!("{v:.6}")
+        format!("{v:.*}", digits)
     }
 }
 

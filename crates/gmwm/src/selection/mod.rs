@@ -78,8 +78,8 @@
 //! // error of it, and it names the canonical model it stands for
 //! let row = s.selected_row();
 //! assert!(row.delta_wic <= row.delta_wic_se);
-//! assert_eq!(row.canonical_model, s.selected_canonical.model);
-//! assert!(s.rows.iter().all(|r| r.wic >= s.rows[0].wic * (1.0 - 1e-6)));
+//! assert_eq!(row.score.canonical_model, s.selected_canonical.model);
+//! assert!(s.rows.iter().all(|r| r.score.wic >= s.rows[0].score.wic * (1.0 - 1e-6)));
 //! ```
 
 pub mod candidates;

@@ -361,8 +361,11 @@ impl Wic {
                 } else {
                     fit_with(c, &weights)?
                 };
-                let score = context.score(c, &fit)?;
                 let canonical = fit.canonical_with(self.separation_limit)?;
+                let score = CandidateScore {
+                    canonical_model: canonical.model.clone(),
+                    ..context.score(c, &fit)?
+                };
                 progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
                 Ok(Scored {
                     score,
@@ -379,7 +382,28 @@ impl Wic {
 
     /// Steps 4 and 5 of [`Wic::select`]: folds the scored candidates into rows of canonical
     /// models and chooses the selected row.
-    fn assemble(&self, scored: Vec<Scored>, omega: &[f64], v: &DMatrix<f64>) -> ModelSelection {
+    fn assemble(&self, mut scored: Vec<Scored>, omega: &[f64], v: &DMatrix<f64>) -> ModelSelection {
+        // candidates with one canonical model and one objective (within WIC_TIE_REL) are one
+        // fit up to terms fitted to nothing: one goodness-of-fit p-value, the smallest one's
+        let shared: Vec<(Option<f64>, bool)> = (0..scored.len())
+            .map(|i| {
+                let same = |j: &usize| {
+                    let (a, b) = (&scored[i].score, &scored[*j].score);
+                    a.canonical_model == b.canonical_model
+                        && (a.objective - b.objective).abs() <= WIC_TIE_REL * a.objective.abs()
+                };
+                let first = (0..scored.len())
+                    .filter(same)
+                    .min_by_key(|&j| (scored[j].score.model.n_params(), j))
+                    .unwrap_or(i);
+                let s = &scored[first].score;
+                (s.gof_p_value, s.gof_p_value_upper_bound)
+            })
+            .collect();
+        for (s, (p, bound)) in scored.iter_mut().zip(shared) {
+            s.score.gof_p_value = p;
+            s.score.gof_p_value_upper_bound = bound;
+        }
         // step 4: rows of equal canonical models, in order of first appearance
         let mut keys: Vec<String> = Vec::new();
         let mut members: Vec<Vec<usize>> = Vec::new();
@@ -464,60 +488,27 @@ impl Wic {
         let table: Vec<SelectionRow> = rows
             .iter()
             .enumerate()
-            .map(|(r, (rep, m))| {
-                let s = &scored[*rep];
-                SelectionRow {
-                    canonical_model: s.canonical.model.clone(),
-                    candidate: s.score.model.clone(),
-                    members: m.iter().map(|&i| scored[i].score.model.clone()).collect(),
-                    objective: s.score.objective,
-                    optimism: s.score.optimism,
-                    wic: s.score.wic,
-                    gof_p_value: s.score.gof_p_value,
-                    gof_p_value_upper_bound: s.score.gof_p_value_upper_bound,
-                    converged: s.score.converged,
-                    delta_wic: delta_wic[r],
-                    delta_wic_se: delta_wic_se[r],
-                    status: if r == chosen {
-                        RowStatus::Selected
-                    } else if equivalent.contains(&r) {
-                        RowStatus::Equivalent
-                    } else {
-                        RowStatus::Separable
-                    },
-                }
+            .map(|(r, (rep, m))| SelectionRow {
+                score: scored[*rep].score.clone(),
+                members: m.iter().map(|&i| scored[i].score.model.clone()).collect(),
+                delta_wic: delta_wic[r],
+                delta_wic_se: delta_wic_se[r],
+                status: if r == chosen {
+                    RowStatus::Selected
+                } else if equivalent.contains(&r) {
+                    RowStatus::Equivalent
+                } else {
+                    RowStatus::Separable
+                },
             })
             .collect();
         let chosen_rep = rows[chosen].0;
         let cand_wics: Vec<f64> = scored.iter().map(|s| s.score.wic).collect();
         let cand_params: Vec<usize> = scored.iter().map(|s| s.score.model.n_params()).collect();
         let cand_order = rank(&cand_wics, &cand_params);
-        // candidates with one canonical model and one objective (within WIC_TIE_REL) are one
-        // fit up to terms fitted to nothing: one goodness-of-fit p-value, the smallest one's
-        let gof: Vec<(Option<f64>, bool)> = (0..scored.len())
-            .map(|i| {
-                let same = |j: &usize| {
-                    let (a, b) = (&scored[i], &scored[*j]);
-                    a.canonical.model == b.canonical.model
-                        && (a.score.objective - b.score.objective).abs()
-                            <= WIC_TIE_REL * a.score.objective.abs()
-                };
-                let first = (0..scored.len())
-                    .filter(same)
-                    .min_by_key(|&j| (scored[j].score.model.n_params(), j))
-                    .unwrap_or(i);
-                let s = &scored[first].score;
-                (s.gof_p_value, s.gof_p_value_upper_bound)
-            })
-            .collect();
         let candidates = cand_order
             .iter()
-            .map(|&i| CandidateScore {
-                canonical_model: scored[i].canonical.model.clone(),
-                gof_p_value: gof[i].0,
-                gof_p_value_upper_bound: gof[i].1,
-                ..scored[i].score.clone()
-            })
+            .map(|&i| scored[i].score.clone())
             .collect();
         let candidate_fits = cand_order.iter().map(|&i| scored[i].fit.clone()).collect();
         let chosen = &scored[chosen_rep];
@@ -794,32 +785,19 @@ pub enum RowStatus {
 
 /// One row of the selection table: a canonical model and the candidates that read as it.
 ///
-/// Wire format: `canonical_model`, `candidate` (the member whose scores the row shows: fewest
-/// parameters, then smallest WIC), `members` (every candidate with this canonical model),
-/// `objective`, `optimism`, `wic`, `gof_p_value`, `gof_p_value_upper_bound`, `converged` (of
-/// `candidate`), `delta_wic` (its WIC less the minimum's), `delta_wic_se` (the standard error
-/// of that difference, [`wic_difference_se`]), `status` (`selected`, `equivalent`,
-/// `separable`).
+/// Wire format: the [`CandidateScore`] fields of the member whose scores the row shows
+/// (fewest parameters, then smallest WIC: `model`, `canonical_model`, `objective`,
+/// `optimism`, `wic`, `gof_p_value`, `gof_p_value_upper_bound`, `converged`), `members` (every
+/// candidate with this canonical model), `delta_wic` (its WIC less the minimum's),
+/// `delta_wic_se` (the standard error of that difference, [`wic_difference_se`]), `status`
+/// (`selected`, `equivalent`, `separable`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SelectionRow {
-    /// The canonical model (guess mode).
-    pub canonical_model: Model,
-    /// The member whose scores the row shows.
-    pub candidate: Model,
+    /// The scores of the member the row shows; `score.canonical_model` is the row's model.
+    #[serde(flatten)]
+    pub score: CandidateScore,
     /// Every candidate with this canonical model.
     pub members: Vec<Model>,
-    /// `candidate`'s objective.
-    pub objective: f64,
-    /// `candidate`'s optimism.
-    pub optimism: f64,
-    /// `candidate`'s WIC.
-    pub wic: f64,
-    /// `candidate`'s GoF p-value.
-    pub gof_p_value: Option<f64>,
-    /// Whether that p-value is an upper bound.
-    pub gof_p_value_upper_bound: bool,
-    /// Whether `candidate`'s optimiser converged.
-    pub converged: bool,
     /// WIC less the minimum's.
     pub delta_wic: f64,
     /// Standard error of `delta_wic` ([`wic_difference_se`]).
@@ -896,7 +874,7 @@ impl ModelSelection {
     pub fn reason(&self) -> String {
         let sel = self.selected_row();
         if std::ptr::eq(sel, &self.rows[0]) {
-            return format!("{} has the smallest WIC", sel.canonical_model);
+            return format!("{} has the smallest WIC", sel.score.canonical_model);
         }
         let best = &self.rows[0];
         let why = match self.rule {
@@ -905,7 +883,7 @@ impl ModelSelection {
                     usize::from(m.count(ProcessKind::Wn) > 0)
                         + usize::from(m.count(ProcessKind::Rw) > 0)
                 };
-                if nav(&sel.canonical_model) > nav(&best.canonical_model) {
+                if nav(&sel.score.canonical_model) > nav(&best.score.canonical_model) {
                     "it keeps the white noise and random walk a navigation filter carries"
                 } else {
                     "it has fewer parameters"
@@ -916,7 +894,7 @@ impl ModelSelection {
         format!(
             "{} has the smallest WIC, but {}'s exceeds it by {:.3e}, within one standard error \
              ({:.3e}) of the difference, and {why}",
-            best.canonical_model, sel.canonical_model, sel.delta_wic, sel.delta_wic_se
+            best.score.canonical_model, sel.score.canonical_model, sel.delta_wic, sel.delta_wic_se
         )
     }
 }
@@ -968,7 +946,7 @@ impl fmt::Display for SelectionTable<'_> {
             .collect();
         let width = shown
             .iter()
-            .map(|&r| s.rows[r].canonical_model.to_string().len())
+            .map(|&r| s.rows[r].score.canonical_model.to_string().len())
             .max()
             .unwrap_or(5)
             .max(15);
@@ -984,26 +962,23 @@ impl fmt::Display for SelectionTable<'_> {
                 RowStatus::Equivalent => "=",
                 RowStatus::Separable => " ",
             };
-            let mut fitted: Vec<String> = vec![row.candidate.to_string()];
+            let sc = &row.score;
+            let mut fitted: Vec<String> = vec![sc.model.to_string()];
             let others = row.members.len() - 1;
             if others > 0 {
                 fitted.push(format!("(+{others} more)"));
             }
-            let conv = if row.converged {
-                ""
-            } else {
-                " (not converged)"
-            };
+            let conv = if sc.converged { "" } else { " (not converged)" };
             writeln!(
                 f,
                 "{mark} {:>3} {:<width$} {:>11.5e} {:>11.5e} {:>11.5e} {:>10} {:>10}  {}{conv}",
                 r + 1,
-                row.canonical_model.to_string(),
-                row.objective,
-                row.optimism,
-                row.wic,
+                sc.canonical_model.to_string(),
+                sc.objective,
+                sc.optimism,
+                sc.wic,
                 se_ratio(row.delta_wic, row.delta_wic_se),
-                p_cell(row.gof_p_value, row.gof_p_value_upper_bound),
+                p_cell(sc.gof_p_value, sc.gof_p_value_upper_bound),
                 fitted.join(" ")
             )?;
         }
@@ -1019,7 +994,7 @@ impl fmt::Display for SelectionTable<'_> {
         writeln!(
             f,
             "selected: {} ({})",
-            s.selected_row().canonical_model,
+            s.selected_row().score.canonical_model,
             s.reason()
         )?;
         write!(f, "{}", s.selected_canonical)
