@@ -50,15 +50,27 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
-/// A flag value outside its domain (`--freq -5`, `--G 0`): one line naming the flag and what
-/// would be valid, exit code 2; other usage errors keep clap's message with the usage.
+/// A flag value outside its domain (`--freq -5`, `--G 0`, `--rule foo`): one line naming the
+/// flag and what would be valid, exit code 2; other usage errors keep clap's message with the
+/// usage.
 fn parse() -> Result<Cli, ExitCode> {
     match Cli::try_parse() {
         Ok(cli) => Ok(cli),
-        Err(e) if e.kind() == clap::error::ErrorKind::ValueValidation => {
+        Err(e)
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::ValueValidation | clap::error::ErrorKind::InvalidValue
+            ) =>
+        {
+            // clap's first line names the flag and the value; an invalid choice lists the
+            // possible values on the next one
             let text = e.to_string();
-            let first = text.lines().next().unwrap_or_default();
-            eprintln!("gmwm: {first}");
+            let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+            let first = lines.next().unwrap_or_default();
+            match lines.next().filter(|l| l.starts_with("[possible values")) {
+                Some(values) => eprintln!("gmwm: {first} {values}"),
+                None => eprintln!("gmwm: {first}"),
+            }
             Err(ExitCode::from(2))
         }
         Err(e) => e.exit(),

@@ -873,6 +873,8 @@ fn issue_10_fit_reports_the_canonical_model() {
     let fit = &doc["fits"][0];
     assert_eq!(fit["model"].as_str().unwrap().matches("AR1(").count(), 2);
     assert_eq!(fit["canonical_model"], "AR1()+WN()");
+    // the fast AR1's shape at the first scales is real: the data support the fitted model
+    assert_eq!(fit["reduced_model"], "2*AR1()");
     let terms = fit["canonical"].as_array().unwrap();
     assert_eq!(terms[1]["process"], "WN");
     assert_eq!(terms[1]["from"], serde_json::json!([1]));
@@ -890,8 +892,18 @@ fn issue_10_fit_reports_the_canonical_model() {
     let out = gmwm().arg("fit").arg(&file).args(args).output().unwrap();
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("canonical model: AR1()+WN()"), "{text}");
+    assert!(!text.contains("fit that model"), "{text}");
+    // where the data support a smaller model, the table says which to fit
+    let kvh = data("precomputed/kvh1750_wv.json");
+    let out = gmwm()
+        .arg("fit")
+        .arg(&kvh)
+        .args(["--columns", "gyro_x", "--model", "3*GM()+WN()+QN()+RW()"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
     assert!(
-        text.contains("fit AR1()+WN() for its own estimates and intervals"),
+        text.contains("the data cannot tell this fit from one of GM()+QN()+RW()"),
         "{text}"
     );
 }

@@ -53,36 +53,31 @@ fn wv_separation_is_a_symmetric_scale_free_distance_in_standard_errors() {
 }
 
 #[test]
-fn canonical_reads_an_ar1_below_the_sampling_interval_as_white_noise() {
-    // white noise plus one slow AR1, fitted as 2*AR1(): one AR1 plays the white noise
+fn canonical_replaces_a_fast_ar1_the_wv_cannot_tell_from_white_noise() {
+    // white noise plus one slow AR1, fitted as 2*AR1(): one AR1 plays the white noise with a
+    // correlation time far below the sampling interval; its WV is white noise's within the
+    // noise, so the reduced model has the white noise itself
     let truth = model("AR1(phi=0.995, sigma2=2e-3)+WN(sigma2=1)");
     let x = simulate_model(&truth, 50_000, 100.0, 11).unwrap();
     for text in ["2*AR1()", "2*GM()"] {
         let f = fit(text, &x, 100.0);
         let forms = f.ar1_gm_forms();
-        let fast = forms
-            .iter()
-            .find(|g| g.phi < (-1.0f64).exp())
-            .unwrap_or_else(|| panic!("{text}: no AR1 below the sampling interval: {forms:?}"));
+        assert!(
+            forms.iter().any(|g| g.phi < (-1.0f64).exp()),
+            "{text}: no AR1 below the sampling interval: {forms:?}"
+        );
         let c = f.canonical().unwrap();
         let kind = if text.contains("GM") { "GM" } else { "AR1" };
-        assert_eq!(c.model.to_string(), format!("{kind}()+WN()"), "{c}");
+        assert_eq!(c.model.to_string(), format!("{kind}()+WN()"), "{f}\n{c}");
+        assert_eq!(c.reduced, c.model, "{c}");
         assert!(has_reading(&c, |r| matches!(
             r,
-            Reading::WhiteAtSamplingRate { correlation_time_s, sampling_interval_s, .. }
-                if *correlation_time_s < *sampling_interval_s
+            Reading::WhiteAtObservedScales { separation, .. } if *separation <= 2.0
         )));
-        // WN variance = sigma2 / (1 - phi)^2 of the fast AR1, read off without a refit
+        assert!(c.separation <= 2.0 && c.separation > 0.0, "{c}");
+        // the white noise of the refit is the truth's, and the read-off is N = sqrt(sigma2 / f)
         let wn = c.term(ProcessKind::Wn).unwrap().parameters[0].value;
-        let want = fast.sigma2 / (1.0 - fast.phi).powi(2);
-        assert!((wn / want - 1.0).abs() < 1e-12, "{text}: {wn} vs {want}");
-        assert!(
-            (wn - 1.0).abs() < 0.03,
-            "{text}: white noise {wn} vs the truth's 1"
-        );
-        assert_eq!(c.separation, 0.0);
-        assert_eq!(c.objective, f.objective);
-        // the physical read-off: N = sqrt(sigma2 / f)
+        assert!((wn - 1.0).abs() < 0.03, "{text}: white noise {wn} vs 1");
         let n = c.physical(ProcessKind::Wn, "white_noise_density").unwrap();
         assert!((n / (wn / 100.0).sqrt() - 1.0).abs() < 1e-12);
     }
@@ -231,33 +226,48 @@ fn canonical_reads_a_drift_as_a_random_walk_when_the_wv_cannot_tell_them_apart()
 
 #[test]
 fn canonical_drops_components_fitted_to_nothing() {
-    // QN and DR on data without them: at the boundary or negligible
-    let x = simulate_model(
-        &model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)"),
-        20_000,
-        1.0,
-        9,
-    )
-    .unwrap();
-    let f = fit("AR1()+WN()+QN()+DR()", &x, 1.0);
+    // QN and DR fitted to the exact WV of an AR1 and a white noise: the fit drives both to
+    // nothing, the canonical model leaves them out and says so, and the reduced model is the
+    // truth's
+    let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)");
+    let wv = exact_wv(&truth, 20_000, 1.0);
+    let f = fit_wv("AR1()+WN()+QN()+DR()", &wv);
     let c = f.canonical().unwrap();
-    for (i, comp) in f.model.components().iter().enumerate() {
-        let share: f64 = f.implied_wv.processes[i]
-            .wv
-            .iter()
-            .zip(&f.implied_wv.wv)
-            .map(|(a, t)| a / t)
-            .fold(0.0, f64::max);
-        let dropped = has_reading(
-            &c,
-            |r| matches!(r, Reading::AtBoundary { component, .. } if *component == i),
+    assert_eq!(c.model.to_string(), "AR1()+WN()", "{f}\n{c}");
+    assert_eq!(c.reduced.to_string(), "AR1()+WN()", "{c}");
+    for i in [2, 3] {
+        assert!(
+            has_reading(
+                &c,
+                |r| matches!(r, Reading::AtBoundary { component, .. } if *component == i)
+            ),
+            "{c}"
         );
-        // a component whose largest share of the WV is below 1e-6 is always dropped
-        if share < 1e-6 {
-            assert!(dropped, "{} (share {share}) kept: {c}", comp.kind);
-        }
     }
-    assert!(c.model.count(ProcessKind::Ar1) == 1 && c.model.count(ProcessKind::Wn) == 1);
+    // nothing was refitted: the canonical model is the fit's own
+    assert_eq!((c.separation, c.objective), (0.0, f.objective));
+}
+
+#[test]
+fn canonical_of_a_fit_without_its_wv_or_with_a_bad_limit_is_an_error() {
+    let truth = model("AR1(phi=0.9, sigma2=0.1)+WN(sigma2=1)");
+    let nu = truth.implied_wv(10, 1.0).unwrap().wv;
+    let bare = Gmwm::new(truth.without_values())
+        .fit_weighted(&nu, gmwm::fit::Weights::unit(10), 1.0, &[0.9, 0.1, 1.0])
+        .unwrap();
+    let e = bare.canonical().unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("without an empirical wavelet variance"),
+        "{e}"
+    );
+    let wv = exact_wv(&truth, 4096, 1.0);
+    let f = fit_wv("AR1()+WN()", &wv);
+    for limit in [-1.0, f64::NAN, f64::INFINITY] {
+        assert!(f.canonical_with(limit).is_err(), "{limit}");
+    }
+    // limit 0 accepts exact reductions only: none here
+    assert!(f.canonical_with(0.0).unwrap().is_as_fitted());
 }
 
 fn kvh_gyro_x() -> gmwm::WaveletVariance {
@@ -278,11 +288,12 @@ fn issue_10_kvh1750_gm_at_infinite_beta_is_white_noise() {
     let f = fit_wv("GM()+WN()+RW()", &wv);
     let c = f.canonical().unwrap();
     // the RW of this fit is negligible (a random-walk density of 1e-8 against the coarse
-    // levels' noise): fitted to nothing
+    // levels' noise): fitted to nothing; the GM at phi = 0 is exactly a white noise
     assert_eq!(c.model.to_string(), "WN()", "{f}\n{c}");
+    assert_eq!(c.reduced.to_string(), "WN()", "{c}");
     assert!(has_reading(&c, |r| matches!(
         r,
-        Reading::WhiteAtSamplingRate { .. }
+        Reading::WhiteAtObservedScales { separation, .. } if *separation < 0.01
     )));
     assert!(has_reading(&c, |r| matches!(
         r,
@@ -291,8 +302,13 @@ fn issue_10_kvh1750_gm_at_infinite_beta_is_white_noise() {
     // the white noise of the canonical model carries the GM's variance and the WN's
     let gm = f.ar1_gm_forms()[0].clone();
     let wn = c.term(ProcessKind::Wn).unwrap().parameters[0].value;
-    let want = gm.sigma2 / (1.0 - gm.phi).powi(2) + f.theta[2];
-    assert!((wn / want - 1.0).abs() < 1e-12, "{wn} vs {want}");
+    let want = gm.sigma2_gm + f.theta[2];
+    assert!((wn / want - 1.0).abs() < 1e-6, "{wn} vs {want}");
+    // the correlation time in the note is 1 / beta, not a phi that underflowed to 0
+    assert!(has_reading(&c, |r| matches!(
+        r,
+        Reading::WhiteAtObservedScales { correlation_time_s, .. } if *correlation_time_s > 0.0
+    )));
     // inference no longer fails: beta gets no standard error, with a warning
     let inf = gmwm::inference::infer(
         &Gmwm::parse("GM()+WN()+RW()").unwrap(),
@@ -322,18 +338,19 @@ fn issue_10_kvh1750_three_gms_at_one_beta_are_one() {
     let wv = kvh_gyro_x();
     let f = fit_wv("3*GM()+WN()+QN()+RW()", &wv);
     let c = f.canonical().unwrap();
-    assert!(c.correlated_terms() <= 1, "{f}\n{c}");
-    // no two GMs of the canonical model within a factor 2 of correlation time (a bound far
-    // looser than the separation test; the fitted three were within 2%)
-    let times: Vec<f64> = c
-        .terms
-        .iter()
-        .filter_map(|t| t.physical.iter().find(|p| p.name == "correlation_time"))
-        .map(|p| p.value)
-        .collect();
-    for w in times.windows(2) {
-        assert!(w[0] / w[1] > 2.0 || w[1] / w[0] > 2.0, "{c}");
-    }
+    assert_eq!(c.correlated_terms(), 1, "{f}\n{c}");
+    assert!(
+        has_reading(&c, |r| matches!(r, Reading::Merged { .. })),
+        "{c}"
+    );
+    // the reduced model, refitted, is within the separation limit of the fit
+    assert_eq!(c.reduced, c.model, "{c}");
+    assert!(c.separation <= 2.0, "{c}");
+    let refit = fit_wv(&c.reduced.to_string(), &wv);
+    assert!(
+        refit.objective <= c.objective * (1.0 + 1e-6),
+        "{refit}\n{c}"
+    );
     // every fitted GM is accounted for: merged, dropped or kept
     let mut seen: Vec<usize> = c.terms.iter().flat_map(|t| t.from.clone()).collect();
     for r in &c.readings {
@@ -354,6 +371,22 @@ fn issue_10_adis_gyro_x_white_noise_density_matches_the_allan_read_off() {
     let f = fit("2*AR1()", &x, 100.0);
     let c = f.canonical().unwrap();
     assert_eq!(c.model.to_string(), "AR1()+WN()", "{f}\n{c}");
+    // the fast AR1's shape at the first scales is real (many standard errors from white
+    // noise): the reduced model keeps it, and the canonical model reads it as white noise with
+    // its low-frequency variance sigma2 / (1 - phi)^2
+    assert_eq!(c.reduced.to_string(), "2*AR1()", "{c}");
+    assert!(
+        has_reading(&c, |r| matches!(
+            r,
+            Reading::WhiteAtSamplingRate { separation, correlation_time_s, sampling_interval_s, .. }
+                if *separation > 2.0 && correlation_time_s < sampling_interval_s
+        )),
+        "{c}"
+    );
+    let fast = f.ar1_gm_forms()[1].clone();
+    let wn = c.term(ProcessKind::Wn).unwrap().parameters[0].value;
+    assert!((wn / (fast.sigma2 / (1.0 - fast.phi).powi(2)) - 1.0).abs() < 1e-12);
+    assert!(!c.is_as_fitted());
     let n = c.physical(ProcessKind::Wn, "white_noise_density").unwrap();
     // IEEE 952: N = sigma(tau) sqrt(tau) on the -1/2 slope; at tau = 1.28 s (m = 128 samples)
     // the white noise dominates the Allan variance of this gyro by far

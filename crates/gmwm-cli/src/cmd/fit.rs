@@ -56,6 +56,9 @@ struct FitReport<'a> {
     navigation: Vec<NavParameter>,
     /// The canonical model (text): what the fitted components are at the observed scales.
     canonical_model: String,
+    /// The reduced model (text): the smallest model whose fit the data cannot tell from this
+    /// one's.
+    reduced_model: String,
     /// Its terms with their physical read-off.
     canonical: &'a [CanonicalTerm],
     /// What the canonical model reads differently from the fit, and why.
@@ -276,6 +279,7 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                         ar1_gm: fit.ar1_gm_forms(),
                         navigation: fit.navigation(None),
                         canonical_model: canonical.model.to_string(),
+                        reduced_model: canonical.reduced.to_string(),
                         canonical: &canonical.terms,
                         canonical_notes: canonical_notes(canonical),
                         fit,
@@ -319,11 +323,12 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                     writeln!(out, "{inf}")?;
                 }
                 writeln!(out, "{canonical}")?;
-                if !canonical.is_as_fitted() {
+                if canonical.reduced != fit.model.without_values() {
                     writeln!(
                         out,
-                        "  (fit {} for its own estimates and intervals)",
-                        canonical.model
+                        "  (the data cannot tell this fit from one of {}: fit that model for \
+                         identified estimates and intervals)",
+                        canonical.reduced
                     )?;
                 }
             }

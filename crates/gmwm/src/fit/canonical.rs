@@ -24,38 +24,37 @@
 //! ```
 //!
 //! ([`WaveletVariance::log_variance`](crate::WaveletVariance::log_variance): `eta_j` are the
-//! equivalent degrees of freedom of METHODS §1.7, `psi'` the trigamma function). For nested
-//! models fitted with efficient weights `delta^2` is, to first order, the drop in the
-//! objective between them (a chi-square statistic); the levels are treated as independent
-//! (adjacent Haar levels are positively correlated, so `delta` leans towards "separable").
-//! Two fits are **not separable** when `delta <= 2` ([`SEPARATION_LIMIT`]): they differ by
-//! less than two standard errors of the WV (an equivalence at about the 5% level for one
-//! parameter).
+//! equivalent degrees of freedom of METHODS §1.7, `psi'` the trigamma function). At one level
+//! `delta` is the number of standard errors of `ln nu2_hat_j` between the two curves; over
+//! the levels it adds them in quadrature, treating the levels as independent (adjacent Haar
+//! levels are positively correlated, so it leans towards "separable"). Two fits whose
+//! separation is at most 2 ([`SEPARATION_LIMIT`], a heuristic limit: two standard errors in
+//! quadrature) are treated as ones the data cannot tell apart. It is a distance, not a test:
+//! failing to separate two fits is not evidence that they are equal.
 //!
 //! # The rules, in order
-//! 1. **At the boundary**: a component fitted to nothing (`crate::fit::active`) is dropped.
-//! 2. **White at the sampling rate** (a reading, no refit): an AR1/GM whose correlation time is
-//!    below the sampling interval (`T < 1/f`, i.e. `phi < 1/e`; `phi <= 0` included) decorrelates
-//!    within one sample and its WV peaks at or below the first scale; a filter running at `f`
-//!    sees white noise. It is read as white noise of variance `sigma2 / (1 - phi)^2`, the level
-//!    of its spectrum at low frequency: the density that governs every scale of one sample and
-//!    more (its fitted shape at the first scale is the sensor's own sub-sample filtering, which
-//!    the fit keeps). A GM with `beta -> infinity` (`phi = 0`) reads as white noise `sigma2_gm`.
-//! 3. **Tested reductions** (each refitted on the same WV and weights from the obvious start,
+//! 1. **Fitted to nothing**: a component at the boundary (`crate::fit::active`) or whose removal
+//!    moves the implied WV by at most [`NEGLIGIBLE_SEPARATION`] (a hundredth of a standard
+//!    error) is dropped.
+//! 2. **Tested reductions** (each refitted on the same WV and weights from the obvious start,
 //!    and accepted when the refit is not separable from the fitted model, `delta <= 2`; the
 //!    closest first, repeated until none passes):
 //!    - an AR1/GM whose WV **rises over every observed scale** (its own WV still grows at the
 //!      last level) replaced by a random walk with `gamma2 = sigma2` (for `tau << L` the AR1's
 //!      increments are its innovations), merged into the model's RW if it has one;
-//!    - an AR1/GM whose WV **falls over every observed scale** (and `T >= 1/f`) replaced by white
-//!      noise `sigma2 / (1 - phi)^2`;
+//!    - an AR1/GM whose WV **falls over every observed scale** (its own WV already falls at the
+//!      first level) replaced by white noise `sigma2 / (1 - phi)^2`, the level of its spectrum
+//!      at low frequency, merged into the model's WN if it has one;
 //!    - **two AR1/GMs adjacent in correlation time** merged into one that keeps their total
 //!      stationary variance `s` and long-run variance `l = sum sigma2_k / (1 - phi_k)^2`:
 //!      `phi = (l - s) / (l + s)`, `sigma2 = s (1 - phi^2)` (exact for equal phis);
 //!    - a **drift** replaced by a random walk (`gamma2 = 3 omega^2 tau_J / 4`, equal WVs at the
-//!      last scale; dropped if the model has a RW): the two cannot be separated at this length,
-//!      and the stochastic one is what a navigation filter models (a deterministic drift is what
-//!      a longer or temperature-controlled recording resolves).
+//!      last scale; dropped if the model has a RW): the stochastic one of the two is what a
+//!      navigation filter models (a deterministic drift is what a longer or
+//!      temperature-controlled recording resolves).
+//!
+//!    The model left after rules 1 and 2 is the *reduced* model: the smallest one whose fit
+//!    the data cannot tell from the fitted model's ([`CanonicalModel::reduced`]).
 //!
 //!    An AR1/GM that rises over every observed scale but is separable from a random walk is kept,
 //!    with a note that its correlation time lies beyond the recording and is poorly determined.
@@ -64,27 +63,36 @@
 //!    about one standard error from the best random walk's (a 2^15-sample recording and a
 //!    correlation length of 5000 samples: tests/canonical.rs). A correlation time beyond the
 //!    recording is not measured by it.
+//! 3. **White at the sampling rate** (a reading, not an equivalence): an AR1/GM of the reduced
+//!    model whose correlation time is below the sampling interval (`T < 1/f`, `phi < 1/e`;
+//!    `phi <= 0` included) has its WV peak at or below the first scale, and its lag-one
+//!    correlation (at most `1/e`) is gone after a few samples. When rule 2 could not replace it
+//!    by white noise, its shape at the first scales is real (typically the sensor's own
+//!    anti-alias or decimation filter, e.g. `phi = 0.16` on the ADIS16405 gyroscopes at 100
+//!    Hz), and the fit keeps it; but a navigation filter, a Kalibr file or a datasheet reads
+//!    such a process as white noise with its low-frequency density `sqrt(sigma2 / (1 -
+//!    phi)^2 / f)`, which is what the angle or velocity random walk is (the Allan deviation at
+//!    1 s agrees, tests/canonical.rs). The canonical model reports it so, and the reading says
+//!    how far that white noise's WV is from the fitted one at the first scales.
 //!
 //! The result, [`CanonicalModel`], lists the canonical terms in a fixed order (AR1/GM by
 //! decreasing correlation time, then WN, QN, RW, DR, then any ARMA-family term as fitted), each
-//! with its values and physical read-off ([`NavParameter`]), the readings that led there, and
-//! the separation of the canonical model's WV from the fitted one.
+//! with its values and physical read-off ([`NavParameter`]), the readings that led there, the
+//! reduced model and the separation of its refit from the fitted WV.
 //!
 //! ```
-//! use gmwm::fit::{Gmwm, Weights};
+//! use gmwm::fit::{Gmwm, StartInputs};
 //! use gmwm::model::Model;
-//! // white noise and a random walk, fitted with a third component: an AR1 whose correlation
-//! // time (0.5 samples) is below the sampling interval
-//! let truth = Model::parse("AR1(phi=0.135, sigma2=0.3)+WN(sigma2=1)+RW(gamma2=1e-4)").unwrap();
-//! let nu = truth.implied_wv(14, 100.0).unwrap().wv;
-//! let fit = Gmwm::new(truth.without_values())
-//!     .fit_weighted(&nu, Weights::flattening(&nu).unwrap(), 100.0, &[0.135, 0.3, 1.0, 1e-4])
-//!     .unwrap();
+//! use gmwm::{sim::simulate_model, wavelet_variance, WvOptions};
+//! // two AR1s at nearly one correlation time and a white noise, fitted to data with one AR1
+//! let truth = Model::parse("AR1(phi=0.99, sigma2=1e-2)+WN(sigma2=1)").unwrap();
+//! let x = simulate_model(&truth, 100_000, 100.0, 3).unwrap();
+//! let start = "AR1(phi=0.991, sigma2=5e-3)+AR1(phi=0.989, sigma2=5e-3)+WN(sigma2=1)";
+//! let fit = Gmwm::parse(start).unwrap().fit(&x, 100.0, &WvOptions::default()).unwrap();
 //! let canonical = fit.canonical().unwrap();
-//! assert_eq!(canonical.model.to_string(), "WN()+RW()");
-//! let wn = &canonical.terms[0];
-//! // 0.3 / (1 - 0.135)^2 + 1
-//! assert!((wn.parameters[0].value / (0.3 / 0.865f64.powi(2) + 1.0) - 1.0).abs() < 1e-6);
+//! assert_eq!(canonical.model.to_string(), "AR1()+WN()");
+//! assert_eq!(canonical.reduced.to_string(), "AR1()+WN()");
+//! assert!(canonical.separation <= gmwm::fit::SEPARATION_LIMIT);
 //! ```
 
 use super::active::active_components;
@@ -162,8 +170,8 @@ pub struct TermParameter {
 /// One term of a canonical model.
 ///
 /// Wire format: `process` (`WN`, `AR1`, ...), `parameters` (`name`, `value`), `physical` (the
-/// read-off: `name`, `value`, `unit`), `from` (0-based positions of the fitted components it
-/// stands for).
+/// read-off: `process`, `index` (this term's 0-based position in the canonical model), `name`,
+/// `value`, `unit`), `from` (0-based positions of the fitted components it stands for).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CanonicalTerm {
     /// Process name.
@@ -182,7 +190,8 @@ pub struct CanonicalTerm {
 /// Why a fitted component reads differently in the canonical model (module doc, rules 1–3).
 ///
 /// Wire format: tagged by `kind` (kebab-case), with the fields below; `component(s)` are 0-based
-/// positions in the fitted model, times in seconds.
+/// positions in the fitted model, times in seconds, `separation` in standard errors of the WV
+/// (module doc). The `Display` text is the reading in words.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 #[non_exhaustive]
@@ -194,18 +203,7 @@ pub enum Reading {
         /// Its process name.
         process: String,
     },
-    /// Rule 2: correlation time below the sampling interval, read as white noise.
-    WhiteAtSamplingRate {
-        /// Component.
-        component: usize,
-        /// Its process name.
-        process: String,
-        /// Its correlation time.
-        correlation_time_s: f64,
-        /// The sampling interval `1 / f`.
-        sampling_interval_s: f64,
-    },
-    /// Rule 3: falls over every observed scale and is not separable from white noise.
+    /// Rule 2: falls over every observed scale and is not separable from white noise.
     WhiteAtObservedScales {
         /// Component.
         component: usize,
@@ -216,7 +214,7 @@ pub enum Reading {
         /// Separation of the refit with white noise instead.
         separation: f64,
     },
-    /// Rule 3: rises over every observed scale and is not separable from a random walk.
+    /// Rule 2: rises over every observed scale and is not separable from a random walk.
     RandomWalkAtObservedScales {
         /// Component.
         component: usize,
@@ -229,7 +227,8 @@ pub enum Reading {
         /// Separation of the refit with a random walk instead.
         separation: f64,
     },
-    /// Rule 3: rises over every observed scale but is separable from a random walk: kept.
+    /// Rule 2: rises over every observed scale but is separable from a random walk: kept (a
+    /// note; the term is as fitted).
     CorrelationBeyondRecording {
         /// Component.
         component: usize,
@@ -242,7 +241,7 @@ pub enum Reading {
         /// Separation of the refit with a random walk instead.
         separation: f64,
     },
-    /// Rule 3: correlation times too close to be separated: merged into one.
+    /// Rule 2: correlation times too close to be separated: merged into one.
     Merged {
         /// The components.
         components: Vec<usize>,
@@ -253,13 +252,47 @@ pub enum Reading {
         /// Separation of the refit with one component instead.
         separation: f64,
     },
-    /// Rule 3: a drift not separable from a random walk at this length.
+    /// Rule 2: a drift not separable from a random walk at this length.
     DriftAsRandomWalk {
         /// Component.
         component: usize,
         /// Separation of the refit with a random walk instead.
         separation: f64,
     },
+    /// Rule 3: correlation time below the sampling interval, reported as white noise with its
+    /// low-frequency density although its WV differs from white noise's at the first scales.
+    WhiteAtSamplingRate {
+        /// Component.
+        component: usize,
+        /// Its process name.
+        process: String,
+        /// Its correlation time.
+        correlation_time_s: f64,
+        /// The sampling interval `1 / f`.
+        sampling_interval_s: f64,
+        /// Separation of the reduced fit's WV with this component read as white noise from
+        /// the reduced fit's WV (more than the limit: rule 2 did not merge it).
+        separation: f64,
+    },
+}
+
+impl Reading {
+    /// Whether the reading is a note only (the term is reported as fitted).
+    pub fn is_note(&self) -> bool {
+        matches!(self, Reading::CorrelationBeyondRecording { .. })
+    }
+
+    fn set_separation(&mut self, d: f64) {
+        match self {
+            Reading::WhiteAtObservedScales { separation, .. }
+            | Reading::RandomWalkAtObservedScales { separation, .. }
+            | Reading::CorrelationBeyondRecording { separation, .. }
+            | Reading::Merged { separation, .. }
+            | Reading::DriftAsRandomWalk { separation, .. }
+            | Reading::WhiteAtSamplingRate { separation, .. } => *separation = d,
+            Reading::AtBoundary { .. } => {}
+        }
+    }
 }
 
 impl fmt::Display for Reading {
@@ -267,21 +300,8 @@ impl fmt::Display for Reading {
         match self {
             Reading::AtBoundary { component, process } => write!(
                 f,
-                "{process}[{component}] is fitted to nothing (its share of the WV is below a hundredth of a \
-                 standard error): left out"
-            ),
-            Reading::WhiteAtSamplingRate {
-                component,
-                process,
-                correlation_time_s,
-                sampling_interval_s,
-            } => write!(
-                f,
-                "{process}[{component}] has a correlation time of {} s, below the sampling \
-                 interval ({} s): it is white noise at the sampling rate and is reported as WN \
-                 with its low-frequency level sigma2 / (1 - phi)^2",
-                short(*correlation_time_s),
-                short(*sampling_interval_s)
+                "{process}[{component}] is fitted to nothing (its share of the WV is below a \
+                 hundredth of a standard error): left out"
             ),
             Reading::WhiteAtObservedScales {
                 component,
@@ -291,10 +311,9 @@ impl fmt::Display for Reading {
             } => write!(
                 f,
                 "{process}[{component}] (correlation time {} s) falls over every observed scale \
-                 and the WV cannot separate it from white noise (separation {:.2} <= \
-                 {SEPARATION_LIMIT}): reported as WN",
+                 and the WV cannot tell it from white noise (separation {separation:.2}): \
+                 reported as WN",
                 short(*correlation_time_s),
-                separation
             ),
             Reading::RandomWalkAtObservedScales {
                 component,
@@ -305,11 +324,10 @@ impl fmt::Display for Reading {
             } => write!(
                 f,
                 "{process}[{component}] (correlation time {} s, longest observed scale {} s) rises \
-                 over every observed scale and the WV cannot separate it from a random walk \
-                 (separation {:.2} <= {SEPARATION_LIMIT}): reported as RW",
+                 over every observed scale and the WV cannot tell it from a random walk \
+                 (separation {separation:.2}): reported as RW",
                 short(*correlation_time_s),
                 short(*longest_scale_s),
-                separation
             ),
             Reading::CorrelationBeyondRecording {
                 component,
@@ -320,12 +338,11 @@ impl fmt::Display for Reading {
             } => write!(
                 f,
                 "{process}[{component}] rises over every observed scale (correlation time {} s, \
-                 longest observed scale {} s) but the WV shows its bend (separation {:.2} from a \
-                 random walk): kept as correlated noise, its correlation time poorly determined \
-                 (a longer recording fixes it)",
+                 longest observed scale {} s) but the WV shows its bend (separation \
+                 {separation:.2} from a random walk): kept as correlated noise, its correlation \
+                 time poorly determined (a longer recording fixes it)",
                 short(*correlation_time_s),
                 short(*longest_scale_s),
-                separation
             ),
             Reading::Merged {
                 components,
@@ -333,16 +350,17 @@ impl fmt::Display for Reading {
                 correlation_times_s,
                 separation,
             } => {
-                let names: Vec<String> =
-                    components.iter().map(|c| format!("{process}[{c}]")).collect();
+                let names: Vec<String> = components
+                    .iter()
+                    .map(|c| format!("{process}[{c}]"))
+                    .collect();
                 let times: Vec<String> = correlation_times_s.iter().map(|t| short(*t)).collect();
                 write!(
                     f,
-                    "{} (correlation times {} s) are too close for the WV to separate \
-                     (separation {:.2} <= {SEPARATION_LIMIT} from one {process}): merged into one",
+                    "{} (correlation times {} s) are too close for the WV to tell apart \
+                     (separation {separation:.2} from one {process}): merged into one",
                     names.join(" and "),
                     times.join(", "),
-                    separation
                 )
             }
             Reading::DriftAsRandomWalk {
@@ -350,11 +368,26 @@ impl fmt::Display for Reading {
                 separation,
             } => write!(
                 f,
-                "DR[{component}] and a random walk cannot be separated at this recording's length \
-                 (separation {:.2} <= {SEPARATION_LIMIT}): both fit; the random walk, which a \
+                "DR[{component}] and a random walk cannot be told apart at this recording's \
+                 length (separation {separation:.2}): both fit; the random walk, which a \
                  navigation filter models, is reported (a longer or temperature-controlled \
-                 recording resolves a drift)",
-                separation
+                 recording resolves a drift)"
+            ),
+            Reading::WhiteAtSamplingRate {
+                component,
+                process,
+                correlation_time_s,
+                sampling_interval_s,
+                separation,
+            } => write!(
+                f,
+                "{process}[{component}] has a correlation time of {} s, below the sampling \
+                 interval ({} s): it is reported as white noise with its low-frequency density \
+                 (the angle/velocity random walk a navigation filter uses); its fitted shape at \
+                 the first scales, {separation:.1} standard errors from pure white noise's, is \
+                 sub-sample correlation (e.g. the sensor's own filter), which the fit keeps",
+                short(*correlation_time_s),
+                short(*sampling_interval_s),
             ),
         }
     }
@@ -368,9 +401,10 @@ fn short(v: f64) -> String {
 /// The canonical model of a fit (module doc).
 ///
 /// Wire format: `model` (guess-mode text such as `AR1()+WN()+RW()`), `terms`
-/// ([`CanonicalTerm`]), `readings` ([`Reading`], each with its `message`), `separation` (of the
-/// canonical model's WV from the fitted one; 0 when nothing was refitted) and `objective` (of
-/// the canonical refit; the fit's own when nothing was refitted).
+/// ([`CanonicalTerm`]), `readings` ([`Reading`]), `reduced` (the reduced model, guess mode),
+/// `separation` (of the reduced model's refit from the fitted WV; 0 when nothing was
+/// refitted), `objective` (of that refit; the fit's own when nothing was refitted) and
+/// `implied_wv` (of that refit).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CanonicalModel {
     /// The canonical model in guess mode (its term list).
@@ -379,19 +413,22 @@ pub struct CanonicalModel {
     pub terms: Vec<CanonicalTerm>,
     /// What was read differently from the fit, and why.
     pub readings: Vec<Reading>,
-    /// Separation of the canonical model's implied WV from the fit's.
+    /// The reduced model (rules 1 and 2, guess mode): the smallest model whose fit the data
+    /// cannot tell from the fitted model's; fit it for identified estimates and intervals.
+    pub reduced: Model,
+    /// Separation of the reduced model's refit from the fitted WV.
     pub separation: f64,
-    /// Objective of the fit behind the canonical model.
+    /// Objective of the reduced model's fit.
     pub objective: f64,
-    /// Implied WV of the fit behind the canonical model (a fast AR1 read as white noise keeps
+    /// Implied WV of the reduced model's fit (a component read as white noise by rule 3 keeps
     /// its fitted shape here).
     pub implied_wv: Vec<f64>,
 }
 
 impl CanonicalModel {
-    /// Whether the canonical model is the fitted model, term for term.
+    /// Whether the canonical model is the fitted model, term for term (notes aside).
     pub fn is_as_fitted(&self) -> bool {
-        self.readings.is_empty()
+        self.readings.iter().all(Reading::is_note)
     }
 
     /// The canonical model with its values.
@@ -477,25 +514,48 @@ impl Part {
             .map(|v| v.unwrap_or(f64::NAN))
             .collect()
     }
-}
 
-/// The per-sample AR1 form of an AR1/GM part.
-fn ar1_of(part: &Part, freq_hz: f64) -> Option<Ar1> {
-    let v = part.values();
-    match part.kind() {
-        ProcessKind::Ar1 => Some(Ar1 {
-            phi: v[0],
-            sigma2: v[1],
-        }),
-        ProcessKind::Gm => Some(
-            Gm {
-                beta: v[0],
-                sigma2_gm: v[1],
-                freq_hz,
+    /// The per-sample AR1 form of an AR1/GM part (METHODS §4.3).
+    fn ar1(&self, freq_hz: f64) -> Option<Ar1> {
+        let v = self.values();
+        match self.kind() {
+            ProcessKind::Ar1 => Some(Ar1 {
+                phi: v[0],
+                sigma2: v[1],
+            }),
+            ProcessKind::Gm => Some(
+                Gm {
+                    beta: v[0],
+                    sigma2_gm: v[1],
+                    freq_hz,
+                }
+                .to_ar1(),
+            ),
+            _ => None,
+        }
+    }
+
+    /// Correlation time in seconds of an AR1/GM part: `1 / beta` for a GM (exact even where
+    /// phi underflows), `-1 / (f ln phi)` for an AR1 (0 for `phi <= 0`).
+    fn correlation_time_s(&self, freq_hz: f64) -> Option<f64> {
+        match self.kind() {
+            ProcessKind::Gm => Some(1.0 / self.values()[0]),
+            ProcessKind::Ar1 => {
+                let phi = self.values()[0];
+                Some(if phi > 0.0 {
+                    -1.0 / (phi.ln() * freq_hz)
+                } else {
+                    0.0
+                })
             }
-            .to_ar1(),
-        ),
-        _ => None,
+            _ => None,
+        }
+    }
+
+    /// Rule 3: the correlation time is below the sampling interval.
+    fn white_at_sampling_rate(&self, freq_hz: f64) -> bool {
+        self.correlation_time_s(freq_hz)
+            .is_some_and(|t| t < 1.0 / freq_hz)
     }
 }
 
@@ -514,22 +574,8 @@ fn part_from_ar1(kind: ProcessKind, ar1: Ar1, freq_hz: f64, from: Vec<usize>) ->
     })
 }
 
-/// Correlation time in seconds of an AR1 form (0 for `phi <= 0`).
-fn correlation_time(ar1: Ar1, freq_hz: f64) -> f64 {
-    if ar1.phi > 0.0 {
-        -1.0 / (ar1.phi.ln() * freq_hz)
-    } else {
-        0.0
-    }
-}
-
-/// Rule 2: the correlation time is below the sampling interval (`phi < 1/e`).
-fn white_at_sampling_rate(ar1: Ar1) -> bool {
-    ar1.phi < (-1.0f64).exp()
-}
-
 /// Long-run variance `sigma2 / (1 - phi)^2`: the white noise an AR1 is at scales far beyond
-/// its correlation length.
+/// its correlation length (the level of its spectrum at low frequency).
 fn long_run_variance(ar1: Ar1) -> f64 {
     ar1.sigma2 / ((1.0 - ar1.phi) * (1.0 - ar1.phi))
 }
@@ -555,10 +601,14 @@ fn add_single(parts: &mut Vec<Part>, kind: ProcessKind, value: f64, from: &[usiz
     Some(())
 }
 
-/// A candidate reduction (rule 3) and its reading once accepted.
+/// A candidate reduction (rule 2): the working model it leads to and its reading (whose
+/// separation is filled in once measured).
 struct Reduction {
     parts: Vec<Part>,
-    reading: Box<dyn Fn(f64) -> Reading>,
+    reading: Reading,
+    /// For a random-walk replacement: the rising part's position (its separation is kept for
+    /// the note when the replacement fails).
+    rising: Option<usize>,
 }
 
 /// The state of the canonicalisation: the working model, its implied WV and objective.
@@ -575,8 +625,7 @@ impl GmwmFit {
     /// AR1/GM, or a pair of adjacent AR1/GMs), a few milliseconds each.
     ///
     /// # Errors
-    /// Errors of the refits' set-up ([`FitError`]); a refit that fails to converge only makes
-    /// its reduction fail the test.
+    /// As [`GmwmFit::canonical_with`].
     pub fn canonical(&self) -> Result<CanonicalModel, FitError> {
         self.canonical_with(SEPARATION_LIMIT)
     }
@@ -585,10 +634,31 @@ impl GmwmFit {
     /// reductions).
     ///
     /// # Errors
-    /// As [`GmwmFit::canonical`].
+    /// [`FitError::Engine`] with a [`crate::ParamError`] for a limit that is not a finite
+    /// number >= 0, or for a fit without an empirical WV (a bare [`Gmwm::fit_weighted`]: the
+    /// separation is measured in the noise of that WV); errors of the refits' set-up. A refit
+    /// that fails to converge only makes its reduction fail the test.
     pub fn canonical_with(&self, limit: f64) -> Result<CanonicalModel, FitError> {
+        if !(limit.is_finite() && limit >= 0.0) {
+            return Err(crate::Error::from(crate::ParamError::new(
+                "separation limit",
+                limit,
+                "a finite number of standard errors >= 0",
+            ))
+            .into());
+        }
+        let Some(wv) = &self.empirical else {
+            return Err(crate::Error::from(crate::ParamError::new(
+                "fit",
+                "without an empirical wavelet variance",
+                "a fit that carries its WV (Gmwm::fit, fit_from_wv, fit_series, fit_wv): the \
+                 separation is measured in that WV's noise",
+            ))
+            .into());
+        };
+        let log_variance = wv.log_variance();
         let levels = self.nu_hat.len();
-        let log_variance = self.log_variance();
+        let freq = self.freq_hz;
         let mut readings = Vec::new();
         // rule 1
         let active = contributing(&self.implied_wv, &log_variance);
@@ -617,7 +687,7 @@ impl GmwmFit {
         let implied = if parts.len() == self.model.n_components() {
             self.implied_wv.clone()
         } else {
-            model_of(&parts)?.implied_wv(levels, self.freq_hz)?
+            model_of(&parts)?.implied_wv(levels, freq)?
         };
         let mut state = State {
             parts,
@@ -625,68 +695,68 @@ impl GmwmFit {
             objective: self.objective,
         };
         let mut separation = 0.0;
-        // rule 3, closest first
-        loop {
+        // rule 2, closest first; the separations of the rising parts' failed replacements in
+        // the last round are the notes'
+        let rising_separation = loop {
             let mut best: Option<(f64, State, Reading)> = None;
+            let mut rising = Vec::new();
             for r in self.reductions(&state) {
-                let Some(next) = self.refit(r.parts, &log_variance)? else {
-                    continue;
+                let d = match self.refit(r.parts, &log_variance)? {
+                    Some(next) => {
+                        let d = wv_separation(&self.implied_wv.wv, &next.implied.wv, &log_variance);
+                        if d <= limit && best.as_ref().map_or(true, |b| d < b.0) {
+                            let mut reading = r.reading;
+                            reading.set_separation(d);
+                            best = Some((d, next, reading));
+                        }
+                        d
+                    }
+                    None => f64::INFINITY,
                 };
-                let d = wv_separation(&self.implied_wv.wv, &next.implied.wv, &log_variance);
-                if d <= limit && best.as_ref().map_or(true, |b| d < b.0) {
-                    best = Some((d, next, (r.reading)(d)));
+                if let Some(k) = r.rising {
+                    rising.push((k, d));
                 }
             }
             let Some((d, next, reading)) = best else {
-                break;
+                break rising;
             };
             readings.push(reading);
             separation = d;
             state = next;
-        }
-        // rule 3, the kept slow ones: a note
+        };
         let longest_scale_s = self.longest_scale_s();
-        for (k, p) in state.parts.iter().enumerate() {
-            if let Some(ar1) = ar1_of(p, self.freq_hz) {
-                if !white_at_sampling_rate(ar1) && rises_everywhere(&state.implied, k) {
-                    let mut replaced = state.parts.clone();
-                    replaced.remove(k);
-                    let d = add_single(&mut replaced, ProcessKind::Rw, ar1.sigma2, &[])
-                        .map(|_| replaced)
-                        .map(|parts| self.refit(parts, &log_variance))
-                        .transpose()?
-                        .flatten()
-                        .map_or(f64::INFINITY, |s| {
-                            wv_separation(&self.implied_wv.wv, &s.implied.wv, &log_variance)
-                        });
-                    readings.push(Reading::CorrelationBeyondRecording {
-                        component: p.from[0],
-                        process: p.kind().name(),
-                        correlation_time_s: correlation_time(ar1, self.freq_hz),
-                        longest_scale_s,
-                        separation: d,
-                    });
-                }
-            }
+        for (k, d) in rising_separation {
+            let p = &state.parts[k];
+            readings.push(Reading::CorrelationBeyondRecording {
+                component: p.from[0],
+                process: p.kind().name(),
+                correlation_time_s: p.correlation_time_s(freq).unwrap_or(f64::NAN),
+                longest_scale_s,
+                separation: d,
+            });
         }
-        // rule 2 and the terms
+        // rule 3 and the terms
+        let tau: Vec<f64> = (1..=levels).map(|j| (j as f64).exp2()).collect();
         let mut terms_parts: Vec<Part> = Vec::new();
-        for p in &state.parts {
-            match ar1_of(p, self.freq_hz) {
-                Some(ar1) if white_at_sampling_rate(ar1) => {
+        for (k, p) in state.parts.iter().enumerate() {
+            match p.ar1(freq) {
+                Some(ar1) if p.white_at_sampling_rate(freq) => {
+                    let sigma2 = long_run_variance(ar1);
+                    // the reduced fit's WV with this component read as white noise
+                    let read: Vec<f64> = (0..levels)
+                        .map(|j| {
+                            state.implied.wv[j] - state.implied.processes[k].wv[j] + sigma2 / tau[j]
+                        })
+                        .collect();
                     readings.push(Reading::WhiteAtSamplingRate {
                         component: p.from[0],
                         process: p.kind().name(),
-                        correlation_time_s: correlation_time(ar1, self.freq_hz),
-                        sampling_interval_s: 1.0 / self.freq_hz,
+                        correlation_time_s: p.correlation_time_s(freq).unwrap_or(f64::NAN),
+                        sampling_interval_s: 1.0 / freq,
+                        separation: wv_separation(&state.implied.wv, &read, &log_variance),
                     });
-                    add_single(
-                        &mut terms_parts,
-                        ProcessKind::Wn,
-                        long_run_variance(ar1),
-                        &p.from,
-                    )
-                    .ok_or_else(|| bad_value("white noise", long_run_variance(ar1)))?;
+                    add_single(&mut terms_parts, ProcessKind::Wn, sigma2, &p.from)
+                        .ok_or_else(|| bad_value("white noise", sigma2))?;
                 }
                 _ if p.kind() == ProcessKind::Wn => {
                     add_single(&mut terms_parts, ProcessKind::Wn, p.values()[0], &p.from)
@@ -695,14 +765,13 @@ impl GmwmFit {
                 _ => terms_parts.push(p.clone()),
             }
         }
-        let terms_parts = canonical_order(terms_parts, self.freq_hz);
-        let model = Model::new(
-            terms_parts
-                .iter()
-                .map(|p| Component::guess(p.kind()))
-                .collect(),
-        )
-        .map_err(crate::Error::from)?;
+        let terms_parts = canonical_order(terms_parts, freq);
+        let guess = |parts: &[Part]| {
+            Model::new(parts.iter().map(|p| Component::guess(p.kind())).collect())
+                .map_err(crate::Error::from)
+        };
+        let model = guess(&terms_parts)?;
+        let reduced = guess(&canonical_order(state.parts.clone(), freq))?;
         let terms = terms_parts
             .iter()
             .enumerate()
@@ -718,7 +787,7 @@ impl GmwmFit {
                         .zip(&theta)
                         .map(|(name, &value)| TermParameter { name, value })
                         .collect(),
-                    physical: physical_parameters(p.kind(), i, &theta, self.freq_hz, None),
+                    physical: physical_parameters(p.kind(), i, &theta, freq, None),
                     from: p.from.clone(),
                 }
             })
@@ -727,26 +796,11 @@ impl GmwmFit {
             model,
             terms,
             readings,
+            reduced,
             separation,
             objective: state.objective,
             implied_wv: state.implied.wv,
         })
-    }
-
-    /// Variance of the log of the empirical WV per level (module doc); from the CI widths
-    /// when the fit carries no empirical WV (a bare [`Gmwm::fit_weighted`]): `V_jj` is then
-    /// the weighting's variance proxy, read as `(2 z_{0.975})^2 Var(nu2_hat_j)`.
-    fn log_variance(&self) -> Vec<f64> {
-        match &self.empirical {
-            Some(wv) => wv.log_variance(),
-            None => self
-                .weights
-                .v
-                .iter()
-                .zip(&self.nu_hat)
-                .map(|(v, nu)| v / (nu * nu * 4.0 * 1.959_963_984_540_054f64.powi(2)))
-                .collect(),
-        }
     }
 
     /// The longest observed scale `2^J / f` in seconds.
@@ -754,7 +808,7 @@ impl GmwmFit {
         (self.nu_hat.len() as f64).exp2() / self.freq_hz
     }
 
-    /// The reductions of rule 3 that apply to `state` (module doc).
+    /// The reductions of rule 2 that apply to `state` (module doc).
     fn reductions(&self, state: &State) -> Vec<Reduction> {
         let f = self.freq_hz;
         let parts = &state.parts;
@@ -762,28 +816,27 @@ impl GmwmFit {
         let correlated: Vec<(usize, Ar1)> = parts
             .iter()
             .enumerate()
-            .filter_map(|(k, p)| ar1_of(p, f).map(|a| (k, a)))
-            .filter(|(_, a)| !white_at_sampling_rate(*a))
+            .filter_map(|(k, p)| p.ar1(f).map(|a| (k, a)))
             .collect();
         let longest_scale_s = self.longest_scale_s();
         for &(k, ar1) in &correlated {
             let p = &parts[k];
             let (component, process) = (p.from[0], p.kind().name());
-            let correlation_time_s = correlation_time(ar1, f);
+            let correlation_time_s = p.correlation_time_s(f).unwrap_or(f64::NAN);
             if rises_everywhere(&state.implied, k) {
                 let mut next = parts.clone();
                 next.remove(k);
                 if add_single(&mut next, ProcessKind::Rw, ar1.sigma2, &p.from).is_some() {
-                    let process = process.clone();
                     out.push(Reduction {
                         parts: next,
-                        reading: Box::new(move |separation| Reading::RandomWalkAtObservedScales {
+                        reading: Reading::RandomWalkAtObservedScales {
                             component,
                             process: process.clone(),
                             correlation_time_s,
                             longest_scale_s,
-                            separation,
-                        }),
+                            separation: f64::NAN,
+                        },
+                        rising: Some(k),
                     });
                 }
             }
@@ -794,17 +847,18 @@ impl GmwmFit {
                 {
                     out.push(Reduction {
                         parts: next,
-                        reading: Box::new(move |separation| Reading::WhiteAtObservedScales {
+                        reading: Reading::WhiteAtObservedScales {
                             component,
-                            process: process.clone(),
+                            process,
                             correlation_time_s,
-                            separation,
-                        }),
+                            separation: f64::NAN,
+                        },
+                        rising: None,
                     });
                 }
             }
         }
-        // adjacent pairs in correlation time (the parts are kept in phi-decreasing order)
+        // adjacent pairs in correlation time
         let mut by_phi = correlated.clone();
         by_phi.sort_by(|a, b| b.1.phi.total_cmp(&a.1.phi));
         for w in by_phi.windows(2) {
@@ -828,18 +882,20 @@ impl GmwmFit {
                 .filter(|(j, _)| *j != i && *j != k)
                 .map(|(_, p)| p.clone())
                 .collect();
-            let components = part.from.clone();
+            let reading = Reading::Merged {
+                components: part.from.clone(),
+                process: parts[i].kind().name(),
+                correlation_times_s: [&parts[i], &parts[k]]
+                    .iter()
+                    .map(|p| p.correlation_time_s(f).unwrap_or(f64::NAN))
+                    .collect(),
+                separation: f64::NAN,
+            };
             next.push(part);
-            let times = vec![correlation_time(a, f), correlation_time(b, f)];
-            let process = parts[i].kind().name();
             out.push(Reduction {
                 parts: next,
-                reading: Box::new(move |separation| Reading::Merged {
-                    components: components.clone(),
-                    process: process.clone(),
-                    correlation_times_s: times.clone(),
-                    separation,
-                }),
+                reading,
+                rising: None,
             });
         }
         if let Some(k) = parts.iter().position(|p| p.kind() == ProcessKind::Dr) {
@@ -855,13 +911,13 @@ impl GmwmFit {
                 add_single(&mut next, ProcessKind::Rw, gamma2, &from)
             };
             if ok.is_some() && (has_rw || gamma2 > 0.0) {
-                let component = from[0];
                 out.push(Reduction {
                     parts: next,
-                    reading: Box::new(move |separation| Reading::DriftAsRandomWalk {
-                        component,
-                        separation,
-                    }),
+                    reading: Reading::DriftAsRandomWalk {
+                        component: from[0],
+                        separation: f64::NAN,
+                    },
+                    rising: None,
                 });
             }
         }
@@ -870,7 +926,7 @@ impl GmwmFit {
 
     /// Refits the working model `parts` (stage 2 from its values, the fit's WV, weights and
     /// transforms, AR1/GMs ordered); `None` when the start is not a valid model or the refit
-    /// fails to converge. Components the refit drives to the boundary are dropped.
+    /// fails to converge. Components the refit fits to nothing (rule 1) are dropped.
     fn refit(&self, parts: Vec<Part>, log_variance: &[f64]) -> Result<Option<State>, FitError> {
         let parts = canonical_order(parts, self.freq_hz);
         let Ok(model) = model_of(&parts) else {
@@ -965,7 +1021,7 @@ fn canonical_order(mut parts: Vec<Part>, freq_hz: f64) -> Vec<Part> {
         ProcessKind::Dr => 4,
         _ => 5,
     };
-    let phi = |p: &Part| ar1_of(p, freq_hz).map_or(0.0, |a| a.phi);
+    let phi = |p: &Part| p.ar1(freq_hz).map_or(0.0, |a| a.phi);
     parts.sort_by(|a, b| {
         rank(a)
             .cmp(&rank(b))

@@ -213,20 +213,23 @@ pub(crate) fn physical_parameters(
     }
 }
 
-/// Six significant digits, scientific outside [1e-3, 1e5).
+/// Six significant digits ([`significant`]).
 fn short(v: f64) -> String {
     significant(v, 6)
 }
 
-/// The display of a value in the engine's tables and notes: `digits` significant digits in
-/// scientific notation outside [1e-3, 1e5), `digits` decimals inside (`digits` 2 to 17).
+/// The display of a value in the engine's tables and notes: `digits` significant digits
+/// (clamped to 2..=17), in scientific notation outside [1e-3, 1e5).
 pub(crate) fn significant(v: f64, digits: usize) -> String {
     let digits = digits.clamp(2, 17);
     let a = v.abs();
-    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+    if a == 0.0 || !a.is_finite() {
+        format!("{v}")
+    } else if !(1e-3..1e5).contains(&a) {
         format!("{v:.*e}", digits - 1)
     } else {
-        format!("{v:.*}", digits)
+        let decimals = (digits as i32 - 1 - a.log10().floor() as i32).max(0) as usize;
+        format!("{v:.decimals$}")
     }
 }
 
@@ -302,7 +305,20 @@ impl fmt::Display for GmwmFit {
 
 #[cfg(test)]
 mod tests {
+    use super::significant;
     use crate::fit::Gmwm;
+
+    #[test]
+    fn significant_keeps_the_asked_digits() {
+        assert_eq!(significant(118.265458, 6), "118.265");
+        assert_eq!(significant(0.0055, 4), "0.005500");
+        assert_eq!(significant(0.999915, 6), "0.999915");
+        assert_eq!(significant(2.14553e-8, 6), "2.14553e-8");
+        assert_eq!(significant(1638.4, 4), "1638");
+        assert_eq!(significant(-0.25, 2), "-0.25");
+        assert_eq!(significant(0.0, 4), "0");
+    }
+
     use crate::model::Model;
     use crate::sim::DemoSensor;
 

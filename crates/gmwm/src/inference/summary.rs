@@ -152,10 +152,11 @@ pub enum InferenceWarning {
         /// The boundary parameters' labels.
         parameters: Vec<String>,
     },
-    /// Parameters without influence on the implied WV at the estimate (the edge of their
-    /// domain, e.g. a GM `beta` so large that `phi` underflowed to 0, which makes the GM a
-    /// white noise): no standard error; the canonical model ([`crate::fit::canonical`]) names
-    /// what the component is.
+    /// Parameters without influence on the implied WV at the estimate (a Jacobian column of
+    /// exactly zero or non-finite Omega-norm: the edge of their domain, e.g. a GM `beta` so large
+    /// that `phi` underflowed to 0, which makes the GM a white noise): no standard error; the
+    /// canonical model ([`crate::fit::canonical`]) names what the component is. A column that
+    /// is merely small stays in the sandwich, where a rank deficiency is reported instead.
     NoInfluence {
         /// The parameters' labels.
         parameters: Vec<String>,

@@ -7,6 +7,7 @@ use super::optimism::{
 };
 use super::SelectionError;
 use crate::error::check_freq;
+use crate::fit::canonical::wv_separation;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{map_replicates, wv_bootstrap, NoProgress, Progress};
@@ -256,6 +257,13 @@ impl Wic {
                 expected: "at least one starting-value draw",
             });
         }
+        if !(self.separation_limit.is_finite() && self.separation_limit >= 0.0) {
+            return Err(SelectionError::Setting {
+                name: "separation limit",
+                value: self.separation_limit.to_string(),
+                expected: "a finite number of standard errors >= 0",
+            });
+        }
         for c in &self.candidates {
             check_candidate(c)?;
         }
@@ -362,10 +370,7 @@ impl Wic {
                     fit_with(c, &weights)?
                 };
                 let canonical = fit.canonical_with(self.separation_limit)?;
-                let score = CandidateScore {
-                    canonical_model: canonical.model.clone(),
-                    ..context.score(c, &fit)?
-                };
+                let score = context.score(c, &canonical.model, &fit)?;
                 progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
                 Ok(Scored {
                     score,
@@ -377,12 +382,18 @@ impl Wic {
             .zip(self.candidates.par_iter())
             .map(|(r, c)| r.map_err(fit_error(c)))
             .collect::<Result<_, _>>()?;
-        Ok(self.assemble(scored, &weights.omega, &v))
+        Ok(self.assemble(scored, &weights.omega, &v, &wv.log_variance()))
     }
 
     /// Steps 4 and 5 of [`Wic::select`]: folds the scored candidates into rows of canonical
     /// models and chooses the selected row.
-    fn assemble(&self, mut scored: Vec<Scored>, omega: &[f64], v: &DMatrix<f64>) -> ModelSelection {
+    fn assemble(
+        &self,
+        mut scored: Vec<Scored>,
+        omega: &[f64],
+        v: &DMatrix<f64>,
+        log_variance: &[f64],
+    ) -> ModelSelection {
         // candidates with one canonical model and one objective (within WIC_TIE_REL) are one
         // fit up to terms fitted to nothing: one goodness-of-fit p-value, the smallest one's
         let shared: Vec<(Option<f64>, bool)> = (0..scored.len())
@@ -405,32 +416,46 @@ impl Wic {
             s.score.gof_p_value_upper_bound = bound;
         }
         // step 4: rows of equal canonical models, in order of first appearance
-        let mut keys: Vec<String> = Vec::new();
+        let mut keys: Vec<&Model> = Vec::new();
         let mut members: Vec<Vec<usize>> = Vec::new();
         for (i, s) in scored.iter().enumerate() {
-            let key = s.canonical.model.to_string();
-            match keys.iter().position(|k| *k == key) {
+            match keys.iter().position(|k| **k == s.canonical.model) {
                 Some(r) => members[r].push(i),
                 None => {
-                    keys.push(key);
+                    keys.push(&s.canonical.model);
                     members.push(vec![i]);
                 }
             }
         }
+        // the row is scored by its best member, or by a smaller member whose fit the data
+        // cannot tell from it (the smallest such): a superset whose extra terms collapsed or
+        // stand in for others never wins on the noise of its optimism, and a member that fits
+        // far better than a smaller one is not hidden behind it
         let mut rows: Vec<(usize, Vec<usize>)> = members
             .into_iter()
             .map(|m| {
+                let best = *m
+                    .iter()
+                    .min_by(|&&a, &&b| scored[a].score.wic.total_cmp(&scored[b].score.wic))
+                    .unwrap_or(&m[0]);
                 let rep = *m
                     .iter()
-                    .min_by(|&&a, &&b| {
-                        let (a, b) = (&scored[a], &scored[b]);
-                        a.score
-                            .model
-                            .n_params()
-                            .cmp(&b.score.model.n_params())
-                            .then(a.score.wic.total_cmp(&b.score.wic))
+                    .filter(|&&i| {
+                        i == best
+                            || wv_separation(
+                                &scored[i].fit.implied_wv.wv,
+                                &scored[best].fit.implied_wv.wv,
+                                log_variance,
+                            ) <= self.separation_limit
                     })
-                    .unwrap_or(&m[0]);
+                    .min_by(|&&a, &&b| {
+                        let (a, b) = (&scored[a].score, &scored[b].score);
+                        a.model
+                            .n_params()
+                            .cmp(&b.model.n_params())
+                            .then(a.wic.total_cmp(&b.wic))
+                    })
+                    .unwrap_or(&best);
                 (rep, m)
             })
             .collect();
@@ -455,12 +480,12 @@ impl Wic {
                     (
                         &s.fit.implied_wv.wv,
                         s.score.optimism,
-                        s.canonical.model.n_params(),
+                        s.fit.active_parameters().len(),
                     ),
                     (
                         &best.fit.implied_wv.wv,
                         best.score.optimism,
-                        best.canonical.model.n_params(),
+                        best.fit.active_parameters().len(),
                     ),
                     omega,
                     v,
@@ -470,10 +495,7 @@ impl Wic {
         let equivalent: Vec<usize> = (0..rows.len())
             .filter(|&r| r == 0 || delta_wic[r] <= WIC_EQUIVALENCE_SE * delta_wic_se[r])
             .collect();
-        let navigation_terms = |r: usize| {
-            let m = &scored[rows[r].0].canonical.model;
-            usize::from(m.count(ProcessKind::Wn) > 0) + usize::from(m.count(ProcessKind::Rw) > 0)
-        };
+        let navigation_terms = |r: usize| navigation_terms(&scored[rows[r].0].canonical.model);
         let chosen = match self.rule {
             SelectionRule::WicMinimum => 0,
             SelectionRule::Parsimonious => *equivalent
@@ -529,6 +551,12 @@ impl Wic {
     }
 }
 
+/// How many of the two terms every navigation filter carries (white noise, random walk) a
+/// model has.
+fn navigation_terms(m: &Model) -> usize {
+    usize::from(m.count(ProcessKind::Wn) > 0) + usize::from(m.count(ProcessKind::Rw) > 0)
+}
+
 /// One candidate's fit, score and canonical reading.
 struct Scored {
     score: CandidateScore,
@@ -559,9 +587,12 @@ pub const WIC_EQUIVALENCE_SE: f64 = 1.0;
 /// ```
 ///
 /// with `d = nu_a - nu_b` (the two fits' implied WVs), `V` the covariance of the WV (the full
-/// model's bootstrap) and `opt` the optimisms: with `k` extra parameters the drop is about
-/// `s chi2_k` with mean `s k` = half the optimism difference (the AIC identity), so its
-/// variance is `2 k s^2`. The optimisms' own estimation noise is not included.
+/// model's bootstrap), `opt` the optimisms and `p` the numbers of active parameters: with `k`
+/// extra parameters the drop is about `s chi2_k` with mean `s k` = half the optimism difference
+/// (the AIC identity), so its variance is `2 k s^2`. For candidates of one size (not nested)
+/// the term is small, their optimisms being close, and `k = 1` is used. Not included: the
+/// optimisms' own estimation noise (about 10% of each with B = 50 replicates behind V), which
+/// for nearly coinciding fits is of the order of this standard error.
 pub fn wic_difference_se(
     a: (&[f64], f64, usize),
     b: (&[f64], f64, usize),
@@ -617,7 +648,12 @@ struct Context<'a> {
 }
 
 impl Context<'_> {
-    fn score(&self, candidate: &Model, fit: &GmwmFit) -> Result<CandidateScore, FitError> {
+    fn score(
+        &self,
+        candidate: &Model,
+        canonical_model: &Model,
+        fit: &GmwmFit,
+    ) -> Result<CandidateScore, FitError> {
         let (optimism, gof_p_value, gof_p_value_upper_bound) = match self.v {
             Some(v) => {
                 let o = self.asymptotic(fit, v)?;
@@ -627,7 +663,7 @@ impl Context<'_> {
         };
         Ok(CandidateScore {
             model: candidate.clone(),
-            canonical_model: candidate.clone(),
+            canonical_model: canonical_model.clone(),
             objective: fit.objective,
             optimism,
             wic: fit.objective + optimism,
@@ -728,8 +764,9 @@ impl Context<'_> {
             above += usize::from(obj > fit.objective);
         }
         let optimism = bootstrap_optimism(&nu_hat, &nu_theta, self.omega)?;
-        // no replicate above: the p-value is below 1 / (B + 1) (the smallest value the
-        // Monte Carlo p-value (1 + above) / (B + 1) takes), reported as that bound
+        // no replicate above: the share is 0, and all the B replicates say is that the p-value
+        // is small; it is reported as the bound 1 / (B + 1), the smallest value of the
+        // (conservative) Monte Carlo p-value (1 + above) / (B + 1)
         let b = self.wic.bootstrap as f64;
         Ok(if above == 0 {
             (optimism, Some(1.0 / (b + 1.0)), true)
@@ -874,27 +911,20 @@ impl ModelSelection {
     pub fn reason(&self) -> String {
         let sel = self.selected_row();
         if std::ptr::eq(sel, &self.rows[0]) {
-            return format!("{} has the smallest WIC", sel.score.canonical_model);
+            return "the smallest WIC".to_string();
         }
-        let best = &self.rows[0];
         let why = match self.rule {
-            SelectionRule::Navigation => {
-                let nav = |m: &Model| {
-                    usize::from(m.count(ProcessKind::Wn) > 0)
-                        + usize::from(m.count(ProcessKind::Rw) > 0)
-                };
-                if nav(&sel.score.canonical_model) > nav(&best.score.canonical_model) {
-                    "it keeps the white noise and random walk a navigation filter carries"
-                } else {
-                    "it has fewer parameters"
-                }
+            SelectionRule::Navigation
+                if navigation_terms(&sel.score.canonical_model)
+                    > navigation_terms(&self.rows[0].score.canonical_model) =>
+            {
+                "it has the white noise and random walk a navigation filter carries"
             }
             _ => "it has fewer parameters",
         };
         format!(
-            "{} has the smallest WIC, but {}'s exceeds it by {:.3e}, within one standard error \
-             ({:.3e}) of the difference, and {why}",
-            best.score.canonical_model, sel.score.canonical_model, sel.delta_wic, sel.delta_wic_se
+            "WIC {:.3e} above the minimum ({}), within one standard error ({:.3e}); {why}",
+            sel.delta_wic, self.rows[0].score.canonical_model, sel.delta_wic_se
         )
     }
 }
@@ -906,23 +936,14 @@ pub struct SelectionTable<'a> {
     top: usize,
 }
 
-/// The WIC difference in units of its standard error (`0` for the minimum itself, `inf` when
-/// the fits coincide but the WICs do not).
-fn se_ratio(delta: f64, se: f64) -> String {
-    if delta == 0.0 {
-        "0".to_string()
-    } else if se > 0.0 {
-        format!("{:.2}", delta / se)
-    } else {
-        "inf".to_string()
-    }
-}
-
-/// A p-value cell: `<x` for an upper bound, `-` when undefined.
+/// A p-value cell: `<x` for an upper bound, `-` when undefined, `<1e-300` for a tail that
+/// underflowed.
 fn p_cell(p: Option<f64>, bound: bool) -> String {
     match p {
         None => "-".to_string(),
         Some(p) if bound => format!("<{p:.2e}"),
+        // a chi-square tail below the smallest double
+        Some(0.0) => "<1e-300".to_string(),
         Some(p) => format!("{p:.2e}"),
     }
 }
@@ -952,8 +973,8 @@ impl fmt::Display for SelectionTable<'_> {
             .max(15);
         writeln!(
             f,
-            "  {:>3} {:<width$} {:>11} {:>11} {:>11} {:>10} {:>10}  fitted as",
-            "#", "canonical model", "objective", "optimism", "WIC", "dWIC / se", "GoF p",
+            "  {:>3} {:<width$} {:>11} {:>11} {:>11} {:>10} {:>10} {:>10}  fitted as",
+            "#", "canonical model", "objective", "optimism", "WIC", "dWIC", "se(dWIC)", "GoF p",
         )?;
         for &r in &shown {
             let row = &s.rows[r];
@@ -971,13 +992,14 @@ impl fmt::Display for SelectionTable<'_> {
             let conv = if sc.converged { "" } else { " (not converged)" };
             writeln!(
                 f,
-                "{mark} {:>3} {:<width$} {:>11.5e} {:>11.5e} {:>11.5e} {:>10} {:>10}  {}{conv}",
+                "{mark} {:>3} {:<width$} {:>11.5e} {:>11.5e} {:>11.5e} {:>10.3e} {:>10.3e} {:>10}  {}{conv}",
                 r + 1,
                 sc.canonical_model.to_string(),
                 sc.objective,
                 sc.optimism,
                 sc.wic,
-                se_ratio(row.delta_wic, row.delta_wic_se),
+                row.delta_wic,
+                row.delta_wic_se,
                 p_cell(sc.gof_p_value, sc.gof_p_value_upper_bound),
                 fitted.join(" ")
             )?;
@@ -988,8 +1010,8 @@ impl fmt::Display for SelectionTable<'_> {
         }
         writeln!(
             f,
-            "  * selected, = equivalent: WIC within one standard error of the minimum (dWIC / se <= \
-             {WIC_EQUIVALENCE_SE})"
+            "  * selected, = equivalent (WIC within {WIC_EQUIVALENCE_SE} standard error of the \
+             minimum: dWIC <= se(dWIC))"
         )?;
         writeln!(
             f,
