@@ -10,7 +10,7 @@
 //! stayed ~30 times above the fit that keeps it.
 //!
 //! After each minimisation, every inactive component (implied WV below
-//! [`NEGLIGIBLE_WV_SHARE`] of the model's at every level) is tried back at its best size: the
+//! [`NEGLIGIBLE_WV_SHARE`](super::NEGLIGIBLE_WV_SHARE) of the model's at every level) is tried back at its best size: the
 //! WV is linear in the scale parameter (WN `sigma2`, QN `q2`, RW `gamma2`, DR `omega^2`, AR1
 //! `sigma2` and GM `sigma2_gm` at a fixed phi or beta), so with `s` the component's WV at unit
 //! scale and `r = nu2(theta) - nu2_hat`, the best size is `t = -s' Omega r / s' Omega s` and

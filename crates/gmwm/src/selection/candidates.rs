@@ -65,7 +65,7 @@ fn model_of(kinds: &[ProcessKind]) -> Model {
 /// Cost: `2^terms` subsets.
 ///
 /// # Errors
-/// [`SelectionError::ArmaNotSupported`] (and the other refusals of [`check_candidate`]);
+/// [`SelectionError::ArmaNotSupported`] (and the other refusals of §8.5);
 /// [`SelectionError::TooManyTerms`] above [`MAX_NESTED_TERMS`] terms.
 pub fn nested_candidates(full: &Model) -> Result<Vec<Model>, SelectionError> {
     check_candidate(full)?;
