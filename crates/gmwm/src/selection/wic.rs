@@ -326,14 +326,12 @@ impl Wic {
             move |source| SelectionError::Fit { candidate, source }
         };
         progress.start(self.candidates.len());
-        // the fast weights of the package (METHODS §5.2, §8.6): the asymptotic optimism is
-        // calibrated for them (selection module docs)
-        let weights = Weights::fast(&wv).map_err(fit_error(&self.full))?;
-        let fit_with = |m: &Model, w: &Weights| -> Result<GmwmFit, FitError> {
-            let g = self.estimator(m);
-            g.finish(g.fit_auto(&wv, w.clone(), inputs)?, &wv, inputs)
-        };
-        let full_fit = fit_with(&self.full, &weights).map_err(fit_error(&self.full))?;
+        // every candidate with the package's fast weights (METHODS §5.2, §8.6), for which the
+        // asymptotic optimism is calibrated (selection module docs)
+        let full_fit = self
+            .estimator(&self.full)
+            .fit_from_wv(&wv, inputs)
+            .map_err(fit_error(&self.full))?;
         let levels = wv.levels();
         let replicate_opts = WvOptions {
             levels: Some(levels),
@@ -350,7 +348,7 @@ impl Wic {
             self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET),
         )?
         .cov;
-        let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&weights.omega));
+        let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&full_fit.weights.omega));
         let context = Context {
             wic: self,
             wv: &wv,
@@ -367,7 +365,7 @@ impl Wic {
                 let fit = if c.kinds() == self.full.kinds() {
                     full_fit.clone()
                 } else {
-                    fit_with(c, &weights)?
+                    self.estimator(c).fit_from_wv(&wv, inputs)?
                 };
                 let canonical = fit.canonical_with(self.separation_limit)?;
                 let score = context.score(c, &canonical.model, &fit)?;
@@ -382,7 +380,7 @@ impl Wic {
             .zip(self.candidates.par_iter())
             .map(|(r, c)| r.map_err(fit_error(c)))
             .collect::<Result<_, _>>()?;
-        Ok(self.assemble(scored, &weights.omega, &v, &wv.log_variance()))
+        Ok(self.assemble(scored, &full_fit.weights.omega, &v, &wv.log_variance()))
     }
 
     /// Steps 4 and 5 of [`Wic::select`]: folds the scored candidates into rows of canonical
