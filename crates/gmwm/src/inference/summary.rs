@@ -194,7 +194,8 @@ impl fmt::Display for InferenceWarning {
                 write!(
                 f,
                 "{} no influence on the implied WV at the estimate (the edge of {} domain): no \
-                 standard error; fit the canonical model for identified intervals",
+                 standard error; the canonical model names what the component is and the reduced \
+                 model to fit for identified intervals",
                 parameters.join(", ") + if parameters.len() == 1 { " has" } else { " have" },
                 if parameters.len() == 1 { "its" } else { "their" }
             )
