@@ -580,13 +580,6 @@ fn long_run_variance(ar1: Ar1) -> f64 {
     ar1.sigma2 / ((1.0 - ar1.phi) * (1.0 - ar1.phi))
 }
 
-fn single(kind: ProcessKind, value: f64, from: Vec<usize>) -> Option<Part> {
-    Some(Part {
-        component: Component::new(kind, vec![Some(value)]).ok()?,
-        from,
-    })
-}
-
 /// Adds a one-parameter term (WN, RW) to `parts`: to the existing one's value, or as a new part.
 fn add_single(parts: &mut Vec<Part>, kind: ProcessKind, value: f64, from: &[usize]) -> Option<()> {
     match parts.iter_mut().find(|p| p.kind() == kind) {
@@ -596,7 +589,10 @@ fn add_single(parts: &mut Vec<Part>, kind: ProcessKind, value: f64, from: &[usiz
             p.from.extend_from_slice(from);
             p.from.sort_unstable();
         }
-        None => parts.push(single(kind, value, from.to_vec())?),
+        None => parts.push(Part {
+            component: Component::new(kind, vec![Some(value)]).ok()?,
+            from: from.to_vec(),
+        }),
     }
     Some(())
 }
@@ -736,7 +732,6 @@ impl GmwmFit {
             });
         }
         // rule 3 and the terms
-        let tau: Vec<f64> = (1..=levels).map(|j| (j as f64).exp2()).collect();
         let mut terms_parts: Vec<Part> = Vec::new();
         for (k, p) in state.parts.iter().enumerate() {
             match p.ar1(freq) {
@@ -745,7 +740,8 @@ impl GmwmFit {
                     // the reduced fit's WV with this component read as white noise
                     let read: Vec<f64> = (0..levels)
                         .map(|j| {
-                            state.implied.wv[j] - state.implied.processes[k].wv[j] + sigma2 / tau[j]
+                            state.implied.wv[j] - state.implied.processes[k].wv[j]
+                                + sigma2 / state.implied.tau[j]
                         })
                         .collect();
                     readings.push(Reading::WhiteAtSamplingRate {

@@ -191,14 +191,18 @@ impl fmt::Display for InferenceWarning {
                 if parameters.len() == 1 { "it" } else { "them" }
             ),
             InferenceWarning::NoInfluence { parameters } => {
+                let (verb, whose) = if parameters.len() == 1 {
+                    ("has", "its")
+                } else {
+                    ("have", "their")
+                };
                 write!(
-                f,
-                "{} no influence on the implied WV at the estimate (the edge of {} domain): no \
-                 standard error; the canonical model names what the component is and the reduced \
-                 model to fit for identified intervals",
-                parameters.join(", ") + if parameters.len() == 1 { " has" } else { " have" },
-                if parameters.len() == 1 { "its" } else { "their" }
-            )
+                    f,
+                    "{} {verb} no influence on the implied WV at the estimate (the edge of \
+                     {whose} domain): no standard error; the canonical model names what the \
+                     component is and the reduced model to fit for identified intervals",
+                    parameters.join(", ")
+                )
             }
             InferenceWarning::NoJTest {
                 levels,
