@@ -17,6 +17,6 @@ pub use bootstrap::{
 pub use gof::{j_test, JTest};
 pub use progress::{NoProgress, Progress};
 pub use summary::{
-    infer, infer_with_progress, BootstrapGof, Inference, InferenceMethod, InferenceOptions,
-    InferenceWarning, ParameterInference, VShape,
+    infer, infer_with_covariance, infer_with_progress, BootstrapGof, Inference, InferenceMethod,
+    InferenceOptions, InferenceWarning, ParameterInference, VShape,
 };

@@ -291,6 +291,57 @@ pub fn infer_with_progress(
     opts: &InferenceOptions,
     progress: &dyn Progress,
 ) -> Result<Inference, FitError> {
+    infer_impl(gmwm, fit, n, wv_opts, opts, progress, None)
+}
+
+/// Asymptotic inference on `fit` (METHODS §7.1–§7.3) with a WV covariance `v` the caller
+/// already has (e.g. the bootstrap V of a model selection, simulated from the full model,
+/// which nests `fit`'s model), from `v_replicates` replicates: the sandwich and the J-test
+/// without simulating again. `opts.bootstrap` and `opts.v_replicates` are ignored.
+///
+/// # Errors
+/// As [`infer`]; [`FitError::Engine`] if `v` is not `J x J` for the fit's `J` levels.
+pub fn infer_with_covariance(
+    gmwm: &Gmwm,
+    fit: &GmwmFit,
+    v: &DMatrix<f64>,
+    v_replicates: usize,
+    wv_opts: &WvOptions,
+    opts: &InferenceOptions,
+) -> Result<Inference, FitError> {
+    let levels = fit.nu_hat.len();
+    if v.nrows() != levels || v.ncols() != levels {
+        return Err(Error::from(ParamError::new(
+            "v",
+            format!("{} x {}", v.nrows(), v.ncols()),
+            format!("a {levels} x {levels} covariance (one row per level of the fit)"),
+        ))
+        .into());
+    }
+    let opts = InferenceOptions {
+        bootstrap: None,
+        ..*opts
+    };
+    infer_impl(
+        gmwm,
+        fit,
+        0,
+        wv_opts,
+        &opts,
+        &NoProgress,
+        Some((v, v_replicates)),
+    )
+}
+
+fn infer_impl(
+    gmwm: &Gmwm,
+    fit: &GmwmFit,
+    n: usize,
+    wv_opts: &WvOptions,
+    opts: &InferenceOptions,
+    progress: &dyn Progress,
+    given_v: Option<(&DMatrix<f64>, usize)>,
+) -> Result<Inference, FitError> {
     crate::fit::check_haar(wv_opts.filter)?;
     let z = z_value(opts.alpha, opts.z).map_err(Error::from)?;
     let levels = fit.nu_hat.len();
@@ -345,30 +396,10 @@ pub fn infer_with_progress(
     let q = keep.len();
     let (method, v, v_replicates, covariance, se, se_g, bootstrap_gof) = match opts.bootstrap {
         None => {
-            let h = opts.v_replicates;
-            if h < 2 {
-                return Err(Error::from(ParamError::new(
-                    "v_replicates",
-                    h,
-                    "must be at least 2 for a covariance",
-                ))
-                .into());
-            }
-            let done = AtomicUsize::new(0);
-            progress.start(h);
-            let samples = map_replicates(
-                &fit.active_model()?,
-                n,
-                fit.freq_hz,
-                &wv_opts,
-                h,
-                opts.seed,
-                |_, wv, _| {
-                    progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
-                    Ok::<_, Error>(wv.wv.clone())
-                },
-            )?;
-            let v = WvBootstrap::from_samples(&samples)?.cov;
+            let (v, h) = match given_v {
+                Some((v, h)) => (v.clone(), h),
+                None => bootstrap_v(fit, n, &wv_opts, opts, progress)?,
+            };
             let v_sand = match opts.v_shape {
                 VShape::Full => v.clone(),
                 VShape::Diagonal => DMatrix::from_diagonal(&v.diagonal()),
@@ -477,6 +508,42 @@ pub fn infer_with_progress(
         bootstrap_gof,
         warnings,
     })
+}
+
+/// The bootstrap V of the asymptotic mode: `opts.v_replicates` series of length `n` simulated
+/// from the fit (METHODS §7.4 `cov_bootstrapper`), and the replicate count.
+fn bootstrap_v(
+    fit: &GmwmFit,
+    n: usize,
+    wv_opts: &WvOptions,
+    opts: &InferenceOptions,
+    progress: &dyn Progress,
+) -> Result<(DMatrix<f64>, usize), FitError> {
+    let h = opts.v_replicates;
+    if h < 2 {
+        return Err(Error::from(ParamError::new(
+            "v_replicates",
+            h,
+            "must be at least 2 for a covariance",
+        ))
+        .into());
+    }
+    let done = AtomicUsize::new(0);
+    progress.start(h);
+    let samples = map_replicates(
+        &fit.active_model()?,
+        n,
+        fit.freq_hz,
+        &wv_opts,
+        h,
+        opts.seed,
+        |_, wv, _| {
+            progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
+            Ok::<_, Error>(wv.wv.clone())
+        },
+    )?;
+    let v = WvBootstrap::from_samples(&samples)?.cov;
+    Ok((v, h))
 }
 
 /// The p x p matrix with `m` (q x q) at the `keep` rows and columns and NaN elsewhere.

@@ -545,6 +545,7 @@ impl Wic {
             selected_canonical: chosen.canonical.clone(),
             fit: chosen.fit.clone(),
             candidate_fits,
+            wv_covariance: v.clone(),
         }
     }
 }
@@ -877,6 +878,11 @@ pub struct ModelSelection {
     /// Every candidate's fit, in the order of `candidates` (not serialised).
     #[serde(skip)]
     pub candidate_fits: Vec<GmwmFit>,
+    /// The bootstrap covariance V of the WV (`bootstrap` replicates simulated from the full
+    /// model's fit, which nests every candidate), for inference on the selected fit without
+    /// simulating again ([`crate::inference::infer_with_covariance`]); not serialised.
+    #[serde(skip)]
+    pub wv_covariance: DMatrix<f64>,
 }
 
 impl ModelSelection {

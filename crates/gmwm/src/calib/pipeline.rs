@@ -1,0 +1,880 @@
+//! The calibration pipeline: per axis of an [`Imu`], the wavelet and Allan variances, the model
+//! selected by WIC, the identified fit with inference, the canonical read-off in continuous
+//! SI units with intervals, the IEEE Std 952 read-off and a verdict on the fit.
+
+use super::ieee::{ieee_readoff, IeeeReadoff};
+use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
+use crate::imu::{Imu, Sensor};
+use crate::inference::{infer_with_covariance, Inference, InferenceOptions, Progress};
+use crate::model::{Model, ProcessKind};
+use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
+use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms};
+use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
+use crate::variance::wv::{WaveletVariance, WvOptions};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use thiserror::Error;
+
+/// The full model whose sub-models are the candidates by default: three Gauss–Markov (AR1)
+/// processes for the bias instability region, white noise, quantization noise, a random walk
+/// and a drift (the R package's `auto.imu` set, 63 candidates).
+pub const DEFAULT_FULL_MODEL: &str = "3*AR1()+WN()+QN()+RW()+DR()";
+
+/// Relative step of the central differences of the delta-method intervals: the read-off
+/// quantities are smooth powers and logarithms of the estimates, so `1e-5` relative keeps the
+/// truncation error near `1e-10` and the rounding error near `1e-11` of the gradient.
+const DELTA_STEP: f64 = 1e-5;
+
+/// Relative agreement below which a canonical term is a function of the fitted estimates
+/// (terms computed by a refit are not, and get no interval from the fit's covariance).
+const SAME_VALUE_REL: f64 = 1e-6;
+
+/// Options of [`Calibration`]. The default is what `gmwm calibrate` runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrationOptions {
+    /// Full model of the selection (default [`DEFAULT_FULL_MODEL`]).
+    pub full_model: Model,
+    /// Wavelet-variance settings (default classical Haar MODWT, 95% intervals).
+    pub wv: WvOptions,
+    /// Bootstrap replicates of the WV covariance V behind the WIC and the intervals (default
+    /// 50, the selection's default: enough for a J x J covariance with J up to 47).
+    pub bootstrap: usize,
+    /// Starting-value draws of every fit (default `None`: the selection's size-dependent G).
+    pub draws: Option<usize>,
+    /// Seed of every search and simulation (default 1337, as the package).
+    pub seed: u64,
+    /// How the selected model is chosen among the equivalent ones (default navigation).
+    pub rule: SelectionRule,
+    /// Unit of the gyroscope samples (default: the recording's, e.g. its sidecar).
+    pub gyro_unit: Option<SignalUnit>,
+    /// Unit of the accelerometer samples (default: the recording's).
+    pub accel_unit: Option<SignalUnit>,
+}
+
+impl Default for CalibrationOptions {
+    fn default() -> Self {
+        Self {
+            full_model: DEFAULT_FULL_MODEL
+                .parse()
+                .expect("the default full model parses"),
+            wv: WvOptions::default(),
+            bootstrap: 50,
+            draws: None,
+            seed: 1337,
+            rule: SelectionRule::Navigation,
+            gyro_unit: None,
+            accel_unit: None,
+        }
+    }
+}
+
+/// Why a calibration failed.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum CalibError {
+    /// The recording has no gyroscope or accelerometer column to calibrate.
+    #[error("no gyroscope or accelerometer column to calibrate (columns: {columns}); name them like gyro_x, accel_z or give the sidecar's meaning")]
+    NoInertialAxis {
+        /// The columns present.
+        columns: String,
+    },
+    /// A unit does not fit the axis (a g unit given for a gyroscope, say).
+    #[error("column {column}: unit {unit} is not a {expected} unit")]
+    WrongUnit {
+        /// Column.
+        column: String,
+        /// The unit.
+        unit: String,
+        /// What the column measures.
+        expected: &'static str,
+    },
+    /// Selecting or fitting one axis failed.
+    #[error("column {column}: {source}")]
+    Selection {
+        /// Column.
+        column: String,
+        /// Cause.
+        source: SelectionError,
+    },
+    /// Fitting or inference on one axis failed.
+    #[error("column {column}: {source}")]
+    Fit {
+        /// Column.
+        column: String,
+        /// Cause.
+        source: FitError,
+    },
+    /// The Allan variance or a setting was unusable.
+    #[error("column {column}: {source}")]
+    Engine {
+        /// Column.
+        column: String,
+        /// Cause.
+        source: crate::Error,
+    },
+}
+
+/// A read-off quantity with its interval, in `unit`.
+///
+/// Wire format: `value`, `ci_low`, `ci_high` (null where no interval exists), `unit`,
+/// `source` (which term or rule gave it), `forms` (continuous SI, discrete and datasheet forms,
+/// METHODS §14.2; null for quantities in the data unit).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Estimate {
+    /// The value.
+    pub value: f64,
+    /// Lower end of the `1 - alpha` interval.
+    pub ci_low: Option<f64>,
+    /// Upper end.
+    pub ci_high: Option<f64>,
+    /// Unit (continuous-time SI for a gyroscope or accelerometer of known unit).
+    pub unit: String,
+    /// Where the value comes from, in words.
+    pub source: String,
+    /// The value in every form (SI, discrete, datasheet).
+    pub forms: Option<UnitForms>,
+}
+
+/// The Gauss–Markov form of the bias (the dominant correlated term): what PX4/Gazebo-style
+/// IMU models take.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GaussMarkovBias {
+    /// Correlation time `1 / beta`, s.
+    pub correlation_time: Estimate,
+    /// Stationary standard deviation `sqrt(sigma2_gm)`.
+    pub sigma: Estimate,
+    /// Driving-noise density `sqrt(2 beta sigma2_gm)`.
+    pub driving_density: Estimate,
+}
+
+/// Whether the selected model explains the data.
+///
+/// Wire format: `j_test_p_value` (null when V had too few replicates), `levels`,
+/// `levels_outside_band` (scales where the model's implied WV leaves the empirical WV's
+/// interval), `explains_wv`, `summary` (one line).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitVerdict {
+    /// p-value of the J-test (METHODS §7.3).
+    pub j_test_p_value: Option<f64>,
+    /// Number of scales.
+    pub levels: usize,
+    /// Scales where the implied WV lies outside the empirical WV's `1 - alpha` interval.
+    pub levels_outside_band: usize,
+    /// `levels_outside_band` is at most the count expected by chance (`alpha` of the levels,
+    /// rounded up).
+    pub explains_wv: bool,
+    /// The verdict in one line.
+    pub summary: String,
+}
+
+/// One axis calibrated.
+///
+/// Wire format: `column`, `kind` (`gyro`, `accel` or null), `data_unit` (as read or given),
+/// `unit` (the unit of the analysis: SI for a known unit, else the data unit), `samples`,
+/// `model` (the selected candidate), `canonical_model`, `noise_density`, `random_walk`,
+/// `bias_instability`, `quantization`, `rate_ramp` ([`Estimate`] or null),
+/// `gauss_markov_bias`, `ieee`, `verdict`, `canonical`, `inference`, `selection` (the table),
+/// `wv`, `allan`, `notes`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisCalibration {
+    /// Column name.
+    pub column: String,
+    /// What the column measures, when known.
+    pub kind: Option<SignalKind>,
+    /// Unit of the samples as read (`None` when unknown).
+    pub data_unit: Option<String>,
+    /// Unit of every result of this axis (SI for a gyroscope/accelerometer of known unit).
+    pub unit: String,
+    /// Samples.
+    pub samples: usize,
+    /// The selected candidate as fitted (guess mode).
+    pub model: String,
+    /// Its canonical model: what the estimates are reported as.
+    pub canonical_model: String,
+    /// White-noise density N (angle / velocity random walk), continuous time.
+    pub noise_density: Option<Estimate>,
+    /// Random-walk density K (rate / acceleration random walk), continuous time.
+    pub random_walk: Option<Estimate>,
+    /// Bias instability B of the IEEE read-off (min Allan deviation / 0.664).
+    pub bias_instability: Option<Estimate>,
+    /// Quantization coefficient Q, when the model has quantization noise.
+    pub quantization: Option<Estimate>,
+    /// Rate ramp R, when the model has a drift.
+    pub rate_ramp: Option<Estimate>,
+    /// The dominant Gauss–Markov term, when the model has one.
+    pub gauss_markov_bias: Option<GaussMarkovBias>,
+    /// IEEE Std 952 read-off from the Allan deviation.
+    pub ieee: IeeeReadoff,
+    /// The verdict on the fit.
+    pub verdict: FitVerdict,
+    /// The canonical model with its terms.
+    pub canonical: CanonicalModel,
+    /// Inference on the identified fit (the canonical model's reduced model).
+    pub inference: Inference,
+    /// The identified fit.
+    pub fit: GmwmFit,
+    /// The selection.
+    pub selection: ModelSelection,
+    /// The wavelet variance (unit²).
+    pub wv: WaveletVariance,
+    /// The overlapping Allan variance (unit²).
+    pub allan: AllanVariance,
+    /// What the read-off did that a user should know, one line each.
+    pub notes: Vec<String>,
+}
+
+/// The calibration of a recording: one [`AxisCalibration`] per gyroscope and accelerometer
+/// axis, in the recording's order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CalibrationReport {
+    /// Name of the recording, if known.
+    pub name: Option<String>,
+    /// Sampling rate, Hz.
+    pub freq_hz: f64,
+    /// Samples per axis.
+    pub samples: usize,
+    /// Length of the recording, s.
+    pub duration_s: f64,
+    /// Full model of the selection.
+    pub full_model: String,
+    /// Selection rule.
+    pub rule: SelectionRule,
+    /// Confidence level of every interval is `1 - alpha`.
+    pub alpha: f64,
+    /// Per axis.
+    pub axes: Vec<AxisCalibration>,
+}
+
+/// The calibration pipeline (module doc).
+///
+/// ```no_run
+/// use gmwm::calib::{Calibration, CalibrationOptions};
+/// use gmwm::imu::{read_table, Imu, ReadOptions};
+/// let table = read_table("imu.csv.gz".as_ref(), &ReadOptions::default())?;
+/// let imu = Imu::from_table(table)?;
+/// let report = Calibration::new(CalibrationOptions::default()).run(&imu)?;
+/// for axis in &report.axes {
+///     println!("{}: {}", axis.column, axis.canonical_model);
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Calibration {
+    options: CalibrationOptions,
+}
+
+impl Calibration {
+    /// A pipeline with these options.
+    pub fn new(options: CalibrationOptions) -> Self {
+        Self { options }
+    }
+
+    /// The options.
+    pub fn options(&self) -> &CalibrationOptions {
+        &self.options
+    }
+
+    /// Number of candidate fits per axis (for progress totals).
+    ///
+    /// # Errors
+    /// [`SelectionError`] for a full model that cannot be enumerated.
+    pub fn candidates_per_axis(&self) -> Result<usize, SelectionError> {
+        Ok(Wic::nested(self.options.full_model.clone())?.candidates().len())
+    }
+
+    /// Calibrates every gyroscope and accelerometer axis of `imu` (in parallel).
+    ///
+    /// # Errors
+    /// [`CalibError`] naming the axis that failed.
+    pub fn run(&self, imu: &Imu) -> Result<CalibrationReport, CalibError> {
+        self.run_with_progress(imu, &crate::inference::NoProgress)
+    }
+
+    /// [`Calibration::run`] reporting each scored candidate of every axis to `progress`
+    /// (`start` once with axes x candidates, then one `advance` per candidate).
+    ///
+    /// # Errors
+    /// As [`Calibration::run`].
+    pub fn run_with_progress(
+        &self,
+        imu: &Imu,
+        progress: &dyn Progress,
+    ) -> Result<CalibrationReport, CalibError> {
+        let axes: Vec<_> = imu
+            .axes()
+            .iter()
+            .filter(|a| a.sensor() != Sensor::Other)
+            .collect();
+        if axes.is_empty() {
+            return Err(CalibError::NoInertialAxis {
+                columns: imu
+                    .axes()
+                    .iter()
+                    .map(|a| a.column.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        let per_axis = self
+            .candidates_per_axis()
+            .map_err(|source| CalibError::Selection {
+                column: axes[0].column.name.clone(),
+                source,
+            })?;
+        progress.start(axes.len() * per_axis);
+        let done = AtomicUsize::new(0);
+        let shared = |_: usize| progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
+        let results: Vec<Result<AxisCalibration, CalibError>> = axes
+            .par_iter()
+            .map(|axis| {
+                let kind = match axis.sensor() {
+                    Sensor::Gyroscope => Some(SignalKind::Gyroscope),
+                    Sensor::Accelerometer => Some(SignalKind::Accelerometer),
+                    Sensor::Other => None,
+                };
+                self.axis(
+                    &axis.column.name,
+                    kind,
+                    axis.info.unit.as_deref(),
+                    axis.values(),
+                    imu.freq_hz(),
+                    &shared,
+                )
+            })
+            .collect();
+        let axes = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+        Ok(CalibrationReport {
+            name: imu.name().map(str::to_string),
+            freq_hz: imu.freq_hz(),
+            samples: imu.len(),
+            duration_s: imu.len() as f64 / imu.freq_hz(),
+            full_model: self.options.full_model.to_string(),
+            rule: self.options.rule,
+            alpha: self.options.wv.alpha,
+            axes,
+        })
+    }
+
+    /// The unit of one axis: the option for its kind, else the recording's text parsed.
+    fn unit_of(
+        &self,
+        column: &str,
+        kind: Option<SignalKind>,
+        recorded: Option<&str>,
+        notes: &mut Vec<String>,
+    ) -> Result<Option<SignalUnit>, CalibError> {
+        let given = match kind {
+            Some(SignalKind::Gyroscope) => self.options.gyro_unit,
+            Some(SignalKind::Accelerometer) => self.options.accel_unit,
+            None => None,
+        };
+        let unit = match (given, recorded) {
+            (Some(u), _) => Some(u),
+            (None, Some(text)) => match text.parse::<SignalUnit>() {
+                Ok(u) => Some(u),
+                Err(_) => {
+                    notes.push(format!(
+                        "unit {text:?} of the recording is not a known inertial unit: results are in the data unit"
+                    ));
+                    None
+                }
+            },
+            (None, None) => {
+                if kind.is_some() {
+                    notes.push(
+                        "unit unknown (no sidecar or header unit, no --gyro-unit/--accel-unit): results are in the data unit \"u\"".to_string(),
+                    );
+                }
+                None
+            }
+        };
+        match (unit, kind) {
+            (Some(u), Some(k)) if u.kind() != k => Err(CalibError::WrongUnit {
+                column: column.to_string(),
+                unit: u.symbol().to_string(),
+                expected: match k {
+                    SignalKind::Gyroscope => "gyroscope (rad/s, deg/s, deg/h)",
+                    SignalKind::Accelerometer => "accelerometer (m/s^2, g, mg)",
+                },
+            }),
+            _ => Ok(unit),
+        }
+    }
+
+    /// One axis (module doc).
+    fn axis(
+        &self,
+        column: &str,
+        kind: Option<SignalKind>,
+        recorded_unit: Option<&str>,
+        values: &[f64],
+        freq_hz: f64,
+        progress: &dyn Progress,
+    ) -> Result<AxisCalibration, CalibError> {
+        let mut notes = Vec::new();
+        let unit = self.unit_of(column, kind, recorded_unit, &mut notes)?;
+        // every result in SI: the samples are converted once, before any statistic
+        let si_values: Option<Vec<f64>> = unit
+            .filter(|u| u.to_si() != 1.0)
+            .map(|u| values.iter().map(|v| v * u.to_si()).collect());
+        let x = si_values.as_deref().unwrap_or(values);
+        // a kind without a known unit reads in the data unit: no SI names, no datasheet forms
+        let unit_kind = kind.filter(|_| unit.is_some());
+        let unit_label = match (unit, kind) {
+            (Some(u), Some(k)) => SignalUnit::si(k).symbol().to_string(),
+            _ => recorded_unit.unwrap_or("u").to_string(),
+        };
+        let engine = |source: crate::Error| CalibError::Engine {
+            column: column.to_string(),
+            source,
+        };
+        let fit_error = |source: FitError| CalibError::Fit {
+            column: column.to_string(),
+            source,
+        };
+        let mut wic = Wic::nested(self.options.full_model.clone())
+            .map_err(|source| CalibError::Selection {
+                column: column.to_string(),
+                source,
+            })?
+            .with_bootstrap(self.options.bootstrap)
+            .with_seed(self.options.seed)
+            .with_rule(self.options.rule)
+            .with_wv_options(self.options.wv);
+        if let Some(g) = self.options.draws {
+            wic = wic.with_draws(g);
+        }
+        let selection = wic
+            .select_with_progress(x, freq_hz, progress)
+            .map_err(|source| CalibError::Selection {
+                column: column.to_string(),
+                source,
+            })?;
+        let wv = selection
+            .fit
+            .empirical
+            .clone()
+            .ok_or_else(|| fit_error(FitError::Length {
+                what: "stored WV",
+                expected: selection.fit.nu_hat.len(),
+                found: 0,
+            }))?;
+        // the identified fit: the canonical model's reduced model, fitted (a candidate of the
+        // selection when it is one) so that every reported term has estimates and intervals
+        let reduced = &selection.selected_canonical.reduced;
+        let fit = match selection.candidate_fit(reduced) {
+            Some(f) => f.clone(),
+            None => {
+                let mut g = Gmwm::new(reduced.clone()).with_seed(self.options.seed);
+                if let Some(d) = self.options.draws {
+                    g = g.with_draws(d);
+                }
+                g.update(&selection.fit).map_err(fit_error)?
+            }
+        };
+        let gmwm = Gmwm::new(fit.model.clone());
+        let inference = infer_with_covariance(
+            &gmwm,
+            &fit,
+            &selection.wv_covariance,
+            selection.bootstrap,
+            &self.options.wv,
+            &InferenceOptions {
+                alpha: self.options.wv.alpha,
+                seed: self.options.seed,
+                ..InferenceOptions::default()
+            },
+        )
+        .map_err(fit_error)?;
+        let canonical = fit
+            .canonical_with(selection.separation_limit)
+            .map_err(fit_error)?;
+        let allan = allan_variance(
+            x,
+            freq_hz,
+            &AllanOptions {
+                alpha: self.options.wv.alpha,
+                ..AllanOptions::default()
+            },
+        )
+        .map_err(engine)?;
+        let ieee = ieee_readoff(&allan).map_err(|e| engine(e.into()))?;
+        let z = inference.z;
+        let readoff = Readoff {
+            fit: &fit,
+            canonical: &canonical,
+            inference: &inference,
+            kind: unit_kind,
+            unit: &unit_label,
+            freq_hz,
+            z,
+        };
+        let noise_density = readoff.noise_density(&mut notes);
+        let random_walk = readoff.random_walk(&mut notes);
+        let quantization = readoff.single(ProcessKind::Qn, NoiseTerm::Quantization, "QN term");
+        let rate_ramp = readoff.single(ProcessKind::Dr, NoiseTerm::RateRamp, "DR term");
+        let gauss_markov_bias = readoff.gauss_markov();
+        let bias_instability = ieee.b.value.map(|value| {
+            readoff.estimate(
+                NoiseTerm::BiasInstability,
+                value,
+                (ieee.b.ci_low, ieee.b.ci_high),
+                "IEEE 952: min Allan deviation / 0.664".to_string(),
+            )
+        });
+        let verdict = verdict(&fit, &wv, &inference, self.options.wv.alpha);
+        for r in &canonical.readings {
+            notes.push(r.to_string());
+        }
+        Ok(AxisCalibration {
+            column: column.to_string(),
+            kind,
+            data_unit: unit
+                .map(|u| u.symbol().to_string())
+                .or_else(|| recorded_unit.map(str::to_string)),
+            unit: unit_label,
+            samples: values.len(),
+            model: selection.selected.to_string(),
+            canonical_model: canonical.model.to_string(),
+            noise_density,
+            random_walk,
+            bias_instability,
+            quantization,
+            rate_ramp,
+            gauss_markov_bias,
+            ieee,
+            verdict,
+            canonical,
+            inference,
+            fit,
+            selection,
+            wv,
+            allan,
+            notes,
+        })
+    }
+}
+
+/// The read-off of one axis: canonical terms as functions of the identified fit's estimates,
+/// with delta-method intervals from its covariance.
+struct Readoff<'a> {
+    fit: &'a GmwmFit,
+    canonical: &'a CanonicalModel,
+    inference: &'a Inference,
+    kind: Option<SignalKind>,
+    unit: &'a str,
+    freq_hz: f64,
+    z: f64,
+}
+
+impl Readoff<'_> {
+    /// Index of the first parameter of each component of the fit.
+    fn offsets(&self) -> Vec<usize> {
+        let mut k = 0;
+        self.fit
+            .model
+            .components()
+            .iter()
+            .map(|c| {
+                let o = k;
+                k += c.kind.n_params();
+                o
+            })
+            .collect()
+    }
+
+    /// An estimate with its forms.
+    fn estimate(
+        &self,
+        term: NoiseTerm,
+        value: f64,
+        (ci_low, ci_high): (Option<f64>, Option<f64>),
+        source: String,
+    ) -> Estimate {
+        Estimate {
+            value,
+            ci_low,
+            ci_high,
+            unit: si_unit(term, self.kind, self.unit),
+            source,
+            forms: Some(forms(term, self.kind, self.unit, value, self.freq_hz)),
+        }
+    }
+
+    /// The quantity `q(theta)` over the parameters `params` of the fit: value and interval,
+    /// the latter on the log scale by the delta method with the inference covariance
+    /// (`None` when a parameter has no covariance, e.g. at the boundary).
+    fn delta(&self, params: &[usize], q: &dyn Fn(&[f64]) -> f64) -> (f64, Option<f64>, Option<f64>) {
+        let theta = &self.fit.theta;
+        let value = q(theta);
+        let cov = &self.inference.covariance;
+        let mut grad = Vec::with_capacity(params.len());
+        for &k in params {
+            let h = DELTA_STEP * theta[k].abs().max(f64::MIN_POSITIVE);
+            let mut up = theta.clone();
+            let mut down = theta.clone();
+            up[k] += h;
+            down[k] -= h;
+            grad.push((q(&up) - q(&down)) / (2.0 * h));
+        }
+        let mut var = 0.0;
+        for (a, &i) in params.iter().enumerate() {
+            for (b, &j) in params.iter().enumerate() {
+                match cov.get(i).and_then(|r| r.get(j)).copied().flatten() {
+                    Some(c) => var += grad[a] * grad[b] * c,
+                    None => return (value, None, None),
+                }
+            }
+        }
+        if !(value > 0.0 && var.is_finite() && var >= 0.0) {
+            return (value, None, None);
+        }
+        let rel = self.z * var.sqrt() / value;
+        (value, Some(value * (-rel).exp()), Some(value * rel.exp()))
+    }
+
+    /// Parameter indices of the components `from`.
+    fn params_of(&self, from: &[usize]) -> Vec<usize> {
+        let offsets = self.offsets();
+        let comps = self.fit.model.components();
+        from.iter()
+            .filter_map(|&c| Some((offsets.get(c)?, comps.get(c)?.kind.n_params())))
+            .flat_map(|(&o, n)| o..o + n)
+            .collect()
+    }
+
+    /// Long-run per-sample variance of the fit's component `c` at `theta`: `sigma2` of a WN,
+    /// `sigma2 / (1 - phi)^2` of an AR1/GM (the white noise it is at long scales).
+    fn white_variance(&self, c: usize, theta: &[f64]) -> Option<f64> {
+        let o = *self.offsets().get(c)?;
+        match self.fit.model.components().get(c)?.kind {
+            ProcessKind::Wn => Some(theta[o]),
+            ProcessKind::Ar1 => Some(theta[o + 1] / (1.0 - theta[o]).powi(2)),
+            ProcessKind::Gm => {
+                let phi = (-theta[o] / self.freq_hz).exp();
+                let sigma2 = theta[o + 1] * (1.0 - phi * phi);
+                Some(sigma2 / (1.0 - phi).powi(2))
+            }
+            _ => None,
+        }
+    }
+
+    /// N from the canonical white-noise term; without one, from the fastest correlated term's
+    /// long-run density (saying so).
+    fn noise_density(&self, notes: &mut Vec<String>) -> Option<Estimate> {
+        let f = self.freq_hz;
+        let (from, source) = match self.canonical.term(ProcessKind::Wn) {
+            Some(t) => (t.from.clone(), "WN term".to_string()),
+            None => {
+                let fastest = self.fastest_correlated()?;
+                notes.push(format!(
+                    "no white-noise term: the noise density is the long-run density of the fastest correlated term (component {fastest})"
+                ));
+                (vec![fastest], "long-run density of the fastest Gauss–Markov term".to_string())
+            }
+        };
+        let q = |theta: &[f64]| -> f64 {
+            from.iter()
+                .map(|&c| self.white_variance(c, theta).unwrap_or(f64::NAN))
+                .sum::<f64>()
+                / f
+        }
+        .sqrt();
+        let (value, lo, hi) = self.checked(
+            &from,
+            &q,
+            self.canonical
+                .physical(ProcessKind::Wn, "white_noise_density"),
+        );
+        Some(self.estimate(NoiseTerm::NoiseDensity, value, (lo, hi), source))
+    }
+
+    /// Value and interval of `q` over the components `from`, the interval dropped when the
+    /// canonical value (`expected`) is not `q` of the fit (a refit term).
+    fn checked(
+        &self,
+        from: &[usize],
+        q: &dyn Fn(&[f64]) -> f64,
+        expected: Option<f64>,
+    ) -> (f64, Option<f64>, Option<f64>) {
+        let params = self.params_of(from);
+        let (value, lo, hi) = self.delta(&params, q);
+        match expected {
+            Some(e) if (e - value).abs() > SAME_VALUE_REL * e.abs() => (e, None, None),
+            _ => (value, lo, hi),
+        }
+    }
+
+    /// The fit's AR1/GM component with the shortest correlation time.
+    fn fastest_correlated(&self) -> Option<usize> {
+        self.correlated_by_time().into_iter().next().map(|(c, _)| c)
+    }
+
+    /// AR1/GM components of the fit with their correlation times, fastest first.
+    fn correlated_by_time(&self) -> Vec<(usize, f64)> {
+        let offsets = self.offsets();
+        let theta = &self.fit.theta;
+        let mut out: Vec<(usize, f64)> = self
+            .fit
+            .model
+            .components()
+            .iter()
+            .enumerate()
+            .filter_map(|(c, comp)| {
+                let o = offsets[c];
+                let t = match comp.kind {
+                    ProcessKind::Ar1 if theta[o] > 0.0 => -1.0 / (theta[o].ln() * self.freq_hz),
+                    ProcessKind::Gm => 1.0 / theta[o],
+                    _ => return None,
+                };
+                t.is_finite().then_some((c, t))
+            })
+            .collect();
+        out.sort_by(|a, b| a.1.total_cmp(&b.1));
+        out
+    }
+
+    /// K from the canonical random-walk term; without one, the slowest Gauss–Markov term's
+    /// driving-noise density (METHODS §14.4, saying so).
+    fn random_walk(&self, notes: &mut Vec<String>) -> Option<Estimate> {
+        let f = self.freq_hz;
+        if let Some(t) = self.canonical.term(ProcessKind::Rw) {
+            let from = t.from.clone();
+            let o = self.params_of(&from);
+            let q = |theta: &[f64]| (o.iter().map(|&k| theta[k]).sum::<f64>() * f).sqrt();
+            let (value, lo, hi) = self.checked(
+                &from,
+                &q,
+                self.canonical
+                    .physical(ProcessKind::Rw, "rate_random_walk_density"),
+            );
+            return Some(self.estimate(
+                NoiseTerm::RandomWalk,
+                value,
+                (lo, hi),
+                "RW term".to_string(),
+            ));
+        }
+        let (slowest, _) = *self.correlated_by_time().last()?;
+        notes.push(format!(
+            "no random-walk term: the random walk is the driving-noise density of the slowest Gauss–Markov term (component {slowest})"
+        ));
+        let est = self.gm_quantity(slowest, "driving_noise_density")?;
+        Some(self.estimate(
+            NoiseTerm::RandomWalk,
+            est.0,
+            (est.1, est.2),
+            "driving-noise density of the slowest Gauss–Markov term".to_string(),
+        ))
+    }
+
+    /// A physical quantity of the fit's AR1/GM component `c` with its interval.
+    fn gm_quantity(&self, c: usize, name: &str) -> Option<(f64, Option<f64>, Option<f64>)> {
+        let comp = self.fit.model.components().get(c)?;
+        let o = *self.offsets().get(c)?;
+        let n = comp.kind.n_params();
+        let kind = comp.kind;
+        let f = self.freq_hz;
+        let q = |theta: &[f64]| {
+            crate::fit::report::physical_parameters(kind, c, &theta[o..o + n], f, None)
+                .into_iter()
+                .find(|p| p.name == name)
+                .map_or(f64::NAN, |p| p.value)
+        };
+        let params: Vec<usize> = (o..o + n).collect();
+        let out = self.delta(&params, &q);
+        out.0.is_finite().then_some(out)
+    }
+
+    /// Q or R from the canonical term of `kind` (one parameter, monotone in it).
+    fn single(&self, kind: ProcessKind, term: NoiseTerm, source: &str) -> Option<Estimate> {
+        let t = self.canonical.term(kind)?;
+        let name = t.physical.first()?.name;
+        let from = t.from.clone();
+        let o = self.params_of(&from);
+        let f = self.freq_hz;
+        let q = |theta: &[f64]| {
+            let v: f64 = o.iter().map(|&k| theta[k]).sum();
+            crate::fit::report::physical_parameters(kind, 0, &[v], f, None)
+                .into_iter()
+                .find(|p| p.name == name)
+                .map_or(f64::NAN, |p| p.value)
+        };
+        let (value, lo, hi) = self.checked(&from, &q, Some(t.physical[0].value));
+        Some(self.estimate(term, value, (lo, hi), source.to_string()))
+    }
+
+    /// The dominant correlated term (the largest stationary variance) as a Gauss–Markov bias.
+    fn gauss_markov(&self) -> Option<GaussMarkovBias> {
+        let offsets = self.offsets();
+        let comps = self.fit.model.components();
+        // only terms the canonical model keeps as correlated noise
+        let kept: Vec<usize> = self
+            .canonical
+            .terms
+            .iter()
+            .filter(|t| matches!(t.kind, ProcessKind::Ar1 | ProcessKind::Gm) && t.from.len() == 1)
+            .map(|t| t.from[0])
+            .collect();
+        let dominant = kept.into_iter().max_by(|&a, &b| {
+            let var = |c: usize| {
+                let o = offsets[c];
+                let n = comps[c].kind.n_params();
+                crate::fit::report::physical_parameters(
+                    comps[c].kind,
+                    c,
+                    &self.fit.theta[o..o + n],
+                    self.freq_hz,
+                    None,
+                )
+                .into_iter()
+                .find(|p| p.name == "gm_std")
+                .map_or(0.0, |p| p.value)
+            };
+            var(a).total_cmp(&var(b))
+        })?;
+        let t = self.gm_quantity(dominant, "correlation_time")?;
+        let s = self.gm_quantity(dominant, "gm_std")?;
+        let d = self.gm_quantity(dominant, "driving_noise_density")?;
+        let source = format!("Gauss–Markov term (component {dominant})");
+        Some(GaussMarkovBias {
+            correlation_time: self.estimate(NoiseTerm::GmCorrelationTime, t.0, (t.1, t.2), source.clone()),
+            sigma: self.estimate(NoiseTerm::GmSigma, s.0, (s.1, s.2), source.clone()),
+            driving_density: self.estimate(NoiseTerm::GmDrivingDensity, d.0, (d.1, d.2), source),
+        })
+    }
+}
+
+/// The verdict: the J-test and how many scales the implied WV leaves the empirical band at.
+fn verdict(fit: &GmwmFit, wv: &WaveletVariance, inference: &Inference, alpha: f64) -> FitVerdict {
+    let implied = &fit.implied_wv.total;
+    let levels = implied.len().min(wv.wv.len());
+    let outside = (0..levels)
+        .filter(|&j| implied[j] < wv.ci_low[j] || implied[j] > wv.ci_high[j])
+        .count();
+    let allowed = (alpha * levels as f64).ceil() as usize;
+    let explains_wv = outside <= allowed;
+    let p = inference.gof.as_ref().map(|g| g.p_value);
+    let band = format!(
+        "implied WV inside the {:.0}% band at {} of {levels} scales",
+        100.0 * (1.0 - alpha),
+        levels - outside
+    );
+    let summary = match (p, explains_wv) {
+        (Some(p), true) if p >= alpha => format!("fits: J-test p = {p:.3}; {band}"),
+        (Some(p), true) => format!(
+            "explains the WV within its band, though the J-test rejects (p = {p:.2e}): the misfit is below the WV's own uncertainty; {band}"
+        ),
+        (Some(p), false) => format!("does not explain the WV: J-test p = {p:.2e}; {band}"),
+        (None, true) => format!("explains the WV within its band (no J-test: too few replicates of V); {band}"),
+        (None, false) => format!("does not explain the WV; {band}"),
+    };
+    FitVerdict {
+        j_test_p_value: p,
+        levels,
+        levels_outside_band: outside,
+        explains_wv,
+        summary,
+    }
+}
