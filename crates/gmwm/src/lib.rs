@@ -19,6 +19,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod calib;
 pub mod error;
 pub mod fit;
 pub mod imu;
@@ -28,6 +29,7 @@ pub mod model;
 pub mod process;
 pub mod selection;
 pub mod sim;
+pub mod units;
 pub mod variance;
 pub mod wavelet;
 
