@@ -66,6 +66,106 @@ pub enum Command {
     /// Select a model by the Wavelet Information Criterion on each selected column (METHODS §8).
     #[command(allow_negative_numbers = true, after_long_help = SELECT_EXAMPLES)]
     Select(SelectArgs),
+    /// Calibrate an IMU recording: per axis the WV, the model selected by WIC, its fit with
+    /// intervals, the noise density, bias instability and random walk in SI and datasheet
+    /// units, the IEEE 952 read-off, and navigation-filter files (Kalibr, OpenVINS, ...).
+    #[command(allow_negative_numbers = true, after_long_help = CALIBRATE_EXAMPLES)]
+    Calibrate(CalibrateArgs),
+}
+
+const CALIBRATE_EXAMPLES: &str = "\
+Record the IMU at rest, warmed up, for at least a few hours: the longest scale the WV sees is
+about a quarter of the recording, and the bias instability and random walk live there.
+
+Examples:
+  gmwm calibrate imu.csv.gz --gyro-unit deg/s --accel-unit g
+  gmwm calibrate imu.csv.gz --kalibr imu.yaml --json calib.json
+  gmwm calibrate flight.bag --topic /imu0 --kalibr imu.yaml --conservative
+  gmwm calibrate run.mcap --export openvins kalibr_imu_chain.yaml --export px4 imu.sdf
+  gmwm calibrate log.bin --format ln200 --axis-policy per-axis --kalibr imu.yaml
+  gmwm calibrate imu.csv.gz --model \"2*AR1()+WN()+RW()\" --inflate 2 --export vins vins.yaml";
+
+/// `gmwm calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// Input.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Unit of the gyroscope samples: rad/s, deg/s or deg/h [default: the sidecar's, SI for
+    /// ROS and binary IMU records].
+    #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
+    pub gyro_unit: Option<gmwm::units::SignalUnit>,
+    /// Unit of the accelerometer samples: m/s^2, g or mg [default: as --gyro-unit].
+    #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
+    pub accel_unit: Option<gmwm::units::SignalUnit>,
+    /// Full model: every sub-model is a candidate of the WIC selection
+    /// [default: 3*AR1()+WN()+QN()+RW()+DR()].
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<String>,
+    /// How the selected model is chosen among the canonical models within one standard error
+    /// of the WIC minimum.
+    #[arg(long, value_enum, default_value_t = RuleArg::Navigation)]
+    pub rule: RuleArg,
+    /// Wavelet-variance settings.
+    #[command(flatten)]
+    pub estimator: WvEstimatorArgs,
+    /// Bootstrap replicates of the WV covariance behind the WIC and every interval.
+    #[arg(long, value_name = "B", default_value_t = 50, value_parser = at_least_2)]
+    pub bootstrap: usize,
+    /// Number of starting-value draws of every fit [default: 20000 for N <= 1e4, else 100000,
+    /// with early stop].
+    #[arg(long = "G", value_name = "N", value_parser = at_least_1)]
+    pub draws: Option<usize>,
+    /// Seed of every search and simulation.
+    #[arg(long, value_name = "S", default_value_t = 1337, value_parser = seed)]
+    pub seed: u64,
+    /// Write everything as JSON to FILE ('-' for standard output, replacing the summary).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Write a Kalibr imu.yaml (noise densities and random walks, continuous-time SI).
+    #[arg(long, value_name = "FILE")]
+    pub kalibr: Option<PathBuf>,
+    /// Write a navigation stack's file: openvins, vins, orbslam3, px4 (or kalibr); repeatable.
+    #[arg(long, num_args = 2, value_names = ["STACK", "FILE"], action = clap::ArgAction::Append)]
+    pub export: Vec<String>,
+    /// Which axis speaks for a sensor triad in the exported files.
+    #[arg(long, value_enum, default_value_t = AxisPolicyArg::Worst)]
+    pub axis_policy: AxisPolicyArg,
+    /// Multiply the exported noise densities and random walks by K (stated in the file).
+    #[arg(long, value_name = "K", value_parser = inflation, conflicts_with = "conservative")]
+    pub inflate: Option<f64>,
+    /// Export the upper ends of the intervals instead of the estimates (stated in the file).
+    #[arg(long)]
+    pub conservative: bool,
+    /// rostopic written to Kalibr/OpenVINS files [default: the ROS topic read, else /imu0].
+    #[arg(long, value_name = "TOPIC")]
+    pub rostopic: Option<String>,
+}
+
+/// `--axis-policy`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AxisPolicyArg {
+    /// The largest value over the axes, per key.
+    Worst,
+    /// The root mean square over the axes.
+    Mean,
+    /// One file per axis letter (FILE.x.yaml, ...).
+    PerAxis,
+}
+
+/// `--gyro-unit`, `--accel-unit`.
+pub fn signal_unit(s: &str) -> Result<gmwm::units::SignalUnit, String> {
+    s.parse::<gmwm::units::SignalUnit>().map_err(|_| {
+        "must be rad/s, deg/s, deg/h (gyroscope) or m/s^2, g, mg (accelerometer)".into()
+    })
+}
+
+/// `--inflate`: a factor of at least 1.
+pub fn inflation(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 1.0 => Ok(v),
+        _ => Err("must be a factor >= 1, e.g. 2".into()),
+    }
 }
 
 const SELECT_EXAMPLES: &str = "\

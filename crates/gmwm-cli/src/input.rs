@@ -19,22 +19,9 @@ fn selector(text: &str) -> ColumnSelector {
     }
 }
 
-/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
-/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
-pub fn load(args: &InputArgs) -> Result<Loaded> {
-    if let Some(f) = args.freq {
-        anyhow::ensure!(
-            f.is_finite() && f > 0.0,
-            "invalid --freq {f}: must be a positive number of hertz"
-        );
-    }
-    if let Some(k) = args.ncols {
-        anyhow::ensure!(
-            k >= 1,
-            "invalid --ncols 0: a binary file has at least one column"
-        );
-    }
-    let opts = ReadOptions {
+/// The engine's read options from the flags.
+fn read_options(args: &InputArgs) -> ReadOptions {
+    ReadOptions {
         format: match args.format {
             FormatArg::Auto => InputFormat::Auto,
             FormatArg::Csv => InputFormat::Csv,
@@ -51,7 +38,25 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
         columns: args.columns.iter().map(|c| selector(c)).collect(),
         ncols: args.ncols,
         freq_hz: args.freq,
-    };
+    }
+}
+
+/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
+/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
+pub fn load(args: &InputArgs) -> Result<Loaded> {
+    if let Some(f) = args.freq {
+        anyhow::ensure!(
+            f.is_finite() && f > 0.0,
+            "invalid --freq {f}: must be a positive number of hertz"
+        );
+    }
+    if let Some(k) = args.ncols {
+        anyhow::ensure!(
+            k >= 1,
+            "invalid --ncols 0: a binary file has at least one column"
+        );
+    }
+    let opts = read_options(args);
     let table = read_table(&args.file, &opts)?;
     let freq_hz = match args.freq.or(table.freq_hz) {
         Some(f) => f,
@@ -104,4 +109,31 @@ pub fn named<T>(items: &[(String, T)]) -> Vec<crate::render::Named<'_, T>> {
         .iter()
         .map(|(name, result)| crate::render::Named { name, result })
         .collect()
+}
+
+/// A recording loaded for calibration.
+pub struct LoadedRecording {
+    /// The file.
+    pub path: std::path::PathBuf,
+    /// Its axes.
+    pub imu: gmwm::imu::Imu,
+    /// The ROS topic read, if any.
+    pub topic: Option<String>,
+    /// What the reader noticed, one line each.
+    pub notes: Vec<String>,
+}
+
+/// Opens the recording named by `args` as an IMU (the engine's `Recording`).
+pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
+    let opts = gmwm::imu::RecordingOptions {
+        read: read_options(args),
+        record_type: None,
+    };
+    let rec = gmwm::imu::Recording::open(&args.file, &opts)?;
+    Ok(LoadedRecording {
+        path: rec.path,
+        imu: rec.imu,
+        topic: rec.topic,
+        notes: rec.notes,
+    })
 }

@@ -1,3 +1,11 @@
 //! Calibration: from a recording to navigation-filter parameters.
 pub mod export;
 pub mod ieee;
+pub mod nav;
+pub mod pipeline;
+
+pub use nav::{Adjustment, AxisPolicy, NavSet};
+pub use pipeline::{
+    AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,
+    FitVerdict, GaussMarkovBias, DEFAULT_FULL_MODEL,
+};

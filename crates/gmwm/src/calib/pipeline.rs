@@ -280,7 +280,9 @@ impl Calibration {
     /// # Errors
     /// [`SelectionError`] for a full model that cannot be enumerated.
     pub fn candidates_per_axis(&self) -> Result<usize, SelectionError> {
-        Ok(Wic::nested(self.options.full_model.clone())?.candidates().len())
+        Ok(Wic::nested(self.options.full_model.clone())?
+            .candidates()
+            .len())
     }
 
     /// Calibrates every gyroscope and accelerometer axis of `imu` (in parallel).
@@ -422,7 +424,7 @@ impl Calibration {
         // a kind without a known unit reads in the data unit: no SI names, no datasheet forms
         let unit_kind = kind.filter(|_| unit.is_some());
         let unit_label = match (unit, kind) {
-            (Some(u), Some(k)) => SignalUnit::si(k).symbol().to_string(),
+            (Some(_), Some(k)) => SignalUnit::si(k).symbol().to_string(),
             _ => recorded_unit.unwrap_or("u").to_string(),
         };
         let engine = |source: crate::Error| CalibError::Engine {
@@ -451,15 +453,13 @@ impl Calibration {
                 column: column.to_string(),
                 source,
             })?;
-        let wv = selection
-            .fit
-            .empirical
-            .clone()
-            .ok_or_else(|| fit_error(FitError::Length {
+        let wv = selection.fit.empirical.clone().ok_or_else(|| {
+            fit_error(FitError::Length {
                 what: "stored WV",
                 expected: selection.fit.nu_hat.len(),
                 found: 0,
-            }))?;
+            })
+        })?;
         // the identified fit: the canonical model's reduced model, fitted (a candidate of the
         // selection when it is one) so that every reported term has estimates and intervals
         let reduced = &selection.selected_canonical.reduced;
@@ -605,7 +605,11 @@ impl Readoff<'_> {
     /// The quantity `q(theta)` over the parameters `params` of the fit: value and interval,
     /// the latter on the log scale by the delta method with the inference covariance
     /// (`None` when a parameter has no covariance, e.g. at the boundary).
-    fn delta(&self, params: &[usize], q: &dyn Fn(&[f64]) -> f64) -> (f64, Option<f64>, Option<f64>) {
+    fn delta(
+        &self,
+        params: &[usize],
+        q: &dyn Fn(&[f64]) -> f64,
+    ) -> (f64, Option<f64>, Option<f64>) {
         let theta = &self.fit.theta;
         let value = q(theta);
         let cov = &self.inference.covariance;
@@ -671,16 +675,20 @@ impl Readoff<'_> {
                 notes.push(format!(
                     "no white-noise term: the noise density is the long-run density of the fastest correlated term (component {fastest})"
                 ));
-                (vec![fastest], "long-run density of the fastest Gauss–Markov term".to_string())
+                (
+                    vec![fastest],
+                    "long-run density of the fastest Gauss–Markov term".to_string(),
+                )
             }
         };
         let q = |theta: &[f64]| -> f64 {
-            from.iter()
+            (from
+                .iter()
                 .map(|&c| self.white_variance(c, theta).unwrap_or(f64::NAN))
                 .sum::<f64>()
-                / f
-        }
-        .sqrt();
+                / f)
+                .sqrt()
+        };
         let (value, lo, hi) = self.checked(
             &from,
             &q,
@@ -839,7 +847,12 @@ impl Readoff<'_> {
         let d = self.gm_quantity(dominant, "driving_noise_density")?;
         let source = format!("Gauss–Markov term (component {dominant})");
         Some(GaussMarkovBias {
-            correlation_time: self.estimate(NoiseTerm::GmCorrelationTime, t.0, (t.1, t.2), source.clone()),
+            correlation_time: self.estimate(
+                NoiseTerm::GmCorrelationTime,
+                t.0,
+                (t.1, t.2),
+                source.clone(),
+            ),
             sigma: self.estimate(NoiseTerm::GmSigma, s.0, (s.1, s.2), source.clone()),
             driving_density: self.estimate(NoiseTerm::GmDrivingDensity, d.0, (d.1, d.2), source),
         })
@@ -848,7 +861,7 @@ impl Readoff<'_> {
 
 /// The verdict: the J-test and how many scales the implied WV leaves the empirical band at.
 fn verdict(fit: &GmwmFit, wv: &WaveletVariance, inference: &Inference, alpha: f64) -> FitVerdict {
-    let implied = &fit.implied_wv.total;
+    let implied = &fit.implied_wv.wv;
     let levels = implied.len().min(wv.wv.len());
     let outside = (0..levels)
         .filter(|&j| implied[j] < wv.ci_low[j] || implied[j] > wv.ci_high[j])

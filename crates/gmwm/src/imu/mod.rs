@@ -24,6 +24,7 @@
 
 mod error;
 pub mod read;
+pub mod recording;
 mod sensor;
 pub mod sidecar;
 pub mod write;
@@ -34,6 +35,7 @@ pub use read::{
     for_each_chunk, read_imu_record_file, read_table, BinaryChunks, Column, ColumnSelector,
     HeaderMode, ImuRecordType, InputFormat, ReadOptions, Table,
 };
+pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
 pub use sidecar::{find_sidecar, ColumnSummary, Sidecar, SidecarColumn, SidecarUnits};
 pub use wv_file::{is_wv_json, read_wv_json};

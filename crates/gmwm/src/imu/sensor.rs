@@ -1,7 +1,7 @@
 //! The [`Imu`] object of METHODS §9.1: sensor columns with their sensor type, axis, unit and a
 //! common sampling rate.
 
-use super::read::{Column, ImuRecordType, Table};
+use super::read::{Column, ColumnSelector, ImuRecordType, Table};
 use super::ReadError;
 use crate::error::{check_freq, Error, ParamError};
 use serde::{Deserialize, Serialize};
@@ -308,6 +308,47 @@ impl Imu {
     /// Always `false`: an [`Imu`] holds at least one sample.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// Keeps the axes named by `columns` (a column name, a tag such as `gyro_x`, or a 1-based
+    /// index into [`Imu::axes`]), in the IMU's order.
+    ///
+    /// # Errors
+    /// [`ReadError::UnknownColumn`] or [`ReadError::ColumnOutOfRange`] naming `path`.
+    pub fn select(
+        mut self,
+        path: &std::path::Path,
+        columns: &[ColumnSelector],
+    ) -> Result<Self, ReadError> {
+        let mut keep = vec![false; self.axes.len()];
+        for sel in columns {
+            let k = match sel {
+                ColumnSelector::Index(i) if (1..=self.axes.len()).contains(i) => i - 1,
+                ColumnSelector::Index(i) => {
+                    return Err(ReadError::ColumnOutOfRange {
+                        path: path.to_path_buf(),
+                        index: *i,
+                        ncols: self.axes.len(),
+                    })
+                }
+                ColumnSelector::Name(n) => self
+                    .axes
+                    .iter()
+                    .position(|a| a.column.name == *n || a.tag().eq_ignore_ascii_case(n))
+                    .ok_or_else(|| ReadError::UnknownColumn {
+                        path: path.to_path_buf(),
+                        name: n.clone(),
+                        available: self.axes.iter().map(|a| a.column.name.clone()).collect(),
+                    })?,
+            };
+            keep[k] = true;
+        }
+        let mut k = 0;
+        self.axes.retain(|_| {
+            k += 1;
+            keep[k - 1]
+        });
+        Ok(self)
     }
 }
 

@@ -1,0 +1,294 @@
+//! `gmwm calibrate`: the engine's calibration pipeline on a recording, a readable summary, and
+//! the files a navigation filter reads.
+
+use crate::args::{AxisPolicyArg, CalibrateArgs, RuleArg};
+use crate::cmd::wv::options;
+use crate::progress::{bar, Ticks};
+use crate::UsageError;
+use anyhow::{Context, Result};
+use gmwm::calib::export::{render, ExportFormat};
+use gmwm::calib::ieee::Readoff;
+use gmwm::calib::{
+    Adjustment, AxisCalibration, AxisPolicy, Calibration, CalibrationOptions, CalibrationReport,
+    Estimate, NavSet, DEFAULT_FULL_MODEL,
+};
+use gmwm::selection::SelectionRule;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The validated options from the flags.
+fn calibration_options(args: &CalibrateArgs) -> Result<CalibrationOptions> {
+    let wv = options(&args.estimator)?;
+    crate::cmd::fit::check_haar_flag(&args.estimator.filter, &wv)?;
+    let full_model = args
+        .model
+        .as_deref()
+        .unwrap_or(DEFAULT_FULL_MODEL)
+        .parse()?;
+    Ok(CalibrationOptions {
+        full_model,
+        wv,
+        bootstrap: args.bootstrap,
+        draws: args.draws,
+        seed: args.seed,
+        rule: match args.rule {
+            RuleArg::Navigation => SelectionRule::Navigation,
+            RuleArg::Parsimonious => SelectionRule::Parsimonious,
+            RuleArg::WicMinimum => SelectionRule::WicMinimum,
+        },
+        gyro_unit: args.gyro_unit,
+        accel_unit: args.accel_unit,
+    })
+}
+
+/// The files to write: (stack, path), Kalibr first.
+fn exports(args: &CalibrateArgs) -> Result<Vec<(ExportFormat, PathBuf)>> {
+    let mut out = Vec::new();
+    if let Some(p) = &args.kalibr {
+        out.push((ExportFormat::Kalibr, p.clone()));
+    }
+    for pair in args.export.chunks(2) {
+        let [stack, file] = pair else {
+            return Err(UsageError("--export takes two values: STACK FILE".into()).into());
+        };
+        let format: ExportFormat = stack.parse().map_err(|_| {
+            UsageError(format!(
+                "invalid --export {stack}: one of kalibr, openvins, vins, orbslam3, px4"
+            ))
+        })?;
+        out.push((format, PathBuf::from(file)));
+    }
+    Ok(out)
+}
+
+/// Runs the subcommand.
+pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
+    let options = calibration_options(args)?;
+    let exports = exports(args)?;
+    let adjustment = match (args.inflate, args.conservative) {
+        (Some(k), _) => Adjustment::inflate(k)?,
+        (None, true) => Adjustment::Conservative,
+        (None, false) => Adjustment::Estimate,
+    };
+    let policy = match args.axis_policy {
+        AxisPolicyArg::Worst => AxisPolicy::Worst,
+        AxisPolicyArg::Mean => AxisPolicy::Mean,
+        AxisPolicyArg::PerAxis => AxisPolicy::PerAxis,
+    };
+    let recording = crate::input::load_recording(&args.input)?;
+    let calibration = Calibration::new(options);
+    let per_axis = calibration.candidates_per_axis()?;
+    let axes = recording.imu.axes().len();
+    let progress = bar((axes * per_axis) as u64, "calibrating", "candidate fits");
+    let report = calibration
+        .run_with_progress(&recording.imu, &Ticks(&progress))
+        .with_context(|| recording.path.display().to_string())?;
+    progress.finish_and_clear();
+    let rostopic = args
+        .rostopic
+        .clone()
+        .or_else(|| recording.topic.clone())
+        .unwrap_or_else(|| "/imu0".to_string());
+    let sets = report.nav_sets(policy, adjustment, Some(&rostopic));
+    let mut written = Vec::new();
+    for (format, path) in &exports {
+        for set in &sets {
+            let target = per_axis_path(path, &set.label);
+            let text = render(*format, &set.noise)
+                .with_context(|| format!("cannot write {} ({format})", target.display()))?;
+            std::fs::write(&target, text)
+                .with_context(|| format!("cannot write {}", target.display()))?;
+            written.push(format!("{} ({format})", target.display()));
+        }
+    }
+    let json_to_stdout = args.json.as_deref() == Some(Path::new("-"));
+    if let Some(path) = &args.json {
+        let doc = JsonDoc {
+            file: &recording.path,
+            notes: &recording.notes,
+            calibration: &report,
+            exported: &sets,
+        };
+        if json_to_stdout {
+            serde_json::to_writer_pretty(&mut *out, &doc)?;
+            writeln!(out)?;
+        } else {
+            let file = std::fs::File::create(path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            let mut w = std::io::BufWriter::new(file);
+            serde_json::to_writer_pretty(&mut w, &doc)?;
+            w.flush()?;
+            written.push(format!("{} (JSON)", path.display()));
+        }
+    }
+    if !json_to_stdout {
+        summary(&recording, &report, out)?;
+        for w in &written {
+            writeln!(out, "wrote {w}")?;
+        }
+    }
+    Ok(())
+}
+
+/// `FILE` for one set, `FILE` with `.x` before its extension for a per-axis set.
+fn per_axis_path(path: &Path, label: &str) -> PathBuf {
+    if label.is_empty() {
+        return path.to_path_buf();
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let name = match path.extension() {
+        Some(ext) => format!("{stem}.{label}.{}", ext.to_string_lossy()),
+        None => format!("{stem}.{label}"),
+    };
+    path.with_file_name(name)
+}
+
+#[derive(serde::Serialize)]
+struct JsonDoc<'a> {
+    file: &'a Path,
+    notes: &'a [String],
+    #[serde(flatten)]
+    calibration: &'a CalibrationReport,
+    exported: &'a [NavSet],
+}
+
+/// Four significant digits.
+fn num(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.3e}")
+    } else {
+        let digits = if a == 0.0 {
+            0
+        } else {
+            (3 - a.log10().floor() as i32).max(0) as usize
+        };
+        format!("{v:.digits$}")
+    }
+}
+
+/// `value unit [lo, hi]  (datasheet)`.
+fn estimate_line(e: &Estimate) -> String {
+    let ci = match (e.ci_low, e.ci_high) {
+        (Some(lo), Some(hi)) => format!(" [{}, {}]", num(lo), num(hi)),
+        _ => " [no interval]".to_string(),
+    };
+    let sheet = e
+        .forms
+        .as_ref()
+        .and_then(|f| f.datasheet.as_ref())
+        .map(|d| format!(" = {} {}", num(d.value), d.unit))
+        .unwrap_or_default();
+    format!("{} {}{ci}{sheet}", num(e.value), e.unit)
+}
+
+fn readoff_cell(r: &Readoff) -> String {
+    match r.value {
+        Some(v) => num(v),
+        None => "-".to_string(),
+    }
+}
+
+fn summary(
+    recording: &crate::input::LoadedRecording,
+    report: &CalibrationReport,
+    out: &mut impl Write,
+) -> Result<()> {
+    let hours = report.duration_s / 3600.0;
+    writeln!(
+        out,
+        "{}: {} samples per axis at {} Hz ({}), {} axes",
+        recording.path.display(),
+        report.samples,
+        num(report.freq_hz),
+        if hours >= 1.0 {
+            format!("{hours:.2} h")
+        } else {
+            format!("{:.0} s", report.duration_s)
+        },
+        report.axes.len()
+    )?;
+    for n in &recording.notes {
+        writeln!(out, "  {n}")?;
+    }
+    writeln!(
+        out,
+        "model: selected by WIC among the sub-models of {} ({} rule); intervals {:.0}%",
+        report.full_model,
+        match report.rule {
+            SelectionRule::Navigation => "navigation",
+            SelectionRule::Parsimonious => "parsimonious",
+            SelectionRule::WicMinimum => "WIC-minimum",
+        },
+        100.0 * (1.0 - report.alpha)
+    )?;
+    for a in &report.axes {
+        axis_block(a, out)?;
+    }
+    Ok(())
+}
+
+fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
+    writeln!(out)?;
+    let unit_note = match (&a.data_unit, a.unit.as_str()) {
+        (Some(d), u) if d != u => format!(", data in {d} converted to {u}"),
+        (None, _) => ", unit unknown".to_string(),
+        _ => String::new(),
+    };
+    writeln!(
+        out,
+        "{}: {}{}{unit_note}",
+        a.column,
+        a.canonical_model,
+        if a.model != a.canonical_model {
+            format!(" (fitted as {})", a.model)
+        } else {
+            String::new()
+        },
+    )?;
+    let line = |label: &str, e: &Option<Estimate>| match e {
+        Some(e) => format!("  {label:<18}{}", estimate_line(e)),
+        None => format!("  {label:<18}- (no such term)"),
+    };
+    writeln!(out, "{}", line("noise density", &a.noise_density))?;
+    writeln!(out, "{}", line("bias instability", &a.bias_instability))?;
+    writeln!(out, "{}", line("random walk", &a.random_walk))?;
+    if let Some(g) = &a.gauss_markov_bias {
+        writeln!(
+            out,
+            "  {:<18}T = {} s [{}], sigma = {}",
+            "Gauss-Markov bias",
+            num(g.correlation_time.value),
+            match (g.correlation_time.ci_low, g.correlation_time.ci_high) {
+                (Some(lo), Some(hi)) => format!("{}, {}", num(lo), num(hi)),
+                _ => "no interval".into(),
+            },
+            estimate_line(&g.sigma)
+        )?;
+    }
+    if let Some(q) = &a.quantization {
+        writeln!(out, "  {:<18}{}", "quantization", estimate_line(q))?;
+    }
+    if let Some(r) = &a.rate_ramp {
+        writeln!(out, "  {:<18}{}", "rate ramp", estimate_line(r))?;
+    }
+    writeln!(
+        out,
+        "  {:<18}N = {}, B = {}, K = {}, Q = {}, R = {} ({})",
+        "IEEE 952",
+        readoff_cell(&a.ieee.n),
+        readoff_cell(&a.ieee.b),
+        readoff_cell(&a.ieee.k),
+        readoff_cell(&a.ieee.q),
+        readoff_cell(&a.ieee.r),
+        a.unit
+    )?;
+    writeln!(out, "  {:<18}{}", "fit", a.verdict.summary)?;
+    for n in &a.notes {
+        writeln!(out, "  note: {n}")?;
+    }
+    Ok(())
+}
