@@ -225,14 +225,14 @@ impl FromStr for SignalUnit {
 
     /// Parses a unit leniently but case-aware (see the module doc): `rad/s`, `rad s^-1`,
     /// `rad/sec`, `deg/s`, `°/s`, `dps`, `deg/h`, `°/h`, `dph`, `m/s^2`, `m/s2`, `m/s²`,
-    /// `m s^-2`, `g`, `mg`. Text from the first `(` on is ignored, and when the whole does not
+    /// `m s^-2`, `g`, `mg`. Text from the first `(`, `;` or `,` on is ignored, and when the whole does not
     /// parse its first word is tried, so sidecar strings such as
     /// `"deg/s (inferred: all values are multiples of 0.05 ...)"` parse.
     ///
     /// # Errors
     /// [`ParamError`] named `unit`, listing what is valid.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let head = s.split('(').next().unwrap_or_default();
+        let head = s.split(['(', ';', ',']).next().unwrap_or_default();
         let t = normalise(head);
         let first = t.split_whitespace().next().unwrap_or_default();
         match_unit(&t)

@@ -346,7 +346,11 @@ fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
 
 /// METHODS §14.3: bias instability, minimum deviation / [`FLICKER_FACTOR`] (module doc).
 fn bias_readoff(s: &Scales) -> Readoff {
-    let Some((i, _)) = s.avar.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)) else {
+    // the minimum; an interior scale attaining it is preferred, so a flat floor counts
+    let min = s.avar.iter().copied().fold(f64::INFINITY, f64::min);
+    let at_min: Vec<usize> = (0..s.len()).filter(|&i| s.avar[i] == min).collect();
+    let interior = at_min.iter().copied().find(|&i| i > 0 && i + 1 < s.len());
+    let Some(i) = interior.or_else(|| at_min.first().copied()) else {
         return Readoff {
             value: None,
             ci_low: None,
