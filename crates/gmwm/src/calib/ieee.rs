@@ -1,52 +1,482 @@
 //! IEEE Std 952 read-offs from the Allan deviation (METHODS §14.3).
+//!
+//! # The region rule
+//! Each coefficient is read off the part of the Allan deviation curve where its own noise term
+//! dominates. Which scales those are is decided on a smooth model, not on noisy local slopes:
+//! the five IEEE terms (METHODS §14.2 derivation check) are fitted to the Allan variance by
+//! non-negative least squares,
+//!
+//! `AV(tau) ~ c_Q 3/tau^2 + c_N / tau + c_B + c_K tau/3 + c_R tau^2/2`, every `c >= 0`,
+//!
+//! in relative terms (residual `AV_model / AV - 1`, weight `min(edf, EDF_CAP)`), exactly: every
+//! subset of the five columns is solved by unconstrained least squares and the best solution
+//! with no negative coefficient is kept (the NNLS optimum is such a solution). A scale belongs
+//! to the region of a term when that term carries at least [`DOMINANCE`] of the fitted AV
+//! there. The fitted model is a posynomial in `tau`, so each region is an interval of scales
+//! (the longest contiguous run is taken all the same). Fitting all five terms, the flicker
+//! floor included, keeps a neighbouring term from being mistaken for the one read.
+//!
+//! On its region the term's line of fixed slope (−1/2 for N, +1/2 for K, −1 for Q, +1 for R in
+//! the deviation) is fitted through the **data** (not the model): the per-scale coefficients
+//! `N_i = sigma_i sqrt(tau_i)`, `K_i = sigma_i sqrt(3 / tau_i)`, `Q_i = sigma_i tau_i / sqrt(3)`,
+//! `R_i = sigma_i sqrt(2) / tau_i` are averaged in logarithms with weights `edf_i` (the inverse
+//! variance of `ln sigma_i` is `2 edf_i`), which is the line's value at its read-off time
+//! (1 s, 3 s, sqrt(3) s, sqrt(2) s). The interval is the same weighted fit through the square
+//! roots of the band bounds `ci_low`, `ci_high`: the typical single-scale interval, not one
+//! narrowed by pooling, because adjacent octaves of the overlapping AV share most of their
+//! terms and are far from independent.
+//!
+//! A region with fewer than two scales gives no value, only a note saying so. Where the other
+//! terms carry up to `1 - DOMINANCE` of the AV on the region, a per-scale coefficient is biased
+//! high by at most `1 / sqrt(DOMINANCE) - 1` (5.4%), and their average by less.
+//!
+//! B is the minimum of the Allan deviation divided by [`FLICKER_FACTOR`]. Since every term
+//! adds to the AV, `min sigma / 0.664` is always an upper bound on B; it is the estimate only
+//! when the minimum is interior (a floor). At the first or last scale it is reported as
+//! `ci_high` alone, with no value.
 
 use crate::error::ParamError;
-use crate::variance::allan::AllanVariance;
+use crate::units::{si_unit, NoiseTerm};
+use crate::variance::allan::{AllanKind, AllanVariance};
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::fmt;
+
+/// METHODS §14.3: the flicker-floor factor `sqrt(2 ln 2 / π) = 0.6643`, rounded to 0.664 as in
+/// IEEE Std 952 and METHODS §14.5 (min ADEV 1e-4 gives B = 1.506024e-4 only with 0.664).
+pub const FLICKER_FACTOR: f64 = 0.664;
+
+/// Share of the fitted AV a term must carry at a scale for the scale to join its region.
+/// 0.9 bounds the contamination of a read-off by the other terms to 5.4% (module doc) while
+/// leaving regions of several octaves on real sensors, whose terms cross within a decade.
+pub const DOMINANCE: f64 = 0.9;
+
+/// Cap on the edf weight of a scale in the model fit: the five-term model is an idealisation
+/// (real sensors add Gauss–Markov bumps), so once a scale's AV is known to about 14%
+/// (`sqrt(2 / 100)`) its exact precision should not let it dominate the classification.
+const EDF_CAP: f64 = 100.0;
+
+/// Singular values below this fraction of the largest are dropped in the subset least squares
+/// (columns are normalised to unit length first): collinear subsets then give the minimum-norm
+/// solution instead of noise.
+const SVD_EPS: f64 = 1e-13;
 
 /// One IEEE Std 952 coefficient read off the Allan deviation (METHODS §14.3).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Readoff {
-    /// The coefficient, or `None` where its slope region holds fewer than two scales.
+    /// The coefficient (data unit), or `None` where its region holds fewer than two scales.
     pub value: Option<f64>,
-    /// Lower confidence bound.
+    /// Lower confidence bound (module doc).
     pub ci_low: Option<f64>,
-    /// Upper confidence bound.
+    /// Upper confidence bound (module doc); for B also the upper bound when there is no value.
     pub ci_high: Option<f64>,
     /// Cluster times (seconds) used.
     pub tau_s: Vec<f64>,
-    /// Where the line is read, seconds: 1, √3, 3, √2, or the minimum's tau for B.
+    /// Where the line is read, seconds: 1 (N), 3 (K), √3 (Q), √2 (R), or the minimum's tau (B).
     pub at_tau_s: f64,
-    /// How the value was obtained or why there is none.
+    /// How the value was obtained, or why there is none.
     pub note: Option<String>,
 }
 
-/// The five IEEE Std 952 coefficients (METHODS §14.3), in the data unit.
+/// The five IEEE Std 952 coefficients (METHODS §14.3), in the data unit `u`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IeeeReadoff {
-    /// Angle / velocity random walk N (u/√Hz), −1/2 slope at 1 s.
+    /// Angle / velocity random walk N (u/√Hz), −1/2-slope line at 1 s.
     pub n: Readoff,
-    /// Bias instability B (u), minimum / 0.664.
+    /// Bias instability B (u), minimum deviation / 0.664.
     pub b: Readoff,
-    /// Rate random walk K (u/s/√Hz), +1/2 slope at 3 s.
+    /// Rate random walk K (u/s/√Hz), +1/2-slope line at 3 s.
     pub k: Readoff,
-    /// Quantization Q (u·s), −1 slope at √3 s.
+    /// Quantization Q (u·s), −1-slope line at √3 s.
     pub q: Readoff,
-    /// Rate ramp R (u/s), +1 slope at √2 s.
+    /// Rate ramp R (u/s), +1-slope line at √2 s.
     pub r: Readoff,
+}
+
+/// A term of the five-term model.
+struct Term {
+    /// What its region is called in notes.
+    region: &'static str,
+    /// Slope of its line in the Allan deviation.
+    slope: &'static str,
+    /// AV per unit squared coefficient at cluster time `tau` (METHODS §14.2 derivation check).
+    basis: fn(f64) -> f64,
+    /// Read-off time, seconds (METHODS §14.3); `basis(at) = 1` there.
+    at_tau_s: f64,
+}
+
+/// METHODS §14.2, §14.3: the five terms in model-column order Q, N, B, K, R.
+const TERMS: [Term; 5] = [
+    Term {
+        region: "quantization",
+        slope: "−1",
+        basis: |t| 3.0 / (t * t),
+        at_tau_s: 1.732_050_807_568_877_2,
+    },
+    Term {
+        region: "white-noise",
+        slope: "−1/2",
+        basis: |t| 1.0 / t,
+        at_tau_s: 1.0,
+    },
+    Term {
+        region: "flicker",
+        slope: "0",
+        basis: |_| 1.0,
+        at_tau_s: f64::NAN,
+    },
+    Term {
+        region: "random-walk",
+        slope: "+1/2",
+        basis: |t| t / 3.0,
+        at_tau_s: 3.0,
+    },
+    Term {
+        region: "rate-ramp",
+        slope: "+1",
+        basis: |t| t * t / 2.0,
+        at_tau_s: std::f64::consts::SQRT_2,
+    },
+];
+const Q: usize = 0;
+const N: usize = 1;
+const K: usize = 3;
+const R: usize = 4;
+
+/// The usable scales of an Allan variance: finite positive tau and AV.
+struct Scales {
+    tau_s: Vec<f64>,
+    avar: Vec<f64>,
+    edf: Vec<f64>,
+    ci_low: Vec<f64>,
+    ci_high: Vec<f64>,
+}
+
+impl Scales {
+    fn of(av: &AllanVariance) -> Scales {
+        let mut s = Scales {
+            tau_s: Vec::new(),
+            avar: Vec::new(),
+            edf: Vec::new(),
+            ci_low: Vec::new(),
+            ci_high: Vec::new(),
+        };
+        for (i, (&t, &v)) in av.tau_s.iter().zip(&av.avar).enumerate() {
+            if !(t.is_finite() && t > 0.0 && v.is_finite() && v > 0.0) {
+                continue;
+            }
+            let edf = av.edf.get(i).copied().unwrap_or(f64::NAN);
+            s.tau_s.push(t);
+            s.avar.push(v);
+            s.edf.push(if edf.is_finite() && edf > 0.0 {
+                edf
+            } else {
+                1.0
+            });
+            s.ci_low.push(av.ci_low.get(i).copied().unwrap_or(f64::NAN));
+            s.ci_high
+                .push(av.ci_high.get(i).copied().unwrap_or(f64::NAN));
+        }
+        s
+    }
+
+    fn len(&self) -> usize {
+        self.tau_s.len()
+    }
+}
+
+/// METHODS §14.3 (module doc): the non-negative least-squares fit of the five-term model, in
+/// relative terms; returns the AV coefficients `c_Q, c_N, c_B, c_K, c_R` (all `>= 0`).
+fn fit_terms(s: &Scales) -> [f64; 5] {
+    let n = s.len();
+    let w: Vec<f64> = s.edf.iter().map(|e| e.min(EDF_CAP).sqrt()).collect();
+    let mut a = DMatrix::<f64>::zeros(n, 5);
+    for i in 0..n {
+        for (j, term) in TERMS.iter().enumerate() {
+            a[(i, j)] = w[i] * (term.basis)(s.tau_s[i]) / s.avar[i];
+        }
+    }
+    let norms: Vec<f64> = (0..5).map(|j| a.column(j).norm()).collect();
+    for (j, &norm) in norms.iter().enumerate() {
+        if norm > 0.0 && norm.is_finite() {
+            a.column_mut(j).unscale_mut(norm);
+        }
+    }
+    let b = DVector::from_vec(w.clone());
+    let scale = b.norm_squared();
+    let mut best: Option<(f64, [f64; 5])> = None;
+    // subsets by increasing size, so that a tie keeps the simpler model
+    let mut masks: Vec<u32> = (1..32u32).collect();
+    masks.sort_by_key(|m| m.count_ones());
+    for mask in masks {
+        let cols: Vec<usize> = (0..5).filter(|j| mask & (1 << j) != 0).collect();
+        if cols.len() > n
+            || cols
+                .iter()
+                .any(|&j| !(norms[j] > 0.0 && norms[j].is_finite()))
+        {
+            continue;
+        }
+        let sub = DMatrix::from_fn(n, cols.len(), |i, k| a[(i, cols[k])]);
+        let svd = sub.clone().svd(true, true);
+        let max_sv = svd.singular_values.max();
+        let Ok(x) = svd.solve(&b, SVD_EPS * max_sv) else {
+            continue;
+        };
+        if x.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            continue;
+        }
+        let resid = (&sub * &x - &b).norm_squared();
+        let better = match &best {
+            None => true,
+            Some((r, _)) => resid < r - 1e-12 * scale,
+        };
+        if better {
+            let mut c = [0.0; 5];
+            for (k, &j) in cols.iter().enumerate() {
+                c[j] = x[k] / norms[j];
+            }
+            best = Some((resid, c));
+        }
+    }
+    best.map(|(_, c)| c).unwrap_or([0.0; 5])
+}
+
+/// The longest contiguous run of scales where term `j` carries at least [`DOMINANCE`] of the
+/// fitted AV (module doc).
+fn region(s: &Scales, c: &[f64; 5], j: usize) -> Vec<usize> {
+    let mut best: Vec<usize> = Vec::new();
+    let mut run: Vec<usize> = Vec::new();
+    for i in 0..s.len() {
+        let parts: Vec<f64> = TERMS
+            .iter()
+            .zip(c)
+            .map(|(t, c)| c * (t.basis)(s.tau_s[i]))
+            .collect();
+        let total: f64 = parts.iter().sum();
+        if total > 0.0 && parts[j] >= DOMINANCE * total {
+            run.push(i);
+            if run.len() > best.len() {
+                best = run.clone();
+            }
+        } else {
+            run.clear();
+        }
+    }
+    best
+}
+
+/// METHODS §14.3: the fixed-slope line of term `j` through the data on `idx`, read at its
+/// read-off time (module doc); `None` when a value is not finite.
+fn line(s: &Scales, j: usize, idx: &[usize], values: &[f64]) -> Option<f64> {
+    let basis = TERMS[j].basis;
+    let (mut num, mut den) = (0.0, 0.0);
+    for &i in idx {
+        let coef = (values[i] / basis(s.tau_s[i])).sqrt();
+        if !(coef.is_finite() && coef > 0.0) {
+            return None;
+        }
+        num += s.edf[i] * coef.ln();
+        den += s.edf[i];
+    }
+    let v = (num / den).exp();
+    v.is_finite().then_some(v)
+}
+
+fn seconds(t: f64) -> String {
+    crate::fit::report::significant(t, 3)
+}
+
+/// METHODS §14.3: the read-off of a line term (N, K, Q or R).
+fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
+    let term = &TERMS[j];
+    let idx = region(s, c, j);
+    let tau_s: Vec<f64> = idx.iter().map(|&i| s.tau_s[i]).collect();
+    let share = format!("{:.0}%", DOMINANCE * 100.0);
+    if idx.len() < 2 {
+        let why = if idx.is_empty() {
+            format!(
+                "no scale where the {} term carries {share} of the fitted AV: no value",
+                term.region
+            )
+        } else {
+            format!(
+                "the {} region holds 1 scale ({} s; 2 needed): no value",
+                term.region,
+                seconds(tau_s[0])
+            )
+        };
+        return Readoff {
+            value: None,
+            ci_low: None,
+            ci_high: None,
+            tau_s,
+            at_tau_s: term.at_tau_s,
+            note: Some(why),
+        };
+    }
+    let value = line(s, j, &idx, &s.avar);
+    let ci_low = line(s, j, &idx, &s.ci_low);
+    let ci_high = line(s, j, &idx, &s.ci_high);
+    let (lo, hi) = (tau_s[0], tau_s[tau_s.len() - 1]);
+    let extrapolated = if term.at_tau_s < lo || term.at_tau_s > hi {
+        ", extrapolated"
+    } else {
+        ""
+    };
+    let note = format!(
+        "{} slope line through {} scales ({} to {} s, {} term ≥ {share} of the fitted AV), \
+         read at {} s{extrapolated}",
+        term.slope,
+        idx.len(),
+        seconds(lo),
+        seconds(hi),
+        term.region,
+        seconds(term.at_tau_s),
+    );
+    Readoff {
+        value,
+        ci_low,
+        ci_high,
+        tau_s,
+        at_tau_s: term.at_tau_s,
+        note: Some(note),
+    }
+}
+
+/// METHODS §14.3: bias instability, minimum deviation / [`FLICKER_FACTOR`] (module doc).
+fn bias_readoff(s: &Scales) -> Readoff {
+    // the minimum; an interior scale attaining it is preferred, so a flat floor counts
+    let min = s.avar.iter().copied().fold(f64::INFINITY, f64::min);
+    let at_min: Vec<usize> = (0..s.len()).filter(|&i| s.avar[i] == min).collect();
+    let interior = at_min.iter().copied().find(|&i| i > 0 && i + 1 < s.len());
+    let Some(i) = interior.or_else(|| at_min.first().copied()) else {
+        return Readoff {
+            value: None,
+            ci_low: None,
+            ci_high: None,
+            tau_s: Vec::new(),
+            at_tau_s: f64::NAN,
+            note: Some("no usable scale: no value".to_string()),
+        };
+    };
+    let bound = |v: f64| {
+        let b = v.sqrt() / FLICKER_FACTOR;
+        (b.is_finite() && b > 0.0).then_some(b)
+    };
+    let b = bound(s.avar[i]);
+    let tau = s.tau_s[i];
+    let (value, ci_low, ci_high, note) = if s.len() >= 3 && i > 0 && i + 1 < s.len() {
+        (
+            b,
+            bound(s.ci_low[i]),
+            bound(s.ci_high[i]),
+            format!(
+                "min ADEV / 0.664 (flicker-floor factor applied), minimum at {} s",
+                seconds(tau)
+            ),
+        )
+    } else {
+        let why = if s.len() < 3 {
+            "fewer than 3 scales: no floor can be seen".to_string()
+        } else if i == 0 {
+            "ADEV rising from the shortest cluster time: no floor reached".to_string()
+        } else {
+            "ADEV still falling at the longest cluster time: no floor reached".to_string()
+        };
+        (
+            None,
+            None,
+            b,
+            format!(
+                "{why}; B ≤ ci_high = min ADEV / 0.664 at {} s: no value",
+                seconds(tau)
+            ),
+        )
+    };
+    Readoff {
+        value,
+        ci_low,
+        ci_high,
+        tau_s: vec![tau],
+        at_tau_s: tau,
+        note: Some(note),
+    }
+}
+
+/// METHODS §14.3: the IEEE Std 952 read-offs N, B, K, Q, R of an Allan variance (region rule
+/// and constants in the module doc), in the unit of the data the AV was computed from.
+///
+/// # Errors
+/// [`ParamError`] named `kind` unless `av` is an Allan variance (overlapping or not): the
+/// Hadamard and modified variances have other constants in the slope laws.
+pub fn ieee_readoff(av: &AllanVariance) -> Result<IeeeReadoff, ParamError> {
+    if !matches!(av.kind, AllanKind::Overlapping | AllanKind::NonOverlapping) {
+        return Err(ParamError::new(
+            "kind",
+            av.kind,
+            "an Allan variance (overlapping or non-overlapping): IEEE Std 952 read-offs use the \
+             Allan slope laws, which differ for the Hadamard and modified variances",
+        ));
+    }
+    let s = Scales::of(av);
+    let c = if s.len() >= 2 {
+        fit_terms(&s)
+    } else {
+        [0.0; 5]
+    };
+    Ok(IeeeReadoff {
+        n: line_readoff(&s, &c, N),
+        b: bias_readoff(&s),
+        k: line_readoff(&s, &c, K),
+        q: line_readoff(&s, &c, Q),
+        r: line_readoff(&s, &c, R),
+    })
+}
+
+impl IeeeReadoff {
+    /// The read-offs with their symbols, in table order N, B, K, Q, R.
+    pub fn rows(&self) -> [(&'static str, NoiseTerm, &Readoff); 5] {
+        [
+            ("N", NoiseTerm::NoiseDensity, &self.n),
+            ("B", NoiseTerm::BiasInstability, &self.b),
+            ("K", NoiseTerm::RandomWalk, &self.k),
+            ("Q", NoiseTerm::Quantization, &self.q),
+            ("R", NoiseTerm::RateRamp, &self.r),
+        ]
+    }
 }
 
 impl fmt::Display for IeeeReadoff {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        todo!("{f:p}")
+        let opt = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.6e}"));
+        writeln!(f, "IEEE Std 952 read-offs (u = data unit)")?;
+        writeln!(
+            f,
+            "{:<3} {:<10} {:>13} {:>13} {:>13} {:>9} {:>6}",
+            "", "unit", "value", "ci_low", "ci_high", "at tau_s", "scales"
+        )?;
+        for (sym, term, r) in self.rows() {
+            writeln!(
+                f,
+                "{sym:<3} {:<10} {:>13} {:>13} {:>13} {:>9} {:>6}",
+                si_unit(term, None, "u"),
+                opt(r.value),
+                opt(r.ci_low),
+                opt(r.ci_high),
+                if r.at_tau_s.is_finite() {
+                    seconds(r.at_tau_s)
+                } else {
+                    "—".to_string()
+                },
+                r.tau_s.len()
+            )?;
+        }
+        let notes: Vec<String> = self
+            .rows()
+            .iter()
+            .filter_map(|(sym, _, r)| r.note.as_ref().map(|n| format!("{sym}: {n}")))
+            .collect();
+        write!(f, "{}", notes.join("\n"))
     }
-}
-
-/// METHODS §14.3: the IEEE Std 952 read-offs of an Allan variance.
-///
-/// # Errors
-/// [`ParamError`] named `kind` unless `av` is an Allan variance (overlapping or not).
-pub fn ieee_readoff(av: &AllanVariance) -> Result<IeeeReadoff, ParamError> {
-    todo!("{}", av.n)
 }
