@@ -4,6 +4,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod allan;
+mod calib;
 mod canonical;
 mod common;
 mod export;

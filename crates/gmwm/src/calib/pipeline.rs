@@ -152,7 +152,7 @@ pub struct GaussMarkovBias {
 ///
 /// Wire format: `j_test_p_value` (null when V had too few replicates), `levels`,
 /// `levels_outside_band` (scales where the model's implied WV leaves the empirical WV's
-/// interval), `explains_wv`, `summary` (one line).
+/// interval), `max_relative_deviation`, `explains_wv`, `summary` (one line).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitVerdict {
     /// p-value of the J-test (METHODS §7.3).
@@ -161,6 +161,8 @@ pub struct FitVerdict {
     pub levels: usize,
     /// Scales where the implied WV lies outside the empirical WV's `1 - alpha` interval.
     pub levels_outside_band: usize,
+    /// Largest `|implied / empirical - 1|` over the scales.
+    pub max_relative_deviation: f64,
     /// `levels_outside_band` is at most the count expected by chance (`alpha` of the levels,
     /// rounded up).
     pub explains_wv: bool,
@@ -859,7 +861,8 @@ impl Readoff<'_> {
     }
 }
 
-/// The verdict: the J-test and how many scales the implied WV leaves the empirical band at.
+/// The verdict: the J-test, how many scales the implied WV leaves the empirical band at, and
+/// the largest relative deviation (what a user weighs against the uses of the model).
 fn verdict(fit: &GmwmFit, wv: &WaveletVariance, inference: &Inference, alpha: f64) -> FitVerdict {
     let implied = &fit.implied_wv.wv;
     let levels = implied.len().min(wv.wv.len());
@@ -868,25 +871,35 @@ fn verdict(fit: &GmwmFit, wv: &WaveletVariance, inference: &Inference, alpha: f6
         .count();
     let allowed = (alpha * levels as f64).ceil() as usize;
     let explains_wv = outside <= allowed;
+    let (worst_level, max_relative_deviation) = (0..levels)
+        .map(|j| (j, (implied[j] / wv.wv[j] - 1.0).abs()))
+        .filter(|(_, d)| d.is_finite())
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((0, 0.0));
     let p = inference.gof.as_ref().map(|g| g.p_value);
     let band = format!(
-        "implied WV inside the {:.0}% band at {} of {levels} scales",
+        "implied WV inside the {:.0}% band at {} of {levels} scales, largest deviation {:.1}% at {} s",
         100.0 * (1.0 - alpha),
-        levels - outside
+        levels - outside,
+        100.0 * max_relative_deviation,
+        crate::fit::report::significant(wv.tau_s[worst_level], 3)
     );
     let summary = match (p, explains_wv) {
         (Some(p), true) if p >= alpha => format!("fits: J-test p = {p:.3}; {band}"),
         (Some(p), true) => format!(
-            "explains the WV within its band, though the J-test rejects (p = {p:.2e}): the misfit is below the WV's own uncertainty; {band}"
+            "explains the WV within its band; the J-test rejects (p = {p:.1e}), the misfit is below the WV's own uncertainty; {band}"
         ),
-        (Some(p), false) => format!("does not explain the WV: J-test p = {p:.2e}; {band}"),
-        (None, true) => format!("explains the WV within its band (no J-test: too few replicates of V); {band}"),
-        (None, false) => format!("does not explain the WV; {band}"),
+        (Some(p), false) => format!("misfit: J-test p = {p:.1e}; {band}"),
+        (None, true) => format!(
+            "explains the WV within its band (no J-test: too few replicates of V); {band}"
+        ),
+        (None, false) => format!("misfit (no J-test: too few replicates of V); {band}"),
     };
     FitVerdict {
         j_test_p_value: p,
         levels,
         levels_outside_band: outside,
+        max_relative_deviation,
         explains_wv,
         summary,
     }

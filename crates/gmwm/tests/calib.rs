@@ -1,0 +1,232 @@
+//! The calibration pipeline (`gmwm::calib`) on simulated IMUs of known noise: the read-off in
+//! continuous SI units, its intervals, unit conversion, the navigation sets and bad input.
+
+use gmwm::calib::export::{render, ExportFormat};
+use gmwm::calib::{Adjustment, AxisPolicy, CalibError, Calibration, CalibrationOptions};
+use gmwm::imu::{Column, Imu, Sensor, SensorInfo};
+use gmwm::model::Model;
+use gmwm::sim::simulate_model;
+use gmwm::units::{SignalKind, SignalUnit};
+
+const FREQ: f64 = 100.0;
+/// 2^17 samples (22 minutes at 100 Hz): the random walk shows over the last four scales.
+const N: usize = 1 << 17;
+/// Gyroscope truth: N = 1e-3 rad/s/√Hz (sigma2 = N² f), K = 1e-4 rad/s²/√Hz (gamma2 = K² / f).
+const GYRO_N: f64 = 1e-3;
+const GYRO_K: f64 = 1e-4;
+/// Accelerometer truth: N = 2e-3 m/s²/√Hz, K = 3e-4 m/s³/√Hz, and a Gauss–Markov bias with a
+/// 5 s correlation time.
+const ACCEL_N: f64 = 2e-3;
+const ACCEL_K: f64 = 3e-4;
+
+fn truth(n: f64, k: f64, gm: Option<(f64, f64)>) -> Model {
+    let mut text = format!("WN(sigma2={})+RW(gamma2={})", n * n * FREQ, k * k / FREQ);
+    if let Some((beta, sigma2_gm)) = gm {
+        text = format!("GM(beta={beta}, sigma2_gm={sigma2_gm})+{text}");
+    }
+    text.parse().unwrap()
+}
+
+fn column(name: &str, values: Vec<f64>) -> Column {
+    Column {
+        name: name.to_string(),
+        values,
+    }
+}
+
+fn info(sensor: Sensor, unit: Option<&str>) -> SensorInfo {
+    SensorInfo {
+        sensor,
+        axis: "X".to_string(),
+        unit: unit.map(str::to_string),
+    }
+}
+
+/// A two-axis IMU (gyro X in `gyro_scale` units of rad/s, accel X in m/s^2) and a temperature.
+fn imu(gyro_unit: Option<&str>, gyro_scale: f64) -> Imu {
+    let gyro: Vec<f64> = simulate_model(&truth(GYRO_N, GYRO_K, None), N, FREQ, 11)
+        .unwrap()
+        .into_iter()
+        .map(|v| v / gyro_scale)
+        .collect();
+    let accel = simulate_model(&truth(ACCEL_N, ACCEL_K, Some((0.2, 4e-6))), N, FREQ, 12).unwrap();
+    let temperature: Vec<f64> = (0..N).map(|t| 25.0 + (t % 7) as f64 * 1e-3).collect();
+    Imu::new(
+        vec![
+            column("gyro_x", gyro),
+            column("accel_x", accel),
+            column("temperature", temperature),
+        ],
+        vec![
+            info(Sensor::Gyroscope, gyro_unit),
+            info(Sensor::Accelerometer, Some("m/s^2")),
+            SensorInfo {
+                sensor: Sensor::Other,
+                axis: "temperature".into(),
+                unit: None,
+            },
+        ],
+        FREQ,
+    )
+    .unwrap()
+}
+
+fn options() -> CalibrationOptions {
+    CalibrationOptions {
+        full_model: "AR1()+WN()+RW()".parse().unwrap(),
+        draws: Some(2000),
+        ..CalibrationOptions::default()
+    }
+}
+
+/// Noise densities within 5% and random walks within 40% of the truth (the bar for a
+/// recording of this length: the WN is estimated from ~1e5 samples, relative SE ~0.3%; the RW
+/// from the last few scales, relative SE ~15%), each interval covering its truth, in SI units
+/// with datasheet forms, the temperature column left alone.
+#[test]
+fn calibration_reads_off_known_noise() {
+    let report = Calibration::new(options())
+        .run(&imu(Some("rad/s"), 1.0))
+        .unwrap();
+    assert_eq!(
+        report.axes.len(),
+        2,
+        "the temperature column is not an inertial axis"
+    );
+    let gyro = &report.axes[0];
+    assert_eq!(gyro.kind, Some(SignalKind::Gyroscope));
+    let n = gyro.noise_density.as_ref().unwrap();
+    let k = gyro.random_walk.as_ref().unwrap();
+    assert_eq!(n.unit, "rad/s/√Hz");
+    assert_eq!(k.unit, "rad/s²/√Hz");
+    assert!((n.value / GYRO_N - 1.0).abs() < 0.05, "N = {}", n.value);
+    assert!((k.value / GYRO_K - 1.0).abs() < 0.4, "K = {}", k.value);
+    for (e, t) in [(n, GYRO_N), (k, GYRO_K)] {
+        let (lo, hi) = (e.ci_low.unwrap(), e.ci_high.unwrap());
+        assert!(lo < t && t < hi, "{lo} < {t} < {hi}");
+    }
+    let sheet = n.forms.as_ref().unwrap().datasheet.as_ref().unwrap();
+    // METHODS §14.2: °/√h = rad/s/√Hz × 180/π × 60
+    let expected = n.value * 180.0 / std::f64::consts::PI * 60.0;
+    assert!(
+        (sheet.value / expected - 1.0).abs() < 1e-12,
+        "{} {}",
+        sheet.value,
+        sheet.unit
+    );
+    let accel = &report.axes[1];
+    assert_eq!(accel.noise_density.as_ref().unwrap().unit, "m/s²/√Hz");
+    assert!((accel.noise_density.as_ref().unwrap().value / ACCEL_N - 1.0).abs() < 0.05);
+    assert!((accel.random_walk.as_ref().unwrap().value / ACCEL_K - 1.0).abs() < 0.4);
+    let gm = accel
+        .gauss_markov_bias
+        .as_ref()
+        .expect("the GM bias is found");
+    assert!(
+        (gm.correlation_time.value / 5.0 - 1.0).abs() < 0.5,
+        "T = {}",
+        gm.correlation_time.value
+    );
+    assert!(accel.bias_instability.is_some());
+    assert!(gyro.ieee.n.value.is_some());
+    assert!(gyro.verdict.levels > 10);
+}
+
+/// The same recording in deg/s, declared as such, gives the same SI results (the samples are
+/// converted before any statistic; equal up to the rounding of the conversion).
+#[test]
+fn calibration_converts_units_first() {
+    let deg = std::f64::consts::PI / 180.0;
+    let a = Calibration::new(options())
+        .run(&imu(Some("rad/s"), 1.0))
+        .unwrap();
+    let b = Calibration::new(options())
+        .run(&imu(Some("deg/s"), deg))
+        .unwrap();
+    let c = Calibration::new(CalibrationOptions {
+        gyro_unit: Some(SignalUnit::DegreePerSecond),
+        ..options()
+    })
+    .run(&imu(None, deg))
+    .unwrap();
+    let na = a.axes[0].noise_density.as_ref().unwrap().value;
+    for r in [&b, &c] {
+        let nb = r.axes[0].noise_density.as_ref().unwrap().value;
+        assert!((na / nb - 1.0).abs() < 1e-6, "{na} vs {nb}");
+        assert_eq!(r.axes[0].unit, "rad/s");
+    }
+    assert_eq!(b.axes[0].data_unit.as_deref(), Some("deg/s"));
+}
+
+/// Without a unit, a gyroscope is reported in the data unit, with a note, and is left out of
+/// the navigation sets (whose keys are SI).
+#[test]
+fn calibration_without_unit_reports_data_unit() {
+    let r = Calibration::new(options()).run(&imu(None, 1.0)).unwrap();
+    let gyro = &r.axes[0];
+    assert_eq!(gyro.unit, "u");
+    assert!(gyro.notes.iter().any(|n| n.contains("unit unknown")));
+    let n = gyro.noise_density.as_ref().unwrap();
+    assert_eq!(n.unit, "u/√Hz");
+    let sets = r.nav_sets(AxisPolicy::Worst, Adjustment::Estimate, None);
+    assert_eq!(sets[0].noise.gyroscope.noise_density, None);
+    let err = render(ExportFormat::Kalibr, &sets[0].noise).unwrap_err();
+    assert!(err.to_string().contains("gyroscope_noise_density"), "{err}");
+}
+
+/// Navigation sets: the worst axis, the RMS, per axis; conservative values are the upper
+/// interval ends, inflated ones the estimates times the factor; both said in the comments.
+#[test]
+fn nav_sets_follow_policy_and_adjustment() {
+    let r = Calibration::new(options())
+        .run(&imu(Some("rad/s"), 1.0))
+        .unwrap();
+    let g = r.axes[0].noise_density.as_ref().unwrap();
+    let worst = &r.nav_sets(AxisPolicy::Worst, Adjustment::Estimate, Some("/imu0"))[0];
+    assert_eq!(worst.noise.gyroscope.noise_density, Some(g.value));
+    assert_eq!(worst.noise.rostopic.as_deref(), Some("/imu0"));
+    let cons = &r.nav_sets(AxisPolicy::Worst, Adjustment::Conservative, None)[0];
+    assert_eq!(cons.noise.gyroscope.noise_density, g.ci_high);
+    assert!(cons.noise.comments.iter().any(|c| c.contains("upper ends")));
+    let infl = &r.nav_sets(AxisPolicy::Mean, Adjustment::inflate(3.0).unwrap(), None)[0];
+    assert!((infl.noise.gyroscope.noise_density.unwrap() / g.value - 3.0).abs() < 1e-12);
+    assert!(infl.noise.comments.iter().any(|c| c.contains("x 3")));
+    let per = r.nav_sets(AxisPolicy::PerAxis, Adjustment::Estimate, None);
+    assert_eq!(
+        per.len(),
+        1,
+        "one axis letter: {:?}",
+        per.iter().map(|s| &s.label).collect::<Vec<_>>()
+    );
+    assert_eq!(per[0].label, "x");
+    let yaml = render(ExportFormat::Kalibr, &worst.noise).unwrap();
+    assert!(yaml.contains("gyroscope_noise_density"));
+}
+
+/// Bad input: no inertial axis, a unit of the wrong kind.
+#[test]
+fn calibration_refuses_bad_input() {
+    let only_temp = Imu::new(
+        vec![column("temperature", vec![1.0, 2.0, 3.0, 4.0])],
+        vec![SensorInfo {
+            sensor: Sensor::Other,
+            axis: "temperature".into(),
+            unit: None,
+        }],
+        FREQ,
+    )
+    .unwrap();
+    let err = Calibration::new(options()).run(&only_temp).unwrap_err();
+    assert!(matches!(err, CalibError::NoInertialAxis { .. }), "{err}");
+    assert!(err.to_string().contains("temperature"));
+    let err = Calibration::new(CalibrationOptions {
+        gyro_unit: Some(SignalUnit::StandardGravity),
+        ..options()
+    })
+    .run(&imu(None, 1.0))
+    .unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "column gyro_x: unit g is not a gyroscope (rad/s, deg/s, deg/h) unit"
+    );
+}
