@@ -15,6 +15,7 @@ mod model;
 mod process;
 mod read;
 mod robust;
+mod ros;
 mod selection;
 mod sim;
 mod wavelet;

@@ -24,6 +24,7 @@
 
 mod error;
 pub mod read;
+pub mod ros;
 mod sensor;
 pub mod sidecar;
 pub mod write;
