@@ -25,6 +25,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Command::Implied(a) => cmd::implied::run(a, &mut out)?,
         Command::Fit(a) => cmd::fit::run(a, &mut out)?,
         Command::Select(a) => cmd::select::run(a, &mut out)?,
+        Command::Topics(a) => cmd::topics::run(a, &mut out)?,
     }
     out.flush()?;
     Ok(())

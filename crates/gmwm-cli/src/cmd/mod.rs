@@ -6,4 +6,5 @@ pub mod fit;
 pub mod implied;
 pub mod select;
 pub mod simulate;
+pub mod topics;
 pub mod wv;

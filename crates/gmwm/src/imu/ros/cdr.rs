@@ -190,7 +190,7 @@ mod tests {
         while (m.len() - 4) % 8 != 0 {
             m.push(0);
         }
-        let mut values = [0.0; 37];
+        let mut values = [0.0f64; 37];
         values[3] = 1.0; // orientation.w
         values[13..16].copy_from_slice(&[1.0, 2.0, 3.0]);
         values[25..28].copy_from_slice(&[4.0, 5.0, 6.0]);
@@ -272,7 +272,7 @@ mod tests {
         m.extend(9u32.to_le_bytes());
         m.extend(3u32.to_le_bytes());
         m.extend(b"imu");
-        let mut values = [0.0; 37];
+        let mut values = [0.0f64; 37];
         values[13..16].copy_from_slice(&[1.0, 2.0, 3.0]);
         values[25..28].copy_from_slice(&[4.0, 5.0, 6.0]);
         for v in values {

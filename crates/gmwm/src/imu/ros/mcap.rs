@@ -119,6 +119,10 @@ fn records<'a>(
     Ok(())
 }
 
+/// Called for each record of a chunk: (opcode, body, chunk offset in the file, record offset
+/// in the decompressed chunk).
+type ChunkVisitor<'v> = dyn FnMut(u8, &[u8], u64, usize) -> Result<(), RosError> + 'v;
+
 /// Decompresses a chunk record's body if needed and walks its records.
 fn chunk(
     path: &Path,
@@ -126,7 +130,7 @@ fn chunk(
     offset: u64,
     dec: &mut Decompressor,
     buf: &mut Vec<u8>,
-    visit: &mut dyn FnMut(u8, &[u8], u64, usize) -> Result<(), RosError>,
+    visit: &mut ChunkVisitor<'_>,
 ) -> Result<(), RosError> {
     let (header, data) = match mcap::parse_record(op::CHUNK, body) {
         Ok(Record::Chunk { header, data }) => (header, data),
