@@ -244,7 +244,7 @@ mod tests {
             }
         ));
         let mut long = m.clone();
-        long[12] = 200; // frame_id length 200
+        long[12..16].copy_from_slice(&1000u32.to_le_bytes()); // frame_id of 1000 bytes
         assert!(matches!(
             decode_cdr(&long).unwrap_err(),
             MessageError::Short {
