@@ -71,6 +71,10 @@ pub enum Command {
     /// units, the IEEE 952 read-off, and navigation-filter files (Kalibr, OpenVINS, ...).
     #[command(allow_negative_numbers = true, after_long_help = CALIBRATE_EXAMPLES)]
     Calibrate(CalibrateArgs),
+    /// List the topics of a ROS recording (ROS1 bag, MCAP, rosbag2 sqlite3) and mark the
+    /// sensor_msgs/Imu topics.
+    #[command(after_long_help = TOPICS_EXAMPLES)]
+    Topics(TopicsArgs),
 }
 
 const CALIBRATE_EXAMPLES: &str = "\
@@ -589,6 +593,29 @@ pub fn seed(s: &str) -> Result<u64, String> {
     s.trim()
         .parse::<u64>()
         .map_err(|_| "must be a whole number from 0 to 18446744073709551615".into())
+}
+
+const TOPICS_EXAMPLES: &str = "\
+FILE is a ROS1 bag (format 2.0), an MCAP file, a rosbag2 sqlite3 .db3 file or a rosbag2 folder
+(metadata.yaml + .mcap/.db3 files); the format is recognised by its first bytes. IMU topics
+(sensor_msgs/Imu) are marked; \"(default)\" marks the one read when no topic is named: the only
+IMU topic holding messages.
+
+Examples:
+  gmwm topics run.bag
+  gmwm topics rosbag2_2024_05_01-10_00_00/
+  gmwm topics run.mcap --json";
+
+/// `gmwm topics`.
+#[derive(Debug, Args)]
+pub struct TopicsArgs {
+    /// ROS recording: .bag, .mcap or .db3 file, or rosbag2 folder.
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// JSON on stdout: {"file", "container", "topics": [{topic, message_type, messages,
+    /// is_imu}]}.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[cfg(test)]

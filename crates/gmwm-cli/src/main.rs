@@ -26,6 +26,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Command::Fit(a) => cmd::fit::run(a, &mut out)?,
         Command::Select(a) => cmd::select::run(a, &mut out)?,
         Command::Calibrate(a) => cmd::calibrate::run(a, &mut out)?,
+        Command::Topics(a) => cmd::topics::run(a, &mut out)?,
     }
     out.flush()?;
     Ok(())

@@ -18,6 +18,7 @@ mod model;
 mod process;
 mod read;
 mod robust;
+mod ros;
 mod selection;
 mod sim;
 mod units;

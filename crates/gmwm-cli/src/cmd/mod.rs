@@ -7,4 +7,5 @@ pub mod fit;
 pub mod implied;
 pub mod select;
 pub mod simulate;
+pub mod topics;
 pub mod wv;

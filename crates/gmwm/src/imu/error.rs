@@ -5,6 +5,7 @@
 //! final period, the path exactly as the caller gave it.
 
 use crate::error::ParamError;
+use crate::imu::ros::RosError;
 use std::path::PathBuf;
 use thiserror::Error;
 
@@ -187,4 +188,7 @@ pub enum ReadError {
     /// An option has an impossible value (e.g. `ncols = 0`, `freq_hz = -1`).
     #[error(transparent)]
     InvalidOption(#[from] ParamError),
+    /// A ROS recording (bag, MCAP, rosbag2 sqlite3) cannot be read (see [`RosError`]).
+    #[error(transparent)]
+    Ros(#[from] RosError),
 }

@@ -25,6 +25,7 @@
 mod error;
 pub mod read;
 pub mod recording;
+pub mod ros;
 mod sensor;
 pub mod sidecar;
 pub mod write;

@@ -1,0 +1,108 @@
+//! `gmwm topics`: the topics of a ROS recording, with the IMU topics marked.
+
+use crate::args::TopicsArgs;
+use anyhow::Result;
+use gmwm::imu::ros::{choose_topic, list_topics, RosContainer, TopicInfo};
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path;
+
+/// One topic in the JSON output.
+#[derive(Serialize)]
+struct TopicRow<'a> {
+    topic: &'a str,
+    message_type: &'a str,
+    messages: u64,
+    is_imu: bool,
+}
+
+/// The JSON document: `{"file", "container", "topics": [...]}`.
+#[derive(Serialize)]
+struct TopicsDoc<'a> {
+    file: &'a Path,
+    container: RosContainer,
+    topics: Vec<TopicRow<'a>>,
+}
+
+/// Runs the subcommand.
+pub fn run(args: &TopicsArgs, out: &mut impl Write) -> Result<()> {
+    let (container, topics) = list_topics(&args.file)?;
+    if args.json {
+        let doc = TopicsDoc {
+            file: &args.file,
+            container,
+            topics: topics
+                .iter()
+                .map(|t| TopicRow {
+                    topic: &t.topic,
+                    message_type: &t.message_type,
+                    messages: t.messages,
+                    is_imu: t.is_imu(),
+                })
+                .collect(),
+        };
+        serde_json::to_writer_pretty(&mut *out, &doc)?;
+        writeln!(out)?;
+    } else {
+        table(out, &args.file, container, &topics)?;
+    }
+    Ok(())
+}
+
+/// Aligned table: topic, type, messages, and `IMU` / `IMU (default)` marks.
+fn table(
+    out: &mut impl Write,
+    file: &Path,
+    container: RosContainer,
+    topics: &[TopicInfo],
+) -> Result<()> {
+    let picked = choose_topic(file, topics, None);
+    let default = picked.as_ref().ok().map(|t| t.topic.as_str());
+    let count = topics.len();
+    writeln!(
+        out,
+        "{} ({container}): {count} topic{}",
+        file.display(),
+        if count == 1 { "" } else { "s" }
+    )?;
+    if topics.is_empty() {
+        return Ok(());
+    }
+    let wt = topics
+        .iter()
+        .map(|t| t.topic.len())
+        .max()
+        .unwrap_or(0)
+        .max(5);
+    let wy = topics
+        .iter()
+        .map(|t| t.message_type.len())
+        .max()
+        .unwrap_or(0)
+        .max(4);
+    writeln!(
+        out,
+        "  {:<wt$}  {:<wy$}  {:>10}  imu",
+        "topic", "type", "messages"
+    )?;
+    for t in topics {
+        let mark = match (t.is_imu(), Some(t.topic.as_str()) == default) {
+            (true, true) => "IMU (default)",
+            (true, false) => "IMU",
+            _ => "",
+        };
+        let line = format!(
+            "  {:<wt$}  {:<wy$}  {:>10}  {mark}",
+            t.topic, t.message_type, t.messages
+        );
+        writeln!(out, "{}", line.trim_end())?;
+    }
+    // why no topic would be read by default (no IMU topic, several, or none with messages)
+    if let Err(e) = picked {
+        let text = e.to_string();
+        let prefix = format!("{}: ", file.display());
+        let reason = text.strip_prefix(&prefix).unwrap_or(&text);
+        writeln!(out, "note: {reason}")?;
+    }
+    Ok(())
+}

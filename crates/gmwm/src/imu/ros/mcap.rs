@@ -1,0 +1,409 @@
+//! MCAP (<https://mcap.dev/spec>), memory-mapped, through the `mcap` crate's summary reader and
+//! record parser; chunks are decompressed here (pure-Rust zstd and lz4).
+//!
+//! Topics are listed from the summary (channels, schemas, statistics) when the file has one,
+//! else from a scan of the data section. Messages are read chunk by chunk: with chunk indexes,
+//! only the chunks holding the topic's channels are opened; without them the data section is
+//! scanned. Messages come out in file order; the caller sorts by log time when needed.
+
+use super::decompress::{Codec, Decompressor};
+use super::error::RosError;
+use super::{Collector, Encoding, RosContainer};
+use mcap::records::{op, Record};
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+/// One channel (topic + schema + encoding) of an MCAP file.
+#[derive(Debug, Clone)]
+pub(crate) struct Channel {
+    pub id: u16,
+    pub topic: String,
+    /// Schema name, e.g. `sensor_msgs/msg/Imu` (empty for a schemaless channel).
+    pub message_type: String,
+    /// Message encoding, e.g. `cdr` or `ros1`.
+    pub encoding: String,
+    pub messages: u64,
+}
+
+/// The channels of a file, and its summary when it has one.
+pub(crate) struct Catalog {
+    pub channels: Vec<Channel>,
+    summary: Option<mcap::Summary>,
+}
+
+fn corrupt(path: &Path, reason: String) -> RosError {
+    RosError::Corrupt {
+        path: path.to_path_buf(),
+        container: RosContainer::Mcap,
+        reason,
+    }
+}
+
+/// An `mcap` crate error as a lowercase phrase.
+fn describe(e: &mcap::McapError) -> String {
+    let text = e.to_string();
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().chain(chars).collect(),
+        None => text,
+    }
+}
+
+/// Checks both magics (a file without the end magic was cut short or never closed).
+fn check_magic(path: &Path, map: &[u8]) -> Result<(), RosError> {
+    if !map.starts_with(mcap::MAGIC) {
+        return Err(RosError::NotRecording {
+            path: path.to_path_buf(),
+            expected: "expected the MCAP magic (0x89 MCAP0 \\r\\n) at the start of an .mcap file"
+                .into(),
+        });
+    }
+    if map.len() < 2 * mcap::MAGIC.len() || !map.ends_with(mcap::MAGIC) {
+        return Err(corrupt(
+            path,
+            format!(
+                "the file ({} bytes) does not end with the MCAP magic: it is cut short or the \
+                 recorder never closed it",
+                map.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Iterates the records of `buf` (opcode u8, length u64, body): calls `visit(opcode, body,
+/// offset)` for each, stopping after a DataEnd record. `base` is the file offset of `buf[0]`
+/// (None inside a decompressed chunk) for messages.
+fn records<'a>(
+    path: &Path,
+    buf: &'a [u8],
+    chunk_at: Option<u64>,
+    visit: &mut dyn FnMut(u8, &'a [u8], usize) -> Result<(), RosError>,
+) -> Result<(), RosError> {
+    let at = |pos: usize| match chunk_at {
+        None => format!("record at byte {pos}"),
+        Some(c) => format!("chunk at byte {c}: record at byte {pos} of the chunk"),
+    };
+    let mut pos = 0;
+    while pos < buf.len() {
+        let Some(head) = buf.get(pos..pos + 9) else {
+            return Err(corrupt(
+                path,
+                format!("{}: 9-byte record header is cut off", at(pos)),
+            ));
+        };
+        let opcode = head[0];
+        let mut len = [0u8; 8];
+        len.copy_from_slice(&head[1..9]);
+        let len = u64::from_le_bytes(len);
+        let body = usize::try_from(len)
+            .ok()
+            .and_then(|l| buf.get(pos + 9..(pos + 9).checked_add(l)?))
+            .ok_or_else(|| {
+                corrupt(
+                    path,
+                    format!(
+                        "{}: record (opcode 0x{opcode:02x}) of {len} bytes runs past the end \
+                         ({} bytes remain)",
+                        at(pos),
+                        buf.len() - pos - 9
+                    ),
+                )
+            })?;
+        visit(opcode, body, pos)?;
+        if opcode == op::DATA_END {
+            break;
+        }
+        pos += 9 + body.len();
+    }
+    Ok(())
+}
+
+/// Called for each record of a chunk: (opcode, body, chunk offset in the file, record offset
+/// in the decompressed chunk).
+type ChunkVisitor<'v> = dyn FnMut(u8, &[u8], u64, usize) -> Result<(), RosError> + 'v;
+
+/// Decompresses a chunk record's body if needed and walks its records.
+fn chunk(
+    path: &Path,
+    body: &[u8],
+    offset: u64,
+    dec: &mut Decompressor,
+    buf: &mut Vec<u8>,
+    visit: &mut ChunkVisitor<'_>,
+) -> Result<(), RosError> {
+    let (header, data) = match mcap::parse_record(op::CHUNK, body) {
+        Ok(Record::Chunk { header, data }) => (header, data),
+        Ok(_) => {
+            return Err(corrupt(
+                path,
+                format!("chunk at byte {offset}: not a chunk"),
+            ))
+        }
+        Err(e) => {
+            return Err(corrupt(
+                path,
+                format!("chunk at byte {offset}: {}", describe(&e)),
+            ))
+        }
+    };
+    let codec = match header.compression.as_str() {
+        "" => None,
+        "zstd" => Some(Codec::Zstd),
+        "lz4" => Some(Codec::Lz4),
+        other => {
+            return Err(RosError::UnsupportedCompression {
+                path: path.to_path_buf(),
+                what: format!("MCAP chunk compression \"{other}\""),
+                hint: "supported: none, zstd, lz4",
+            })
+        }
+    };
+    let size = usize::try_from(header.uncompressed_size).map_err(|_| {
+        corrupt(
+            path,
+            format!(
+                "chunk at byte {offset}: uncompressed size {} is too large",
+                header.uncompressed_size
+            ),
+        )
+    })?;
+    let inner: &[u8] = match codec {
+        None => {
+            if data.len() != size {
+                return Err(corrupt(
+                    path,
+                    format!(
+                        "chunk at byte {offset}: uncompressed chunk holds {} bytes, its header \
+                         says {size}",
+                        data.len()
+                    ),
+                ));
+            }
+            &data
+        }
+        Some(codec) => {
+            dec.decompress(codec, &data, size, buf)
+                .map_err(|e| corrupt(path, format!("chunk at byte {offset}: {e}")))?;
+            buf
+        }
+    };
+    records(path, inner, Some(offset), &mut |opcode, body, pos| {
+        visit(opcode, body, offset, pos)
+    })
+}
+
+/// Collects schemas and channels met in a scan, and counts messages per channel.
+#[derive(Default)]
+struct Scan {
+    schemas: HashMap<u16, String>,
+    channels: BTreeMap<u16, (String, u16, String)>,
+    counts: HashMap<u16, u64>,
+}
+
+impl Scan {
+    fn record(&mut self, path: &Path, opcode: u8, body: &[u8], at: &str) -> Result<(), RosError> {
+        let parse = || {
+            mcap::parse_record(opcode, body)
+                .map_err(|e| corrupt(path, format!("{at}: {}", describe(&e))))
+        };
+        match opcode {
+            op::SCHEMA => {
+                if let Record::Schema { header, .. } = parse()? {
+                    self.schemas.entry(header.id).or_insert(header.name);
+                }
+            }
+            op::CHANNEL => {
+                if let Record::Channel(c) = parse()? {
+                    self.channels
+                        .entry(c.id)
+                        .or_insert((c.topic, c.schema_id, c.message_encoding));
+                }
+            }
+            op::MESSAGE => {
+                let id = body
+                    .get(..2)
+                    .map(|b| u16::from_le_bytes([b[0], b[1]]))
+                    .ok_or_else(|| corrupt(path, format!("{at}: message record is cut off")))?;
+                *self.counts.entry(id).or_insert(0) += 1;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// Lists the channels with their message counts.
+pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
+    check_magic(path, map)?;
+    let summary = mcap::Summary::read(map)
+        .map_err(|e| corrupt(path, format!("summary section: {}", describe(&e))))?;
+    if let Some(s) = summary.as_ref() {
+        if let Some(stats) = s.stats.as_ref() {
+            let mut channels: Vec<Channel> = s
+                .channels
+                .values()
+                .map(|c| Channel {
+                    id: c.id,
+                    topic: c.topic.clone(),
+                    message_type: c
+                        .schema
+                        .as_ref()
+                        .map(|s| s.name.clone())
+                        .unwrap_or_default(),
+                    encoding: c.message_encoding.clone(),
+                    messages: stats
+                        .channel_message_counts
+                        .get(&c.id)
+                        .copied()
+                        .unwrap_or(0),
+                })
+                .collect();
+            channels.sort_by_key(|c| c.id);
+            return Ok(Catalog { channels, summary });
+        }
+    }
+    // no statistics: scan the data section, opening every chunk
+    let mut scan = Scan::default();
+    let mut dec = Decompressor::new();
+    let mut buf = Vec::new();
+    let data = &map[mcap::MAGIC.len()..map.len() - mcap::MAGIC.len()];
+    let base = mcap::MAGIC.len();
+    records(path, data, None, &mut |opcode, body, pos| {
+        let offset = (base + pos) as u64;
+        if opcode == op::CHUNK {
+            chunk(path, body, offset, &mut dec, &mut buf, &mut |o, b, c, p| {
+                scan.record(
+                    path,
+                    o,
+                    b,
+                    &format!("chunk at byte {c}: record at byte {p} of the chunk"),
+                )
+            })
+        } else {
+            scan.record(path, opcode, body, &format!("record at byte {offset}"))
+        }
+    })?;
+    let channels = scan
+        .channels
+        .into_iter()
+        .map(|(id, (topic, schema, encoding))| Channel {
+            id,
+            topic,
+            message_type: scan.schemas.get(&schema).cloned().unwrap_or_default(),
+            encoding,
+            messages: scan.counts.get(&id).copied().unwrap_or(0),
+        })
+        .collect();
+    Ok(Catalog { channels, summary })
+}
+
+/// Reads the messages of the channels in `wanted` (id -> encoding) into `out`, in file order.
+pub(crate) fn read(
+    path: &Path,
+    map: &[u8],
+    catalog: &Catalog,
+    wanted: &HashMap<u16, Encoding>,
+    out: &mut Collector<'_>,
+) -> Result<(), RosError> {
+    check_magic(path, map)?;
+    let mut dec = Decompressor::new();
+    let mut buf = Vec::new();
+    let mut message = |body: &[u8], at: &dyn Fn() -> String| -> Result<(), RosError> {
+        let Some(id) = body.get(..2).map(|b| u16::from_le_bytes([b[0], b[1]])) else {
+            return Err(corrupt(
+                path,
+                format!("{}: message record is cut off", at()),
+            ));
+        };
+        let Some(&encoding) = wanted.get(&id) else {
+            return Ok(());
+        };
+        let (header, data) = match mcap::parse_record(op::MESSAGE, body) {
+            Ok(Record::Message { header, data }) => (header, data),
+            Ok(_) => return Err(corrupt(path, format!("{}: not a message", at()))),
+            Err(e) => return Err(corrupt(path, format!("{}: {}", at(), describe(&e)))),
+        };
+        let log_time = i64::try_from(header.log_time).map_err(|_| {
+            corrupt(
+                path,
+                format!(
+                    "{}: log time {} ns is past the year 2262",
+                    at(),
+                    header.log_time
+                ),
+            )
+        })?;
+        out.push(encoding, log_time, &data)
+    };
+    let indexes = catalog
+        .summary
+        .as_ref()
+        .map(|s| s.chunk_indexes.as_slice())
+        .unwrap_or_default();
+    if !indexes.is_empty() {
+        let mut chunks: Vec<&mcap::records::ChunkIndex> = indexes
+            .iter()
+            .filter(|c| {
+                c.message_index_offsets.is_empty()
+                    || c.message_index_offsets
+                        .keys()
+                        .any(|k| wanted.contains_key(k))
+            })
+            .collect();
+        chunks.sort_by_key(|c| c.chunk_start_offset);
+        for c in chunks {
+            let offset = c.chunk_start_offset;
+            let record = usize::try_from(offset)
+                .ok()
+                .zip(usize::try_from(c.chunk_length).ok())
+                .and_then(|(s, l)| map.get(s..s.checked_add(l)?))
+                .filter(|r| r.len() >= 9 && r[0] == op::CHUNK)
+                .ok_or_else(|| {
+                    corrupt(
+                        path,
+                        format!(
+                            "the chunk index points to a chunk at byte {offset} ({} bytes) that \
+                             is not there",
+                            c.chunk_length
+                        ),
+                    )
+                })?;
+            chunk(
+                path,
+                &record[9..],
+                offset,
+                &mut dec,
+                &mut buf,
+                &mut |opcode, body, c, p| {
+                    if opcode == op::MESSAGE {
+                        message(body, &|| {
+                            format!("chunk at byte {c}: record at byte {p} of the chunk")
+                        })
+                    } else {
+                        Ok(())
+                    }
+                },
+            )?;
+        }
+        return Ok(());
+    }
+    let data = &map[mcap::MAGIC.len()..map.len() - mcap::MAGIC.len()];
+    let base = mcap::MAGIC.len();
+    records(path, data, None, &mut |opcode, body, pos| {
+        let offset = (base + pos) as u64;
+        match opcode {
+            op::CHUNK => chunk(path, body, offset, &mut dec, &mut buf, &mut |o, b, c, p| {
+                if o == op::MESSAGE {
+                    message(b, &|| {
+                        format!("chunk at byte {c}: record at byte {p} of the chunk")
+                    })
+                } else {
+                    Ok(())
+                }
+            }),
+            op::MESSAGE => message(body, &|| format!("record at byte {offset}")),
+            _ => Ok(()),
+        }
+    })
+}

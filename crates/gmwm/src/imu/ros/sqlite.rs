@@ -1,0 +1,164 @@
+//! rosbag2 sqlite3 storage (`.db3`, the default up to ROS 2 Humble), read-only through
+//! `rusqlite` (SQLite compiled in).
+//!
+//! Tables used: `topics(id, name, type, serialization_format, ...)` and
+//! `messages(id, topic_id, timestamp, data)`; messages are read `ORDER BY timestamp, id`, which
+//! the `timestamp_idx` index of rosbag2 serves without sorting, one row at a time.
+
+use super::error::RosError;
+use super::{Collector, Encoding, RosContainer};
+use crate::imu::ReadError;
+use rusqlite::{Connection, OpenFlags};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// One row of `topics`, with its message count.
+#[derive(Debug, Clone)]
+pub(crate) struct Topic {
+    pub id: i64,
+    pub name: String,
+    pub message_type: String,
+    /// `serialization_format`, `cdr` for ROS 2.
+    pub encoding: String,
+    pub messages: u64,
+}
+
+fn sql_error(path: &Path, e: rusqlite::Error) -> RosError {
+    RosError::Sqlite {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    }
+}
+
+fn corrupt(path: &Path, reason: String) -> RosError {
+    RosError::Corrupt {
+        path: path.to_path_buf(),
+        container: RosContainer::Sqlite3,
+        reason,
+    }
+}
+
+/// Checks the file size against the database header (<https://sqlite.org/fileformat.html>,
+/// §1.3): SQLite itself reads a missing tail as zeros and may not notice a cut-short file.
+fn check_size(path: &Path, head: &[u8], len: u64) -> Result<(), RosError> {
+    if head.len() < 100 {
+        return Err(corrupt(
+            path,
+            format!(
+                "the 100-byte database header is cut off ({} bytes)",
+                head.len()
+            ),
+        ));
+    }
+    let be32 = |at: usize| u32::from_be_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]]);
+    let page_size = match u16::from_be_bytes([head[16], head[17]]) {
+        1 => 65_536,
+        p => u64::from(p),
+    };
+    if !(512..=65_536).contains(&page_size) || !page_size.is_power_of_two() {
+        return Err(corrupt(
+            path,
+            format!("the header gives a page size of {page_size} bytes"),
+        ));
+    }
+    let pages = u64::from(be32(28));
+    // the in-header size is valid when the change counter matches "version-valid-for"
+    if be32(24) == be32(92) && pages > 0 && len < pages * page_size {
+        return Err(corrupt(
+            path,
+            format!(
+                "the header declares {pages} pages of {page_size} bytes ({} bytes) but the \
+                 file has {len}: it is cut short",
+                pages * page_size
+            ),
+        ));
+    }
+    if len % page_size != 0 {
+        return Err(corrupt(
+            path,
+            format!(
+                "{len} bytes is not a whole number of {page_size}-byte pages: the file is cut \
+                 short"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Opens the database read-only, after checking its size against its header.
+pub(crate) fn open(path: &Path) -> Result<Connection, ReadError> {
+    let io = |source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    let mut head = Vec::with_capacity(100);
+    std::io::Read::read_to_end(&mut std::io::Read::take(&mut file, 100), &mut head).map_err(io)?;
+    check_size(path, &head, len)?;
+    Connection::open_with_flags(
+        path,
+        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+    )
+    .map_err(|e| sql_error(path, e).into())
+}
+
+/// Lists the topics with their message counts (one pass over `messages`).
+pub(crate) fn catalog(path: &Path, db: &Connection) -> Result<Vec<Topic>, RosError> {
+    let err = |e| sql_error(path, e);
+    let mut counts: HashMap<i64, u64> = HashMap::new();
+    let mut stmt = db
+        .prepare("SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id")
+        .map_err(err)?;
+    let mut rows = stmt.query([]).map_err(err)?;
+    while let Some(row) = rows.next().map_err(err)? {
+        let id: i64 = row.get(0).map_err(err)?;
+        let n: i64 = row.get(1).map_err(err)?;
+        counts.insert(id, u64::try_from(n).unwrap_or(0));
+    }
+    let mut stmt = db
+        .prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")
+        .map_err(err)?;
+    let mut rows = stmt.query([]).map_err(err)?;
+    let mut topics = Vec::new();
+    while let Some(row) = rows.next().map_err(err)? {
+        let id: i64 = row.get(0).map_err(err)?;
+        topics.push(Topic {
+            id,
+            name: row.get(1).map_err(err)?,
+            message_type: row.get(2).map_err(err)?,
+            encoding: row.get(3).map_err(err)?,
+            messages: counts.get(&id).copied().unwrap_or(0),
+        });
+    }
+    Ok(topics)
+}
+
+/// Reads the messages of the topic ids in `wanted` (id -> encoding) into `out`, ordered by
+/// timestamp (ties by row id).
+pub(crate) fn read(
+    path: &Path,
+    db: &Connection,
+    wanted: &HashMap<i64, Encoding>,
+    out: &mut Collector<'_>,
+) -> Result<(), RosError> {
+    let err = |e| sql_error(path, e);
+    // ids come from the database itself (integers): safe to inline
+    let ids: Vec<String> = wanted.keys().map(i64::to_string).collect();
+    let sql = format!(
+        "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN ({}) \
+         ORDER BY timestamp, id",
+        ids.join(", ")
+    );
+    let mut stmt = db.prepare(&sql).map_err(err)?;
+    let mut rows = stmt.query([]).map_err(err)?;
+    while let Some(row) = rows.next().map_err(err)? {
+        let id: i64 = row.get(0).map_err(err)?;
+        let t: i64 = row.get(1).map_err(err)?;
+        let data = row.get_ref(2).map_err(err)?;
+        let bytes = data.as_blob().map_err(|e| err(e.into()))?;
+        let encoding = wanted.get(&id).copied().unwrap_or(Encoding::Cdr);
+        out.push(encoding, t, bytes)?;
+    }
+    Ok(())
+}
