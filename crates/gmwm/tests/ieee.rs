@@ -72,7 +72,8 @@ fn value(r: &gmwm::calib::ieee::Readoff) -> f64 {
 #[test]
 fn ieee_pure_power_laws_come_back_exactly() {
     // one term at a time: the value, and the interval through the constant band
-    let cases: [(&str, Box<dyn Fn(f64) -> f64>, f64); 4] = [
+    type Law = Box<dyn Fn(f64) -> f64>;
+    let cases: [(&str, Law, f64); 4] = [
         ("N", Box::new(wn(1e-4)), 1e-4),
         ("K", Box::new(rw(1e-5)), 1e-5),
         ("Q", Box::new(qn(1e-6)), 1e-6),
