@@ -366,3 +366,13 @@ fn export_formats_parse_and_name_their_files() {
         "{e}"
     );
 }
+
+/// STYLE §6.9: public results are `Send + Sync + Clone`.
+#[test]
+fn export_calib_and_units_results_are_send_sync_clone() {
+    fn check<T: Send + Sync + Clone>() {}
+    check::<NavNoise>();
+    check::<ExportError>();
+    check::<gmwm::calib::ieee::IeeeReadoff>();
+    check::<gmwm::units::UnitForms>();
+}
