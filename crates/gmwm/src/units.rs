@@ -286,6 +286,12 @@ pub struct Quantity {
     pub unit: String,
 }
 
+impl fmt::Display for Quantity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:.6e} {}", self.value, self.unit)
+    }
+}
+
 /// One noise term in every form a user may need.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct UnitForms {

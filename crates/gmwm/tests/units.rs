@@ -65,6 +65,7 @@ fn units_white_noise_hand_values() {
         "{s:?}"
     );
     assert!(f.conversion.contains("× 180/π × 60"), "{}", f.conversion);
+    assert_eq!(f.si.to_string(), "1.000000e-4 rad/s/√Hz");
     // 0.1 °/√h = 2.908882e-5 rad/s/√Hz
     let n = from_datasheet(NoiseTerm::NoiseDensity, GYRO, 0.1).unwrap();
     assert!(rel_diff(n, 2.908882e-5) < TOL_7, "{n}");

@@ -276,10 +276,10 @@ fn hash_comments(out: &mut String, noise: &NavNoise, own: &[String]) {
 /// One `key: value  # [unit] what` line, with an indent.
 fn yaml_line(out: &mut String, indent: &str, key: &str, value: &str, unit: &str, what: &str) {
     let head = format!("{indent}{key}: {value}");
-    let _ = if unit.is_empty() && what.is_empty() {
-        writeln!(out, "{head}")
-    } else {
-        writeln!(out, "{head:<48} # [{unit}] {what}")
+    let _ = match (unit.is_empty(), what.is_empty()) {
+        (true, true) => writeln!(out, "{head}"),
+        (true, false) => writeln!(out, "{head:<48} # {what}"),
+        _ => writeln!(out, "{head:<48} # [{unit}] {what}"),
     };
 }
 

@@ -283,8 +283,14 @@ fn line(s: &Scales, j: usize, idx: &[usize], values: &[f64]) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
+/// A cluster time in notes and tables: 4 significant digits, trailing zeros dropped.
 fn seconds(t: f64) -> String {
-    crate::fit::report::significant(t, 3)
+    let s = crate::fit::report::significant(t, 4);
+    if s.contains('.') && !s.contains('e') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
 }
 
 /// METHODS §14.3: the read-off of a line term (N, K, Q or R).
