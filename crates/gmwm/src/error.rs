@@ -28,6 +28,12 @@ pub enum Error {
     /// A WIC model selection could not be set up or run (METHODS §8).
     #[error(transparent)]
     Selection(#[from] crate::selection::SelectionError),
+    /// Calibrating a recording failed.
+    #[error(transparent)]
+    Calibration(#[from] crate::calib::CalibError),
+    /// A navigation-stack file could not be rendered.
+    #[error(transparent)]
+    Export(#[from] crate::calib::export::ExportError),
 }
 
 /// A series that cannot be analysed.

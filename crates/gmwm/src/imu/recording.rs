@@ -1,8 +1,11 @@
 //! A recording opened for calibration: whatever the container (text, raw binary, binary IMU
-//! records), an [`Imu`] with its rate, where it came from and what the reader noticed.
+//! records, a ROS bag), an [`Imu`] with its rate, where it came from and what the reader
+//! noticed.
 
-use super::read::{read_imu_record_file, read_table, ImuRecordType, ReadOptions};
-use super::Imu;
+use super::read::{read_imu_record_file, read_table, Column, ImuRecordType, ReadOptions};
+use super::ros::{container_of, read_imu_messages, ImuMessages};
+use super::timing::{check_times, TimeUnit, TimingReport, UnitSource};
+use super::{Imu, ReadError, Sensor, SensorInfo};
 use crate::Error;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -14,7 +17,13 @@ pub struct RecordingOptions {
     pub read: ReadOptions,
     /// Binary IMU records of this type (METHODS §9.2) instead of a table.
     pub record_type: Option<ImuRecordType>,
+    /// The `sensor_msgs/Imu` topic of a ROS recording (default: its only IMU topic).
+    pub topic: Option<String>,
 }
+
+/// Relative difference between a given rate and the stamps' above which the reader says so
+/// (1%: a rate rounded to a nominal figure agrees, a wrong one does not).
+const RATE_TOLERANCE: f64 = 0.01;
 
 /// What a recording was read from.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -27,6 +36,13 @@ pub enum RecordingSource {
     Records {
         /// The record type.
         record_type: String,
+    },
+    /// A ROS recording's `sensor_msgs/Imu` topic.
+    Ros {
+        /// Container (`ROS1 bag`, `MCAP`, `rosbag2 sqlite3`).
+        container: String,
+        /// The topic.
+        topic: String,
     },
 }
 
@@ -41,6 +57,8 @@ pub struct Recording {
     pub source: RecordingSource,
     /// The ROS topic it came from, if any.
     pub topic: Option<String>,
+    /// What the time stamps say (rate, gaps, duplicates, reordering), when there are stamps.
+    pub timing: Option<TimingReport>,
     /// What the reader noticed (time column, rate, gaps, units), one line each.
     pub notes: Vec<String>,
 }
@@ -53,6 +71,9 @@ impl Recording {
     /// Any read error of the container, or [`crate::imu::ReadError::FreqNotDerivable`] when no
     /// rate can be found.
     pub fn open(path: &Path, opts: &RecordingOptions) -> Result<Self, Error> {
+        if opts.record_type.is_none() && container_of(path).is_some() {
+            return Self::open_ros(path, opts);
+        }
         let mut notes = Vec::new();
         let (imu, source) = match opts.record_type {
             Some(t) => {
@@ -81,7 +102,121 @@ impl Recording {
             imu,
             source,
             topic: None,
+            timing: None,
             notes,
         })
     }
+
+    /// A ROS recording: the IMU topic's angular velocity and linear acceleration (SI by the
+    /// message definition) as six axes, the rate from the header stamps (the log times when
+    /// every header stamp is the same, as with drivers that leave them unset), the stamps
+    /// checked and reported.
+    fn open_ros(path: &Path, opts: &RecordingOptions) -> Result<Self, Error> {
+        let msgs = read_imu_messages(path, opts.topic.as_deref())?;
+        let mut notes = vec![format!(
+            "{} topic {} (sensor_msgs/Imu{}): {} messages; angular velocity in rad/s and linear acceleration in m/s^2 by the message definition",
+            msgs.container,
+            msgs.topic,
+            msgs.frame_id
+                .as_deref()
+                .map(|f| format!(", frame {f}"))
+                .unwrap_or_default(),
+            msgs.len()
+        )];
+        let mut timing = stamps_report("header.stamp", &msgs.header_stamp_ns);
+        if !(timing.rate_hz.is_finite() && timing.rate_hz > 0.0) {
+            notes.push(
+                "the header stamps do not advance: the rate comes from the bag's log times"
+                    .to_string(),
+            );
+            timing = stamps_report("log time", &msgs.log_time_ns);
+        }
+        notes.push(format!(
+            "{}: {} Hz from the regular steps over {:.1} s",
+            timing.column,
+            crate::fit::report::significant(timing.rate_hz, 6),
+            timing.span_s
+        ));
+        notes.extend(timing.warnings().iter().map(ToString::to_string));
+        let freq_hz = match opts.read.freq_hz {
+            Some(f) => {
+                if (f / timing.rate_hz - 1.0).abs() > RATE_TOLERANCE {
+                    notes.push(format!(
+                        "the given rate {f} Hz differs from the stamps' {} Hz; the given rate is used",
+                        crate::fit::report::significant(timing.rate_hz, 6)
+                    ));
+                }
+                f
+            }
+            None => timing.rate_hz,
+        };
+        if !(freq_hz.is_finite() && freq_hz > 0.0) {
+            return Err(ReadError::FreqNotDerivable {
+                path: path.to_path_buf(),
+                reason: "the stamps of the IMU topic do not advance; give the rate",
+            }
+            .into());
+        }
+        let topic = msgs.topic.clone();
+        let container = msgs.container.to_string();
+        let mut imu = imu_of_messages(msgs, freq_hz)?;
+        if !opts.read.columns.is_empty() {
+            imu = imu.select(path, &opts.read.columns)?;
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            imu,
+            source: RecordingSource::Ros {
+                container,
+                topic: topic.clone(),
+            },
+            topic: Some(topic),
+            timing: Some(timing),
+            notes,
+        })
+    }
+}
+
+/// The timing report of nanosecond stamps, in seconds after the first (whole nanoseconds
+/// subtracted exactly, so epoch stamps keep their precision).
+fn stamps_report(column: &str, ns: &[i64]) -> TimingReport {
+    let first = ns.first().copied().unwrap_or(0);
+    let s: Vec<f64> = ns
+        .iter()
+        .map(|&t| t.wrapping_sub(first) as f64 * 1e-9)
+        .collect();
+    let mut r = check_times(column, &s, TimeUnit::Nanoseconds, UnitSource::Stated);
+    r.start_s = first as f64 * 1e-9;
+    r
+}
+
+/// Six axes from the IMU messages (consumed: the vectors move into the columns).
+fn imu_of_messages(msgs: ImuMessages, freq_hz: f64) -> Result<Imu, Error> {
+    let [gx, gy, gz] = msgs.angular_velocity;
+    let [ax, ay, az] = msgs.linear_acceleration;
+    let mut columns = Vec::with_capacity(6);
+    let mut info = Vec::with_capacity(6);
+    for (k, values) in [gx, gy, gz, ax, ay, az].into_iter().enumerate() {
+        let (sensor, prefix, unit) = if k < 3 {
+            (Sensor::Gyroscope, "gyro", "rad/s")
+        } else {
+            (Sensor::Accelerometer, "accel", "m/s^2")
+        };
+        let axis = ["x", "y", "z"][k % 3];
+        columns.push(Column {
+            name: format!("{prefix}_{axis}"),
+            values,
+        });
+        info.push(SensorInfo {
+            sensor,
+            axis: axis.to_ascii_uppercase(),
+            unit: Some(unit.to_string()),
+        });
+    }
+    let name = msgs
+        .path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok(Imu::new(columns, info, freq_hz)?.with_name(name))
 }

@@ -1,0 +1,234 @@
+//! End-to-end tests of `gmwm calibrate`: ROS recordings written by a real writer (the Python
+//! `rosbags` package, `crates/gmwm/tests/fixtures/write_imu_bag.py`) with a simulated 100 Hz
+//! IMU of known noise, through `--kalibr`; the ADIS16405 recording with its units; the files
+//! and flags; one test per bad-input class. Without Python 3 and rosbags the ROS tests fail,
+//! saying `python3 -m pip install rosbags`.
+
+mod common;
+
+use common::{assert_one_line_error, assert_usage_error, gmwm, run_json};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const SCRIPT: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../gmwm/tests/fixtures/write_imu_bag.py"
+);
+
+/// The simulated IMU's truth (continuous-time SI): gyro N and K, accel N and K. The random
+/// walk dominates the Allan variance beyond sqrt(3) N / K (17 s for the gyro, 12 s for the
+/// accelerometer), so a 2^17-sample recording (22 min) shows it over six octaves.
+const GYRO_N: f64 = 1e-3;
+const GYRO_K: f64 = 1e-4;
+const ACCEL_N: f64 = 2e-3;
+const ACCEL_K: f64 = 3e-4;
+const MESSAGES: usize = 1 << 17;
+
+fn data_dir() -> PathBuf {
+    std::env::var_os("GMWM_DATA_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
+}
+
+/// Writes `dir/name` with the fixture script.
+fn write_bag(dir: &Path, name: &str, container: &str, n: usize, extra: &[&str]) -> PathBuf {
+    let path = dir.join(name);
+    let out = Command::new("python3")
+        .arg(SCRIPT)
+        .args(["--container", container, "--out"])
+        .arg(&path)
+        .args(["--n", &n.to_string(), "--rate", "100", "--seed", "7"])
+        .args(["--gyro-wn-density", &GYRO_N.to_string()])
+        .args(["--gyro-rw-density", &GYRO_K.to_string()])
+        .args(["--accel-wn-density", &ACCEL_N.to_string()])
+        .args(["--accel-rw-density", &ACCEL_K.to_string()])
+        .args(extra)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run python3 ({e}): python3 -m pip install rosbags"));
+    assert!(
+        out.status.success(),
+        "the fixture writer failed (python3 -m pip install rosbags): {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
+
+/// `key: value` lines of a YAML file (comments and blank lines skipped).
+fn yaml(path: &Path) -> BTreeMap<String, String> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
+        .filter_map(|l| {
+            let (k, v) = l.split_once(':')?;
+            let v = v.split('#').next().unwrap_or("").trim();
+            Some((k.trim().to_string(), v.to_string()))
+        })
+        .collect()
+}
+
+fn number(map: &BTreeMap<String, String>, key: &str) -> f64 {
+    map.get(key)
+        .unwrap_or_else(|| panic!("{key} missing in {map:?}"))
+        .parse()
+        .unwrap()
+}
+
+/// The bar: each container through `gmwm calibrate --kalibr`, noise densities within
+/// 5% and random walks within 40% of the truth (worst axis of three: the estimates' spread is
+/// ~0.5% for N and ~15% for K at this length), the topic and rate in the file.
+#[test]
+fn calibrate_ros_recordings_to_kalibr() {
+    let dir = tempfile::tempdir().unwrap();
+    for (container, name) in [
+        ("ros1", "imu.bag"),
+        ("mcap", "imu_mcap"),
+        ("sqlite3", "imu_db3"),
+    ] {
+        let bag = write_bag(dir.path(), name, container, MESSAGES, &["--topic", "/imu/data"]);
+        let kalibr = dir.path().join(format!("{container}.yaml"));
+        let out = gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--model", "AR1()+WN()+RW()", "--G", "2000", "--kalibr"])
+            .arg(&kalibr)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{container}: {}", String::from_utf8_lossy(&out.stderr));
+        let summary = String::from_utf8_lossy(&out.stdout);
+        assert!(summary.contains("/imu/data"), "{summary}");
+        let y = yaml(&kalibr);
+        for (key, truth, tol) in [
+            ("gyroscope_noise_density", GYRO_N, 0.05),
+            ("accelerometer_noise_density", ACCEL_N, 0.05),
+            ("gyroscope_random_walk", GYRO_K, 0.4),
+            ("accelerometer_random_walk", ACCEL_K, 0.4),
+        ] {
+            let v = number(&y, key);
+            assert!(
+                (v / truth - 1.0).abs() < tol,
+                "{container}: {key} = {v}, truth {truth}"
+            );
+        }
+        assert_eq!(number(&y, "update_rate"), 100.0);
+        assert_eq!(y["rostopic"], "/imu/data");
+    }
+}
+
+/// Two IMU topics: without --topic one line naming both; with it, that topic; a wrong topic
+/// lists the topics.
+#[test]
+fn calibrate_ros_topic_choice() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = write_bag(
+        dir.path(),
+        "two.bag",
+        "ros1",
+        4096,
+        &["--topic", "/imu0", "--topic", "/imu1"],
+    );
+    assert_one_line_error(
+        gmwm().arg("calibrate").arg(&bag),
+        &["/imu0", "/imu1", "--topic"],
+    );
+    assert_one_line_error(
+        gmwm().arg("calibrate").arg(&bag).args(["--topic", "/camera"]),
+        &["/camera", "/imu0"],
+    );
+    let doc = run_json(
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--topic", "/imu1", "--model", "WN()+RW()", "--G", "500"])
+            .args(["--json", "-"]),
+    );
+    assert_eq!(doc["axes"].as_array().unwrap().len(), 6);
+    assert_eq!(doc["exported"][0]["noise"]["rostopic"], "/imu1");
+}
+
+/// The ADIS16405 recording with its units: all six axes, SI units in the JSON, a Kalibr file
+/// and every other stack's file.
+#[test]
+fn calibrate_adis_with_units_and_exports() {
+    let file = data_dir().join("adis_16405_imu1.csv.gz");
+    assert!(file.is_file(), "missing {}", file.display());
+    let dir = tempfile::tempdir().unwrap();
+    let kalibr = dir.path().join("imu.yaml");
+    let px4 = dir.path().join("imu.sdf");
+    let vins = dir.path().join("vins.yaml");
+    let json = dir.path().join("calib.json");
+    let out = gmwm()
+        .arg("calibrate")
+        .arg(&file)
+        .args(["--gyro-unit", "deg/s", "--accel-unit", "g", "--kalibr"])
+        .arg(&kalibr)
+        .args(["--export", "px4"])
+        .arg(&px4)
+        .args(["--export", "vins"])
+        .arg(&vins)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary = String::from_utf8_lossy(&out.stdout);
+    for col in ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"] {
+        assert!(summary.contains(&format!("{col}:")), "{col} missing: {summary}");
+    }
+    assert!(summary.contains("°/√h"), "datasheet units beside SI: {summary}");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let axes = doc["axes"].as_array().unwrap();
+    assert_eq!(axes.len(), 6);
+    for a in axes {
+        for key in ["column", "kind", "model", "canonical_model"] {
+            assert!(!a[key].is_null(), "{key} in {a:?}");
+        }
+        let unit = a["noise_density"]["unit"].as_str().unwrap();
+        match a["kind"].as_str().unwrap() {
+            "gyro" => assert_eq!(unit, "rad/s/√Hz"),
+            "accel" => assert_eq!(unit, "m/s²/√Hz"),
+            k => panic!("kind {k}"),
+        }
+        for key in ["noise_density", "random_walk", "bias_instability"] {
+            let e = &a[key];
+            for f in ["value", "ci_low", "ci_high", "unit"] {
+                assert!(e.get(f).is_some(), "{key}.{f} in {}", a["column"]);
+            }
+        }
+        for k in ["N", "B", "K", "Q", "R"] {
+            assert!(a["ieee"].get(k).is_some(), "ieee.{k}");
+        }
+    }
+    let y = yaml(&kalibr);
+    // gyro N of the ADIS16405 is about 2.5 °/√h = 7.3e-4 rad/s/√Hz at tau >= 1 s
+    let n = number(&y, "gyroscope_noise_density");
+    assert!((5e-4..1e-3).contains(&n), "{n}");
+    assert!(std::fs::read_to_string(&px4).unwrap().contains("gyroscopeNoiseDensity"));
+    assert!(std::fs::read_to_string(&vins).unwrap().contains("gyr_n"));
+}
+
+/// Bad flags: an accelerometer unit for the gyroscope, a bad --export stack, --inflate below 1.
+#[test]
+fn calibrate_refuses_bad_flags() {
+    let file = data_dir().join("adis_16405_imu1.csv.gz");
+    assert_usage_error(
+        gmwm().arg("calibrate").arg(&file).args(["--gyro-unit", "furlong"]),
+        &["--gyro-unit", "rad/s"],
+    );
+    assert_usage_error(
+        gmwm().arg("calibrate").arg(&file).args(["--inflate", "0.5"]),
+        &["--inflate", ">= 1"],
+    );
+    assert_usage_error(
+        gmwm().arg("calibrate").arg(&file).args(["--export", "rovio", "x.yaml"]),
+        &["--export rovio", "openvins"],
+    );
+    assert_one_line_error(
+        gmwm()
+            .arg("calibrate")
+            .arg(&file)
+            .args(["--gyro-unit", "g", "--columns", "gyro_x", "--G", "200"]),
+        &["gyro_x", "not a gyroscope"],
+    );
+}
