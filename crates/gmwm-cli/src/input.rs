@@ -38,6 +38,7 @@ fn read_options(args: &InputArgs) -> ReadOptions {
         columns: args.columns.iter().map(|c| selector(c)).collect(),
         ncols: args.ncols,
         freq_hz: args.freq,
+        time_unit: None,
     }
 }
 
@@ -127,7 +128,7 @@ pub struct LoadedRecording {
 pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
     let opts = gmwm::imu::RecordingOptions {
         read: read_options(args),
-        record_type: None,
+        topic: None,
     };
     let rec = gmwm::imu::Recording::open(&args.file, &opts)?;
     Ok(LoadedRecording {

@@ -86,7 +86,13 @@ fn calibrate_ros_recordings_to_kalibr() {
         ("mcap", "imu_mcap"),
         ("sqlite3", "imu_db3"),
     ] {
-        let bag = write_bag(dir.path(), name, container, MESSAGES, &["--topic", "/imu/data"]);
+        let bag = write_bag(
+            dir.path(),
+            name,
+            container,
+            MESSAGES,
+            &["--topic", "/imu/data"],
+        );
         let kalibr = dir.path().join(format!("{container}.yaml"));
         let out = gmwm()
             .arg("calibrate")
@@ -95,7 +101,11 @@ fn calibrate_ros_recordings_to_kalibr() {
             .arg(&kalibr)
             .output()
             .unwrap();
-        assert!(out.status.success(), "{container}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{container}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let summary = String::from_utf8_lossy(&out.stdout);
         assert!(summary.contains("/imu/data"), "{summary}");
         let y = yaml(&kalibr);
@@ -133,7 +143,10 @@ fn calibrate_ros_topic_choice() {
         &["/imu0", "/imu1", "--topic"],
     );
     assert_one_line_error(
-        gmwm().arg("calibrate").arg(&bag).args(["--topic", "/camera"]),
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--topic", "/camera"]),
         &["/camera", "/imu0"],
     );
     let doc = run_json(
@@ -171,12 +184,24 @@ fn calibrate_adis_with_units_and_exports() {
         .arg(&json)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary = String::from_utf8_lossy(&out.stdout);
-    for col in ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"] {
-        assert!(summary.contains(&format!("{col}:")), "{col} missing: {summary}");
+    for col in [
+        "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+    ] {
+        assert!(
+            summary.contains(&format!("{col}:")),
+            "{col} missing: {summary}"
+        );
     }
-    assert!(summary.contains("°/√h"), "datasheet units beside SI: {summary}");
+    assert!(
+        summary.contains("°/√h"),
+        "datasheet units beside SI: {summary}"
+    );
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     let axes = doc["axes"].as_array().unwrap();
     assert_eq!(axes.len(), 6);
@@ -204,7 +229,9 @@ fn calibrate_adis_with_units_and_exports() {
     // gyro N of the ADIS16405 is about 2.5 °/√h = 7.3e-4 rad/s/√Hz at tau >= 1 s
     let n = number(&y, "gyroscope_noise_density");
     assert!((5e-4..1e-3).contains(&n), "{n}");
-    assert!(std::fs::read_to_string(&px4).unwrap().contains("gyroscopeNoiseDensity"));
+    assert!(std::fs::read_to_string(&px4)
+        .unwrap()
+        .contains("gyroscopeNoiseDensity"));
     assert!(std::fs::read_to_string(&vins).unwrap().contains("gyr_n"));
 }
 
@@ -213,22 +240,35 @@ fn calibrate_adis_with_units_and_exports() {
 fn calibrate_refuses_bad_flags() {
     let file = data_dir().join("adis_16405_imu1.csv.gz");
     assert_usage_error(
-        gmwm().arg("calibrate").arg(&file).args(["--gyro-unit", "furlong"]),
-        &["--gyro-unit", "rad/s"],
-    );
-    assert_usage_error(
-        gmwm().arg("calibrate").arg(&file).args(["--inflate", "0.5"]),
-        &["--inflate", ">= 1"],
-    );
-    assert_usage_error(
-        gmwm().arg("calibrate").arg(&file).args(["--export", "rovio", "x.yaml"]),
-        &["--export rovio", "openvins"],
-    );
-    assert_one_line_error(
         gmwm()
             .arg("calibrate")
             .arg(&file)
-            .args(["--gyro-unit", "g", "--columns", "gyro_x", "--G", "200"]),
+            .args(["--gyro-unit", "furlong"]),
+        &["--gyro-unit", "rad/s"],
+    );
+    assert_usage_error(
+        gmwm()
+            .arg("calibrate")
+            .arg(&file)
+            .args(["--inflate", "0.5"]),
+        &["--inflate", ">= 1"],
+    );
+    assert_usage_error(
+        gmwm()
+            .arg("calibrate")
+            .arg(&file)
+            .args(["--export", "rovio", "x.yaml"]),
+        &["--export rovio", "openvins"],
+    );
+    assert_one_line_error(
+        gmwm().arg("calibrate").arg(&file).args([
+            "--gyro-unit",
+            "g",
+            "--columns",
+            "gyro_x",
+            "--G",
+            "200",
+        ]),
         &["gyro_x", "not a gyroscope"],
     );
 }

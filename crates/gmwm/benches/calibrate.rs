@@ -9,7 +9,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use gmwm::calib::{Calibration, CalibrationOptions};
-use gmwm::imu::{ImuRecordType, Recording, RecordingOptions};
+use gmwm::imu::{ImuRecordType, InputFormat, ReadOptions, Recording, RecordingOptions};
 use gmwm::model::Model;
 use gmwm::sim::simulate_model;
 use std::io::Write;
@@ -47,8 +47,13 @@ fn write_ixsea(path: &Path, axes: &[Vec<f64>]) {
     for i in 0..axes[0].len() {
         out.write_all(&(i as f64 / FREQ).to_le_bytes()).unwrap();
         for (k, a) in axes.iter().enumerate() {
-            let scale = if k < 3 { t.scale_gyro() } else { t.scale_accel() };
-            out.write_all(&(a[i] / (FREQ * scale)).to_le_bytes()).unwrap();
+            let scale = if k < 3 {
+                t.scale_gyro()
+            } else {
+                t.scale_accel()
+            };
+            out.write_all(&(a[i] / (FREQ * scale)).to_le_bytes())
+                .unwrap();
         }
     }
     out.flush().unwrap();
@@ -82,9 +87,7 @@ fn imu_cdr(sec: i32, nsec: u32, gyro: [f64; 3], accel: [f64; 3], buf: &mut Vec<u
 fn write_mcap(path: &Path, axes: &[Vec<f64>]) {
     let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
     let mut w = mcap::Writer::new(file).unwrap();
-    let schema = w
-        .add_schema("sensor_msgs/msg/Imu", "ros2msg", b"")
-        .unwrap();
+    let schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
     let channel = w
         .add_channel(schema, "/imu0", "cdr", &Default::default())
         .unwrap();
@@ -115,11 +118,14 @@ fn write_mcap(path: &Path, axes: &[Vec<f64>]) {
     w.finish().unwrap();
 }
 
-fn calibrate(path: &Path, record_type: Option<ImuRecordType>) -> usize {
+fn calibrate(path: &Path, format: InputFormat) -> usize {
     let rec = Recording::open(
         path,
         &RecordingOptions {
-            record_type,
+            read: ReadOptions {
+                format,
+                ..ReadOptions::default()
+            },
             ..RecordingOptions::default()
         },
     )
@@ -143,9 +149,11 @@ fn bench_calibrate(c: &mut Criterion) {
     g.sample_size(10);
     g.throughput(Throughput::Elements((6 * n) as u64));
     g.bench_function(format!("raw/{n}"), |b| {
-        b.iter(|| calibrate(&raw, Some(ImuRecordType::Ixsea)))
+        b.iter(|| calibrate(&raw, InputFormat::ImuRecord(ImuRecordType::Ixsea)))
     });
-    g.bench_function(format!("ros/{n}"), |b| b.iter(|| calibrate(&ros, None)));
+    g.bench_function(format!("ros/{n}"), |b| {
+        b.iter(|| calibrate(&ros, InputFormat::Auto))
+    });
     g.finish();
 }
 

@@ -111,7 +111,7 @@ pub enum CalibError {
         /// Column.
         column: String,
         /// Cause.
-        source: crate::Error,
+        source: Box<crate::Error>,
     },
 }
 
@@ -431,7 +431,7 @@ impl Calibration {
         };
         let engine = |source: crate::Error| CalibError::Engine {
             column: column.to_string(),
-            source,
+            source: Box::new(source),
         };
         let fit_error = |source: FitError| CalibError::Fit {
             column: column.to_string(),

@@ -9,10 +9,45 @@ use crate::imu::ros::RosError;
 use std::path::PathBuf;
 use thiserror::Error;
 
+/// Longest text from a file quoted in a message, in characters (a cell, a header name).
+pub const QUOTE_MAX: usize = 40;
+
+/// Text from a file made safe for a one-line message: control and other non-printable
+/// characters escaped (`\n`, `\u{0}`), cut to [`QUOTE_MAX`] characters with `...` appended.
+pub fn quote(text: &str) -> String {
+    let mut out = String::new();
+    for (count, c) in text.chars().enumerate() {
+        if count == QUOTE_MAX {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() || c == '\u{fffd}' {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// At most this many column names are listed in an error (the rest are counted).
+const LIST_MAX: usize = 20;
+
+/// Column names for a message: each [`quote`]d, at most 20, then `... (N more)`.
+pub(crate) fn name_list(names: &[String]) -> String {
+    let mut parts: Vec<String> = names.iter().take(LIST_MAX).map(|n| quote(n)).collect();
+    if names.len() > LIST_MAX {
+        parts.push(format!("... ({} more)", names.len() - LIST_MAX));
+    }
+    parts.join(", ")
+}
+
 /// Reading or decoding an input file failed.
 ///
 /// Line numbers are 1-based physical lines of the (decompressed) file, the header being line 1;
-/// column indices are 1-based; sample indices in binary files are 0-based rows.
+/// column indices are 1-based; sample indices in binary files are 0-based rows. Text taken
+/// from a file (cells, header names) is cut to [`QUOTE_MAX`] characters with non-printable
+/// characters escaped ([`quote`]), so no message can dump a file.
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum ReadError {
@@ -94,9 +129,10 @@ pub enum ReadError {
     },
     /// A column was selected by a name the file does not have.
     #[error(
-        "{}: no column named \"{name}\"; available: {}",
+        "{}: no column named \"{}\"; available: {}",
         .path.display(),
-        .available.join(", ")
+        quote(.name),
+        name_list(.available)
     )]
     UnknownColumn {
         /// File.
@@ -105,6 +141,34 @@ pub enum ReadError {
         name: String,
         /// The names the file has (header names, or `col1`, `col2`, ... without a header).
         available: Vec<String>,
+    },
+    /// A series of a wavelet-variance JSON was selected by a name the file does not have.
+    #[error(
+        "{}: no series named \"{}\"; available: {}",
+        .path.display(),
+        quote(.name),
+        name_list(.available)
+    )]
+    UnknownSeries {
+        /// File.
+        path: PathBuf,
+        /// The requested name.
+        name: String,
+        /// The series names of the file.
+        available: Vec<String>,
+    },
+    /// A series of a wavelet-variance JSON was selected by an index outside `1..=count`.
+    #[error(
+        "{}: series {index} is out of range; the file has {count} series (1-based: 1..={count})",
+        .path.display()
+    )]
+    SeriesOutOfRange {
+        /// File.
+        path: PathBuf,
+        /// The requested 1-based index.
+        index: usize,
+        /// Number of series in the file.
+        count: usize,
     },
     /// A column was selected by an index outside `1..=ncols`.
     #[error(
@@ -118,6 +182,43 @@ pub enum ReadError {
         index: usize,
         /// Number of columns of the file.
         ncols: usize,
+    },
+    /// A file read as text (no binary `format` given, none known from its name or sidecar)
+    /// holds bytes that no text file has (NUL or invalid UTF-8 in its first 4 KiB).
+    #[error(
+        "{}: looks like binary data, not text; give --format \
+         f64|f32|imar|ln200|ln200ig|ixsea|navchip-int|navchip-flt",
+        .path.display()
+    )]
+    LooksBinary {
+        /// File.
+        path: PathBuf,
+    },
+    /// A JSON document was given where a table of samples is read.
+    #[error(
+        "{}: is JSON, not a table of samples (a wavelet variance saved by `gmwm wv --json` is \
+         read as such by fit, select, wv and avar)",
+        .path.display()
+    )]
+    NotATable {
+        /// File.
+        path: PathBuf,
+    },
+    /// The epochs of a binary IMU record file (METHODS §9.2) are not in increasing time order.
+    #[error(
+        "{}: record {index} (0-based): time {value} is not greater than the previous time \
+         {previous}; the epochs must be in strictly increasing time order",
+        .path.display()
+    )]
+    RecordTimeNotIncreasing {
+        /// File.
+        path: PathBuf,
+        /// 0-based index of the offending record.
+        index: u64,
+        /// Time of the record before it, in seconds.
+        previous: f64,
+        /// Its time, in seconds.
+        value: f64,
     },
     /// A raw binary file does not hold a whole number of records.
     #[error(

@@ -1,10 +1,14 @@
 //! IMU data and readers (METHODS §9).
 //!
-//! - [`read_table`]: CSV/TSV text (plain or gzip) and raw little-endian f64/f32 binary into a
-//!   [`Table`] of named columns, with the JSON [`Sidecar`] and the sampling rate;
+//! - [`read_table`]: CSV/TSV text (plain or gzip), raw little-endian f64/f32 binary and binary
+//!   IMU records into a [`Table`] of named columns, with the JSON [`Sidecar`], the time column
+//!   ([`TimingReport`]), soft problems ([`ReadWarning`]) and the sampling rate;
+//! - [`check_times`]: rate, gaps, duplicates and reordering of any time stamps (module
+//!   [`timing`]);
 //! - [`BinaryChunks`] / [`for_each_chunk`]: one column of a huge binary file in bounded memory;
 //! - [`read_imu_record_file`]: the binary IMU epoch records of METHODS §9.2–9.3;
 //! - [`read_wv_json`]: a wavelet variance computed elsewhere (`gmwm wv --json`), to fit again;
+//! - [`write::SeriesWriter`]: series to CSV, TSV, gzip or raw binary by file name;
 //! - [`Imu`]: gyroscope/accelerometer axes with a common rate (METHODS §9.1).
 //!
 //! This module knows no statistics; every error is a [`ReadError`] (or a
@@ -28,15 +32,22 @@ pub mod recording;
 pub mod ros;
 mod sensor;
 pub mod sidecar;
+pub mod timing;
 pub mod write;
 pub mod wv_file;
 
-pub use error::ReadError;
+pub use error::{quote, ReadError, QUOTE_MAX};
 pub use read::{
-    for_each_chunk, read_imu_record_file, read_table, BinaryChunks, Column, ColumnSelector,
-    HeaderMode, ImuRecordType, InputFormat, ReadOptions, Table,
+    binary_layout, for_each_chunk, read_imu_record_file, read_table, resolve_format, sniff,
+    BinaryChunks, BinaryLayout, Column, ColumnSelector, Content, HeaderMode, ImuRecordType,
+    InputFormat, ReadOptions, ReadWarning, Table,
 };
 pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
 pub use sidecar::{find_sidecar, ColumnSummary, Sidecar, SidecarColumn, SidecarUnits};
-pub use wv_file::{is_wv_json, read_wv_json};
+pub use timing::{
+    check_times, infer_time_unit, time_column_unit, Gap, TimeUnit, TimingReport, TimingWarning,
+    UnitSource,
+};
+pub use write::{OutputFormat, SeriesWriter};
+pub use wv_file::{allan_from_wv, is_wv_json, read_wv_json, select_series};

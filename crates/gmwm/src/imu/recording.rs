@@ -2,7 +2,7 @@
 //! records, a ROS bag), an [`Imu`] with its rate, where it came from and what the reader
 //! noticed.
 
-use super::read::{read_imu_record_file, read_table, Column, ImuRecordType, ReadOptions};
+use super::read::{read_table, Column, InputFormat, ReadOptions};
 use super::ros::{container_of, read_imu_messages, ImuMessages};
 use super::timing::{check_times, TimeUnit, TimingReport, UnitSource};
 use super::{Imu, ReadError, Sensor, SensorInfo};
@@ -13,10 +13,9 @@ use std::path::{Path, PathBuf};
 /// How to open a recording ([`Recording::open`]).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RecordingOptions {
-    /// Options of delimited text and raw binary tables (columns, time column, rate, ...).
+    /// Options of text, raw binary and binary IMU record files (format, columns, time column,
+    /// rate, ...); the columns and the rate apply to ROS recordings too.
     pub read: ReadOptions,
-    /// Binary IMU records of this type (METHODS §9.2) instead of a table.
-    pub record_type: Option<ImuRecordType>,
     /// The `sensor_msgs/Imu` topic of a ROS recording (default: its only IMU topic).
     pub topic: Option<String>,
 }
@@ -71,38 +70,44 @@ impl Recording {
     /// Any read error of the container, or [`crate::imu::ReadError::FreqNotDerivable`] when no
     /// rate can be found.
     pub fn open(path: &Path, opts: &RecordingOptions) -> Result<Self, Error> {
-        if opts.record_type.is_none() && container_of(path).is_some() {
+        if opts.read.format == InputFormat::Auto && container_of(path).is_some() {
             return Self::open_ros(path, opts);
         }
+        let table = read_table(path, &opts.read)?;
         let mut notes = Vec::new();
-        let (imu, source) = match opts.record_type {
-            Some(t) => {
-                let mut imu = read_imu_record_file(path, t)?;
-                if !opts.read.columns.is_empty() {
-                    imu = imu.select(path, &opts.read.columns)?;
-                }
-                notes.push(format!(
-                    "{t} records: rates from increments x {} Hz x the type's scale factors, in rad/s and m/s^2",
-                    imu.freq_hz()
-                ));
-                (
-                    imu,
-                    RecordingSource::Records {
-                        record_type: t.name().to_string(),
-                    },
-                )
-            }
-            None => {
-                let table = read_table(path, &opts.read)?;
-                (Imu::from_table(table)?, RecordingSource::Table)
-            }
+        if let Some(t) = table.record_type {
+            notes.push(format!(
+                "{t} records: rates are the increments x the rate from the time stamps x the type's scale factors (METHODS §9.3), in rad/s and m/s^2"
+            ));
+        }
+        if let Some(timing) = &table.timing {
+            notes.push(format!(
+                "time column {:?} ({}, {}): {} Hz from the regular steps over {:.1} s",
+                timing.column,
+                timing.unit.symbol(),
+                timing.unit_source,
+                crate::fit::report::significant(timing.rate_hz, 6),
+                timing.span_s
+            ));
+        }
+        if !table.skipped.is_empty() {
+            notes.push(format!("columns left out: {}", table.skipped.join(", ")));
+        }
+        notes.extend(table.warnings.iter().map(ToString::to_string));
+        let source = match table.record_type {
+            Some(t) => RecordingSource::Records {
+                record_type: t.name().to_string(),
+            },
+            None => RecordingSource::Table,
         };
+        let timing = table.timing.clone();
+        let imu = Imu::from_table(table)?;
         Ok(Self {
             path: path.to_path_buf(),
             imu,
             source,
             topic: None,
-            timing: None,
+            timing,
             notes,
         })
     }
@@ -185,9 +190,7 @@ fn stamps_report(column: &str, ns: &[i64]) -> TimingReport {
         .iter()
         .map(|&t| t.wrapping_sub(first) as f64 * 1e-9)
         .collect();
-    let mut r = check_times(column, &s, TimeUnit::Nanoseconds, UnitSource::Stated);
-    r.start_s = first as f64 * 1e-9;
-    r
+    check_times(column, &s, TimeUnit::Nanoseconds, UnitSource::Stated)
 }
 
 /// Six axes from the IMU messages (consumed: the vectors move into the columns).

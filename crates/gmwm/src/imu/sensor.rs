@@ -1,7 +1,8 @@
 //! The [`Imu`] object of METHODS §9.1: sensor columns with their sensor type, axis, unit and a
 //! common sampling rate.
 
-use super::read::{Column, ColumnSelector, ImuRecordType, Table};
+use super::read::{Column, ColumnSelector, ImuRecordType, ReadWarning, Table};
+use super::timing::TimingReport;
 use super::ReadError;
 use crate::error::{check_freq, Error, ParamError};
 use serde::{Deserialize, Serialize};
@@ -51,25 +52,49 @@ pub struct SensorInfo {
 }
 
 impl SensorInfo {
-    /// Infers sensor and axis from a column name or a meaning text: a word starting with `gyro`
-    /// → gyroscope, with `acc` → accelerometer; the axis is a one-letter word `x`/`y`/`z` or a
-    /// suffix glued to the sensor word (`gyrox`, `accz`). `gyro_x`, `Gyro. X`,
-    /// `"gyroscope X axis, ..."` all give gyroscope X. `None` when either part is missing.
+    /// Infers sensor and axis from a column name or a meaning text (a trailing `[..]` or `(..)`
+    /// unit is ignored):
+    ///
+    /// - gyroscope: a word starting with `gyr` (`gyro_x`, `Gyro. X`, `gyr_z`), `angular`
+    ///   followed by `velocity`/`vel`/`rate` (`angular_velocity.x`,
+    ///   `field.angular_velocity.x`), or a first word `w`, `omega` or `g` (`w_RS_S_x` of
+    ///   EuRoC/TUM-VI, `wx`, `gx`);
+    /// - accelerometer: a word starting with `acc` (`accel_z`, `acc_x`,
+    ///   `linear_acceleration.x`) or a first word `a` (`a_RS_S_x`, `ax`);
+    ///
+    /// the axis is a one-letter word `x`/`y`/`z` after the sensor word or a suffix glued to it
+    /// (`gyrox`, `accz`, `wx`). `gyro_x`, `Gyro. X`, `"gyroscope X axis, ..."`,
+    /// `w_RS_S_x [rad s^-1]` all give gyroscope X. `None` when either part is missing.
     pub fn infer(text: &str) -> Option<(Sensor, String)> {
-        let lower = text.to_ascii_lowercase();
+        let lower = strip_unit(text).to_ascii_lowercase();
         let words: Vec<&str> = lower
             .split(|c: char| !c.is_ascii_alphanumeric())
             .filter(|w| !w.is_empty())
             .collect();
-        let (pos, sensor, rest) = words.iter().enumerate().find_map(|(i, w)| {
-            if let Some(r) = strip_any(w, &["gyroscope", "gyro"]) {
-                Some((i, Sensor::Gyroscope, r))
-            } else {
-                strip_any(w, &["accelerometer", "accel", "acc"])
-                    .map(|r| (i, Sensor::Accelerometer, r))
-            }
-        })?;
         let is_axis = |w: &str| matches!(w, "x" | "y" | "z");
+        // sensor words anywhere first, then the one-letter forms of the first word
+        let (pos, sensor, rest) = words
+            .iter()
+            .enumerate()
+            .find_map(|(i, w)| {
+                if let Some(r) = strip_any(w, &["gyroscope", "gyro", "gyr"]) {
+                    Some((i, Sensor::Gyroscope, r))
+                } else if let Some(r) = strip_any(w, &["accelerometer", "accel", "acc"]) {
+                    Some((i, Sensor::Accelerometer, r))
+                } else if *w == "angular"
+                    && words
+                        .get(i + 1)
+                        .is_some_and(|n| matches!(*n, "velocity" | "vel" | "rate"))
+                {
+                    Some((i + 1, Sensor::Gyroscope, ""))
+                } else {
+                    None
+                }
+            })
+            .or_else(|| {
+                let w = words.first()?;
+                first_letter(w).map(|(s, r)| (0, s, r))
+            })?;
         let axis = if is_axis(rest) {
             rest
         } else {
@@ -77,6 +102,47 @@ impl SensorInfo {
         };
         Some((sensor, axis.to_ascii_uppercase()))
     }
+
+    /// The unit a column name states in a trailing `[..]` or `(..)`, as text:
+    /// `w_RS_S_x [rad s^-1]` → `rad s^-1`, `acc_x (m/s^2)` → `m/s^2`; `None` without one.
+    pub fn unit_from_name(name: &str) -> Option<String> {
+        let stripped = strip_unit(name);
+        let rest = name.trim()[stripped.len()..].trim();
+        let inner = rest.get(1..rest.len().saturating_sub(1))?.trim();
+        (!inner.is_empty()).then(|| inner.to_string())
+    }
+}
+
+/// The one-letter sensor forms of a first word: `w`, `omega`, `g` (gyroscope), `a`
+/// (accelerometer), alone or with a glued axis (`wx`, `ax`); the rest is the glued axis.
+fn first_letter(w: &str) -> Option<(Sensor, &str)> {
+    let is_axis = |w: &str| matches!(w, "x" | "y" | "z");
+    for (p, sensor) in [
+        ("omega", Sensor::Gyroscope),
+        ("w", Sensor::Gyroscope),
+        ("g", Sensor::Gyroscope),
+        ("a", Sensor::Accelerometer),
+    ] {
+        if let Some(r) = w.strip_prefix(p) {
+            if r.is_empty() || is_axis(r) {
+                return Some((sensor, r));
+            }
+        }
+    }
+    None
+}
+
+/// `name` without a trailing `[..]` or `(..)` group (and the blanks before it).
+fn strip_unit(name: &str) -> &str {
+    let t = name.trim();
+    for (open, close) in [('[', ']'), ('(', ')')] {
+        if t.ends_with(close) {
+            if let Some(at) = t.rfind(open) {
+                return t[..at].trim_end();
+            }
+        }
+    }
+    t
 }
 
 fn strip_any<'a>(w: &'a str, prefixes: &[&str]) -> Option<&'a str> {
@@ -120,6 +186,8 @@ pub struct Imu {
     freq_hz: f64,
     name: Option<String>,
     record_type: Option<ImuRecordType>,
+    timing: Option<TimingReport>,
+    warnings: Vec<ReadWarning>,
 }
 
 impl Imu {
@@ -189,13 +257,17 @@ impl Imu {
             freq_hz,
             name: None,
             record_type: None,
+            timing: None,
+            warnings: Vec::new(),
         })
     }
 
     /// Builds an IMU from a table, inferring sensor and axis of each column from its name, else
     /// from the sidecar's meaning ([`SensorInfo::infer`]); columns that match neither become
-    /// [`Sensor::Other`] with the column name as label. Units come from the sidecar; the name
-    /// from the sidecar, else the file name.
+    /// [`Sensor::Other`] with the column name as label. Units: the one the column name states
+    /// ([`SensorInfo::unit_from_name`]), else the sidecar's, else rad/s and m/s^2 for binary
+    /// IMU records (METHODS §9.3), as text. The name comes from the sidecar, else the file name.
+    /// The table's timing report and warnings are kept ([`Imu::timing`], [`Imu::warnings`]).
     ///
     /// # Errors
     /// [`ReadError::FreqNotDerivable`] if `table.freq_hz` is `None`; [`ParamError`] as
@@ -209,6 +281,7 @@ impl Imu {
             .into());
         };
         let sidecar = table.sidecar.as_ref();
+        let record = table.record_type.is_some();
         let info = table
             .columns
             .iter()
@@ -220,11 +293,15 @@ impl Imu {
                 });
                 let (sensor, axis) = inferred.unwrap_or((Sensor::Other, c.name.clone()));
                 let units = sidecar.and_then(|s| s.units.as_ref());
-                let unit = match sensor {
-                    Sensor::Gyroscope => units.and_then(|u| u.gyro.clone()),
-                    Sensor::Accelerometer => units.and_then(|u| u.accel.clone()),
+                let unit = SensorInfo::unit_from_name(&c.name).or_else(|| match sensor {
+                    Sensor::Gyroscope => units
+                        .and_then(|u| u.gyro.clone())
+                        .or_else(|| record.then(|| "rad/s".to_string())),
+                    Sensor::Accelerometer => units
+                        .and_then(|u| u.accel.clone())
+                        .or_else(|| record.then(|| "m/s^2".to_string())),
                     Sensor::Other => None,
-                };
+                });
                 SensorInfo { sensor, axis, unit }
             })
             .collect();
@@ -236,6 +313,9 @@ impl Imu {
         });
         let mut imu = Self::new(table.columns, info, freq_hz)?;
         imu.name = name;
+        imu.record_type = table.record_type;
+        imu.timing = table.timing;
+        imu.warnings = table.warnings;
         Ok(imu)
     }
 
@@ -298,6 +378,16 @@ impl Imu {
     /// Binary record type, if read from one (METHODS §9.1 `stype`).
     pub fn record_type(&self) -> Option<ImuRecordType> {
         self.record_type
+    }
+
+    /// What the time column of the file said about the sampling, if it had one.
+    pub fn timing(&self) -> Option<&TimingReport> {
+        self.timing.as_ref()
+    }
+
+    /// Soft problems found while reading the file ([`Table::warnings`]).
+    pub fn warnings(&self) -> &[ReadWarning] {
+        &self.warnings
     }
 
     /// Number of samples per axis.
@@ -383,6 +473,55 @@ mod tests {
         );
         assert_eq!(g("temperature"), None);
         assert_eq!(g("gyro"), None);
+        // EuRoC / TUM-VI, ROS and short headers
+        assert_eq!(
+            g("w_RS_S_x [rad s^-1]"),
+            Some((Sensor::Gyroscope, "X".into()))
+        );
+        assert_eq!(
+            g("a_RS_S_z [m s^-2]"),
+            Some((Sensor::Accelerometer, "Z".into()))
+        );
+        for (name, sensor, axis) in [
+            ("gx", Sensor::Gyroscope, "X"),
+            ("wy", Sensor::Gyroscope, "Y"),
+            ("ax", Sensor::Accelerometer, "X"),
+            ("acc_x", Sensor::Accelerometer, "X"),
+            ("gyr_z", Sensor::Gyroscope, "Z"),
+            ("angular_velocity.x", Sensor::Gyroscope, "X"),
+            ("field.angular_velocity.y", Sensor::Gyroscope, "Y"),
+            ("linear_acceleration.z", Sensor::Accelerometer, "Z"),
+            ("field.linear_acceleration.x", Sensor::Accelerometer, "X"),
+        ] {
+            assert_eq!(g(name), Some((sensor, axis.to_string())), "{name}");
+        }
+        for name in [
+            "a",
+            "x",
+            "time",
+            "field.orientation.x",
+            "field.angular_velocity_covariance0",
+            "field.header.seq",
+            "temperature x",
+        ] {
+            assert_eq!(g(name), None, "{name}");
+        }
+        assert_eq!(
+            g("a gyroscope X axis"),
+            Some((Sensor::Gyroscope, "X".into()))
+        );
+        for name in ["gps_x", "wheel_x", "axis"] {
+            assert_eq!(g(name), None, "{name}");
+        }
+    }
+
+    #[test]
+    fn unit_from_name() {
+        let u = SensorInfo::unit_from_name;
+        assert_eq!(u("w_RS_S_x [rad s^-1]").as_deref(), Some("rad s^-1"));
+        assert_eq!(u("acc_x (m/s^2)").as_deref(), Some("m/s^2"));
+        assert_eq!(u("gyro_x"), None);
+        assert_eq!(u("gyro_x []"), None);
     }
 
     #[test]

@@ -1,4 +1,6 @@
-//! JSON sidecar files: `<name>.json` beside `<name>.csv.gz` (see `shared/data/README.md`).
+//! JSON sidecar files: `<file name>.json` beside the data (`x.f64.json`, `x.csv.gz.json`, as
+//! [`write_sidecar`](crate::imu::write::write_sidecar) names them), or `<name>.json` beside
+//! `<name>.csv.gz` (see `shared/data/README.md`).
 //!
 //! Reading is tolerant: every field is optional and unknown fields are ignored, so sidecars of
 //! other origins can be used. A sidecar that is not valid JSON, or whose known fields have the
@@ -27,6 +29,12 @@ pub struct Sidecar {
     pub sampling_frequency_hz: Option<f64>,
     /// Units of the gyroscope and accelerometer columns (free text).
     pub units: Option<SidecarUnits>,
+    /// Format of the data file, as [`InputFormat`](crate::imu::InputFormat) parses it (`f64`,
+    /// `f32`: little-endian, interleaved; `csv`, `tsv`; a record type): lets a raw binary file
+    /// be read without flags.
+    pub format: Option<String>,
+    /// Number of columns (interleaved columns of a raw binary file).
+    pub n_columns: Option<usize>,
     /// Column names and meanings, in file order.
     pub columns: Vec<SidecarColumn>,
     /// Number of data rows.
@@ -102,15 +110,19 @@ impl Sidecar {
     }
 }
 
-/// Candidate sidecar paths of a data file, most specific first: known data extensions are
-/// stripped one at a time from the right and `.json` appended (`x.csv.gz` → `x.csv.json`,
-/// `x.json`).
+/// Candidate sidecar paths of a data file, most specific first: the whole file name with
+/// `.json` appended (`x.csv.gz` → `x.csv.gz.json`, the name the writers use, so that `x.f64`
+/// and `x.txt` never share one), then known data extensions stripped one at a time from the
+/// right and `.json` appended (`x.csv.json`, `x.json`).
 pub fn sidecar_candidates(data: &Path) -> Vec<PathBuf> {
     let Some(file_name) = data.file_name().and_then(|f| f.to_str()) else {
         return Vec::new();
     };
     let mut stem = file_name;
     let mut out = Vec::new();
+    if !file_name.starts_with('.') && !file_name.to_ascii_lowercase().ends_with(".json") {
+        out.push(data.with_file_name(format!("{file_name}.json")));
+    }
     while let Some((head, ext)) = stem.rsplit_once('.') {
         if head.is_empty() || !DATA_EXTENSIONS.contains(&ext.to_ascii_lowercase().as_str()) {
             break;
@@ -141,15 +153,27 @@ mod tests {
         let c = sidecar_candidates(Path::new("/d/x.csv.gz"));
         assert_eq!(
             c,
-            vec![PathBuf::from("/d/x.csv.json"), PathBuf::from("/d/x.json")]
+            vec![
+                PathBuf::from("/d/x.csv.gz.json"),
+                PathBuf::from("/d/x.csv.json"),
+                PathBuf::from("/d/x.json")
+            ]
         );
         let c = sidecar_candidates(Path::new("a.b.f64le.bin"));
         assert_eq!(
             c,
-            vec![PathBuf::from("a.b.f64le.json"), PathBuf::from("a.b.json")]
+            vec![
+                PathBuf::from("a.b.f64le.bin.json"),
+                PathBuf::from("a.b.f64le.json"),
+                PathBuf::from("a.b.json")
+            ]
         );
-        assert!(sidecar_candidates(Path::new("noext")).is_empty());
+        assert_eq!(
+            sidecar_candidates(Path::new("noext")),
+            vec![PathBuf::from("noext.json")]
+        );
         assert!(sidecar_candidates(Path::new(".csv")).is_empty());
+        assert!(sidecar_candidates(Path::new("wv.json")).is_empty());
     }
 
     #[test]

@@ -1,23 +1,253 @@
-//! Writing series: CSV text (gzip-compressed when the path ends in `.gz`) streamed row by row,
-//! and the JSON sidecar that tells readers the sampling rate.
+//! Writing series: a [`SeriesWriter`] whose format follows the file's extension (CSV, gzip CSV,
+//! TSV, raw little-endian f64/f32), streamed row by row, and the JSON sidecar that tells
+//! readers the sampling rate and, for raw binary, the layout.
 
-use super::{ReadError, Sidecar};
+use super::{InputFormat, ReadError, Sidecar};
+use crate::error::ParamError;
 use flate2::write::GzEncoder;
 use flate2::Compression;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Opens `path` for writing, gzip-compressed when it ends in `.gz`.
+/// Write buffer: large enough that system calls are rare.
+const BUF_CAPACITY: usize = 1 << 20;
+
+/// The file names [`OutputFormat::from_path`] accepts, for messages.
+pub const OUTPUT_EXTENSIONS: &str = ".csv, .txt, .tsv (each optionally .gz), .f64, .f64le, \
+                                     .f64.bin, .f64le.bin, .f32, .f32le, .f32.bin, .f32le.bin";
+
+/// Format of a series file, from its name ([`OutputFormat::from_path`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// Delimited text with a header line; `gzip` for names ending in `.gz`.
+    Text {
+        /// `b','` (`.csv`, `.txt`) or `b'\t'` (`.tsv`).
+        delimiter: u8,
+        /// gzip-compressed.
+        gzip: bool,
+    },
+    /// Raw little-endian f64, columns interleaved row by row, no header.
+    F64,
+    /// Raw little-endian f32, columns interleaved row by row, no header.
+    F32,
+}
+
+impl OutputFormat {
+    /// The format of a file name: `.csv`/`.txt` → comma-separated text, `.tsv` → tab-separated,
+    /// either followed by `.gz` → gzip-compressed; `.f64`, `.f64le`, `.f64.bin`, `.f64le.bin` →
+    /// raw f64; the same with `f32` → raw f32 (case-insensitive).
+    ///
+    /// # Errors
+    /// [`ParamError`] `output` for any other name, listing [`OUTPUT_EXTENSIONS`].
+    pub fn from_path(path: &Path) -> Result<Self, ParamError> {
+        let name = path
+            .file_name()
+            .and_then(|f| f.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        let (stem, gzip) = match name.strip_suffix(".gz") {
+            Some(s) => (s, true),
+            None => (name.as_str(), false),
+        };
+        let text = |delimiter| Ok(Self::Text { delimiter, gzip });
+        if stem.ends_with(".csv") || stem.ends_with(".txt") {
+            return text(b',');
+        }
+        if stem.ends_with(".tsv") {
+            return text(b'\t');
+        }
+        if !gzip {
+            match InputFormat::Auto.resolve(path) {
+                InputFormat::F64 => return Ok(Self::F64),
+                InputFormat::F32 => return Ok(Self::F32),
+                _ => {}
+            }
+        }
+        Err(ParamError::new(
+            "output",
+            path.display(),
+            format!("a file name ending in {OUTPUT_EXTENSIONS}"),
+        ))
+    }
+
+    /// The name of the format as a sidecar's `format` records it (`csv`, `tsv`, `f64`, `f32`).
+    pub fn sidecar_name(self) -> &'static str {
+        match self {
+            Self::Text {
+                delimiter: b'\t', ..
+            } => "tsv",
+            Self::Text { .. } => "csv",
+            Self::F64 => "f64",
+            Self::F32 => "f32",
+        }
+    }
+}
+
+enum Sink {
+    Plain(BufWriter<File>),
+    Gzip(GzEncoder<BufWriter<File>>),
+}
+
+impl Sink {
+    fn writer(&mut self) -> &mut dyn Write {
+        match self {
+            Self::Plain(w) => w,
+            Self::Gzip(w) => w,
+        }
+    }
+}
+
+/// Writes equal-length columns to a file in the format of its name ([`OutputFormat`]), a
+/// block of rows at a time: text with a header line and shortest round-tripping numbers (the
+/// file reads back to the same bits), raw binary interleaved little-endian.
+pub struct SeriesWriter {
+    path: PathBuf,
+    format: OutputFormat,
+    sink: Sink,
+    ncols: usize,
+    rows: u64,
+    line: String,
+}
+
+impl SeriesWriter {
+    /// Creates `path` and, for text, writes the header line (names are quoted when they hold
+    /// the delimiter or a quote).
+    ///
+    /// # Errors
+    /// [`ReadError::InvalidOption`] for a name of no known format ([`OutputFormat::from_path`])
+    /// or no columns; [`ReadError::Io`] naming the path when it cannot be created.
+    pub fn create(path: &Path, names: &[&str]) -> Result<Self, ReadError> {
+        let format = OutputFormat::from_path(path)?;
+        if names.is_empty() {
+            return Err(ParamError::new("columns", 0, "at least one column to write").into());
+        }
+        let file = File::create(path).map_err(|e| io_error(path, e))?;
+        let buffered = BufWriter::with_capacity(BUF_CAPACITY, file);
+        let sink = match format {
+            OutputFormat::Text { gzip: true, .. } => {
+                Sink::Gzip(GzEncoder::new(buffered, Compression::default()))
+            }
+            _ => Sink::Plain(buffered),
+        };
+        let mut w = Self {
+            path: path.to_path_buf(),
+            format,
+            sink,
+            ncols: names.len(),
+            rows: 0,
+            line: String::new(),
+        };
+        if let OutputFormat::Text { delimiter, .. } = format {
+            let d = char::from(delimiter);
+            let quoted: Vec<String> = names.iter().map(|n| quote_field(n, d)).collect();
+            let header = quoted.join(&d.to_string()) + "\n";
+            w.sink
+                .writer()
+                .write_all(header.as_bytes())
+                .map_err(|e| io_error(path, e))?;
+        }
+        Ok(w)
+    }
+
+    /// The format written.
+    pub fn format(&self) -> OutputFormat {
+        self.format
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Appends rows: `columns[k][t]` is row `t` of column `k`.
+    ///
+    /// # Errors
+    /// [`ReadError::InvalidOption`] if the number of columns differs from the header's or the
+    /// columns differ in length; [`ReadError::Io`] when the write fails.
+    pub fn write_rows(&mut self, columns: &[&[f64]]) -> Result<(), ReadError> {
+        let n = columns.first().map_or(0, |c| c.len());
+        if columns.len() != self.ncols || columns.iter().any(|c| c.len() != n) {
+            return Err(ParamError::new(
+                "columns",
+                columns.len(),
+                format!("{} columns of equal length", self.ncols),
+            )
+            .into());
+        }
+        let path = &self.path;
+        let out = self.sink.writer();
+        let result = match self.format {
+            OutputFormat::Text { delimiter, .. } => {
+                let d = char::from(delimiter);
+                let line = &mut self.line;
+                (0..n).try_for_each(|t| {
+                    line.clear();
+                    for (k, c) in columns.iter().enumerate() {
+                        if k > 0 {
+                            line.push(d);
+                        }
+                        use std::fmt::Write as _;
+                        let _ = write!(line, "{}", c[t]);
+                    }
+                    line.push('\n');
+                    out.write_all(line.as_bytes())
+                })
+            }
+            OutputFormat::F64 => (0..n).try_for_each(|t| {
+                columns
+                    .iter()
+                    .try_for_each(|c| out.write_all(&c[t].to_le_bytes()))
+            }),
+            OutputFormat::F32 => (0..n).try_for_each(|t| {
+                columns
+                    .iter()
+                    .try_for_each(|c| out.write_all(&(c[t] as f32).to_le_bytes()))
+            }),
+        };
+        result.map_err(|e| io_error(path, e))?;
+        self.rows += n as u64;
+        Ok(())
+    }
+
+    /// Flushes the file (and ends the gzip stream).
+    ///
+    /// # Errors
+    /// [`ReadError::Io`] when the final writes fail.
+    pub fn finish(self) -> Result<(), ReadError> {
+        let path = self.path;
+        match self.sink {
+            Sink::Plain(mut w) => w.flush(),
+            Sink::Gzip(w) => w.finish().and_then(|mut w| w.flush()),
+        }
+        .map_err(|e| io_error(&path, e))
+    }
+}
+
+fn quote_field(s: &str, delimiter: char) -> String {
+    if s.contains([delimiter, '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+#[cold]
+fn io_error(path: &Path, source: io::Error) -> ReadError {
+    ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Opens `path` for writing, gzip-compressed when it ends in `.gz` (the gzip stream is ended
+/// when the writer is dropped; prefer [`SeriesWriter`], which reports that last write).
 ///
 /// # Errors
 /// [`ReadError::Io`] naming the path when it cannot be created.
 pub fn create(path: &Path) -> Result<Box<dyn Write>, ReadError> {
-    let file = File::create(path).map_err(|source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let buffered = BufWriter::with_capacity(1 << 20, file);
+    let file = File::create(path).map_err(|e| io_error(path, e))?;
+    let buffered = BufWriter::with_capacity(BUF_CAPACITY, file);
     let gz = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gz"));
@@ -60,20 +290,72 @@ pub fn write_csv_header(out: &mut dyn Write, names: &[&str]) -> io::Result<()> {
     writeln!(out, "{}", names.join(","))
 }
 
-/// Writes the JSON sidecar of a data file: `<file without .csv/.gz/...>.json`, the name the
-/// readers look for first.
+/// The sidecar path of a data file: its whole name with `.json` appended (`x.f64.json`,
+/// `x.csv.gz.json`), the first name the readers look for, so that `x.txt` and `x.f64` never
+/// share a sidecar.
+pub fn sidecar_path(data: &Path) -> PathBuf {
+    let mut name = data.file_name().unwrap_or_default().to_os_string();
+    name.push(".json");
+    data.with_file_name(name)
+}
+
+/// Writes the JSON sidecar of a data file at [`sidecar_path`] and returns that path.
 ///
 /// # Errors
 /// [`ReadError::Io`] when it cannot be written.
-pub fn write_sidecar(data: &Path, sidecar: &Sidecar) -> Result<std::path::PathBuf, ReadError> {
-    let path = super::sidecar::sidecar_candidates(data)
-        .into_iter()
-        .last()
-        .unwrap_or_else(|| data.with_extension("json"));
+pub fn write_sidecar(data: &Path, sidecar: &Sidecar) -> Result<PathBuf, ReadError> {
+    let path = sidecar_path(data);
     let text = serde_json::to_string_pretty(sidecar).expect("a sidecar serialises");
-    std::fs::write(&path, text + "\n").map_err(|source| ReadError::Io {
-        path: path.clone(),
-        source,
-    })?;
+    std::fs::write(&path, text + "\n").map_err(|e| io_error(&path, e))?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_format_from_path() {
+        let f = |p: &str| OutputFormat::from_path(Path::new(p));
+        let csv = OutputFormat::Text {
+            delimiter: b',',
+            gzip: false,
+        };
+        assert_eq!(f("x.csv").unwrap(), csv);
+        assert_eq!(f("x.TXT").unwrap(), csv);
+        assert_eq!(
+            f("x.csv.gz").unwrap(),
+            OutputFormat::Text {
+                delimiter: b',',
+                gzip: true
+            }
+        );
+        assert_eq!(
+            f("x.tsv").unwrap(),
+            OutputFormat::Text {
+                delimiter: b'\t',
+                gzip: false
+            }
+        );
+        for p in ["x.f64", "x.f64le", "x.f64.bin", "x.F64LE.BIN"] {
+            assert_eq!(f(p).unwrap(), OutputFormat::F64, "{p}");
+        }
+        assert_eq!(f("x.f32.bin").unwrap(), OutputFormat::F32);
+        for p in ["x.xyz", "x", "x.bin", "x.f64.gz", "x.json"] {
+            let e = f(p).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("invalid output = {p}: a file name ending in .csv")));
+        }
+    }
+
+    #[test]
+    fn sidecar_path_appends_json() {
+        assert_eq!(
+            sidecar_path(Path::new("d/x.f64")),
+            Path::new("d/x.f64.json")
+        );
+        assert_eq!(
+            sidecar_path(Path::new("x.csv.gz")),
+            Path::new("x.csv.gz.json")
+        );
+    }
 }

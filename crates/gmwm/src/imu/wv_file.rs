@@ -9,7 +9,11 @@
 //! `n_coefficients`, `eta` (as `gmwm wv --json` writes them; defaults: Haar MODWT, alpha 0.05,
 //! classical, counts and eta3 degrees of freedom recomputed from `n`).
 
+use super::error::quote;
+use super::read::{sniff, ColumnSelector, Content};
 use super::ReadError;
+use crate::error::ParamError;
+use crate::variance::allan::{package_error, AllanKind, AllanVariance, AvConvention};
 use crate::variance::ci::eta3;
 use crate::variance::robust::RobustOptions;
 use crate::variance::wv::{kept_count, WaveletVariance};
@@ -40,12 +44,109 @@ struct SeriesDoc {
     eta: Option<Vec<f64>>,
 }
 
-/// True when `path` looks like a WV JSON (extension `.json`), the test `gmwm fit` uses to
-/// choose between a recording and a precomputed WV.
+/// True when `path` looks like a WV JSON: extension `.json`, or content that is a JSON object
+/// ([`sniff`]: first non-blank character `{`), whatever the name; the test the CLI uses to
+/// choose between a recording and a precomputed WV. A file that cannot be read is not one (the
+/// reader then reports why).
 pub fn is_wv_json(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        || matches!(sniff(path), Ok(Content::Json))
+}
+
+/// The series of a WV JSON picked by name or 1-based index, in the order given (all of them
+/// when `selectors` is empty).
+///
+/// # Errors
+/// [`ReadError::UnknownSeries`] for a name the file does not have,
+/// [`ReadError::SeriesOutOfRange`] for an index outside `1..=series.len()`.
+pub fn select_series(
+    path: &Path,
+    series: Vec<(String, WaveletVariance)>,
+    selectors: &[ColumnSelector],
+) -> Result<Vec<(String, WaveletVariance)>, ReadError> {
+    if selectors.is_empty() {
+        return Ok(series);
+    }
+    let names: Vec<String> = series.iter().map(|(n, _)| n.clone()).collect();
+    selectors
+        .iter()
+        .map(|sel| {
+            let k = match sel {
+                ColumnSelector::Index(i) if (1..=series.len()).contains(i) => i - 1,
+                ColumnSelector::Index(i) => {
+                    return Err(ReadError::SeriesOutOfRange {
+                        path: path.to_path_buf(),
+                        index: *i,
+                        count: series.len(),
+                    })
+                }
+                ColumnSelector::Name(n) => {
+                    names
+                        .iter()
+                        .position(|m| m == n)
+                        .ok_or_else(|| ReadError::UnknownSeries {
+                            path: path.to_path_buf(),
+                            name: n.clone(),
+                            available: names.clone(),
+                        })?
+                }
+            };
+            Ok(series[k].clone())
+        })
+        .collect()
+}
+
+/// METHODS §3.4, the overlapping Allan variance from the classical Haar MODWT WV:
+/// `AV(m) = 2 nu2(tau = 2m)` at cluster lengths `m = tau / 2`, exact for the estimators over
+/// the same index set (the textbook overlapping AV of
+/// [`allan_variance`](crate::allan_variance) with every `N - 2m + 1` term); the interval is the
+/// WV's chi-square interval times 2 and the edf its eta3 (as `allan_variance` computes them),
+/// `terms` the WV's coefficient counts, `error` the package's `1 / sqrt(2 (N/m - 1))`.
+///
+/// # Errors
+/// [`ParamError`] `wavelet variance` for a robust, non-Haar or DWT wavelet variance, for which
+/// the identity does not hold.
+pub fn allan_from_wv(wv: &WaveletVariance) -> Result<AllanVariance, ParamError> {
+    let what = if wv.robust.is_some() {
+        Some("robust".to_string())
+    } else if wv.filter != WaveletFilter::Haar {
+        Some(format!("filter {:?}", wv.filter).to_lowercase())
+    } else if wv.transform != Transform::Modwt {
+        Some(format!("transform {:?}", wv.transform).to_lowercase())
+    } else {
+        None
+    };
+    if let Some(what) = what {
+        return Err(ParamError::new(
+            "wavelet variance",
+            what,
+            "the classical Haar MODWT one, which gives the Allan variance by AV(m) = 2 WV(2m) \
+             (METHODS §3.4)",
+        ));
+    }
+    let tau: Vec<f64> = wv.tau.iter().map(|t| t / 2.0).collect();
+    let avar: Vec<f64> = wv.wv.iter().map(|v| 2.0 * v).collect();
+    Ok(AllanVariance {
+        kind: AllanKind::Overlapping,
+        convention: AvConvention::Textbook,
+        n: wv.n,
+        freq_hz: wv.freq_hz,
+        alpha: wv.alpha,
+        tau_s: tau.iter().map(|m| m / wv.freq_hz).collect(),
+        adev: avar.iter().map(|v| v.sqrt()).collect(),
+        ci_low: wv.ci_low.iter().map(|v| 2.0 * v).collect(),
+        ci_high: wv.ci_high.iter().map(|v| 2.0 * v).collect(),
+        edf: wv.eta.clone(),
+        terms: wv.n_coefficients.clone(),
+        error: tau
+            .iter()
+            .map(|&m| package_error(wv.n, m as usize))
+            .collect(),
+        tau,
+        avar,
+    })
 }
 
 /// Reads every series of a WV JSON file (see the module doc); `freq_hz` overrides the file's
@@ -78,7 +179,7 @@ pub fn read_wv_json(
     let mut out = Vec::with_capacity(series.len());
     for (i, s) in series.into_iter().enumerate() {
         let name = s.name.clone().unwrap_or_default();
-        let at = |what: &str| format!("series[{i}] ({name}): {what}");
+        let at = |what: &str| format!("series[{i}] ({}): {what}", quote(&name));
         let need = |field: &'static str| bad(at(&format!("missing \"{field}\"")));
         if name.is_empty() {
             return Err(bad(format!("series[{i}]: missing \"name\"")));

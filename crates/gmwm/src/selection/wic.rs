@@ -320,7 +320,46 @@ impl Wic {
         check_freq(freq_hz).map_err(crate::Error::from)?;
         crate::fit::check_haar(self.wv_options.filter).map_err(crate::Error::from)?;
         let wv = wavelet_variance(x, freq_hz, &self.wv_options)?;
-        let inputs = StartInputs::from_series(x);
+        self.select_from(&wv, StartInputs::from_series(x), progress)
+    }
+
+    /// [`Wic::select`] on a wavelet variance computed before (e.g. read by
+    /// [`read_wv_json`](crate::imu::read_wv_json)) instead of a series: the same steps, the
+    /// starting values from the WV alone ([`StartInputs::from_wv`]: no series range for drift
+    /// draws), the bootstrap V simulated at the WV's `n` and rate with its own estimator
+    /// settings (transform, filter, alpha, robustness, levels); the `wv_options` of this
+    /// selection are not used.
+    ///
+    /// # Errors
+    /// As [`Wic::select`] (a non-Haar WV is refused).
+    pub fn select_wv(&self, wv: &WaveletVariance) -> Result<ModelSelection, SelectionError> {
+        self.select_wv_with_progress(wv, &NoProgress)
+    }
+
+    /// [`Wic::select_wv`] reporting each scored candidate to `progress` (as
+    /// [`Wic::select_with_progress`]).
+    ///
+    /// # Errors
+    /// As [`Wic::select_wv`].
+    pub fn select_wv_with_progress(
+        &self,
+        wv: &WaveletVariance,
+        progress: &dyn Progress,
+    ) -> Result<ModelSelection, SelectionError> {
+        self.check_settings()?;
+        check_freq(wv.freq_hz).map_err(crate::Error::from)?;
+        crate::fit::check_haar(wv.filter).map_err(crate::Error::from)?;
+        self.select_from(wv, StartInputs::from_wv(wv), progress)
+    }
+
+    /// Steps 1 (after the WV) to 5 of [`Wic::select`].
+    fn select_from(
+        &self,
+        wv: &WaveletVariance,
+        inputs: StartInputs,
+        progress: &dyn Progress,
+    ) -> Result<ModelSelection, SelectionError> {
+        let freq_hz = wv.freq_hz;
         let fit_error = |m: &Model| {
             let candidate = m.to_string();
             move |source| SelectionError::Fit { candidate, source }
@@ -330,18 +369,22 @@ impl Wic {
         // asymptotic optimism is calibrated (selection module docs)
         let full_fit = self
             .estimator(&self.full)
-            .fit_from_wv(&wv, inputs)
+            .fit_from_wv(wv, inputs)
             .map_err(fit_error(&self.full))?;
         let levels = wv.levels();
+        // the WV's own settings: those of `wv_options` for a WV computed by `select`
         let replicate_opts = WvOptions {
+            transform: wv.transform,
+            filter: wv.filter,
             levels: Some(levels),
-            ..self.wv_options
+            alpha: wv.alpha,
+            robust: wv.robust,
         };
         // V of the full model: the asymptotic optimism's, and with either optimism the
         // sampling covariance behind the WIC differences' standard errors (step 5)
         let v = wv_bootstrap(
             &full_fit.active_model().map_err(fit_error(&self.full))?,
-            x.len(),
+            wv.n,
             freq_hz,
             &replicate_opts,
             self.bootstrap,
@@ -351,7 +394,7 @@ impl Wic {
         let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&full_fit.weights.omega));
         let context = Context {
             wic: self,
-            wv: &wv,
+            wv,
             inputs,
             omega: &omega,
             v: (self.method == OptimismMethod::Asymptotic).then_some(&v),
@@ -365,7 +408,7 @@ impl Wic {
                 let fit = if c.kinds() == self.full.kinds() {
                     full_fit.clone()
                 } else {
-                    self.estimator(c).fit_from_wv(&wv, inputs)?
+                    self.estimator(c).fit_from_wv(wv, inputs)?
                 };
                 let canonical = fit.canonical_with(self.separation_limit)?;
                 let score = context.score(c, &canonical.model, &fit)?;

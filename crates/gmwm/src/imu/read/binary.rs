@@ -5,9 +5,10 @@
 //! file; [`BinaryChunks`] reads fixed-size blocks so that series of 10^9 samples can be consumed
 //! in bounded memory.
 
-use super::{default_name, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
+use super::{binary_names, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
 use crate::error::{Error, ParamError};
-use crate::imu::{Imu, ReadError, Sensor, SensorInfo};
+use crate::imu::timing::{check_times, TimeUnit, UnitSource};
+use crate::imu::{Imu, ReadError, Sidecar};
 use memmap2::Mmap;
 use std::fmt;
 use std::fs::File;
@@ -110,16 +111,21 @@ fn check_ncols(ncols: usize) -> Result<(), ParamError> {
 }
 
 /// Reads a raw binary table (memory-mapped). The file must not change while it is read.
+/// `ncols` and the column names come from the options, else the sidecar.
 pub(crate) fn read_binary_table(
     path: &Path,
     format: InputFormat,
     opts: &ReadOptions,
+    sidecar: Option<&Sidecar>,
 ) -> Result<RawTable, ReadError> {
     let width = width_of(format)?;
-    let ncols = opts.ncols.unwrap_or(1);
+    let ncols = opts
+        .ncols
+        .or_else(|| sidecar.and_then(|s| s.n_columns))
+        .unwrap_or(1);
     check_ncols(ncols)?;
-    let names: Vec<String> = (0..ncols).map(default_name).collect();
-    let sel = resolve_selection(path, &names, opts)?;
+    let names = binary_names(sidecar, ncols);
+    let sel = resolve_selection(path, &names, opts, sidecar)?;
     let (file, _rows) = open_records(path, width * ncols)?;
     let bytes = map(path, &file)?;
     let record = width * ncols;
@@ -162,7 +168,14 @@ pub(crate) fn read_binary_table(
             })
         })
         .collect::<Result<_, ReadError>>()?;
-    Ok(RawTable { columns, time })
+    Ok(RawTable {
+        columns,
+        time,
+        time_unit: sel.time_unit,
+        freq_hz: None,
+        lines: None,
+        skipped: sel.skipped,
+    })
 }
 
 /// Streaming reader of one column of a raw binary file, chunk by chunk, in bounded memory
@@ -403,68 +416,83 @@ impl FromStr for ImuRecordType {
     }
 }
 
-/// `round(1 / mean(diff(t)))` of METHODS §9.2 (rounded, unlike [`super::read_table`]).
+/// METHODS §9.2's `round(1 / mean(diff(time)))`, the mean taken over the regular steps
+/// ([`check_times`]: steps within 1.5 nominal steps), so that a gap in the epochs does not lower
+/// the rate that converts every increment; identical to the package's on a file without gaps.
 fn record_freq(path: &Path, t: &[f64]) -> Result<f64, ReadError> {
     let not_derivable = |reason| ReadError::FreqNotDerivable {
         path: path.to_path_buf(),
         reason,
     };
-    match (t.first(), t.last()) {
-        (Some(first), Some(last)) if t.len() >= 2 => {
-            let freq = ((t.len() - 1) as f64 / (last - first)).round();
-            if freq.is_finite() && freq > 0.0 {
-                Ok(freq)
-            } else {
-                Err(not_derivable(
-                    "round(1 / mean(diff(time))) is not a positive finite rate",
-                ))
-            }
-        }
-        _ => Err(not_derivable("fewer than 2 epochs")),
+    if t.len() < 2 {
+        return Err(not_derivable("fewer than 2 epochs"));
+    }
+    let freq = check_times("time", t, TimeUnit::Seconds, UnitSource::Stated)
+        .rate_hz
+        .round();
+    if freq.is_finite() && freq > 0.0 {
+        Ok(freq)
+    } else {
+        Err(not_derivable(
+            "round(1 / mean time step) is not a positive finite rate",
+        ))
     }
 }
 
-/// Reads a binary IMU record file (METHODS §9.2): each epoch is a little-endian f64 time then
-/// gyro X, Y, Z and accel X, Y, Z increments (int32 or f64 by type). Returns an [`Imu`] with
-/// `freq = round(1 / mean(diff(time)))` and rates `raw · freq · scale` (METHODS §9.3), in rad/s
-/// and m/s^2, columns named `gyro_x` ... `accel_z`.
-///
-/// The file is memory-mapped and must not change while it is read.
-///
-/// # Errors
-/// [`ReadError::Io`], [`ReadError::Empty`], [`ReadError::BinarySize`] (size not a multiple of
-/// 32 or 56 bytes), [`ReadError::BinaryNonFinite`] (column 1 is the time),
-/// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span).
-pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<Imu, Error> {
+/// Column names of the IMU records, in record order (METHODS §9.2).
+pub(crate) const RECORD_COLUMNS: [&str; 6] = [
+    "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+];
+
+/// Reads the selected columns of a binary IMU record file (METHODS §9.2–9.3), memory-mapped:
+/// the times are decoded once (checked finite and strictly increasing), then each selected
+/// column is decoded and scaled in one pass straight from the map, so no raw copy is held.
+pub(crate) fn read_record_table(
+    path: &Path,
+    record_type: ImuRecordType,
+    opts: &ReadOptions,
+) -> Result<RawTable, ReadError> {
     let record = record_type.record_size();
+    let names: Vec<String> = RECORD_COLUMNS.iter().map(|n| n.to_string()).collect();
+    // the time is the records' own; a time column option does not apply
+    let select = ReadOptions {
+        time_column: None,
+        ..opts.clone()
+    };
+    let sel = resolve_selection(path, &names, &select, None)?;
     let (file, _rows) = open_records(path, record)?;
     let bytes = map(path, &file)?;
     let time: Vec<f64> = bytes.chunks_exact(record).map(|r| decode(r, 8)).collect();
     if let Some(i) = time.iter().position(|v| !v.is_finite()) {
-        return Err(non_finite(path, i, 1, time[i]).into());
+        return Err(non_finite(path, i, 1, time[i]));
+    }
+    if let Some(i) = time.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(ReadError::RecordTimeNotIncreasing {
+            path: path.to_path_buf(),
+            index: i as u64 + 1,
+            previous: time[i],
+            value: time[i + 1],
+        });
     }
     let freq = record_freq(path, &time)?;
-    let names = [
-        "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
-    ];
-    let mut columns = Vec::with_capacity(6);
-    let mut info = Vec::with_capacity(6);
-    for (k, name) in names.into_iter().enumerate() {
-        let (sensor, scale, unit) = if k < 3 {
-            (Sensor::Gyroscope, record_type.scale_gyro(), "rad/s")
+    let mut columns = Vec::with_capacity(sel.columns.len());
+    for &k in &sel.columns {
+        let scale = if k < 3 {
+            record_type.scale_gyro()
         } else {
-            (Sensor::Accelerometer, record_type.scale_accel(), "m/s^2")
+            record_type.scale_accel()
         };
         let factor = freq * scale;
         let values: Vec<f64> = if record_type.is_double() {
-            let raw: Vec<f64> = bytes
-                .chunks_exact(record)
-                .map(|r| decode(&r[8 + 8 * k..], 8))
-                .collect();
-            if let Some(i) = raw.iter().position(|v| !v.is_finite()) {
-                return Err(non_finite(path, i, k + 2, raw[i]).into());
+            let mut values = Vec::with_capacity(time.len());
+            for (i, r) in bytes.chunks_exact(record).enumerate() {
+                let raw = decode(&r[8 + 8 * k..], 8);
+                if !raw.is_finite() {
+                    return Err(non_finite(path, i, k + 2, raw));
+                }
+                values.push(raw * factor);
             }
-            raw.into_iter().map(|v| v * factor).collect()
+            values
         } else {
             bytes
                 .chunks_exact(record)
@@ -472,23 +500,49 @@ pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<I
                 .collect()
         };
         columns.push(Column {
-            name: name.to_string(),
+            name: names[k].clone(),
             values,
         });
-        info.push(SensorInfo {
-            sensor,
-            axis: ["X", "Y", "Z"][k % 3].to_string(),
-            unit: Some(unit.to_string()),
-        });
     }
+    Ok(RawTable {
+        columns,
+        time: Some(Column {
+            name: "time".into(),
+            values: time,
+        }),
+        time_unit: Some(TimeUnit::Seconds),
+        freq_hz: Some(freq),
+        lines: None,
+        skipped: Vec::new(),
+    })
+}
+
+/// Reads a binary IMU record file (METHODS §9.2): each epoch is a little-endian f64 time then
+/// gyro X, Y, Z and accel X, Y, Z increments (int32 or f64 by type). Returns an [`Imu`] with
+/// `freq = round(1 / mean time step)` (the mean over the regular steps, see `record_freq`:
+/// METHODS §9.2's rate on a file without gaps) and rates `raw · freq · scale` (METHODS §9.3),
+/// in rad/s and m/s^2, columns named `gyro_x` ... `accel_z`; its [`Imu::timing`] reports the
+/// epochs' gaps. The same columns are read by [`read_table`](super::read_table) with
+/// [`InputFormat::ImuRecord`].
+///
+/// The file is memory-mapped and must not change while it is read.
+///
+/// # Errors
+/// [`ReadError::Io`], [`ReadError::Empty`], [`ReadError::BinarySize`] (size not a multiple of
+/// 32 or 56 bytes, with the bytes left over), [`ReadError::BinaryNonFinite`] (column 1 is the
+/// time), [`ReadError::RecordTimeNotIncreasing`] (with the 0-based record and both times),
+/// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span).
+pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<Imu, Error> {
+    let opts = ReadOptions {
+        format: InputFormat::ImuRecord(record_type),
+        ..ReadOptions::default()
+    };
+    let table = super::read_table(path, &opts)?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let imu = Imu::new(columns, info, freq)?
-        .with_name(name)
-        .with_record_type(record_type);
-    Ok(imu)
+    Ok(Imu::from_table(table)?.with_name(name))
 }
 
 #[cfg(test)]

@@ -1,18 +1,24 @@
 //! Readers: delimited text (CSV/TSV, optionally gzip-compressed) and raw little-endian binary.
 //!
 //! [`read_table`] is the entry point: it picks the format ([`InputFormat::Auto`] looks at the
-//! file name and the gzip magic bytes), materialises only the selected columns, reads the JSON
-//! sidecar if there is one and resolves the sampling frequency (see [`read_table`]).
+//! file name, the JSON sidecar and the first bytes), finds the time column, materialises only
+//! the selected columns and resolves the sampling frequency (see [`read_table`]).
 
 pub(crate) mod binary;
 pub(crate) mod text;
 
 pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordType};
 
+use super::error::quote;
 use super::sidecar::{find_sidecar, Sidecar};
-use super::ReadError;
+use super::timing::{
+    check_times, fmt_hz, infer_time_unit, time_column_unit, TimeUnit, TimingReport, TimingWarning,
+    UnitSource,
+};
+use super::{ReadError, SensorInfo};
 use crate::error::{check_freq, ParamError};
 use serde::{Deserialize, Serialize};
+use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
@@ -60,9 +66,12 @@ impl std::fmt::Display for ColumnSelector {
 /// Input format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum InputFormat {
-    /// From the file name (default): `*.f64`, `*.f64le`, `*.f64.bin`, `*.f64le.bin` → [`F64`],
-    /// the same with `f32` → [`F32`], anything else is delimited text whose delimiter is sniffed
-    /// from the first line (`.tsv` prefers tab, other names prefer comma).
+    /// From the file name, then the sidecar, then the content (default): `*.f64`, `*.f64le`,
+    /// `*.f64.bin`, `*.f64le.bin` → [`F64`], the same with `f32` → [`F32`]; else the sidecar's
+    /// `format` (`f64`, `f32`, a record type, `csv`, `tsv`); else the first bytes: a gzip
+    /// stream or text is delimited text whose delimiter is sniffed from the first line (`.tsv`
+    /// prefers tab, other names prefer comma), JSON is refused ([`ReadError::NotATable`]),
+    /// anything else is refused as binary ([`ReadError::LooksBinary`]).
     ///
     /// [`F64`]: InputFormat::F64
     /// [`F32`]: InputFormat::F32
@@ -72,6 +81,9 @@ pub enum InputFormat {
     Csv,
     /// Tab separated (no sniffing).
     Tsv,
+    /// Binary IMU epoch records of METHODS §9.2 (time, then gyro X, Y, Z and accel X, Y, Z
+    /// increments), read as columns `gyro_x` ... `accel_z` in rad/s and m/s^2 and the time.
+    ImuRecord(ImuRecordType),
     /// Raw little-endian f64, `ncols` interleaved columns.
     F64,
     /// Raw little-endian f32, `ncols` interleaved columns.
@@ -81,25 +93,47 @@ pub enum InputFormat {
 impl FromStr for InputFormat {
     type Err = ParamError;
 
-    /// `auto`, `csv`, `tsv`, `f64`, `f32` (case-insensitive).
+    /// `auto`, `csv`, `tsv`, `f64`, `f32` or a record type (`imar`, `ln200`, `ln200ig`,
+    /// `ixsea`, `navchip-int`, `navchip-flt`, also with `_`), case-insensitive.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.trim().to_ascii_lowercase().as_str() {
             "auto" => Ok(Self::Auto),
             "csv" => Ok(Self::Csv),
             "tsv" => Ok(Self::Tsv),
-            "f64" => Ok(Self::F64),
-            "f32" => Ok(Self::F32),
-            _ => Err(ParamError::new(
-                "format",
-                s,
-                "one of auto, csv, tsv, f64, f32",
-            )),
+            "f64" | "f64le" => Ok(Self::F64),
+            "f32" | "f32le" => Ok(Self::F32),
+            other => other
+                .replace('-', "_")
+                .parse::<ImuRecordType>()
+                .map(Self::ImuRecord)
+                .map_err(|_| {
+                    ParamError::new(
+                        "format",
+                        s,
+                        "one of auto, csv, tsv, f64, f32, imar, ln200, ln200ig, ixsea, \
+                         navchip-int, navchip-flt",
+                    )
+                }),
+        }
+    }
+}
+
+impl fmt::Display for InputFormat {
+    /// The name [`InputFormat::from_str`] reads back (`f64`, `ln200`, `navchip-int`, ...).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Auto => f.write_str("auto"),
+            Self::Csv => f.write_str("csv"),
+            Self::Tsv => f.write_str("tsv"),
+            Self::F64 => f.write_str("f64"),
+            Self::F32 => f.write_str("f32"),
+            Self::ImuRecord(t) => f.write_str(&t.name().to_ascii_lowercase().replace('_', "-")),
         }
     }
 }
 
 impl InputFormat {
-    /// Bytes per value of a binary format, `None` for text formats.
+    /// Bytes per value of a raw binary format, `None` for text formats and IMU records.
     pub fn value_width(self) -> Option<usize> {
         match self {
             Self::F64 => Some(8),
@@ -108,7 +142,8 @@ impl InputFormat {
         }
     }
 
-    /// Resolves [`InputFormat::Auto`] from the file name (see the variant's doc).
+    /// Resolves [`InputFormat::Auto`] from the file name only (see the variant's doc; the
+    /// sidecar and the content are looked at by [`read_table`]).
     pub fn resolve(self, path: &Path) -> Self {
         if self != Self::Auto {
             return self;
@@ -127,6 +162,72 @@ impl InputFormat {
             Self::Auto
         }
     }
+}
+
+/// What the first bytes of a file are ([`sniff`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Content {
+    /// Plain text.
+    Text,
+    /// A gzip stream whose start decompresses to text.
+    Gzip,
+    /// A JSON object (first non-blank character `{`).
+    Json,
+    /// Neither: NUL bytes or invalid UTF-8 in the first [`SNIFF_BYTES`].
+    Binary,
+}
+
+/// Bytes looked at by [`sniff`]: 4 KiB.
+pub const SNIFF_BYTES: usize = 4096;
+
+/// Looks at the first [`SNIFF_BYTES`] bytes of a file (decompressed if it starts with the gzip
+/// magic bytes) and says whether it is text, gzip text, JSON or binary data. Text is UTF-8
+/// without NUL bytes (a UTF-8 sequence cut by the 4 KiB window counts as text).
+///
+/// # Errors
+/// [`ReadError::Io`] if the file cannot be read; [`ReadError::Gzip`] if the gzip stream is
+/// corrupt at its start.
+pub fn sniff(path: &Path) -> Result<Content, ReadError> {
+    use std::io::Read;
+    let io = |source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut head = Vec::with_capacity(SNIFF_BYTES);
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take(SNIFF_BYTES as u64)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    let gzip = head.starts_with(&[0x1f, 0x8b]);
+    if gzip {
+        let file = std::fs::File::open(path).map_err(io)?;
+        let mut text = Vec::with_capacity(SNIFF_BYTES);
+        flate2::read::MultiGzDecoder::new(file)
+            .take(SNIFF_BYTES as u64)
+            .read_to_end(&mut text)
+            .map_err(|source| ReadError::Gzip {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        head = text;
+    }
+    let is_text = !head.contains(&0)
+        && match std::str::from_utf8(&head) {
+            Ok(_) => true,
+            // a multi-byte character cut at the end of the window
+            Err(e) => e.error_len().is_none(),
+        };
+    let body = head.strip_prefix(&[0xef, 0xbb, 0xbf][..]).unwrap_or(&head);
+    Ok(if !is_text {
+        Content::Binary
+    } else if body.trim_ascii_start().starts_with(b"{") {
+        Content::Json
+    } else if gzip {
+        Content::Gzip
+    } else {
+        Content::Text
+    })
 }
 
 /// Header handling of delimited text.
@@ -149,12 +250,17 @@ pub struct ReadOptions {
     pub format: InputFormat,
     /// Header handling of text files (default [`HeaderMode::Auto`]); ignored for binary.
     pub header: HeaderMode,
-    /// Time column, if any (default none: rows are equally spaced at `freq_hz`). Must be finite
-    /// and strictly increasing; it is returned in [`Table::time`], not among the columns.
+    /// Time column (default `None`: found by name, see [`read_table`]). Must be finite and
+    /// strictly increasing; it is returned in [`Table::time`] (in seconds), not among the
+    /// columns.
     pub time_column: Option<ColumnSelector>,
-    /// Columns to read, in this order (default empty: all but the time column).
+    /// Unit of the time column (default `None`: stated by its name, else inferred, see
+    /// [`infer_time_unit`](crate::imu::infer_time_unit)).
+    pub time_unit: Option<TimeUnit>,
+    /// Columns to read, in this order (default empty: see [`read_table`]).
     pub columns: Vec<ColumnSelector>,
-    /// Interleaved columns in a binary file (default `None` = 1); ignored for text.
+    /// Interleaved columns in a binary file (default `None`: the sidecar's `n_columns`, else
+    /// 1); ignored for text.
     pub ncols: Option<usize>,
     /// Sampling rate override in Hz (default `None`: from the time column, else the sidecar).
     pub freq_hz: Option<f64>,
@@ -180,8 +286,17 @@ pub struct Table {
     pub freq_hz: Option<f64>,
     /// The JSON sidecar beside the file, if any.
     pub sidecar: Option<Sidecar>,
-    /// The time column (finite, strictly increasing), if one was selected.
+    /// The time column in seconds (finite, strictly increasing), if one was given or found.
     pub time: Option<Column>,
+    /// What the time column says about the sampling (unit, rate, gaps, ...), if there is one.
+    pub timing: Option<TimingReport>,
+    /// Soft problems found while reading (gaps, a rate that disagrees with the time column).
+    pub warnings: Vec<ReadWarning>,
+    /// Columns left out of the default selection: other time columns, and the columns that
+    /// are neither a gyroscope nor an accelerometer axis when the file has such axes.
+    pub skipped: Vec<String>,
+    /// The binary IMU record type the table was decoded from, if any (METHODS §9.1 `stype`).
+    pub record_type: Option<ImuRecordType>,
 }
 
 impl Table {
@@ -201,33 +316,280 @@ impl Table {
     }
 }
 
+/// A soft problem found by [`read_table`]; `Display` is one line starting with the file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum ReadWarning {
+    /// A problem of the time stamps (gaps, duplicates, reordering, jitter).
+    Timing {
+        /// File.
+        path: PathBuf,
+        /// What.
+        warning: TimingWarning,
+    },
+    /// The rate given by the caller differs by more than [`RATE_TOLERANCE`] from the time
+    /// column's; the given rate is used.
+    FreqDisagrees {
+        /// File.
+        path: PathBuf,
+        /// The rate given, in Hz (used).
+        given_hz: f64,
+        /// Time column.
+        column: String,
+        /// Its rate, in Hz.
+        time_hz: f64,
+    },
+    /// The sidecar's `sampling_frequency_hz` differs by more than [`RATE_TOLERANCE`] from the
+    /// time column's; the time column's is used.
+    SidecarFreqDisagrees {
+        /// File.
+        path: PathBuf,
+        /// The sidecar's rate, in Hz.
+        sidecar_hz: f64,
+        /// Time column.
+        column: String,
+        /// Its rate, in Hz (used).
+        time_hz: f64,
+    },
+}
+
+/// Relative difference between two rates above which they disagree: 1% (a time column and a
+/// nominal rate agree far better; a factor such as 100 vs 200 Hz is a wrong rate).
+pub const RATE_TOLERANCE: f64 = 0.01;
+
+impl fmt::Display for ReadWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let pct = |a: f64, b: f64| 100.0 * (a - b).abs() / b;
+        match self {
+            Self::Timing { path, warning } => write!(f, "{}: {warning}", path.display()),
+            Self::FreqDisagrees {
+                path,
+                given_hz,
+                column,
+                time_hz,
+            } => write!(
+                f,
+                "{}: the rate given ({} Hz) differs by {:.0}% from time column \"{}\" ({} Hz); \
+                 the given rate is used",
+                path.display(),
+                fmt_hz(*given_hz),
+                pct(*given_hz, *time_hz),
+                quote(column),
+                fmt_hz(*time_hz)
+            ),
+            Self::SidecarFreqDisagrees {
+                path,
+                sidecar_hz,
+                column,
+                time_hz,
+            } => write!(
+                f,
+                "{}: the sidecar's sampling_frequency_hz ({} Hz) differs by {:.0}% from time \
+                 column \"{}\" ({} Hz); the time column's rate is used",
+                path.display(),
+                fmt_hz(*sidecar_hz),
+                pct(*sidecar_hz, *time_hz),
+                quote(column),
+                fmt_hz(*time_hz)
+            ),
+        }
+    }
+}
+
+/// The format [`read_table`] reads `path` with: `opts.format` unless [`InputFormat::Auto`],
+/// else as documented on [`InputFormat::Auto`]. Text formats are checked to be text.
+///
+/// # Errors
+/// [`ReadError::LooksBinary`], [`ReadError::NotATable`], [`ReadError::Io`],
+/// [`ReadError::Gzip`].
+pub fn resolve_format(
+    path: &Path,
+    format: InputFormat,
+    sidecar: Option<&Sidecar>,
+) -> Result<InputFormat, ReadError> {
+    let mut format = format.resolve(path);
+    if format == InputFormat::Auto {
+        if let Some(f) = sidecar
+            .and_then(|s| s.format.as_deref())
+            .and_then(|f| f.parse::<InputFormat>().ok())
+        {
+            format = f;
+        }
+    }
+    if matches!(
+        format,
+        InputFormat::Auto | InputFormat::Csv | InputFormat::Tsv
+    ) {
+        match sniff(path)? {
+            Content::Binary => {
+                return Err(ReadError::LooksBinary {
+                    path: path.to_path_buf(),
+                })
+            }
+            Content::Json => {
+                return Err(ReadError::NotATable {
+                    path: path.to_path_buf(),
+                })
+            }
+            Content::Text | Content::Gzip => {}
+        }
+    }
+    Ok(format)
+}
+
+/// Layout of a raw f64/f32 file: what [`read_table`] would use for it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BinaryLayout {
+    /// [`InputFormat::F64`] or [`InputFormat::F32`].
+    pub format: InputFormat,
+    /// Interleaved columns: `opts.ncols`, else the sidecar's `n_columns`, else 1.
+    pub ncols: usize,
+    /// Column names: the sidecar's when it names `ncols` columns, else `col1`, `col2`, ...
+    pub names: Vec<String>,
+}
+
+/// The raw binary layout of `path` if [`read_table`] would read it as raw f64/f32 (from
+/// `opts.format`, the name or the sidecar), `None` otherwise; for readers that stream
+/// ([`BinaryChunks`]).
+///
+/// # Errors
+/// As [`resolve_format`] and [`find_sidecar`].
+pub fn binary_layout(path: &Path, opts: &ReadOptions) -> Result<Option<BinaryLayout>, ReadError> {
+    let sidecar = find_sidecar(path)?;
+    let format = resolve_format(path, opts.format, sidecar.as_ref())?;
+    if format.value_width().is_none() {
+        return Ok(None);
+    }
+    let ncols = opts
+        .ncols
+        .or_else(|| sidecar.as_ref().and_then(|s| s.n_columns))
+        .unwrap_or(1);
+    Ok(Some(BinaryLayout {
+        format,
+        ncols,
+        names: binary_names(sidecar.as_ref(), ncols),
+    }))
+}
+
+/// Column names of a raw binary file: the sidecar's if it names exactly `ncols` columns.
+pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<String> {
+    match sidecar {
+        Some(s) if s.columns.len() == ncols && s.columns.iter().all(|c| !c.name.is_empty()) => {
+            s.columns.iter().map(|c| c.name.clone()).collect()
+        }
+        _ => (0..ncols).map(default_name).collect(),
+    }
+}
+
 /// Reads a text or binary file into a [`Table`].
 ///
-/// Sampling frequency, first match wins: `opts.freq_hz`; the time column, as
-/// `1 / mean(diff(t)) = (n - 1) / (t_last - t_first)` — unlike METHODS §9.2 (binary IMU records)
-/// it is not rounded, so non-integer rates such as 62.5 Hz survive; the sidecar's
-/// `sampling_frequency_hz`; otherwise `None` and the caller decides.
+/// Format: [`resolve_format`] (name, sidecar, content).
+///
+/// Time column: `opts.time_column`, else found by name ([`time_column_unit`]: `time`,
+/// `timestamp`, `t`, `stamp`, `%time`, `#timestamp [ns]`, `timestamp_ns`, `time_s`,
+/// `time [s]`, `field.header.stamp`, ...; a header stamp is preferred, else the first in file
+/// order) unless `opts.columns` selects that column explicitly. Its unit: `opts.time_unit`,
+/// else the one its name states, else [`infer_time_unit`](crate::imu::infer_time_unit)
+/// (seconds if nothing can be inferred). The stamps are converted to seconds and checked
+/// ([`check_times`](crate::imu::check_times), [`Table::timing`]); in a text or raw binary file
+/// they must strictly increase ([`ReadError::TimeNotIncreasing`] names the line).
+///
+/// Columns: `opts.columns` in that order; by default every column but the time columns, and
+/// if some columns are gyroscope or accelerometer axes ([`SensorInfo::infer`] on the name or
+/// the sidecar's meaning) only those; the others are listed in [`Table::skipped`].
+///
+/// Sampling frequency, first match wins: `opts.freq_hz`; the time column's rate,
+/// [`TimingReport::rate_hz`] (1 / the nominal step: the mean of the steps within 1.5 median
+/// steps, so gaps do not lower it; not rounded, so 62.5 Hz survives) — for IMU records
+/// METHODS §9.2's rounded rate; the sidecar's `sampling_frequency_hz`; otherwise `None` and
+/// the caller decides. A given rate or a sidecar rate that differs from the time column's by
+/// more than [`RATE_TOLERANCE`] is a [`ReadWarning`].
 ///
 /// Cost: one pass over the file; only the selected columns are stored.
 ///
 /// # Errors
 /// Any [`ReadError`]: I/O, empty or header-only file, ragged row, non-numeric or non-finite cell
 /// (with its line and column), unknown column, binary size not a multiple of the record size,
-/// corrupt gzip, unreadable sidecar, non-increasing time, invalid options.
+/// binary content without a binary format, corrupt gzip, unreadable sidecar, non-increasing
+/// time, invalid options.
 pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
     if let Some(f) = opts.freq_hz {
         check_freq(f)?;
     }
-    let raw = match opts.format.resolve(path) {
-        f @ (InputFormat::F64 | InputFormat::F32) => binary::read_binary_table(path, f, opts)?,
-        f => text::read_text_table(path, f, opts)?,
-    };
     let sidecar = find_sidecar(path)?;
-    let freq_from_time = raw.time.as_ref().and_then(|t| freq_from_times(&t.values));
+    let format = resolve_format(path, opts.format, sidecar.as_ref())?;
+    let raw = match format {
+        InputFormat::F64 | InputFormat::F32 => {
+            binary::read_binary_table(path, format, opts, sidecar.as_ref())?
+        }
+        InputFormat::ImuRecord(t) => binary::read_record_table(path, t, opts)?,
+        f => text::read_text_table(path, f, opts, sidecar.as_ref())?,
+    };
+    let mut warnings = Vec::new();
+    let (time, timing) = match raw.time {
+        Some(mut col) => {
+            let (unit, source) = match (opts.time_unit, raw.time_unit) {
+                (Some(u), _) => (u, UnitSource::Flag),
+                (None, Some(u)) => (u, UnitSource::Stated),
+                (None, None) => (
+                    infer_time_unit(&col.values).unwrap_or(TimeUnit::Seconds),
+                    UnitSource::Inferred,
+                ),
+            };
+            if unit != TimeUnit::Seconds {
+                let k = unit.to_seconds();
+                col.values.iter_mut().for_each(|t| *t *= k);
+            }
+            let mut report = check_times(&col.name, &col.values, unit, source);
+            if let Some(lines) = &raw.lines {
+                for g in &mut report.gaps {
+                    g.line = Some(lines.line_of(g.row));
+                }
+            }
+            warnings.extend(
+                report
+                    .warnings()
+                    .into_iter()
+                    .map(|warning| ReadWarning::Timing {
+                        path: path.to_path_buf(),
+                        warning,
+                    }),
+            );
+            (Some(col), Some(report))
+        }
+        None => (None, None),
+    };
+    let time_hz = timing
+        .as_ref()
+        .filter(|r| r.rate_hz.is_finite() && r.rate_hz > 0.0)
+        .map(|r| (r.column.clone(), raw.freq_hz.unwrap_or(r.rate_hz)));
+    let sidecar_hz = sidecar.as_ref().and_then(|s| s.sampling_frequency_hz);
+    let disagree = |a: f64, b: f64| (a - b).abs() > RATE_TOLERANCE * b;
+    if let Some((column, time_hz)) = &time_hz {
+        if let Some(given_hz) = opts.freq_hz.filter(|&g| disagree(g, *time_hz)) {
+            warnings.push(ReadWarning::FreqDisagrees {
+                path: path.to_path_buf(),
+                given_hz,
+                column: column.clone(),
+                time_hz: *time_hz,
+            });
+        } else if let Some(sidecar_hz) = sidecar_hz.filter(|&s| disagree(s, *time_hz)) {
+            if opts.freq_hz.is_none() {
+                warnings.push(ReadWarning::SidecarFreqDisagrees {
+                    path: path.to_path_buf(),
+                    sidecar_hz,
+                    column: column.clone(),
+                    time_hz: *time_hz,
+                });
+            }
+        }
+    }
     let freq_hz = opts
         .freq_hz
-        .or(freq_from_time)
-        .or_else(|| sidecar.as_ref().and_then(|s| s.sampling_frequency_hz));
+        .or(time_hz.map(|(_, f)| f))
+        .or(raw.freq_hz)
+        .or(sidecar_hz);
     if let Some(f) = freq_hz {
         // a rate from the options, the time column or the sidecar must be usable: never
         // silently replaced by a default
@@ -238,35 +600,78 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         columns: raw.columns,
         freq_hz,
         sidecar,
-        time: raw.time,
+        time,
+        timing,
+        warnings,
+        skipped: raw.skipped,
+        record_type: match format {
+            InputFormat::ImuRecord(t) => Some(t),
+            _ => None,
+        },
     })
 }
 
-/// Columns and time as decoded by a format reader, before sidecar and frequency resolution.
+/// Columns and time as decoded by a format reader, before unit, sidecar and frequency
+/// resolution.
 pub(crate) struct RawTable {
     pub(crate) columns: Vec<Column>,
+    /// Raw stamps (in `time_unit` if stated, else unknown).
     pub(crate) time: Option<Column>,
+    /// Unit stated by the time column's name or the format.
+    pub(crate) time_unit: Option<TimeUnit>,
+    /// Rate fixed by the format (IMU records: METHODS §9.2).
+    pub(crate) freq_hz: Option<f64>,
+    /// Physical lines of the data rows (text files).
+    pub(crate) lines: Option<LineMap>,
+    /// Columns left out of the default selection.
+    pub(crate) skipped: Vec<String>,
 }
 
-/// `1 / mean(diff(t))`, `None` with fewer than two times or a non-positive span.
-pub(crate) fn freq_from_times(t: &[f64]) -> Option<f64> {
-    let (first, last) = (t.first()?, t.last()?);
-    let span = last - first;
-    let f = (t.len() - 1) as f64 / span;
-    (t.len() >= 2 && span > 0.0 && f.is_finite()).then_some(f)
+/// Physical line of each data row of a text file, stored as the rows where the line stops
+/// following the row (blank lines): `(row, line)` pairs, the first at row 0.
+#[derive(Debug, Default)]
+pub(crate) struct LineMap {
+    breaks: Vec<(usize, u64)>,
+    rows: usize,
+}
+
+impl LineMap {
+    /// Records that the next data row is on `line`.
+    #[inline]
+    pub(crate) fn push(&mut self, line: u64) {
+        let expected = self.breaks.last().map(|&(r, l)| l + (self.rows - r) as u64);
+        if expected != Some(line) {
+            self.breaks.push((self.rows, line));
+        }
+        self.rows += 1;
+    }
+
+    /// The 1-based physical line of the 0-based data row `row`.
+    pub(crate) fn line_of(&self, row: usize) -> u64 {
+        let i = self.breaks.partition_point(|&(r, _)| r <= row);
+        match i.checked_sub(1).map(|i| self.breaks[i]) {
+            Some((r, l)) => l + (row - r) as u64,
+            None => row as u64 + 1,
+        }
+    }
 }
 
 /// Resolved column selection: 0-based indices of the time column and the data columns.
 pub(crate) struct Selection {
     pub(crate) time: Option<usize>,
+    /// Unit stated by the time column's name.
+    pub(crate) time_unit: Option<TimeUnit>,
     pub(crate) columns: Vec<usize>,
+    pub(crate) skipped: Vec<String>,
 }
 
-/// Resolves selectors against the column names of a file (`names.len()` = number of columns).
+/// Resolves selectors against the column names of a file (`names.len()` = number of columns),
+/// finding the time column and the default columns as documented on [`read_table`].
 pub(crate) fn resolve_selection(
     path: &Path,
     names: &[String],
     opts: &ReadOptions,
+    sidecar: Option<&Sidecar>,
 ) -> Result<Selection, ReadError> {
     let resolve = |sel: &ColumnSelector| -> Result<usize, ReadError> {
         match sel {
@@ -288,13 +693,54 @@ pub(crate) fn resolve_selection(
             }
         }
     };
-    let time = opts.time_column.as_ref().map(resolve).transpose()?;
-    let columns = if opts.columns.is_empty() {
-        (0..names.len()).filter(|&k| Some(k) != time).collect()
-    } else {
-        opts.columns.iter().map(resolve).collect::<Result<_, _>>()?
+    let explicit: Vec<usize> = opts.columns.iter().map(resolve).collect::<Result<_, _>>()?;
+    // every column named like a time column, header stamps first
+    let mut times: Vec<(usize, Option<TimeUnit>)> = names
+        .iter()
+        .enumerate()
+        .filter_map(|(k, n)| time_column_unit(n).map(|u| (k, u)))
+        .collect();
+    times.sort_by_key(|&(k, _)| (!names[k].to_ascii_lowercase().contains("header.stamp"), k));
+    let (time, time_unit) = match &opts.time_column {
+        Some(sel) => {
+            let k = resolve(sel)?;
+            (Some(k), time_column_unit(&names[k]).flatten())
+        }
+        None => match times.iter().find(|(k, _)| !explicit.contains(k)) {
+            Some(&(k, u)) => (Some(k), u),
+            None => (None, None),
+        },
     };
-    Ok(Selection { time, columns })
+    if !opts.columns.is_empty() {
+        return Ok(Selection {
+            time,
+            time_unit,
+            columns: explicit,
+            skipped: Vec::new(),
+        });
+    }
+    let data: Vec<usize> = (0..names.len())
+        .filter(|&k| Some(k) != time && !times.iter().any(|&(t, _)| t == k))
+        .collect();
+    let is_axis = |k: usize| {
+        SensorInfo::infer(&names[k]).is_some()
+            || sidecar
+                .and_then(|s| s.meaning(&names[k]))
+                .and_then(SensorInfo::infer)
+                .is_some()
+    };
+    let axes: Vec<usize> = data.iter().copied().filter(|&k| is_axis(k)).collect();
+    let columns = if axes.is_empty() { data } else { axes };
+    let skipped = (0..names.len())
+        .filter(|&k| Some(k) != time && !columns.contains(&k))
+        .map(|k| names[k].clone())
+        .collect();
+    Ok(Selection {
+        time,
+        time_unit,
+        columns,
+        skipped,
+    })
 }
 
 /// Default name of the 0-based column `k`: `col{k+1}`.
@@ -328,6 +774,21 @@ mod tests {
         assert_eq!("F64".parse::<InputFormat>().unwrap(), InputFormat::F64);
         assert_eq!("tsv".parse::<InputFormat>().unwrap(), InputFormat::Tsv);
         assert!("xml".parse::<InputFormat>().is_err());
+        for (text, f) in [
+            ("ln200", InputFormat::ImuRecord(ImuRecordType::Ln200)),
+            (
+                "navchip-int",
+                InputFormat::ImuRecord(ImuRecordType::NavchipInt),
+            ),
+            (
+                "NAVCHIP_FLT",
+                InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
+            ),
+            ("f64le", InputFormat::F64),
+        ] {
+            assert_eq!(text.parse::<InputFormat>().unwrap(), f);
+            assert_eq!(f.to_string().parse::<InputFormat>().unwrap(), f);
+        }
         let r = |p: &str| InputFormat::Auto.resolve(Path::new(p));
         assert_eq!(r("gm3_N1000000.f64le.bin"), InputFormat::F64);
         assert_eq!(r("x.F32"), InputFormat::F32);
@@ -339,11 +800,13 @@ mod tests {
     }
 
     #[test]
-    fn freq_from_times_is_inverse_mean_step() {
-        assert_eq!(freq_from_times(&[0.0, 0.016, 0.032]), Some(62.5));
-        assert_eq!(freq_from_times(&[1.0]), None);
-        assert_eq!(freq_from_times(&[]), None);
-        assert!(check_freq(0.0).is_err() && check_freq(f64::NAN).is_err());
-        assert!(check_freq(100.0).is_ok());
+    fn line_map_follows_blank_lines() {
+        let mut m = LineMap::default();
+        for l in [2, 3, 5, 6, 7, 10] {
+            m.push(l);
+        }
+        let lines: Vec<u64> = (0..6).map(|r| m.line_of(r)).collect();
+        assert_eq!(lines, [2, 3, 5, 6, 7, 10]);
+        assert_eq!(m.breaks.len(), 3);
     }
 }

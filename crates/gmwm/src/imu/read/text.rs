@@ -4,9 +4,10 @@
 //! their bytes (`str::parse::<f64>`), never copied into a `String`, and only the selected
 //! columns are stored.
 
-use super::{default_name, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
+use super::{default_name, resolve_selection, Column, InputFormat, LineMap, RawTable, ReadOptions};
+use crate::imu::error::quote;
 use crate::imu::read::HeaderMode;
-use crate::imu::ReadError;
+use crate::imu::{ReadError, Sidecar};
 use csv::ByteRecord;
 use flate2::read::MultiGzDecoder;
 use std::fs::File;
@@ -134,6 +135,7 @@ pub(crate) fn read_text_table(
     path: &Path,
     format: InputFormat,
     opts: &ReadOptions,
+    sidecar: Option<&Sidecar>,
 ) -> Result<RawTable, ReadError> {
     let Source { mut reader, gzip } = open(path)?;
     let stream_error = |e: io::Error| {
@@ -218,7 +220,7 @@ pub(crate) fn read_text_table(
     } else {
         (0..ncols).map(default_name).collect()
     };
-    let sel = resolve_selection(path, &names, opts)?;
+    let sel = resolve_selection(path, &names, opts, sidecar)?;
 
     let mut rows = Rows {
         path,
@@ -229,6 +231,7 @@ pub(crate) fn read_text_table(
         time_index: sel.time,
         values: vec![Vec::new(); sel.columns.len()],
         time: Vec::new(),
+        lines: LineMap::default(),
     };
     if !has_header {
         rows.push(&rec, first_line_no)?;
@@ -265,7 +268,14 @@ pub(crate) fn read_text_table(
         name: names[k].clone(),
         values: rows.time,
     });
-    Ok(RawTable { columns, time })
+    Ok(RawTable {
+        columns,
+        time,
+        time_unit: sel.time_unit,
+        freq_hz: None,
+        lines: sel.time.map(|_| rows.lines),
+        skipped: sel.skipped,
+    })
 }
 
 /// Accumulates the selected cells of each data row.
@@ -278,6 +288,8 @@ struct Rows<'a> {
     time_index: Option<usize>,
     values: Vec<Vec<f64>>,
     time: Vec<f64>,
+    /// Physical lines of the rows (kept only with a time column, for the gaps' lines).
+    lines: LineMap,
 }
 
 impl Rows<'_> {
@@ -298,6 +310,7 @@ impl Rows<'_> {
                 }
             }
             self.time.push(t);
+            self.lines.push(line);
         }
         Ok(())
     }
@@ -326,8 +339,8 @@ impl Rows<'_> {
     #[cold]
     fn bad_cell(&self, k: usize, line: u64, bytes: &[u8], numeric: bool) -> ReadError {
         let path = self.path.to_path_buf();
-        let column = self.names[k].clone();
-        let text = String::from_utf8_lossy(bytes.trim_ascii()).into_owned();
+        let column = quote(&self.names[k]);
+        let text = quote(&String::from_utf8_lossy(bytes.trim_ascii()));
         if numeric {
             ReadError::NonFinite {
                 path,
@@ -350,7 +363,7 @@ impl Rows<'_> {
         ReadError::TimeNotIncreasing {
             path: self.path.to_path_buf(),
             line,
-            column: self.names[k].clone(),
+            column: quote(&self.names[k]),
             previous,
             value,
         }
