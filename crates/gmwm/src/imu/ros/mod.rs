@@ -158,10 +158,16 @@ fn encoding(path: &Path, topic: &str, name: &str) -> Result<Encoding, RosError> 
     }
 }
 
+/// Start of a Zstandard frame: a rosbag2 message compressed one by one
+/// (`compression_mode: message`); a CDR message starts with 0x00.
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
+
 /// Decodes messages into the output vectors, checking each.
 pub(crate) struct Collector<'a> {
     /// Storage file being read (for messages).
     file: PathBuf,
+    /// A decompressed message (rosbag2 per-message compression).
+    scratch: Vec<u8>,
     topic: &'a str,
     frame_id: Option<String>,
     header_stamp_ns: Vec<i64>,
@@ -175,6 +181,7 @@ impl<'a> Collector<'a> {
         let f = || Vec::with_capacity(capacity);
         Self {
             file: PathBuf::new(),
+            scratch: Vec::new(),
             topic,
             frame_id: None,
             header_stamp_ns: Vec::with_capacity(capacity),
@@ -202,6 +209,15 @@ impl<'a> Collector<'a> {
         log_time_ns: i64,
         data: &[u8],
     ) -> Result<(), RosError> {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let data = if encoding == Encoding::Cdr && data.starts_with(&ZSTD_MAGIC) {
+            scratch.clear();
+            decompress::zstd_frame(data, &mut scratch)
+                .map_err(|reason| self.error(log_time_ns, MessageError::Decompress { reason }))?;
+            &scratch
+        } else {
+            data
+        };
         let decoded = match encoding {
             Encoding::Ros1 => cdr::decode_ros1(data),
             Encoding::Cdr => cdr::decode_cdr(data),
@@ -228,6 +244,7 @@ impl<'a> Collector<'a> {
             self.angular_velocity[a].push(values[a]);
             self.linear_acceleration[a].push(values[3 + a]);
         }
+        self.scratch = scratch;
         Ok(())
     }
 
