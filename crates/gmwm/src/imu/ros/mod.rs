@@ -474,6 +474,42 @@ pub fn container_of(path: &Path) -> Option<RosContainer> {
     source(path).ok().map(|s| s.container)
 }
 
+/// Read ranges are handed back to the kernel in steps of this many bytes (see [`Release`]).
+const RELEASE_STEP: usize = 8 << 20;
+
+/// Hands the pages of a memory map that have been decoded back to the kernel, so that the
+/// resident set holds the output and about one step of the file instead of the whole file.
+pub(crate) struct Release<'m> {
+    map: &'m Mmap,
+    done: usize,
+}
+
+impl<'m> Release<'m> {
+    pub(crate) fn new(map: &'m Mmap) -> Self {
+        Self { map, done: 0 }
+    }
+
+    /// Everything before `pos` has been read; release it once a step has accumulated.
+    pub(crate) fn upto(&mut self, pos: usize) {
+        if pos >= self.done.saturating_add(RELEASE_STEP) && pos <= self.map.len() {
+            #[cfg(unix)]
+            {
+                // SAFETY: a private, read-only file mapping that is never written: MADV_DONTNEED
+                // only drops its resident pages, and any later access faults them in again
+                // from the file with the same contents.
+                let _ = unsafe {
+                    self.map.unchecked_advise_range(
+                        memmap2::UncheckedAdvice::DontNeed,
+                        self.done,
+                        pos - self.done,
+                    )
+                };
+            }
+            self.done = pos;
+        }
+    }
+}
+
 fn map_file(path: &Path) -> Result<Mmap, ReadError> {
     let file = File::open(path).map_err(|e| io_error(path, e))?;
     // SAFETY: read-only private map; as with any map, the file must not be truncated by
