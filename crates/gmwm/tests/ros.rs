@@ -666,3 +666,30 @@ fn ros_read_throughput() {
         m.len() as f64 / s
     );
 }
+
+#[test]
+fn ros_flipped_bytes_never_panic() {
+    let f = fixtures();
+    let dir = tempfile::tempdir().unwrap();
+    let files = [
+        (f.two_imu[0].path.clone(), "bag"),
+        (storage_file(&f.two_imu[1].path, "mcap"), "mcap"),
+        (storage_file(&f.two_imu[2].path, "db3"), "db3"),
+    ];
+    for (src, ext) in files {
+        let bytes = std::fs::read(&src).unwrap();
+        let p = dir.path().join(format!("flipped.{ext}"));
+        // 150 positions spread over the file, headers and indexes included
+        for k in 0..150 {
+            let at = (k * 7919 + k * k * 31) % bytes.len();
+            let mut b = bytes.clone();
+            b[at] ^= 0xA5;
+            std::fs::write(&p, &b).unwrap();
+            // an error or (a flipped value byte) data; never a panic
+            if let Err(e) = read_imu_messages(&p, Some("/imu0")) {
+                assert!(!e.to_string().contains('\n'), "{e}");
+            }
+            let _ = list_topics(&p);
+        }
+    }
+}
