@@ -757,10 +757,17 @@ pub fn read_imu_messages(path: &Path, topic: Option<&str>) -> Result<ImuMessages
     for o in &opened {
         o.read(&chosen.topic, &mut out)?;
     }
-    if out.log_time_ns.is_empty() {
-        return Err(RosError::EmptyTopic {
+    if out.log_time_ns.len() as u64 != chosen.messages {
+        // the index (ROS1), statistics (MCAP) or COUNT(*) (sqlite3) disagrees with the data
+        return Err(RosError::Corrupt {
             path: path.to_path_buf(),
-            topics: vec![chosen.topic.clone()],
+            container: source.container,
+            reason: format!(
+                "the index counts {} messages on {}, the data holds {}",
+                chosen.messages,
+                chosen.topic,
+                out.log_time_ns.len()
+            ),
         }
         .into());
     }
