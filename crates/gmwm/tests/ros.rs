@@ -287,6 +287,48 @@ fn ros_sqlite3_round_trips_from_folder_and_file() {
 }
 
 #[test]
+fn ros_per_message_zstd_round_trips() {
+    let dir = tempfile::tempdir().unwrap();
+    for (container, name) in [("sqlite3", "msg_db3"), ("mcap", "msg_mcap")] {
+        let delay = LOG_DELAY_NS.to_string();
+        let extra = ["--compression", "message", "--log-delay-ns", &delay];
+        let fx = make(dir.path(), name, container, 300, 11, &extra);
+        let m = read(&fx.path);
+        assert_exact_values(&m, &fx, "/imu0");
+        assert_eq!(m.frame_id.as_deref(), Some("imu_link"));
+    }
+}
+
+/// The bag as a recorder leaves it when stopped before closing: `index_pos = 0` in the bag
+/// header and no index section.
+fn unindexed_copy(src: &Path, dst: &Path) {
+    let mut bytes = std::fs::read(src).unwrap();
+    let key = b"index_pos=";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len();
+    let mut index_pos = [0u8; 8];
+    index_pos.copy_from_slice(&bytes[at..at + 8]);
+    bytes.truncate(u64::from_le_bytes(index_pos) as usize);
+    bytes[at..at + 8].fill(0);
+    std::fs::write(dst, bytes).unwrap();
+}
+
+#[test]
+fn ros_unindexed_ros1_bag_is_scanned() {
+    let f = fixtures();
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("unindexed.bag");
+    unindexed_copy(&f.ros1_lz4.path, &p);
+    assert_eq!(
+        topics(&p),
+        [
+            info("/chatter", "std_msgs/String", 700),
+            info("/imu0", "sensor_msgs/Imu", N as u64)
+        ]
+    );
+    assert_exact(&read(&p), &f.ros1_lz4, "/imu0");
+}
+
+#[test]
 fn ros_misnamed_files_are_recognised_by_magic() {
     let f = fixtures();
     let dir = tempfile::tempdir().unwrap();
@@ -606,4 +648,48 @@ fn ros_choose_topic_is_what_read_takes() {
             .messages,
         300
     );
+}
+
+#[test]
+#[ignore = "throughput on a large recording: GMWM_ROS_BENCH=PATH cargo test --release -p gmwm \
+            --test integration ros_read_throughput -- --ignored --nocapture"]
+fn ros_read_throughput() {
+    let path = PathBuf::from(std::env::var_os("GMWM_ROS_BENCH").expect("GMWM_ROS_BENCH=PATH"));
+    let start = std::time::Instant::now();
+    let m = read(&path);
+    let s = start.elapsed().as_secs_f64();
+    println!(
+        "{}: {} messages of {} in {s:.3} s: {:.3e} messages/s",
+        path.display(),
+        m.len(),
+        m.topic,
+        m.len() as f64 / s
+    );
+}
+
+#[test]
+fn ros_flipped_bytes_never_panic() {
+    let f = fixtures();
+    let dir = tempfile::tempdir().unwrap();
+    let files = [
+        (f.two_imu[0].path.clone(), "bag"),
+        (storage_file(&f.two_imu[1].path, "mcap"), "mcap"),
+        (storage_file(&f.two_imu[2].path, "db3"), "db3"),
+    ];
+    for (src, ext) in files {
+        let bytes = std::fs::read(&src).unwrap();
+        let p = dir.path().join(format!("flipped.{ext}"));
+        // 150 positions spread over the file, headers and indexes included
+        for k in 0..150 {
+            let at = (k * 7919 + k * k * 31) % bytes.len();
+            let mut b = bytes.clone();
+            b[at] ^= 0xA5;
+            std::fs::write(&p, &b).unwrap();
+            // an error or (a flipped value byte) data; never a panic
+            if let Err(e) = read_imu_messages(&p, Some("/imu0")) {
+                assert!(!e.to_string().contains('\n'), "{e}");
+            }
+            let _ = list_topics(&p);
+        }
+    }
 }

@@ -71,6 +71,22 @@ impl Decompressor {
     }
 }
 
+/// Largest decompressed message accepted (a `sensor_msgs/Imu` is about 350 bytes).
+const MAX_MESSAGE: u64 = 1 << 20;
+
+/// Decompresses one Zstandard frame (a message of a rosbag2 bag with `compression_mode:
+/// message`) into `dst`.
+///
+/// # Errors
+/// The decoder's message as one line.
+pub(crate) fn zstd_frame(src: &[u8], dst: &mut Vec<u8>) -> Result<(), String> {
+    let dec = ruzstd::decoding::StreamingDecoder::new(src).map_err(|e| e.to_string())?;
+    dec.take(MAX_MESSAGE)
+        .read_to_end(dst)
+        .map(drop)
+        .map_err(|e| e.to_string())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -159,6 +159,12 @@ pub enum MessageError {
          0x0000 big-endian CDR)"
     )]
     Encapsulation(u8, u8),
+    /// A zstd-compressed message (rosbag2 `compression_mode: message`) does not decompress.
+    #[error("zstd-compressed message does not decompress: {reason}")]
+    Decompress {
+        /// The decoder's message.
+        reason: String,
+    },
     /// A measurement is NaN or infinite.
     #[error("{field} = {value} is not a finite number")]
     NonFinite {

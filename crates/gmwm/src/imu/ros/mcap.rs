@@ -8,7 +8,7 @@
 
 use super::decompress::{Codec, Decompressor};
 use super::error::RosError;
-use super::{Collector, Encoding, RosContainer};
+use super::{Collector, Encoding, Release, RosContainer};
 use mcap::records::{op, Record};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -301,12 +301,14 @@ pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
 /// Reads the messages of the channels in `wanted` (id -> encoding) into `out`, in file order.
 pub(crate) fn read(
     path: &Path,
-    map: &[u8],
+    mapped: &memmap2::Mmap,
     catalog: &Catalog,
     wanted: &HashMap<u16, Encoding>,
     out: &mut Collector<'_>,
 ) -> Result<(), RosError> {
+    let map: &[u8] = mapped;
     check_magic(path, map)?;
+    let mut release = Release::new(mapped);
     let mut dec = Decompressor::new();
     let mut buf = Vec::new();
     let mut message = |body: &[u8], at: &dyn Fn() -> String| -> Result<(), RosError> {
@@ -385,6 +387,7 @@ pub(crate) fn read(
                     }
                 },
             )?;
+            release.upto(record.as_ptr() as usize - map.as_ptr() as usize + record.len());
         }
         return Ok(());
     }
@@ -392,6 +395,7 @@ pub(crate) fn read(
     let base = mcap::MAGIC.len();
     records(path, data, None, &mut |opcode, body, pos| {
         let offset = (base + pos) as u64;
+        release.upto(base + pos);
         match opcode {
             op::CHUNK => chunk(path, body, offset, &mut dec, &mut buf, &mut |o, b, c, p| {
                 if o == op::MESSAGE {

@@ -158,10 +158,16 @@ fn encoding(path: &Path, topic: &str, name: &str) -> Result<Encoding, RosError> 
     }
 }
 
+/// Start of a Zstandard frame: a rosbag2 message compressed one by one
+/// (`compression_mode: message`); a CDR message starts with 0x00.
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
+
 /// Decodes messages into the output vectors, checking each.
 pub(crate) struct Collector<'a> {
     /// Storage file being read (for messages).
     file: PathBuf,
+    /// A decompressed message (rosbag2 per-message compression).
+    scratch: Vec<u8>,
     topic: &'a str,
     frame_id: Option<String>,
     header_stamp_ns: Vec<i64>,
@@ -175,6 +181,7 @@ impl<'a> Collector<'a> {
         let f = || Vec::with_capacity(capacity);
         Self {
             file: PathBuf::new(),
+            scratch: Vec::new(),
             topic,
             frame_id: None,
             header_stamp_ns: Vec::with_capacity(capacity),
@@ -202,6 +209,15 @@ impl<'a> Collector<'a> {
         log_time_ns: i64,
         data: &[u8],
     ) -> Result<(), RosError> {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let data = if encoding == Encoding::Cdr && data.starts_with(&ZSTD_MAGIC) {
+            scratch.clear();
+            decompress::zstd_frame(data, &mut scratch)
+                .map_err(|reason| self.error(log_time_ns, MessageError::Decompress { reason }))?;
+            &scratch
+        } else {
+            data
+        };
         let decoded = match encoding {
             Encoding::Ros1 => cdr::decode_ros1(data),
             Encoding::Cdr => cdr::decode_cdr(data),
@@ -228,6 +244,7 @@ impl<'a> Collector<'a> {
             self.angular_velocity[a].push(values[a]);
             self.linear_acceleration[a].push(values[3 + a]);
         }
+        self.scratch = scratch;
         Ok(())
     }
 
@@ -455,6 +472,42 @@ fn folder(dir: &Path) -> Result<Source, ReadError> {
 /// if it is none of them (or cannot be read).
 pub fn container_of(path: &Path) -> Option<RosContainer> {
     source(path).ok().map(|s| s.container)
+}
+
+/// Read ranges are handed back to the kernel in steps of this many bytes (see [`Release`]).
+const RELEASE_STEP: usize = 8 << 20;
+
+/// Hands the pages of a memory map that have been decoded back to the kernel, so that the
+/// resident set holds the output and about one step of the file instead of the whole file.
+pub(crate) struct Release<'m> {
+    map: &'m Mmap,
+    done: usize,
+}
+
+impl<'m> Release<'m> {
+    pub(crate) fn new(map: &'m Mmap) -> Self {
+        Self { map, done: 0 }
+    }
+
+    /// Everything before `pos` has been read; release it once a step has accumulated.
+    pub(crate) fn upto(&mut self, pos: usize) {
+        if pos >= self.done.saturating_add(RELEASE_STEP) && pos <= self.map.len() {
+            #[cfg(unix)]
+            {
+                // SAFETY: a private, read-only file mapping that is never written: MADV_DONTNEED
+                // only drops its resident pages, and any later access faults them in again
+                // from the file with the same contents.
+                let _ = unsafe {
+                    self.map.unchecked_advise_range(
+                        memmap2::UncheckedAdvice::DontNeed,
+                        self.done,
+                        pos - self.done,
+                    )
+                };
+            }
+            self.done = pos;
+        }
+    }
 }
 
 fn map_file(path: &Path) -> Result<Mmap, ReadError> {
@@ -704,10 +757,17 @@ pub fn read_imu_messages(path: &Path, topic: Option<&str>) -> Result<ImuMessages
     for o in &opened {
         o.read(&chosen.topic, &mut out)?;
     }
-    if out.log_time_ns.is_empty() {
-        return Err(RosError::EmptyTopic {
+    if out.log_time_ns.len() as u64 != chosen.messages {
+        // the index (ROS1), statistics (MCAP) or COUNT(*) (sqlite3) disagrees with the data
+        return Err(RosError::Corrupt {
             path: path.to_path_buf(),
-            topics: vec![chosen.topic.clone()],
+            container: source.container,
+            reason: format!(
+                "the index counts {} messages on {}, the data holds {}",
+                chosen.messages,
+                chosen.topic,
+                out.log_time_ns.len()
+            ),
         }
         .into());
     }

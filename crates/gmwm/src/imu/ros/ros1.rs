@@ -10,7 +10,7 @@
 
 use super::decompress::{Codec, Decompressor};
 use super::error::RosError;
-use super::{Collector, Encoding, RosContainer};
+use super::{Collector, Encoding, Release, RosContainer};
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 
@@ -232,7 +232,7 @@ pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
     if index_pos == 0 {
         // never indexed (recording interrupted): count by walking every chunk
         let mut conns: BTreeMap<u32, Connection> = BTreeMap::new();
-        walk(path, map, first, map.len(), None, &mut |item| {
+        walk(path, map, first, map.len(), None, None, &mut |item| {
             match item {
                 Item::Connection(c) => {
                     conns.entry(c.id).or_insert(c);
@@ -344,6 +344,7 @@ fn walk(
     from: usize,
     to: usize,
     only: Option<&HashSet<u64>>,
+    mut release: Option<&mut Release<'_>>,
     visit: &mut dyn FnMut(Item<'_>) -> Result<(), RosError>,
 ) -> Result<(), RosError> {
     let region = &map[..to];
@@ -408,6 +409,9 @@ fn walk(
             _ => {}
         }
         pos = next;
+        if let Some(r) = release.as_deref_mut() {
+            r.upto(pos);
+        }
     }
     Ok(())
 }
@@ -457,7 +461,7 @@ fn message(
 /// Reads the messages of the connections `wanted` into `out`, in file order.
 pub(crate) fn read(
     path: &Path,
-    map: &[u8],
+    map: &memmap2::Mmap,
     catalog: &Catalog,
     wanted: &HashSet<u32>,
     out: &mut Collector<'_>,
@@ -474,12 +478,14 @@ pub(crate) fn read(
             .map(|(p, _)| *p)
             .collect()
     });
+    let mut release = Release::new(map);
     walk(
         path,
         map,
         first,
         to,
         only.as_ref(),
+        Some(&mut release),
         &mut |item| match item {
             Item::Message {
                 conn,
