@@ -1,8 +1,14 @@
-//! Turning `InputArgs` into engine read options and loaded columns.
+//! Turning `InputArgs` into engine read options and loaded columns, and printing what the
+//! reader found (time column, skipped columns, warnings) once per file on stderr.
 
-use crate::args::{FormatArg, HeaderArg, InputArgs};
+use crate::args::{FormatArg, HeaderArg, InputArgs, TimeUnitArg, WvEstimatorArgs};
 use anyhow::{Context, Result};
-use gmwm::imu::{read_table, ColumnSelector, HeaderMode, InputFormat, ReadOptions, Table};
+use gmwm::imu::{
+    is_wv_json, quote, read_table, read_wv_json, select_series, ColumnSelector, HeaderMode,
+    ImuRecordType, InputFormat, ReadOptions, ReadWarning, Table, TimeUnit,
+};
+use gmwm::WaveletVariance;
+use std::path::Path;
 
 /// A loaded input: the table and the sampling rate to use.
 pub struct Loaded {
@@ -12,16 +18,33 @@ pub struct Loaded {
     pub freq_hz: f64,
 }
 
-fn selector(text: &str) -> ColumnSelector {
+/// `--columns` entries: all digits → a 1-based index, anything else a name.
+pub fn selector(text: &str) -> ColumnSelector {
     match text.trim().parse::<usize>() {
         Ok(i) => ColumnSelector::Index(i),
         Err(_) => ColumnSelector::Name(text.trim().to_string()),
     }
 }
 
-/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
-/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
-pub fn load(args: &InputArgs) -> Result<Loaded> {
+/// The engine format of `--format`.
+pub fn format(arg: FormatArg) -> InputFormat {
+    match arg {
+        FormatArg::Auto => InputFormat::Auto,
+        FormatArg::Csv => InputFormat::Csv,
+        FormatArg::Tsv => InputFormat::Tsv,
+        FormatArg::Imar => InputFormat::ImuRecord(ImuRecordType::Imar),
+        FormatArg::Ln200 => InputFormat::ImuRecord(ImuRecordType::Ln200),
+        FormatArg::Ln200ig => InputFormat::ImuRecord(ImuRecordType::Ln200Ig),
+        FormatArg::Ixsea => InputFormat::ImuRecord(ImuRecordType::Ixsea),
+        FormatArg::NavchipInt => InputFormat::ImuRecord(ImuRecordType::NavchipInt),
+        FormatArg::NavchipFlt => InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
+        FormatArg::F64 => InputFormat::F64,
+        FormatArg::F32 => InputFormat::F32,
+    }
+}
+
+/// Checks the input flags and turns them into engine read options.
+pub fn options(args: &InputArgs) -> Result<ReadOptions> {
     if let Some(f) = args.freq {
         anyhow::ensure!(
             f.is_finite() && f > 0.0,
@@ -34,25 +57,97 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
             "invalid --ncols 0: a binary file has at least one column"
         );
     }
-    let opts = ReadOptions {
-        format: match args.format {
-            FormatArg::Auto => InputFormat::Auto,
-            FormatArg::Csv => InputFormat::Csv,
-            FormatArg::Tsv => InputFormat::Tsv,
-            FormatArg::F64 => InputFormat::F64,
-            FormatArg::F32 => InputFormat::F32,
-        },
+    Ok(ReadOptions {
+        format: format(args.format),
         header: match args.header {
             HeaderArg::Auto => HeaderMode::Auto,
             HeaderArg::Yes => HeaderMode::Present,
             HeaderArg::No => HeaderMode::Absent,
         },
         time_column: args.time_column.as_deref().map(selector),
+        time_unit: args.time_unit.map(|u| match u {
+            TimeUnitArg::S => TimeUnit::Seconds,
+            TimeUnitArg::Ms => TimeUnit::Milliseconds,
+            TimeUnitArg::Us => TimeUnit::Microseconds,
+            TimeUnitArg::Ns => TimeUnit::Nanoseconds,
+        }),
         columns: args.columns.iter().map(|c| selector(c)).collect(),
         ncols: args.ncols,
         freq_hz: args.freq,
-    };
+    })
+}
+
+/// Whether FILE is a wavelet variance saved by `gmwm wv --json` (by name or content) rather
+/// than a recording; never with an explicit recording `--format`.
+pub fn is_wv(args: &InputArgs) -> bool {
+    args.format == FormatArg::Auto && is_wv_json(&args.file)
+}
+
+/// A rate for messages: 6 significant digits, trailing zeros dropped (`200`, `62.5`).
+fn hz(x: f64) -> String {
+    let s = format!(
+        "{:.*}",
+        5usize.saturating_sub(x.abs().log10().floor().max(0.0) as usize),
+        x
+    );
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Prints a note on stderr.
+pub fn note(file: &Path, text: &str) {
+    eprintln!("gmwm: note: {}: {text}", file.display());
+}
+
+/// Prints what the reader found: the time column and its rate, the columns left out, then
+/// every warning, each once.
+fn report(table: &Table) {
+    let file = &table.path;
+    if let Some(t) = &table.timing {
+        note(file, &t.to_string());
+    }
+    if !table.skipped.is_empty() {
+        let names: Vec<String> = table.skipped.iter().map(|n| quote(n)).collect();
+        note(
+            file,
+            &format!(
+                "not analysed: {} (not a gyroscope or accelerometer axis, or another time \
+                 column; --columns selects any column)",
+                names.join(", ")
+            ),
+        );
+    }
+    for w in &table.warnings {
+        match w {
+            ReadWarning::FreqDisagrees {
+                given_hz,
+                column,
+                time_hz,
+                ..
+            } => eprintln!(
+                "gmwm: warning: {}: --freq {} Hz differs by {:.0}% from time column \"{}\" \
+                 ({} Hz); --freq is used",
+                file.display(),
+                hz(*given_hz),
+                100.0 * (given_hz - time_hz).abs() / time_hz,
+                quote(column),
+                hz(*time_hz),
+            ),
+            w => eprintln!("gmwm: warning: {w}"),
+        }
+    }
+}
+
+/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
+/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
+/// The reader's notes and warnings are printed on stderr.
+pub fn load(args: &InputArgs) -> Result<Loaded> {
+    let opts = options(args)?;
     let table = read_table(&args.file, &opts)?;
+    report(&table);
     let freq_hz = match args.freq.or(table.freq_hz) {
         Some(f) => f,
         None => {
@@ -64,6 +159,53 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
         }
     };
     Ok(Loaded { table, freq_hz })
+}
+
+/// Refuses estimator flags that need the series when FILE is a saved wavelet variance: it is
+/// used as it is (robust if it says so).
+pub fn check_wv_estimator(file: &Path, e: &WvEstimatorArgs) -> Result<()> {
+    anyhow::ensure!(
+        !e.robust,
+        "{}: --robust needs the series; a wavelet-variance file is used as it is (robust if it says so)",
+        file.display()
+    );
+    anyhow::ensure!(
+        e.filter == "haar" && e.transform == crate::args::TransformArg::Modwt,
+        "{}: --filter/--transform apply to a recording; a wavelet-variance file is used as it is",
+        file.display()
+    );
+    Ok(())
+}
+
+/// Keeps the first `j` levels of a WV.
+fn truncate_levels(wv: &mut WaveletVariance, j: usize) {
+    wv.tau.truncate(j);
+    wv.tau_s.truncate(j);
+    wv.wv.truncate(j);
+    wv.ci_low.truncate(j);
+    wv.ci_high.truncate(j);
+    wv.n_coefficients.truncate(j);
+    wv.eta.truncate(j);
+}
+
+/// Reads a saved wavelet variance: the series `--columns` selects (names or 1-based indices),
+/// the rate from `--freq` or the file, the first `levels` levels.
+pub fn load_wv(args: &InputArgs, levels: Option<usize>) -> Result<Vec<(String, WaveletVariance)>> {
+    let file = &args.file;
+    let selectors: Vec<ColumnSelector> = args.columns.iter().map(|c| selector(c)).collect();
+    let mut series = select_series(file, read_wv_json(file, args.freq)?, &selectors)?;
+    if let Some(j) = levels {
+        for (name, wv) in &mut series {
+            anyhow::ensure!(
+                j >= 1 && j <= wv.levels(),
+                "{}: series {name}: --levels {j} is outside 1..={}",
+                file.display(),
+                wv.levels()
+            );
+            truncate_levels(wv, j);
+        }
+    }
+    Ok(series)
 }
 
 /// Adds "FILE: column NAME" to a per-column engine error.

@@ -349,7 +349,10 @@ mod tests {
 
     #[test]
     fn sidecar_path_appends_json() {
-        assert_eq!(sidecar_path(Path::new("d/x.f64")), Path::new("d/x.f64.json"));
+        assert_eq!(
+            sidecar_path(Path::new("d/x.f64")),
+            Path::new("d/x.f64.json")
+        );
         assert_eq!(
             sidecar_path(Path::new("x.csv.gz")),
             Path::new("x.csv.gz.json")

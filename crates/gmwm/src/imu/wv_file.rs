@@ -140,7 +140,10 @@ pub fn allan_from_wv(wv: &WaveletVariance) -> Result<AllanVariance, ParamError> 
         ci_high: wv.ci_high.iter().map(|v| 2.0 * v).collect(),
         edf: wv.eta.clone(),
         terms: wv.n_coefficients.clone(),
-        error: tau.iter().map(|&m| package_error(wv.n, m as usize)).collect(),
+        error: tau
+            .iter()
+            .map(|&m| package_error(wv.n, m as usize))
+            .collect(),
         tau,
         avar,
     })

@@ -12,8 +12,8 @@ pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordTy
 use super::error::quote;
 use super::sidecar::{find_sidecar, Sidecar};
 use super::timing::{
-    check_times, fmt_hz, infer_time_unit, time_column_unit, TimeUnit, TimingReport,
-    TimingWarning, UnitSource,
+    check_times, fmt_hz, infer_unit, time_column_unit, TimeUnit, TimingReport, TimingWarning,
+    UnitSource,
 };
 use super::{ReadError, SensorInfo};
 use crate::error::{check_freq, ParamError};
@@ -251,8 +251,8 @@ pub struct ReadOptions {
     /// Header handling of text files (default [`HeaderMode::Auto`]); ignored for binary.
     pub header: HeaderMode,
     /// Time column (default `None`: found by name, see [`read_table`]). Must be finite and
-    /// strictly increasing; it is returned in [`Table::time`] (in seconds), not among the
-    /// columns.
+    /// strictly increasing; it is returned in [`Table::time`] (in seconds after its first
+    /// stamp), not among the columns.
     pub time_column: Option<ColumnSelector>,
     /// Unit of the time column (default `None`: stated by its name, else inferred, see
     /// [`infer_time_unit`](crate::imu::infer_time_unit)).
@@ -286,7 +286,9 @@ pub struct Table {
     pub freq_hz: Option<f64>,
     /// The JSON sidecar beside the file, if any.
     pub sidecar: Option<Sidecar>,
-    /// The time column in seconds (finite, strictly increasing), if one was given or found.
+    /// The time column, if one was given or found: seconds after its first stamp (which is
+    /// [`TimingReport::start_s`]), finite and strictly increasing; relative so that epoch
+    /// stamps keep their precision (whole-number stamps are subtracted exactly).
     pub time: Option<Column>,
     /// What the time column says about the sampling (unit, rate, gaps, ...), if there is one.
     pub timing: Option<TimingReport>,
@@ -533,7 +535,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
                 (Some(u), _) => (u, UnitSource::Flag),
                 (None, Some(u)) => (u, UnitSource::Stated),
                 (None, None) => (
-                    infer_time_unit(&col.values).unwrap_or(TimeUnit::Seconds),
+                    infer_unit(raw.time_origin, &col.values).unwrap_or(TimeUnit::Seconds),
                     UnitSource::Inferred,
                 ),
             };
@@ -542,17 +544,21 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
                 col.values.iter_mut().for_each(|t| *t *= k);
             }
             let mut report = check_times(&col.name, &col.values, unit, source);
+            report.start_s = raw.time_origin * unit.to_seconds();
             if let Some(lines) = &raw.lines {
                 for g in &mut report.gaps {
                     g.line = Some(lines.line_of(g.row));
                 }
             }
-            warnings.extend(report.warnings().into_iter().map(|warning| {
-                ReadWarning::Timing {
-                    path: path.to_path_buf(),
-                    warning,
-                }
-            }));
+            warnings.extend(
+                report
+                    .warnings()
+                    .into_iter()
+                    .map(|warning| ReadWarning::Timing {
+                        path: path.to_path_buf(),
+                        warning,
+                    }),
+            );
             (Some(col), Some(report))
         }
         None => (None, None),
@@ -612,8 +618,11 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
 /// resolution.
 pub(crate) struct RawTable {
     pub(crate) columns: Vec<Column>,
-    /// Raw stamps (in `time_unit` if stated, else unknown).
+    /// Stamps relative to the first one (in `time_unit` if stated, else unknown), exact for
+    /// whole-number stamps.
     pub(crate) time: Option<Column>,
+    /// The first stamp, in the same unit.
+    pub(crate) time_origin: f64,
     /// Unit stated by the time column's name or the format.
     pub(crate) time_unit: Option<TimeUnit>,
     /// Rate fixed by the format (IMU records: METHODS §9.2).
@@ -636,10 +645,7 @@ impl LineMap {
     /// Records that the next data row is on `line`.
     #[inline]
     pub(crate) fn push(&mut self, line: u64) {
-        let expected = self
-            .breaks
-            .last()
-            .map(|&(r, l)| l + (self.rows - r) as u64);
+        let expected = self.breaks.last().map(|&(r, l)| l + (self.rows - r) as u64);
         if expected != Some(line) {
             self.breaks.push((self.rows, line));
         }
@@ -776,8 +782,14 @@ mod tests {
         assert!("xml".parse::<InputFormat>().is_err());
         for (text, f) in [
             ("ln200", InputFormat::ImuRecord(ImuRecordType::Ln200)),
-            ("navchip-int", InputFormat::ImuRecord(ImuRecordType::NavchipInt)),
-            ("NAVCHIP_FLT", InputFormat::ImuRecord(ImuRecordType::NavchipFlt)),
+            (
+                "navchip-int",
+                InputFormat::ImuRecord(ImuRecordType::NavchipInt),
+            ),
+            (
+                "NAVCHIP_FLT",
+                InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
+            ),
             ("f64le", InputFormat::F64),
         ] {
             assert_eq!(text.parse::<InputFormat>().unwrap(), f);
