@@ -198,8 +198,9 @@ pub fn load_wv(args: &InputArgs, levels: Option<usize>) -> Result<Vec<(String, W
         for (name, wv) in &mut series {
             anyhow::ensure!(
                 j >= 1 && j <= wv.levels(),
-                "{}: series {name}: --levels {j} is outside 1..={}",
+                "{}: series {}: --levels {j} is outside 1..={}",
                 file.display(),
+                quote(name),
                 wv.levels()
             );
             truncate_levels(wv, j);
@@ -208,13 +209,13 @@ pub fn load_wv(args: &InputArgs, levels: Option<usize>) -> Result<Vec<(String, W
     Ok(series)
 }
 
-/// Adds "FILE: column NAME" to a per-column engine error.
+/// Adds "FILE: column NAME" to a per-column engine error (the name cut to 40 characters).
 pub fn column_context<T>(
     r: Result<T, gmwm::Error>,
     file: &std::path::Path,
     column: &str,
 ) -> Result<T> {
-    r.with_context(|| format!("{}: column {column}", file.display()))
+    r.with_context(|| format!("{}: column {}", file.display(), quote(column)))
 }
 
 /// Runs a per-series computation over every loaded column in parallel (the engine's

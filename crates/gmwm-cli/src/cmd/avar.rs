@@ -26,9 +26,10 @@ fn run_saved(args: &AvarArgs, opts: &AllanOptions, out: &mut impl Write) -> Resu
     for (name, wv) in &series {
         anyhow::ensure!(
             (wv.alpha - opts.alpha).abs() <= 1e-12 || opts.alpha == 0.05,
-            "{}: series {name}: --alpha {} needs the raw recording; the file's intervals are at \
+            "{}: series {}: --alpha {} needs the raw recording; the file's intervals are at \
              alpha {}",
             file.display(),
+            gmwm::imu::quote(name),
             opts.alpha,
             wv.alpha
         );

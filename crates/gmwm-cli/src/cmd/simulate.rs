@@ -15,7 +15,7 @@ const CHUNK: usize = 1 << 16;
 /// Where the rows go.
 enum Sink<'a> {
     Stdout(&'a mut dyn Write),
-    File(SeriesWriter),
+    File(Box<SeriesWriter>),
 }
 
 impl Sink<'_> {
@@ -46,10 +46,10 @@ pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
     // Create the file first so a bad path or an unknown extension fails before any work.
     let mut sink = match &args.output {
-        Some(p) => Sink::File(
+        Some(p) => Sink::File(Box::new(
             SeriesWriter::create(p, &refs)
                 .with_context(|| "cannot create the output file".to_string())?,
-        ),
+        )),
         None => {
             let quoted: Vec<String> = names.iter().map(|n| csv_quote(n)).collect();
             let refs: Vec<&str> = quoted.iter().map(String::as_str).collect();

@@ -168,8 +168,9 @@ fn run_saved(args: &WvArgs, out: &mut impl Write) -> Result<()> {
     {
         anyhow::ensure!(
             args.estimator.alpha == 0.05,
-            "{}: series {name}: --alpha {} needs the series; the file's intervals are at alpha {}",
+            "{}: series {}: --alpha {} needs the series; the file's intervals are at alpha {}",
             file.display(),
+            gmwm::imu::quote(name),
             args.estimator.alpha,
             wv.alpha
         );

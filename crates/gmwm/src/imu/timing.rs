@@ -127,6 +127,8 @@ pub enum UnitSource {
     /// Stated by the column name (`[ns]`, `_ms`, `(s)`, ...) or by the convention of the tool
     /// that names columns so (`%time` and `field.header.stamp` of `rostopic echo -p` are ns).
     Stated,
+    /// Fixed by the file format (the seconds of binary IMU records, METHODS §9.2).
+    Format,
     /// Inferred from the values ([`infer_time_unit`]).
     Inferred,
     /// Given by the caller (`ReadOptions::time_unit`, the CLI's `--time-unit`).
@@ -137,6 +139,7 @@ impl fmt::Display for UnitSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             Self::Stated => "from the header",
+            Self::Format => "from the format",
             Self::Inferred => "inferred from the values",
             Self::Flag => "as given",
         })

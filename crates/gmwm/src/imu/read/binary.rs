@@ -434,7 +434,7 @@ fn record_freq(path: &Path, t: &[f64]) -> Result<f64, ReadError> {
     if t.len() < 2 {
         return Err(not_derivable("fewer than 2 epochs"));
     }
-    let freq = check_times("time", t, TimeUnit::Seconds, UnitSource::Stated)
+    let freq = check_times("time", t, TimeUnit::Seconds, UnitSource::Format)
         .rate_hz
         .round();
     if freq.is_finite() && freq > 0.0 {

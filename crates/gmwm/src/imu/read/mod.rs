@@ -492,9 +492,9 @@ pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<Strin
 /// `timestamp`, `t`, `stamp`, `%time`, `#timestamp [ns]`, `timestamp_ns`, `time_s`,
 /// `time [s]`, `field.header.stamp`, ...; a header stamp is preferred, else the first in file
 /// order) unless `opts.columns` selects that column explicitly. Its unit: `opts.time_unit`,
-/// else the one its name states, else [`infer_time_unit`](crate::imu::infer_time_unit)
+/// else the one its name states, else [`infer_time_unit`](super::timing::infer_time_unit)
 /// (seconds if nothing can be inferred). The stamps are converted to seconds and checked
-/// ([`check_times`](crate::imu::check_times), [`Table::timing`]); in a text or raw binary file
+/// ([`check_times`], [`Table::timing`]); in a text or raw binary file
 /// they must strictly increase ([`ReadError::TimeNotIncreasing`] names the line).
 ///
 /// Columns: `opts.columns` in that order; by default every column but the time columns, and
@@ -533,6 +533,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         Some(mut col) => {
             let (unit, source) = match (opts.time_unit, raw.time_unit) {
                 (Some(u), _) => (u, UnitSource::Flag),
+                (None, Some(u)) if raw.freq_hz.is_some() => (u, UnitSource::Format),
                 (None, Some(u)) => (u, UnitSource::Stated),
                 (None, None) => (
                     infer_unit(raw.time_origin, &col.values).unwrap_or(TimeUnit::Seconds),
