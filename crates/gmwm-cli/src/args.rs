@@ -11,6 +11,8 @@ Examples:
   gmwm wv imu.csv.gz --columns gyro_x,3 --robust --eff 0.6 --json
   gmwm avar imu.csv.gz --kind modified --csv
   gmwm wv log.bin --format f64 --ncols 6 --columns 1 --freq 400
+  gmwm wv ln200.bin --format ln200 --columns gyro_x
+  gmwm wv euroc_imu0.csv                      time column and units from the EuRoC header
   gmwm select imu.csv.gz --model \"3*AR1()+WN()+RW()+QN()+DR()\"";
 
 /// Stochastic error calibration of inertial sensors with the Generalized Method of Wavelet
@@ -332,7 +334,10 @@ pub struct SimulateArgs {
     /// Seed of the simulation (same seed, same bits).
     #[arg(long, value_name = "S", default_value_t = 0, value_parser = seed)]
     pub seed: u64,
-    /// Output file (.csv or .csv.gz) with a JSON sidecar beside it [default: CSV on stdout].
+    /// Output file, written in the format of its name: .csv/.txt (CSV), .tsv, either with .gz
+    /// (gzip), .f64/.f64le/.f64.bin or .f32/... (raw little-endian, columns interleaved), with a
+    /// JSON sidecar FILE.json (rate, format, columns) that lets every command read it back
+    /// without flags [default: CSV on stdout].
     #[arg(short = 'o', long, value_name = "FILE")]
     pub output: Option<std::path::PathBuf>,
     /// Also write each component as its own column (x is their sum).
@@ -357,30 +362,80 @@ pub struct ImpliedArgs {
     pub json: bool,
 }
 
+/// How FILE is read (long help of every command that reads a recording).
+const INPUT_HELP: &str = "\
+Data file: CSV/TSV (optionally .gz), raw little-endian binary, binary IMU records
+(--format imar|ln200|ln200ig|ixsea|navchip-int|navchip-flt) or a wavelet variance saved by
+`gmwm wv --json`.
+
+FILE is read by its name, its JSON sidecar and its content: .f64/.f32 (also .f64le, .f64.bin)
+are raw little-endian binary; a sidecar FILE.json (or NAME.json beside NAME.csv.gz) gives the
+rate, and for raw binary the format, --ncols and the column names; gzip is recognised by its
+first bytes; binary data without --format is refused instead of being read as text; a JSON
+document is a wavelet variance saved by `gmwm wv --json`.
+
+Time column: --time-column, else the first column named time, timestamp, t, stamp, %time
+(rostopic echo -p, ns), #timestamp [ns] (EuRoC/TUM-VI), timestamp_ns, time_s, time [s],
+field.header.stamp (ns), ... (case-insensitive; a header stamp is preferred). It is not
+analysed. Its unit: --time-unit, else the name ([ns], _ms, (us), [s], ...), else inferred:
+Unix-epoch-sized stamps (~1.7e9 s, 1.7e12 ms, 1.7e15 us, 1.7e18 ns), fractional stamps with a
+step <= 1 are seconds, else the unit giving a rate of 10 Hz to 10 kHz. The rate is 1 / the
+nominal step (the mean of the steps within 1.5 median steps): gaps (steps over 1.5 nominal
+steps), repeated and reordered stamps are reported as warnings, and stamps must increase. A
+--freq that differs from the time column by more than 1% is used, with a warning.
+
+Columns: --columns, else every column but the time columns; when some columns are gyroscope
+or accelerometer axes (gyro_x, acc_x, gx, ax, wx, w_RS_S_x, angular_velocity.x,
+linear_acceleration.x, ...), only those, and the others are listed in a note.";
+
 /// Where the data come from and how to read them.
 #[derive(Debug, Args)]
 pub struct InputArgs {
-    /// Data file: CSV/TSV (optionally .gz) or raw little-endian binary (--format f64|f32).
-    #[arg(value_name = "FILE")]
+    /// Data file: CSV/TSV (optionally .gz), raw little-endian binary (.f64, .f32 or
+    /// --format f64|f32), binary IMU records (--format imar|ln200|...), or a wavelet variance
+    /// saved by `gmwm wv --json` (see --help for how FILE is read).
+    #[arg(value_name = "FILE", long_help = INPUT_HELP)]
     pub file: PathBuf,
-    /// Columns to analyse, comma-separated names or 1-based indices [default: all].
+    /// Columns to analyse, comma-separated names or 1-based indices (also the series of a
+    /// wavelet-variance JSON) [default: the sensor axes, else all but the time columns].
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub columns: Vec<String>,
     /// Sampling rate in Hz [default: from a time column or the JSON sidecar beside FILE].
     #[arg(long, value_name = "HZ", value_parser = positive_hz)]
     pub freq: Option<f64>,
-    /// Input format.
+    /// Input format [default: from the name, the sidecar and the content].
     #[arg(long, value_enum, default_value_t = FormatArg::Auto)]
     pub format: FormatArg,
-    /// Number of interleaved columns of a binary file.
+    /// Number of interleaved columns of a raw binary file [default: the sidecar's, else 1].
     #[arg(long, value_name = "K", value_parser = at_least_1)]
     pub ncols: Option<usize>,
     /// Whether the first row of a text file is a header.
     #[arg(long, value_enum, default_value_t = HeaderArg::Auto)]
     pub header: HeaderArg,
-    /// Column holding time stamps in seconds (name or 1-based index); excluded from analysis.
+    /// Column holding time stamps (name or 1-based index); excluded from analysis
+    /// [default: a column named like time, timestamp, t, %time, #timestamp [ns], ...].
     #[arg(long, value_name = "COL")]
     pub time_column: Option<String>,
+    /// Unit of the time column [default: stated by its name, else inferred from the values].
+    #[arg(long, value_enum, value_name = "UNIT")]
+    pub time_unit: Option<TimeUnitArg>,
+    /// The sensor_msgs/Imu topic of a ROS recording (ROS1 .bag, MCAP, rosbag2 .db3 or folder)
+    /// [default: its only IMU topic; `gmwm topics FILE` lists them].
+    #[arg(long, value_name = "TOPIC")]
+    pub topic: Option<String>,
+}
+
+/// `--time-unit`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TimeUnitArg {
+    /// Seconds.
+    S,
+    /// Milliseconds.
+    Ms,
+    /// Microseconds.
+    Us,
+    /// Nanoseconds.
+    Ns,
 }
 
 /// Output format shared by the analysis commands.
@@ -476,12 +531,24 @@ pub struct AvarArgs {
 /// `--format`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum FormatArg {
-    /// From the file name (.csv, .tsv, .txt, optionally .gz).
+    /// From the name, the JSON sidecar and the first bytes (.csv, .tsv, .txt, .gz, .f64, .f32).
     Auto,
     /// Comma-separated text.
     Csv,
     /// Tab-separated text.
     Tsv,
+    /// iMAR binary IMU records (METHODS §9.2-9.3: f64 time + 6 int32 increments).
+    Imar,
+    /// Northrop Grumman LN-200 records (int32 increments, gyro 2^-21 rad).
+    Ln200,
+    /// LN-200 IG records (int32 increments, gyro 2^-19 rad).
+    Ln200ig,
+    /// iXblue (IXSEA) records (f64 increments, gyro 1 arcsec).
+    Ixsea,
+    /// NavChip integer records (int32 increments).
+    NavchipInt,
+    /// NavChip float records (f64 increments).
+    NavchipFlt,
     /// Raw little-endian 64-bit floats.
     F64,
     /// Raw little-endian 32-bit floats.

@@ -1,8 +1,14 @@
-//! Turning `InputArgs` into engine read options and loaded columns.
+//! Turning `InputArgs` into engine read options and loaded columns, and printing what the
+//! reader found (time column, skipped columns, warnings) once per file on stderr.
 
-use crate::args::{FormatArg, HeaderArg, InputArgs};
+use crate::args::{FormatArg, HeaderArg, InputArgs, TimeUnitArg, WvEstimatorArgs};
 use anyhow::{Context, Result};
-use gmwm::imu::{read_table, ColumnSelector, HeaderMode, InputFormat, ReadOptions, Table};
+use gmwm::imu::{
+    is_wv_json, quote, read_table, read_wv_json, select_series, ColumnSelector, HeaderMode,
+    ImuRecordType, InputFormat, ReadOptions, ReadWarning, Table, TimeUnit,
+};
+use gmwm::WaveletVariance;
+use std::path::Path;
 
 /// A loaded input: the table and the sampling rate to use.
 pub struct Loaded {
@@ -12,39 +18,33 @@ pub struct Loaded {
     pub freq_hz: f64,
 }
 
-fn selector(text: &str) -> ColumnSelector {
+/// `--columns` entries: all digits → a 1-based index, anything else a name.
+pub fn selector(text: &str) -> ColumnSelector {
     match text.trim().parse::<usize>() {
         Ok(i) => ColumnSelector::Index(i),
         Err(_) => ColumnSelector::Name(text.trim().to_string()),
     }
 }
 
-/// The engine's read options from the flags.
-fn read_options(args: &InputArgs) -> ReadOptions {
-    ReadOptions {
-        format: match args.format {
-            FormatArg::Auto => InputFormat::Auto,
-            FormatArg::Csv => InputFormat::Csv,
-            FormatArg::Tsv => InputFormat::Tsv,
-            FormatArg::F64 => InputFormat::F64,
-            FormatArg::F32 => InputFormat::F32,
-        },
-        header: match args.header {
-            HeaderArg::Auto => HeaderMode::Auto,
-            HeaderArg::Yes => HeaderMode::Present,
-            HeaderArg::No => HeaderMode::Absent,
-        },
-        time_column: args.time_column.as_deref().map(selector),
-        columns: args.columns.iter().map(|c| selector(c)).collect(),
-        ncols: args.ncols,
-        freq_hz: args.freq,
-        time_unit: None,
+/// The engine format of `--format`.
+pub fn format(arg: FormatArg) -> InputFormat {
+    match arg {
+        FormatArg::Auto => InputFormat::Auto,
+        FormatArg::Csv => InputFormat::Csv,
+        FormatArg::Tsv => InputFormat::Tsv,
+        FormatArg::Imar => InputFormat::ImuRecord(ImuRecordType::Imar),
+        FormatArg::Ln200 => InputFormat::ImuRecord(ImuRecordType::Ln200),
+        FormatArg::Ln200ig => InputFormat::ImuRecord(ImuRecordType::Ln200Ig),
+        FormatArg::Ixsea => InputFormat::ImuRecord(ImuRecordType::Ixsea),
+        FormatArg::NavchipInt => InputFormat::ImuRecord(ImuRecordType::NavchipInt),
+        FormatArg::NavchipFlt => InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
+        FormatArg::F64 => InputFormat::F64,
+        FormatArg::F32 => InputFormat::F32,
     }
 }
 
-/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
-/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
-pub fn load(args: &InputArgs) -> Result<Loaded> {
+/// Checks the input flags and turns them into engine read options.
+pub fn options(args: &InputArgs) -> Result<ReadOptions> {
     if let Some(f) = args.freq {
         anyhow::ensure!(
             f.is_finite() && f > 0.0,
@@ -57,8 +57,107 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
             "invalid --ncols 0: a binary file has at least one column"
         );
     }
-    let opts = read_options(args);
+    Ok(ReadOptions {
+        format: format(args.format),
+        header: match args.header {
+            HeaderArg::Auto => HeaderMode::Auto,
+            HeaderArg::Yes => HeaderMode::Present,
+            HeaderArg::No => HeaderMode::Absent,
+        },
+        time_column: args.time_column.as_deref().map(selector),
+        time_unit: args.time_unit.map(|u| match u {
+            TimeUnitArg::S => TimeUnit::Seconds,
+            TimeUnitArg::Ms => TimeUnit::Milliseconds,
+            TimeUnitArg::Us => TimeUnit::Microseconds,
+            TimeUnitArg::Ns => TimeUnit::Nanoseconds,
+        }),
+        columns: args.columns.iter().map(|c| selector(c)).collect(),
+        ncols: args.ncols,
+        freq_hz: args.freq,
+    })
+}
+
+/// Whether FILE is a wavelet variance saved by `gmwm wv --json` (by name or content) rather
+/// than a recording; never with an explicit recording `--format`.
+pub fn is_wv(args: &InputArgs) -> bool {
+    args.format == FormatArg::Auto && is_wv_json(&args.file)
+}
+
+/// A rate for messages: 6 significant digits, trailing zeros dropped (`200`, `62.5`).
+fn hz(x: f64) -> String {
+    let s = format!(
+        "{:.*}",
+        5usize.saturating_sub(x.abs().log10().floor().max(0.0) as usize),
+        x
+    );
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Prints a note on stderr.
+pub fn note(file: &Path, text: &str) {
+    eprintln!("gmwm: note: {}: {text}", file.display());
+}
+
+/// Prints what the reader found: the time column and its rate, the columns left out, then
+/// every warning, each once.
+fn report(table: &Table) {
+    let file = &table.path;
+    if let Some(t) = &table.timing {
+        note(file, &t.to_string());
+    }
+    if !table.skipped.is_empty() {
+        let names: Vec<String> = table.skipped.iter().map(|n| quote(n)).collect();
+        note(
+            file,
+            &format!(
+                "not analysed: {} (not a gyroscope or accelerometer axis, or another time \
+                 column; --columns selects any column)",
+                names.join(", ")
+            ),
+        );
+    }
+    for w in &table.warnings {
+        match w {
+            ReadWarning::FreqDisagrees {
+                given_hz,
+                column,
+                time_hz,
+                ..
+            } => eprintln!(
+                "gmwm: warning: {}: --freq {} Hz differs by {:.0}% from time column \"{}\" \
+                 ({} Hz); --freq is used",
+                file.display(),
+                hz(*given_hz),
+                100.0 * (given_hz - time_hz).abs() / time_hz,
+                quote(column),
+                hz(*time_hz),
+            ),
+            w => eprintln!("gmwm: warning: {w}"),
+        }
+    }
+}
+
+/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
+/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
+/// The reader's notes and warnings are printed on stderr.
+pub fn load(args: &InputArgs) -> Result<Loaded> {
+    let opts = options(args)?;
+    if args.format == FormatArg::Auto && gmwm::imu::ros::container_of(&args.file).is_some() {
+        return load_ros(args, opts);
+    }
+    if let Some(topic) = &args.topic {
+        return Err(crate::UsageError(format!(
+            "invalid --topic {topic}: {} is not a ROS recording (ROS1 bag, MCAP, rosbag2 sqlite3)",
+            args.file.display()
+        ))
+        .into());
+    }
     let table = read_table(&args.file, &opts)?;
+    report(&table);
     let freq_hz = match args.freq.or(table.freq_hz) {
         Some(f) => f,
         None => {
@@ -72,13 +171,61 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
     Ok(Loaded { table, freq_hz })
 }
 
-/// Adds "FILE: column NAME" to a per-column engine error.
+/// Refuses estimator flags that need the series when FILE is a saved wavelet variance: it is
+/// used as it is (robust if it says so).
+pub fn check_wv_estimator(file: &Path, e: &WvEstimatorArgs) -> Result<()> {
+    anyhow::ensure!(
+        !e.robust,
+        "{}: --robust needs the series; a wavelet-variance file is used as it is (robust if it says so)",
+        file.display()
+    );
+    anyhow::ensure!(
+        e.filter == "haar" && e.transform == crate::args::TransformArg::Modwt,
+        "{}: --filter/--transform apply to a recording; a wavelet-variance file is used as it is",
+        file.display()
+    );
+    Ok(())
+}
+
+/// Keeps the first `j` levels of a WV.
+fn truncate_levels(wv: &mut WaveletVariance, j: usize) {
+    wv.tau.truncate(j);
+    wv.tau_s.truncate(j);
+    wv.wv.truncate(j);
+    wv.ci_low.truncate(j);
+    wv.ci_high.truncate(j);
+    wv.n_coefficients.truncate(j);
+    wv.eta.truncate(j);
+}
+
+/// Reads a saved wavelet variance: the series `--columns` selects (names or 1-based indices),
+/// the rate from `--freq` or the file, the first `levels` levels.
+pub fn load_wv(args: &InputArgs, levels: Option<usize>) -> Result<Vec<(String, WaveletVariance)>> {
+    let file = &args.file;
+    let selectors: Vec<ColumnSelector> = args.columns.iter().map(|c| selector(c)).collect();
+    let mut series = select_series(file, read_wv_json(file, args.freq)?, &selectors)?;
+    if let Some(j) = levels {
+        for (name, wv) in &mut series {
+            anyhow::ensure!(
+                j >= 1 && j <= wv.levels(),
+                "{}: series {}: --levels {j} is outside 1..={}",
+                file.display(),
+                quote(name),
+                wv.levels()
+            );
+            truncate_levels(wv, j);
+        }
+    }
+    Ok(series)
+}
+
+/// Adds "FILE: column NAME" to a per-column engine error (the name cut to 40 characters).
 pub fn column_context<T>(
     r: Result<T, gmwm::Error>,
     file: &std::path::Path,
     column: &str,
 ) -> Result<T> {
-    r.with_context(|| format!("{}: column {column}", file.display()))
+    r.with_context(|| format!("{}: column {}", file.display(), quote(column)))
 }
 
 /// Runs a per-series computation over every loaded column in parallel (the engine's
@@ -124,11 +271,12 @@ pub struct LoadedRecording {
     pub notes: Vec<String>,
 }
 
-/// Opens the recording named by `args` as an IMU (the engine's `Recording`).
+/// Opens the recording named by `args` as an IMU (the engine's `Recording`: text, raw binary,
+/// binary IMU records or a ROS recording).
 pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
     let opts = gmwm::imu::RecordingOptions {
-        read: read_options(args),
-        topic: None,
+        read: options(args)?,
+        topic: args.topic.clone(),
     };
     let rec = gmwm::imu::Recording::open(&args.file, &opts)?;
     Ok(LoadedRecording {
@@ -137,4 +285,31 @@ pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
         topic: rec.topic,
         notes: rec.notes,
     })
+}
+
+/// A ROS recording read as a table: the IMU topic's six axes at the header stamps' rate.
+fn load_ros(args: &InputArgs, read: ReadOptions) -> Result<Loaded> {
+    let rec = gmwm::imu::Recording::open(
+        &args.file,
+        &gmwm::imu::RecordingOptions {
+            read,
+            topic: args.topic.clone(),
+        },
+    )?;
+    for n in &rec.notes {
+        note(&args.file, n);
+    }
+    let freq_hz = rec.imu.freq_hz();
+    let table = Table {
+        path: rec.path,
+        columns: rec.imu.axes().iter().map(|a| a.column.clone()).collect(),
+        freq_hz: Some(freq_hz),
+        sidecar: None,
+        time: None,
+        timing: rec.timing,
+        warnings: Vec::new(),
+        skipped: Vec::new(),
+        record_type: None,
+    };
+    Ok(Loaded { table, freq_hz })
 }

@@ -515,8 +515,10 @@ fn simulate_to_gz_file_writes_a_sidecar_that_wv_reads() {
         .assert()
         .success()
         .stdout("");
+    // the sidecar is named after the whole file name (it was sim.json, shared by sim.txt and
+    // sim.f64: the collision this name avoids)
     assert!(
-        dir.path().join("sim.json").is_file(),
+        dir.path().join("sim.csv.gz.json").is_file(),
         "sidecar beside the data"
     );
     let out = gmwm()

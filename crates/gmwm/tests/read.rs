@@ -4,9 +4,12 @@
 use crate::common::data_dir;
 use flate2::write::GzEncoder;
 use flate2::Compression;
+use gmwm::imu::write::write_sidecar;
 use gmwm::imu::{
-    for_each_chunk, read_imu_record_file, read_table, BinaryChunks, ColumnSelector, HeaderMode,
-    Imu, ImuRecordType, InputFormat, ReadError, ReadOptions, Sensor,
+    allan_from_wv, binary_layout, for_each_chunk, is_wv_json, read_imu_record_file, read_table,
+    select_series, sniff, BinaryChunks, ColumnSelector, Content, HeaderMode, Imu, ImuRecordType,
+    InputFormat, ReadError, ReadOptions, ReadWarning, Sensor, SeriesWriter, Sidecar, SidecarColumn,
+    TimeUnit, TimingWarning, UnitSource,
 };
 use gmwm::math::sum::NeumaierSum;
 use std::io::Write;
@@ -790,4 +793,617 @@ fn read_multi_member_gzip() {
     z.extend(gzip(b"3\n4\n"));
     let p = write(&d, "m.csv.gz", &z);
     assert_eq!(read(&p).unwrap().columns[0].values, [1.0, 2.0, 3.0, 4.0]);
+}
+
+// ---------------------------------------------------------------- time columns (issue: new user)
+
+/// `n` rows `t,gyro_x` with stamps `t0 + i * step` (plus `hole` after row `gap_at`).
+fn timed_csv(header: &str, t0: f64, step: f64, n: usize, gap_at: usize, hole: f64) -> String {
+    let mut s = format!("{header},gyro_x\n");
+    for i in 0..n {
+        let t = t0 + i as f64 * step + if i >= gap_at { hole } else { 0.0 };
+        s.push_str(&format!("{t},{}\n", (i % 7) as f64 * 0.1));
+    }
+    s
+}
+
+/// A ROS-style time column in nanoseconds was read as seconds (rate 1e-7 Hz, no warning).
+#[test]
+fn issue_time_column_in_ns_is_not_read_as_seconds() {
+    let d = tempfile::tempdir().unwrap();
+    // relative ns stamps (ROS sim time): the step says ns
+    let p = write(
+        &d,
+        "ros.csv",
+        timed_csv("stamp", 0.0, 5e6, 100, usize::MAX, 0.0).as_bytes(),
+    );
+    let t = read(&p).unwrap();
+    assert_eq!(t.freq_hz, Some(200.0));
+    let timing = t.timing.as_ref().unwrap();
+    assert_eq!(timing.unit, TimeUnit::Nanoseconds);
+    assert_eq!(timing.unit_source, UnitSource::Inferred);
+    assert_eq!(
+        t.time.as_ref().unwrap().values[1],
+        0.005,
+        "stamps in seconds"
+    );
+    // Unix-epoch ns stamps, the column given by index: the magnitude says ns
+    let mut epoch = String::from("when,gyro_x\n");
+    for i in 0..100u64 {
+        epoch.push_str(&format!(
+            "{},{}\n",
+            1_700_000_000_000_000_000 + i * 5_000_000,
+            i % 3
+        ));
+    }
+    let p = write(&d, "epoch.csv", epoch.as_bytes());
+    let o = ReadOptions {
+        time_column: Some(ColumnSelector::Index(1)),
+        ..ReadOptions::default()
+    };
+    let t = read_table(&p, &o).unwrap();
+    assert!((t.freq_hz.unwrap() - 200.0).abs() < 1e-6, "{:?}", t.freq_hz);
+    assert_eq!(t.timing.as_ref().unwrap().unit, TimeUnit::Nanoseconds);
+    // the name states the unit; a given unit wins and is reported as given
+    let p = write(
+        &d,
+        "stated.csv",
+        timed_csv("%time", 0.0, 5e6, 100, usize::MAX, 0.0).as_bytes(),
+    );
+    let t = read(&p).unwrap();
+    assert_eq!(t.timing.as_ref().unwrap().unit_source, UnitSource::Stated);
+    assert_eq!(t.freq_hz, Some(200.0));
+    let o = ReadOptions {
+        time_unit: Some(TimeUnit::Microseconds),
+        ..ReadOptions::default()
+    };
+    let t = read_table(&p, &o).unwrap();
+    assert_eq!(t.timing.as_ref().unwrap().unit_source, UnitSource::Flag);
+    assert!((t.freq_hz.unwrap() - 0.2).abs() < 1e-12);
+}
+
+/// A 0.5 s gap in a 200 Hz log was averaged into the rate silently.
+#[test]
+fn issue_gap_is_not_averaged_into_the_rate() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(
+        &d,
+        "gap.csv",
+        timed_csv("time", 0.0, 0.005, 2000, 1000, 0.5).as_bytes(),
+    );
+    let t = read(&p).unwrap();
+    assert!((t.freq_hz.unwrap() - 200.0).abs() < 1e-9, "{:?}", t.freq_hz);
+    let timing = t.timing.as_ref().unwrap();
+    assert!((timing.mean_rate_hz - 1999.0 / 10.495).abs() < 1e-9);
+    assert_eq!(timing.gaps.len(), 1);
+    let g = &timing.gaps[0];
+    assert_eq!((g.row, g.line, g.missing), (1000, Some(1002), 100));
+    assert!((g.duration_s - 0.5).abs() < 1e-9);
+    assert_eq!(t.warnings.len(), 1);
+    assert_eq!(
+        t.warnings[0].to_string(),
+        format!(
+            "{}: time column \"time\": 1 gap (100 samples missing), largest 0.50 s at line 1002 \
+             (5.00 s after the start); the rows are analysed as if evenly spaced at 200 Hz",
+            p.display()
+        )
+    );
+    assert!(matches!(
+        &t.warnings[0],
+        ReadWarning::Timing {
+            warning: TimingWarning::Gaps { count: 1, .. },
+            ..
+        }
+    ));
+}
+
+/// `--freq 100` silently overrode a 200 Hz time column.
+#[test]
+fn issue_freq_disagreeing_with_the_time_column_is_warned() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(
+        &d,
+        "t.csv",
+        timed_csv("t", 0.0, 0.005, 100, usize::MAX, 0.0).as_bytes(),
+    );
+    let o = ReadOptions {
+        freq_hz: Some(100.0),
+        ..ReadOptions::default()
+    };
+    let t = read_table(&p, &o).unwrap();
+    assert_eq!(t.freq_hz, Some(100.0), "the given rate still wins");
+    assert_eq!(t.warnings.len(), 1);
+    assert_eq!(
+        t.warnings[0].to_string(),
+        format!(
+            "{}: the rate given (100 Hz) differs by 50% from time column \"t\" (200 Hz); the \
+             given rate is used",
+            p.display()
+        )
+    );
+    // within 1%: no warning
+    let o = ReadOptions {
+        freq_hz: Some(200.5),
+        ..ReadOptions::default()
+    };
+    assert!(read_table(&p, &o).unwrap().warnings.is_empty());
+    // a sidecar rate that disagrees is reported, the time column's is used
+    write(&d, "t.csv.json", br#"{"sampling_frequency_hz": 100}"#);
+    let t = read(&p).unwrap();
+    assert!((t.freq_hz.unwrap() - 200.0).abs() < 1e-9);
+    assert!(matches!(
+        t.warnings[..],
+        [ReadWarning::SidecarFreqDisagrees { .. }]
+    ));
+}
+
+/// Columns named `time` or `timestamp` were analysed as sensor data.
+#[test]
+fn issue_time_columns_are_not_analysed() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(
+        &d,
+        "two.csv",
+        b"timestamp,x,time\n0,1,10\n0.01,2,10.01\n0.02,4,10.02\n",
+    );
+    let t = read(&p).unwrap();
+    let names: Vec<&str> = t.columns.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["x"]);
+    assert_eq!(t.timing.as_ref().unwrap().column, "timestamp");
+    assert_eq!(t.skipped, ["time"]);
+    assert!((t.freq_hz.unwrap() - 100.0).abs() < 1e-9);
+    // selecting the time column explicitly analyses it (and it is then not the time)
+    let o = ReadOptions {
+        columns: names_of(&["timestamp", "x"]),
+        ..ReadOptions::default()
+    };
+    let t = read_table(&p, &o).unwrap();
+    assert_eq!(t.columns.len(), 2);
+    assert_eq!(t.timing.as_ref().unwrap().column, "time");
+    // time stamps that go backwards stay an error naming the line
+    let p = write(&d, "back.csv", b"time,x\n0,1\n0.01,2\n0.005,3\n");
+    assert_eq!(
+        err(&p, &ReadOptions::default()),
+        format!(
+            "{}:4: column time: time 0.005 is not greater than the previous time 0.01; the time \
+             column must be strictly increasing",
+            p.display()
+        )
+    );
+}
+
+fn names_of(v: &[&str]) -> Vec<ColumnSelector> {
+    v.iter().map(|s| s.parse().unwrap()).collect()
+}
+
+/// EuRoC / TUM-VI `imu0/data.csv`: ns stamps named in the header, gyro `w_*`, accel `a_*`,
+/// units from the brackets.
+#[test]
+fn euroc_layout_reads_as_an_imu() {
+    let d = tempfile::tempdir().unwrap();
+    let mut s = String::from(
+        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],\
+         a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+    );
+    for i in 0..400u64 {
+        let t = 1_403_636_579_758_555_392 + i * 5_000_000;
+        s.push_str(&format!("{t},0.1,-0.2,{},9.8,0.1,0.2\n", i % 3));
+    }
+    let p = write(&d, "data.csv", s.as_bytes());
+    let imu = Imu::from_table(read(&p).unwrap()).unwrap();
+    assert_eq!(imu.num_sensor(), (3, 3));
+    assert!((imu.freq_hz() - 200.0).abs() < 1e-6);
+    let timing = imu.timing().unwrap();
+    assert_eq!(timing.column, "#timestamp [ns]");
+    assert_eq!(
+        (timing.unit, timing.unit_source),
+        (TimeUnit::Nanoseconds, UnitSource::Stated)
+    );
+    let g = imu.axis("gyro_z").unwrap();
+    assert_eq!(g.info.unit.as_deref(), Some("rad s^-1"));
+    assert_eq!(g.column.name, "w_RS_S_z [rad s^-1]");
+    assert_eq!(
+        imu.axis("accel_x").unwrap().info.unit.as_deref(),
+        Some("m s^-2")
+    );
+    assert!(imu.warnings().is_empty());
+}
+
+/// `rostopic echo -p` CSV: `%time` and `field.header.stamp` (ns, the header stamp preferred),
+/// non-sensor columns (one of them text) left out of the default selection.
+#[test]
+fn rostopic_layout_reads_the_sensor_columns() {
+    let d = tempfile::tempdir().unwrap();
+    let mut s = String::from(
+        "%time,field.header.seq,field.header.stamp,field.header.frame_id,field.orientation.x,\
+         field.angular_velocity.x,field.angular_velocity.y,field.angular_velocity.z,\
+         field.linear_acceleration.x,field.linear_acceleration.y,field.linear_acceleration.z\n",
+    );
+    for i in 0..300u64 {
+        let stamp = 1_700_000_000_000_000_000 + i * 10_000_000;
+        let recv = stamp + 2_000_000 + (i % 5) * 100_000;
+        s.push_str(&format!(
+            "{recv},{i},{stamp},imu_link,0,0.1,0.2,0.3,0,0,9.8\n"
+        ));
+    }
+    let p = write(&d, "imu.csv", s.as_bytes());
+    let t = read(&p).unwrap();
+    assert_eq!(t.timing.as_ref().unwrap().column, "field.header.stamp");
+    assert!((t.freq_hz.unwrap() - 100.0).abs() < 1e-6);
+    assert_eq!(
+        t.skipped,
+        [
+            "%time",
+            "field.header.seq",
+            "field.header.frame_id",
+            "field.orientation.x"
+        ]
+    );
+    let imu = Imu::from_table(t).unwrap();
+    let tags: Vec<String> = imu.iter().map(|(t, _)| t).collect();
+    assert_eq!(
+        tags,
+        ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]
+    );
+}
+
+#[test]
+fn short_headers_time_ax_gx() {
+    let d = tempfile::tempdir().unwrap();
+    let mut s = String::from("time,ax,ay,az,gx,gy,gz,temp\n");
+    for i in 0..50 {
+        s.push_str(&format!("{},1,2,3,4,5,{},25\n", i as f64 * 0.01, i % 4));
+    }
+    let p = write(&d, "log.txt", s.as_bytes());
+    let t = read(&p).unwrap();
+    assert_eq!(t.skipped, ["temp"]);
+    let imu = Imu::from_table(t).unwrap();
+    assert_eq!(imu.num_sensor(), (3, 3));
+    assert!((imu.freq_hz() - 100.0).abs() < 1e-9);
+}
+
+// ---------------------------------------------------------------- content sniffing
+
+/// A `.bin` without a format was parsed as text and ~19 KB of raw bytes landed in the error.
+#[test]
+fn issue_binary_content_without_format_is_one_short_line() {
+    let d = tempfile::tempdir().unwrap();
+    let mut state = 12345u64;
+    let bytes: Vec<u8> = (0..19_000)
+        .map(|_| {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (state >> 33) as u8
+        })
+        .collect();
+    let p = write(&d, "x.bin", &bytes);
+    let e = err(&p, &ReadOptions::default());
+    assert_eq!(
+        e,
+        format!(
+            "{}: looks like binary data, not text; give --format \
+             f64|f32|imar|ln200|ln200ig|ixsea|navchip-int|navchip-flt",
+            p.display()
+        )
+    );
+    assert_eq!(sniff(&p).unwrap(), Content::Binary);
+    // gzip of binary data too
+    let p = write(&d, "y.gz", &gzip(&bytes));
+    assert!(matches!(read(&p), Err(ReadError::LooksBinary { .. })));
+    // forcing csv does not dump the bytes either
+    let o = ReadOptions {
+        format: InputFormat::Csv,
+        ..ReadOptions::default()
+    };
+    assert!(matches!(
+        read_table(&p, &o),
+        Err(ReadError::LooksBinary { .. })
+    ));
+}
+
+/// Text quoted in an error is at most 40 characters, non-printables escaped.
+#[test]
+fn quoted_file_text_is_cut_and_escaped() {
+    let d = tempfile::tempdir().unwrap();
+    let long = "y".repeat(500);
+    let p = write(&d, "q.csv", format!("x\n1\n{long}\x07\n").as_bytes());
+    let e = err(&p, &ReadOptions::default());
+    assert_eq!(
+        e,
+        format!(
+            "{}:3: column x: \"{}...\" is not a number",
+            p.display(),
+            "y".repeat(40)
+        )
+    );
+    assert_eq!(gmwm::imu::quote("a\u{0}b\tc"), "a\\0b\\tc");
+    // a long header in an unknown-column error
+    let names: Vec<String> = (0..30).map(|k| format!("{}{k}", "h".repeat(60))).collect();
+    let p = write(&d, "h.csv", format!("{}\n", names.join(",")).as_bytes());
+    let o = ReadOptions {
+        columns: names_of(&["nope"]),
+        ..ReadOptions::default()
+    };
+    let e = err(&p, &o);
+    assert!(e.len() < 1200, "{}", e.len());
+    assert!(e.ends_with("... (10 more)"), "{e}");
+}
+
+#[test]
+fn json_is_not_a_table() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(&d, "wv.txt", b"  {\"series\": []}");
+    assert_eq!(sniff(&p).unwrap(), Content::Json);
+    assert!(is_wv_json(&p));
+    assert!(matches!(read(&p), Err(ReadError::NotATable { .. })));
+}
+
+// ---------------------------------------------------------------- writers and sidecars
+
+/// `x.f64` was written as CSV text, and `x.txt` / `x.f64` both wrote `x.json`.
+#[test]
+fn issue_series_files_follow_their_extension_and_sidecars_do_not_collide() {
+    let d = tempfile::tempdir().unwrap();
+    let a: Vec<f64> = (0..100).map(|i| (i as f64 * 0.37).sin()).collect();
+    let b: Vec<f64> = (0..100).map(|i| i as f64 * 1e-3 - 0.05).collect();
+    for (name, format) in [
+        ("x.f64", "f64"),
+        ("x.txt", "csv"),
+        ("x.f32.bin", "f32"),
+        ("x.tsv", "tsv"),
+        ("x.csv.gz", "csv"),
+    ] {
+        let p = d.path().join(name);
+        let mut w = SeriesWriter::create(&p, &["a", "b"]).unwrap();
+        w.write_rows(&[&a[..50], &b[..50]]).unwrap();
+        w.write_rows(&[&a[50..], &b[50..]]).unwrap();
+        assert_eq!(w.format().sidecar_name(), format);
+        w.finish().unwrap();
+        let sidecar = Sidecar {
+            sampling_frequency_hz: Some(50.0),
+            format: Some(format.into()),
+            n_columns: Some(2),
+            columns: ["a", "b"]
+                .iter()
+                .map(|n| SidecarColumn {
+                    name: n.to_string(),
+                    meaning: None,
+                })
+                .collect(),
+            ..Sidecar::default()
+        };
+        let side = write_sidecar(&p, &sidecar).unwrap();
+        assert_eq!(side, d.path().join(format!("{name}.json")));
+        // read back without options
+        let t = read(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(t.freq_hz, Some(50.0));
+        assert_eq!(t.columns[0].name, "a", "{name}");
+        if format == "f32" {
+            let a32: Vec<f64> = a.iter().map(|&v| f64::from(v as f32)).collect();
+            assert_eq!(t.columns[0].values, a32);
+        } else {
+            assert_eq!(t.columns[0].values, a, "{name}: same bits");
+            assert_eq!(t.columns[1].values, b, "{name}");
+        }
+    }
+    let raw = std::fs::read(d.path().join("x.f64")).unwrap();
+    assert_eq!(raw.len(), 100 * 2 * 8, "raw interleaved f64, no text");
+    assert_eq!(raw[..8], a[0].to_le_bytes());
+    assert_eq!(raw[8..16], b[0].to_le_bytes());
+    // the binary layout from the sidecar, for streaming readers
+    let layout = binary_layout(&d.path().join("x.f64"), &ReadOptions::default())
+        .unwrap()
+        .unwrap();
+    assert_eq!((layout.format, layout.ncols), (InputFormat::F64, 2));
+    assert_eq!(layout.names, ["a", "b"]);
+    assert!(
+        binary_layout(&d.path().join("x.txt"), &ReadOptions::default())
+            .unwrap()
+            .is_none()
+    );
+    // unknown extensions are refused with the list
+    let e = SeriesWriter::create(&d.path().join("x.xyz"), &["a"])
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("a file name ending in .csv, .txt, .tsv"), "{e}");
+}
+
+// ---------------------------------------------------------------- IMU records, every type
+
+/// Hand scale factors of METHODS §9.3 (rad or m/s per count), independent of the library's.
+fn scales(t: ImuRecordType) -> (f64, f64) {
+    let arcsec = std::f64::consts::PI / (180.0 * 3600.0);
+    match t {
+        ImuRecordType::Imar => (0.1 * arcsec, 1.52588e-6),
+        ImuRecordType::Ln200 => (2f64.powi(-21), 2f64.powi(-14)),
+        ImuRecordType::Ln200Ig => (2f64.powi(-19), 2f64.powi(-14)),
+        ImuRecordType::Ixsea => (arcsec, 0.001),
+        ImuRecordType::NavchipFlt => (2.0 * std::f64::consts::PI / (3600.0 * 360.0), 0.001),
+        ImuRecordType::NavchipInt => (6.25e-6, 3.90625e-5),
+    }
+}
+
+fn record(t: ImuRecordType, time: f64, counts: [i32; 6]) -> Vec<u8> {
+    if t.is_double() {
+        double_record(time, counts.map(f64::from))
+    } else {
+        int_record(time, counts)
+    }
+}
+
+/// Every record type: known counts at 400 Hz read back as `counts · 400 · scale`, through
+/// `read_table` (with `--columns`) and `read_imu_record_file`; truncated and non-monotonic
+/// files refused with their errors.
+#[test]
+fn imu_records_every_type_rates_and_errors() {
+    let d = tempfile::tempdir().unwrap();
+    let counts = [[1000, -2000, 3, 10, -20, 30], [7, 0, -1, 16384, 1, -5]];
+    for t in ImuRecordType::ALL {
+        let mut b = Vec::new();
+        for i in 0..6 {
+            b.extend(record(t, 100.0 + i as f64 * 0.0025, counts[i % 2]));
+        }
+        let name = format!("{t}.bin");
+        let p = write(&d, &name, &b);
+        let (sg, sa) = scales(t);
+        let imu = read_imu_record_file(&p, t).unwrap_or_else(|e| panic!("{t}: {e}"));
+        assert_eq!(imu.freq_hz(), 400.0, "{t}");
+        assert_eq!(imu.record_type(), Some(t));
+        for (k, (tag, axis)) in imu.iter().enumerate() {
+            let scale = if k < 3 { sg } else { sa };
+            for (i, &v) in axis.values().iter().enumerate() {
+                let want = f64::from(counts[i % 2][k]) * 400.0 * scale;
+                assert!(
+                    (v - want).abs() <= 1e-12 * want.abs(),
+                    "{t} {tag}[{i}]: {v} vs {want}"
+                );
+            }
+        }
+        assert_eq!(
+            imu.gyroscopes().next().unwrap().info.unit.as_deref(),
+            Some("rad/s")
+        );
+        // read_table with the format and a column selection
+        let o = ReadOptions {
+            format: InputFormat::ImuRecord(t),
+            columns: names_of(&["accel_z", "2"]),
+            ..ReadOptions::default()
+        };
+        let table = read_table(&p, &o).unwrap();
+        assert_eq!(table.freq_hz, Some(400.0));
+        assert_eq!(table.columns[0].name, "accel_z");
+        assert_eq!(
+            table.columns[0].values,
+            imu.axis("accel_z").unwrap().values()
+        );
+        assert_eq!(
+            table.columns[1].values,
+            imu.axis("gyro_y").unwrap().values()
+        );
+        assert_eq!(table.record_type, Some(t));
+        // truncated
+        let mut cut = b[..2 * t.record_size()].to_vec();
+        cut.extend_from_slice(&[0; 5]);
+        let p = write(&d, &format!("cut_{name}"), &cut);
+        assert_eq!(
+            read_imu_record_file(&p, t).unwrap_err().to_string(),
+            format!(
+                "{}: size {} bytes is not a multiple of the record size {} bytes (5 bytes left \
+                 over)",
+                p.display(),
+                cut.len(),
+                t.record_size()
+            )
+        );
+        // time going backwards at record 2
+        let mut back = record(t, 0.0, counts[0]);
+        back.extend(record(t, 0.005, counts[0]));
+        back.extend(record(t, 0.004, counts[0]));
+        let p = write(&d, &format!("back_{name}"), &back);
+        assert_eq!(
+            read_table(
+                &p,
+                &ReadOptions {
+                    format: InputFormat::ImuRecord(t),
+                    ..ReadOptions::default()
+                }
+            )
+            .unwrap_err()
+            .to_string(),
+            format!(
+                "{}: record 2 (0-based): time 0.004 is not greater than the previous time 0.005; \
+                 the epochs must be in strictly increasing time order",
+                p.display()
+            )
+        );
+    }
+}
+
+/// A gap in the epochs does not lower the rate that converts every increment.
+#[test]
+fn imu_record_gap_keeps_the_rate() {
+    let d = tempfile::tempdir().unwrap();
+    let mut b = Vec::new();
+    for i in 0..100 {
+        let t = i as f64 * 0.005 + if i >= 50 { 1.0 } else { 0.0 };
+        b.extend(int_record(t, [2_097_152, 0, 0, 0, 0, 0]));
+    }
+    let p = write(&d, "gap.bin", &b);
+    let imu = read_imu_record_file(&p, ImuRecordType::Ln200).unwrap();
+    assert_eq!(imu.freq_hz(), 200.0);
+    assert_eq!(imu.axis("gyro_x").unwrap().values()[0], 200.0);
+    assert_eq!(imu.timing().unwrap().gaps.len(), 1);
+    assert_eq!(imu.warnings().len(), 1);
+}
+
+// ---------------------------------------------------------------- WV JSON
+
+#[test]
+fn wv_json_series_by_name_or_index_and_allan_by_methods_3_4() {
+    use gmwm::{allan_variance, wavelet_variance, AllanOptions, WvOptions};
+    let x: Vec<f64> = (0..4096)
+        .map(|i| ((i as f64) * 0.731).sin() + ((i * i) as f64 * 1e-3).cos())
+        .collect();
+    let wv = wavelet_variance(&x, 10.0, &WvOptions::default()).unwrap();
+    let av = allan_variance(&x, 10.0, &AllanOptions::default()).unwrap();
+    let conv = allan_from_wv(&wv).unwrap();
+    let levels = conv.tau.len();
+    assert_eq!(conv.tau[..], av.tau[..levels]);
+    for j in 0..levels {
+        for (a, b) in [
+            (conv.avar[j], av.avar[j]),
+            (conv.ci_low[j], av.ci_low[j]),
+            (conv.ci_high[j], av.ci_high[j]),
+            (conv.edf[j], av.edf[j]),
+        ] {
+            assert!((a - b).abs() <= 1e-9 * b.abs(), "level {j}: {a} vs {b}");
+        }
+        assert_eq!(conv.terms[j], av.terms[j]);
+    }
+    let robust = wavelet_variance(
+        &x,
+        10.0,
+        &WvOptions {
+            robust: Some(gmwm::RobustOptions::default()),
+            ..WvOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(allan_from_wv(&robust).is_err());
+    // selection by name and index
+    let p = Path::new("wv.json");
+    let series = vec![("a".to_string(), wv.clone()), ("b".to_string(), wv)];
+    let picked = select_series(p, series.clone(), &names_of(&["2", "a"])).unwrap();
+    let names: Vec<&str> = picked.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["b", "a"]);
+    assert_eq!(
+        select_series(p, series.clone(), &names_of(&["3"]))
+            .unwrap_err()
+            .to_string(),
+        "wv.json: series 3 is out of range; the file has 2 series (1-based: 1..=2)"
+    );
+    assert_eq!(
+        select_series(p, series, &names_of(&["c"]))
+            .unwrap_err()
+            .to_string(),
+        "wv.json: no series named \"c\"; available: a, b"
+    );
+}
+
+/// `Wic::select_wv` on the WV of a series is `Wic::select` on the series (no drift in the
+/// model, so the series range of the starting values plays no part).
+#[test]
+fn wic_select_wv_equals_select_on_the_series() {
+    use gmwm::{wavelet_variance, Wic, WvOptions};
+    let x = crate::common::white_noise(2000, 1.0, 5);
+    let wic = Wic::nested("AR1()+WN()".parse().unwrap())
+        .unwrap()
+        .with_bootstrap(10)
+        .with_draws(200)
+        .with_seed(3);
+    let from_series = wic.select(&x, 10.0).unwrap();
+    let wv = wavelet_variance(&x, 10.0, &WvOptions::default()).unwrap();
+    let from_wv = wic.select_wv(&wv).unwrap();
+    assert_eq!(from_wv.selected, from_series.selected);
+    assert_eq!(from_wv.candidates, from_series.candidates);
 }

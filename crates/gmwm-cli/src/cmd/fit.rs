@@ -1,8 +1,8 @@
 //! `gmwm fit`: GMWM estimation of a latent error model on each selected column (METHODS §5).
 
-use crate::args::{FitArgs, TransformArg, WeightsArg};
+use crate::args::{FitArgs, WeightsArg};
 use crate::cmd::wv::options;
-use crate::input::{analyse_columns, column_context, load};
+use crate::input::{analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv};
 use crate::progress::bar;
 use crate::render::{canonical_notes, CanonicalNote, Style};
 use crate::UsageError;
@@ -10,7 +10,6 @@ use anyhow::Result;
 use gmwm::fit::{
     Ar1GmForms, CanonicalModel, CanonicalTerm, NavParameter, ParameterEstimate, StartInputs,
 };
-use gmwm::imu::{is_wv_json, read_wv_json};
 use gmwm::inference::{infer_with_progress, Inference, InferenceOptions, JTest};
 use gmwm::model::Model;
 use gmwm::{Gmwm, GmwmFit, WaveletFilter, WaveletVariance, Weighting, WvOptions};
@@ -71,63 +70,17 @@ struct FitsDoc<'a> {
     fits: Vec<FitReport<'a>>,
 }
 
-/// Keeps the first `j` levels of a WV.
-fn truncate_levels(wv: &mut WaveletVariance, j: usize) {
-    wv.tau.truncate(j);
-    wv.tau_s.truncate(j);
-    wv.wv.truncate(j);
-    wv.ci_low.truncate(j);
-    wv.ci_high.truncate(j);
-    wv.n_coefficients.truncate(j);
-    wv.eta.truncate(j);
-}
-
-/// Fits every series of a WV JSON file (`gmwm wv --json`) selected by `--columns` (names).
+/// Fits every series of a WV JSON file (`gmwm wv --json`) selected by `--columns` (names or
+/// 1-based indices).
 fn fit_wv_file(args: &FitArgs, gmwm: &Gmwm) -> Result<Vec<(String, GmwmFit)>> {
     let file = &args.input.file;
-    let e = &args.estimator;
-    anyhow::ensure!(
-        !e.robust,
-        "{}: --robust needs the series; a wavelet-variance file is fitted as it is (robust if it says so)",
-        file.display()
-    );
-    anyhow::ensure!(
-        e.filter == "haar" && e.transform == TransformArg::Modwt,
-        "{}: --filter/--transform apply to a recording; a wavelet-variance file is fitted as it is",
-        file.display()
-    );
+    check_wv_estimator(file, &args.estimator)?;
     anyhow::ensure!(
         args.weights != WeightsArg::Diag,
         "{}: --weights diag needs the series; use fast or bootstrap with a wavelet-variance file",
         file.display()
     );
-    let mut series = read_wv_json(file, args.input.freq)?;
-    if !args.input.columns.is_empty() {
-        let available: Vec<String> = series.iter().map(|(n, _)| n.clone()).collect();
-        let mut kept = Vec::new();
-        for c in &args.input.columns {
-            let pos = series.iter().position(|(n, _)| n == c).ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{}: no series named \"{c}\"; available: {}",
-                    file.display(),
-                    available.join(", ")
-                )
-            })?;
-            kept.push(series[pos].clone());
-        }
-        series = kept;
-    }
-    if let Some(j) = e.levels {
-        for (name, wv) in &mut series {
-            anyhow::ensure!(
-                j >= 1 && j <= wv.levels(),
-                "{}: series {name}: --levels {j} is outside 1..={}",
-                file.display(),
-                wv.levels()
-            );
-            truncate_levels(wv, j);
-        }
-    }
+    let series = load_wv(&args.input, args.estimator.levels)?;
     let wvs: Vec<&WaveletVariance> = series.iter().map(|(_, w)| w).collect();
     let fits: Vec<_> = wvs
         .par_iter()
@@ -211,7 +164,7 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
         anyhow::ensure!(g >= 1, "invalid --G 0: at least one starting-value draw");
         gmwm = gmwm.with_draws(g);
     }
-    let fits = if is_wv_json(&args.input.file) {
+    let fits = if is_wv(&args.input) {
         fit_wv_file(args, &gmwm)?
     } else {
         let loaded = load(&args.input)?;

@@ -3,7 +3,7 @@
 
 use crate::args::{OptimismArg, OptimismConventionArg, RuleArg, SelectArgs};
 use crate::cmd::wv::options;
-use crate::input::{analyse_columns, load};
+use crate::input::{analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv};
 use crate::progress::{bar, Ticks};
 use crate::render::{canonical_notes, CanonicalNote, Style};
 use anyhow::Result;
@@ -143,20 +143,44 @@ fn write_csv(results: &[(String, ModelSelection)], out: &mut impl Write) -> Resu
 /// Runs the subcommand.
 pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
     let wic = wic(args)?;
-    let loaded = load(&args.input)?;
-    let columns = loaded.table.columns.len();
-    let progress = bar(
-        (columns * wic.candidates().len()) as u64,
-        "WIC selection",
-        "candidates",
-    );
-    let ticks = Ticks(&progress);
-    let results: Result<Vec<(String, ModelSelection)>> =
-        analyse_columns(&loaded, &args.input.file, |x| {
+    let file = &args.input.file;
+    let results: Result<Vec<(String, ModelSelection)>> = if is_wv(&args.input) {
+        // a saved wavelet variance: selected as it is, the bootstrap V simulated at its n
+        check_wv_estimator(file, &args.estimator)?;
+        let series = load_wv(&args.input, args.estimator.levels)?;
+        let progress = bar(
+            (series.len() * wic.candidates().len()) as u64,
+            "WIC selection",
+            "candidates",
+        );
+        let ticks = Ticks(&progress);
+        let results = series
+            .iter()
+            .map(|(name, wv)| {
+                let s = wic
+                    .select_wv_with_progress(wv, &ticks)
+                    .map_err(gmwm::Error::from);
+                Ok((name.clone(), column_context(s, file, name)?))
+            })
+            .collect();
+        progress.finish_and_clear();
+        results
+    } else {
+        let loaded = load(&args.input)?;
+        let columns = loaded.table.columns.len();
+        let progress = bar(
+            (columns * wic.candidates().len()) as u64,
+            "WIC selection",
+            "candidates",
+        );
+        let ticks = Ticks(&progress);
+        let results = analyse_columns(&loaded, file, |x| {
             wic.select_with_progress(x, loaded.freq_hz, &ticks)
                 .map_err(gmwm::Error::from)
         });
-    progress.finish_and_clear();
+        progress.finish_and_clear();
+        results
+    };
     let results = results?;
     for (name, s) in &results {
         if !s.fit.convergence.converged {

@@ -1,15 +1,32 @@
-//! `gmwm simulate`: seeded simulation of a fully specified model, streamed to CSV.
+//! `gmwm simulate`: seeded simulation of a fully specified model, streamed to CSV on stdout or
+//! to a file in the format of its name (CSV, TSV, gzip, raw f64/f32) with a sidecar.
 
 use crate::args::SimulateArgs;
 use anyhow::{Context, Result};
-use gmwm::imu::write::{create, write_csv_header, write_csv_rows, write_sidecar};
-use gmwm::imu::{Sidecar, SidecarColumn};
+use gmwm::imu::write::{write_csv_header, write_csv_rows, write_sidecar};
+use gmwm::imu::{SeriesWriter, Sidecar, SidecarColumn};
 use gmwm::model::Model;
 use gmwm::sim::Simulator;
 use std::io::Write;
 
 /// Samples simulated and written per step: bounded memory for any N.
 const CHUNK: usize = 1 << 16;
+
+/// Where the rows go.
+enum Sink<'a> {
+    Stdout(&'a mut dyn Write),
+    File(Box<SeriesWriter>),
+}
+
+impl Sink<'_> {
+    fn write(&mut self, columns: &[&[f64]]) -> Result<()> {
+        match self {
+            Self::Stdout(out) => write_csv_rows(*out, columns)?,
+            Self::File(w) => w.write_rows(columns)?,
+        }
+        Ok(())
+    }
+}
 
 /// Runs the subcommand.
 pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
@@ -26,18 +43,20 @@ pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
     if args.components {
         names.extend(model.components().iter().map(|c| c.to_string()));
     }
-    // Create the file first so a bad path fails before any work.
-    let mut file = match &args.output {
-        Some(p) => Some(create(p).with_context(|| "cannot create the output file".to_string())?),
-        None => None,
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    // Create the file first so a bad path or an unknown extension fails before any work.
+    let mut sink = match &args.output {
+        Some(p) => Sink::File(Box::new(
+            SeriesWriter::create(p, &refs)
+                .with_context(|| "cannot create the output file".to_string())?,
+        )),
+        None => {
+            let quoted: Vec<String> = names.iter().map(|n| csv_quote(n)).collect();
+            let refs: Vec<&str> = quoted.iter().map(String::as_str).collect();
+            write_csv_header(stdout, &refs)?;
+            Sink::Stdout(stdout)
+        }
     };
-    let out: &mut dyn Write = match file.as_mut() {
-        Some(f) => f.as_mut(),
-        None => stdout,
-    };
-    let quoted: Vec<String> = names.iter().map(|n| csv_quote(n)).collect();
-    let refs: Vec<&str> = quoted.iter().map(String::as_str).collect();
-    write_csv_header(out, &refs)?;
     let mut parts: Vec<Vec<f64>> = vec![Vec::new(); k];
     let mut total = Vec::new();
     let mut left = args.n;
@@ -54,31 +73,37 @@ pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
             }
             let mut cols: Vec<&[f64]> = vec![&total];
             cols.extend(parts.iter().map(Vec::as_slice));
-            write_csv_rows(out, &cols)?;
+            sink.write(&cols)?;
         } else {
             sim.fill(&mut total);
-            write_csv_rows(out, &[&total])?;
+            sink.write(&[&total])?;
         }
         left -= len;
     }
-    out.flush()?;
-    drop(file);
-    if let Some(path) = &args.output {
-        let sidecar = Sidecar {
-            name: path.file_name().map(|f| f.to_string_lossy().into_owned()),
-            sensor: Some(format!("simulated by gmwm: {} (seed {})", model, args.seed)),
-            sampling_frequency_hz: Some(args.freq),
-            n_rows: Some(args.n as u64),
-            columns: names
-                .iter()
-                .map(|n| SidecarColumn {
-                    name: n.clone(),
-                    meaning: None,
-                })
-                .collect(),
-            ..Sidecar::default()
-        };
-        write_sidecar(path, &sidecar)?;
+    match sink {
+        Sink::Stdout(out) => out.flush()?,
+        Sink::File(w) => {
+            let format = w.format();
+            w.finish()?;
+            let path = args.output.as_deref().unwrap_or(std::path::Path::new(""));
+            let sidecar = Sidecar {
+                name: path.file_name().map(|f| f.to_string_lossy().into_owned()),
+                sensor: Some(format!("simulated by gmwm: {} (seed {})", model, args.seed)),
+                sampling_frequency_hz: Some(args.freq),
+                format: Some(format.sidecar_name().to_string()),
+                n_columns: Some(names.len()),
+                n_rows: Some(args.n as u64),
+                columns: names
+                    .iter()
+                    .map(|n| SidecarColumn {
+                        name: n.clone(),
+                        meaning: None,
+                    })
+                    .collect(),
+                ..Sidecar::default()
+            };
+            write_sidecar(path, &sidecar)?;
+        }
     }
     Ok(())
 }

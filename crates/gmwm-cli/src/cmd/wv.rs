@@ -1,10 +1,13 @@
 //! `gmwm wv`: wavelet variance of each selected column.
 
-use crate::args::{FormatArg, RobustConventionArg, TransformArg, WvArgs, WvEstimatorArgs};
-use crate::input::{analyse_columns, column_context, load, named};
+use crate::args::{RobustConventionArg, TransformArg, WvArgs, WvEstimatorArgs};
+use crate::input::{
+    analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv, named, note,
+    options as read_options, selector,
+};
 use crate::render::{self, Style};
 use anyhow::Result;
-use gmwm::imu::{BinaryChunks, InputFormat};
+use gmwm::imu::{binary_layout, BinaryChunks, BinaryLayout, ColumnSelector, InputFormat};
 use gmwm::variance::default_levels;
 use gmwm::{
     wavelet_variance, HaarWvAccumulator, RobustConvention, RobustOptions, Transform, WaveletFilter,
@@ -39,31 +42,41 @@ pub fn options(a: &WvEstimatorArgs) -> Result<WvOptions> {
 /// Samples per read of the streaming path: 1 Mi values (8 MiB) per chunk.
 const STREAM_CHUNK: usize = 1 << 20;
 
-/// Raw binary input with the classical Haar MODWT estimator streams: each selected column is
-/// read in chunks through [`HaarWvAccumulator`], never materialised, so memory stays at the
-/// accumulator's `8 · 2^J` bytes plus one chunk whatever the file size.
-fn streamable(args: &WvArgs, opts: &WvOptions) -> bool {
-    matches!(args.input.format, FormatArg::F64 | FormatArg::F32)
-        && args.input.time_column.is_none()
-        && opts.robust.is_none()
-        && opts.transform == Transform::Modwt
-        && opts.filter == WaveletFilter::Haar
+/// Raw binary input (from `--format`, the name or the sidecar) with the classical Haar MODWT
+/// estimator and no time column streams: each selected column is read in chunks through
+/// [`HaarWvAccumulator`], never materialised, so memory stays at the accumulator's `8 · 2^J`
+/// bytes plus one chunk whatever the file size.
+fn streamable(args: &WvArgs, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
+    if args.input.time_column.is_some()
+        || opts.robust.is_some()
+        || opts.transform != Transform::Modwt
+        || opts.filter != WaveletFilter::Haar
+    {
+        return Ok(None);
+    }
+    let layout = binary_layout(&args.input.file, &read_options(&args.input)?)?;
+    // a column named like a time column is a time column: the in-memory reader handles it
+    Ok(layout.filter(|l| {
+        l.names
+            .iter()
+            .all(|n| gmwm::imu::time_column_unit(n).is_none())
+    }))
 }
 
-fn run_streaming(args: &WvArgs, opts: &WvOptions, out: &mut impl Write) -> Result<()> {
+fn run_streaming(
+    args: &WvArgs,
+    layout: &BinaryLayout,
+    opts: &WvOptions,
+    out: &mut impl Write,
+) -> Result<()> {
     let input = &args.input;
-    let format = match input.format {
-        FormatArg::F32 => InputFormat::F32,
-        _ => InputFormat::F64,
-    };
-    let ncols = input.ncols.unwrap_or(1);
     let columns: Vec<usize> = if input.columns.is_empty() {
-        (1..=ncols).collect()
+        (1..=layout.ncols).collect()
     } else {
         input
             .columns
             .iter()
-            .map(|c| binary_column_index(c, ncols))
+            .map(|c| binary_column_index(c, layout))
             .collect::<Result<_>>()?
     };
     let freq_hz = match input.freq {
@@ -72,9 +85,9 @@ fn run_streaming(args: &WvArgs, opts: &WvOptions, out: &mut impl Write) -> Resul
     };
     let mut results = Vec::with_capacity(columns.len());
     for &col in &columns {
-        let name = format!("col{col}");
+        let name = layout.names[col - 1].clone();
         let wv = column_context(
-            stream_column(&input.file, format, ncols, col, opts, freq_hz),
+            stream_column(&input.file, layout.format, layout.ncols, col, opts, freq_hz),
             &input.file,
             &name,
         )?;
@@ -103,17 +116,26 @@ fn stream_column(
     acc.finish(freq_hz, opts.alpha)
 }
 
-fn binary_column_index(text: &str, ncols: usize) -> Result<usize> {
+/// A `--columns` entry of a raw binary file: a 1-based index, a name of the sidecar, or
+/// `colK`.
+fn binary_column_index(text: &str, layout: &BinaryLayout) -> Result<usize> {
     let t = text.trim();
-    let index = t
-        .strip_prefix("col")
-        .unwrap_or(t)
-        .parse::<usize>()
-        .map_err(|_| {
-            anyhow::anyhow!(
-                "invalid --columns {t:?}: binary columns are 1-based indices (or col1, col2, ...)"
-            )
-        })?;
+    let ncols = layout.ncols;
+    let index = match selector(t) {
+        ColumnSelector::Index(i) => Some(i),
+        ColumnSelector::Name(n) => layout
+            .names
+            .iter()
+            .position(|m| *m == n)
+            .map(|k| k + 1)
+            .or_else(|| n.strip_prefix("col").and_then(|k| k.parse().ok())),
+    };
+    let index = index.ok_or_else(|| {
+        anyhow::anyhow!(
+            "invalid --columns {t:?}: binary columns are 1-based indices or the names {}",
+            layout.names.join(", ")
+        )
+    })?;
     anyhow::ensure!(
         (1..=ncols).contains(&index),
         "invalid --columns {t}: the file has {ncols} interleaved column(s) (--ncols)"
@@ -135,23 +157,40 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
     })
 }
 
+/// Prints a saved wavelet variance as it is (no recomputation).
+fn run_saved(args: &WvArgs, out: &mut impl Write) -> Result<()> {
+    let file = &args.input.file;
+    check_wv_estimator(file, &args.estimator)?;
+    let series = load_wv(&args.input, args.estimator.levels)?;
+    if let Some((name, wv)) = series
+        .iter()
+        .find(|(_, wv)| (wv.alpha - args.estimator.alpha).abs() > 1e-12)
+    {
+        anyhow::ensure!(
+            args.estimator.alpha == 0.05,
+            "{}: series {}: --alpha {} needs the series; the file's intervals are at alpha {}",
+            file.display(),
+            gmwm::imu::quote(name),
+            args.estimator.alpha,
+            wv.alpha
+        );
+    }
+    note(
+        file,
+        "a wavelet variance saved by gmwm wv --json: shown as read, not recomputed",
+    );
+    render::series(out, &named(&series), Style::from(&args.output))
+}
+
 /// Runs the subcommand.
 pub fn run(args: &WvArgs, out: &mut impl Write) -> Result<()> {
     let opts = options(&args.estimator)?;
-    if let Some(f) = args.input.freq {
-        anyhow::ensure!(
-            f.is_finite() && f > 0.0,
-            "invalid --freq {f}: must be a positive number of hertz"
-        );
+    read_options(&args.input)?;
+    if is_wv(&args.input) {
+        return run_saved(args, out);
     }
-    if let Some(k) = args.input.ncols {
-        anyhow::ensure!(
-            k >= 1,
-            "invalid --ncols 0: a binary file has at least one column"
-        );
-    }
-    if streamable(args, &opts) {
-        return run_streaming(args, &opts, out);
+    if let Some(layout) = streamable(args, &opts)? {
+        return run_streaming(args, &layout, &opts, out);
     }
     let loaded = load(&args.input)?;
     let items = analyse_columns(&loaded, &args.input.file, |x| {

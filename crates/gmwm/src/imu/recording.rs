@@ -73,6 +73,17 @@ impl Recording {
         if opts.read.format == InputFormat::Auto && container_of(path).is_some() {
             return Self::open_ros(path, opts);
         }
+        if let Some(topic) = &opts.topic {
+            return Err(crate::error::ParamError::new(
+                "topic",
+                topic,
+                format!(
+                    "a topic of a ROS recording; {} is not one (ROS1 bag, MCAP, rosbag2 sqlite3)",
+                    path.display()
+                ),
+            )
+            .into());
+        }
         let table = read_table(path, &opts.read)?;
         let mut notes = Vec::new();
         if let Some(t) = table.record_type {

@@ -127,6 +127,8 @@ pub enum UnitSource {
     /// Stated by the column name (`[ns]`, `_ms`, `(s)`, ...) or by the convention of the tool
     /// that names columns so (`%time` and `field.header.stamp` of `rostopic echo -p` are ns).
     Stated,
+    /// Fixed by the file format (the seconds of binary IMU records, METHODS §9.2).
+    Format,
     /// Inferred from the values ([`infer_time_unit`]).
     Inferred,
     /// Given by the caller (`ReadOptions::time_unit`, the CLI's `--time-unit`).
@@ -137,6 +139,7 @@ impl fmt::Display for UnitSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             Self::Stated => "from the header",
+            Self::Format => "from the format",
             Self::Inferred => "inferred from the values",
             Self::Flag => "as given",
         })
@@ -205,7 +208,13 @@ fn split_unit(name: &str) -> (&str, Option<TimeUnit>) {
 /// `None` when neither rule applies (fewer than two stamps and no epoch-sized first stamp, or
 /// no positive step).
 pub fn infer_time_unit(raw: &[f64]) -> Option<TimeUnit> {
-    let first = raw.first()?.abs();
+    infer_unit(0.0, raw)
+}
+
+/// [`infer_time_unit`] of the stamps `origin + raw[i]` (the readers give stamps relative to
+/// the first one to keep their precision).
+pub(crate) fn infer_unit(origin: f64, raw: &[f64]) -> Option<TimeUnit> {
+    let first = (origin + *raw.first()?).abs();
     if let Some(u) = TimeUnit::ALL.into_iter().find(|u| {
         let s = first * u.to_seconds();
         s >= EPOCH_S.0 && s <= EPOCH_S.1
@@ -218,7 +227,7 @@ pub fn infer_time_unit(raw: &[f64]) -> Option<TimeUnit> {
         .filter(|d| *d > 0.0)
         .collect();
     let step = median(&mut steps)?;
-    if step <= 1.0 && raw.iter().any(|t| t.fract() != 0.0) {
+    if step <= 1.0 && raw.iter().any(|t| (origin + t).fract() != 0.0) {
         return Some(TimeUnit::Seconds);
     }
     let unit = TimeUnit::ALL
@@ -238,7 +247,8 @@ pub struct Gap {
     pub line: Option<u64>,
     /// Start of the gap (time of the sample before it), in seconds after the first sample.
     pub time_s: f64,
-    /// Length of the step, in seconds.
+    /// Time without samples beyond the nominal step: the step less one nominal step, in
+    /// seconds (a 0.5 s hole in a 200 Hz log is a step of 0.505 s and a gap of 0.5 s).
     pub duration_s: f64,
     /// Samples missing at the nominal rate: `round(duration / nominal step) - 1` (>= 1).
     pub missing: usize,
@@ -247,7 +257,7 @@ pub struct Gap {
 /// What a time column says about the sampling ([`check_times`]).
 ///
 /// Wire format: `column`, `unit` (`seconds`, ...), `unit_source` (`stated`, `inferred`,
-/// `flag`), `samples`, `span_s`, `rate_hz`, `mean_rate_hz`, `gaps` ([`Gap`]: `row`, `line`,
+/// `flag`), `samples`, `start_s`, `span_s`, `rate_hz`, `mean_rate_hz`, `gaps` ([`Gap`]: `row`, `line`,
 /// `time_s`, `duration_s`, `missing`), `duplicates`, `reordered`, `jitter` (`null` when
 /// undefined).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -260,6 +270,8 @@ pub struct TimingReport {
     pub unit_source: UnitSource,
     /// Number of stamps.
     pub samples: usize,
+    /// The first stamp, in seconds (e.g. Unix time; an f64, so to about 0.2 µs at 1.7e9 s).
+    pub start_s: f64,
     /// Latest minus earliest stamp, in seconds.
     pub span_s: f64,
     /// Rate in Hz: `1 / nominal step`, the mean of the regular steps (module docs; equal to
@@ -344,7 +356,7 @@ pub fn check_times(
                         row: i + 1,
                         line: None,
                         time_s: times_s[i] - first,
-                        duration_s: d,
+                        duration_s: d - nominal,
                         missing,
                     });
                 }
@@ -363,6 +375,7 @@ pub fn check_times(
         unit,
         unit_source,
         samples: times_s.len(),
+        start_s: first,
         span_s,
         rate_hz,
         mean_rate_hz,
@@ -449,7 +462,7 @@ pub(crate) fn fmt_hz(hz: f64) -> String {
 
 /// A duration for messages: 3 significant digits, at least 2 decimals (`0.50`, `12.3`).
 fn fmt_s(s: f64) -> String {
-    format!("{:.*}", decimals(s, 3).max(2), s)
+    format!("{:.*}", decimals(s, 2).max(2), s)
 }
 
 fn decimals(x: f64, significant: i32) -> usize {
@@ -654,12 +667,12 @@ mod tests {
         assert_eq!(r.gaps.len(), 1);
         assert_eq!(r.gaps[0].row, 400);
         assert_eq!(r.gaps[0].missing, 100);
-        assert!((r.gaps[0].duration_s - 0.505).abs() < 1e-12);
+        assert!((r.gaps[0].duration_s - 0.5).abs() < 1e-12);
         let w = r.warnings();
         assert_eq!(w.len(), 1);
         assert_eq!(
             w[0].to_string(),
-            "time column \"t\": 1 gap (100 samples missing), largest 0.505 s at sample 400 \
+            "time column \"t\": 1 gap (100 samples missing), largest 0.50 s at sample 400 \
              (0-based) (2.00 s after the start); the rows are analysed as if evenly spaced at \
              200 Hz"
         );

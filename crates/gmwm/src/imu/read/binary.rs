@@ -158,6 +158,12 @@ pub(crate) fn read_binary_table(
         }
         None => None,
     };
+    // stamps relative to the first, as the text reader gives them
+    let time_origin = time.as_ref().map_or(0.0, |t| t.values[0]);
+    let time = time.map(|mut t| {
+        t.values.iter_mut().for_each(|v| *v -= time_origin);
+        t
+    });
     let columns = sel
         .columns
         .iter()
@@ -171,6 +177,7 @@ pub(crate) fn read_binary_table(
     Ok(RawTable {
         columns,
         time,
+        time_origin,
         time_unit: sel.time_unit,
         freq_hz: None,
         lines: None,
@@ -427,7 +434,7 @@ fn record_freq(path: &Path, t: &[f64]) -> Result<f64, ReadError> {
     if t.len() < 2 {
         return Err(not_derivable("fewer than 2 epochs"));
     }
-    let freq = check_times("time", t, TimeUnit::Seconds, UnitSource::Stated)
+    let freq = check_times("time", t, TimeUnit::Seconds, UnitSource::Format)
         .rate_hz
         .round();
     if freq.is_finite() && freq > 0.0 {
@@ -504,12 +511,14 @@ pub(crate) fn read_record_table(
             values,
         });
     }
+    let time_origin = time[0];
     Ok(RawTable {
         columns,
         time: Some(Column {
             name: "time".into(),
-            values: time,
+            values: time.iter().map(|t| t - time_origin).collect(),
         }),
+        time_origin,
         time_unit: Some(TimeUnit::Seconds),
         freq_hz: Some(freq),
         lines: None,

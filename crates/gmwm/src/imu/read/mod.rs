@@ -12,7 +12,7 @@ pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordTy
 use super::error::quote;
 use super::sidecar::{find_sidecar, Sidecar};
 use super::timing::{
-    check_times, fmt_hz, infer_time_unit, time_column_unit, TimeUnit, TimingReport, TimingWarning,
+    check_times, fmt_hz, infer_unit, time_column_unit, TimeUnit, TimingReport, TimingWarning,
     UnitSource,
 };
 use super::{ReadError, SensorInfo};
@@ -251,8 +251,8 @@ pub struct ReadOptions {
     /// Header handling of text files (default [`HeaderMode::Auto`]); ignored for binary.
     pub header: HeaderMode,
     /// Time column (default `None`: found by name, see [`read_table`]). Must be finite and
-    /// strictly increasing; it is returned in [`Table::time`] (in seconds), not among the
-    /// columns.
+    /// strictly increasing; it is returned in [`Table::time`] (in seconds after its first
+    /// stamp), not among the columns.
     pub time_column: Option<ColumnSelector>,
     /// Unit of the time column (default `None`: stated by its name, else inferred, see
     /// [`infer_time_unit`](crate::imu::infer_time_unit)).
@@ -286,7 +286,9 @@ pub struct Table {
     pub freq_hz: Option<f64>,
     /// The JSON sidecar beside the file, if any.
     pub sidecar: Option<Sidecar>,
-    /// The time column in seconds (finite, strictly increasing), if one was given or found.
+    /// The time column, if one was given or found: seconds after its first stamp (which is
+    /// [`TimingReport::start_s`]), finite and strictly increasing; relative so that epoch
+    /// stamps keep their precision (whole-number stamps are subtracted exactly).
     pub time: Option<Column>,
     /// What the time column says about the sampling (unit, rate, gaps, ...), if there is one.
     pub timing: Option<TimingReport>,
@@ -490,9 +492,9 @@ pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<Strin
 /// `timestamp`, `t`, `stamp`, `%time`, `#timestamp [ns]`, `timestamp_ns`, `time_s`,
 /// `time [s]`, `field.header.stamp`, ...; a header stamp is preferred, else the first in file
 /// order) unless `opts.columns` selects that column explicitly. Its unit: `opts.time_unit`,
-/// else the one its name states, else [`infer_time_unit`](crate::imu::infer_time_unit)
+/// else the one its name states, else [`infer_time_unit`](super::timing::infer_time_unit)
 /// (seconds if nothing can be inferred). The stamps are converted to seconds and checked
-/// ([`check_times`](crate::imu::check_times), [`Table::timing`]); in a text or raw binary file
+/// ([`check_times`], [`Table::timing`]); in a text or raw binary file
 /// they must strictly increase ([`ReadError::TimeNotIncreasing`] names the line).
 ///
 /// Columns: `opts.columns` in that order; by default every column but the time columns, and
@@ -531,9 +533,10 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         Some(mut col) => {
             let (unit, source) = match (opts.time_unit, raw.time_unit) {
                 (Some(u), _) => (u, UnitSource::Flag),
+                (None, Some(u)) if raw.freq_hz.is_some() => (u, UnitSource::Format),
                 (None, Some(u)) => (u, UnitSource::Stated),
                 (None, None) => (
-                    infer_time_unit(&col.values).unwrap_or(TimeUnit::Seconds),
+                    infer_unit(raw.time_origin, &col.values).unwrap_or(TimeUnit::Seconds),
                     UnitSource::Inferred,
                 ),
             };
@@ -542,6 +545,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
                 col.values.iter_mut().for_each(|t| *t *= k);
             }
             let mut report = check_times(&col.name, &col.values, unit, source);
+            report.start_s = raw.time_origin * unit.to_seconds();
             if let Some(lines) = &raw.lines {
                 for g in &mut report.gaps {
                     g.line = Some(lines.line_of(g.row));
@@ -615,8 +619,11 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
 /// resolution.
 pub(crate) struct RawTable {
     pub(crate) columns: Vec<Column>,
-    /// Raw stamps (in `time_unit` if stated, else unknown).
+    /// Stamps relative to the first one (in `time_unit` if stated, else unknown), exact for
+    /// whole-number stamps.
     pub(crate) time: Option<Column>,
+    /// The first stamp, in the same unit.
+    pub(crate) time_origin: f64,
     /// Unit stated by the time column's name or the format.
     pub(crate) time_unit: Option<TimeUnit>,
     /// Rate fixed by the format (IMU records: METHODS §9.2).

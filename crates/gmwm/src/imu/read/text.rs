@@ -91,6 +91,24 @@ fn parse_cell(bytes: &[u8]) -> Option<f64> {
     }
 }
 
+/// A whole number that fits an i64 (optionally signed), exactly; `None` otherwise.
+#[inline]
+fn parse_int(bytes: &[u8]) -> Option<i64> {
+    let bytes = bytes.trim_ascii();
+    let digits = bytes
+        .strip_prefix(b"-")
+        .or(bytes.strip_prefix(b"+"))
+        .unwrap_or(bytes);
+    if digits.is_empty() || digits.len() > 19 || !digits.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    std::str::from_utf8(bytes)
+        .ok()?
+        .trim_start_matches('+')
+        .parse()
+        .ok()
+}
+
 /// Clinger's fast path for plain decimals `[+-]digits[.digits]` with at most 19 significant
 /// digits: when the digit string `m < 2^53` and the number of fraction digits `k <= 22`, both
 /// `m` and `10^k` are exact f64 values and one IEEE division `m / 10^k` is correctly rounded,
@@ -231,6 +249,8 @@ pub(crate) fn read_text_table(
         time_index: sel.time,
         values: vec![Vec::new(); sel.columns.len()],
         time: Vec::new(),
+        origin: None,
+        previous_abs: 0.0,
         lines: LineMap::default(),
     };
     if !has_header {
@@ -264,6 +284,7 @@ pub(crate) fn read_text_table(
             values,
         })
         .collect();
+    let time_origin = rows.origin.map_or(0.0, |o| o.0);
     let time = sel.time.map(|k| Column {
         name: names[k].clone(),
         values: rows.time,
@@ -271,6 +292,7 @@ pub(crate) fn read_text_table(
     Ok(RawTable {
         columns,
         time,
+        time_origin,
         time_unit: sel.time_unit,
         freq_hz: None,
         lines: sel.time.map(|_| rows.lines),
@@ -287,7 +309,12 @@ struct Rows<'a> {
     columns: &'a [usize],
     time_index: Option<usize>,
     values: Vec<Vec<f64>>,
+    /// Time stamps relative to the first one, in the column's unit.
     time: Vec<f64>,
+    /// The first stamp: its value and, if it is a whole number, its exact integer.
+    origin: Option<(f64, Option<i64>)>,
+    /// The previous stamp as read (for messages).
+    previous_abs: f64,
     /// Physical lines of the rows (kept only with a time column, for the gaps' lines).
     lines: LineMap,
 }
@@ -304,12 +331,21 @@ impl Rows<'_> {
         }
         if let Some(k) = self.time_index {
             let t = self.cell(rec, k, line)?;
+            // whole-number stamps (ns since 1970 are ~1.7e18, beyond f64's 2^53) are taken
+            // relative to the first one exactly, in integers
+            let int = parse_int(rec.get(k).unwrap_or_default());
+            let origin = *self.origin.get_or_insert((t, int));
+            let rel = match (origin.1, int) {
+                (Some(o), Some(v)) => v.checked_sub(o).map_or(t - origin.0, |d| d as f64),
+                _ => t - origin.0,
+            };
             if let Some(&previous) = self.time.last() {
-                if t <= previous {
-                    return Err(self.not_increasing(k, line, previous, t));
+                if rel <= previous {
+                    return Err(self.not_increasing(k, line, self.previous_abs, t));
                 }
             }
-            self.time.push(t);
+            self.previous_abs = t;
+            self.time.push(rel);
             self.lines.push(line);
         }
         Ok(())
@@ -409,6 +445,20 @@ mod tests {
         assert_eq!(parse_cell(b"+.5"), Some(0.5));
         assert_eq!(parse_cell(b"-0"), Some(-0.0));
         assert!(parse_cell(b"-0").unwrap().is_sign_negative());
+    }
+
+    #[test]
+    fn parse_int_is_exact_for_epoch_nanoseconds() {
+        assert_eq!(
+            parse_int(b" 1403636579758555392\r"),
+            Some(1_403_636_579_758_555_392)
+        );
+        assert_eq!(parse_int(b"-12"), Some(-12));
+        assert_eq!(parse_int(b"+7"), Some(7));
+        assert_eq!(parse_int(b"99999999999999999999"), None);
+        assert_eq!(parse_int(b"1.5"), None);
+        assert_eq!(parse_int(b""), None);
+        assert_eq!(parse_int(b"-"), None);
     }
 
     /// The fast path is bit-identical to `str::parse` on every input it accepts.
