@@ -79,17 +79,24 @@ pub struct Readoff {
 }
 
 /// The five IEEE Std 952 coefficients (METHODS §14.3), in the data unit `u`.
+///
+/// Wire format: `N`, `B`, `K`, `Q`, `R`, each a [`Readoff`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IeeeReadoff {
     /// Angle / velocity random walk N (u/√Hz), −1/2-slope line at 1 s.
+    #[serde(rename = "N")]
     pub n: Readoff,
     /// Bias instability B (u), minimum deviation / 0.664.
+    #[serde(rename = "B")]
     pub b: Readoff,
     /// Rate random walk K (u/s/√Hz), +1/2-slope line at 3 s.
+    #[serde(rename = "K")]
     pub k: Readoff,
     /// Quantization Q (u·s), −1-slope line at √3 s.
+    #[serde(rename = "Q")]
     pub q: Readoff,
     /// Rate ramp R (u/s), +1-slope line at √2 s.
+    #[serde(rename = "R")]
     pub r: Readoff,
 }
 
