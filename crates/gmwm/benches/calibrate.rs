@@ -7,6 +7,9 @@
 //! per axis; `GMWM_BENCH_CALIBRATE_N=10000000` runs the size (one iteration takes
 //! minutes: run it with `--sample-size 10` and expect a long wait).
 
+// parallel per-axis arrays are indexed by sample throughout
+#![allow(clippy::needless_range_loop)]
+
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use gmwm::calib::{Calibration, CalibrationOptions};
 use gmwm::imu::{ImuRecordType, InputFormat, ReadOptions, Recording, RecordingOptions};

@@ -534,7 +534,7 @@ fn bootstrap_v(
         &fit.active_model()?,
         n,
         fit.freq_hz,
-        &wv_opts,
+        wv_opts,
         h,
         opts.seed,
         |_, wv, _| {
