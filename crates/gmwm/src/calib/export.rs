@@ -207,7 +207,7 @@ fn value(format: ExportFormat, s: &SensorNoise, key: &Key) -> Result<f64, Export
         Field::NoiseDensity => (s.noise_density, " (from the white-noise term)"),
         Field::RandomWalk => (
             s.random_walk,
-            " (from a random-walk term, or the slowest GM's driving density, METHODS §14.4)",
+            " (from a random-walk term, or the slowest GM's driving density)",
         ),
         Field::CorrelationTime => (s.bias_correlation_time_s, " (from a Gauss-Markov term)"),
         Field::BiasSigma => (s.bias_sigma, " (from a Gauss-Markov term)"),
@@ -322,7 +322,7 @@ fn kalibr_like(format: ExportFormat, noise: &NavNoise) -> Result<String, ExportE
     }
     let (rostopic, placeholder) = topic(noise, "/imu0");
     let mut own = vec![
-        "IMU noise, continuous-time SI densities (METHODS §14.4); the filter discretises them \
+        "IMU noise, continuous-time SI densities; the filter discretises them \
          at update_rate"
             .to_string(),
     ];
@@ -438,7 +438,7 @@ fn vins(noise: &NavNoise) -> Result<String, ExportError> {
     let mut own = vec![
         "VINS-Fusion IMU block: paste into the estimator config (cv::FileStorage YAML)".to_string(),
         format!(
-            "acc_n, gyr_n, acc_w, gyr_w: continuous-time densities (METHODS §14.4), the values \
+            "acc_n, gyr_n, acc_w, gyr_w: continuous-time densities, the values \
              VINS users take from Kalibr; VINS's own comments call them standard deviations. \
              IMU rate {} Hz",
             real(noise.update_rate_hz)
@@ -642,7 +642,7 @@ fn px4(noise: &NavNoise) -> Result<String, ExportError> {
          set linkName to the model's IMU link"
             .to_string(),
         format!(
-            "continuous-time SI values (METHODS §14.4), measured at {} Hz; the plugin \
+            "continuous-time SI values, measured at {} Hz; the plugin \
              discretises them at its own step",
             real(rate)
         ),

@@ -16,7 +16,8 @@
 //! (the longest contiguous run is taken all the same). Fitting all five terms, the flicker
 //! floor included, keeps a neighbouring term from being mistaken for the one read.
 //!
-//! On its region the term's line of fixed slope (−1/2 for N, +1/2 for K, −1 for Q, +1 for R in
+//! On its region (narrowed to the scales within a factor [`READ_OFF_WINDOW`] of the read-off
+//! time when two or more are there) the term's line of fixed slope (−1/2 for N, +1/2 for K, −1 for Q, +1 for R in
 //! the deviation) is fitted through the **data** (not the model): the per-scale coefficients
 //! `N_i = sigma_i sqrt(tau_i)`, `K_i = sigma_i sqrt(3 / tau_i)`, `Q_i = sigma_i tau_i / sqrt(3)`,
 //! `R_i = sigma_i sqrt(2) / tau_i` are averaged in logarithms with weights `edf_i` (the inverse
@@ -290,6 +291,29 @@ fn line(s: &Scales, j: usize, idx: &[usize], values: &[f64]) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
+/// Half-width, as a factor, of the window of cluster times around the read-off time that a
+/// line is fitted through when the region has at least two scales there: the line is read
+/// where it is used, so that the first scales, which a sensor's anti-alias filter lowers below
+/// the white-noise line, do not pull the N read at 1 s (ADIS16405 gyro X: 6.06e-4 through
+/// 0.01–2.56 s, 7.0e-4 through 0.16–2.56 s, where the deviation's local slope is −1/2 within
+/// 0.02).
+pub const READ_OFF_WINDOW: f64 = 8.0;
+
+/// The scales of `idx` within [`READ_OFF_WINDOW`] of `at_tau_s` when there are two or more,
+/// else `idx`.
+fn near_read_off(s: &Scales, idx: Vec<usize>, at_tau_s: f64) -> Vec<usize> {
+    let near: Vec<usize> = idx
+        .iter()
+        .copied()
+        .filter(|&i| (s.tau_s[i] / at_tau_s).ln().abs() <= READ_OFF_WINDOW.ln() + 1e-12)
+        .collect();
+    if near.len() >= 2 {
+        near
+    } else {
+        idx
+    }
+}
+
 /// A cluster time in notes and tables: 4 significant digits, trailing zeros dropped.
 fn seconds(t: f64) -> String {
     let s = crate::fit::report::significant(t, 4);
@@ -303,7 +327,7 @@ fn seconds(t: f64) -> String {
 /// METHODS §14.3: the read-off of a line term (N, K, Q or R).
 fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
     let term = &TERMS[j];
-    let idx = region(s, c, j);
+    let idx = near_read_off(s, region(s, c, j), term.at_tau_s);
     let tau_s: Vec<f64> = idx.iter().map(|&i| s.tau_s[i]).collect();
     let share = format!("{:.0}%", DOMINANCE * 100.0);
     if idx.len() < 2 {
