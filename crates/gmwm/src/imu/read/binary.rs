@@ -461,7 +461,15 @@ pub(crate) fn read_record_table(
 ) -> Result<RawTable, ReadError> {
     let record = record_type.record_size();
     let names: Vec<String> = RECORD_COLUMNS.iter().map(|n| n.to_string()).collect();
-    // the time is the records' own; a time column option does not apply
+    // the time is the records' own
+    if let Some(t) = &opts.time_column {
+        return Err(ParamError::new(
+            "time column",
+            t,
+            "none: IMU records carry their own time (METHODS §9.2)",
+        )
+        .into());
+    }
     let select = ReadOptions {
         time_column: None,
         ..opts.clone()
