@@ -466,7 +466,15 @@ pub(crate) fn read_record_table(
         return Err(ParamError::new(
             "time column",
             t,
-            "none: IMU records carry their own time (METHODS §9.2)",
+            "no time column: IMU records carry their own time (METHODS §9.2)",
+        )
+        .into());
+    }
+    if let Some(u) = opts.time_unit {
+        return Err(ParamError::new(
+            "time unit",
+            u,
+            "no unit: IMU record times are in seconds (METHODS §9.2)",
         )
         .into());
     }
