@@ -403,7 +403,7 @@ pub struct InputArgs {
     /// Sampling rate in Hz [default: from a time column or the JSON sidecar beside FILE].
     #[arg(long, value_name = "HZ", value_parser = positive_hz)]
     pub freq: Option<f64>,
-    /// Input format [default: from the name, the sidecar and the content].
+    /// Input format (auto: from the name, the sidecar and the content).
     #[arg(long, value_enum, default_value_t = FormatArg::Auto)]
     pub format: FormatArg,
     /// Number of interleaved columns of a raw binary file [default: the sidecar's, else 1].

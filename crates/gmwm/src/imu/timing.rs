@@ -23,6 +23,11 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::ParamError;
+use crate::math::sum::NeumaierSum;
+
+/// 1 / Phi^-1(3/4): the median absolute deviation times this estimates a Gaussian standard
+/// deviation.
+const MAD_TO_SD: f64 = 1.4826;
 
 /// A step longer than this many nominal steps is a gap (1.5: one missing sample at a perfectly
 /// regular rate makes a step of 2, a jittery but complete log stays well below 1.5).
@@ -275,7 +280,8 @@ pub struct TimingReport {
     /// Latest minus earliest stamp, in seconds.
     pub span_s: f64,
     /// Rate in Hz: `1 / nominal step`, the mean of the regular steps (module docs; equal to
-    /// `1 / median step` on evenly stamped data); NaN when no step is positive.
+    /// `1 / median step` on evenly stamped data), to 12 significant digits; NaN when no step is
+    /// positive.
     pub rate_hz: f64,
     /// `(samples - 1) / span_s`: what the rate would be without gaps (NaN for a zero span).
     pub mean_rate_hz: f64,
@@ -304,30 +310,57 @@ fn median(v: &mut [f64]) -> Option<f64> {
     })
 }
 
+/// Significant digits kept in [`TimingReport::rate_hz`]: 12, far finer than any time stamp
+/// resolves a rate (ns stamps over 1 s: 1e-9), so that a 200 Hz log reads 200 and not
+/// 199.99999999999997 from the rounding of its steps.
+const RATE_DIGITS: i32 = 12;
+
+fn round_significant(x: f64) -> f64 {
+    if !x.is_finite() || x == 0.0 {
+        return x;
+    }
+    let d = RATE_DIGITS - 1 - x.abs().log10().floor() as i32;
+    let p = 10f64.powi(d.abs());
+    let r = if d >= 0 {
+        (x * p).round() / p
+    } else {
+        (x / p).round() * p
+    };
+    if r.is_finite() {
+        r
+    } else {
+        x
+    }
+}
+
 /// Mean of the positive steps no longer than `limit`; `None` if there is none.
-fn mean_within(steps: &[f64], limit: f64) -> Option<f64> {
-    let (sum, count) = steps
-        .iter()
-        .filter(|&&d| d > 0.0 && d <= limit)
-        .fold((0.0, 0usize), |(s, c), &d| (s + d, c + 1));
-    (count > 0).then(|| sum / count as f64)
+fn mean_within(steps: impl Iterator<Item = f64>, limit: f64) -> Option<f64> {
+    let mut sum = NeumaierSum::default();
+    let mut count = 0usize;
+    for d in steps.filter(|&d| d > 0.0 && d <= limit) {
+        sum.add(d);
+        count += 1;
+    }
+    (count > 0).then(|| sum.total() / count as f64)
 }
 
 /// Checks time stamps in seconds (any order; duplicates and reordering are counted, not
 /// refused): rate, gaps, duplicates, reordering and jitter, as documented on
 /// [`TimingReport`] and the module. Gaps carry no line numbers (`Gap::line` is `None`).
 ///
-/// Cost: O(n log n) (one sort of the steps), O(n) extra memory.
+/// Cost: O(n log n) (two sorts), one buffer of n values.
 pub fn check_times(
     column: &str,
     times_s: &[f64],
     unit: TimeUnit,
     unit_source: UnitSource,
 ) -> TimingReport {
-    let steps: Vec<f64> = times_s.windows(2).map(|w| w[1] - w[0]).collect();
-    let duplicates = steps.iter().filter(|&&d| d == 0.0).count();
-    let reordered = steps.iter().filter(|&&d| d < 0.0).count();
-    let mut positive: Vec<f64> = steps.iter().copied().filter(|&d| d > 0.0).collect();
+    // the steps are recomputed on each pass: one buffer of n values at most (the sorted
+    // positive steps, then their deviations)
+    let steps = || times_s.windows(2).map(|w| w[1] - w[0]);
+    let duplicates = steps().filter(|&d| d == 0.0).count();
+    let reordered = steps().filter(|&d| d < 0.0).count();
+    let mut buffer: Vec<f64> = steps().filter(|&d| d > 0.0).collect();
     let (lo, hi) = times_s
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
@@ -341,15 +374,15 @@ pub fn check_times(
     };
     let first = times_s.first().copied().unwrap_or(0.0);
     let mut gaps = Vec::new();
-    let (rate_hz, jitter) = match median(&mut positive) {
+    let (rate_hz, jitter) = match median(&mut buffer) {
         None => (f64::NAN, f64::NAN),
         Some(med) => {
             // provisional nominal step over the steps within twice the median, then the
             // regular steps are those within GAP_FACTOR of it
-            let provisional = mean_within(&steps, 2.0 * med).unwrap_or(med);
+            let provisional = mean_within(steps(), 2.0 * med).unwrap_or(med);
             let limit = GAP_FACTOR * provisional;
-            let nominal = mean_within(&steps, limit).unwrap_or(provisional);
-            for (i, &d) in steps.iter().enumerate() {
+            let nominal = mean_within(steps(), limit).unwrap_or(provisional);
+            for (i, d) in steps().enumerate() {
                 if d > GAP_FACTOR * nominal {
                     let missing = ((d / nominal).round() as usize).saturating_sub(1).max(1);
                     gaps.push(Gap {
@@ -361,13 +394,14 @@ pub fn check_times(
                     });
                 }
             }
-            let mut dev: Vec<f64> = steps
-                .iter()
-                .filter(|&&d| d > 0.0 && d <= GAP_FACTOR * nominal)
-                .map(|&d| (d - nominal).abs())
-                .collect();
-            let mad = median(&mut dev).unwrap_or(0.0);
-            (1.0 / nominal, 1.4826 * mad / nominal)
+            buffer.clear();
+            buffer.extend(
+                steps()
+                    .filter(|&d| d > 0.0 && d <= GAP_FACTOR * nominal)
+                    .map(|d| (d - nominal).abs()),
+            );
+            let mad = median(&mut buffer).unwrap_or(0.0);
+            (round_significant(1.0 / nominal), MAD_TO_SD * mad / nominal)
         }
     };
     TimingReport {

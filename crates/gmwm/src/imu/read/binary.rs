@@ -461,7 +461,23 @@ pub(crate) fn read_record_table(
 ) -> Result<RawTable, ReadError> {
     let record = record_type.record_size();
     let names: Vec<String> = RECORD_COLUMNS.iter().map(|n| n.to_string()).collect();
-    // the time is the records' own; a time column option does not apply
+    // the time is the records' own
+    if let Some(t) = &opts.time_column {
+        return Err(ParamError::new(
+            "time column",
+            t,
+            "no time column: IMU records carry their own time (METHODS §9.2)",
+        )
+        .into());
+    }
+    if let Some(u) = opts.time_unit {
+        return Err(ParamError::new(
+            "time unit",
+            u,
+            "no unit: IMU record times are in seconds (METHODS §9.2)",
+        )
+        .into());
+    }
     let select = ReadOptions {
         time_column: None,
         ..opts.clone()
