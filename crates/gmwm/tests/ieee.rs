@@ -88,8 +88,13 @@ fn ieee_pure_power_laws_come_back_exactly() {
                 let hi = r.ci_high.unwrap();
                 assert!(rel_diff(lo, truth / BAND.sqrt()) < TOL_POWER_LAW, "{sym}");
                 assert!(rel_diff(hi, truth * BAND.sqrt()) < TOL_POWER_LAW, "{sym}");
-                // every scale is in the region of the only term
-                assert_eq!(r.tau_s.len(), 20, "{sym}: {ro}");
+                // every scale is in the region of the only term; the line goes through those
+                // within READ_OFF_WINDOW of the read-off time
+                let w = gmwm::calib::ieee::READ_OFF_WINDOW;
+                assert!(r.tau_s.len() >= 2, "{sym}: {ro}");
+                for t in &r.tau_s {
+                    assert!((t / r.at_tau_s).ln().abs() <= w.ln() + 1e-9, "{sym}: {t}");
+                }
             } else if s != "B" {
                 assert!(r.value.is_none(), "{sym} alone gave {s}: {ro}");
                 assert!(r.note.as_ref().unwrap().contains("no value"));
