@@ -365,8 +365,10 @@ pub struct ImpliedArgs {
 /// How FILE is read (long help of every command that reads a recording).
 const INPUT_HELP: &str = "\
 Data file: CSV/TSV (optionally .gz), raw little-endian binary, binary IMU records
-(--format imar|ln200|ln200ig|ixsea|navchip-int|navchip-flt) or a wavelet variance saved by
-`gmwm wv --json`.
+(--format imar|ln200|ln200ig|ixsea|navchip-int|navchip-flt), a ROS recording (ROS1 .bag, ROS2
+.mcap or .db3, or the rosbag2 folder holding one; its sensor_msgs/Imu topic, --topic if it has
+several, becomes gyro_x ... accel_z in rad/s and m/s^2 at the rate of its header stamps) or a
+wavelet variance saved by `gmwm wv --json` (not for calibrate, which needs the samples).
 
 FILE is read by its name, its JSON sidecar and its content: .f64/.f32 (also .f64le, .f64.bin)
 are raw little-endian binary; a sidecar FILE.json (or NAME.json beside NAME.csv.gz) gives the
@@ -392,8 +394,9 @@ linear_acceleration.x, ...), only those, and the others are listed in a note.";
 #[derive(Debug, Args)]
 pub struct InputArgs {
     /// Data file: CSV/TSV (optionally .gz), raw little-endian binary (.f64, .f32 or
-    /// --format f64|f32), binary IMU records (--format imar|ln200|...), or a wavelet variance
-    /// saved by `gmwm wv --json` (see --help for how FILE is read).
+    /// --format f64|f32), binary IMU records (--format imar|ln200|...), a ROS recording (.bag,
+    /// .mcap, .db3, rosbag2 folder), or a wavelet variance saved by `gmwm wv --json` (see --help
+    /// for how FILE is read).
     #[arg(value_name = "FILE", long_help = INPUT_HELP)]
     pub file: PathBuf,
     /// Columns to analyse, comma-separated names or 1-based indices (also the series of a

@@ -214,6 +214,9 @@ fn summary(
     for n in &recording.notes {
         writeln!(out, "  {n}")?;
     }
+    for c in &report.checks {
+        writeln!(out, "  check: {c}")?;
+    }
     writeln!(
         out,
         "model: selected by WIC among the sub-models of {} ({} rule); intervals {:.0}%",

@@ -161,7 +161,7 @@ pub struct FitVerdict {
     pub levels: usize,
     /// Scales where the implied WV lies outside the empirical WV's `1 - alpha` interval.
     pub levels_outside_band: usize,
-    /// Largest `|implied / empirical - 1|` over the scales.
+    /// Largest `|implied / empirical - 1|` over the scales outside the band (0 when none is).
     pub max_relative_deviation: f64,
     /// `levels_outside_band` is at most the count expected by chance (`alpha` of the levels,
     /// rounded up).
@@ -246,7 +246,14 @@ pub struct CalibrationReport {
     pub alpha: f64,
     /// Per axis.
     pub axes: Vec<AxisCalibration>,
+    /// Checks on the recording as a whole that a user should read, one line each.
+    pub checks: Vec<String>,
 }
+
+/// Longest scale, in seconds, below which a recording is reported as too short to show the
+/// bias instability and the random walk: those of MEMS and tactical IMUs show between 10 s and
+/// 1000 s, and the WV's longest scale is about a quarter of the recording.
+pub const SHORT_RECORDING_SCALE_S: f64 = 1000.0;
 
 /// The calibration pipeline (module doc).
 ///
@@ -348,15 +355,31 @@ impl Calibration {
             })
             .collect();
         let axes = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+        let mut checks = Vec::new();
+        let duration_s = imu.len() as f64 / imu.freq_hz();
+        if let Some(longest) = axes
+            .iter()
+            .filter_map(|a| a.wv.tau_s.last().copied())
+            .reduce(f64::max)
+        {
+            if longest < SHORT_RECORDING_SCALE_S {
+                checks.push(format!(
+                    "the recording lasts {} s, so the longest scale observed is {} s: the bias instability and random walk of most IMUs show between 10 s and 1000 s; record for 2-3 hours (a MEMS IMU) or more to pin them down",
+                    crate::fit::report::significant(duration_s, 3),
+                    crate::fit::report::significant(longest, 3)
+                ));
+            }
+        }
         Ok(CalibrationReport {
             name: imu.name().map(str::to_string),
             freq_hz: imu.freq_hz(),
             samples: imu.len(),
-            duration_s: imu.len() as f64 / imu.freq_hz(),
+            duration_s,
             full_model: self.options.full_model.to_string(),
             rule: self.options.rule,
             alpha: self.options.wv.alpha,
             axes,
+            checks,
         })
     }
 
@@ -871,19 +894,28 @@ fn verdict(fit: &GmwmFit, wv: &WaveletVariance, inference: &Inference, alpha: f6
         .count();
     let allowed = (alpha * levels as f64).ceil() as usize;
     let explains_wv = outside <= allowed;
-    let (worst_level, max_relative_deviation) = (0..levels)
+    // the furthest outside the band, relative to the empirical WV (inside the band a deviation
+    // is the WV's own noise, and at the last scales the band spans orders of magnitude)
+    let outside_deviation = (0..levels)
+        .filter(|&j| implied[j] < wv.ci_low[j] || implied[j] > wv.ci_high[j])
         .map(|j| (j, (implied[j] / wv.wv[j] - 1.0).abs()))
         .filter(|(_, d)| d.is_finite())
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .unwrap_or((0, 0.0));
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    let max_relative_deviation = outside_deviation.map_or(0.0, |(_, d)| d);
     let p = inference.gof.as_ref().map(|g| g.p_value);
-    let band = format!(
-        "implied WV inside the {:.0}% band at {} of {levels} scales, largest deviation {:.1}% at {} s",
-        100.0 * (1.0 - alpha),
-        levels - outside,
-        100.0 * max_relative_deviation,
-        crate::fit::report::significant(wv.tau_s[worst_level], 3)
-    );
+    let band = match outside_deviation {
+        None => format!(
+            "implied WV inside the {:.0}% band at all {levels} scales",
+            100.0 * (1.0 - alpha)
+        ),
+        Some((j, d)) => format!(
+            "implied WV inside the {:.0}% band at {} of {levels} scales, the furthest outside {:.1}% off at {} s",
+            100.0 * (1.0 - alpha),
+            levels - outside,
+            100.0 * d,
+            crate::fit::report::significant(wv.tau_s[j], 3)
+        ),
+    };
     let summary = match (p, explains_wv) {
         (Some(p), true) if p >= alpha => format!("fits: J-test p = {p:.3}; {band}"),
         (Some(p), true) => format!(

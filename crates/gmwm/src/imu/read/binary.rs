@@ -16,6 +16,9 @@ use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+/// Records decoded between two hand-backs of the mapped pages (64 Ki records, 2–3.5 MiB).
+const RELEASE_EVERY: usize = 1 << 16;
+
 /// Read buffer of [`BinaryChunks`].
 const BUF_CAPACITY: usize = 1 << 20;
 
@@ -483,56 +486,70 @@ pub(crate) fn read_record_table(
         ..opts.clone()
     };
     let sel = resolve_selection(path, &names, &select, None)?;
-    let (file, _rows) = open_records(path, record)?;
+    let (file, rows) = open_records(path, record)?;
     let bytes = map(path, &file)?;
-    let time: Vec<f64> = bytes.chunks_exact(record).map(|r| decode(r, 8)).collect();
-    if let Some(i) = time.iter().position(|v| !v.is_finite()) {
-        return Err(non_finite(path, i, 1, time[i]));
-    }
-    if let Some(i) = time.windows(2).position(|w| w[1] <= w[0]) {
-        return Err(ReadError::RecordTimeNotIncreasing {
-            path: path.to_path_buf(),
-            index: i as u64 + 1,
-            previous: time[i],
-            value: time[i + 1],
-        });
+    // one pass over the records, handing decoded pages back to the kernel as it goes: the
+    // resident set is the output plus about one release step of the file
+    let mut release = crate::imu::ros::Release::new(&bytes);
+    let mut time: Vec<f64> = Vec::with_capacity(rows as usize);
+    let mut counts: Vec<Vec<f64>> = sel
+        .columns
+        .iter()
+        .map(|_| Vec::with_capacity(rows as usize))
+        .collect();
+    for (i, r) in bytes.chunks_exact(record).enumerate() {
+        let t = decode(r, 8);
+        if !t.is_finite() {
+            return Err(non_finite(path, i, 1, t));
+        }
+        if let Some(&previous) = time.last() {
+            if t <= previous {
+                return Err(ReadError::RecordTimeNotIncreasing {
+                    path: path.to_path_buf(),
+                    index: i as u64,
+                    previous,
+                    value: t,
+                });
+            }
+        }
+        time.push(t);
+        for (c, &k) in sel.columns.iter().enumerate() {
+            let raw = if record_type.is_double() {
+                decode(&r[8 + 8 * k..], 8)
+            } else {
+                decode_i32(&r[8 + 4 * k..])
+            };
+            if !raw.is_finite() {
+                return Err(non_finite(path, i, k + 2, raw));
+            }
+            counts[c].push(raw);
+        }
+        if i % RELEASE_EVERY == 0 {
+            release.upto(i * record);
+        }
     }
     let freq = record_freq(path, &time)?;
     let mut columns = Vec::with_capacity(sel.columns.len());
-    for &k in &sel.columns {
+    for (&k, mut values) in sel.columns.iter().zip(counts) {
         let scale = if k < 3 {
             record_type.scale_gyro()
         } else {
             record_type.scale_accel()
         };
         let factor = freq * scale;
-        let values: Vec<f64> = if record_type.is_double() {
-            let mut values = Vec::with_capacity(time.len());
-            for (i, r) in bytes.chunks_exact(record).enumerate() {
-                let raw = decode(&r[8 + 8 * k..], 8);
-                if !raw.is_finite() {
-                    return Err(non_finite(path, i, k + 2, raw));
-                }
-                values.push(raw * factor);
-            }
-            values
-        } else {
-            bytes
-                .chunks_exact(record)
-                .map(|r| decode_i32(&r[8 + 4 * k..]) * factor)
-                .collect()
-        };
+        values.iter_mut().for_each(|v| *v *= factor);
         columns.push(Column {
             name: names[k].clone(),
             values,
         });
     }
     let time_origin = time[0];
+    time.iter_mut().for_each(|t| *t -= time_origin);
     Ok(RawTable {
         columns,
         time: Some(Column {
             name: "time".into(),
-            values: time.iter().map(|t| t - time_origin).collect(),
+            values: time,
         }),
         time_origin,
         time_unit: Some(TimeUnit::Seconds),
