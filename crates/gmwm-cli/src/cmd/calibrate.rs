@@ -84,12 +84,10 @@ pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
         .run_with_progress(&recording.imu, &Ticks(&progress))
         .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();
-    let rostopic = args
-        .rostopic
-        .clone()
-        .or_else(|| recording.topic.clone())
-        .unwrap_or_else(|| "/imu0".to_string());
-    let sets = report.nav_sets(policy, adjustment, Some(&rostopic));
+    // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
+    // says so in a comment
+    let rostopic = args.rostopic.clone().or_else(|| recording.topic.clone());
+    let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
     let mut written = Vec::new();
     for (format, path) in &exports {
         for set in &sets {
