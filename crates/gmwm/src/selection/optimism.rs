@@ -132,6 +132,24 @@ pub fn asymptotic_optimism(
     check_len("Omega columns", j, omega.ncols())?;
     check_len("V rows", j, v.nrows())?;
     check_len("V columns", j, v.ncols())?;
+    // a parameter whose derivatives are not finite sits on the edge of its domain (a GM whose
+    // phi underflowed, a variance at zero): it has no local influence to be optimistic about
+    // and is left out, as inference leaves it out of the sandwich
+    let keep: Vec<usize> = (0..p)
+        .filter(|&k| {
+            a.column(k).iter().all(|x| x.is_finite())
+                && d.row(k).iter().all(|x| x.is_finite())
+                && d.column(k).iter().all(|x| x.is_finite())
+        })
+        .collect();
+    if keep.len() < p {
+        if keep.is_empty() {
+            return Ok(0.0);
+        }
+        let a = a.select_columns(&keep);
+        let d = d.select_rows(&keep).select_columns(&keep);
+        return asymptotic_optimism(&a, &d, omega, v, convention);
+    }
     let at_omega = a.transpose() * omega;
     let b = &at_omega * a;
     // M is the matrix to pseudo-invert: B + D (corrected) or D - B (package)
@@ -215,6 +233,10 @@ pub(crate) fn pinv(m: &DMatrix<f64>) -> DMatrix<f64> {
     if r == 0 || c == 0 {
         return DMatrix::zeros(c, r);
     }
+    if m.iter().any(|v| !v.is_finite()) {
+        // an SVD of a matrix holding NaN or infinity panics or never converges: no inverse
+        return DMatrix::from_element(c, r, f64::NAN);
+    }
     let svd = m.clone().svd(true, true);
     let smax = svd.singular_values.iter().copied().fold(0.0, f64::max);
     let tol = r.max(c) as f64 * f64::EPSILON * smax;
@@ -247,6 +269,33 @@ mod tests {
         let s = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]);
         // pinv of the all-ones 2x2 is itself / 4
         assert!((pinv(&s) - &s / 4.0).norm() < 1e-14);
+    }
+
+    /// Issue 11 review: a Jacobian or D with NaN/inf (a parameter on the edge of its domain)
+    /// made the SVD panic or never return; pinv gives NaN, the optimism leaves the parameter out.
+    #[test]
+    fn issue_11_optimism_survives_non_finite_derivatives() {
+        let nan = DMatrix::from_row_slice(2, 2, &[1.0, f64::NAN, 0.0, 1.0]);
+        assert!(pinv(&nan).iter().all(|v| v.is_nan()));
+        let inf = DMatrix::from_row_slice(2, 2, &[f64::INFINITY, 0.0, 0.0, 1.0]);
+        assert!(pinv(&inf).iter().all(|v| v.is_nan()));
+        let a = DMatrix::from_row_slice(3, 2, &[1.0, f64::NAN, 0.5, f64::NAN, 0.25, f64::NAN]);
+        let d = DMatrix::zeros(2, 2);
+        let omega = DMatrix::identity(3, 3);
+        let v = DMatrix::identity(3, 3) * 0.1;
+        let with = asymptotic_optimism(&a, &d, &omega, &v, OptimismConvention::Corrected).unwrap();
+        let alone = asymptotic_optimism(
+            &a.columns(0, 1).into_owned(),
+            &DMatrix::zeros(1, 1),
+            &omega,
+            &v,
+            OptimismConvention::Corrected,
+        )
+        .unwrap();
+        assert!(
+            with.is_finite() && (with - alone).abs() < 1e-15,
+            "{with} {alone}"
+        );
     }
 
     #[test]
