@@ -13,12 +13,14 @@ const GYRO: SensorNoise = SensorNoise {
     random_walk: Some(1.9393e-5),
     bias_correlation_time_s: Some(1000.0),
     bias_sigma: Some(8.7e-3),
+    bias_driving_density: Some(1.9393e-5),
 };
 const ACCEL: SensorNoise = SensorNoise {
     noise_density: Some(2.0e-3),
     random_walk: Some(3.0e-3),
     bias_correlation_time_s: Some(300.0),
     bias_sigma: Some(0.196),
+    bias_driving_density: Some(3.0e-3),
 };
 
 fn noise() -> NavNoise {
@@ -282,10 +284,19 @@ fn export_missing_values_are_errors_naming_the_key() {
         (ExportFormat::OpenVins, "gyroscope_random_walk"),
         (ExportFormat::Vins, "gyr_w"),
         (ExportFormat::OrbSlam3, "IMU.GyroWalk"),
-        (ExportFormat::Px4, "gyroscopeRandomWalk"),
     ];
     let mut n = noise();
     n.gyroscope.random_walk = None;
+    // PX4's random walk drives its Gauss–Markov bias: it is the GM driving density, present
+    let px4 = render(ExportFormat::Px4, &n).unwrap();
+    assert!(px4.contains("gyroscopeRandomWalk"));
+    n.gyroscope.bias_driving_density = None;
+    let e = render(ExportFormat::Px4, &n).unwrap_err();
+    assert!(e.to_string().contains("gyroscopeRandomWalk"), "{e}");
+    assert!(
+        e.to_string().contains("--model"),
+        "the hint says how to get one: {e}"
+    );
     for (format, key) in cases {
         let e = render(format, &n).unwrap_err();
         assert!(

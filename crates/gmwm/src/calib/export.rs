@@ -43,6 +43,9 @@ pub struct SensorNoise {
     pub bias_correlation_time_s: Option<f64>,
     /// Gauss–Markov bias standard deviation: rad/s or m/s².
     pub bias_sigma: Option<f64>,
+    /// Density of the noise driving the Gauss–Markov bias, `sqrt(2 sigma^2 / T)` (rad/s²/√Hz
+    /// or m/s³/√Hz): the random walk of a bias that is a Gauss–Markov process (PX4).
+    pub bias_driving_density: Option<f64>,
 }
 
 /// What a navigation filter needs, with provenance (METHODS §14.4).
@@ -189,6 +192,7 @@ fn real(v: f64) -> String {
 enum Field {
     NoiseDensity,
     RandomWalk,
+    BiasDrivingDensity,
     CorrelationTime,
     BiasSigma,
 }
@@ -209,7 +213,14 @@ fn value(format: ExportFormat, s: &SensorNoise, key: &Key) -> Result<f64, Export
             s.random_walk,
             " (from a random-walk term, or the slowest GM's driving density)",
         ),
-        Field::CorrelationTime => (s.bias_correlation_time_s, " (from a Gauss-Markov term)"),
+        Field::BiasDrivingDensity => (
+            s.bias_driving_density,
+            " (the driving density of a Gauss-Markov bias: the model has none; fit one with --model, e.g. AR1()+WN()+RW())",
+        ),
+        Field::CorrelationTime => (
+            s.bias_correlation_time_s,
+            " (from a Gauss-Markov term: the model has none; fit one with --model, e.g. AR1()+WN()+RW())",
+        ),
         Field::BiasSigma => (s.bias_sigma, " (from a Gauss-Markov term)"),
     };
     let v = v.ok_or(ExportError::Missing {
@@ -569,7 +580,7 @@ fn px4(noise: &NavNoise) -> Result<String, ExportError> {
                 ),
                 key(
                     "gyroscopeRandomWalk",
-                    Field::RandomWalk,
+                    Field::BiasDrivingDensity,
                     "rad/s^2/sqrt(Hz)",
                     "density of the noise driving the GM bias",
                 ),
@@ -600,7 +611,7 @@ fn px4(noise: &NavNoise) -> Result<String, ExportError> {
                 ),
                 key(
                     "accelerometerRandomWalk",
-                    Field::RandomWalk,
+                    Field::BiasDrivingDensity,
                     "m/s^3/sqrt(Hz)",
                     "density of the noise driving the GM bias",
                 ),

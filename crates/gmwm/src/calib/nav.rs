@@ -261,32 +261,36 @@ fn triad(
     };
     let noise_density = pick("noise_density", &|a| a.noise_density.as_ref());
     let random_walk = pick("random_walk", &|a| a.random_walk.as_ref());
-    // the Gauss–Markov pair comes from one axis: the one with the largest bias sigma
+    // the Gauss–Markov bias (correlation time, sigma, driving density) comes from one axis:
+    // the one with the largest bias sigma, all three from its bias term
     let gm = of_kind
         .iter()
         .filter_map(|a| a.gauss_markov_bias.as_ref().map(|g| (a, g)))
         .max_by(|a, b| a.1.sigma.value.total_cmp(&b.1.sigma.value));
-    let (bias_correlation_time_s, bias_sigma) = match gm {
+    let (bias_correlation_time_s, bias_sigma, bias_driving_density) = match gm {
         Some((a, g)) => {
             comments.push(format!(
-                "{name} Gauss-Markov bias: {} (its dominant correlated term: T = {:.4e} s, sigma = {:.4e} {})",
+                "{name} Gauss-Markov bias: {} (its slowest correlated term: T = {:.4e} s, sigma = {:.4e} {})",
                 a.column, g.correlation_time.value, g.sigma.value, g.sigma.unit
             ));
+            let pick = |e: &Estimate| match adjustment {
+                Adjustment::Conservative => e.ci_high.unwrap_or(e.value),
+                _ => e.value,
+            };
             (
                 Some(g.correlation_time.value),
-                Some(match adjustment {
-                    Adjustment::Conservative => g.sigma.ci_high.unwrap_or(g.sigma.value),
-                    _ => g.sigma.value,
-                }),
+                Some(pick(&g.sigma)),
+                Some(pick(&g.driving_density)),
             )
         }
-        None => (None, None),
+        None => (None, None, None),
     };
     SensorNoise {
         noise_density,
         random_walk,
         bias_correlation_time_s,
         bias_sigma,
+        bias_driving_density,
     }
 }
 

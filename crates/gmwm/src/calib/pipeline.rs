@@ -136,8 +136,8 @@ pub struct Estimate {
     pub forms: Option<UnitForms>,
 }
 
-/// The Gauss–Markov form of the bias (the dominant correlated term): what PX4/Gazebo-style
-/// IMU models take.
+/// The Gauss–Markov form of the bias (the slowest correlated term the canonical model keeps):
+/// what PX4/Gazebo-style IMU models take.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GaussMarkovBias {
     /// Correlation time `1 / beta`, s.
@@ -744,16 +744,30 @@ impl Readoff<'_> {
         self.correlated_by_time().into_iter().next().map(|(c, _)| c)
     }
 
-    /// AR1/GM components of the fit with their correlation times, fastest first.
+    /// The fit's components that the canonical model keeps as correlated noise (an AR1 it
+    /// reads as white noise or a random walk is not one).
+    fn kept_correlated(&self) -> Vec<usize> {
+        self.canonical
+            .terms
+            .iter()
+            .filter(|t| matches!(t.kind, ProcessKind::Ar1 | ProcessKind::Gm) && t.from.len() == 1)
+            .map(|t| t.from[0])
+            .collect()
+    }
+
+    /// The AR1/GM components the canonical model keeps, with their correlation times, fastest
+    /// first.
     fn correlated_by_time(&self) -> Vec<(usize, f64)> {
         let offsets = self.offsets();
         let theta = &self.fit.theta;
+        let kept = self.kept_correlated();
         let mut out: Vec<(usize, f64)> = self
             .fit
             .model
             .components()
             .iter()
             .enumerate()
+            .filter(|(c, _)| kept.contains(c))
             .filter_map(|(c, comp)| {
                 let o = offsets[c];
                 let t = match comp.kind {
@@ -838,35 +852,16 @@ impl Readoff<'_> {
         Some(self.estimate(term, value, (lo, hi), source.to_string()))
     }
 
-    /// The dominant correlated term (the largest stationary variance) as a Gauss–Markov bias.
+    /// The slowest correlated term the canonical model keeps, as a Gauss–Markov bias: the bias
+    /// a navigation filter carries is the term that wanders longest (a sub-second one is
+    /// coloured noise, not bias).
     fn gauss_markov(&self) -> Option<GaussMarkovBias> {
-        let offsets = self.offsets();
-        let comps = self.fit.model.components();
-        // only terms the canonical model keeps as correlated noise
-        let kept: Vec<usize> = self
-            .canonical
-            .terms
-            .iter()
-            .filter(|t| matches!(t.kind, ProcessKind::Ar1 | ProcessKind::Gm) && t.from.len() == 1)
-            .map(|t| t.from[0])
-            .collect();
-        let dominant = kept.into_iter().max_by(|&a, &b| {
-            let var = |c: usize| {
-                let o = offsets[c];
-                let n = comps[c].kind.n_params();
-                crate::fit::report::physical_parameters(
-                    comps[c].kind,
-                    c,
-                    &self.fit.theta[o..o + n],
-                    self.freq_hz,
-                    None,
-                )
-                .into_iter()
-                .find(|p| p.name == "gm_std")
-                .map_or(0.0, |p| p.value)
-            };
-            var(a).total_cmp(&var(b))
-        })?;
+        let (slowest, _) = *self.correlated_by_time().last()?;
+        self.gauss_markov_of(slowest)
+    }
+
+    /// The Gauss–Markov form of the fit's AR1/GM component `dominant`.
+    fn gauss_markov_of(&self, dominant: usize) -> Option<GaussMarkovBias> {
         let t = self.gm_quantity(dominant, "correlation_time")?;
         let s = self.gm_quantity(dominant, "gm_std")?;
         let d = self.gm_quantity(dominant, "driving_noise_density")?;
