@@ -76,6 +76,9 @@ pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
         AxisPolicyArg::PerAxis => AxisPolicy::PerAxis,
     };
     let recording = crate::input::load_recording(&args.input)?;
+    if !exports.is_empty() {
+        check_units_known(args, &recording)?;
+    }
     let calibration = Calibration::new(options);
     let per_axis = calibration.candidates_per_axis()?;
     let axes = recording.imu.axes().len();
@@ -88,15 +91,19 @@ pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
     // says so in a comment
     let rostopic = args.rostopic.clone().or_else(|| recording.topic.clone());
     let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
+    // every file that can be written is, then the failures are reported together
     let mut written = Vec::new();
+    let mut failed = Vec::new();
     for (format, path) in &exports {
         for set in &sets {
             let target = per_axis_path(path, &set.label);
-            let text = render(*format, &set.noise)
-                .with_context(|| format!("cannot write {} ({format})", target.display()))?;
-            std::fs::write(&target, text)
-                .with_context(|| format!("cannot write {}", target.display()))?;
-            written.push(format!("{} ({format})", target.display()));
+            let result = render(*format, &set.noise)
+                .map_err(anyhow::Error::from)
+                .and_then(|text| std::fs::write(&target, text).map_err(anyhow::Error::from));
+            match result {
+                Ok(()) => written.push(format!("{} ({format})", target.display())),
+                Err(e) => failed.push(format!("{} ({format}): {e}", target.display())),
+            }
         }
     }
     let json_to_stdout = args.json.as_deref() == Some(Path::new("-"));
@@ -123,6 +130,45 @@ pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
         summary(&recording, &report, out)?;
         for w in &written {
             writeln!(out, "wrote {w}")?;
+        }
+    }
+    out.flush()?;
+    if !failed.is_empty() {
+        anyhow::bail!("not written: {}", failed.join("; "));
+    }
+    Ok(())
+}
+
+/// Exported files are SI: every gyroscope and accelerometer axis needs a unit the engine
+/// understands, from the recording or the flags; said before any computation.
+fn check_units_known(
+    args: &CalibrateArgs,
+    recording: &crate::input::LoadedRecording,
+) -> Result<()> {
+    use gmwm::imu::Sensor;
+    for a in recording.imu.axes() {
+        let (given, flag) = match a.sensor() {
+            Sensor::Gyroscope => (args.gyro_unit.is_some(), "--gyro-unit rad/s|deg/s|deg/h"),
+            Sensor::Accelerometer => (args.accel_unit.is_some(), "--accel-unit m/s^2|g|mg"),
+            _ => continue,
+        };
+        let known = a
+            .info
+            .unit
+            .as_deref()
+            .is_some_and(|u| u.parse::<gmwm::units::SignalUnit>().is_ok());
+        if !given && !known {
+            return Err(UsageError(format!(
+                "{}: the unit of column {} is unknown{} and the exported files are SI: give {flag}",
+                recording.path.display(),
+                a.column.name,
+                a.info
+                    .unit
+                    .as_deref()
+                    .map(|u| format!(" ({})", gmwm::imu::quote(u)))
+                    .unwrap_or_default()
+            ))
+            .into());
         }
     }
     Ok(())

@@ -4,7 +4,7 @@
 use super::export::{NavNoise, SensorNoise};
 use super::pipeline::{AxisCalibration, CalibrationReport, Estimate};
 use crate::error::ParamError;
-use crate::units::SignalKind;
+use crate::units::{SignalKind, SignalUnit};
 use serde::Serialize;
 use std::str::FromStr;
 
@@ -106,7 +106,7 @@ impl CalibrationReport {
             AxisPolicy::PerAxis => {
                 let mut letters: Vec<String> = Vec::new();
                 for a in &self.axes {
-                    let l = axis_letter(&a.column);
+                    let l = a.axis.to_ascii_lowercase();
                     if !letters.contains(&l) {
                         letters.push(l);
                     }
@@ -117,7 +117,7 @@ impl CalibrationReport {
                         let axes = self
                             .axes
                             .iter()
-                            .filter(|a| axis_letter(&a.column) == l)
+                            .filter(|a| a.axis.eq_ignore_ascii_case(&l))
                             .collect();
                         (l, axes)
                     })
@@ -185,16 +185,6 @@ impl CalibrationReport {
     }
 }
 
-/// The axis letter of a column (`gyro_x` → `x`), else the column name.
-fn axis_letter(column: &str) -> String {
-    column
-        .rsplit(['_', '.', ' '])
-        .next()
-        .filter(|l| l.len() == 1)
-        .unwrap_or(column)
-        .to_ascii_lowercase()
-}
-
 /// Combines the axes of one kind into one [`SensorNoise`].
 fn triad(
     axes: &[&AxisCalibration],
@@ -207,7 +197,7 @@ fn triad(
     let of_kind: Vec<&AxisCalibration> = axes
         .iter()
         .copied()
-        .filter(|a| a.kind == Some(kind) && a.unit != "u")
+        .filter(|a| a.kind == Some(kind) && a.unit == SignalUnit::si(kind).symbol())
         .collect();
     let name = match kind {
         SignalKind::Gyroscope => "gyroscope",
@@ -305,9 +295,6 @@ mod tests {
             AxisPolicy::PerAxis
         );
         assert!("best".parse::<AxisPolicy>().is_err());
-        assert_eq!(axis_letter("gyro_x"), "x");
-        assert_eq!(axis_letter("accel.Z"), "z");
-        assert_eq!(axis_letter("temperature"), "temperature");
         assert!(Adjustment::inflate(0.5).is_err());
         assert!(Adjustment::inflate(f64::NAN).is_err());
         assert_eq!(Adjustment::inflate(2.0).unwrap(), Adjustment::Inflate(2.0));

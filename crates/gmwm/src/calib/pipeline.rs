@@ -172,7 +172,7 @@ pub struct FitVerdict {
 
 /// One axis calibrated.
 ///
-/// Wire format: `column`, `kind` (`gyro`, `accel` or null), `data_unit` (as read or given),
+/// Wire format: `column`, `kind` (`gyro`, `accel` or null), `axis` (`X`, ...), `data_unit` (as read or given),
 /// `unit` (the unit of the analysis: SI for a known unit, else the data unit), `samples`,
 /// `model` (the selected candidate), `canonical_model`, `noise_density`, `random_walk`,
 /// `bias_instability`, `quantization`, `rate_ramp` ([`Estimate`] or null),
@@ -184,6 +184,8 @@ pub struct AxisCalibration {
     pub column: String,
     /// What the column measures, when known.
     pub kind: Option<SignalKind>,
+    /// The sensor axis it measures along (`X`, `Y`, `Z`, as the reader recognised it).
+    pub axis: String,
     /// Unit of the samples as read (`None` when unknown).
     pub data_unit: Option<String>,
     /// Unit of every result of this axis (SI for a gyroscope/accelerometer of known unit).
@@ -346,6 +348,7 @@ impl Calibration {
                 };
                 self.axis(
                     &axis.column.name,
+                    &axis.info.axis,
                     kind,
                     axis.info.unit.as_deref(),
                     axis.values(),
@@ -430,9 +433,11 @@ impl Calibration {
     }
 
     /// One axis (module doc).
+    #[allow(clippy::too_many_arguments)]
     fn axis(
         &self,
         column: &str,
+        axis_label: &str,
         kind: Option<SignalKind>,
         recorded_unit: Option<&str>,
         values: &[f64],
@@ -448,9 +453,11 @@ impl Calibration {
         let x = si_values.as_deref().unwrap_or(values);
         // a kind without a known unit reads in the data unit: no SI names, no datasheet forms
         let unit_kind = kind.filter(|_| unit.is_some());
+        // results of an axis whose unit is not understood are in the data unit, named "u" (the
+        // recorded text, which may be a sentence, is kept in `data_unit`)
         let unit_label = match (unit, kind) {
             (Some(_), Some(k)) => SignalUnit::si(k).symbol().to_string(),
-            _ => recorded_unit.unwrap_or("u").to_string(),
+            _ => "u".to_string(),
         };
         let engine = |source: crate::Error| CalibError::Engine {
             column: column.to_string(),
@@ -555,6 +562,7 @@ impl Calibration {
         Ok(AxisCalibration {
             column: column.to_string(),
             kind,
+            axis: axis_label.to_string(),
             data_unit: unit
                 .map(|u| u.symbol().to_string())
                 .or_else(|| recorded_unit.map(str::to_string)),
