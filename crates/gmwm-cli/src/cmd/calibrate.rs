@@ -7,7 +7,6 @@ use crate::progress::{bar, Ticks};
 use crate::UsageError;
 use anyhow::{Context, Result};
 use gmwm::calib::export::{render, ExportFormat};
-use gmwm::calib::ieee::Readoff;
 use gmwm::calib::{
     Adjustment, AxisCalibration, AxisPolicy, Calibration, CalibrationOptions, CalibrationReport,
     Estimate, NavSet, DEFAULT_FULL_MODEL,
@@ -218,6 +217,7 @@ fn num(v: f64) -> String {
 fn estimate_line(e: &Estimate) -> String {
     let ci = match (e.ci_low, e.ci_high) {
         (Some(lo), Some(hi)) => format!(" [{}, {}]", num(lo), num(hi)),
+        _ if e.source.contains("not determined") => " [not determined by the data]".to_string(),
         _ => " [no interval]".to_string(),
     };
     let sheet = e
@@ -229,13 +229,6 @@ fn estimate_line(e: &Estimate) -> String {
     format!("{} {}{ci}{sheet}", num(e.value), e.unit)
 }
 
-fn readoff_cell(r: &Readoff) -> String {
-    match r.value {
-        Some(v) => num(v),
-        None => "-".to_string(),
-    }
-}
-
 fn summary(
     recording: &crate::input::LoadedRecording,
     report: &CalibrationReport,
@@ -244,7 +237,7 @@ fn summary(
     let hours = report.duration_s / 3600.0;
     writeln!(
         out,
-        "{}: {} samples per axis at {} Hz ({}), {} axes",
+        "{}: {} samples per axis at {} Hz ({}), {}",
         recording.path.display(),
         report.samples,
         num(report.freq_hz),
@@ -253,7 +246,10 @@ fn summary(
         } else {
             format!("{:.0} s", report.duration_s)
         },
-        report.axes.len()
+        match report.axes.len() {
+            1 => "1 axis".to_string(),
+            n => format!("{n} axes"),
+        }
     )?;
     for n in &recording.notes {
         writeln!(out, "  {n}")?;
@@ -285,23 +281,39 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
         (None, _) => ", unit unknown".to_string(),
         _ => String::new(),
     };
+    let fitted = if a.model == a.canonical_model {
+        String::new()
+    } else if a.identified_model == a.model {
+        format!(" (fitted as {})", a.model)
+    } else {
+        format!(
+            " (selected {}; estimates from its reduced model {})",
+            a.model, a.identified_model
+        )
+    };
     writeln!(
         out,
-        "{}: {}{}{unit_note}",
-        a.column,
-        a.canonical_model,
-        if a.model != a.canonical_model {
-            format!(" (fitted as {})", a.model)
-        } else {
-            String::new()
-        },
+        "{}: {}{fitted}{unit_note}",
+        a.column, a.canonical_model
     )?;
     let line = |label: &str, e: &Option<Estimate>| match e {
         Some(e) => format!("  {label:<18}{}", estimate_line(e)),
         None => format!("  {label:<18}- (no such term)"),
     };
     writeln!(out, "{}", line("noise density", &a.noise_density))?;
-    writeln!(out, "{}", line("bias instability", &a.bias_instability))?;
+    match &a.bias_instability {
+        Some(_) => writeln!(out, "{}", line("bias instability", &a.bias_instability))?,
+        None => writeln!(
+            out,
+            "  {:<18}- ({})",
+            "bias instability",
+            a.ieee
+                .b
+                .note
+                .as_deref()
+                .unwrap_or("no minimum of the Allan deviation observed")
+        )?,
+    }
     writeln!(out, "{}", line("random walk", &a.random_walk))?;
     if let Some(g) = &a.gauss_markov_bias {
         writeln!(
@@ -322,17 +334,20 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
     if let Some(r) = &a.rate_ramp {
         writeln!(out, "  {:<18}{}", "rate ramp", estimate_line(r))?;
     }
-    writeln!(
-        out,
-        "  {:<18}N = {}, B = {}, K = {}, Q = {}, R = {} ({})",
-        "IEEE 952",
-        readoff_cell(&a.ieee.n),
-        readoff_cell(&a.ieee.b),
-        readoff_cell(&a.ieee.k),
-        readoff_cell(&a.ieee.q),
-        readoff_cell(&a.ieee.r),
-        a.unit
-    )?;
+    let ieee: Vec<String> = a
+        .ieee
+        .rows()
+        .iter()
+        .map(|(sym, term, r)| match r.value {
+            Some(v) => format!(
+                "{sym} = {} {}",
+                num(v),
+                gmwm::units::si_unit(*term, a.kind.filter(|_| a.unit != "u"), &a.unit)
+            ),
+            None => format!("{sym} = -"),
+        })
+        .collect();
+    writeln!(out, "  {:<18}{}", "IEEE 952", ieee.join(", "))?;
     writeln!(out, "  {:<18}{}", "fit", a.verdict.summary)?;
     for n in &a.notes {
         writeln!(out, "  note: {n}")?;

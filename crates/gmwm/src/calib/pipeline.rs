@@ -26,6 +26,16 @@ pub const DEFAULT_FULL_MODEL: &str = "3*AR1()+WN()+QN()+RW()+DR()";
 /// truncation error near `1e-10` and the rounding error near `1e-11` of the gradient.
 const DELTA_STEP: f64 = 1e-5;
 
+/// Largest relative miss of the band that the verdict still puts down to chance when no more
+/// than `alpha` of the scales are outside (10%: beyond it one scale misses by more than the
+/// WV's own precision at the scales a filter integrates over).
+pub const CHANCE_MISS_REL: f64 = 0.1;
+
+/// Relative standard error above which a read-off is reported without an interval, as not
+/// determined by the data: beyond it the log-scale interval spans more than a factor e^(2 z)
+/// (50 at 95%), which says nothing a filter could use, and `--conservative` would export noise.
+pub const UNDETERMINED_SE_REL: f64 = 1.0;
+
 /// Relative agreement below which a canonical term is a function of the fitted estimates
 /// (terms computed by a refit are not, and get no interval from the fit's covariance).
 const SAME_VALUE_REL: f64 = 1e-6;
@@ -174,7 +184,7 @@ pub struct FitVerdict {
 ///
 /// Wire format: `column`, `kind` (`gyro`, `accel` or null), `axis` (`X`, ...), `data_unit` (as read or given),
 /// `unit` (the unit of the analysis: SI for a known unit, else the data unit), `samples`,
-/// `model` (the selected candidate), `canonical_model`, `noise_density`, `random_walk`,
+/// `model` (the selected candidate), `canonical_model`, `identified_model`, `noise_density`, `random_walk`,
 /// `bias_instability`, `quantization`, `rate_ramp` ([`Estimate`] or null),
 /// `gauss_markov_bias`, `ieee`, `verdict`, `canonical`, `inference`, `selection` (the table),
 /// `wv`, `allan`, `notes`.
@@ -196,6 +206,9 @@ pub struct AxisCalibration {
     pub model: String,
     /// Its canonical model: what the estimates are reported as.
     pub canonical_model: String,
+    /// The model the estimates and intervals come from (the canonical model's reduced model,
+    /// fitted), guess mode.
+    pub identified_model: String,
     /// White-noise density N (angle / velocity random walk), continuous time.
     pub noise_density: Option<Estimate>,
     /// Random-walk density K (rate / acceleration random walk), continuous time.
@@ -357,8 +370,25 @@ impl Calibration {
                 )
             })
             .collect();
-        let axes = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+        // an axis that cannot be calibrated (a dead, constant channel, say) is left out with a
+        // check line; only when none can is the calibration an error
         let mut checks = Vec::new();
+        let mut axes = Vec::new();
+        let mut first_error = None;
+        for r in results {
+            match r {
+                Ok(a) => axes.push(a),
+                Err(e) => {
+                    checks.push(format!("not calibrated: {e}"));
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+        if axes.is_empty() {
+            if let Some(e) = first_error {
+                return Err(e);
+            }
+        }
         let duration_s = imu.len() as f64 / imu.freq_hz();
         if let Some(longest) = axes
             .iter()
@@ -534,6 +564,7 @@ impl Calibration {
         let ieee = ieee_readoff(&allan).map_err(|e| engine(e.into()))?;
         let z = inference.z;
         let readoff = Readoff {
+            undetermined: std::cell::RefCell::new(Vec::new()),
             fit: &fit,
             canonical: &canonical,
             inference: &inference,
@@ -556,9 +587,21 @@ impl Calibration {
             )
         });
         let verdict = verdict(&fit, &wv, &inference, self.options.wv.alpha);
+        // how the selected fit reads as the canonical model (a drift read as a random walk,
+        // ...), then what the identified fit adds
+        let mut readings: Vec<String> = selection
+            .selected_canonical
+            .readings
+            .iter()
+            .map(ToString::to_string)
+            .collect();
         for r in &canonical.readings {
-            notes.push(r.to_string());
+            let text = r.to_string();
+            if !readings.contains(&text) {
+                readings.push(text);
+            }
         }
+        notes.extend(readings);
         Ok(AxisCalibration {
             column: column.to_string(),
             kind,
@@ -570,6 +613,7 @@ impl Calibration {
             samples: values.len(),
             model: selection.selected.to_string(),
             canonical_model: canonical.model.to_string(),
+            identified_model: fit.model.without_values().to_string(),
             noise_density,
             random_walk,
             bias_instability,
@@ -592,6 +636,9 @@ impl Calibration {
 /// The read-off of one axis: canonical terms as functions of the identified fit's estimates,
 /// with delta-method intervals from its covariance.
 struct Readoff<'a> {
+    /// Relative standard errors of the read-offs left without an interval (drained by
+    /// [`Readoff::estimate`] into the estimate's `source`).
+    undetermined: std::cell::RefCell<Vec<f64>>,
     fit: &'a GmwmFit,
     canonical: &'a CanonicalModel,
     inference: &'a Inference,
@@ -625,6 +672,13 @@ impl Readoff<'_> {
         (ci_low, ci_high): (Option<f64>, Option<f64>),
         source: String,
     ) -> Estimate {
+        let source = match self.undetermined.borrow_mut().drain(..).reduce(f64::max) {
+            Some(se_rel) => format!(
+                "{source}; not determined by the data (relative standard error {:.0}%): no interval",
+                100.0 * se_rel
+            ),
+            None => source,
+        };
         Estimate {
             value,
             ci_low,
@@ -667,7 +721,12 @@ impl Readoff<'_> {
         if !(value > 0.0 && var.is_finite() && var >= 0.0) {
             return (value, None, None);
         }
-        let rel = self.z * var.sqrt() / value;
+        let se_rel = var.sqrt() / value;
+        if se_rel > UNDETERMINED_SE_REL {
+            self.undetermined.borrow_mut().push(se_rel);
+            return (value, None, None);
+        }
+        let rel = self.z * se_rel;
         (value, Some(value * (-rel).exp()), Some(value * rel.exp()))
     }
 
@@ -896,7 +955,6 @@ fn verdict(fit: &GmwmFit, wv: &WaveletVariance, inference: &Inference, alpha: f6
         .filter(|&j| implied[j] < wv.ci_low[j] || implied[j] > wv.ci_high[j])
         .count();
     let allowed = (alpha * levels as f64).ceil() as usize;
-    let explains_wv = outside <= allowed;
     // the furthest outside the band, relative to the empirical WV (inside the band a deviation
     // is the WV's own noise, and at the last scales the band spans orders of magnitude)
     let outside_deviation = (0..levels)
@@ -905,6 +963,8 @@ fn verdict(fit: &GmwmFit, wv: &WaveletVariance, inference: &Inference, alpha: f6
         .filter(|(_, d)| d.is_finite())
         .max_by(|a, b| a.1.total_cmp(&b.1));
     let max_relative_deviation = outside_deviation.map_or(0.0, |(_, d)| d);
+    let max_outside = max_relative_deviation;
+    let explains_wv = outside == 0 || (outside <= allowed && max_outside < CHANCE_MISS_REL);
     let p = inference.gof.as_ref().map(|g| g.p_value);
     let band = match outside_deviation {
         None => format!(
