@@ -230,3 +230,33 @@ fn calibration_refuses_bad_input() {
         "column gyro_x: unit g is not a gyroscope (rad/s, deg/s, deg/h) unit"
     );
 }
+
+/// A dead (constant) channel is left out with a check line; the other axes are calibrated.
+#[test]
+fn calibration_skips_a_dead_channel() {
+    let good = imu(Some("rad/s"), 1.0);
+    let gyro = good.axes()[0].values().to_vec();
+    let dead = Imu::new(
+        vec![column("gyro_x", gyro), column("gyro_y", vec![0.25; N])],
+        vec![
+            info(Sensor::Gyroscope, Some("rad/s")),
+            SensorInfo {
+                sensor: Sensor::Gyroscope,
+                axis: "Y".into(),
+                unit: Some("rad/s".into()),
+            },
+        ],
+        FREQ,
+    )
+    .unwrap();
+    let r = Calibration::new(options()).run(&dead).unwrap();
+    assert_eq!(r.axes.len(), 1);
+    assert_eq!(r.axes[0].column, "gyro_x");
+    assert!(
+        r.checks
+            .iter()
+            .any(|c| c.contains("gyro_y") && c.contains("constant")),
+        "{:?}",
+        r.checks
+    );
+}

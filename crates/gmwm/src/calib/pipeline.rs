@@ -378,6 +378,8 @@ impl Calibration {
         for r in results {
             match r {
                 Ok(a) => axes.push(a),
+                // a unit of the wrong kind is the caller's mistake, not the data's
+                Err(e @ CalibError::WrongUnit { .. }) => return Err(e),
                 Err(e) => {
                     checks.push(format!("not calibrated: {e}"));
                     first_error.get_or_insert(e);
