@@ -160,6 +160,32 @@ fn calibrate_ros_topic_choice() {
     assert_eq!(doc["exported"][0]["noise"]["rostopic"], "/imu1");
 }
 
+/// Every command reads a ROS recording: a rosbag2 folder (MCAP) through `gmwm wv` and `avar`,
+/// its six axes at the stamps' rate; `--topic` on a file that is not one is a usage error.
+#[test]
+fn ros_recordings_feed_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = write_bag(dir.path(), "run", "mcap", 4096, &[]);
+    for cmd in ["wv", "avar"] {
+        let doc =
+            run_json(
+                gmwm()
+                    .arg(cmd)
+                    .arg(&folder)
+                    .args(["--columns", "gyro_x,accel_z", "--json"]),
+            );
+        let series = doc["series"].as_array().unwrap();
+        assert_eq!(series.len(), 2, "{cmd}");
+        assert_eq!(series[0]["name"], "gyro_x");
+        assert_eq!(series[0]["freq_hz"], 100.0, "{cmd}");
+    }
+    let file = data_dir().join("adis_16405_imu1.csv.gz");
+    assert_usage_error(
+        gmwm().arg("wv").arg(&file).args(["--topic", "/imu0"]),
+        &["--topic", "not a ROS recording"],
+    );
+}
+
 /// The ADIS16405 recording with its units: all six axes, SI units in the JSON, a Kalibr file
 /// and every other stack's file.
 #[test]

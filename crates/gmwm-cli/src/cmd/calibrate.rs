@@ -277,8 +277,8 @@ fn summary(
 fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
     writeln!(out)?;
     let unit_note = match (&a.data_unit, a.unit.as_str()) {
+        (_, "u") => ", unit not known: results in the data unit u".to_string(),
         (Some(d), u) if d != u => format!(", data in {d} converted to {u}"),
-        (None, _) => ", unit unknown".to_string(),
         _ => String::new(),
     };
     let fitted = if a.model == a.canonical_model {

@@ -48,6 +48,7 @@ const STREAM_CHUNK: usize = 1 << 20;
 /// bytes plus one chunk whatever the file size.
 fn streamable(args: &WvArgs, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
     if args.input.time_column.is_some()
+        || gmwm::imu::ros::container_of(&args.input.file).is_some()
         || opts.robust.is_some()
         || opts.transform != Transform::Modwt
         || opts.filter != WaveletFilter::Haar
