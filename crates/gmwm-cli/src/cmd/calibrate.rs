@@ -271,6 +271,38 @@ fn summary(
     for a in &report.axes {
         axis_block(a, out)?;
     }
+    // the conversions behind the datasheet and discrete forms, once per quantity and sensor
+    let mut conversions: Vec<String> = Vec::new();
+    for a in &report.axes {
+        for (what, e) in [
+            ("noise density", &a.noise_density),
+            ("random walk", &a.random_walk),
+            ("bias instability", &a.bias_instability),
+        ] {
+            let Some(c) = e
+                .as_ref()
+                .and_then(|e| e.forms.as_ref())
+                .map(|f| &f.conversion)
+            else {
+                continue;
+            };
+            let kind = match a.kind {
+                Some(gmwm::units::SignalKind::Gyroscope) => "gyro",
+                Some(gmwm::units::SignalKind::Accelerometer) => "accel",
+                None => "other",
+            };
+            let line = format!("{kind} {what}: {c}");
+            if !c.is_empty() && !conversions.contains(&line) {
+                conversions.push(line);
+            }
+        }
+    }
+    if !conversions.is_empty() {
+        writeln!(out, "\nconversions (f = {} Hz):", num(report.freq_hz))?;
+        for c in &conversions {
+            writeln!(out, "  {c}")?;
+        }
+    }
     Ok(())
 }
 
@@ -326,6 +358,21 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
                 _ => "no interval".into(),
             },
             estimate_line(&g.sigma)
+        )?;
+    }
+    let discrete = |e: &Option<Estimate>| {
+        e.as_ref()
+            .and_then(|e| e.forms.as_ref())
+            .and_then(|f| f.discrete.as_ref())
+            .map(|d| format!("{} {}", num(d.value), d.unit))
+    };
+    if let (Some(n), k) = (discrete(&a.noise_density), discrete(&a.random_walk)) {
+        writeln!(
+            out,
+            "  {:<18}white-noise sd {n} per sample{}",
+            "discrete",
+            k.map(|k| format!(", random-walk step sd {k}"))
+                .unwrap_or_default()
         )?;
     }
     if let Some(q) = &a.quantization {
