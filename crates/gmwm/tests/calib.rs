@@ -260,3 +260,42 @@ fn calibration_skips_a_dead_channel() {
         r.checks
     );
 }
+
+/// A recording without a random walk gets an upper bound on it, said to be one (from the
+/// Allan variance's band, METHODS §14.2 AV of a random walk `K^2 tau / 3`), never an estimate.
+#[test]
+fn calibration_bounds_an_undetected_random_walk() {
+    let x = simulate_model(&"WN(sigma2=1e-4)".parse().unwrap(), N, FREQ, 21).unwrap();
+    let imu = Imu::new(
+        vec![column("gyro_x", x)],
+        vec![info(Sensor::Gyroscope, Some("rad/s"))],
+        FREQ,
+    )
+    .unwrap();
+    // a full model without a random walk, so that none can be selected
+    let r = Calibration::new(CalibrationOptions {
+        full_model: "AR1()+WN()".parse().unwrap(),
+        ..options()
+    })
+    .run(&imu)
+    .unwrap();
+    let a = &r.axes[0];
+    assert_eq!(a.canonical_model, "WN()");
+    let k = a.random_walk.as_ref().expect("a bound");
+    assert!(k.source.starts_with("not detected"), "{}", k.source);
+    assert_eq!(k.ci_high, Some(k.value));
+    assert_eq!(k.ci_low, None);
+    // the bound is the tightest sqrt(3 AV_high(tau) / tau) of the axis's Allan variance
+    let tightest = a
+        .allan
+        .ci_high
+        .iter()
+        .zip(&a.allan.tau_s)
+        .map(|(h, t)| (3.0 * h / t).sqrt())
+        .fold(f64::INFINITY, f64::min);
+    assert!((k.value / tightest - 1.0).abs() < 1e-12);
+    assert!(a
+        .notes
+        .iter()
+        .any(|n| n.contains("no random walk detected")));
+}

@@ -213,8 +213,21 @@ fn num(v: f64) -> String {
     }
 }
 
-/// `value unit [lo, hi]  (datasheet)`.
+/// `value unit [lo, hi]  (datasheet)`; a bound for a term not detected.
 fn estimate_line(e: &Estimate) -> String {
+    if e.source.starts_with("not detected") {
+        let sheet = e
+            .forms
+            .as_ref()
+            .and_then(|f| f.datasheet.as_ref())
+            .map(|d| format!(" = {} {}", num(d.value), d.unit))
+            .unwrap_or_default();
+        return format!(
+            "<= {} {}{sheet} (not detected: an upper bound)",
+            num(e.value),
+            e.unit
+        );
+    }
     let ci = match (e.ci_low, e.ci_high) {
         (Some(lo), Some(hi)) => format!(" [{}, {}]", num(lo), num(hi)),
         _ if e.source.contains("not determined") => " [not determined by the data]".to_string(),

@@ -576,7 +576,23 @@ impl Calibration {
             z,
         };
         let noise_density = readoff.noise_density(&mut notes);
-        let random_walk = readoff.random_walk(&mut notes);
+        let random_walk = readoff.random_walk(&mut notes).or_else(|| {
+            let (bound, tau_s) = random_walk_upper_bound(&allan)?;
+            notes.push(format!(
+                "no random walk detected: its density is at most {} (the upper end of the Allan variance's band at {} s, where the bound is tightest), the value a filter can take as conservative",
+                crate::fit::report::significant(bound, 4),
+                crate::fit::report::significant(tau_s, 4)
+            ));
+            Some(readoff.estimate(
+                NoiseTerm::RandomWalk,
+                bound,
+                (None, Some(bound)),
+                format!(
+                    "not detected: upper bound from the Allan variance's band at {} s",
+                    crate::fit::report::significant(tau_s, 4)
+                ),
+            ))
+        });
         let quantization = readoff.single(ProcessKind::Qn, NoiseTerm::Quantization, "QN term");
         let rate_ramp = readoff.single(ProcessKind::Dr, NoiseTerm::RateRamp, "DR term");
         let gauss_markov_bias = readoff.gauss_markov();
@@ -946,6 +962,19 @@ impl Readoff<'_> {
             driving_density: self.estimate(NoiseTerm::GmDrivingDensity, d.0, (d.1, d.2), source),
         })
     }
+}
+
+/// An upper bound on the random-walk density K of a recording whose model has no random walk:
+/// a random walk adds `K^2 tau / 3` to the Allan variance (METHODS §14.2), so at every cluster
+/// time `K <= sqrt(3 AV_high(tau) / tau)` with `AV_high` the upper end of the AV's band; the
+/// tightest of these, with its cluster time. `None` without a finite positive bound.
+fn random_walk_upper_bound(av: &AllanVariance) -> Option<(f64, f64)> {
+    av.ci_high
+        .iter()
+        .zip(&av.tau_s)
+        .map(|(&hi, &tau)| ((3.0 * hi / tau).sqrt(), tau))
+        .filter(|(k, _)| k.is_finite() && *k > 0.0)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
 /// The verdict: the J-test, how many scales the implied WV leaves the empirical band at, and
