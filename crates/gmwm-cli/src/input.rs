@@ -302,7 +302,7 @@ fn load_ros(args: &InputArgs, read: ReadOptions) -> Result<Loaded> {
     let freq_hz = rec.imu.freq_hz();
     let table = Table {
         path: rec.path,
-        columns: rec.imu.axes().iter().map(|a| a.column.clone()).collect(),
+        columns: rec.imu.into_axes().into_iter().map(|a| a.column).collect(),
         freq_hz: Some(freq_hz),
         sidecar: None,
         time: None,

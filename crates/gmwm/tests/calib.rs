@@ -283,6 +283,7 @@ fn calibration_bounds_an_undetected_random_walk() {
     assert_eq!(a.canonical_model, "WN()");
     let k = a.random_walk.as_ref().expect("a bound");
     assert!(k.source.starts_with("not detected"), "{}", k.source);
+    assert_eq!(k.status, gmwm::calib::EstimateStatus::UpperBound);
     assert_eq!(k.ci_high, Some(k.value));
     assert_eq!(k.ci_low, None);
     // the bound is the tightest sqrt(3 AV_high(tau) / tau) of the axis's Allan variance

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use gmwm::calib::export::{render, ExportFormat};
 use gmwm::calib::{
     Adjustment, AxisCalibration, AxisPolicy, Calibration, CalibrationOptions, CalibrationReport,
-    Estimate, NavSet, DEFAULT_FULL_MODEL,
+    Estimate, EstimateStatus, NavSet, DEFAULT_FULL_MODEL,
 };
 use gmwm::selection::SelectionRule;
 use std::io::Write;
@@ -213,32 +213,26 @@ fn num(v: f64) -> String {
     }
 }
 
-/// `value unit [lo, hi]  (datasheet)`; a bound for a term not detected.
+/// `value unit [lo, hi] = datasheet`; `<= bound` for a term not detected.
 fn estimate_line(e: &Estimate) -> String {
-    if e.source.starts_with("not detected") {
-        let sheet = e
-            .forms
-            .as_ref()
-            .and_then(|f| f.datasheet.as_ref())
-            .map(|d| format!(" = {} {}", num(d.value), d.unit))
-            .unwrap_or_default();
-        return format!(
-            "<= {} {}{sheet} (not detected: an upper bound)",
-            num(e.value),
-            e.unit
-        );
-    }
-    let ci = match (e.ci_low, e.ci_high) {
-        (Some(lo), Some(hi)) => format!(" [{}, {}]", num(lo), num(hi)),
-        _ if e.source.contains("not determined") => " [not determined by the data]".to_string(),
-        _ => " [no interval]".to_string(),
-    };
     let sheet = e
         .forms
         .as_ref()
         .and_then(|f| f.datasheet.as_ref())
         .map(|d| format!(" = {} {}", num(d.value), d.unit))
         .unwrap_or_default();
+    let ci = match (e.status, e.ci_low, e.ci_high) {
+        (EstimateStatus::UpperBound, ..) => {
+            return format!(
+                "<= {} {}{sheet} (not detected: an upper bound)",
+                num(e.value),
+                e.unit
+            )
+        }
+        (_, Some(lo), Some(hi)) => format!(" [{}, {}]", num(lo), num(hi)),
+        (EstimateStatus::Undetermined, ..) => " [not determined by the data]".to_string(),
+        _ => " [no interval]".to_string(),
+    };
     format!("{} {}{ci}{sheet}", num(e.value), e.unit)
 }
 

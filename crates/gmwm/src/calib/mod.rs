@@ -7,5 +7,5 @@ pub mod pipeline;
 pub use nav::{Adjustment, AxisPolicy, NavSet};
 pub use pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,
-    FitVerdict, GaussMarkovBias, DEFAULT_FULL_MODEL,
+    EstimateStatus, FitVerdict, GaussMarkovBias, DEFAULT_FULL_MODEL,
 };

@@ -3,10 +3,12 @@
 //! SI units with intervals, the IEEE Std 952 read-off and a verdict on the fit.
 
 use super::ieee::{ieee_readoff, IeeeReadoff};
+use crate::fit::canonical::long_run_variance;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
 use crate::imu::{Imu, Sensor};
 use crate::inference::{infer_with_covariance, Inference, InferenceOptions, Progress};
 use crate::model::{Model, ProcessKind};
+use crate::process::{Ar1, Gm};
 use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
 use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms};
 use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
@@ -125,11 +127,25 @@ pub enum CalibError {
     },
 }
 
+/// What kind of number an [`Estimate`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EstimateStatus {
+    /// An estimate (with its interval when the fit's covariance gives one).
+    Estimated,
+    /// An estimate the data do not determine: no interval
+    /// ([`UNDETERMINED_SE_REL`]).
+    Undetermined,
+    /// The term was not detected; `value` (= `ci_high`) is an upper bound.
+    UpperBound,
+}
+
 /// A read-off quantity with its interval, in `unit`.
 ///
 /// Wire format: `value`, `ci_low`, `ci_high` (null where no interval exists), `unit`,
-/// `source` (which term or rule gave it), `forms` (continuous SI, discrete and datasheet forms,
-/// METHODS §14.2; null for quantities in the data unit).
+/// `status` (`estimated`, `undetermined`, `upper-bound`), `source` (which term or rule gave
+/// it), `forms` (continuous SI, discrete and datasheet forms, METHODS §14.2; null for
+/// quantities in the data unit).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Estimate {
     /// The value.
@@ -140,6 +156,8 @@ pub struct Estimate {
     pub ci_high: Option<f64>,
     /// Unit (continuous-time SI for a gyroscope or accelerometer of known unit).
     pub unit: String,
+    /// What kind of number `value` is.
+    pub status: EstimateStatus,
     /// Where the value comes from, in words.
     pub source: String,
     /// The value in every form (SI, discrete, datasheet).
@@ -567,6 +585,16 @@ impl Calibration {
         let z = inference.z;
         let readoff = Readoff {
             undetermined: std::cell::RefCell::new(Vec::new()),
+            offsets: fit
+                .model
+                .components()
+                .iter()
+                .scan(0, |k, c| {
+                    let o = *k;
+                    *k += c.kind.n_params();
+                    Some(o)
+                })
+                .collect(),
             fit: &fit,
             canonical: &canonical,
             inference: &inference,
@@ -583,15 +611,18 @@ impl Calibration {
                 crate::fit::report::significant(bound, 4),
                 crate::fit::report::significant(tau_s, 4)
             ));
-            Some(readoff.estimate(
-                NoiseTerm::RandomWalk,
-                bound,
-                (None, Some(bound)),
-                format!(
-                    "not detected: upper bound from the Allan variance's band at {} s",
-                    crate::fit::report::significant(tau_s, 4)
-                ),
-            ))
+            Some(Estimate {
+                status: EstimateStatus::UpperBound,
+                ..readoff.estimate(
+                    NoiseTerm::RandomWalk,
+                    bound,
+                    (None, Some(bound)),
+                    format!(
+                        "not detected: upper bound from the Allan variance's band at {} s",
+                        crate::fit::report::significant(tau_s, 4)
+                    ),
+                )
+            })
         });
         let quantization = readoff.single(ProcessKind::Qn, NoiseTerm::Quantization, "QN term");
         let rate_ramp = readoff.single(ProcessKind::Dr, NoiseTerm::RateRamp, "DR term");
@@ -657,6 +688,8 @@ struct Readoff<'a> {
     /// Relative standard errors of the read-offs left without an interval (drained by
     /// [`Readoff::estimate`] into the estimate's `source`).
     undetermined: std::cell::RefCell<Vec<f64>>,
+    /// Index of the first parameter of each component of the fit.
+    offsets: Vec<usize>,
     fit: &'a GmwmFit,
     canonical: &'a CanonicalModel,
     inference: &'a Inference,
@@ -668,18 +701,8 @@ struct Readoff<'a> {
 
 impl Readoff<'_> {
     /// Index of the first parameter of each component of the fit.
-    fn offsets(&self) -> Vec<usize> {
-        let mut k = 0;
-        self.fit
-            .model
-            .components()
-            .iter()
-            .map(|c| {
-                let o = k;
-                k += c.kind.n_params();
-                o
-            })
-            .collect()
+    fn offsets(&self) -> &[usize] {
+        &self.offsets
     }
 
     /// An estimate with its forms.
@@ -690,18 +713,22 @@ impl Readoff<'_> {
         (ci_low, ci_high): (Option<f64>, Option<f64>),
         source: String,
     ) -> Estimate {
-        let source = match self.undetermined.borrow_mut().drain(..).reduce(f64::max) {
-            Some(se_rel) => format!(
-                "{source}; not determined by the data (relative standard error {:.0}%): no interval",
-                100.0 * se_rel
+        let (status, source) = match self.undetermined.borrow_mut().drain(..).reduce(f64::max) {
+            Some(se_rel) => (
+                EstimateStatus::Undetermined,
+                format!(
+                    "{source}; not determined by the data (relative standard error {:.0}%): no interval",
+                    100.0 * se_rel
+                ),
             ),
-            None => source,
+            None => (EstimateStatus::Estimated, source),
         };
         Estimate {
             value,
             ci_low,
             ci_high,
             unit: si_unit(term, self.kind, self.unit),
+            status,
             source,
             forms: Some(forms(term, self.kind, self.unit, value, self.freq_hz)),
         }
@@ -764,12 +791,18 @@ impl Readoff<'_> {
         let o = *self.offsets().get(c)?;
         match self.fit.model.components().get(c)?.kind {
             ProcessKind::Wn => Some(theta[o]),
-            ProcessKind::Ar1 => Some(theta[o + 1] / (1.0 - theta[o]).powi(2)),
-            ProcessKind::Gm => {
-                let phi = (-theta[o] / self.freq_hz).exp();
-                let sigma2 = theta[o + 1] * (1.0 - phi * phi);
-                Some(sigma2 / (1.0 - phi).powi(2))
-            }
+            ProcessKind::Ar1 => Some(long_run_variance(Ar1 {
+                phi: theta[o],
+                sigma2: theta[o + 1],
+            })),
+            ProcessKind::Gm => Some(long_run_variance(
+                Gm {
+                    beta: theta[o],
+                    sigma2_gm: theta[o + 1],
+                    freq_hz: self.freq_hz,
+                }
+                .to_ar1(),
+            )),
             _ => None,
         }
     }

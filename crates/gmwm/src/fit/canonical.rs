@@ -576,7 +576,7 @@ fn part_from_ar1(kind: ProcessKind, ar1: Ar1, freq_hz: f64, from: Vec<usize>) ->
 
 /// Long-run variance `sigma2 / (1 - phi)^2`: the white noise an AR1 is at scales far beyond
 /// its correlation length (the level of its spectrum at low frequency).
-fn long_run_variance(ar1: Ar1) -> f64 {
+pub(crate) fn long_run_variance(ar1: Ar1) -> f64 {
     ar1.sigma2 / ((1.0 - ar1.phi) * (1.0 - ar1.phi))
 }
 

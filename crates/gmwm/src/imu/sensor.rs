@@ -341,6 +341,11 @@ impl Imu {
         self.axes.iter().map(|a| (a.tag(), a))
     }
 
+    /// The axes, consumed (their columns move out without a copy).
+    pub fn into_axes(self) -> Vec<Axis> {
+        self.axes
+    }
+
     /// The gyroscope axes.
     pub fn gyroscopes(&self) -> impl Iterator<Item = &Axis> {
         self.axes
