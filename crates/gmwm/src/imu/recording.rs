@@ -2,7 +2,7 @@
 //! records, a ROS bag), an [`Imu`] with its rate, where it came from and what the reader
 //! noticed.
 
-use super::read::{read_table, Column, InputFormat, ReadOptions};
+use super::read::{read_table, Column, InputFormat, ReadOptions, ReadWarning, RATE_TOLERANCE};
 use super::ros::{container_of, read_imu_messages, ImuMessages};
 use super::timing::{check_times, TimeUnit, TimingReport, UnitSource};
 use super::{Imu, ReadError, Sensor, SensorInfo};
@@ -19,10 +19,6 @@ pub struct RecordingOptions {
     /// The `sensor_msgs/Imu` topic of a ROS recording (default: its only IMU topic).
     pub topic: Option<String>,
 }
-
-/// Relative difference between a given rate and the stamps' above which the reader says so
-/// (1%: a rate rounded to a nominal figure agrees, a wrong one does not).
-const RATE_TOLERANCE: f64 = 0.01;
 
 /// What a recording was read from.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -92,14 +88,7 @@ impl Recording {
             ));
         }
         if let Some(timing) = &table.timing {
-            notes.push(format!(
-                "time column {:?} ({}, {}): {} Hz from the regular steps over {:.1} s",
-                timing.column,
-                timing.unit.symbol(),
-                timing.unit_source,
-                crate::fit::report::significant(timing.rate_hz, 6),
-                timing.span_s
-            ));
+            notes.push(timing.to_string());
         }
         if !table.skipped.is_empty() {
             notes.push(format!("columns left out: {}", table.skipped.join(", ")));
@@ -147,20 +136,18 @@ impl Recording {
             );
             timing = stamps_report("log time", &msgs.log_time_ns);
         }
-        notes.push(format!(
-            "{}: {} Hz from the regular steps over {:.1} s",
-            timing.column,
-            crate::fit::report::significant(timing.rate_hz, 6),
-            timing.span_s
-        ));
+        notes.push(timing.to_string());
         notes.extend(timing.warnings().iter().map(ToString::to_string));
         let freq_hz = match opts.read.freq_hz {
             Some(f) => {
                 if (f / timing.rate_hz - 1.0).abs() > RATE_TOLERANCE {
-                    notes.push(format!(
-                        "the given rate {f} Hz differs from the stamps' {} Hz; the given rate is used",
-                        crate::fit::report::significant(timing.rate_hz, 6)
-                    ));
+                    let disagrees = ReadWarning::FreqDisagrees {
+                        path: path.to_path_buf(),
+                        given_hz: f,
+                        column: timing.column.clone(),
+                        time_hz: timing.rate_hz,
+                    };
+                    notes.push(disagrees.to_string());
                 }
                 f
             }
