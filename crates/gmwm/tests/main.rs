@@ -7,6 +7,7 @@ mod allan;
 mod calib;
 mod canonical;
 mod common;
+mod contamination;
 mod export;
 mod fit;
 mod fit_mc;

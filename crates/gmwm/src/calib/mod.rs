@@ -1,9 +1,11 @@
 //! Calibration: from a recording to navigation-filter parameters.
+pub mod contamination;
 pub mod export;
 pub mod ieee;
 pub mod nav;
 pub mod pipeline;
 
+pub use contamination::{compare_classical_robust, Contamination};
 pub use nav::{Adjustment, AxisPolicy, NavSet};
 pub use pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,

@@ -2,6 +2,7 @@
 //! selected by WIC, the identified fit with inference, the canonical read-off in continuous
 //! SI units with intervals, the IEEE Std 952 read-off and a verdict on the fit.
 
+use super::contamination::{compare_classical_robust, Contamination};
 use super::ieee::{ieee_readoff, IeeeReadoff};
 use crate::fit::canonical::long_run_variance;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
@@ -12,7 +13,8 @@ use crate::process::{Ar1, Gm};
 use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
 use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms};
 use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
-use crate::variance::wv::{WaveletVariance, WvOptions};
+use crate::variance::robust::RobustOptions;
+use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -62,6 +64,9 @@ pub struct CalibrationOptions {
     pub gyro_unit: Option<SignalUnit>,
     /// Unit of the accelerometer samples (default: the recording's).
     pub accel_unit: Option<SignalUnit>,
+    /// The robust estimator the classical WV is compared with to tell whether contamination
+    /// matters (paper Fig. 2; default `eff = 0.6`, the package's; `None` skips the check).
+    pub robust_check: Option<RobustOptions>,
 }
 
 impl Default for CalibrationOptions {
@@ -77,6 +82,7 @@ impl Default for CalibrationOptions {
             rule: SelectionRule::Navigation,
             gyro_unit: None,
             accel_unit: None,
+            robust_check: Some(RobustOptions::default()),
         }
     }
 }
@@ -255,6 +261,9 @@ pub struct AxisCalibration {
     pub wv: WaveletVariance,
     /// The overlapping Allan variance (unit²).
     pub allan: AllanVariance,
+    /// The classical WV against the robust one: whether contamination matters (`None` when
+    /// the check is off or the robust WV could not be computed, with a note).
+    pub contamination: Option<Contamination>,
     /// What the read-off did that a user should know, one line each.
     pub notes: Vec<String>,
 }
@@ -651,6 +660,7 @@ impl Calibration {
             }
         }
         notes.extend(readings);
+        let contamination = self.contamination(x, freq_hz, &wv, &mut notes);
         Ok(AxisCalibration {
             column: column.to_string(),
             kind,
@@ -677,8 +687,41 @@ impl Calibration {
             selection,
             wv,
             allan,
+            contamination,
             notes,
         })
+    }
+
+    /// The classical WV of `x` against the robust one ([`compare_classical_robust`]); `wv` is
+    /// the axis' WV, classical or robust as the options ask, so only the other is computed.
+    fn contamination(
+        &self,
+        x: &[f64],
+        freq_hz: f64,
+        wv: &WaveletVariance,
+        notes: &mut Vec<String>,
+    ) -> Option<Contamination> {
+        let robust_options = self.options.robust_check?;
+        let other = WvOptions {
+            levels: Some(wv.levels()),
+            robust: match wv.robust {
+                Some(_) => None,
+                None => Some(robust_options),
+            },
+            ..self.options.wv
+        };
+        match wavelet_variance(x, freq_hz, &other) {
+            Ok(w) => Some(match wv.robust {
+                Some(_) => compare_classical_robust(&w, wv.clone(), self.options.wv.alpha),
+                None => compare_classical_robust(wv, w, self.options.wv.alpha),
+            }),
+            Err(e) => {
+                notes.push(format!(
+                    "the classical and robust WVs could not be compared: {e}"
+                ));
+                None
+            }
+        }
     }
 }
 
