@@ -73,6 +73,15 @@ pub enum Command {
     /// units, the IEEE 952 read-off, and navigation-filter files (Kalibr, OpenVINS, ...).
     #[command(allow_negative_numbers = true, after_long_help = CALIBRATE_EXAMPLES)]
     Calibrate(CalibrateArgs),
+    /// Draw a figure (SVG or PNG, by the file name): wavelet or Allan variances, classical
+    /// against robust, a fit with its decomposition, a model selection, the IEEE read-off.
+    #[command(after_long_help = PLOT_EXAMPLES)]
+    Plot(PlotArgs),
+    /// Calibrate a recording (as `gmwm calibrate`) and write one self-contained HTML report:
+    /// the recording, every figure, the selection, the estimates, the IEEE read-off, the
+    /// filter files, the contamination check.
+    #[command(allow_negative_numbers = true, after_long_help = REPORT_EXAMPLES)]
+    Report(ReportArgs),
     /// List the topics of a ROS recording (ROS1 bag, MCAP, rosbag2 sqlite3) and mark the
     /// sensor_msgs/Imu topics.
     #[command(after_long_help = TOPICS_EXAMPLES)]
@@ -146,6 +155,137 @@ pub struct CalibrateArgs {
     /// rostopic written to Kalibr/OpenVINS files [default: the ROS topic read, else /imu0].
     #[arg(long, value_name = "TOPIC")]
     pub rostopic: Option<String>,
+    /// Also write the HTML report (as `gmwm report`) to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+}
+
+const REPORT_EXAMPLES: &str = "\
+The page is one file: figures are embedded, nothing is fetched, it prints one axis per page.
+Its numbers are those of `gmwm calibrate --json`, which the page also carries verbatim.
+
+Examples:
+  gmwm report imu.csv.gz                       writes imu.report.html
+  gmwm report imu.csv.gz -o acceptance.html --gyro-unit deg/s --accel-unit g
+  gmwm report flight.bag --topic /imu0 --kalibr imu.yaml -o report.html
+  gmwm calibrate imu.csv.gz --report report.html --json calib.json";
+
+/// `gmwm report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// The calibration's flags, as `gmwm calibrate`.
+    #[command(flatten)]
+    pub calibrate: CalibrateArgs,
+    /// The HTML file to write [default: the recording's name with .report.html, in the current
+    /// folder].
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+}
+
+const PLOT_EXAMPLES: &str = "\
+FIGURE is written as SVG or PNG by its extension. Each figure takes the data and model flags of
+the matching command (gmwm wv, avar, fit, select); scales are in seconds, the WV's (2^j / f) or
+the Allan cluster time (m / f), as each axis says.
+
+Examples:
+  gmwm plot wv imu.csv.gz -o wv.svg                    grid: gyroscope / accelerometer x axes
+  gmwm plot wv imu.csv.gz --overlay -o wv.png          one panel per sensor, axes overlaid
+  gmwm plot avar imu.csv.gz --columns gyro_x -o adev.png
+  gmwm plot compare cont.csv.gz --eff 0.6 -o robust.svg   classical against robust WV
+  gmwm plot fit imu.csv.gz --columns gyro_x --model \"2*AR1()+WN()+RW()\" -o fit.svg
+  gmwm plot select imu.csv.gz --columns gyro_x --model \"2*AR1()+WN()+RW()+QN()\" -o select.png
+  gmwm plot ieee imu.csv.gz --columns gyro_x -o ieee.svg";
+
+/// `gmwm plot`.
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// The figure.
+    #[command(subcommand)]
+    pub figure: PlotCommand,
+}
+
+/// The figures of `gmwm plot`.
+#[derive(Debug, Subcommand)]
+pub enum PlotCommand {
+    /// Wavelet variances with their intervals (paper Fig. 1).
+    #[command(allow_negative_numbers = true)]
+    Wv {
+        /// Data and estimator flags, as `gmwm wv`.
+        #[command(flatten)]
+        args: WvArgs,
+        /// Figure file and layout.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+    /// Allan, modified Allan or Hadamard deviations with their intervals.
+    #[command(allow_negative_numbers = true)]
+    Avar {
+        /// Data and estimator flags, as `gmwm avar`.
+        #[command(flatten)]
+        args: AvarArgs,
+        /// Figure file and layout.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+    /// Classical against robust wavelet variance of each column (paper Fig. 2); --eff sets
+    /// the robust estimator's efficiency.
+    #[command(allow_negative_numbers = true)]
+    Compare {
+        /// Data and estimator flags, as `gmwm wv` (--robust is implied for the second series).
+        #[command(flatten)]
+        args: WvArgs,
+        /// Figure file.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+    /// A fit: empirical WV, the model's implied WV and each process's (paper Fig. 3).
+    #[command(allow_negative_numbers = true)]
+    Fit {
+        /// Data and model flags, as `gmwm fit`.
+        #[command(flatten)]
+        args: FitArgs,
+        /// Figure file.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+    /// A model selection: the selected model against the WV and the candidates' WIC (Fig. 4).
+    #[command(allow_negative_numbers = true)]
+    Select {
+        /// Data and model flags, as `gmwm select`.
+        #[command(flatten)]
+        args: SelectArgs,
+        /// Figure file.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+    /// The IEEE Std 952 read-off on the Allan deviation: N, B, K with their slope lines.
+    #[command(allow_negative_numbers = true)]
+    Ieee {
+        /// Data flags, as `gmwm avar` (overlapping Allan variance).
+        #[command(flatten)]
+        args: AvarArgs,
+        /// Figure file.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+}
+
+/// Where a figure goes and how it is laid out.
+#[derive(Debug, Args)]
+pub struct FigureArgs {
+    /// The figure file: .svg or .png.
+    #[arg(short = 'o', long = "output", value_name = "FIGURE", required = true)]
+    pub output: PathBuf,
+    /// One panel per sensor type with the axes overlaid (paper Fig. 1b) instead of a grid of
+    /// panels (wv, avar).
+    #[arg(long)]
+    pub overlay: bool,
+    /// Width in pixels [default: by the figure's panels].
+    #[arg(long, value_name = "PX", value_parser = at_least_1)]
+    pub width: Option<usize>,
+    /// Height in pixels [default: by the figure's panels].
+    #[arg(long, value_name = "PX", value_parser = at_least_1)]
+    pub height: Option<usize>,
 }
 
 /// `--axis-policy`.

@@ -27,6 +27,8 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Command::Select(a) => cmd::select::run(a, &mut out)?,
         Command::Calibrate(a) => cmd::calibrate::run(a, &mut out)?,
         Command::Topics(a) => cmd::topics::run(a, &mut out)?,
+        Command::Plot(a) => cmd::plot::run(a, &mut out)?,
+        Command::Report(a) => cmd::report::run(a, &mut out)?,
     }
     out.flush()?;
     Ok(())

@@ -5,13 +5,13 @@ use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named,
 use crate::render::{self, Style};
 use anyhow::Result;
 use gmwm::imu::allan_from_wv;
-use gmwm::{allan_variance, AllanKind, AllanOptions, AvConvention};
+use gmwm::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
 use std::io::Write;
 
 /// A saved wavelet variance: the overlapping Allan variance by METHODS §3.4,
 /// `AV(m) = 2 WV(2m)`, exact for the classical Haar MODWT WV and the textbook estimator; other
 /// kinds and conventions need the recording.
-fn run_saved(args: &AvarArgs, opts: &AllanOptions, out: &mut impl Write) -> Result<()> {
+fn run_saved(args: &AvarArgs, opts: &AllanOptions) -> Result<Vec<(String, AllanVariance)>> {
     let file = &args.input.file;
     anyhow::ensure!(
         opts.kind == AllanKind::Overlapping && opts.convention == AvConvention::Textbook,
@@ -41,11 +41,17 @@ fn run_saved(args: &AvarArgs, opts: &AllanOptions, out: &mut impl Write) -> Resu
         "Allan variance from the saved Haar wavelet variance, AV(m) = 2 WV(2m) (METHODS §3.4), \
          intervals the WV's times 2; not recomputed from a recording",
     );
-    render::series(out, &named(&items), Style::from(&args.output))
+    Ok(items)
 }
 
 /// Runs the subcommand.
 pub fn run(args: &AvarArgs, out: &mut impl Write) -> Result<()> {
+    let items = compute(args)?;
+    render::series(out, &named(&items), Style::from(&args.output))
+}
+
+/// The Allan-type variance of every selected column (from a saved WV: the overlapping one).
+pub fn compute(args: &AvarArgs) -> Result<Vec<(String, AllanVariance)>> {
     gmwm::variance::ci::check_alpha(args.alpha)?;
     let opts = AllanOptions {
         kind: match args.kind {
@@ -62,11 +68,10 @@ pub fn run(args: &AvarArgs, out: &mut impl Write) -> Result<()> {
         },
     };
     if is_wv(&args.input) {
-        return run_saved(args, &opts, out);
+        return run_saved(args, &opts);
     }
     let loaded = load(&args.input)?;
-    let items = analyse_columns(&loaded, &args.input.file, |x| {
+    analyse_columns(&loaded, &args.input.file, |x| {
         allan_variance(x, loaded.freq_hz, &opts)
-    })?;
-    render::series(out, &named(&items), Style::from(&args.output))
+    })
 }

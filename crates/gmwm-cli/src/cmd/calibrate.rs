@@ -37,6 +37,11 @@ fn calibration_options(args: &CalibrateArgs) -> Result<CalibrationOptions> {
         },
         gyro_unit: args.gyro_unit,
         accel_unit: args.accel_unit,
+        // the contamination check compares with the robust WV at --eff
+        robust_check: Some(gmwm::RobustOptions::new(
+            args.estimator.eff,
+            gmwm::RobustConvention::Exact,
+        )?),
     })
 }
 
@@ -62,6 +67,17 @@ fn exports(args: &CalibrateArgs) -> Result<Vec<(ExportFormat, PathBuf)>> {
 
 /// Runs the subcommand.
 pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
+    execute(args, args.report.as_deref(), true, out)
+}
+
+/// The calibration, its files, and the HTML report when `report` names one; the summary is
+/// printed when `print_summary`, else only what was written.
+pub fn execute(
+    args: &CalibrateArgs,
+    report_path: Option<&Path>,
+    print_summary: bool,
+    out: &mut impl Write,
+) -> Result<()> {
     let options = calibration_options(args)?;
     let exports = exports(args)?;
     let adjustment = match (args.inflate, args.conservative) {
@@ -106,13 +122,22 @@ pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
         }
     }
     let json_to_stdout = args.json.as_deref() == Some(Path::new("-"));
+    let doc = JsonDoc {
+        file: &recording.path,
+        notes: &recording.notes,
+        calibration: &report,
+        exported: &sets,
+    };
+    if let Some(path) = report_path {
+        match write_report(args, path, &recording, &report, &sets, &exports, &doc) {
+            Ok(figures) => written.push(format!(
+                "{} (HTML report, {figures} figures)",
+                path.display()
+            )),
+            Err(e) => failed.push(format!("{} (HTML report): {e:#}", path.display())),
+        }
+    }
     if let Some(path) = &args.json {
-        let doc = JsonDoc {
-            file: &recording.path,
-            notes: &recording.notes,
-            calibration: &report,
-            exported: &sets,
-        };
         if json_to_stdout {
             serde_json::to_writer_pretty(&mut *out, &doc)?;
             writeln!(out)?;
@@ -126,7 +151,9 @@ pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
         }
     }
     if !json_to_stdout {
-        summary(&recording, &report, out)?;
+        if print_summary {
+            summary(&recording, &report, out)?;
+        }
         for w in &written {
             writeln!(out, "wrote {w}")?;
         }
@@ -136,6 +163,59 @@ pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
         anyhow::bail!("not written: {}", failed.join("; "));
     }
     Ok(())
+}
+
+/// The HTML report: the calibration rendered by gmwm-plot with the filter files as exported
+/// (Kalibr's always, for the page, and every one asked for) and the JSON of `--json`; returns
+/// the number of figures.
+#[allow(clippy::too_many_arguments)]
+fn write_report(
+    args: &CalibrateArgs,
+    path: &Path,
+    recording: &crate::input::LoadedRecording,
+    report: &CalibrationReport,
+    sets: &[NavSet],
+    exports: &[(ExportFormat, PathBuf)],
+    doc: &JsonDoc<'_>,
+) -> Result<usize> {
+    let mut formats: Vec<(ExportFormat, Option<&Path>)> = exports
+        .iter()
+        .map(|(f, p)| (*f, Some(p.as_path())))
+        .collect();
+    if !formats.iter().any(|(f, _)| *f == ExportFormat::Kalibr) {
+        formats.insert(0, (ExportFormat::Kalibr, None));
+    }
+    let mut files = Vec::new();
+    for (format, target) in &formats {
+        for set in sets {
+            let name = match target {
+                Some(p) => per_axis_path(p, &set.label).display().to_string(),
+                None => format!("not written (add --kalibr FILE); {}", set.label),
+            };
+            let content = match render(*format, &set.noise) {
+                Ok(text) => text,
+                Err(e) => format!("# cannot be exported: {e}"),
+            };
+            files.push((format.to_string(), name, content));
+        }
+    }
+    let ctx = gmwm_plot::report::ReportContext {
+        file: args.input.file.display().to_string(),
+        topic: recording.topic.clone(),
+        reader_notes: recording.notes.clone(),
+        timing: recording.imu.timing().map(ToString::to_string),
+        command: std::iter::once("gmwm".to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" "),
+        exports: files,
+        json: serde_json::to_string(doc)?,
+        generator: format!("gmwm {}", env!("CARGO_PKG_VERSION")),
+    };
+    let html = gmwm_plot::report::render(report, &ctx)?;
+    let figures = html.matches("<figure>").count();
+    std::fs::write(path, html).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(figures)
 }
 
 /// Exported files are SI: every gyroscope and accelerometer axis needs a unit the engine

@@ -151,6 +151,13 @@ pub fn check_haar_flag(name: &str, opts: &WvOptions) -> Result<()> {
 
 /// Runs the subcommand.
 pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
+    let (gmwm, fits) = compute(args)?;
+    render_fits(args, &gmwm, &fits, out)
+}
+
+/// The estimator from the flags and its fit on every selected column (convergence warnings
+/// printed).
+pub fn compute(args: &FitArgs) -> Result<(Gmwm, Vec<(String, GmwmFit)>)> {
     let model: Model = args.model.parse()?;
     let wv_opts = options(&args.estimator)?;
     check_haar_flag(&args.estimator.filter, &wv_opts)?;
@@ -182,6 +189,15 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
             );
         }
     }
+    Ok((gmwm, fits))
+}
+
+fn render_fits(
+    args: &FitArgs,
+    gmwm: &Gmwm,
+    fits: &[(String, GmwmFit)],
+    out: &mut impl Write,
+) -> Result<()> {
     let canonicals: Vec<CanonicalModel> = fits
         .par_iter()
         .map(|(column, fit)| {
@@ -194,7 +210,7 @@ pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
         .collect::<Result<_>>()?;
     let inferences: Vec<Option<Inference>> = if args.inference {
         fits.iter()
-            .map(|(column, fit)| inference(args, &gmwm, column, fit).map(Some))
+            .map(|(column, fit)| inference(args, gmwm, column, fit).map(Some))
             .collect::<Result<_>>()?
     } else {
         fits.iter().map(|_| None).collect()

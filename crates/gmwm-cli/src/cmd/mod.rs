@@ -5,6 +5,8 @@ pub mod calibrate;
 pub mod demo;
 pub mod fit;
 pub mod implied;
+pub mod plot;
+pub mod report;
 pub mod select;
 pub mod simulate;
 pub mod topics;

@@ -142,6 +142,12 @@ fn write_csv(results: &[(String, ModelSelection)], out: &mut impl Write) -> Resu
 
 /// Runs the subcommand.
 pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
+    let results = compute(args)?;
+    render_selections(args, &results, out)
+}
+
+/// The WIC selection on every selected column (convergence warnings printed).
+pub fn compute(args: &SelectArgs) -> Result<Vec<(String, ModelSelection)>> {
     let wic = wic(args)?;
     let file = &args.input.file;
     let results: Result<Vec<(String, ModelSelection)>> = if is_wv(&args.input) {
@@ -192,6 +198,14 @@ pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
             );
         }
     }
+    Ok(results)
+}
+
+fn render_selections(
+    args: &SelectArgs,
+    results: &[(String, ModelSelection)],
+    out: &mut impl Write,
+) -> Result<()> {
     match Style::from(&args.output) {
         Style::Json => {
             let doc = SelectionsDoc {
@@ -225,7 +239,7 @@ pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
             serde_json::to_writer_pretty(&mut *out, &doc)?;
             writeln!(out)?;
         }
-        Style::Csv => write_csv(&results, out)?,
+        Style::Csv => write_csv(results, out)?,
         Style::Table => {
             for (i, (column, s)) in results.iter().enumerate() {
                 if i > 0 {

@@ -68,8 +68,7 @@ fn run_streaming(
     args: &WvArgs,
     layout: &BinaryLayout,
     opts: &WvOptions,
-    out: &mut impl Write,
-) -> Result<()> {
+) -> Result<Vec<(String, WaveletVariance)>> {
     let input = &args.input;
     let columns: Vec<usize> = if input.columns.is_empty() {
         (1..=layout.ncols).collect()
@@ -94,7 +93,7 @@ fn run_streaming(
         )?;
         results.push((name, wv));
     }
-    render::series(out, &named(&results), Style::from(&args.output))
+    Ok(results)
 }
 
 fn stream_column(
@@ -158,8 +157,8 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
     })
 }
 
-/// Prints a saved wavelet variance as it is (no recomputation).
-fn run_saved(args: &WvArgs, out: &mut impl Write) -> Result<()> {
+/// A saved wavelet variance as it is (no recomputation).
+fn run_saved(args: &WvArgs) -> Result<Vec<(String, WaveletVariance)>> {
     let file = &args.input.file;
     check_wv_estimator(file, &args.estimator)?;
     let series = load_wv(&args.input, args.estimator.levels)?;
@@ -180,18 +179,25 @@ fn run_saved(args: &WvArgs, out: &mut impl Write) -> Result<()> {
         file,
         "a wavelet variance saved by gmwm wv --json: shown as read, not recomputed",
     );
-    render::series(out, &named(&series), Style::from(&args.output))
+    Ok(series)
 }
 
 /// Runs the subcommand.
 pub fn run(args: &WvArgs, out: &mut impl Write) -> Result<()> {
+    let items = compute(args)?;
+    render::series(out, &named(&items), Style::from(&args.output))
+}
+
+/// The wavelet variance of every selected column: read from a saved WV, streamed from raw
+/// binary, or computed from the loaded columns (warnings printed).
+pub fn compute(args: &WvArgs) -> Result<Vec<(String, WaveletVariance)>> {
     let opts = options(&args.estimator)?;
     read_options(&args.input)?;
     if is_wv(&args.input) {
-        return run_saved(args, out);
+        return run_saved(args);
     }
     if let Some(layout) = streamable(args, &opts)? {
-        return run_streaming(args, &layout, &opts, out);
+        return run_streaming(args, &layout, &opts);
     }
     let loaded = load(&args.input)?;
     let items = analyse_columns(&loaded, &args.input.file, |x| {
@@ -205,5 +211,5 @@ pub fn run(args: &WvArgs, out: &mut impl Write) -> Result<()> {
             );
         }
     }
-    render::series(out, &named(&items), Style::from(&args.output))
+    Ok(items)
 }

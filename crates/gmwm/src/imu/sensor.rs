@@ -2,6 +2,7 @@
 //! common sampling rate.
 
 use super::read::{Column, ColumnSelector, ImuRecordType, ReadWarning, Table};
+use super::sidecar::Sidecar;
 use super::timing::TimingReport;
 use super::ReadError;
 use crate::error::{check_freq, Error, ParamError};
@@ -101,6 +102,48 @@ impl SensorInfo {
             words.iter().skip(pos + 1).copied().find(|w| is_axis(w))?
         };
         Some((sensor, axis.to_ascii_uppercase()))
+    }
+
+    /// Sensor, axis and unit of every column of `table`, as [`Imu::from_table`] reads them:
+    /// sensor and axis from the column name, else the sidecar's meaning; the unit the name
+    /// states, else the sidecar's, else rad/s and m/s^2 for binary IMU records (METHODS §9.3).
+    pub fn of_table(table: &Table) -> Vec<SensorInfo> {
+        let sidecar = table.sidecar.as_ref();
+        let record = table.record_type.is_some();
+        table
+            .columns
+            .iter()
+            .map(|c| {
+                let inferred = SensorInfo::infer(&c.name).or_else(|| {
+                    sidecar
+                        .and_then(|s| s.meaning(&c.name))
+                        .and_then(SensorInfo::infer)
+                });
+                let (sensor, axis) = inferred.unwrap_or((Sensor::Other, c.name.clone()));
+                let unit = SensorInfo::column_unit(&c.name, sensor, sidecar, record);
+                SensorInfo { sensor, axis, unit }
+            })
+            .collect()
+    }
+
+    /// The unit of a column, as text: the one its name states, else the sidecar's for its
+    /// sensor, else rad/s and m/s^2 for binary IMU records (`record`, METHODS §9.3).
+    pub fn column_unit(
+        name: &str,
+        sensor: Sensor,
+        sidecar: Option<&Sidecar>,
+        record: bool,
+    ) -> Option<String> {
+        let units = sidecar.and_then(|s| s.units.as_ref());
+        SensorInfo::unit_from_name(name).or_else(|| match sensor {
+            Sensor::Gyroscope => units
+                .and_then(|u| u.gyro.clone())
+                .or_else(|| record.then(|| "rad/s".to_string())),
+            Sensor::Accelerometer => units
+                .and_then(|u| u.accel.clone())
+                .or_else(|| record.then(|| "m/s^2".to_string())),
+            Sensor::Other => None,
+        })
     }
 
     /// The unit a column name states in a trailing `[..]` or `(..)`, as text:
@@ -280,31 +323,8 @@ impl Imu {
             }
             .into());
         };
+        let info = SensorInfo::of_table(&table);
         let sidecar = table.sidecar.as_ref();
-        let record = table.record_type.is_some();
-        let info = table
-            .columns
-            .iter()
-            .map(|c| {
-                let inferred = SensorInfo::infer(&c.name).or_else(|| {
-                    sidecar
-                        .and_then(|s| s.meaning(&c.name))
-                        .and_then(SensorInfo::infer)
-                });
-                let (sensor, axis) = inferred.unwrap_or((Sensor::Other, c.name.clone()));
-                let units = sidecar.and_then(|s| s.units.as_ref());
-                let unit = SensorInfo::unit_from_name(&c.name).or_else(|| match sensor {
-                    Sensor::Gyroscope => units
-                        .and_then(|u| u.gyro.clone())
-                        .or_else(|| record.then(|| "rad/s".to_string())),
-                    Sensor::Accelerometer => units
-                        .and_then(|u| u.accel.clone())
-                        .or_else(|| record.then(|| "m/s^2".to_string())),
-                    Sensor::Other => None,
-                });
-                SensorInfo { sensor, axis, unit }
-            })
-            .collect();
         let name = sidecar.and_then(|s| s.name.clone()).or_else(|| {
             table
                 .path

@@ -1,0 +1,213 @@
+//! `gmwm plot`: one figure of the matching command's results (gmwm-plot renders; the numbers
+//! are those `gmwm wv|avar|fit|select --json` gives).
+
+use crate::args::{FigureArgs, InputArgs, OutputArgs, PlotArgs, PlotCommand};
+use crate::input::is_wv;
+use crate::UsageError;
+use anyhow::{Context, Result};
+use gmwm::calib::ieee::ieee_readoff;
+use gmwm::imu::{Sensor, SensorInfo};
+use gmwm::units::SignalUnit;
+use gmwm::{AllanKind, RobustOptions, WvOptions};
+use gmwm_plot::{Column, Figure, ImageFormat, Layout};
+use std::io::Write;
+
+/// The unit of each column for axis labels and legends: the one its name or the sidecar
+/// states (SI for ROS recordings and binary IMU records), as its symbol; `u` when unknown.
+fn column_units(input: &InputArgs, names: &[String]) -> Vec<String> {
+    let ros = gmwm::imu::ros::container_of(&input.file).is_some();
+    let record = matches!(
+        crate::input::format(input.format),
+        gmwm::imu::InputFormat::ImuRecord(_)
+    );
+    let sidecar = if ros || is_wv(input) {
+        None
+    } else {
+        gmwm::imu::find_sidecar(&input.file).ok().flatten()
+    };
+    names
+        .iter()
+        .map(|name| {
+            let sensor = SensorInfo::infer(name).map_or(Sensor::Other, |(s, _)| s);
+            let text = if ros {
+                match sensor {
+                    Sensor::Gyroscope => Some("rad/s".to_string()),
+                    Sensor::Accelerometer => Some("m/s^2".to_string()),
+                    Sensor::Other => None,
+                }
+            } else {
+                SensorInfo::column_unit(name, sensor, sidecar.as_ref(), record)
+            };
+            text.and_then(|t| t.parse::<SignalUnit>().ok())
+                .map_or_else(|| "u".to_string(), |u| u.symbol().to_string())
+        })
+        .collect()
+}
+
+/// `--json`/`--csv` belong to the tables; a figure refuses them instead of ignoring them.
+fn no_table_output(output: &OutputArgs) -> Result<()> {
+    if output.json || output.csv {
+        return Err(UsageError(
+            "gmwm plot draws a figure: --json and --csv belong to gmwm wv|avar|fit|select".into(),
+        )
+        .into());
+    }
+    Ok(())
+}
+
+fn columns<'a, T>(items: &'a [(String, T)], units: &'a [String]) -> Vec<Column<'a, T>> {
+    items
+        .iter()
+        .zip(units)
+        .map(|((name, data), unit)| Column { name, unit, data })
+        .collect()
+}
+
+fn layout(figure: &FigureArgs) -> Layout {
+    if figure.overlay {
+        Layout::Overlay
+    } else {
+        Layout::Grid
+    }
+}
+
+/// A figure file name the renderer can write, checked before any computation.
+fn check_output(figure: &FigureArgs) -> Result<()> {
+    ImageFormat::of(&figure.output)
+        .map(|_| ())
+        .map_err(|e| UsageError(format!("invalid --output {e}")).into())
+}
+
+/// Writes `fig` at the requested size and says where.
+fn save(fig: Figure, args: &FigureArgs, out: &mut impl Write) -> Result<()> {
+    let (w, h) = fig.size;
+    let size = (
+        args.width
+            .map_or(w, |v| u32::try_from(v).unwrap_or(u32::MAX)),
+        args.height
+            .map_or(h, |v| u32::try_from(v).unwrap_or(u32::MAX)),
+    );
+    let fig = fig.with_size(size);
+    fig.save(&args.output)
+        .with_context(|| format!("cannot draw {}", args.output.display()))?;
+    writeln!(
+        out,
+        "wrote {} ({}x{} px, {} panel(s))",
+        args.output.display(),
+        size.0,
+        size.1,
+        fig.panels.len()
+    )?;
+    Ok(())
+}
+
+fn names<T>(items: &[(String, T)]) -> Vec<String> {
+    items.iter().map(|(n, _)| n.clone()).collect()
+}
+
+/// Runs the subcommand.
+pub fn run(args: &PlotArgs, out: &mut impl Write) -> Result<()> {
+    match &args.figure {
+        PlotCommand::Wv { args, figure } => {
+            no_table_output(&args.output)?;
+            check_output(figure)?;
+            let items = crate::cmd::wv::compute(args)?;
+            let units = column_units(&args.input, &names(&items));
+            save(
+                gmwm_plot::wv_figure(&columns(&items, &units), layout(figure)),
+                figure,
+                out,
+            )
+        }
+        PlotCommand::Avar { args, figure } => {
+            no_table_output(&args.output)?;
+            check_output(figure)?;
+            let items = crate::cmd::avar::compute(args)?;
+            let units = column_units(&args.input, &names(&items));
+            save(
+                gmwm_plot::allan_figure(&columns(&items, &units), layout(figure)),
+                figure,
+                out,
+            )
+        }
+        PlotCommand::Compare { args, figure } => {
+            no_table_output(&args.output)?;
+            check_output(figure)?;
+            anyhow::ensure!(
+                !is_wv(&args.input),
+                "{}: classical against robust needs the samples, not a saved wavelet variance",
+                args.input.file.display()
+            );
+            let classical_opts = WvOptions {
+                robust: None,
+                ..crate::cmd::wv::options(&args.estimator)?
+            };
+            let robust_opts = WvOptions {
+                robust: Some(RobustOptions::new(
+                    args.estimator.eff,
+                    gmwm::RobustConvention::Exact,
+                )?),
+                ..classical_opts
+            };
+            let loaded = crate::input::load(&args.input)?;
+            let items = crate::input::analyse_columns(&loaded, &args.input.file, |x| {
+                Ok((
+                    gmwm::wavelet_variance(x, loaded.freq_hz, &classical_opts)?,
+                    gmwm::wavelet_variance(x, loaded.freq_hz, &robust_opts)?,
+                ))
+            })?;
+            let units = column_units(&args.input, &names(&items));
+            save(
+                gmwm_plot::compare_figure(&columns(&items, &units)),
+                figure,
+                out,
+            )
+        }
+        PlotCommand::Fit { args, figure } => {
+            no_table_output(&args.output)?;
+            check_output(figure)?;
+            if args.inference {
+                return Err(UsageError(
+                    "gmwm plot fit draws the fit: --inference belongs to gmwm fit".into(),
+                )
+                .into());
+            }
+            let (_, fits) = crate::cmd::fit::compute(args)?;
+            let units = column_units(&args.input, &names(&fits));
+            save(gmwm_plot::fit_figure(&columns(&fits, &units)), figure, out)
+        }
+        PlotCommand::Select { args, figure } => {
+            no_table_output(&args.output)?;
+            check_output(figure)?;
+            let selections = crate::cmd::select::compute(args)?;
+            let units = column_units(&args.input, &names(&selections));
+            save(
+                gmwm_plot::selection_figure(&columns(&selections, &units)),
+                figure,
+                out,
+            )
+        }
+        PlotCommand::Ieee { args, figure } => {
+            no_table_output(&args.output)?;
+            check_output(figure)?;
+            let items = crate::cmd::avar::compute(args)?;
+            let mut pairs = Vec::with_capacity(items.len());
+            for (name, av) in items {
+                anyhow::ensure!(
+                    av.kind == AllanKind::Overlapping,
+                    "the IEEE 952 read-off uses the overlapping Allan variance: drop --kind"
+                );
+                let readoff = ieee_readoff(&av)
+                    .map_err(gmwm::Error::from)
+                    .with_context(|| format!("{}: column {name}", args.input.file.display()))?;
+                pairs.push((name, (av, readoff)));
+            }
+            let units = column_units(&args.input, &names(&pairs));
+            save(
+                gmwm_plot::ieee_figure(&columns(&pairs, &units)),
+                figure,
+                out,
+            )
+        }
+    }
+}

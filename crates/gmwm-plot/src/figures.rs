@@ -1,0 +1,546 @@
+//! The figures of METHODS §11 (paper Figs. 1–4) and the IEEE Std 952 read-off, built from the
+//! engine's results. Each builder only arranges numbers the engine computed.
+
+use crate::chart::{BarRow, Bars, Mark, Panel, PanelKind, Series};
+use crate::style::number;
+use crate::Figure;
+use gmwm::calib::ieee::IeeeReadoff;
+use gmwm::imu::{Sensor, SensorInfo};
+use gmwm::{AllanKind, AllanVariance, GmwmFit, ModelSelection, WaveletVariance};
+
+/// A named series of a recording with the unit of its samples (`"u"` when unknown).
+#[derive(Debug, Clone, Copy)]
+pub struct Column<'a, T> {
+    /// Column name (`gyro_x`, ...).
+    pub name: &'a str,
+    /// Unit of the samples.
+    pub unit: &'a str,
+    /// What is drawn.
+    pub data: &'a T,
+}
+
+/// How several columns' variances share a figure (paper Fig. 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layout {
+    /// One panel per column: rows gyroscope / accelerometer / other, columns the axes (Fig. 1a).
+    Grid,
+    /// One panel per sensor type with its axes overlaid (Fig. 1b).
+    Overlay,
+}
+
+/// Horizontal axis of a WV figure: the Haar WV scale (METHODS §14.1).
+pub const WV_SCALE: &str = "scale τ = 2^j/f (s)";
+/// Horizontal axis of an Allan-type figure: the cluster time (METHODS §14.1).
+pub const AV_SCALE: &str = "cluster time τ = m/f (s)";
+
+/// A unit as set in figures: `m/s^2` as `m/s²`.
+fn pretty(unit: &str) -> String {
+    unit.replace("^2", "²").replace("^3", "³")
+}
+
+fn squared(unit: &str) -> String {
+    let unit = pretty(unit);
+    if unit.contains('/') || unit.contains('·') || unit.contains('*') {
+        format!("({unit})²")
+    } else {
+        format!("{unit}²")
+    }
+}
+
+fn wv_label(unit: &str) -> String {
+    format!("wavelet variance ν² [{}]", squared(unit))
+}
+
+/// The estimate with its band as two series (band first, so the points are drawn on top).
+fn estimate_series(
+    tau_s: &[f64],
+    value: &[f64],
+    low: &[f64],
+    high: &[f64],
+    colour: Option<usize>,
+) -> [Series; 2] {
+    let mut band = Series::band(tau_s, low, high);
+    let mut points = Series::new(Mark::LinePoints, tau_s, value);
+    band.colour = colour;
+    points.colour = colour;
+    [band, points]
+}
+
+/// Sensor row and axis of a column (from its name, as the readers recognise it).
+fn place(name: &str) -> (usize, String) {
+    match SensorInfo::infer(name) {
+        Some((Sensor::Gyroscope, axis)) => (0, axis),
+        Some((Sensor::Accelerometer, axis)) => (1, axis),
+        _ => (2, name.to_string()),
+    }
+}
+
+const SENSOR_TITLES: [&str; 3] = ["gyroscope", "accelerometer", "other"];
+
+/// What one column of a variance figure contributes: scale, value, band, and labels.
+struct Curve<'a> {
+    name: &'a str,
+    unit: &'a str,
+    tau_s: Vec<f64>,
+    value: Vec<f64>,
+    low: Vec<f64>,
+    high: Vec<f64>,
+}
+
+fn variance_figure(
+    curves: &[Curve<'_>],
+    layout: Layout,
+    x_label: &str,
+    y_label: &dyn Fn(&str) -> String,
+    what: &str,
+) -> Figure {
+    match layout {
+        Layout::Grid => {
+            let placed: Vec<(usize, String)> = curves.iter().map(|c| place(c.name)).collect();
+            let mut rows: Vec<usize> = placed.iter().map(|p| p.0).collect();
+            rows.sort_unstable();
+            rows.dedup();
+            let cols = rows
+                .iter()
+                .map(|r| placed.iter().filter(|p| p.0 == *r).count())
+                .max()
+                .unwrap_or(1);
+            let mut panels = Vec::new();
+            for r in &rows {
+                let members: Vec<usize> =
+                    (0..curves.len()).filter(|&i| placed[i].0 == *r).collect();
+                for k in 0..cols {
+                    panels.push(match members.get(k) {
+                        Some(&i) => {
+                            let c = &curves[i];
+                            Panel {
+                                title: format!("{} ({what})", c.name),
+                                x_label: x_label.to_string(),
+                                y_label: y_label(c.unit),
+                                kind: PanelKind::LogLog(
+                                    estimate_series(&c.tau_s, &c.value, &c.low, &c.high, None)
+                                        .to_vec(),
+                                ),
+                            }
+                        }
+                        // a short sensor row keeps the grid: an empty panel
+                        None => Panel {
+                            title: String::new(),
+                            x_label: String::new(),
+                            y_label: String::new(),
+                            kind: PanelKind::LogLog(Vec::new()),
+                        },
+                    });
+                }
+            }
+            let panels: Vec<Panel> = panels;
+            let size = (420 * cols as u32 + 80, 380 * rows.len() as u32 + 40);
+            Figure::new(panels, (rows.len(), cols), size)
+        }
+        Layout::Overlay => {
+            let mut panels = Vec::new();
+            for (row, title) in SENSOR_TITLES.iter().enumerate() {
+                let members: Vec<&Curve<'_>> =
+                    curves.iter().filter(|c| place(c.name).0 == row).collect();
+                if members.is_empty() {
+                    continue;
+                }
+                let mut series = Vec::new();
+                for (k, c) in members.iter().enumerate() {
+                    let [band, points] =
+                        estimate_series(&c.tau_s, &c.value, &c.low, &c.high, Some(k + 1));
+                    let axis = place(c.name).1;
+                    series.push(band);
+                    series.push(points.labelled(format!("axis {axis}")));
+                }
+                panels.push(Panel {
+                    title: format!("{title} ({what})"),
+                    x_label: x_label.to_string(),
+                    y_label: y_label(members[0].unit),
+                    kind: PanelKind::LogLog(series),
+                });
+            }
+            let n = panels.len().max(1);
+            Figure::new(panels, (n, 1), (1000, 520 * n as u32))
+        }
+    }
+}
+
+/// Wavelet variances with their confidence bands, one panel per column (`Layout::Grid`, paper
+/// Fig. 1a) or one per sensor type with the axes overlaid (Fig. 1b).
+pub fn wv_figure(columns: &[Column<'_, WaveletVariance>], layout: Layout) -> Figure {
+    let curves: Vec<Curve<'_>> = columns
+        .iter()
+        .map(|c| Curve {
+            name: c.name,
+            unit: c.unit,
+            tau_s: c.data.tau_s.clone(),
+            value: c.data.wv.clone(),
+            low: c.data.ci_low.clone(),
+            high: c.data.ci_high.clone(),
+        })
+        .collect();
+    let what = match columns.first().map(|c| c.data.robust.is_some()) {
+        Some(true) => "robust WV",
+        _ => "WV",
+    };
+    variance_figure(&curves, layout, WV_SCALE, &wv_label, what)
+}
+
+/// Allan, modified Allan or Hadamard deviations with their bands (square roots of the
+/// variance's interval), laid out as [`wv_figure`].
+pub fn allan_figure(columns: &[Column<'_, AllanVariance>], layout: Layout) -> Figure {
+    let curves: Vec<Curve<'_>> = columns
+        .iter()
+        .map(|c| Curve {
+            name: c.name,
+            unit: c.unit,
+            tau_s: c.data.tau_s.clone(),
+            value: c.data.adev.clone(),
+            low: c.data.ci_low.iter().map(|v| v.sqrt()).collect(),
+            high: c.data.ci_high.iter().map(|v| v.sqrt()).collect(),
+        })
+        .collect();
+    let (what, quantity) = match columns.first().map(|c| c.data.kind) {
+        Some(AllanKind::Modified) => ("modified Allan deviation", "modified Allan deviation"),
+        Some(AllanKind::Hadamard | AllanKind::HadamardNonOverlapping) => {
+            ("Hadamard deviation", "Hadamard deviation")
+        }
+        _ => ("Allan deviation", "Allan deviation σ(τ)"),
+    };
+    let label = move |unit: &str| format!("{quantity} [{}]", pretty(unit));
+    variance_figure(&curves, layout, AV_SCALE, &label, what)
+}
+
+/// A grid with up to three panels a row for one panel per column.
+fn stacked(panels: Vec<Panel>, cols: usize, panel_size: (u32, u32)) -> Figure {
+    let n = panels.len().max(1);
+    let cols = cols.min(n).max(1);
+    let rows = n.div_ceil(cols);
+    Figure::new(
+        panels,
+        (rows, cols),
+        (panel_size.0 * cols as u32, panel_size.1 * rows as u32),
+    )
+}
+
+/// The classical against the robust WV of each column (paper Fig. 2): where outliers inflate
+/// the classical estimate, its points leave the robust band.
+pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]) -> Figure {
+    let panels = columns
+        .iter()
+        .map(|c| {
+            let (classical, robust) = c.data;
+            let eff = robust.robust.map_or(0.6, |r| r.eff);
+            let level = 100.0 * (1.0 - classical.alpha);
+            let [cb, cp] = estimate_series(
+                &classical.tau_s,
+                &classical.wv,
+                &classical.ci_low,
+                &classical.ci_high,
+                Some(4),
+            );
+            let [rb, rp] = estimate_series(
+                &robust.tau_s,
+                &robust.wv,
+                &robust.ci_low,
+                &robust.ci_high,
+                Some(5),
+            );
+            Panel {
+                title: format!("{}: classical and robust WV", c.name),
+                x_label: WV_SCALE.to_string(),
+                y_label: wv_label(c.unit),
+                kind: PanelKind::LogLog(vec![
+                    cb.labelled(format!("classical {level:.0}% interval")),
+                    rb.labelled(format!("robust {level:.0}% interval")),
+                    cp.labelled("classical WV"),
+                    rp.labelled(format!("robust WV (efficiency {eff})")),
+                ]),
+            }
+        })
+        .collect();
+    stacked(panels, 1, (1000, 560))
+}
+
+/// The legend entry of one fitted component: its process and the values a filter uses, in the
+/// data unit (continuous time; METHODS §14.2, through the engine's read-off).
+fn component_label(fit: &GmwmFit, index: usize, unit: &str) -> String {
+    let unit = pretty(unit);
+    let unit = unit.as_str();
+    let component = &fit.model.components()[index];
+    let kind = component.kind.name();
+    let values: Vec<String> = fit
+        .navigation(Some(unit))
+        .into_iter()
+        .filter(|p| p.index == index && p.name != "driving_noise_density")
+        .map(|p| {
+            let symbol = match p.name {
+                "white_noise_density" => "N",
+                "quantization_coefficient" => "Q",
+                "rate_random_walk_density" => "K",
+                "drift_rate" => "R",
+                "correlation_time" => "T",
+                "gm_std" => "σ",
+                other => other,
+            };
+            let unit = p
+                .unit
+                .replace("*sqrt(Hz)", "/√s")
+                .replace("/sqrt(Hz)", "/√Hz")
+                .replace('*', "·");
+            format!("{symbol} = {} {unit}", number(p.value))
+        })
+        .collect();
+    if values.is_empty() {
+        component.to_string()
+    } else {
+        format!("{kind}: {}", values.join(", "))
+    }
+}
+
+/// The empirical WV with its band and the fitted model's implied WV (total, thick), as series.
+fn empirical_and_model(fit: &GmwmFit, model_label: &str) -> Vec<Series> {
+    let implied = &fit.implied_wv;
+    let mut series = Vec::new();
+    if let Some(wv) = &fit.empirical {
+        let level = 100.0 * (1.0 - wv.alpha);
+        let [band, points] = estimate_series(&wv.tau_s, &wv.wv, &wv.ci_low, &wv.ci_high, None);
+        series.push(band.labelled(format!("{level:.0}% interval")));
+        series.push(points.labelled("empirical WV"));
+    } else {
+        series.push(
+            Series::new(Mark::LinePoints, &implied.tau_s, &fit.nu_hat).labelled("empirical WV"),
+        );
+    }
+    series.push(
+        Series::new(
+            Mark::Line {
+                width: 3,
+                dashed: false,
+            },
+            &implied.tau_s,
+            &implied.wv,
+        )
+        .coloured(0)
+        .clipped()
+        .labelled(model_label),
+    );
+    series
+}
+
+/// A fit (paper Figs. 3a, 3b): the empirical WV with its band, the model's implied WV and,
+/// with more than one component, each component's implied WV as its own line, the legend
+/// naming each process with its values in the data unit.
+pub fn fit_figure(columns: &[Column<'_, GmwmFit>]) -> Figure {
+    let panels = columns
+        .iter()
+        .map(|c| {
+            let fit = c.data;
+            let mut series = empirical_and_model(fit, "model (implied WV)");
+            if fit.implied_wv.processes.len() > 1 {
+                for (k, p) in fit.implied_wv.processes.iter().enumerate() {
+                    series.push(
+                        Series::new(
+                            Mark::Line {
+                                width: 2,
+                                dashed: false,
+                            },
+                            &fit.implied_wv.tau_s,
+                            &p.wv,
+                        )
+                        .coloured(k + 1)
+                        .clipped()
+                        .labelled(component_label(fit, k, c.unit)),
+                    );
+                }
+            }
+            Panel {
+                title: format!("{}: {}", c.name, fit.model.without_values()),
+                x_label: WV_SCALE.to_string(),
+                y_label: wv_label(c.unit),
+                kind: PanelKind::LogLog(series),
+            }
+        })
+        .collect();
+    stacked(panels, 1, (1100, 600))
+}
+
+/// Rows of the WIC chart: the selected row and the best others, at most this many.
+pub const WIC_ROWS: usize = 10;
+
+/// A model without its empty parentheses, for chart labels.
+fn short_model(text: &str) -> String {
+    text.replace("()", "")
+}
+
+/// Model selection (paper Fig. 4): per column, the empirical WV against the selected model's
+/// implied WV, beside the candidates' WIC with objective and optimism stacked (the best
+/// [`WIC_ROWS`] canonical models, the selected one marked ▶).
+pub fn selection_figure(columns: &[Column<'_, ModelSelection>]) -> Figure {
+    let mut panels = Vec::new();
+    for c in columns {
+        let s = c.data;
+        let selected = s.selected_canonical.model.to_string();
+        panels.push(Panel {
+            title: format!("{}: selected {}", c.name, short_model(&selected)),
+            x_label: WV_SCALE.to_string(),
+            y_label: wv_label(c.unit),
+            kind: PanelKind::LogLog(empirical_and_model(&s.fit, "selected model (implied WV)")),
+        });
+        let selected_row = s
+            .rows
+            .iter()
+            .position(|r| r.status == gmwm::selection::RowStatus::Selected);
+        let mut shown: Vec<usize> = (0..s.rows.len().min(WIC_ROWS)).collect();
+        if let Some(i) = selected_row {
+            if !shown.contains(&i) {
+                shown.pop();
+                shown.push(i);
+            }
+        }
+        let rows = shown
+            .iter()
+            .map(|&i| {
+                let r = &s.rows[i];
+                BarRow {
+                    label: short_model(&r.score.canonical_model.to_string()),
+                    first: r.score.objective,
+                    second: r.score.optimism,
+                    emphasised: Some(i) == selected_row,
+                }
+            })
+            .collect();
+        panels.push(Panel {
+            title: format!("{}: WIC of the best canonical models", c.name),
+            x_label: "WIC = objective + optimism".to_string(),
+            y_label: String::new(),
+            kind: PanelKind::Bars(Bars {
+                rows,
+                segment_labels: [
+                    "objective (fit)".to_string(),
+                    "optimism (penalty)".to_string(),
+                ],
+            }),
+        });
+    }
+    let n = columns.len().max(1);
+    Figure::new(panels, (n, 2), (1500, 560 * n as u32))
+}
+
+/// The IEEE Std 952 read-off (METHODS §14.3) on the Allan deviation: the −1/2 slope line
+/// through N at 1 s, the flat line at the minimum (B × 0.664) and the +1/2 slope line through
+/// K at 3 s, each with its read-off point; a term without a value is left out and named in
+/// the legend.
+pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figure {
+    let panels = columns
+        .iter()
+        .map(|c| {
+            let (av, readoff) = c.data;
+            let level = 100.0 * (1.0 - av.alpha);
+            let low: Vec<f64> = av.ci_low.iter().map(|v| v.sqrt()).collect();
+            let high: Vec<f64> = av.ci_high.iter().map(|v| v.sqrt()).collect();
+            let [band, points] = estimate_series(&av.tau_s, &av.adev, &low, &high, None);
+            let mut series = vec![
+                band.labelled(format!("{level:.0}% interval")),
+                points.labelled("Allan deviation"),
+            ];
+            let span = |f: &dyn Fn(f64) -> f64| -> (Vec<f64>, Vec<f64>) {
+                let (a, b) = (
+                    av.tau_s.first().copied().unwrap_or(1.0),
+                    av.tau_s.last().copied().unwrap_or(1.0),
+                );
+                let xs = vec![a.min(1.0) / 2.0, b.max(3.0) * 2.0];
+                let ys = xs.iter().map(|&t| f(t)).collect();
+                (xs, ys)
+            };
+            let u = pretty(c.unit);
+            let mut missing = Vec::new();
+            if let Some(n) = readoff.n.value {
+                let (xs, ys) = span(&|t| n / t.sqrt());
+                series.push(
+                    Series::new(
+                        Mark::Line {
+                            width: 2,
+                            dashed: true,
+                        },
+                        &xs,
+                        &ys,
+                    )
+                    .coloured(4)
+                    .clipped(),
+                );
+                series.push(
+                    Series::new(Mark::Points, &[1.0], &[n])
+                        .coloured(4)
+                        .clipped()
+                        .labelled(format!("N = {} {u}/√Hz (slope −1/2, at 1 s)", number(n))),
+                );
+            } else {
+                missing.push("N");
+            }
+            if let Some(b) = readoff.b.value {
+                let floor = b * gmwm::calib::ieee::FLICKER_FACTOR;
+                let (xs, _) = span(&|_| floor);
+                series.push(
+                    Series::new(
+                        Mark::Line {
+                            width: 2,
+                            dashed: true,
+                        },
+                        &xs,
+                        &[floor, floor],
+                    )
+                    .coloured(3)
+                    .clipped(),
+                );
+                series.push(
+                    Series::new(Mark::Points, &[readoff.b.at_tau_s], &[floor])
+                        .coloured(3)
+                        .clipped()
+                        .labelled(format!(
+                            "B = {} {u} (slope 0: min σ / 0.664, at {} s)",
+                            number(b),
+                            number(readoff.b.at_tau_s)
+                        )),
+                );
+            } else {
+                missing.push("B");
+            }
+            if let Some(k) = readoff.k.value {
+                let (xs, ys) = span(&|t| k * (t / 3.0).sqrt());
+                series.push(
+                    Series::new(
+                        Mark::Line {
+                            width: 2,
+                            dashed: true,
+                        },
+                        &xs,
+                        &ys,
+                    )
+                    .coloured(5)
+                    .clipped(),
+                );
+                series.push(
+                    Series::new(Mark::Points, &[3.0], &[k])
+                        .coloured(5)
+                        .clipped()
+                        .labelled(format!("K = {} {u}/√s (slope +1/2, at 3 s)", number(k))),
+                );
+            } else {
+                missing.push("K");
+            }
+            let mut title = format!("{}: IEEE 952 read-off", c.name);
+            if !missing.is_empty() {
+                title.push_str(&format!(" ({}: region too short)", missing.join(", ")));
+            }
+            Panel {
+                title,
+                x_label: AV_SCALE.to_string(),
+                y_label: format!("Allan deviation σ(τ) [{u}]"),
+                kind: PanelKind::LogLog(series),
+            }
+        })
+        .collect();
+    stacked(panels, 1, (1100, 600))
+}

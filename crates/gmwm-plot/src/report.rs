@@ -1,0 +1,523 @@
+//! The calibration report: one self-contained HTML page (no external asset, works offline,
+//! prints well) that renders a [`CalibrationReport`] — the recording's summary, every figure,
+//! the selection table, the estimates with intervals and the fit verdict, the IEEE read-off
+//! beside the GMWM values, the navigation-filter files as exported and the classical-vs-robust
+//! check. It computes nothing: the page's numbers are the report's, whose JSON (as
+//! `gmwm calibrate --json` writes it) is embedded in the page.
+
+use crate::figures::{
+    compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column, Layout,
+};
+use crate::style::number;
+use crate::{Figure, PlotError};
+use base64::Engine as _;
+use gmwm::calib::{AxisCalibration, CalibrationReport, Estimate, EstimateStatus};
+use gmwm::selection::RowStatus;
+use std::fmt::Write as _;
+
+/// Everything the page shows besides the calibration itself.
+#[derive(Debug, Clone, Default)]
+pub struct ReportContext {
+    /// The recording's file, as the user named it.
+    pub file: String,
+    /// The ROS topic read, if any.
+    pub topic: Option<String>,
+    /// What the reader noticed (timestamps, columns left out), one line each.
+    pub reader_notes: Vec<String>,
+    /// The timestamp checks, as text (`None`: no time column).
+    pub timing: Option<String>,
+    /// The command that made the report.
+    pub command: String,
+    /// The navigation-filter files as exported: (stack, file name, content).
+    pub exports: Vec<(String, String, String)>,
+    /// The JSON document `--json` writes for this calibration, embedded verbatim.
+    pub json: String,
+    /// The program and version that made the report.
+    pub generator: String,
+}
+
+/// A sentence with its first letter upper-case.
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    chars
+        .next()
+        .map(|c| c.to_uppercase().chain(chars).collect())
+        .unwrap_or_default()
+}
+
+/// HTML-escapes text.
+fn esc(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// A figure as an `<img>` with an SVG data URI, inside a `<figure>` with its caption.
+fn figure_html(figure: &Figure, caption: &str) -> Result<String, PlotError> {
+    let svg = figure.svg()?;
+    let data = base64::engine::general_purpose::STANDARD.encode(svg.as_bytes());
+    Ok(format!(
+        "<figure><img src=\"data:image/svg+xml;base64,{data}\" width=\"{}\" height=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>\n",
+        figure.size.0,
+        figure.size.1,
+        esc(caption),
+        esc(caption)
+    ))
+}
+
+/// An estimate with its interval, unit and, where they exist, its datasheet form.
+fn estimate_cell(e: &Estimate) -> String {
+    let value = match e.status {
+        EstimateStatus::UpperBound => format!("≤ {}", number(e.value)),
+        _ => number(e.value),
+    };
+    let interval = match (e.ci_low, e.ci_high, e.status) {
+        (Some(lo), Some(hi), EstimateStatus::Estimated) => {
+            format!(
+                " <span class=\"ci\">[{}, {}]</span>",
+                number(lo),
+                number(hi)
+            )
+        }
+        (_, _, EstimateStatus::Undetermined) => {
+            " <span class=\"ci\">(not determined)</span>".to_string()
+        }
+        _ => String::new(),
+    };
+    let datasheet = e
+        .forms
+        .as_ref()
+        .and_then(|f| f.datasheet.as_ref())
+        .map(|q| {
+            format!(
+                "<br><span class=\"alt\">{} {}</span>",
+                number(q.value),
+                esc(&q.unit)
+            )
+        })
+        .unwrap_or_default();
+    format!("{value} {}{interval}{datasheet}", esc(&e.unit))
+}
+
+fn row(out: &mut String, cells: &[String]) {
+    out.push_str("<tr>");
+    for c in cells {
+        let _ = write!(out, "<td>{c}</td>");
+    }
+    out.push_str("</tr>\n");
+}
+
+fn header(out: &mut String, cells: &[&str]) {
+    out.push_str("<thead><tr>");
+    for c in cells {
+        let _ = write!(out, "<th>{}</th>", esc(c));
+    }
+    out.push_str("</tr></thead>\n");
+}
+
+/// The recording's summary.
+fn summary(out: &mut String, report: &CalibrationReport, ctx: &ReportContext) {
+    out.push_str("<section id=\"recording\"><h2>Recording</h2><table class=\"kv\">\n");
+    let hours = report.duration_s / 3600.0;
+    let duration = if hours >= 1.0 {
+        format!("{} s ({:.2} h)", number(report.duration_s), hours)
+    } else {
+        format!("{} s", number(report.duration_s))
+    };
+    let mut kv = vec![
+        ("file", esc(&ctx.file)),
+        ("name", esc(report.name.as_deref().unwrap_or("—"))),
+        ("samples per axis", report.samples.to_string()),
+        ("sampling rate", format!("{} Hz", number(report.freq_hz))),
+        ("length", duration),
+        (
+            "columns",
+            report
+                .axes
+                .iter()
+                .map(|a| {
+                    format!(
+                        "{} ({})",
+                        esc(&a.column),
+                        esc(a.data_unit.as_deref().unwrap_or("unit unknown"))
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+        (
+            "timestamps",
+            esc(ctx
+                .timing
+                .as_deref()
+                .unwrap_or("no time column: rate from the sidecar or --freq")),
+        ),
+        ("full model", esc(&report.full_model)),
+        (
+            "confidence level",
+            format!("{:.0}%", 100.0 * (1.0 - report.alpha)),
+        ),
+    ];
+    if let Some(t) = &ctx.topic {
+        kv.insert(1, ("ROS topic", esc(t)));
+    }
+    for (k, v) in kv {
+        let _ = writeln!(out, "<tr><th>{k}</th><td>{v}</td></tr>");
+    }
+    out.push_str("</table>\n");
+    let notes: Vec<&String> = ctx.reader_notes.iter().chain(&report.checks).collect();
+    if !notes.is_empty() {
+        out.push_str("<ul class=\"notes\">");
+        for n in notes {
+            let _ = write!(out, "<li>{}</li>", esc(n));
+        }
+        out.push_str("</ul>\n");
+    }
+    out.push_str("</section>\n");
+}
+
+/// The overview table: one row per axis with the values a filter takes.
+fn overview(out: &mut String, report: &CalibrationReport) {
+    out.push_str("<section id=\"overview\"><h2>Summary</h2><table>\n");
+    header(
+        out,
+        &[
+            "axis",
+            "selected model",
+            "noise density N",
+            "random walk K",
+            "bias instability B",
+            "fit",
+        ],
+    );
+    out.push_str("<tbody>\n");
+    for a in &report.axes {
+        let cell = |e: &Option<Estimate>| e.as_ref().map_or("—".to_string(), estimate_cell);
+        row(
+            out,
+            &[
+                format!("<a href=\"#axis-{0}\">{0}</a>", esc(&a.column)),
+                esc(&a.canonical_model),
+                cell(&a.noise_density),
+                cell(&a.random_walk),
+                cell(&a.bias_instability),
+                if a.verdict.explains_wv {
+                    "explains the WV".into()
+                } else {
+                    "<b>misfit</b>".into()
+                },
+            ],
+        );
+    }
+    out.push_str("</tbody></table></section>\n");
+}
+
+fn status_text(status: RowStatus) -> &'static str {
+    match status {
+        RowStatus::Selected => "selected",
+        RowStatus::Equivalent => "equivalent",
+        RowStatus::Separable => "",
+    }
+}
+
+/// Rows of the selection table shown: the best ten and every selected or equivalent one.
+const TABLE_ROWS: usize = 10;
+
+/// The axis' column of a figure.
+fn one<'a, T>(a: &'a AxisCalibration, data: &'a T) -> [Column<'a, T>; 1] {
+    [Column {
+        name: &a.column,
+        unit: &a.unit,
+        data,
+    }]
+}
+
+fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(), PlotError> {
+    let id = esc(&a.column);
+    let _ = writeln!(
+        out,
+        "<section class=\"axis\" id=\"axis-{id}\"><h2>{id}</h2>"
+    );
+    let _ = writeln!(
+        out,
+        "<p>Selected <b>{}</b> (canonical model {}; estimates from the identified fit of {}). {}</p>",
+        esc(&a.model),
+        esc(&a.canonical_model),
+        esc(&a.identified_model),
+        esc(&capitalised(&a.selection.reason()))
+    );
+    let unit = a.unit.as_str();
+
+    // model selection
+    out.push_str(&figure_html(
+        &selection_figure(&one(a, &a.selection)),
+        &format!("{}: the empirical WV and the selected model's implied WV; the WIC of the best canonical models (objective + optimism, the selected one marked ▶).", a.column),
+    )?);
+    out.push_str("<h3>Model selection (WIC)</h3><table>\n");
+    header(
+        out,
+        &[
+            "canonical model",
+            "candidates",
+            "objective",
+            "optimism",
+            "WIC",
+            "ΔWIC ± se",
+            "status",
+        ],
+    );
+    out.push_str("<tbody>\n");
+    for (i, r) in a.selection.rows.iter().enumerate() {
+        if i >= TABLE_ROWS && r.status == RowStatus::Separable {
+            continue;
+        }
+        let class = if r.status == RowStatus::Selected {
+            " class=\"selected\""
+        } else {
+            ""
+        };
+        let _ = write!(out, "<tr{class}>");
+        for c in [
+            esc(&r.score.canonical_model.to_string()),
+            r.members.len().to_string(),
+            number(r.score.objective),
+            number(r.score.optimism),
+            number(r.score.wic),
+            format!("{} ± {}", number(r.delta_wic), number(r.delta_wic_se)),
+            status_text(r.status).to_string(),
+        ] {
+            let _ = write!(out, "<td>{c}</td>");
+        }
+        out.push_str("</tr>\n");
+    }
+    let _ = writeln!(out, "</tbody></table><p class=\"small\">{} canonical models from {} candidates; rows beyond the best {TABLE_ROWS} that are neither selected nor equivalent are left out (they are in the JSON).</p>", a.selection.rows.len(), a.selection.candidates.len());
+
+    // estimates
+    out.push_str("<h3>Estimates</h3><table>\n");
+    header(out, &["quantity", "value (SI) [interval]", "source"]);
+    out.push_str("<tbody>\n");
+    let named: Vec<(&str, Option<&Estimate>)> = vec![
+        ("noise density N", a.noise_density.as_ref()),
+        ("random walk K", a.random_walk.as_ref()),
+        ("bias instability B", a.bias_instability.as_ref()),
+        ("quantization Q", a.quantization.as_ref()),
+        ("rate ramp R", a.rate_ramp.as_ref()),
+        (
+            "Gauss–Markov correlation time",
+            a.gauss_markov_bias.as_ref().map(|g| &g.correlation_time),
+        ),
+        (
+            "Gauss–Markov σ",
+            a.gauss_markov_bias.as_ref().map(|g| &g.sigma),
+        ),
+        (
+            "Gauss–Markov driving density",
+            a.gauss_markov_bias.as_ref().map(|g| &g.driving_density),
+        ),
+    ];
+    for (name, e) in named {
+        if let Some(e) = e {
+            row(out, &[name.to_string(), estimate_cell(e), esc(&e.source)]);
+        }
+    }
+    out.push_str("</tbody></table>\n<table>\n");
+    header(
+        out,
+        &[
+            "parameter of the identified fit",
+            "estimate",
+            "se",
+            &format!("{:.0}% interval", 100.0 * (1.0 - alpha)),
+        ],
+    );
+    out.push_str("<tbody>\n");
+    for p in &a.inference.parameters {
+        let opt = |v: Option<f64>| v.map_or("—".to_string(), number);
+        let interval = match (p.ci_low, p.ci_high) {
+            (Some(lo), Some(hi)) => format!("[{}, {}]", number(lo), number(hi)),
+            _ => "—".to_string(),
+        };
+        row(
+            out,
+            &[esc(&p.name), number(p.estimate), opt(p.se), interval],
+        );
+    }
+    out.push_str("</tbody></table>\n");
+    let _ = writeln!(
+        out,
+        "<p class=\"verdict {}\"><b>Goodness of fit:</b> {}</p>",
+        if a.verdict.explains_wv { "ok" } else { "bad" },
+        esc(&a.verdict.summary)
+    );
+    out.push_str(&figure_html(
+        &fit_figure(&one(a, &a.fit)),
+        &format!(
+            "{}: the identified fit {}, its implied WV and each process's (values in {unit}).",
+            a.column,
+            a.fit.model.without_values()
+        ),
+    )?);
+
+    // IEEE beside GMWM
+    out.push_str("<h3>IEEE 952 read-off beside the GMWM values</h3><table>\n");
+    header(out, &["term", "IEEE 952 (Allan deviation)", "GMWM"]);
+    out.push_str("<tbody>\n");
+    let ieee = &a.ieee;
+    for (term, r, gmwm) in [
+        ("N", &ieee.n, a.noise_density.as_ref()),
+        ("B", &ieee.b, a.bias_instability.as_ref()),
+        ("K", &ieee.k, a.random_walk.as_ref()),
+        ("Q", &ieee.q, a.quantization.as_ref()),
+        ("R", &ieee.r, a.rate_ramp.as_ref()),
+    ] {
+        let read = match (r.value, r.ci_low, r.ci_high) {
+            (Some(v), Some(lo), Some(hi)) => format!(
+                "{} [{}, {}] at {} s",
+                number(v),
+                number(lo),
+                number(hi),
+                number(r.at_tau_s)
+            ),
+            (Some(v), _, _) => format!("{} at {} s", number(v), number(r.at_tau_s)),
+            (None, _, _) => format!("— {}", esc(r.note.as_deref().unwrap_or(""))),
+        };
+        let g = match (term, gmwm) {
+            ("B", _) => "read from the Allan deviation only; the model's Gauss–Markov terms are under Estimates".to_string(),
+            (_, Some(e)) => estimate_cell(e),
+            (_, None) => "not in the model".to_string(),
+        };
+        row(out, &[term.to_string(), read, g]);
+    }
+    out.push_str("</tbody></table>\n");
+    let pair = (a.allan.clone(), a.ieee.clone());
+    out.push_str(&figure_html(
+        &ieee_figure(&one(a, &pair)),
+        &format!("{}: Allan deviation with the IEEE 952 slope lines (cluster time m/f, half the WV scale of the same information, METHODS §14.1).", a.column),
+    )?);
+
+    // contamination
+    out.push_str("<h3>Classical against robust WV</h3>\n");
+    match &a.contamination {
+        Some(c) => {
+            let _ = writeln!(
+                out,
+                "<p class=\"verdict {}\">{}</p>",
+                if c.matters { "bad" } else { "ok" },
+                esc(&c.summary)
+            );
+            let pair = (a.wv.clone(), c.robust.clone());
+            out.push_str(&figure_html(
+                &compare_figure(&one(a, &pair)),
+                &format!(
+                    "{}: classical and robust (efficiency {}) WV with their intervals.",
+                    a.column,
+                    c.robust.robust.map_or(0.6, |r| r.eff)
+                ),
+            )?);
+        }
+        None => out.push_str("<p>Not compared (see the notes).</p>\n"),
+    }
+    if !a.notes.is_empty() {
+        out.push_str("<h3>Notes</h3><ul class=\"notes\">");
+        for n in &a.notes {
+            let _ = write!(out, "<li>{}</li>", esc(n));
+        }
+        out.push_str("</ul>\n");
+    }
+    out.push_str("</section>\n");
+    Ok(())
+}
+
+const CSS: &str = "
+body{font-family:'DejaVu Sans',Verdana,Arial,sans-serif;margin:24px auto;max-width:1560px;padding:0 16px;color:#111;line-height:1.45}
+h1{font-size:26px;margin-bottom:4px}h2{font-size:21px;border-bottom:2px solid #0072b2;padding-bottom:3px;margin-top:36px}
+h3{font-size:17px;margin-top:22px}table{border-collapse:collapse;margin:8px 0 14px;font-size:14px}
+td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}thead th{background:#eef4f8}
+table.kv th{background:#f6f6f6;font-weight:600;white-space:nowrap}tr.selected td{background:#e6f2ea;font-weight:600}
+.ci{color:#444}.alt{color:#555;font-size:13px}.small{font-size:13px;color:#444}
+.verdict{padding:6px 10px;border-left:4px solid #999;background:#f7f7f7}.verdict.ok{border-color:#009e73}.verdict.bad{border-color:#d55e00}
+figure{margin:12px 0 20px}figure img{max-width:100%;height:auto;border:1px solid #e3e3e3}figcaption{font-size:13px;color:#333;margin-top:4px}
+pre{background:#f6f6f6;border:1px solid #ddd;padding:8px;font-size:12.5px;overflow-x:auto;white-space:pre-wrap}
+ul.notes{font-size:14px}nav a{margin-right:10px}.meta{color:#555;font-size:13px}
+@media print{body{max-width:none;margin:0}section.axis{break-before:page}figure,table,pre{break-inside:avoid}nav{display:none}a{color:inherit;text-decoration:none}}
+";
+
+/// Renders the page.
+///
+/// # Errors
+/// [`PlotError`] if a figure cannot be drawn.
+pub fn render(report: &CalibrationReport, ctx: &ReportContext) -> Result<String, PlotError> {
+    let title = format!(
+        "Calibration of {}",
+        report.name.as_deref().unwrap_or(ctx.file.as_str())
+    );
+    let mut out = String::with_capacity(1 << 20);
+    let _ = write!(
+        out,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n<h1>{}</h1>\n<p class=\"meta\">{} · made by <code>{}</code></p>\n<nav>",
+        esc(&title),
+        esc(&title),
+        esc(&ctx.generator),
+        esc(&ctx.command)
+    );
+    for a in &report.axes {
+        let _ = write!(out, "<a href=\"#axis-{0}\">{0}</a>", esc(&a.column));
+    }
+    out.push_str("<a href=\"#filters\">filter files</a></nav>\n");
+    summary(&mut out, report, ctx);
+    overview(&mut out, report);
+    let wvs: Vec<Column<'_, gmwm::WaveletVariance>> = report
+        .axes
+        .iter()
+        .map(|a| Column {
+            name: &a.column,
+            unit: &a.unit,
+            data: &a.wv,
+        })
+        .collect();
+    out.push_str("<section id=\"wv\"><h2>Wavelet variances</h2>\n");
+    out.push_str(&figure_html(
+        &wv_figure(&wvs, Layout::Grid),
+        &format!(
+            "Wavelet variance of every axis with its {:.0}% interval (Haar MODWT; scale τ = 2^j samples / f).",
+            100.0 * (1.0 - report.alpha)
+        ),
+    )?);
+    out.push_str("</section>\n");
+    for a in &report.axes {
+        axis_section(&mut out, a, report.alpha)?;
+    }
+    out.push_str("<section id=\"filters\"><h2>Navigation-filter parameters</h2>\n");
+    if ctx.exports.is_empty() {
+        out.push_str(
+            "<p>No filter file was exported (use --kalibr FILE or --export STACK FILE).</p>\n",
+        );
+    }
+    for (stack, name, content) in &ctx.exports {
+        let _ = writeln!(
+            out,
+            "<h3>{} <span class=\"small\">({})</span></h3><pre>{}</pre>",
+            esc(stack),
+            esc(name),
+            esc(content)
+        );
+    }
+    out.push_str("</section>\n");
+    // the machine-readable calibration, exactly as --json writes it; `<` is escaped so that
+    // no text inside can close the script element
+    let _ = write!(
+        out,
+        "<script type=\"application/json\" id=\"calibration-json\">{}</script>\n</body></html>\n",
+        ctx.json.replace('<', "\\u003c")
+    );
+    Ok(out)
+}

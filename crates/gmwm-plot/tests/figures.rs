@@ -1,0 +1,387 @@
+//! Every figure renders for real recordings (ADIS16405, the contaminated cont_imu1, a
+//! precomputed WV) and for edge cases (one level, a component below the plot, an undefined
+//! robust level): the SVG parses and holds the expected series and legend entries, the PNG
+//! decodes to the stated size. With `GMWM_FIGURES_DIR` set, the figures are also written there
+//! for a person to look at.
+
+use gmwm::calib::ieee::ieee_readoff;
+use gmwm::imu::{read_table, read_wv_json, ReadOptions};
+use gmwm::{allan_variance, AllanOptions, Gmwm, RobustOptions, WaveletVariance, Wic, WvOptions};
+use gmwm_plot::{
+    allan_figure, compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column,
+    Figure, Layout,
+};
+use std::path::PathBuf;
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(name)
+}
+
+/// Columns of a recording (`limit` samples each) and its rate.
+fn recording(name: &str, limit: usize) -> (Vec<(String, Vec<f64>)>, f64) {
+    let table = read_table(&data(name), &ReadOptions::default()).unwrap();
+    let freq = table.freq_hz.unwrap();
+    let cols = table
+        .columns
+        .into_iter()
+        .map(|c| {
+            let n = c.values.len().min(limit);
+            (c.name, c.values[..n].to_vec())
+        })
+        .collect();
+    (cols, freq)
+}
+
+fn wv(x: &[f64], freq: f64, robust: bool) -> WaveletVariance {
+    let opts = WvOptions {
+        robust: robust.then(RobustOptions::default),
+        ..WvOptions::default()
+    };
+    gmwm::wavelet_variance(x, freq, &opts).unwrap()
+}
+
+/// Element counts of an SVG document.
+struct Svg {
+    polygons: usize,
+    polylines: usize,
+    circles: usize,
+    texts: Vec<String>,
+}
+
+/// Parses the SVG (failing the test if it is not well-formed XML with an `svg` root) and counts
+/// its elements.
+fn parse(svg: &str) -> Svg {
+    let doc = roxmltree::Document::parse(svg).expect("the SVG parses as XML");
+    assert_eq!(doc.root_element().tag_name().name(), "svg");
+    let count = |tag: &str| doc.descendants().filter(|n| n.has_tag_name(tag)).count();
+    Svg {
+        polygons: count("polygon"),
+        polylines: count("polyline"),
+        circles: count("circle"),
+        texts: doc
+            .descendants()
+            .filter(|n| n.has_tag_name("text"))
+            .map(|n| n.text().unwrap_or_default().trim().to_string())
+            .collect(),
+    }
+}
+
+/// Renders both formats, checks the PNG's size, saves them when asked; returns the SVG counts.
+fn render(figure: &Figure, name: &str) -> Svg {
+    let svg = figure.svg().unwrap();
+    let png = figure.png().unwrap();
+    let decoder = png::Decoder::new(std::io::Cursor::new(&png));
+    let reader = decoder.read_info().expect("the PNG decodes");
+    let info = reader.info();
+    assert_eq!((info.width, info.height), figure.size, "{name}: PNG size");
+    if let Some(dir) = std::env::var_os("GMWM_FIGURES_DIR") {
+        let dir = PathBuf::from(dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join(format!("{name}.svg")), &svg).unwrap();
+        std::fs::write(dir.join(format!("{name}.png")), &png).unwrap();
+    }
+    for label in figure.legend() {
+        let shown = label.clone();
+        let svg_doc = parse(&svg);
+        assert!(
+            svg_doc.texts.iter().any(|t| t.starts_with(&shown)),
+            "{name}: legend entry {label:?} not drawn"
+        );
+    }
+    parse(&svg)
+}
+
+#[test]
+fn figures_wv_grid_and_overlay_of_the_adis_imu() {
+    let (cols, freq) = recording("adis_16405_imu1.csv.gz", usize::MAX);
+    let wvs: Vec<(String, WaveletVariance)> = cols
+        .iter()
+        .map(|(n, x)| (n.clone(), wv(x, freq, false)))
+        .collect();
+    let columns: Vec<Column<'_, WaveletVariance>> = wvs
+        .iter()
+        .map(|(n, w)| Column {
+            name: n,
+            unit: if n.starts_with("gyro") {
+                "rad/s"
+            } else {
+                "m/s²"
+            },
+            data: w,
+        })
+        .collect();
+    let levels = wvs[0].1.levels();
+    let grid = wv_figure(&columns, Layout::Grid);
+    assert_eq!(
+        grid.grid,
+        (2, 3),
+        "gyroscope and accelerometer rows, X Y Z columns"
+    );
+    let svg = render(&grid, "wv_grid_adis");
+    assert_eq!(svg.polygons, 6, "one band per axis");
+    assert_eq!(svg.circles, 6 * levels, "one point per scale and axis");
+    assert!(svg.texts.iter().any(|t| t.contains("gyro_y")));
+    assert!(
+        svg.texts.iter().any(|t| t == "10⁻²"),
+        "tick labels as powers of ten"
+    );
+
+    let overlay = wv_figure(&columns, Layout::Overlay);
+    assert_eq!(overlay.grid, (2, 1));
+    assert_eq!(
+        overlay.legend(),
+        vec!["axis X", "axis Y", "axis Z", "axis X", "axis Y", "axis Z"]
+    );
+    let svg = render(&overlay, "wv_overlay_adis");
+    assert_eq!(svg.polygons, 6);
+    assert!(svg
+        .texts
+        .iter()
+        .any(|t| t.contains("Allan") || t.contains("wavelet-variance scale")));
+}
+
+#[test]
+fn figures_allan_deviation_of_a_precomputed_wv_and_the_recording() {
+    // the precomputed WV of the R package is read as it is
+    let series = read_wv_json(&data("precomputed/adis_wv.json"), None).unwrap();
+    let columns: Vec<Column<'_, WaveletVariance>> = series
+        .iter()
+        .map(|(n, w)| Column {
+            name: n,
+            unit: "u",
+            data: w,
+        })
+        .collect();
+    let figure = wv_figure(&columns, Layout::Grid);
+    let svg = render(&figure, "wv_grid_precomputed");
+    assert_eq!(svg.polygons, series.len());
+
+    let (cols, freq) = recording("adis_16405_imu1.csv.gz", 1 << 18);
+    let av = allan_variance(&cols[0].1, freq, &AllanOptions::default()).unwrap();
+    let figure = allan_figure(
+        &[Column {
+            name: &cols[0].0,
+            unit: "rad/s",
+            data: &av,
+        }],
+        Layout::Grid,
+    );
+    let svg = render(&figure, "avar_adis_gyro_x");
+    assert_eq!(svg.circles, av.tau_s.len());
+    assert!(svg.texts.iter().any(|t| t.contains("Allan deviation")));
+    assert!(
+        svg.texts.iter().any(|t| t.contains("cluster time")),
+        "the AV scale is named (METHODS §14.1)"
+    );
+}
+
+#[test]
+fn figures_classical_against_robust_shows_the_contamination() {
+    let (cols, freq) = recording("cont_imu1.csv.gz", usize::MAX);
+    let x = &cols[0].1;
+    let pair = (wv(x, freq, false), wv(x, freq, true));
+    let figure = compare_figure(&[Column {
+        name: "gyro_x",
+        unit: "rad/s",
+        data: &pair,
+    }]);
+    assert_eq!(figure.legend().len(), 4);
+    let svg = render(&figure, "compare_cont_imu1");
+    assert_eq!(svg.polygons, 2, "one band each");
+    assert_eq!(
+        svg.circles,
+        2 * pair.0.levels() + 2,
+        "a point per scale and estimator, and two legend markers"
+    );
+}
+
+#[test]
+fn figures_compare_with_an_undefined_robust_level_splits_its_band() {
+    let (cols, freq) = recording("cont_imu1.csv.gz", 1 << 16);
+    let x = &cols[0].1;
+    let (classical, mut robust) = (wv(x, freq, false), wv(x, freq, true));
+    for v in [&mut robust.wv, &mut robust.ci_low, &mut robust.ci_high] {
+        v[4] = f64::NAN;
+    }
+    let levels = classical.levels();
+    let pair = (classical, robust);
+    let svg = render(
+        &compare_figure(&[Column {
+            name: "gyro_x",
+            unit: "rad/s",
+            data: &pair,
+        }]),
+        "compare_undefined_level",
+    );
+    assert_eq!(
+        svg.polygons, 3,
+        "the robust band in two pieces around the undefined level"
+    );
+    assert_eq!(
+        svg.circles,
+        2 * levels - 1 + 2,
+        "no point for the undefined level (two legend markers)"
+    );
+}
+
+#[test]
+fn figures_fit_decomposition_names_every_process_with_its_value() {
+    let (cols, freq) = recording("adis_16405_imu1.csv.gz", usize::MAX);
+    let x = &cols[0].1;
+    let fit = Gmwm::new("2*AR1()+WN()+RW()".parse().unwrap())
+        .with_seed(1)
+        .fit(x, freq, &WvOptions::default())
+        .unwrap();
+    let figure = fit_figure(&[Column {
+        name: "gyro_x",
+        unit: "rad/s",
+        data: &fit,
+    }]);
+    let legend = figure.legend();
+    // band, empirical, model, and one line per component
+    assert_eq!(legend.len(), 3 + 4, "{legend:?}");
+    assert!(
+        legend
+            .iter()
+            .any(|l| l.starts_with("WN: N = ") && l.contains("rad/s/√Hz")),
+        "{legend:?}"
+    );
+    assert!(
+        legend.iter().any(|l| l.starts_with("RW: K = ")),
+        "{legend:?}"
+    );
+    assert!(
+        legend
+            .iter()
+            .any(|l| l.starts_with("AR1: T = ") && l.contains(" s, σ = ")),
+        "{legend:?}"
+    );
+    let svg = render(&figure, "fit_adis_gyro_x");
+    assert_eq!(svg.polygons, 1);
+    assert!(
+        svg.polylines >= 5,
+        "model and four components: {}",
+        svg.polylines
+    );
+}
+
+#[test]
+fn figures_fit_with_a_component_below_the_plot_says_so() {
+    let (cols, freq) = recording("adis_16405_imu1.csv.gz", 1 << 16);
+    let mut fit = Gmwm::new("AR1()+WN()".parse().unwrap())
+        .with_seed(1)
+        .fit(&cols[0].1, freq, &WvOptions::default())
+        .unwrap();
+    for v in &mut fit.implied_wv.processes[0].wv {
+        *v *= 1e-12;
+    }
+    let figure = fit_figure(&[Column {
+        name: "gyro_x",
+        unit: "rad/s",
+        data: &fit,
+    }]);
+    let svg = render(&figure, "fit_component_below");
+    assert!(
+        svg.texts
+            .iter()
+            .any(|t| t.starts_with("AR1: ") && t.ends_with("(below the plot)")),
+        "{:?}",
+        svg.texts
+    );
+}
+
+#[test]
+fn figures_one_level_still_has_axes_and_its_interval() {
+    let x: Vec<f64> = (0..64).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+    let opts = WvOptions {
+        levels: Some(1),
+        ..WvOptions::default()
+    };
+    let w = gmwm::wavelet_variance(&x, 10.0, &opts).unwrap();
+    assert_eq!(w.levels(), 1);
+    let figure = wv_figure(
+        &[Column {
+            name: "x",
+            unit: "V",
+            data: &w,
+        }],
+        Layout::Grid,
+    );
+    let svg = render(&figure, "wv_one_level");
+    assert_eq!(svg.circles, 1);
+    assert_eq!(svg.polygons, 0, "a one-level band is an interval bar");
+    assert!(
+        svg.texts
+            .iter()
+            .any(|t| t.contains('×') || t.starts_with("10")),
+        "ticks exist"
+    );
+}
+
+#[test]
+fn figures_selection_and_ieee_on_the_adis_gyroscope() {
+    let (cols, freq) = recording("adis_16405_imu1.csv.gz", 1 << 18);
+    let x = &cols[0].1;
+    let selection = Wic::nested("2*AR1()+WN()+RW()".parse().unwrap())
+        .unwrap()
+        .with_bootstrap(10)
+        .with_draws(2000)
+        .select(x, freq)
+        .unwrap();
+    let figure = selection_figure(&[Column {
+        name: "gyro_x",
+        unit: "rad/s",
+        data: &selection,
+    }]);
+    assert_eq!(figure.grid, (1, 2));
+    let svg = render(&figure, "select_adis_gyro_x");
+    let shown = selection.rows.len().min(gmwm_plot::WIC_ROWS);
+    // two segments per shown row, plus the legend's two swatches, plus the fit panel's band
+    assert!(
+        svg.texts.iter().any(|t| t.starts_with("▶ ")),
+        "the selected row is marked"
+    );
+    assert!(svg.polygons + count_rects(&figure) >= 2 * shown);
+
+    let av = allan_variance(x, freq, &AllanOptions::default()).unwrap();
+    let readoff = ieee_readoff(&av).unwrap();
+    let pair = (av, readoff);
+    let figure = ieee_figure(&[Column {
+        name: "gyro_x",
+        unit: "rad/s",
+        data: &pair,
+    }]);
+    let legend = figure.legend();
+    assert!(legend.iter().any(|l| l.starts_with("N = ")), "{legend:?}");
+    assert!(legend.iter().any(|l| l.starts_with("B = ")), "{legend:?}");
+    render(&figure, "ieee_adis_gyro_x");
+}
+
+/// Rectangles of the SVG (bars are `rect` elements).
+fn count_rects(figure: &Figure) -> usize {
+    let svg = figure.svg().unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    doc.descendants().filter(|n| n.has_tag_name("rect")).count()
+}
+
+#[test]
+fn figures_refuse_a_bad_name_or_size_in_one_line() {
+    let x: Vec<f64> = (0..256).map(|i| (i % 7) as f64).collect();
+    let w = gmwm::wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+    let figure = wv_figure(
+        &[Column {
+            name: "x",
+            unit: "u",
+            data: &w,
+        }],
+        Layout::Grid,
+    );
+    let e = figure
+        .save(std::path::Path::new("/tmp/figure.jpg"))
+        .unwrap_err();
+    assert!(e.to_string().contains(".svg or .png"), "{e}");
+    let e = figure.clone().with_size((100, 50)).svg().unwrap_err();
+    assert!(e.to_string().contains("100x50"), "{e}");
+}
