@@ -23,7 +23,13 @@ const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/browser/fixtu
 
 /// Runs `gmwm plot ...`, asserts success and returns the figure's bytes.
 fn plot(args: &[&str], out: &Path) -> Vec<u8> {
-    let result = gmwm().arg("plot").args(args).arg("-o").arg(out).output().unwrap();
+    let result = gmwm()
+        .arg("plot")
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap();
     assert!(
         result.status.success(),
         "{args:?}: {}",
@@ -53,34 +59,72 @@ fn plot_every_figure_on_the_real_recordings() {
     assert!(svg.starts_with("<svg") && svg.contains("gyro_z") && svg.contains("accel_x"));
     assert!(svg.contains("(deg/s)²"), "the sidecar's unit on the axis");
 
-    let png = plot(&["wv", adis, "--overlay", "--width", "900", "--height", "700"], &dir.path().join("wv.png"));
+    let png = plot(
+        &["wv", adis, "--overlay", "--width", "900", "--height", "700"],
+        &dir.path().join("wv.png"),
+    );
     assert_eq!(png_size(&png), (900, 700));
 
-    let svg = String::from_utf8(plot(&["avar", adis, "--columns", "gyro_x"], &dir.path().join("av.svg"))).unwrap();
+    let svg = String::from_utf8(plot(
+        &["avar", adis, "--columns", "gyro_x"],
+        &dir.path().join("av.svg"),
+    ))
+    .unwrap();
     assert!(svg.contains("Allan deviation") && svg.contains("cluster time"));
 
     let svg = String::from_utf8(plot(&["compare", cont], &dir.path().join("cmp.svg"))).unwrap();
     assert!(svg.contains("robust WV (efficiency 0.6)"));
 
     let svg = String::from_utf8(plot(
-        &["fit", adis, "--columns", "gyro_x", "--model", "AR1()+WN()+RW()", "--G", "2000"],
+        &[
+            "fit",
+            adis,
+            "--columns",
+            "gyro_x",
+            "--model",
+            "AR1()+WN()+RW()",
+            "--G",
+            "2000",
+        ],
         &dir.path().join("fit.svg"),
     ))
     .unwrap();
-    assert!(svg.contains("WN: N = ") && svg.contains("RW: K = "), "legend with values");
+    assert!(
+        svg.contains("WN: N = ") && svg.contains("RW: K = "),
+        "legend with values"
+    );
 
     let png = plot(
-        &["select", adis, "--columns", "gyro_x", "--model", "AR1()+WN()+RW()", "--bootstrap", "10", "--G", "2000"],
+        &[
+            "select",
+            adis,
+            "--columns",
+            "gyro_x",
+            "--model",
+            "AR1()+WN()+RW()",
+            "--bootstrap",
+            "10",
+            "--G",
+            "2000",
+        ],
         &dir.path().join("select.png"),
     );
     assert_eq!(png_size(&png), (1500, 560));
 
-    let svg = String::from_utf8(plot(&["ieee", adis, "--columns", "gyro_x"], &dir.path().join("ieee.svg"))).unwrap();
+    let svg = String::from_utf8(plot(
+        &["ieee", adis, "--columns", "gyro_x"],
+        &dir.path().join("ieee.svg"),
+    ))
+    .unwrap();
     assert!(svg.contains("N = ") && svg.contains("slope −1/2"));
 
     // a saved WV (precomputed by the R package) is drawn as it is
     let pre = data("precomputed/adis_wv.json");
-    let svg = String::from_utf8(plot(&["wv", pre.to_str().unwrap()], &dir.path().join("pre.svg"))).unwrap();
+    let svg = String::from_utf8(plot(
+        &["wv", pre.to_str().unwrap()],
+        &dir.path().join("pre.svg"),
+    ))
+    .unwrap();
     assert!(svg.contains("gyro_x"));
 }
 
@@ -88,11 +132,17 @@ fn plot_every_figure_on_the_real_recordings() {
 fn plot_refuses_bad_flags_in_one_line() {
     let adis = data("adis_16405_imu1.csv.gz");
     assert_usage_error(
-        gmwm().args(["plot", "wv"]).arg(&adis).args(["-o", "/tmp/fig.jpg"]),
+        gmwm()
+            .args(["plot", "wv"])
+            .arg(&adis)
+            .args(["-o", "/tmp/fig.jpg"]),
         &["--output", ".svg or .png"],
     );
     assert_usage_error(
-        gmwm().args(["plot", "wv"]).arg(&adis).args(["--json", "-o", "/tmp/fig.svg"]),
+        gmwm()
+            .args(["plot", "wv"])
+            .arg(&adis)
+            .args(["--json", "-o", "/tmp/fig.svg"]),
         &["--json"],
     );
     let out = gmwm().args(["plot", "wv"]).arg(&adis).output().unwrap();
@@ -101,7 +151,10 @@ fn plot_refuses_bad_flags_in_one_line() {
 
 /// The JSON embedded in the page.
 fn embedded_json(html: &str) -> serde_json::Value {
-    let start = html.find("id=\"calibration-json\">").expect("embedded JSON") + "id=\"calibration-json\">".len();
+    let start = html
+        .find("id=\"calibration-json\">")
+        .expect("embedded JSON")
+        + "id=\"calibration-json\">".len();
     let end = start + html[start..].find("</script>").unwrap();
     serde_json::from_str(&html[start..end].replace("\\u003c", "<")).unwrap()
 }
@@ -120,25 +173,43 @@ fn report_numbers_are_the_json_and_chromium_finds_no_fault() {
         .arg(&json_path)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("(HTML report, 25 figures)"), "{stdout}");
     let html = std::fs::read_to_string(&html_path).unwrap();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
-    assert_eq!(embedded_json(&html), json, "the page carries the --json document");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    assert_eq!(
+        embedded_json(&html),
+        json,
+        "the page carries the --json document"
+    );
     // every headline number of every axis appears in the page as --json gives it
     let axes = json["axes"].as_array().unwrap();
     assert_eq!(axes.len(), 6);
     for axis in axes {
         let column = axis["column"].as_str().unwrap();
-        assert!(html.contains(&format!("id=\"axis-{column}\"")), "{column} has its section");
+        assert!(
+            html.contains(&format!("id=\"axis-{column}\"")),
+            "{column} has its section"
+        );
         for key in ["noise_density", "random_walk", "bias_instability"] {
             let value = axis[key]["value"].as_f64().unwrap();
             let shown = gmwm_plot::style::number(value);
-            assert!(html.contains(&shown), "{column} {key}: {shown} not in the page");
+            assert!(
+                html.contains(&shown),
+                "{column} {key}: {shown} not in the page"
+            );
         }
         let wic = axis["selection"]["rows"][0]["wic"].as_f64().unwrap();
-        assert!(html.contains(&gmwm_plot::style::number(wic)), "{column}: WIC {wic}");
+        assert!(
+            html.contains(&gmwm_plot::style::number(wic)),
+            "{column}: WIC {wic}"
+        );
         let summary = axis["contamination"]["summary"].as_str().unwrap();
         assert!(html.contains(summary), "{column}: contamination sentence");
     }
@@ -190,7 +261,11 @@ fn report_browser_checker_catches_each_fault() {
     let dir = tempfile::tempdir().unwrap();
     let shot = dir.path().join("shot.png");
     let good = checker(&Path::new(FIXTURES).join("good.html"), &shot, 2);
-    assert!(good.status.success(), "{}", String::from_utf8_lossy(&good.stderr));
+    assert!(
+        good.status.success(),
+        "{}",
+        String::from_utf8_lossy(&good.stderr)
+    );
     for (page, expected) in [
         ("console_error.html", "console error"),
         ("page_error.html", "page error"),
@@ -221,11 +296,23 @@ fn calibrate_report_flag_writes_the_same_page() {
     let out = gmwm()
         .args(["calibrate"])
         .arg(&csv)
-        .args(["--model", "AR1()+WN()+RW()", "--bootstrap", "10", "--G", "1000", "--report"])
+        .args([
+            "--model",
+            "AR1()+WN()+RW()",
+            "--bootstrap",
+            "10",
+            "--G",
+            "1000",
+            "--report",
+        ])
         .arg(&html)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("HTML report"), "{stdout}");
     let page = std::fs::read_to_string(&html).unwrap();

@@ -136,10 +136,10 @@ fn figures_wv_grid_and_overlay_of_the_adis_imu() {
     );
     let svg = render(&overlay, "wv_overlay_adis");
     assert_eq!(svg.polygons, 6);
-    assert!(svg
-        .texts
-        .iter()
-        .any(|t| t.contains("Allan") || t.contains("wavelet-variance scale")));
+    assert!(
+        svg.texts.iter().any(|t| t == gmwm_plot::WV_SCALE),
+        "the WV scale is named (METHODS §14.1)"
+    );
 }
 
 #[test]

@@ -18,8 +18,16 @@ fn imu() -> Imu {
         })
         .collect();
     let info = vec![
-        SensorInfo { sensor: Sensor::Gyroscope, axis: "X".into(), unit: Some("rad/s".into()) },
-        SensorInfo { sensor: Sensor::Accelerometer, axis: "X".into(), unit: Some("m/s^2".into()) },
+        SensorInfo {
+            sensor: Sensor::Gyroscope,
+            axis: "X".into(),
+            unit: Some("rad/s".into()),
+        },
+        SensorInfo {
+            sensor: Sensor::Accelerometer,
+            axis: "X".into(),
+            unit: Some("m/s^2".into()),
+        },
     ];
     Imu::new(columns, info, 100.0).unwrap()
 }
@@ -39,20 +47,38 @@ fn report_holds_every_section_and_the_calibration_numbers() {
     let ctx = ReportContext {
         file: "sim.csv".into(),
         json: serde_json::to_string(&report).unwrap(),
-        exports: vec![("kalibr".into(), "imu.yaml".into(), "accelerometer_noise_density: 1\n".into())],
+        exports: vec![(
+            "kalibr".into(),
+            "imu.yaml".into(),
+            "accelerometer_noise_density: 1\n".into(),
+        )],
         ..ReportContext::default()
     };
     let html = render(&report, &ctx).unwrap();
     // one WV grid, then per axis selection, fit, IEEE and classical-vs-robust figures
     assert_eq!(html.matches("<figure>").count(), 1 + 4 * report.axes.len());
-    assert_eq!(html.matches("data:image/svg+xml;base64,").count(), 1 + 4 * report.axes.len());
-    for section in ["id=\"recording\"", "id=\"overview\"", "id=\"wv\"", "id=\"filters\"", "id=\"axis-gyro_x\"", "id=\"axis-accel_x\""] {
+    assert_eq!(
+        html.matches("data:image/svg+xml;base64,").count(),
+        1 + 4 * report.axes.len()
+    );
+    for section in [
+        "id=\"recording\"",
+        "id=\"overview\"",
+        "id=\"wv\"",
+        "id=\"filters\"",
+        "id=\"axis-gyro_x\"",
+        "id=\"axis-accel_x\"",
+    ] {
         assert!(html.contains(section), "{section}");
     }
     for axis in &report.axes {
         let n = axis.noise_density.as_ref().unwrap();
         assert!(html.contains(&number(n.value)), "{}: N", axis.column);
-        assert!(html.contains(&axis.verdict.summary), "{}: verdict", axis.column);
+        assert!(
+            html.contains(&axis.verdict.summary),
+            "{}: verdict",
+            axis.column
+        );
     }
     assert!(html.contains("imu.yaml") && html.contains("accelerometer_noise_density"));
     assert!(!html.contains("src=\"http") && !html.contains("href=\"http"));
@@ -61,9 +87,12 @@ fn report_holds_every_section_and_the_calibration_numbers() {
 
 #[test]
 fn report_says_when_contamination_was_not_checked() {
-    let report = Calibration::new(CalibrationOptions { robust_check: None, ..options() })
-        .run(&imu())
-        .unwrap();
+    let report = Calibration::new(CalibrationOptions {
+        robust_check: None,
+        ..options()
+    })
+    .run(&imu())
+    .unwrap();
     let html = render(&report, &ReportContext::default()).unwrap();
     assert_eq!(html.matches("<figure>").count(), 1 + 3 * report.axes.len());
     assert!(html.contains("Not compared"));
