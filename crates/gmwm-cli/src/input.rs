@@ -267,6 +267,8 @@ pub struct LoadedRecording {
     pub imu: gmwm::imu::Imu,
     /// The ROS topic read, if any.
     pub topic: Option<String>,
+    /// What it was read from.
+    pub source: gmwm::imu::RecordingSource,
     /// What the reader noticed, one line each.
     pub notes: Vec<String>,
 }
@@ -283,6 +285,7 @@ pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
         path: rec.path,
         imu: rec.imu,
         topic: rec.topic,
+        source: rec.source,
         notes: rec.notes,
     })
 }

@@ -20,6 +20,8 @@ use std::fmt::Write as _;
 pub struct ReportContext {
     /// The recording's file, as the user named it.
     pub file: String,
+    /// What it was read from (text, binary records, a ROS container and topic).
+    pub source: String,
     /// The ROS topic read, if any.
     pub topic: Option<String>,
     /// What the reader noticed (timestamps, columns left out), one line each.
@@ -135,6 +137,7 @@ fn summary(out: &mut String, report: &CalibrationReport, ctx: &ReportContext) {
     };
     let mut kv = vec![
         ("file", esc(&ctx.file)),
+        ("read as", esc(&ctx.source)),
         ("name", esc(report.name.as_deref().unwrap_or("—"))),
         ("samples per axis", report.samples.to_string()),
         ("sampling rate", format!("{} Hz", number(report.freq_hz))),

@@ -338,12 +338,14 @@ fn figures_selection_and_ieee_on_the_adis_gyroscope() {
     assert_eq!(figure.grid, (1, 2));
     let svg = render(&figure, "select_adis_gyro_x");
     let shown = selection.rows.len().min(gmwm_plot::WIC_ROWS);
-    // two segments per shown row, plus the legend's two swatches, plus the fit panel's band
+    // two segments per shown row, the bar legend's two swatches, the fit legend's band swatch
+    // and the white background
     assert!(
         svg.texts.iter().any(|t| t.starts_with("▶ ")),
         "the selected row is marked"
     );
-    assert!(svg.polygons + count_rects(&figure) >= 2 * shown);
+    assert_eq!(count_rects(&figure), 2 * shown + 2 + 1 + 1);
+    assert_eq!(svg.polygons, 1, "the fit panel's band");
 
     let av = allan_variance(x, freq, &AllanOptions::default()).unwrap();
     let readoff = ieee_readoff(&av).unwrap();

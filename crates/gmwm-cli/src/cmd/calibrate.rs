@@ -201,6 +201,15 @@ fn write_report(
     }
     let ctx = gmwm_plot::report::ReportContext {
         file: args.input.file.display().to_string(),
+        source: match &recording.source {
+            gmwm::imu::RecordingSource::Records { record_type } => {
+                format!("binary IMU records ({record_type})")
+            }
+            gmwm::imu::RecordingSource::Ros { container, topic } => {
+                format!("{container}, topic {topic}")
+            }
+            _ => "delimited text or raw binary columns".to_string(),
+        },
         topic: recording.topic.clone(),
         reader_notes: recording.notes.clone(),
         timing: recording.imu.timing().map(ToString::to_string),
