@@ -145,6 +145,23 @@ fn plot_refuses_bad_flags_in_one_line() {
             .args(["--json", "-o", "/tmp/fig.svg"]),
         &["--json"],
     );
+    assert_usage_error(
+        gmwm()
+            .args(["plot", "ieee"])
+            .arg(&adis)
+            .args(["--kind", "modified", "-o", "/tmp/fig.svg"]),
+        &["overlapping Allan variance"],
+    );
+    assert_usage_error(
+        gmwm().args(["plot", "fit"]).arg(&adis).args([
+            "--model",
+            "WN()",
+            "--inference",
+            "-o",
+            "/tmp/fig.svg",
+        ]),
+        &["--inference"],
+    );
     let out = gmwm().args(["plot", "wv"]).arg(&adis).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "-o is required");
 }

@@ -445,90 +445,67 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 band.labelled(format!("{level:.0}% interval")),
                 points.labelled("Allan deviation"),
             ];
-            let span = |f: &dyn Fn(f64) -> f64| -> (Vec<f64>, Vec<f64>) {
-                let (a, b) = (
-                    av.tau_s.first().copied().unwrap_or(1.0),
-                    av.tau_s.last().copied().unwrap_or(1.0),
-                );
-                let xs = vec![a.min(1.0) / 2.0, b.max(3.0) * 2.0];
-                let ys = xs.iter().map(|&t| f(t)).collect();
-                (xs, ys)
-            };
+            // each line spans the observed cluster times and the read-off time
+            let xs = [
+                av.tau_s.first().copied().unwrap_or(1.0).min(1.0) / 2.0,
+                av.tau_s.last().copied().unwrap_or(1.0).max(3.0) * 2.0,
+            ];
             let u = pretty(c.unit);
+            // (symbol, value, the line sigma(tau), where it is read, colour, legend)
+            let terms: [(
+                &str,
+                Option<f64>,
+                &dyn Fn(f64, f64) -> f64,
+                f64,
+                usize,
+                String,
+            ); 3] = [
+                (
+                    "N",
+                    readoff.n.value,
+                    &|n, t| n / t.sqrt(),
+                    1.0,
+                    4,
+                    format!("{u}/√Hz (slope −1/2, at 1 s)"),
+                ),
+                (
+                    "B",
+                    readoff.b.value,
+                    &|b, _| b * gmwm::calib::ieee::FLICKER_FACTOR,
+                    readoff.b.at_tau_s,
+                    3,
+                    format!(
+                        "{u} (slope 0: min σ / 0.664, at {} s)",
+                        number(readoff.b.at_tau_s)
+                    ),
+                ),
+                (
+                    "K",
+                    readoff.k.value,
+                    &|k, t| k * (t / 3.0).sqrt(),
+                    3.0,
+                    5,
+                    format!("{u}/√s (slope +1/2, at 3 s)"),
+                ),
+            ];
             let mut missing = Vec::new();
-            if let Some(n) = readoff.n.value {
-                let (xs, ys) = span(&|t| n / t.sqrt());
+            for (symbol, value, line, at, colour, unit_text) in terms {
+                let Some(v) = value else {
+                    missing.push(symbol);
+                    continue;
+                };
+                let ys: Vec<f64> = xs.iter().map(|&t| line(v, t)).collect();
+                let dashed = Mark::Line {
+                    width: 2,
+                    dashed: true,
+                };
+                series.push(Series::new(dashed, &xs, &ys).coloured(colour).clipped());
                 series.push(
-                    Series::new(
-                        Mark::Line {
-                            width: 2,
-                            dashed: true,
-                        },
-                        &xs,
-                        &ys,
-                    )
-                    .coloured(4)
-                    .clipped(),
-                );
-                series.push(
-                    Series::new(Mark::Points, &[1.0], &[n])
-                        .coloured(4)
+                    Series::new(Mark::Points, &[at], &[line(v, at)])
+                        .coloured(colour)
                         .clipped()
-                        .labelled(format!("N = {} {u}/√Hz (slope −1/2, at 1 s)", number(n))),
+                        .labelled(format!("{symbol} = {} {unit_text}", number(v))),
                 );
-            } else {
-                missing.push("N");
-            }
-            if let Some(b) = readoff.b.value {
-                let floor = b * gmwm::calib::ieee::FLICKER_FACTOR;
-                let (xs, _) = span(&|_| floor);
-                series.push(
-                    Series::new(
-                        Mark::Line {
-                            width: 2,
-                            dashed: true,
-                        },
-                        &xs,
-                        &[floor, floor],
-                    )
-                    .coloured(3)
-                    .clipped(),
-                );
-                series.push(
-                    Series::new(Mark::Points, &[readoff.b.at_tau_s], &[floor])
-                        .coloured(3)
-                        .clipped()
-                        .labelled(format!(
-                            "B = {} {u} (slope 0: min σ / 0.664, at {} s)",
-                            number(b),
-                            number(readoff.b.at_tau_s)
-                        )),
-                );
-            } else {
-                missing.push("B");
-            }
-            if let Some(k) = readoff.k.value {
-                let (xs, ys) = span(&|t| k * (t / 3.0).sqrt());
-                series.push(
-                    Series::new(
-                        Mark::Line {
-                            width: 2,
-                            dashed: true,
-                        },
-                        &xs,
-                        &ys,
-                    )
-                    .coloured(5)
-                    .clipped(),
-                );
-                series.push(
-                    Series::new(Mark::Points, &[3.0], &[k])
-                        .coloured(5)
-                        .clipped()
-                        .labelled(format!("K = {} {u}/√s (slope +1/2, at 3 s)", number(k))),
-                );
-            } else {
-                missing.push("K");
             }
             let mut title = format!("{}: IEEE 952 read-off", c.name);
             if !missing.is_empty() {

@@ -359,6 +359,48 @@ fn figures_selection_and_ieee_on_the_adis_gyroscope() {
     assert!(legend.iter().any(|l| l.starts_with("N = ")), "{legend:?}");
     assert!(legend.iter().any(|l| l.starts_with("B = ")), "{legend:?}");
     render(&figure, "ieee_adis_gyro_x");
+    // each read-off point lies on its own slope line: sigma = N / sqrt(tau) through (1 s, N),
+    // the flat line at 0.664 B through the minimum, sigma = K sqrt(tau / 3) through (3 s, K)
+    let gmwm_plot::PanelKind::LogLog(series) = &figure.panels[0].kind else {
+        panic!("a log-log panel")
+    };
+    let readoff = &pair.1;
+    for (symbol, value, at, line) in [
+        (
+            "N",
+            readoff.n.value,
+            1.0,
+            &(|v: f64, t: f64| v / t.sqrt()) as &dyn Fn(f64, f64) -> f64,
+        ),
+        ("B", readoff.b.value, readoff.b.at_tau_s, &|v: f64, _| {
+            v * 0.664
+        }),
+        ("K", readoff.k.value, 3.0, &|v: f64, t: f64| {
+            v * (t / 3.0).sqrt()
+        }),
+    ] {
+        let Some(v) = value else { continue };
+        let k = series
+            .iter()
+            .position(|s| {
+                s.label
+                    .as_deref()
+                    .is_some_and(|l| l.starts_with(&format!("{symbol} = ")))
+            })
+            .unwrap_or_else(|| panic!("{symbol} has a legend entry"));
+        let (point, slope) = (&series[k], &series[k - 1]);
+        assert_eq!(
+            (point.x[0], point.y[0]),
+            (at, line(v, at)),
+            "{symbol} read-off point"
+        );
+        for (x, y) in slope.x.iter().zip(&slope.y) {
+            assert!(
+                (y / line(v, *x) - 1.0).abs() < 1e-12,
+                "{symbol} line at {x}"
+            );
+        }
+    }
 }
 
 /// Rectangles of the SVG (bars are `rect` elements).

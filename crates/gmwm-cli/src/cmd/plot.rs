@@ -1,14 +1,14 @@
 //! `gmwm plot`: one figure of the matching command's results (gmwm-plot renders; the numbers
 //! are those `gmwm wv|avar|fit|select --json` gives).
 
-use crate::args::{FigureArgs, InputArgs, OutputArgs, PlotArgs, PlotCommand};
+use crate::args::{FigureArgs, InputArgs, KindArg, OutputArgs, PlotArgs, PlotCommand};
 use crate::input::is_wv;
 use crate::UsageError;
 use anyhow::{Context, Result};
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{Sensor, SensorInfo};
 use gmwm::units::SignalUnit;
-use gmwm::{AllanKind, RobustOptions, WvOptions};
+use gmwm::{RobustOptions, WvOptions};
 use gmwm_plot::{Column, Figure, ImageFormat, Layout};
 use std::io::Write;
 
@@ -105,34 +105,77 @@ fn names<T>(items: &[(String, T)]) -> Vec<String> {
     items.iter().map(|(n, _)| n.clone()).collect()
 }
 
+/// Draws `items` with `build` in the columns' units and writes the figure.
+fn draw<T>(
+    input: &InputArgs,
+    items: &[(String, T)],
+    build: impl Fn(&[Column<'_, T>]) -> Figure,
+    figure: &FigureArgs,
+    out: &mut impl Write,
+) -> Result<()> {
+    let units = column_units(input, &names(items));
+    save(build(&columns(items, &units)), figure, out)
+}
+
+/// Flags the figure cannot honour, refused before any computation.
+fn check_flags(command: &PlotCommand) -> Result<()> {
+    let (output, figure) = match command {
+        PlotCommand::Wv { args, figure } | PlotCommand::Compare { args, figure } => {
+            (&args.output, figure)
+        }
+        PlotCommand::Avar { args, figure } => (&args.output, figure),
+        PlotCommand::Ieee { args, figure } => {
+            if args.kind != KindArg::Overlapping {
+                return Err(UsageError(
+                    "gmwm plot ieee reads the overlapping Allan variance (IEEE Std 952): drop --kind"
+                        .into(),
+                )
+                .into());
+            }
+            (&args.output, figure)
+        }
+        PlotCommand::Fit { args, figure } => {
+            if args.inference {
+                return Err(UsageError(
+                    "gmwm plot fit draws the fit: --inference belongs to gmwm fit".into(),
+                )
+                .into());
+            }
+            (&args.output, figure)
+        }
+        PlotCommand::Select { args, figure } => (&args.output, figure),
+    };
+    no_table_output(output)?;
+    check_output(figure)
+}
+
 /// Runs the subcommand.
 pub fn run(args: &PlotArgs, out: &mut impl Write) -> Result<()> {
+    check_flags(&args.figure)?;
     match &args.figure {
         PlotCommand::Wv { args, figure } => {
-            no_table_output(&args.output)?;
-            check_output(figure)?;
             let items = crate::cmd::wv::compute(args)?;
-            let units = column_units(&args.input, &names(&items));
-            save(
-                gmwm_plot::wv_figure(&columns(&items, &units), layout(figure)),
+            let layout = layout(figure);
+            draw(
+                &args.input,
+                &items,
+                |c| gmwm_plot::wv_figure(c, layout),
                 figure,
                 out,
             )
         }
         PlotCommand::Avar { args, figure } => {
-            no_table_output(&args.output)?;
-            check_output(figure)?;
             let items = crate::cmd::avar::compute(args)?;
-            let units = column_units(&args.input, &names(&items));
-            save(
-                gmwm_plot::allan_figure(&columns(&items, &units), layout(figure)),
+            let layout = layout(figure);
+            draw(
+                &args.input,
+                &items,
+                |c| gmwm_plot::allan_figure(c, layout),
                 figure,
                 out,
             )
         }
         PlotCommand::Compare { args, figure } => {
-            no_table_output(&args.output)?;
-            check_output(figure)?;
             anyhow::ensure!(
                 !is_wv(&args.input),
                 "{}: classical against robust needs the samples, not a saved wavelet variance",
@@ -156,58 +199,32 @@ pub fn run(args: &PlotArgs, out: &mut impl Write) -> Result<()> {
                     gmwm::wavelet_variance(x, loaded.freq_hz, &robust_opts)?,
                 ))
             })?;
-            let units = column_units(&args.input, &names(&items));
-            save(
-                gmwm_plot::compare_figure(&columns(&items, &units)),
-                figure,
-                out,
-            )
+            draw(&args.input, &items, gmwm_plot::compare_figure, figure, out)
         }
         PlotCommand::Fit { args, figure } => {
-            no_table_output(&args.output)?;
-            check_output(figure)?;
-            if args.inference {
-                return Err(UsageError(
-                    "gmwm plot fit draws the fit: --inference belongs to gmwm fit".into(),
-                )
-                .into());
-            }
             let (_, fits) = crate::cmd::fit::compute(args)?;
-            let units = column_units(&args.input, &names(&fits));
-            save(gmwm_plot::fit_figure(&columns(&fits, &units)), figure, out)
+            draw(&args.input, &fits, gmwm_plot::fit_figure, figure, out)
         }
         PlotCommand::Select { args, figure } => {
-            no_table_output(&args.output)?;
-            check_output(figure)?;
             let selections = crate::cmd::select::compute(args)?;
-            let units = column_units(&args.input, &names(&selections));
-            save(
-                gmwm_plot::selection_figure(&columns(&selections, &units)),
+            draw(
+                &args.input,
+                &selections,
+                gmwm_plot::selection_figure,
                 figure,
                 out,
             )
         }
         PlotCommand::Ieee { args, figure } => {
-            no_table_output(&args.output)?;
-            check_output(figure)?;
             let items = crate::cmd::avar::compute(args)?;
             let mut pairs = Vec::with_capacity(items.len());
             for (name, av) in items {
-                anyhow::ensure!(
-                    av.kind == AllanKind::Overlapping,
-                    "the IEEE 952 read-off uses the overlapping Allan variance: drop --kind"
-                );
                 let readoff = ieee_readoff(&av)
                     .map_err(gmwm::Error::from)
                     .with_context(|| format!("{}: column {name}", args.input.file.display()))?;
                 pairs.push((name, (av, readoff)));
             }
-            let units = column_units(&args.input, &names(&pairs));
-            save(
-                gmwm_plot::ieee_figure(&columns(&pairs, &units)),
-                figure,
-                out,
-            )
+            draw(&args.input, &pairs, gmwm_plot::ieee_figure, figure, out)
         }
     }
 }
