@@ -200,6 +200,7 @@ fn overview(out: &mut String, report: &CalibrationReport) {
             "random walk K",
             "bias instability B",
             "fit",
+            "contamination",
         ],
     );
     out.push_str("<tbody>\n");
@@ -217,6 +218,11 @@ fn overview(out: &mut String, report: &CalibrationReport) {
                     "explains the WV".into()
                 } else {
                     "<b>misfit</b>".into()
+                },
+                match &a.contamination {
+                    Some(c) if c.matters => "<b>matters</b>".into(),
+                    Some(_) => "does not matter".into(),
+                    None => "not checked".into(),
                 },
             ],
         );
@@ -451,7 +457,7 @@ table.kv th{background:#f6f6f6;font-weight:600;white-space:nowrap}tr.selected td
 figure{margin:12px 0 20px}figure img{max-width:100%;height:auto;border:1px solid #e3e3e3}figcaption{font-size:13px;color:#333;margin-top:4px}
 pre{background:#f6f6f6;border:1px solid #ddd;padding:8px;font-size:12.5px;overflow-x:auto;white-space:pre-wrap}
 ul.notes{font-size:14px}nav a{margin-right:10px}.meta{color:#555;font-size:13px}
-@media print{body{max-width:none;margin:0}section.axis{break-before:page}figure,table,pre{break-inside:avoid}nav{display:none}a{color:inherit;text-decoration:none}}
+@media print{body{max-width:none;margin:0}section.axis{break-before:page}figure,table,pre,.verdict{break-inside:avoid}h2,h3{break-after:avoid}nav{display:none}a{color:inherit;text-decoration:none}}
 ";
 
 /// Renders the page.
