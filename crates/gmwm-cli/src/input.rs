@@ -269,6 +269,8 @@ pub struct LoadedRecording {
     pub topic: Option<String>,
     /// What it was read from.
     pub source: gmwm::imu::RecordingSource,
+    /// What the time stamps say, when there are stamps (a time column or ROS header stamps).
+    pub timing: Option<gmwm::imu::TimingReport>,
     /// What the reader noticed, one line each.
     pub notes: Vec<String>,
 }
@@ -286,6 +288,7 @@ pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
         imu: rec.imu,
         topic: rec.topic,
         source: rec.source,
+        timing: rec.timing,
         notes: rec.notes,
     })
 }

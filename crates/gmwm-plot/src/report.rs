@@ -22,8 +22,6 @@ pub struct ReportContext {
     pub file: String,
     /// What it was read from (text, binary records, a ROS container and topic).
     pub source: String,
-    /// The ROS topic read, if any.
-    pub topic: Option<String>,
     /// What the reader noticed (timestamps, columns left out), one line each.
     pub reader_notes: Vec<String>,
     /// The timestamp checks, as text (`None`: no time column).
@@ -135,7 +133,7 @@ fn summary(out: &mut String, report: &CalibrationReport, ctx: &ReportContext) {
     } else {
         format!("{} s", number(report.duration_s))
     };
-    let mut kv = vec![
+    let kv = vec![
         ("file", esc(&ctx.file)),
         ("read as", esc(&ctx.source)),
         ("name", esc(report.name.as_deref().unwrap_or("—"))),
@@ -170,14 +168,17 @@ fn summary(out: &mut String, report: &CalibrationReport, ctx: &ReportContext) {
             format!("{:.0}%", 100.0 * (1.0 - report.alpha)),
         ),
     ];
-    if let Some(t) = &ctx.topic {
-        kv.insert(1, ("ROS topic", esc(t)));
-    }
     for (k, v) in kv {
         let _ = writeln!(out, "<tr><th>{k}</th><td>{v}</td></tr>");
     }
     out.push_str("</table>\n");
-    let notes: Vec<&String> = ctx.reader_notes.iter().chain(&report.checks).collect();
+    // the timestamp checks have their own row
+    let notes: Vec<&String> = ctx
+        .reader_notes
+        .iter()
+        .filter(|n| Some(n.as_str()) != ctx.timing.as_deref())
+        .chain(&report.checks)
+        .collect();
     if !notes.is_empty() {
         out.push_str("<ul class=\"notes\">");
         for n in notes {

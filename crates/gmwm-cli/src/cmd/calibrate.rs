@@ -210,9 +210,8 @@ fn write_report(
             }
             _ => "delimited text or raw binary columns".to_string(),
         },
-        topic: recording.topic.clone(),
         reader_notes: recording.notes.clone(),
-        timing: recording.imu.timing().map(ToString::to_string),
+        timing: recording.timing.as_ref().map(ToString::to_string),
         command: std::iter::once("gmwm".to_string())
             .chain(std::env::args().skip(1))
             .collect::<Vec<_>>()
