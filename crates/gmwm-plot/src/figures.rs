@@ -428,6 +428,17 @@ pub fn selection_figure(columns: &[Column<'_, ModelSelection>]) -> Figure {
     Figure::new(panels, (n, 2), (1500, 560 * n as u32))
 }
 
+/// One IEEE 952 term on the Allan deviation: its line `sigma(value, tau)` and where it is
+/// read (METHODS §14.3).
+struct SlopeLine {
+    symbol: &'static str,
+    value: Option<f64>,
+    sigma: fn(f64, f64) -> f64,
+    at_tau_s: f64,
+    colour: usize,
+    legend: String,
+}
+
 /// The IEEE Std 952 read-off (METHODS §14.3) on the Allan deviation: the −1/2 slope line
 /// through N at 1 s, the flat line at the minimum (B × 0.664) and the +1/2 slope line through
 /// K at 3 s, each with its read-off point; a term without a value is left out and named in
@@ -451,45 +462,45 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 av.tau_s.last().copied().unwrap_or(1.0).max(3.0) * 2.0,
             ];
             let u = pretty(c.unit);
-            // (symbol, value, the line sigma(tau), where it is read, colour, legend)
-            let terms: [(
-                &str,
-                Option<f64>,
-                &dyn Fn(f64, f64) -> f64,
-                f64,
-                usize,
-                String,
-            ); 3] = [
-                (
-                    "N",
-                    readoff.n.value,
-                    &|n, t| n / t.sqrt(),
-                    1.0,
-                    4,
-                    format!("{u}/√Hz (slope −1/2, at 1 s)"),
-                ),
-                (
-                    "B",
-                    readoff.b.value,
-                    &|b, _| b * gmwm::calib::ieee::FLICKER_FACTOR,
-                    readoff.b.at_tau_s,
-                    3,
-                    format!(
+            let terms = [
+                SlopeLine {
+                    symbol: "N",
+                    value: readoff.n.value,
+                    sigma: |n, t| n / t.sqrt(),
+                    at_tau_s: 1.0,
+                    colour: 4,
+                    legend: format!("{u}/√Hz (slope −1/2, at 1 s)"),
+                },
+                SlopeLine {
+                    symbol: "B",
+                    value: readoff.b.value,
+                    sigma: |b, _| b * gmwm::calib::ieee::FLICKER_FACTOR,
+                    at_tau_s: readoff.b.at_tau_s,
+                    colour: 3,
+                    legend: format!(
                         "{u} (slope 0: min σ / 0.664, at {} s)",
                         number(readoff.b.at_tau_s)
                     ),
-                ),
-                (
-                    "K",
-                    readoff.k.value,
-                    &|k, t| k * (t / 3.0).sqrt(),
-                    3.0,
-                    5,
-                    format!("{u}/√s (slope +1/2, at 3 s)"),
-                ),
+                },
+                SlopeLine {
+                    symbol: "K",
+                    value: readoff.k.value,
+                    sigma: |k, t| k * (t / 3.0).sqrt(),
+                    at_tau_s: 3.0,
+                    colour: 5,
+                    legend: format!("{u}/√s (slope +1/2, at 3 s)"),
+                },
             ];
             let mut missing = Vec::new();
-            for (symbol, value, line, at, colour, unit_text) in terms {
+            for term in terms {
+                let SlopeLine {
+                    symbol,
+                    value,
+                    sigma: line,
+                    at_tau_s: at,
+                    colour,
+                    legend: unit_text,
+                } = term;
                 let Some(v) = value else {
                     missing.push(symbol);
                     continue;
