@@ -73,6 +73,7 @@ fn plot_every_figure_on_the_real_recordings() {
     assert!(svg.contains("Allan deviation") && svg.contains("cluster time"));
 
     let svg = String::from_utf8(plot(&["compare", cont], &dir.path().join("cmp.svg"))).unwrap();
+    assert!(svg.contains("classical WV"));
     assert!(svg.contains("robust WV (efficiency 0.6)"));
 
     let svg = String::from_utf8(plot(
@@ -161,6 +162,23 @@ fn plot_refuses_bad_flags_in_one_line() {
             "/tmp/fig.svg",
         ]),
         &["--inference"],
+    );
+    assert_usage_error(
+        gmwm().args(["plot", "fit"]).arg(&adis).args([
+            "--model",
+            "WN()",
+            "--overlay",
+            "-o",
+            "/tmp/fig.svg",
+        ]),
+        &["--overlay"],
+    );
+    assert_usage_error(
+        gmwm()
+            .args(["plot", "wv"])
+            .arg(&adis)
+            .args(["--width", "30000", "-o", "/tmp/fig.svg"]),
+        &["--width"],
     );
     let out = gmwm().args(["plot", "wv"]).arg(&adis).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "-o is required");
@@ -289,6 +307,7 @@ fn report_browser_checker_catches_each_fault() {
         ("broken_image.html", "broken image"),
         ("external.html", "external request"),
         ("missing_figures.html", "too few figures"),
+        ("sibling.html", "external request"),
     ] {
         let out = checker(&Path::new(FIXTURES).join(page), &shot, 1);
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -309,20 +328,21 @@ fn calibrate_report_flag_writes_the_same_page() {
     }
     let csv = dir.path().join("sim.csv");
     std::fs::write(&csv, text).unwrap();
-    let html = dir.path().join("r.html");
+    let flags = [
+        "--model",
+        "AR1()+WN()+RW()",
+        "--bootstrap",
+        "10",
+        "--G",
+        "1000",
+    ];
+    let via_calibrate = dir.path().join("calibrate.html");
     let out = gmwm()
-        .args(["calibrate"])
+        .arg("calibrate")
         .arg(&csv)
-        .args([
-            "--model",
-            "AR1()+WN()+RW()",
-            "--bootstrap",
-            "10",
-            "--G",
-            "1000",
-            "--report",
-        ])
-        .arg(&html)
+        .args(flags)
+        .arg("--report")
+        .arg(&via_calibrate)
         .output()
         .unwrap();
     assert!(
@@ -331,7 +351,86 @@ fn calibrate_report_flag_writes_the_same_page() {
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("HTML report"), "{stdout}");
-    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(
+        stdout.contains("gyro_x") && stdout.contains("HTML report"),
+        "summary and the page: {stdout}"
+    );
+    let via_report = dir.path().join("report.html");
+    let out = gmwm()
+        .arg("report")
+        .arg(&csv)
+        .args(flags)
+        .arg("-o")
+        .arg(&via_report)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // the same page but for the command line it names
+    let without_command = |p: &Path| {
+        let page = std::fs::read_to_string(p).unwrap();
+        page.lines()
+            .filter(|l| !l.contains("made by"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let page = without_command(&via_calibrate);
     assert!(page.starts_with("<!DOCTYPE html>") && page.contains("<figure>"));
+    assert_eq!(page, without_command(&via_report));
+    // the file named twice is refused
+    assert_usage_error(
+        gmwm()
+            .arg("report")
+            .arg(&csv)
+            .args(["-o", "a.html", "--report", "b.html"]),
+        &["once"],
+    );
+}
+
+#[test]
+fn report_with_the_robust_estimator_compares_with_the_classical_wv() {
+    let dir = tempfile::tempdir().unwrap();
+    let html = dir.path().join("r.html");
+    let json = dir.path().join("c.json");
+    let out = gmwm()
+        .arg("report")
+        .arg(data("cont_imu1.csv.gz"))
+        .args([
+            "--robust",
+            "--bootstrap",
+            "10",
+            "--model",
+            "2*AR1()+WN()+RW()",
+            "-o",
+        ])
+        .arg(&html)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let axis = &doc["axes"][0];
+    let c = &axis["contamination"];
+    assert_eq!(c["fit_uses"], "robust");
+    assert_eq!(
+        c["robust"]["wv"], axis["wv"]["wv"],
+        "the fit's WV is the robust one"
+    );
+    assert_ne!(
+        c["classical"]["wv"], axis["wv"]["wv"],
+        "the classical WV is the other one"
+    );
+    assert_eq!(c["matters"], true);
+    let summary = c["summary"].as_str().unwrap();
+    assert!(summary.contains("the robust fit used here"), "{summary}");
+    assert!(std::fs::read_to_string(&html).unwrap().contains(summary));
 }

@@ -17,25 +17,15 @@ fn bench(c: &mut Criterion) {
         .with_draws(2000)
         .fit(&x, 100.0, &WvOptions::default())
         .unwrap();
-    let figure = fit_figure(&[Column {
-        name: "gyro_x",
-        unit: "rad/s",
-        data: &fit,
-    }]);
+    let figure = fit_figure(&[Column::new("gyro_x", "rad/s", &fit)]);
     c.bench_function("fit_figure_svg", |b| b.iter(|| figure.svg().unwrap()));
     c.bench_function("fit_figure_png", |b| b.iter(|| figure.png().unwrap()));
     let wv = fit.empirical.clone().unwrap();
     let names = [
         "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
     ];
-    let columns: Vec<Column<'_, gmwm::WaveletVariance>> = names
-        .iter()
-        .map(|n| Column {
-            name: n,
-            unit: "u",
-            data: &wv,
-        })
-        .collect();
+    let columns: Vec<Column<'_, gmwm::WaveletVariance>> =
+        names.iter().map(|n| Column::new(n, "u", &wv)).collect();
     let grid = wv_figure(&columns, Layout::Grid);
     c.bench_function("wv_grid_svg", |b| b.iter(|| grid.svg().unwrap()));
 }

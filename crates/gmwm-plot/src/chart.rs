@@ -395,14 +395,20 @@ fn draw_loglog<DB: DrawingBackend>(
         .iter()
         .filter_map(|s| {
             let label = s.label.as_ref()?;
-            let visible =
+            let finite: Vec<f64> =
                 s.y.iter()
                     .chain(s.upper.iter().flatten())
-                    .any(|v| v.is_finite() && *v >= yr.0 && *v <= yr.1);
-            let label = if visible {
+                    .copied()
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .collect();
+            let label = if finite.iter().any(|v| *v >= yr.0 && *v <= yr.1) {
                 label.clone()
-            } else {
+            } else if finite.is_empty() {
+                format!("{label} (no value to draw)")
+            } else if finite.iter().all(|v| *v < yr.0) {
                 format!("{label} (below the plot)")
+            } else {
+                format!("{label} (outside the plot)")
             };
             Some((label, s.rgb(), s.mark))
         })
@@ -507,8 +513,9 @@ fn draw_loglog<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Draws a horizontal stacked bar chart; bars beyond ten times the smallest total are cut at
-/// the edge with their value written, so the margin between the best rows stays visible.
+/// Draws a horizontal stacked bar chart on an axis up to 12.5 times the smallest total (1.25
+/// times a cap at ten times it); longer bars are cut at the edge with their value written, so
+/// the margin between the best rows stays visible.
 fn draw_bars<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,

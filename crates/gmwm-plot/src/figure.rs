@@ -5,6 +5,16 @@ use crate::PlotError;
 use plotters::prelude::{BitMapBackend, IntoDrawingArea, SVGBackend};
 use std::path::Path;
 
+/// Largest side of a figure, pixels.
+pub const MAX_SIDE: u32 = 20_000;
+/// Largest area of a figure, pixels (a 40-megapixel PNG buffer is 120 MB).
+pub const MAX_PIXELS: u64 = 40_000_000;
+
+/// Whether a `width` x `height` figure is within [`MAX_SIDE`] and [`MAX_PIXELS`].
+pub fn within_limits(width: u32, height: u32) -> bool {
+    width <= MAX_SIDE && height <= MAX_SIDE && u64::from(width) * u64::from(height) <= MAX_PIXELS
+}
+
 /// Output format of a figure file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ImageFormat {
@@ -133,7 +143,7 @@ impl Figure {
         let (w, h) = self.size;
         let (rows, cols) = self.grid;
         let (min_w, min_h) = (320 * cols.max(1) as u32, 240 * rows.max(1) as u32);
-        if w < min_w || h < min_h || w > 20_000 || h > 20_000 {
+        if w < min_w || h < min_h || !within_limits(w, h) {
             return Err(PlotError::Size {
                 width: w,
                 height: h,

@@ -6,17 +6,51 @@ use crate::style::number;
 use crate::Figure;
 use gmwm::calib::ieee::IeeeReadoff;
 use gmwm::imu::{Sensor, SensorInfo};
+use gmwm::units::{si_unit, NoiseTerm, SignalUnit};
 use gmwm::{AllanKind, AllanVariance, GmwmFit, ModelSelection, WaveletVariance};
 
 /// A named series of a recording with the unit of its samples (`"u"` when unknown).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Column<'a, T> {
     /// Column name (`gyro_x`, ...).
     pub name: &'a str,
     /// Unit of the samples.
     pub unit: &'a str,
+    /// The sensor and axis the column measures (`None`: inferred from its name).
+    pub sensor_axis: Option<(Sensor, String)>,
     /// What is drawn.
     pub data: &'a T,
+}
+
+impl<'a, T> Column<'a, T> {
+    /// A column whose sensor and axis are inferred from its name.
+    pub fn new(name: &'a str, unit: &'a str, data: &'a T) -> Self {
+        Self {
+            name,
+            unit,
+            sensor_axis: None,
+            data,
+        }
+    }
+
+    /// With the sensor and axis the reader recognised (e.g. from a sidecar's meaning).
+    pub fn with_sensor(mut self, sensor: Sensor, axis: impl Into<String>) -> Self {
+        self.sensor_axis = Some((sensor, axis.into()));
+        self
+    }
+
+    /// Sensor row (gyroscope, accelerometer, other) and axis label.
+    fn place(&self) -> (usize, String) {
+        let known = self
+            .sensor_axis
+            .clone()
+            .or_else(|| SensorInfo::infer(self.name));
+        match known {
+            Some((Sensor::Gyroscope, axis)) => (0, axis),
+            Some((Sensor::Accelerometer, axis)) => (1, axis),
+            _ => (2, self.name.to_string()),
+        }
+    }
 }
 
 /// How several columns' variances share a figure (paper Fig. 1).
@@ -36,6 +70,16 @@ pub const AV_SCALE: &str = "cluster time τ = m/f (s)";
 /// A unit as set in figures: `m/s^2` as `m/s²`.
 fn pretty(unit: &str) -> String {
     unit.replace("^2", "²").replace("^3", "³")
+}
+
+/// The unit of a noise term for a series in `unit`: SI names when the data are in SI
+/// (`rad/s`, `m/s^2`), else in terms of the data unit; the engine's one formula
+/// ([`gmwm::units::si_unit`], METHODS §14.2), so figures and report agree.
+fn term_unit(term: NoiseTerm, unit: &str) -> String {
+    match unit.parse::<SignalUnit>() {
+        Ok(u) if u.to_si() == 1.0 => si_unit(term, Some(u.kind()), unit),
+        _ => si_unit(term, None, &pretty(unit)),
+    }
 }
 
 fn squared(unit: &str) -> String {
@@ -66,20 +110,13 @@ fn estimate_series(
     [band, points]
 }
 
-/// Sensor row and axis of a column (from its name, as the readers recognise it).
-fn place(name: &str) -> (usize, String) {
-    match SensorInfo::infer(name) {
-        Some((Sensor::Gyroscope, axis)) => (0, axis),
-        Some((Sensor::Accelerometer, axis)) => (1, axis),
-        _ => (2, name.to_string()),
-    }
-}
-
 const SENSOR_TITLES: [&str; 3] = ["gyroscope", "accelerometer", "other"];
 
 /// What one column of a variance figure contributes: scale, value, band, and labels.
 struct Curve<'a> {
     name: &'a str,
+    /// Sensor row and axis label.
+    place: (usize, String),
     unit: &'a str,
     tau_s: Vec<f64>,
     value: Vec<f64>,
@@ -94,9 +131,18 @@ fn variance_figure(
     y_label: &dyn Fn(&str) -> String,
     what: &str,
 ) -> Figure {
+    if curves.is_empty() {
+        let empty = Panel {
+            title: "no column".to_string(),
+            x_label: x_label.to_string(),
+            y_label: String::new(),
+            kind: PanelKind::LogLog(Vec::new()),
+        };
+        return Figure::new(vec![empty], (1, 1), (500, 420));
+    }
     match layout {
         Layout::Grid => {
-            let placed: Vec<(usize, String)> = curves.iter().map(|c| place(c.name)).collect();
+            let placed: Vec<(usize, String)> = curves.iter().map(|c| c.place.clone()).collect();
             let mut rows: Vec<usize> = placed.iter().map(|p| p.0).collect();
             rows.sort_unstable();
             rows.dedup();
@@ -140,8 +186,7 @@ fn variance_figure(
         Layout::Overlay => {
             let mut panels = Vec::new();
             for (row, title) in SENSOR_TITLES.iter().enumerate() {
-                let members: Vec<&Curve<'_>> =
-                    curves.iter().filter(|c| place(c.name).0 == row).collect();
+                let members: Vec<&Curve<'_>> = curves.iter().filter(|c| c.place.0 == row).collect();
                 if members.is_empty() {
                     continue;
                 }
@@ -149,7 +194,7 @@ fn variance_figure(
                 for (k, c) in members.iter().enumerate() {
                     let [band, points] =
                         estimate_series(&c.tau_s, &c.value, &c.low, &c.high, Some(k + 1));
-                    let axis = place(c.name).1;
+                    let axis = &c.place.1;
                     series.push(band);
                     series.push(points.labelled(format!("axis {axis}")));
                 }
@@ -173,6 +218,7 @@ pub fn wv_figure(columns: &[Column<'_, WaveletVariance>], layout: Layout) -> Fig
         .iter()
         .map(|c| Curve {
             name: c.name,
+            place: c.place(),
             unit: c.unit,
             tau_s: c.data.tau_s.clone(),
             value: c.data.wv.clone(),
@@ -194,6 +240,7 @@ pub fn allan_figure(columns: &[Column<'_, AllanVariance>], layout: Layout) -> Fi
         .iter()
         .map(|c| Curve {
             name: c.name,
+            place: c.place(),
             unit: c.unit,
             tau_s: c.data.tau_s.clone(),
             value: c.data.adev.clone(),
@@ -266,30 +313,27 @@ pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]
 /// The legend entry of one fitted component: its process and the values a filter uses, in the
 /// data unit (continuous time; METHODS §14.2, through the engine's read-off).
 fn component_label(fit: &GmwmFit, index: usize, unit: &str) -> String {
-    let unit = pretty(unit);
-    let unit = unit.as_str();
     let component = &fit.model.components()[index];
     let kind = component.kind.name();
     let values: Vec<String> = fit
         .navigation(Some(unit))
         .into_iter()
         .filter(|p| p.index == index && p.name != "driving_noise_density")
-        .map(|p| {
-            let symbol = match p.name {
-                "white_noise_density" => "N",
-                "quantization_coefficient" => "Q",
-                "rate_random_walk_density" => "K",
-                "drift_rate" => "R",
-                "correlation_time" => "T",
-                "gm_std" => "σ",
-                other => other,
+        .filter_map(|p| {
+            let (symbol, term) = match p.name {
+                "white_noise_density" => ("N", NoiseTerm::NoiseDensity),
+                "quantization_coefficient" => ("Q", NoiseTerm::Quantization),
+                "rate_random_walk_density" => ("K", NoiseTerm::RandomWalk),
+                "drift_rate" => ("R", NoiseTerm::RateRamp),
+                "correlation_time" => ("T", NoiseTerm::GmCorrelationTime),
+                "gm_std" => ("σ", NoiseTerm::GmSigma),
+                _ => return None,
             };
-            let unit = p
-                .unit
-                .replace("*sqrt(Hz)", "/√s")
-                .replace("/sqrt(Hz)", "/√Hz")
-                .replace('*', "·");
-            format!("{symbol} = {} {unit}", number(p.value))
+            Some(format!(
+                "{symbol} = {} {}",
+                number(p.value),
+                term_unit(term, unit)
+            ))
         })
         .collect();
     if values.is_empty() {
@@ -366,7 +410,7 @@ pub fn fit_figure(columns: &[Column<'_, GmwmFit>]) -> Figure {
     stacked(panels, 1, (1100, 600))
 }
 
-/// Rows of the WIC chart: the selected row and the best others, at most this many.
+/// Rows of the WIC chart in the report: the selected row and the best others.
 pub const WIC_ROWS: usize = 10;
 
 /// A model without its empty parentheses, for chart labels.
@@ -375,9 +419,9 @@ fn short_model(text: &str) -> String {
 }
 
 /// Model selection (paper Fig. 4): per column, the empirical WV against the selected model's
-/// implied WV, beside the candidates' WIC with objective and optimism stacked (the best
-/// [`WIC_ROWS`] canonical models, the selected one marked ▶).
-pub fn selection_figure(columns: &[Column<'_, ModelSelection>]) -> Figure {
+/// implied WV, beside the candidates' WIC with objective and optimism stacked (the best `rows`
+/// canonical models, 0 for all, always with the selected one, marked ▶).
+pub fn selection_figure(columns: &[Column<'_, ModelSelection>], rows: usize) -> Figure {
     let mut panels = Vec::new();
     for c in columns {
         let s = c.data;
@@ -392,7 +436,8 @@ pub fn selection_figure(columns: &[Column<'_, ModelSelection>]) -> Figure {
             .rows
             .iter()
             .position(|r| r.status == gmwm::selection::RowStatus::Selected);
-        let mut shown: Vec<usize> = (0..s.rows.len().min(WIC_ROWS)).collect();
+        let limit = if rows == 0 { s.rows.len() } else { rows };
+        let mut shown: Vec<usize> = (0..s.rows.len().min(limit)).collect();
         if let Some(i) = selected_row {
             if !shown.contains(&i) {
                 shown.pop();
@@ -442,7 +487,7 @@ struct SlopeLine {
 /// The IEEE Std 952 read-off (METHODS §14.3) on the Allan deviation: the −1/2 slope line
 /// through N at 1 s, the flat line at the minimum (B × 0.664) and the +1/2 slope line through
 /// K at 3 s, each with its read-off point; a term without a value is left out and named in
-/// the legend.
+/// the title.
 pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figure {
     let panels = columns
         .iter()
@@ -467,9 +512,13 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                     symbol: "N",
                     value: readoff.n.value,
                     sigma: |n, t| n / t.sqrt(),
-                    at_tau_s: 1.0,
+                    at_tau_s: readoff.n.at_tau_s,
                     colour: 4,
-                    legend: format!("{u}/√Hz (slope −1/2, at 1 s)"),
+                    legend: format!(
+                        "{} (slope −1/2, at {} s)",
+                        term_unit(NoiseTerm::NoiseDensity, c.unit),
+                        number(readoff.n.at_tau_s)
+                    ),
                 },
                 SlopeLine {
                     symbol: "B",
@@ -478,7 +527,8 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                     at_tau_s: readoff.b.at_tau_s,
                     colour: 3,
                     legend: format!(
-                        "{u} (slope 0: min σ / 0.664, at {} s)",
+                        "{} (slope 0: min σ / 0.664, at {} s)",
+                        term_unit(NoiseTerm::BiasInstability, c.unit),
                         number(readoff.b.at_tau_s)
                     ),
                 },
@@ -486,9 +536,13 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                     symbol: "K",
                     value: readoff.k.value,
                     sigma: |k, t| k * (t / 3.0).sqrt(),
-                    at_tau_s: 3.0,
+                    at_tau_s: readoff.k.at_tau_s,
                     colour: 5,
-                    legend: format!("{u}/√s (slope +1/2, at 3 s)"),
+                    legend: format!(
+                        "{} (slope +1/2, at {} s)",
+                        term_unit(NoiseTerm::RandomWalk, c.unit),
+                        number(readoff.k.at_tau_s)
+                    ),
                 },
             ];
             let mut missing = Vec::new();
@@ -512,9 +566,9 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 };
                 series.push(Series::new(dashed, &xs, &ys).coloured(colour).clipped());
                 series.push(
+                    // the read-off point sets the range: K at 3 s often lies below the data
                     Series::new(Mark::Points, &[at], &[line(v, at)])
                         .coloured(colour)
-                        .clipped()
                         .labelled(format!("{symbol} = {} {unit_text}", number(v))),
                 );
             }

@@ -10,7 +10,7 @@
 //! use gmwm_plot::{wv_figure, Column, Layout};
 //! let x: Vec<f64> = (0..4096).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
 //! let wv = gmwm::wavelet_variance(&x, 100.0, &gmwm::WvOptions::default()).unwrap();
-//! let figure = wv_figure(&[Column { name: "gyro_x", unit: "rad/s", data: &wv }], Layout::Grid);
+//! let figure = wv_figure(&[Column::new("gyro_x", "rad/s", &wv)], Layout::Grid);
 //! let svg = figure.svg().unwrap();
 //! assert!(svg.contains("gyro_x"));
 //! ```
@@ -22,7 +22,7 @@ pub mod report;
 pub mod style;
 
 pub use chart::{BarRow, Bars, Mark, Panel, PanelKind, Series};
-pub use figure::{Figure, ImageFormat};
+pub use figure::{within_limits, Figure, ImageFormat, MAX_PIXELS, MAX_SIDE};
 pub use figures::{
     allan_figure, compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column,
     Layout, AV_SCALE, WIC_ROWS, WV_SCALE,
@@ -41,7 +41,7 @@ pub enum PlotError {
     #[error("{0}: a figure is written as .svg or .png (by the file name's extension)")]
     Format(String),
     /// A size too small for the panels' axes, or absurdly large.
-    #[error("figure size {width}x{height} px: needs at least {min_width}x{min_height} px for its panels, at most 20000 px a side")]
+    #[error("figure size {width}x{height} px: needs at least {min_width}x{min_height} px for its panels, at most 20000 px a side and 40 megapixels (fewer --columns make a smaller figure)")]
     Size {
         /// Requested width.
         width: u32,

@@ -6,13 +6,15 @@
 //! `gmwm calibrate --json` writes it) is embedded in the page.
 
 use crate::figures::{
-    compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column, Layout,
+    compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column, Layout, WIC_ROWS,
 };
 use crate::style::number;
 use crate::{Figure, PlotError};
 use base64::Engine as _;
 use gmwm::calib::{AxisCalibration, CalibrationReport, Estimate, EstimateStatus};
+use gmwm::imu::Sensor;
 use gmwm::selection::RowStatus;
+use gmwm::units::SignalKind;
 use std::fmt::Write as _;
 
 /// Everything the page shows besides the calibration itself.
@@ -30,7 +32,8 @@ pub struct ReportContext {
     pub command: String,
     /// The navigation-filter files as exported: (stack, file name, content).
     pub exports: Vec<(String, String, String)>,
-    /// The JSON document `--json` writes for this calibration, embedded verbatim.
+    /// The JSON document `--json` writes for this calibration, embedded (compact, `<` escaped
+    /// as `\u003c`).
     pub json: String,
     /// The program and version that made the report.
     pub generator: String,
@@ -43,6 +46,20 @@ fn capitalised(text: &str) -> String {
         .next()
         .map(|c| c.to_uppercase().chain(chars).collect())
         .unwrap_or_default()
+}
+
+/// An HTML id for a column: letters, digits, `_` and `-` kept, anything else `-`.
+fn slug(column: &str) -> String {
+    column
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect()
 }
 
 /// HTML-escapes text.
@@ -210,7 +227,11 @@ fn overview(out: &mut String, report: &CalibrationReport) {
         row(
             out,
             &[
-                format!("<a href=\"#axis-{0}\">{0}</a>", esc(&a.column)),
+                format!(
+                    "<a href=\"#axis-{}\">{}</a>",
+                    slug(&a.column),
+                    esc(&a.column)
+                ),
                 esc(&a.canonical_model),
                 cell(&a.noise_density),
                 cell(&a.random_walk),
@@ -244,11 +265,17 @@ const TABLE_ROWS: usize = 10;
 
 /// The axis' column of a figure.
 fn one<'a, T>(a: &'a AxisCalibration, data: &'a T) -> [Column<'a, T>; 1] {
-    [Column {
-        name: &a.column,
-        unit: &a.unit,
-        data,
-    }]
+    [column(a, data)]
+}
+
+/// The axis' column, placed by the sensor and axis the engine recognised.
+fn column<'a, T>(a: &'a AxisCalibration, data: &'a T) -> Column<'a, T> {
+    let c = Column::new(&a.column, &a.unit, data);
+    match a.kind {
+        Some(SignalKind::Gyroscope) => c.with_sensor(Sensor::Gyroscope, &a.axis),
+        Some(SignalKind::Accelerometer) => c.with_sensor(Sensor::Accelerometer, &a.axis),
+        None => c,
+    }
 }
 
 fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(), PlotError> {
@@ -269,7 +296,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
 
     // model selection
     out.push_str(&figure_html(
-        &selection_figure(&one(a, &a.selection)),
+        &selection_figure(&one(a, &a.selection), WIC_ROWS),
         &format!("{}: the empirical WV and the selected model's implied WV; the WIC of the best canonical models (objective + optimism, the selected one marked ▶).", a.column),
     )?);
     out.push_str("<h3>Model selection (WIC)</h3><table>\n");
@@ -424,7 +451,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
                 if c.matters { "bad" } else { "ok" },
                 esc(&c.summary)
             );
-            let pair = (a.wv.clone(), c.robust.clone());
+            let pair = (c.classical.clone(), c.robust.clone());
             out.push_str(&figure_html(
                 &compare_figure(&one(a, &pair)),
                 &format!(
@@ -480,20 +507,18 @@ pub fn render(report: &CalibrationReport, ctx: &ReportContext) -> Result<String,
         esc(&ctx.command)
     );
     for a in &report.axes {
-        let _ = write!(out, "<a href=\"#axis-{0}\">{0}</a>", esc(&a.column));
+        let _ = write!(
+            out,
+            "<a href=\"#axis-{}\">{}</a>",
+            slug(&a.column),
+            esc(&a.column)
+        );
     }
     out.push_str("<a href=\"#filters\">filter files</a></nav>\n");
     summary(&mut out, report, ctx);
     overview(&mut out, report);
-    let wvs: Vec<Column<'_, gmwm::WaveletVariance>> = report
-        .axes
-        .iter()
-        .map(|a| Column {
-            name: &a.column,
-            unit: &a.unit,
-            data: &a.wv,
-        })
-        .collect();
+    let wvs: Vec<Column<'_, gmwm::WaveletVariance>> =
+        report.axes.iter().map(|a| column(a, &a.wv)).collect();
     out.push_str("<section id=\"wv\"><h2>Wavelet variances</h2>\n");
     out.push_str(&figure_html(
         &wv_figure(&wvs, Layout::Grid),
@@ -522,8 +547,8 @@ pub fn render(report: &CalibrationReport, ctx: &ReportContext) -> Result<String,
         );
     }
     out.push_str("</section>\n");
-    // the machine-readable calibration, exactly as --json writes it; `<` is escaped so that
-    // no text inside can close the script element
+    // the machine-readable calibration: the document --json writes (compact), with `<` written
+    // as \u003c so that no text inside can close the script element
     let _ = write!(
         out,
         "<script type=\"application/json\" id=\"calibration-json\">{}</script>\n</body></html>\n",

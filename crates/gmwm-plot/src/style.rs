@@ -103,8 +103,13 @@ pub fn number(v: f64) -> String {
             s
         }
     } else {
-        let k = a.log10().floor() as i32;
-        let m = v / 10f64.powi(k);
+        let mut k = a.log10().floor() as i32;
+        let mut m = v / 10f64.powi(k);
+        // a mantissa that rounds up to 10 moves to the next power: 9.9996e-4 is 1×10⁻³
+        if format!("{:.3}", m.abs()).starts_with("10") {
+            k += 1;
+            m /= 10.0;
+        }
         let ms = format!("{m:.3}");
         let ms = ms.trim_end_matches('0').trim_end_matches('.');
         format!("{ms}×10{}", superscript(k))
@@ -130,5 +135,6 @@ mod tests {
         assert_eq!(number(12.5), "12.5");
         assert_eq!(number(3.2e-6), "3.2×10⁻⁶");
         assert_eq!(number(-4.0e5), "-4×10⁵");
+        assert_eq!(number(9.9996e-4), "1×10⁻³");
     }
 }

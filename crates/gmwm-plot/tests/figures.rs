@@ -102,14 +102,16 @@ fn figures_wv_grid_and_overlay_of_the_adis_imu() {
         .collect();
     let columns: Vec<Column<'_, WaveletVariance>> = wvs
         .iter()
-        .map(|(n, w)| Column {
-            name: n,
-            unit: if n.starts_with("gyro") {
-                "rad/s"
-            } else {
-                "m/s²"
-            },
-            data: w,
+        .map(|(n, w)| {
+            Column::new(
+                n,
+                if n.starts_with("gyro") {
+                    "rad/s"
+                } else {
+                    "m/s²"
+                },
+                w,
+            )
         })
         .collect();
     let levels = wvs[0].1.levels();
@@ -146,28 +148,15 @@ fn figures_wv_grid_and_overlay_of_the_adis_imu() {
 fn figures_allan_deviation_of_a_precomputed_wv_and_the_recording() {
     // the precomputed WV of the R package is read as it is
     let series = read_wv_json(&data("precomputed/adis_wv.json"), None).unwrap();
-    let columns: Vec<Column<'_, WaveletVariance>> = series
-        .iter()
-        .map(|(n, w)| Column {
-            name: n,
-            unit: "u",
-            data: w,
-        })
-        .collect();
+    let columns: Vec<Column<'_, WaveletVariance>> =
+        series.iter().map(|(n, w)| Column::new(n, "u", w)).collect();
     let figure = wv_figure(&columns, Layout::Grid);
     let svg = render(&figure, "wv_grid_precomputed");
     assert_eq!(svg.polygons, series.len());
 
     let (cols, freq) = recording("adis_16405_imu1.csv.gz", 1 << 18);
     let av = allan_variance(&cols[0].1, freq, &AllanOptions::default()).unwrap();
-    let figure = allan_figure(
-        &[Column {
-            name: &cols[0].0,
-            unit: "rad/s",
-            data: &av,
-        }],
-        Layout::Grid,
-    );
+    let figure = allan_figure(&[Column::new(&cols[0].0, "rad/s", &av)], Layout::Grid);
     let svg = render(&figure, "avar_adis_gyro_x");
     assert_eq!(svg.circles, av.tau_s.len());
     assert!(svg.texts.iter().any(|t| t.contains("Allan deviation")));
@@ -182,11 +171,7 @@ fn figures_classical_against_robust_shows_the_contamination() {
     let (cols, freq) = recording("cont_imu1.csv.gz", usize::MAX);
     let x = &cols[0].1;
     let pair = (wv(x, freq, false), wv(x, freq, true));
-    let figure = compare_figure(&[Column {
-        name: "gyro_x",
-        unit: "rad/s",
-        data: &pair,
-    }]);
+    let figure = compare_figure(&[Column::new("gyro_x", "rad/s", &pair)]);
     assert_eq!(figure.legend().len(), 4);
     let svg = render(&figure, "compare_cont_imu1");
     assert_eq!(svg.polygons, 2, "one band each");
@@ -208,11 +193,7 @@ fn figures_compare_with_an_undefined_robust_level_splits_its_band() {
     let levels = classical.levels();
     let pair = (classical, robust);
     let svg = render(
-        &compare_figure(&[Column {
-            name: "gyro_x",
-            unit: "rad/s",
-            data: &pair,
-        }]),
+        &compare_figure(&[Column::new("gyro_x", "rad/s", &pair)]),
         "compare_undefined_level",
     );
     assert_eq!(
@@ -234,11 +215,7 @@ fn figures_fit_decomposition_names_every_process_with_its_value() {
         .with_seed(1)
         .fit(x, freq, &WvOptions::default())
         .unwrap();
-    let figure = fit_figure(&[Column {
-        name: "gyro_x",
-        unit: "rad/s",
-        data: &fit,
-    }]);
+    let figure = fit_figure(&[Column::new("gyro_x", "rad/s", &fit)]);
     let legend = figure.legend();
     // band, empirical, model, and one line per component
     assert_eq!(legend.len(), 3 + 4, "{legend:?}");
@@ -277,11 +254,7 @@ fn figures_fit_with_a_component_below_the_plot_says_so() {
     for v in &mut fit.implied_wv.processes[0].wv {
         *v *= 1e-12;
     }
-    let figure = fit_figure(&[Column {
-        name: "gyro_x",
-        unit: "rad/s",
-        data: &fit,
-    }]);
+    let figure = fit_figure(&[Column::new("gyro_x", "rad/s", &fit)]);
     let svg = render(&figure, "fit_component_below");
     assert!(
         svg.texts
@@ -301,14 +274,7 @@ fn figures_one_level_still_has_axes_and_its_interval() {
     };
     let w = gmwm::wavelet_variance(&x, 10.0, &opts).unwrap();
     assert_eq!(w.levels(), 1);
-    let figure = wv_figure(
-        &[Column {
-            name: "x",
-            unit: "V",
-            data: &w,
-        }],
-        Layout::Grid,
-    );
+    let figure = wv_figure(&[Column::new("x", "V", &w)], Layout::Grid);
     let svg = render(&figure, "wv_one_level");
     assert_eq!(svg.circles, 1);
     assert_eq!(svg.polygons, 0, "a one-level band is an interval bar");
@@ -330,11 +296,10 @@ fn figures_selection_and_ieee_on_the_adis_gyroscope() {
         .with_draws(2000)
         .select(x, freq)
         .unwrap();
-    let figure = selection_figure(&[Column {
-        name: "gyro_x",
-        unit: "rad/s",
-        data: &selection,
-    }]);
+    let figure = selection_figure(
+        &[Column::new("gyro_x", "rad/s", &selection)],
+        gmwm_plot::WIC_ROWS,
+    );
     assert_eq!(figure.grid, (1, 2));
     let svg = render(&figure, "select_adis_gyro_x");
     let shown = selection.rows.len().min(gmwm_plot::WIC_ROWS);
@@ -350,11 +315,7 @@ fn figures_selection_and_ieee_on_the_adis_gyroscope() {
     let av = allan_variance(x, freq, &AllanOptions::default()).unwrap();
     let readoff = ieee_readoff(&av).unwrap();
     let pair = (av, readoff);
-    let figure = ieee_figure(&[Column {
-        name: "gyro_x",
-        unit: "rad/s",
-        data: &pair,
-    }]);
+    let figure = ieee_figure(&[Column::new("gyro_x", "rad/s", &pair)]);
     let legend = figure.legend();
     assert!(legend.iter().any(|l| l.starts_with("N = ")), "{legend:?}");
     assert!(legend.iter().any(|l| l.starts_with("B = ")), "{legend:?}");
@@ -414,18 +375,75 @@ fn count_rects(figure: &Figure) -> usize {
 fn figures_refuse_a_bad_name_or_size_in_one_line() {
     let x: Vec<f64> = (0..256).map(|i| (i % 7) as f64).collect();
     let w = gmwm::wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
-    let figure = wv_figure(
-        &[Column {
-            name: "x",
-            unit: "u",
-            data: &w,
-        }],
-        Layout::Grid,
-    );
+    let figure = wv_figure(&[Column::new("x", "u", &w)], Layout::Grid);
     let e = figure
         .save(std::path::Path::new("/tmp/figure.jpg"))
         .unwrap_err();
     assert!(e.to_string().contains(".svg or .png"), "{e}");
     let e = figure.clone().with_size((100, 50)).svg().unwrap_err();
     assert!(e.to_string().contains("100x50"), "{e}");
+}
+
+#[test]
+fn figures_ieee_lines_of_white_noise_and_random_walk_go_through_their_read_offs() {
+    // N = 1e-3 rad/s/√Hz and K = 1e-4 rad/s²/√Hz at 100 Hz (sigma2 = N² f, gamma2 = K² / f):
+    // both regions are read, and each point lies on its line (METHODS §14.3)
+    let model: gmwm::model::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();
+    let x = gmwm::sim::simulate_model(&model, 1 << 20, 100.0, 5).unwrap();
+    let av = allan_variance(&x, 100.0, &AllanOptions::default()).unwrap();
+    let readoff = ieee_readoff(&av).unwrap();
+    let (n, k) = (
+        readoff.n.value.unwrap(),
+        readoff.k.value.unwrap_or_else(|| panic!("{:?}", readoff.k)),
+    );
+    assert!((n / 1e-3 - 1.0).abs() < 0.05, "N {n}");
+    assert!((k / 1e-4 - 1.0).abs() < 0.5, "K {k}");
+    let pair = (av, readoff);
+    let figure = ieee_figure(&[Column::new("gyro_x", "rad/s", &pair)]);
+    let legend = figure.legend();
+    assert!(
+        legend
+            .iter()
+            .any(|l| l.starts_with("N = ") && l.contains("rad/s/√Hz")),
+        "{legend:?}"
+    );
+    assert!(
+        legend
+            .iter()
+            .any(|l| l.starts_with("K = ") && l.contains("rad/s²/√Hz")),
+        "{legend:?}"
+    );
+    let gmwm_plot::PanelKind::LogLog(series) = &figure.panels[0].kind else {
+        panic!("a log-log panel")
+    };
+    let on_line = |symbol: &str, v: f64, sigma: &dyn Fn(f64) -> f64| {
+        let i = series
+            .iter()
+            .position(|s| {
+                s.label
+                    .as_deref()
+                    .is_some_and(|l| l.starts_with(&format!("{symbol} = ")))
+            })
+            .unwrap();
+        let (point, line) = (&series[i], &series[i - 1]);
+        assert!(
+            (point.y[0] / sigma(point.x[0]) - 1.0).abs() < 1e-12,
+            "{symbol} point"
+        );
+        for (x, y) in line.x.iter().zip(&line.y) {
+            assert!((y / sigma(*x) - 1.0).abs() < 1e-12, "{symbol} line at {x}");
+        }
+        assert!(v > 0.0);
+    };
+    on_line("N", n, &|t| n / t.sqrt());
+    on_line("K", k, &|t| k * (t / 3.0).sqrt());
+    render(&figure, "ieee_wn_rw");
+}
+
+#[test]
+fn figures_without_columns_are_an_empty_figure_not_an_error() {
+    let figure = wv_figure(&[], Layout::Grid);
+    assert!(figure.svg().is_ok());
+    let figure = wv_figure(&[], Layout::Overlay);
+    assert!(figure.svg().is_ok());
 }

@@ -2,7 +2,7 @@
 //! caught at the scales they reach, an undefined robust level is reported, and the real
 //! contaminated recording `cont_imu1` is flagged.
 
-use gmwm::calib::compare_classical_robust;
+use gmwm::calib::{compare_classical_robust, FitUses};
 use gmwm::{wavelet_variance, RobustOptions, WaveletVariance, WvOptions};
 
 const FREQ: f64 = 100.0;
@@ -31,7 +31,7 @@ fn contamination_clean_gaussian_data_does_not_matter() {
     for seed in 1..=5 {
         let x = white_noise(1 << 16, seed);
         let (c, r) = pair(&x);
-        let check = compare_classical_robust(&c, r, 0.05);
+        let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
         assert!(!check.matters, "seed {seed}: {}", check.summary);
         assert!(check.max_ratio < 1.1, "seed {seed}: {}", check.max_ratio);
         assert!(
@@ -44,13 +44,13 @@ fn contamination_clean_gaussian_data_does_not_matter() {
 
 #[test]
 fn contamination_outliers_inflate_the_first_scales() {
-    // 0.2% of the samples replaced by spikes 30 standard deviations high
+    // spikes of 30 standard deviations added to 0.2% of the samples
     let mut x = white_noise(1 << 16, 7);
     for k in (0..x.len()).step_by(500) {
         x[k] += 0.3 * if k % 1000 == 0 { 1.0 } else { -1.0 };
     }
     let (c, r) = pair(&x);
-    let check = compare_classical_robust(&c, r, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
     assert!(check.matters, "{}", check.summary);
     assert!(check.levels_above.contains(&1), "{:?}", check.levels_above);
     // the spikes add 0.002 * 0.09 / 2 = 9e-5 to the level-1 WV of 5e-5: a factor near 2.8
@@ -70,7 +70,7 @@ fn contamination_undefined_robust_level_is_named_not_compared() {
     r.ci_low[2] = f64::NAN;
     r.ci_high[2] = f64::NAN;
     let levels = c.wv.len();
-    let check = compare_classical_robust(&c, r, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
     assert_eq!(check.undefined_levels, vec![3]);
     assert_eq!(check.levels, levels - 1);
     assert!(
@@ -84,7 +84,36 @@ fn contamination_undefined_robust_level_is_named_not_compared() {
 fn contamination_real_contaminated_recording_is_flagged() {
     let x = crate::common::read_column("cont_imu1", "gyro_x");
     let (c, r) = pair(&x);
-    let check = compare_classical_robust(&c, r, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
     assert!(check.matters, "{}", check.summary);
     assert!(!check.levels_above.is_empty());
+}
+
+#[test]
+fn contamination_advice_follows_the_estimator_the_fit_used() {
+    let x = crate::common::read_column("cont_imu1", "gyro_x");
+    let (c, r) = pair(&x);
+    let check = compare_classical_robust(c, r, FitUses::Robust, 0.05);
+    assert!(check.matters, "{}", check.summary);
+    assert!(
+        check.summary.contains("the robust fit used here"),
+        "{}",
+        check.summary
+    );
+    assert!(!check.summary.contains("--robust"), "{}", check.summary);
+}
+
+#[test]
+fn contamination_nothing_to_compare_says_so() {
+    let x = white_noise(1 << 10, 9);
+    let (c, mut r) = pair(&x);
+    r.wv.iter_mut().for_each(|v| *v = f64::NAN);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
+    assert_eq!(check.levels, 0);
+    assert!(!check.matters);
+    assert!(
+        check.summary.contains("could not be compared"),
+        "{}",
+        check.summary
+    );
 }

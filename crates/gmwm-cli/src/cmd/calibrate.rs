@@ -40,7 +40,7 @@ fn calibration_options(args: &CalibrateArgs) -> Result<CalibrationOptions> {
         // the contamination check compares with the robust WV at --eff
         robust_check: Some(gmwm::RobustOptions::new(
             args.estimator.eff,
-            gmwm::RobustConvention::Exact,
+            crate::cmd::wv::robust_convention(args.estimator.robust_convention),
         )?),
     })
 }
@@ -212,10 +212,7 @@ fn write_report(
         },
         reader_notes: recording.notes.clone(),
         timing: recording.timing.as_ref().map(ToString::to_string),
-        command: std::iter::once("gmwm".to_string())
-            .chain(std::env::args().skip(1))
-            .collect::<Vec<_>>()
-            .join(" "),
+        command: command_line(),
         exports: files,
         json: serde_json::to_string(doc)?,
         generator: format!("gmwm {}", env!("CARGO_PKG_VERSION")),
@@ -224,6 +221,23 @@ fn write_report(
     let figures = html.matches("<figure>").count();
     std::fs::write(path, html).with_context(|| format!("cannot write {}", path.display()))?;
     Ok(figures)
+}
+
+/// The command as typed, to paste back into a shell: `gmwm` and the arguments, each quoted
+/// when it holds anything but letters, digits and `-_./:=,+@%` (non-UTF-8 bytes shown as �).
+fn command_line() -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_./:=,+@%".contains(c);
+    std::iter::once("gmwm".to_string())
+        .chain(std::env::args_os().skip(1).map(|a| {
+            let a = a.to_string_lossy().into_owned();
+            if !a.is_empty() && a.chars().all(plain) {
+                a
+            } else {
+                format!("'{}'", a.replace('\'', "'\\''"))
+            }
+        }))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// Exported files are SI: every gyroscope and accelerometer axis needs a unit the engine
@@ -491,6 +505,9 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
         .collect();
     writeln!(out, "  {:<18}{}", "IEEE 952", ieee.join(", "))?;
     writeln!(out, "  {:<18}{}", "fit", a.verdict.summary)?;
+    if let Some(c) = a.contamination.as_ref().filter(|c| c.matters) {
+        writeln!(out, "  {:<18}{}", "contamination", c.summary)?;
+    }
     for n in &a.notes {
         writeln!(out, "  note: {n}")?;
     }

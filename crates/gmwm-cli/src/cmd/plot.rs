@@ -16,19 +16,32 @@ use std::io::Write;
 /// states (SI for ROS recordings and binary IMU records), as its symbol; `u` when unknown.
 fn column_units(input: &InputArgs, names: &[String]) -> Vec<String> {
     let ros = gmwm::imu::ros::container_of(&input.file).is_some();
-    let record = matches!(
-        crate::input::format(input.format),
-        gmwm::imu::InputFormat::ImuRecord(_)
-    );
     let sidecar = if ros || is_wv(input) {
         None
     } else {
         gmwm::imu::find_sidecar(&input.file).ok().flatten()
     };
+    // binary IMU records by --format or by the sidecar's format, as the reader resolves it
+    let record = matches!(
+        crate::input::format(input.format),
+        gmwm::imu::InputFormat::ImuRecord(_)
+    ) || sidecar
+        .as_ref()
+        .and_then(|s| s.format.as_deref())
+        .and_then(|f| f.parse::<gmwm::imu::InputFormat>().ok())
+        .is_some_and(|f| matches!(f, gmwm::imu::InputFormat::ImuRecord(_)));
     names
         .iter()
         .map(|name| {
-            let sensor = SensorInfo::infer(name).map_or(Sensor::Other, |(s, _)| s);
+            // the sensor from the name, else the sidecar's meaning (as SensorInfo::of_table)
+            let sensor = SensorInfo::infer(name)
+                .or_else(|| {
+                    sidecar
+                        .as_ref()
+                        .and_then(|s| s.meaning(name))
+                        .and_then(SensorInfo::infer)
+                })
+                .map_or(Sensor::Other, |(s, _)| s);
             let text = if ros {
                 match sensor {
                     Sensor::Gyroscope => Some("rad/s".to_string()),
@@ -59,7 +72,7 @@ fn columns<'a, T>(items: &'a [(String, T)], units: &'a [String]) -> Vec<Column<'
     items
         .iter()
         .zip(units)
-        .map(|((name, data), unit)| Column { name, unit, data })
+        .map(|((name, data), unit)| Column::new(name, unit, data))
         .collect()
 }
 
@@ -88,8 +101,11 @@ fn save(fig: Figure, args: &FigureArgs, out: &mut impl Write) -> Result<()> {
             .map_or(h, |v| u32::try_from(v).unwrap_or(u32::MAX)),
     );
     let fig = fig.with_size(size);
-    fig.save(&args.output)
-        .with_context(|| format!("cannot draw {}", args.output.display()))?;
+    fig.save(&args.output).map_err(|e| match e {
+        // a write error names the file already
+        gmwm_plot::PlotError::Io { .. } => anyhow::Error::from(e),
+        other => anyhow::anyhow!("{}: {other}", args.output.display()),
+    })?;
     writeln!(
         out,
         "wrote {} ({}x{} px, {} panel(s))",
@@ -146,6 +162,31 @@ fn check_flags(command: &PlotCommand) -> Result<()> {
         PlotCommand::Select { args, figure } => (&args.output, figure),
     };
     no_table_output(output)?;
+    let layered = matches!(command, PlotCommand::Wv { .. } | PlotCommand::Avar { .. });
+    if figure.overlay && !layered {
+        return Err(UsageError(
+            "--overlay lays out the axes of gmwm plot wv and avar; this figure has one panel per column"
+                .into(),
+        )
+        .into());
+    }
+    let too_large = |v: Option<usize>| v.is_some_and(|v| v > gmwm_plot::MAX_SIDE as usize);
+    if too_large(figure.width) || too_large(figure.height) {
+        return Err(UsageError(format!(
+            "invalid --width/--height: at most {} px a side",
+            gmwm_plot::MAX_SIDE
+        ))
+        .into());
+    }
+    if let (Some(w), Some(h)) = (figure.width, figure.height) {
+        if (w as u64) * (h as u64) > gmwm_plot::MAX_PIXELS {
+            return Err(UsageError(format!(
+                "invalid --width {w} --height {h}: at most {} megapixels",
+                gmwm_plot::MAX_PIXELS / 1_000_000
+            ))
+            .into());
+        }
+    }
     check_output(figure)
 }
 
@@ -188,7 +229,7 @@ pub fn run(args: &PlotArgs, out: &mut impl Write) -> Result<()> {
             let robust_opts = WvOptions {
                 robust: Some(RobustOptions::new(
                     args.estimator.eff,
-                    gmwm::RobustConvention::Exact,
+                    crate::cmd::wv::robust_convention(args.estimator.robust_convention),
                 )?),
                 ..classical_opts
             };
@@ -207,13 +248,9 @@ pub fn run(args: &PlotArgs, out: &mut impl Write) -> Result<()> {
         }
         PlotCommand::Select { args, figure } => {
             let selections = crate::cmd::select::compute(args)?;
-            draw(
-                &args.input,
-                &selections,
-                gmwm_plot::selection_figure,
-                figure,
-                out,
-            )
+            let top = args.top;
+            let build = |c: &[Column<'_, _>]| gmwm_plot::selection_figure(c, top);
+            draw(&args.input, &selections, build, figure, out)
         }
         PlotCommand::Ieee { args, figure } => {
             let items = crate::cmd::avar::compute(args)?;

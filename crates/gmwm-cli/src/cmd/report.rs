@@ -27,6 +27,14 @@ fn default_output(file: &std::path::Path) -> PathBuf {
 
 /// Runs the subcommand.
 pub fn run(args: &ReportArgs, out: &mut impl Write) -> Result<()> {
+    if let (Some(o), Some(r)) = (&args.output, &args.calibrate.report) {
+        return Err(crate::UsageError(format!(
+            "give the report's file once: -o {} or --report {}",
+            o.display(),
+            r.display()
+        ))
+        .into());
+    }
     let path = args
         .output
         .clone()

@@ -15,14 +15,21 @@ use gmwm::{
 };
 use std::io::Write;
 
+/// The engine convention of `--robust-convention`.
+pub fn robust_convention(arg: RobustConventionArg) -> RobustConvention {
+    match arg {
+        RobustConventionArg::Exact => RobustConvention::Exact,
+        RobustConventionArg::Package => RobustConvention::Package,
+    }
+}
+
 /// Validated estimator options from the flags.
 pub fn options(a: &WvEstimatorArgs) -> Result<WvOptions> {
     let robust = if a.robust {
-        let convention = match a.robust_convention {
-            RobustConventionArg::Exact => RobustConvention::Exact,
-            RobustConventionArg::Package => RobustConvention::Package,
-        };
-        Some(RobustOptions::new(a.eff, convention)?)
+        Some(RobustOptions::new(
+            a.eff,
+            robust_convention(a.robust_convention),
+        )?)
     } else {
         None
     };

@@ -5,7 +5,8 @@ Usage: check_report.py REPORT.html SCREENSHOT.png [--min-figures N] [--timeout S
 
 The report is opened from its file:// URL with network access blocked.  The
 check fails (exit 1, one ``check_report: `` line per problem on stderr) on
-console errors, uncaught page errors, requests that would leave the machine,
+console errors, uncaught page errors, requests for anything but the report itself
+and inline data: URIs (a sibling file too: the report must be self-contained),
 broken images, too few figures, a missing <h1>, figure images that vanish in
 print, or when the total deadline passes.  A full-page screenshot is saved
 whenever the page loaded.  Exit 2 means a usage error, exit 3 a missing
@@ -44,7 +45,8 @@ CHROMIUM_ARGS = [
     "--proxy-server=127.0.0.1:9",
     "--force-webrtc-ip-handling-policy=disable_non_proxied_udp",
 ]
-LOCAL_SCHEMES = frozenset({"file", "data", "about"})
+# a self-contained report loads nothing but itself, data: URIs and about: pages
+INLINE_SCHEMES = frozenset({"data", "about"})
 VIEWPORT = {"width": 1280, "height": 900}
 WATCHDOG_GRACE_S = 5.0
 MAX_URL_CHARS = 100
@@ -187,9 +189,12 @@ def shorten(url: str) -> str:
     return url if len(url) <= MAX_URL_CHARS else url[: MAX_URL_CHARS - 3] + "..."
 
 
-def is_local(url: str) -> bool:
-    """Tell whether a URL stays on this machine (file:, data:, about:)."""
-    return urlsplit(url).scheme.lower() in LOCAL_SCHEMES
+def is_self_contained(url: str, report_url: str) -> bool:
+    """Tell whether a request is the report itself or inline (data:, about:): anything else,
+    a sibling file included, means the report is not self-contained."""
+    if urlsplit(url).scheme.lower() in INLINE_SCHEMES:
+        return True
+    return url.split("#", 1)[0] == report_url
 
 
 def png_size(path: Path) -> tuple[int, int]:
@@ -201,17 +206,17 @@ def png_size(path: Path) -> tuple[int, int]:
     return struct.unpack(">II", head[16:24])
 
 
-def block_network(context, outcome: Outcome) -> None:
-    """Abort every non-local request and report each one as external."""
+def block_network(context, outcome: Outcome, report_url: str) -> None:
+    """Abort every request but the report's own and inline ones, reporting each as external."""
 
     def route(route) -> None:
-        if is_local(route.request.url):
+        if is_self_contained(route.request.url, report_url):
             route.continue_()
         else:
             route.abort()
 
     def on_request(request) -> None:
-        if not is_local(request.url):
+        if not is_self_contained(request.url, report_url):
             outcome.add_external(shorten(request.url))
 
     context.route("**/*", route)
@@ -265,7 +270,7 @@ def inspect_report(browser, args: argparse.Namespace, deadline: Deadline, outcom
     """Load the report, run all page checks and save the screenshot."""
     context = browser.new_context(viewport=VIEWPORT, device_scale_factor=1, service_workers="block")
     context.set_default_timeout(deadline.ms())
-    block_network(context, outcome)
+    block_network(context, outcome, args.report.resolve().as_uri())
     page = context.new_page()
     watch_page(page, outcome)
     page.goto(args.report.resolve().as_uri(), wait_until="load", timeout=deadline.ms())

@@ -10,15 +10,20 @@ use serde::Serialize;
 
 /// The classical against the robust wavelet variance of one axis.
 ///
-/// Wire format: `robust` (the robust [`WaveletVariance`]), `levels` (scales compared: both
+/// Wire format: `classical` and `robust` (the two [`WaveletVariance`]s), `fit_uses` (`classical`
+/// or `robust`: which of them the axis' fit used), `levels` (scales compared: both
 /// defined), `undefined_levels` (1-based levels whose robust WV is undefined), `levels_above`
 /// and `levels_below` (1-based levels where the classical estimate lies above / below the
 /// robust interval), `max_ratio` (the largest classical / robust ratio, or its inverse when
 /// smaller than one, over the levels outside), `matters`, `summary`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Contamination {
+    /// The classical wavelet variance.
+    pub classical: WaveletVariance,
     /// The robust wavelet variance (same transform, filter and levels as the classical one).
     pub robust: WaveletVariance,
+    /// Which of the two the axis' fit used.
+    pub fit_uses: FitUses,
     /// Number of scales where both estimates are defined.
     pub levels: usize,
     /// 1-based levels whose robust WV is undefined (no root of the scale equation).
@@ -38,13 +43,24 @@ pub struct Contamination {
     pub summary: String,
 }
 
+/// Which wavelet variance a fit used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FitUses {
+    /// The classical estimator.
+    Classical,
+    /// The robust estimator.
+    Robust,
+}
+
 /// Compares `classical` with `robust` (METHODS §2, paper Fig. 2) at confidence level
 /// `1 - alpha`: a level counts as outside when the classical estimate is beyond the robust
 /// interval; the verdict is the fit verdict's rule (more than `ceil(alpha J)` levels outside, or
 /// one outside by more than [`CHANCE_MISS_REL`] relative).
 pub fn compare_classical_robust(
-    classical: &WaveletVariance,
+    classical: WaveletVariance,
     robust: WaveletVariance,
+    fit_uses: FitUses,
     alpha: f64,
 ) -> Contamination {
     let total = classical.wv.len().min(robust.wv.len());
@@ -92,7 +108,13 @@ pub fn compare_classical_robust(
         _ => String::new(),
     };
     let band = format!("{:.0}%", 100.0 * (1.0 - alpha));
-    let mut summary = if outside == 0 {
+    let advice = match fit_uses {
+        FitUses::Classical => "compare with a robust fit (--robust)",
+        FitUses::Robust => "the robust fit used here is the one to trust",
+    };
+    let mut summary = if compared.is_empty() {
+        "The classical and robust WVs could not be compared: the robust WV is undefined at every scale.".to_string()
+    } else if outside == 0 {
         format!(
             "The classical WV lies inside the robust {band} interval at all {} scales compared: contamination does not matter here, and the classical fit stands.",
             compared.len()
@@ -121,7 +143,7 @@ pub fn compare_classical_robust(
         }
         let at = furthest.map(|(l, _)| tau(l)).unwrap_or_default();
         format!(
-            "The classical WV lies {} of {} compared, up to a factor {} at {at} s: contamination matters; compare with a robust fit (--robust).",
+            "The classical WV lies {} of {} compared, up to a factor {} at {at} s: contamination matters; {advice}.",
             parts.join(" and "),
             compared.len(),
             significant(max_ratio, 3)
@@ -138,7 +160,9 @@ pub fn compare_classical_robust(
         ));
     }
     Contamination {
+        classical,
         robust,
+        fit_uses,
         levels: compared.len(),
         undefined_levels,
         levels_above,

@@ -5,7 +5,7 @@ pub mod ieee;
 pub mod nav;
 pub mod pipeline;
 
-pub use contamination::{compare_classical_robust, Contamination};
+pub use contamination::{compare_classical_robust, Contamination, FitUses};
 pub use nav::{Adjustment, AxisPolicy, NavSet};
 pub use pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,

@@ -2,7 +2,7 @@
 //! selected by WIC, the identified fit with inference, the canonical read-off in continuous
 //! SI units with intervals, the IEEE Std 952 read-off and a verdict on the fit.
 
-use super::contamination::{compare_classical_robust, Contamination};
+use super::contamination::{compare_classical_robust, Contamination, FitUses};
 use super::ieee::{ieee_readoff, IeeeReadoff};
 use crate::fit::canonical::long_run_variance;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
@@ -710,10 +710,11 @@ impl Calibration {
             },
             ..self.options.wv
         };
+        let alpha = self.options.wv.alpha;
         match wavelet_variance(x, freq_hz, &other) {
             Ok(w) => Some(match wv.robust {
-                Some(_) => compare_classical_robust(&w, wv.clone(), self.options.wv.alpha),
-                None => compare_classical_robust(wv, w, self.options.wv.alpha),
+                Some(_) => compare_classical_robust(w, wv.clone(), FitUses::Robust, alpha),
+                None => compare_classical_robust(wv.clone(), w, FitUses::Classical, alpha),
             }),
             Err(e) => {
                 notes.push(format!(
