@@ -382,6 +382,7 @@ fn figures_refuse_a_bad_name_or_size_in_one_line() {
     assert!(e.to_string().contains(".svg or .png"), "{e}");
     let e = figure.clone().with_size((100, 50)).svg().unwrap_err();
     assert!(e.to_string().contains("100x50"), "{e}");
+    assert!(!e.to_string().contains('\n'), "one line: {e}");
 }
 
 #[test]
