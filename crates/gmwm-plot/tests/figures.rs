@@ -102,17 +102,7 @@ fn figures_wv_grid_and_overlay_of_the_adis_imu() {
         .collect();
     let columns: Vec<Column<'_, WaveletVariance>> = wvs
         .iter()
-        .map(|(n, w)| {
-            Column::new(
-                n,
-                if n.starts_with("gyro") {
-                    "rad/s"
-                } else {
-                    "m/s²"
-                },
-                w,
-            )
-        })
+        .map(|(n, w)| Column::new(n, if n.starts_with("gyro") { "deg/s" } else { "g" }, w))
         .collect();
     let levels = wvs[0].1.levels();
     let grid = wv_figure(&columns, Layout::Grid);
@@ -156,7 +146,7 @@ fn figures_allan_deviation_of_a_precomputed_wv_and_the_recording() {
 
     let (cols, freq) = recording("adis_16405_imu1.csv.gz", 1 << 18);
     let av = allan_variance(&cols[0].1, freq, &AllanOptions::default()).unwrap();
-    let figure = allan_figure(&[Column::new(&cols[0].0, "rad/s", &av)], Layout::Grid);
+    let figure = allan_figure(&[Column::new(&cols[0].0, "deg/s", &av)], Layout::Grid);
     let svg = render(&figure, "avar_adis_gyro_x");
     assert_eq!(svg.circles, av.tau_s.len());
     assert!(svg.texts.iter().any(|t| t.contains("Allan deviation")));
@@ -171,7 +161,7 @@ fn figures_classical_against_robust_shows_the_contamination() {
     let (cols, freq) = recording("cont_imu1.csv.gz", usize::MAX);
     let x = &cols[0].1;
     let pair = (wv(x, freq, false), wv(x, freq, true));
-    let figure = compare_figure(&[Column::new("gyro_x", "rad/s", &pair)]);
+    let figure = compare_figure(&[Column::new("gyro_x", "u", &pair)]);
     assert_eq!(figure.legend().len(), 4);
     let svg = render(&figure, "compare_cont_imu1");
     assert_eq!(svg.polygons, 2, "one band each");
@@ -193,7 +183,7 @@ fn figures_compare_with_an_undefined_robust_level_splits_its_band() {
     let levels = classical.levels();
     let pair = (classical, robust);
     let svg = render(
-        &compare_figure(&[Column::new("gyro_x", "rad/s", &pair)]),
+        &compare_figure(&[Column::new("gyro_x", "u", &pair)]),
         "compare_undefined_level",
     );
     assert_eq!(
@@ -215,14 +205,14 @@ fn figures_fit_decomposition_names_every_process_with_its_value() {
         .with_seed(1)
         .fit(x, freq, &WvOptions::default())
         .unwrap();
-    let figure = fit_figure(&[Column::new("gyro_x", "rad/s", &fit)]);
+    let figure = fit_figure(&[Column::new("gyro_x", "deg/s", &fit)]);
     let legend = figure.legend();
     // band, empirical, model, and one line per component
     assert_eq!(legend.len(), 3 + 4, "{legend:?}");
     assert!(
         legend
             .iter()
-            .any(|l| l.starts_with("WN: N = ") && l.contains("rad/s/√Hz")),
+            .any(|l| l.starts_with("WN: N = ") && l.contains("deg/s/√Hz")),
         "{legend:?}"
     );
     assert!(
@@ -254,7 +244,7 @@ fn figures_fit_with_a_component_below_the_plot_says_so() {
     for v in &mut fit.implied_wv.processes[0].wv {
         *v *= 1e-12;
     }
-    let figure = fit_figure(&[Column::new("gyro_x", "rad/s", &fit)]);
+    let figure = fit_figure(&[Column::new("gyro_x", "deg/s", &fit)]);
     let svg = render(&figure, "fit_component_below");
     assert!(
         svg.texts
@@ -297,7 +287,7 @@ fn figures_selection_and_ieee_on_the_adis_gyroscope() {
         .select(x, freq)
         .unwrap();
     let figure = selection_figure(
-        &[Column::new("gyro_x", "rad/s", &selection)],
+        &[Column::new("gyro_x", "deg/s", &selection)],
         gmwm_plot::WIC_ROWS,
     );
     assert_eq!(figure.grid, (1, 2));
@@ -315,7 +305,7 @@ fn figures_selection_and_ieee_on_the_adis_gyroscope() {
     let av = allan_variance(x, freq, &AllanOptions::default()).unwrap();
     let readoff = ieee_readoff(&av).unwrap();
     let pair = (av, readoff);
-    let figure = ieee_figure(&[Column::new("gyro_x", "rad/s", &pair)]);
+    let figure = ieee_figure(&[Column::new("gyro_x", "deg/s", &pair)]);
     let legend = figure.legend();
     assert!(legend.iter().any(|l| l.starts_with("N = ")), "{legend:?}");
     assert!(legend.iter().any(|l| l.starts_with("B = ")), "{legend:?}");
