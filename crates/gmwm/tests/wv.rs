@@ -234,8 +234,8 @@ fn eta3_ci_covers_white_noise_wv_at_nominal_rate() {
         let eta = (m_kept as f64 / (1 << j) as f64).max(1.0);
         let e = white_noise_edf(j, m_kept);
         let chi = ChiSquared::new(e).unwrap();
-        let predicted = chi.cdf(e * chi_square_quantile(1.0 - alpha / 2.0, eta) / eta)
-            - chi.cdf(e * chi_square_quantile(alpha / 2.0, eta) / eta);
+        let predicted = chi.cdf(e * chi_square_quantile(1.0 - alpha / 2.0, eta).unwrap() / eta)
+            - chi.cdf(e * chi_square_quantile(alpha / 2.0, eta).unwrap() / eta);
         let rate = c as f64 / B as f64;
         let se = (predicted * (1.0 - predicted) / B as f64).sqrt();
         assert!(

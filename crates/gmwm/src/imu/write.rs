@@ -261,14 +261,20 @@ pub fn create(path: &Path) -> Result<Box<dyn Write>, ReadError> {
 /// Writes rows of equal-length columns as CSV (shortest round-tripping floats, so reading the
 /// file back gives the same bits). The header is written by [`write_csv_header`].
 ///
-/// # Panics
-/// If the columns have different lengths (an internal invariant of the callers).
+/// # Errors
+/// [`io::ErrorKind::InvalidInput`] when the columns have different lengths (nothing is
+/// written); errors of `out`.
 pub fn write_csv_rows(out: &mut dyn Write, columns: &[&[f64]]) -> io::Result<()> {
     let n = columns.first().map_or(0, |c| c.len());
-    assert!(
-        columns.iter().all(|c| c.len() == n),
-        "columns of equal length"
-    );
+    if let Some(c) = columns.iter().find(|c| c.len() != n) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "CSV columns must have equal lengths ({n} and {} samples)",
+                c.len()
+            ),
+        ));
+    }
     let mut line = String::with_capacity(32 * columns.len());
     for t in 0..n {
         line.clear();
@@ -313,6 +319,16 @@ pub fn write_sidecar(data: &Path, sidecar: &Sidecar) -> Result<PathBuf, ReadErro
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unequal_csv_columns_are_an_error() {
+        let mut out = Vec::new();
+        let e = write_csv_rows(&mut out, &[&[1.0, 2.0], &[3.0]]).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::InvalidInput);
+        assert!(out.is_empty());
+        write_csv_rows(&mut out, &[&[1.0, 2.0], &[3.0, 4.5]]).unwrap();
+        assert_eq!(String::from_utf8(out).unwrap(), "1,3\n2,4.5\n");
+    }
 
     #[test]
     fn output_format_from_path() {

@@ -38,11 +38,13 @@ impl fmt::Display for JTest {
 }
 
 /// Upper tail `1 - F_chi2(t; df)` of the chi-square distribution (METHODS §7.3), accurate far
-/// into the tail (regularised upper incomplete gamma `Q(df/2, t/2)`); 1 for `t <= 0`.
+/// into the tail (regularised upper incomplete gamma `Q(df/2, t/2)`); 1 for `t <= 0`, NaN for a
+/// NaN `t`. With `df = 0` the distribution is the point mass at 0, whose upper tail at `t > 0`
+/// is 0.
 pub fn chi_square_upper_tail(t: f64, df: usize) -> f64 {
     if t <= 0.0 {
         1.0
-    } else if t.is_infinite() {
+    } else if t.is_infinite() || df == 0 {
         0.0
     } else {
         gamma_ur(df as f64 / 2.0, t / 2.0)
@@ -124,6 +126,9 @@ mod tests {
         }
         assert!((chi_square_upper_tail(3.841_458_820_694_124, 1) - 0.05).abs() < 1e-12);
         assert_eq!(chi_square_upper_tail(0.0, 3), 1.0);
+        // df = 0 (the point mass at 0) and NaN are answers, not panics
+        assert_eq!(chi_square_upper_tail(1.0, 0), 0.0);
+        assert!(chi_square_upper_tail(f64::NAN, 2).is_nan());
     }
 
     #[test]

@@ -29,7 +29,7 @@
 
 use crate::error::{check_series, Error, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
-use crate::variance::ci::{check_alpha, chi_square_interval};
+use crate::variance::ci::{check_alpha, interval_unchecked};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -365,7 +365,7 @@ pub fn allan_variance(
     for (&m, row) in clusters.iter().zip(rows) {
         let mf = m as f64;
         let edf = row.edf.max(1.0);
-        let (lo, hi) = chi_square_interval(row.value, edf, opts.alpha);
+        let (lo, hi) = interval_unchecked(row.value, edf, opts.alpha);
         out.tau.push(mf);
         out.tau_s.push(mf / freq_hz);
         out.avar.push(row.value);

@@ -26,11 +26,41 @@ pub fn eta3(kept: usize, j: usize) -> f64 {
     (kept as f64 / (j as f64).exp2()).max(1.0)
 }
 
+/// Checks chi-square degrees of freedom: finite and positive (they may be fractional).
+fn check_df(name: &'static str, df: f64) -> Result<(), ParamError> {
+    if df.is_finite() && df > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(
+            name,
+            df,
+            "must be a finite positive number of degrees of freedom",
+        ))
+    }
+}
+
 /// Chi-square interval of a variance estimate with `eta` equivalent degrees of freedom,
 /// METHODS §1.7: `[eta v / q(1 - alpha/2; eta), eta v / q(alpha/2; eta)]`.
 ///
-/// `alpha` must already be valid ([`check_alpha`]) and `eta >= 1`.
-pub fn chi_square_interval(estimate: f64, eta: f64, alpha: f64) -> (f64, f64) {
+/// # Errors
+/// [`ParamError`] naming `alpha` when it is outside (0, 1) ([`check_alpha`]), `eta` when it is
+/// not finite and positive, or `estimate` when it is negative or not finite.
+pub fn chi_square_interval(estimate: f64, eta: f64, alpha: f64) -> Result<(f64, f64), ParamError> {
+    check_alpha(alpha)?;
+    check_df("eta", eta)?;
+    if !(estimate.is_finite() && estimate >= 0.0) {
+        return Err(ParamError::new(
+            "estimate",
+            estimate,
+            "must be a finite non-negative variance",
+        ));
+    }
+    Ok(interval_unchecked(estimate, eta, alpha))
+}
+
+/// [`chi_square_interval`] for arguments the caller has validated (`alpha` in (0, 1), finite
+/// `eta > 0`).
+pub(crate) fn interval_unchecked(estimate: f64, eta: f64, alpha: f64) -> (f64, f64) {
     // Solve each tail directly: 1 - alpha/2 rounds to 1 for alpha < ~2e-16.
     let upper_q = quantile_from_tail(alpha / 2.0, true, eta);
     let lower_q = quantile_from_tail(alpha / 2.0, false, eta);
@@ -45,14 +75,19 @@ pub fn chi_square_interval(estimate: f64, eta: f64, alpha: f64) -> (f64, f64) {
 /// (or `Q(df/2, x/2) = 1 - p` above the median, for accuracy in the upper tail) by Newton steps
 /// safeguarded by a bisection bracket, from the Wilson–Hilferty start, to ~1e-15 relative.
 ///
-/// # Panics
-/// Never for `df > 0` and `p` in (0, 1); callers validate both.
-pub fn chi_square_quantile(p: f64, df: f64) -> f64 {
-    if p > 0.5 {
+/// # Errors
+/// [`ParamError`] naming `p` when it is outside (0, 1) or `df` when it is not finite and
+/// positive.
+pub fn chi_square_quantile(p: f64, df: f64) -> Result<f64, ParamError> {
+    if !(p > 0.0 && p < 1.0) {
+        return Err(ParamError::new("p", p, "must be a probability in (0, 1)"));
+    }
+    check_df("df", df)?;
+    Ok(if p > 0.5 {
         quantile_from_tail(1.0 - p, true, df)
     } else {
         quantile_from_tail(p, false, df)
-    }
+    })
 }
 
 /// The chi-square quantile whose lower tail (`upper = false`) or upper tail (`upper = true`)
@@ -67,7 +102,9 @@ fn quantile_from_tail(tail: f64, upper: bool, df: f64) -> f64 {
             gamma_lr(k, x / 2.0) - tail
         }
     };
-    let chi = ChiSquared::new(df).expect("df > 0 is a valid chi-square df");
+    let Ok(chi) = ChiSquared::new(df) else {
+        return f64::NAN; // unreachable: callers pass a finite df > 0
+    };
     let z_lower = Normal::standard().inverse_cdf(tail);
     let z = if upper { -z_lower } else { z_lower };
     let c = 2.0 / (9.0 * df);
@@ -125,13 +162,13 @@ mod tests {
             (2, 0.6150596, 1.905528),
             (3, 0.5200056, 2.657153),
         ] {
-            let (l, h) = chi_square_interval(1.0, eta3(100, j), 0.05);
+            let (l, h) = chi_square_interval(1.0, eta3(100, j), 0.05).unwrap();
             assert!(close(l, lo) && close(h, hi), "level {j}: {l} {h}");
         }
         // x = 1..8: level 1 eta 3.5, level 2 eta 1.25
-        let (l, h) = chi_square_interval(0.25, eta3(7, 1), 0.05);
+        let (l, h) = chi_square_interval(0.25, eta3(7, 1), 0.05).unwrap();
         assert!(close(l, 0.08526516) && close(h, 2.582085), "{l} {h}");
-        let (l, h) = chi_square_interval(1.0, eta3(5, 2), 0.05);
+        let (l, h) = chi_square_interval(1.0, eta3(5, 2), 0.05).unwrap();
         assert!(close(l, 0.22025899) && close(h, 271.909147), "{l} {h}");
     }
 
@@ -141,7 +178,7 @@ mod tests {
         for df in [1.0, 1.25, 3.5, 12.5, 50.0, 1e3, 5e5, 4e7] {
             let chi = ChiSquared::new(df).unwrap();
             for p in [1e-6, 0.025, 0.5, 0.975] {
-                let q = chi_square_quantile(p, df);
+                let q = chi_square_quantile(p, df).unwrap();
                 let err = if p > 0.5 {
                     chi.sf(q) - (1.0 - p)
                 } else {
@@ -158,20 +195,45 @@ mod tests {
         }
         // R: qchisq(0.975, 1) = 5.023886187314888, qchisq(0.025, 1) = 0.000982069117175
         // (statrs' inverse_cdf returns NaN for the latter)
-        assert!((chi_square_quantile(0.975, 1.0) - 5.023886187314888).abs() < 1e-13);
-        assert!((chi_square_quantile(0.025, 1.0) / 0.000982069117175 - 1.0).abs() < 1e-9);
+        assert!((chi_square_quantile(0.975, 1.0).unwrap() - 5.023886187314888).abs() < 1e-13);
+        assert!((chi_square_quantile(0.025, 1.0).unwrap() / 0.000982069117175 - 1.0).abs() < 1e-9);
     }
 
     #[test]
     fn tiny_alpha_gives_finite_wide_intervals() {
         // 1 - 1e-16 / 2 rounds to 1: the tails must be solved directly (review finding)
         for alpha in [1e-16, 1e-300] {
-            let (lo, hi) = chi_square_interval(1.0, 50.0, alpha);
+            let (lo, hi) = chi_square_interval(1.0, 50.0, alpha).unwrap();
             assert!(
                 lo > 0.0 && lo < 0.7 && hi > 1.5 && hi.is_finite(),
                 "{alpha}: {lo} {hi}"
             );
         }
+    }
+
+    #[test]
+    fn bad_arguments_are_errors_not_panics() {
+        for df in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(chi_square_quantile(0.5, df).unwrap_err().name, "df");
+            assert_eq!(chi_square_interval(1.0, df, 0.05).unwrap_err().name, "eta");
+        }
+        for p in [0.0, 1.0, -0.5, 2.0, f64::NAN] {
+            assert_eq!(chi_square_quantile(p, 3.0).unwrap_err().name, "p");
+        }
+        assert_eq!(
+            chi_square_interval(1.0, 3.0, 1.5).unwrap_err().name,
+            "alpha"
+        );
+        for v in [-1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(
+                chi_square_interval(v, 3.0, 0.05).unwrap_err().name,
+                "estimate"
+            );
+        }
+        // fractional df below 1 is a valid chi-square
+        let q = chi_square_quantile(0.5, 0.5).unwrap();
+        let chi = ChiSquared::new(0.5).unwrap();
+        assert!((chi.cdf(q) - 0.5).abs() < 1e-12, "{q}");
     }
 
     #[test]

@@ -8,7 +8,7 @@
 use crate::error::{check_finite, check_freq, check_series, Error, ParamError, SeriesError};
 use crate::math::special::trigamma;
 use crate::math::sum::NeumaierSum;
-use crate::variance::ci::{check_alpha, chi_square_interval, eta3};
+use crate::variance::ci::{check_alpha, eta3, interval_unchecked};
 use crate::variance::haar::haar_square_sums;
 use crate::variance::haar_robust::haar_robust_levels;
 use crate::variance::robust::{
@@ -161,7 +161,7 @@ impl WaveletVariance {
         let mut ci_high = Vec::with_capacity(levels);
         let mut lowest: Option<f64> = None;
         for (i, (&nu_c, &e)) in classical.iter().zip(&eta).enumerate() {
-            let (lo_c, hi_c) = chi_square_interval(nu_c, e, opts.alpha);
+            let (lo_c, hi_c) = interval_unchecked(nu_c, e, opts.alpha);
             match (robust, opts.robust) {
                 (Some(r), Some(ro)) => {
                     let (lo, hi) = robust_ci(r[i], nu_c, lo_c, hi_c, ro.eff, lowest);
