@@ -30,19 +30,13 @@ impl From<&OutputArgs> for Style {
     }
 }
 
-/// A result tagged with the series (column) it belongs to; JSON flattens the result into it.
-#[derive(Debug, Serialize)]
+/// A result tagged with the series (column) it belongs to.
+#[derive(Debug)]
 pub struct Named<'a, T> {
     /// Series name.
     pub name: &'a str,
     /// The result.
-    #[serde(flatten)]
     pub result: &'a T,
-}
-
-#[derive(Serialize)]
-struct SeriesDoc<'a, T> {
-    series: &'a [Named<'a, T>],
 }
 
 /// A result with a CSV form: one header, then one row per scale.
@@ -121,7 +115,11 @@ pub fn series<T: Serialize + std::fmt::Display + CsvRows>(
 }
 
 fn json<T: Serialize>(out: &mut impl Write, items: &[Named<T>]) -> Result<()> {
-    serde_json::to_writer_pretty(&mut *out, &SeriesDoc { series: items })?;
+    let pairs: Vec<(String, &T)> = items
+        .iter()
+        .map(|it| (it.name.to_string(), it.result))
+        .collect();
+    serde_json::to_writer_pretty(&mut *out, &gmwm::document::series(&pairs))?;
     writeln!(out)?;
     Ok(())
 }
@@ -133,26 +131,4 @@ fn csv_field(s: &str) -> String {
     } else {
         s.to_string()
     }
-}
-
-/// A reading of a canonical model with its sentence, for JSON.
-#[derive(Serialize)]
-pub struct CanonicalNote<'a> {
-    /// The reading's fields (`kind`, components, times, separation).
-    #[serde(flatten)]
-    pub reading: &'a gmwm::fit::Reading,
-    /// The reading in words.
-    pub message: String,
-}
-
-/// The readings of `canonical` with their sentences.
-pub fn canonical_notes(canonical: &gmwm::fit::CanonicalModel) -> Vec<CanonicalNote<'_>> {
-    canonical
-        .readings
-        .iter()
-        .map(|reading| CanonicalNote {
-            reading,
-            message: reading.to_string(),
-        })
-        .collect()
 }

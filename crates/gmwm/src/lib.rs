@@ -19,12 +19,18 @@
 //! ```
 #![deny(missing_docs)]
 
+// Unit tests that exercise crate-internal kernels are written against `gmwm::` paths, like the
+// integration tests they were moved from.
+#[cfg(test)]
+extern crate self as gmwm;
+
 pub mod calib;
+pub mod document;
 pub mod error;
 pub mod fit;
 pub mod imu;
 pub mod inference;
-pub mod math;
+pub(crate) mod math;
 pub mod model;
 pub mod process;
 pub mod selection;

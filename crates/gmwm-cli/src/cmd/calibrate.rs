@@ -122,12 +122,7 @@ pub fn execute(
         }
     }
     let json_to_stdout = args.json.as_deref() == Some(Path::new("-"));
-    let doc = JsonDoc {
-        file: &recording.path,
-        notes: &recording.notes,
-        calibration: &report,
-        exported: &sets,
-    };
+    let doc = gmwm::document::calibration(&recording.path, &recording.notes, &report, &sets);
     if let Some(path) = report_path {
         match write_report(args, path, &recording, &report, &sets, &exports, &doc) {
             Ok(figures) => written.push(format!(
@@ -176,7 +171,7 @@ fn write_report(
     report: &CalibrationReport,
     sets: &[NavSet],
     exports: &[(ExportFormat, PathBuf)],
-    doc: &JsonDoc<'_>,
+    doc: &serde_json::Value,
 ) -> Result<usize> {
     let mut formats: Vec<(ExportFormat, Option<&Path>)> = exports
         .iter()
@@ -289,15 +284,6 @@ fn per_axis_path(path: &Path, label: &str) -> PathBuf {
         None => format!("{stem}.{label}"),
     };
     path.with_file_name(name)
-}
-
-#[derive(serde::Serialize)]
-struct JsonDoc<'a> {
-    file: &'a Path,
-    notes: &'a [String],
-    #[serde(flatten)]
-    calibration: &'a CalibrationReport,
-    exported: &'a [NavSet],
 }
 
 /// Four significant digits.

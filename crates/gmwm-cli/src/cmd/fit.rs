@@ -4,71 +4,15 @@ use crate::args::{FitArgs, WeightsArg};
 use crate::cmd::wv::options;
 use crate::input::{analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv};
 use crate::progress::bar;
-use crate::render::{canonical_notes, CanonicalNote, Style};
+use crate::render::Style;
 use crate::UsageError;
 use anyhow::Result;
-use gmwm::fit::{
-    Ar1GmForms, CanonicalModel, CanonicalTerm, NavParameter, ParameterEstimate, StartInputs,
-};
-use gmwm::inference::{infer_with_progress, Inference, InferenceOptions, JTest};
+use gmwm::fit::{CanonicalModel, StartInputs};
+use gmwm::inference::{infer_with_progress, Inference, InferenceOptions};
 use gmwm::model::Model;
 use gmwm::{Gmwm, GmwmFit, WaveletFilter, WaveletVariance, Weighting, WvOptions};
 use rayon::prelude::*;
-use serde::Serialize;
 use std::io::Write;
-
-/// One parameter in the JSON output: the estimate, plus its inference when asked.
-#[derive(Serialize)]
-struct ParameterReport {
-    #[serde(flatten)]
-    estimate: ParameterEstimate,
-    /// With --inference: `se`, `ci_low`, `ci_high` (null for a parameter at the boundary).
-    #[serde(flatten)]
-    inference: Option<ParameterInterval>,
-}
-
-#[derive(Serialize)]
-struct ParameterInterval {
-    se: Option<f64>,
-    ci_low: Option<f64>,
-    ci_high: Option<f64>,
-}
-
-/// One column's fit in the JSON output.
-#[derive(Serialize)]
-struct FitReport<'a> {
-    column: &'a str,
-    model: String,
-    objective: f64,
-    converged: bool,
-    /// `{process, index, name, value, start[, se, ci_low, ci_high]}` in model order.
-    parameters: Vec<ParameterReport>,
-    /// The J-test `{statistic, df, p_value}` (with --inference; null when it cannot be formed).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    gof: Option<Option<JTest>>,
-    /// The whole inference (with --inference).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    inference: Option<&'a Inference>,
-    /// AR1/GM components in both forms.
-    ar1_gm: Vec<Ar1GmForms>,
-    /// Physical units (u = the data unit).
-    navigation: Vec<NavParameter>,
-    /// The canonical model (text): what the fitted components are at the observed scales.
-    canonical_model: String,
-    /// The reduced model (text): the smallest model whose fit the data cannot tell from this
-    /// one's.
-    reduced_model: String,
-    /// Its terms with their physical read-off.
-    canonical: &'a [CanonicalTerm],
-    /// What the canonical model reads differently from the fit, and why.
-    canonical_notes: Vec<CanonicalNote<'a>>,
-    fit: &'a GmwmFit,
-}
-
-#[derive(Serialize)]
-struct FitsDoc<'a> {
-    fits: Vec<FitReport<'a>>,
-}
 
 /// Fits every series of a WV JSON file (`gmwm wv --json`) selected by `--columns` (names or
 /// 1-based indices).
@@ -217,45 +161,20 @@ fn render_fits(
     };
     match Style::from(&args.output) {
         Style::Json => {
-            let doc = FitsDoc {
-                fits: fits
-                    .iter()
-                    .zip(&inferences)
-                    .zip(&canonicals)
-                    .map(|(((column, fit), inf), canonical)| FitReport {
+            let items: Vec<gmwm::document::FitItem<'_>> = fits
+                .iter()
+                .zip(&inferences)
+                .zip(&canonicals)
+                .map(
+                    |(((column, fit), inf), canonical)| gmwm::document::FitItem {
                         column,
-                        model: fit.model.to_string(),
-                        objective: fit.objective,
-                        converged: fit.convergence.converged,
-                        parameters: fit
-                            .parameters()
-                            .into_iter()
-                            .enumerate()
-                            .map(|(k, estimate)| {
-                                let p = inf.as_ref().map(|i| &i.parameters[k]);
-                                ParameterReport {
-                                    estimate,
-                                    inference: p.map(|p| ParameterInterval {
-                                        se: p.se,
-                                        ci_low: p.ci_low,
-                                        ci_high: p.ci_high,
-                                    }),
-                                }
-                            })
-                            .collect(),
-                        gof: inf.as_ref().map(|i| i.gof.clone()),
-                        inference: inf.as_ref(),
-                        ar1_gm: fit.ar1_gm_forms(),
-                        navigation: fit.navigation(None),
-                        canonical_model: canonical.model.to_string(),
-                        reduced_model: canonical.reduced.to_string(),
-                        canonical: &canonical.terms,
-                        canonical_notes: canonical_notes(canonical),
                         fit,
-                    })
-                    .collect(),
-            };
-            serde_json::to_writer_pretty(&mut *out, &doc)?;
+                        canonical,
+                        inference: inf.as_ref(),
+                    },
+                )
+                .collect();
+            serde_json::to_writer_pretty(&mut *out, &gmwm::document::fits(&items))?;
             writeln!(out)?;
         }
         Style::Csv => {

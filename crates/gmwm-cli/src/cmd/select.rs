@@ -5,52 +5,12 @@ use crate::args::{OptimismArg, OptimismConventionArg, RuleArg, SelectArgs};
 use crate::cmd::wv::options;
 use crate::input::{analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv};
 use crate::progress::{bar, Ticks};
-use crate::render::{canonical_notes, CanonicalNote, Style};
+use crate::render::Style;
 use anyhow::Result;
-use gmwm::fit::CanonicalTerm;
 use gmwm::model::Model;
-use gmwm::selection::{OptimismConvention, OptimismMethod, RowStatus, SelectionRow, SelectionRule};
+use gmwm::selection::{OptimismConvention, OptimismMethod, RowStatus, SelectionRule};
 use gmwm::{ModelSelection, Wic};
-use serde::Serialize;
 use std::io::Write;
-
-/// One candidate in the JSON output.
-#[derive(Serialize)]
-struct CandidateRow {
-    model: String,
-    canonical_model: String,
-    objective: f64,
-    optimism: f64,
-    wic: f64,
-    gof_p_value: Option<f64>,
-    gof_p_value_upper_bound: bool,
-}
-
-/// One column's selection in the JSON output.
-#[derive(Serialize)]
-struct SelectionReport<'a> {
-    column: &'a str,
-    /// The selected candidate, as fitted.
-    selected: String,
-    /// Its canonical model (text).
-    selected_canonical: String,
-    /// The canonical model's terms with their physical read-off.
-    canonical: &'a [CanonicalTerm],
-    /// What the canonical model reads differently from the fit, and why.
-    canonical_notes: Vec<CanonicalNote<'a>>,
-    /// Why the selected row was chosen.
-    reason: String,
-    rule: SelectionRule,
-    /// One row per canonical model, sorted by WIC.
-    rows: &'a [SelectionRow],
-    /// Every candidate, sorted by WIC.
-    candidates: Vec<CandidateRow>,
-}
-
-#[derive(Serialize)]
-struct SelectionsDoc<'a> {
-    selections: Vec<SelectionReport<'a>>,
-}
 
 /// The validated selection settings from the flags.
 fn wic(args: &SelectArgs) -> Result<Wic> {
@@ -208,35 +168,7 @@ fn render_selections(
 ) -> Result<()> {
     match Style::from(&args.output) {
         Style::Json => {
-            let doc = SelectionsDoc {
-                selections: results
-                    .iter()
-                    .map(|(column, s)| SelectionReport {
-                        column,
-                        selected: s.selected.to_string(),
-                        selected_canonical: s.selected_canonical.model.to_string(),
-                        canonical: &s.selected_canonical.terms,
-                        canonical_notes: canonical_notes(&s.selected_canonical),
-                        reason: s.reason(),
-                        rule: s.rule,
-                        rows: &s.rows,
-                        candidates: s
-                            .candidates
-                            .iter()
-                            .map(|c| CandidateRow {
-                                model: c.model.to_string(),
-                                canonical_model: c.canonical_model.to_string(),
-                                objective: c.objective,
-                                optimism: c.optimism,
-                                wic: c.wic,
-                                gof_p_value: c.gof_p_value,
-                                gof_p_value_upper_bound: c.gof_p_value_upper_bound,
-                            })
-                            .collect(),
-                    })
-                    .collect(),
-            };
-            serde_json::to_writer_pretty(&mut *out, &doc)?;
+            serde_json::to_writer_pretty(&mut *out, &gmwm::document::selections(results))?;
             writeln!(out)?;
         }
         Style::Csv => write_csv(results, out)?,
