@@ -1,0 +1,103 @@
+"""Fleet calibration: many recordings, one table.
+
+``calibrate_many(paths, client=None, **options)`` runs :func:`gmwm.calibrate` on every
+recording, on a ``dask.distributed`` client when one is given (``pip install 'gmwm[fleet]'``),
+else in a local process pool. Each recording is one task keyed by its position and path; a
+worker lost mid-run has its tasks rescheduled by the scheduler, and the results are gathered
+once, in the order of ``paths``: nothing is reported twice or dropped.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any, Dict, List, Optional, Sequence
+
+from ._results import CalibrationResult, summary_rows
+
+
+def _unit_name(path: str) -> str:
+    """The unit's name: the file name without its data extensions."""
+    name = os.path.basename(os.fspath(path).rstrip("/"))
+    for ext in (".gz", ".csv", ".tsv", ".txt", ".bag", ".mcap", ".db3", ".bin", ".f64", ".f32"):
+        if name.endswith(ext):
+            name = name[: -len(ext)]
+    return name or os.fspath(path)
+
+
+def calibrate_one(path: str, options: Dict[str, Any]) -> Dict[str, Any]:
+    """One recording's calibration document (what a worker runs; plain data, picklable)."""
+    from . import calibrate
+
+    return calibrate(path, **options).to_dict()
+
+
+class FleetResult:
+    """The calibrations of a fleet: ``results`` (unit -> :class:`CalibrationResult`, in input
+    order), ``table`` (one row per unit and axis: unit, axis, model, N, B, K with intervals,
+    verdict; a pandas ``DataFrame`` when pandas is installed, else a list of dicts) and
+    ``errors`` (unit -> message, for recordings that could not be calibrated)."""
+
+    def __init__(self, units: List[str], docs: List[Optional[Dict[str, Any]]], errors: Dict[str, str]):
+        self.results: Dict[str, CalibrationResult] = {
+            u: CalibrationResult(d) for u, d in zip(units, docs) if d is not None
+        }
+        self.errors = errors
+        rows = [row for u, d in zip(units, docs) if d is not None for row in summary_rows(d, unit=u)]
+        try:
+            import pandas
+
+            self.table = pandas.DataFrame(rows)
+        except ImportError:  # pragma: no cover - pandas is in the fleet extra
+            self.table = rows
+
+    def __len__(self) -> int:
+        return len(self.results)
+
+    def __repr__(self) -> str:
+        return f"<FleetResult: {len(self.results)} calibrated, {len(self.errors)} failed>"
+
+
+def calibrate_many(
+    paths: Sequence[str],
+    client=None,
+    *,
+    max_workers: Optional[int] = None,
+    retries: int = 1,
+    **options,
+) -> FleetResult:
+    """Calibrates every recording of ``paths`` with the same ``options`` (those of
+    :func:`gmwm.calibrate`). With a ``dask.distributed.Client`` each recording is a task
+    (``retries`` more attempts on an exception; a lost worker's tasks are rescheduled by Dask);
+    without one, a ``ProcessPoolExecutor`` of ``max_workers`` processes runs them. A recording
+    that fails is reported in ``errors`` with the engine's message, not raised, so that one bad
+    unit does not lose the fleet."""
+    paths = [os.fspath(p) for p in paths]
+    units = [_unit_name(p) for p in paths]
+    if len(set(units)) != len(units):
+        units = [f"{i + 1}:{u}" for i, u in enumerate(units)]
+    docs: List[Optional[Dict[str, Any]]] = [None] * len(paths)
+    errors: Dict[str, str] = {}
+    if client is not None:
+        futures = client.map(
+            calibrate_one,
+            paths,
+            [options] * len(paths),
+            key=[f"gmwm-calibrate-{i}-{u}" for i, u in enumerate(units)],
+            retries=retries,
+            pure=False,
+        )
+        for i, f in enumerate(futures):
+            try:
+                docs[i] = f.result()
+            except Exception as e:  # noqa: BLE001 - reported per unit, not raised
+                errors[units[i]] = str(e)
+    else:
+        with ProcessPoolExecutor(max_workers=max_workers) as pool:
+            futures = [pool.submit(calibrate_one, p, options) for p in paths]
+            for i, f in enumerate(futures):
+                try:
+                    docs[i] = f.result()
+                except Exception as e:  # noqa: BLE001
+                    errors[units[i]] = str(e)
+    return FleetResult(units, docs, errors)

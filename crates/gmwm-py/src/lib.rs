@@ -1,0 +1,864 @@
+//! `gmwm._native`: the engine's verbs for Python. Conversions only: numpy arrays in (borrowed
+//! when contiguous float64, copied otherwise, and counted), the engine's JSON documents out
+//! (`gmwm::document`, the CLI's `--json`), engine errors as `gmwm.GmwmError`; the GIL is released
+//! while the engine works. The Python package (`python/gmwm`) wraps these in typed results.
+
+use gmwm::calib::{Adjustment, AxisPolicy, Calibration, CalibrationOptions};
+use gmwm::imu::{
+    read_table, ColumnSelector, HeaderMode, Imu, InputFormat, ReadOptions, Recording,
+    RecordingOptions, SensorInfo, TimeUnit,
+};
+use gmwm::inference::{infer_with_progress, InferenceOptions, Progress};
+use gmwm::model::Model;
+use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
+use gmwm::{
+    allan_variance, wavelet_variance, AllanKind, AllanOptions, AvConvention, Gmwm,
+    RobustConvention, RobustOptions, Transform, WaveletFilter, Weighting, Wic, WvOptions,
+};
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::borrow::Cow;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+create_exception!(
+    _native,
+    GmwmError,
+    PyValueError,
+    "An input or computation the engine refuses; the message names what is wrong."
+);
+
+/// Columns copied because they were not contiguous float64 (a test hook for zero-copy).
+static COPIES: AtomicUsize = AtomicUsize::new(0);
+
+fn err(e: impl std::fmt::Display) -> PyErr {
+    GmwmError::new_err(e.to_string())
+}
+
+/// One line from an engine error and its causes, as the CLI prints it.
+fn engine(e: impl std::error::Error) -> PyErr {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        let t = s.to_string();
+        if !text.contains(&t) {
+            text.push_str(": ");
+            text.push_str(&t);
+        }
+        source = s.source();
+    }
+    GmwmError::new_err(text)
+}
+
+/// Borrowed 1-D float64 arrays (see [`columns`]).
+type Borrowed<'py> = Vec<PyReadonlyArray1<'py, f64>>;
+
+/// Borrows each 1-D float64 array; a non-contiguous one is copied (and counted).
+fn columns_of<'a>(arrays: &'a Borrowed<'_>) -> Vec<Cow<'a, [f64]>> {
+    arrays
+        .iter()
+        .map(|a| match a.as_slice() {
+            Ok(s) => Cow::Borrowed(s),
+            Err(_) => {
+                COPIES.fetch_add(1, Ordering::Relaxed);
+                Cow::Owned(a.as_array().iter().copied().collect())
+            }
+        })
+        .collect()
+}
+
+fn check_columns(arrays: &Borrowed<'_>, names: &[String]) -> PyResult<()> {
+    if arrays.len() != names.len() {
+        return Err(err(format!(
+            "{} column(s) but {} name(s)",
+            arrays.len(),
+            names.len()
+        )));
+    }
+    if arrays.is_empty() {
+        return Err(err("no column to analyse"));
+    }
+    Ok(())
+}
+
+fn check_freq(freq: f64) -> PyResult<()> {
+    if freq.is_finite() && freq > 0.0 {
+        Ok(())
+    } else {
+        Err(err(format!(
+            "invalid freq {freq}: must be a positive number of hertz"
+        )))
+    }
+}
+
+/// The WV options of the keywords (the flags of `gmwm wv`).
+#[allow(clippy::too_many_arguments)]
+fn wv_options(
+    robust: bool,
+    eff: f64,
+    robust_convention: &str,
+    filter: &str,
+    transform: &str,
+    levels: Option<usize>,
+    alpha: f64,
+) -> PyResult<WvOptions> {
+    let convention = match robust_convention {
+        "exact" => RobustConvention::Exact,
+        "package" => RobustConvention::Package,
+        other => {
+            return Err(err(format!(
+                "invalid robust_convention {other:?}: \"exact\" or \"package\""
+            )))
+        }
+    };
+    let robust = if robust {
+        Some(RobustOptions::new(eff, convention).map_err(engine)?)
+    } else {
+        None
+    };
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(err(format!(
+            "invalid alpha {alpha}: must be in (0, 1); 0.05 gives 95% intervals"
+        )));
+    }
+    if levels == Some(0) {
+        return Err(err("invalid levels 0: at least one level"));
+    }
+    Ok(WvOptions {
+        transform: match transform {
+            "modwt" => Transform::Modwt,
+            "dwt" => Transform::Dwt,
+            other => {
+                return Err(err(format!(
+                    "invalid transform {other:?}: \"modwt\" or \"dwt\""
+                )))
+            }
+        },
+        filter: filter.parse::<WaveletFilter>().map_err(engine)?,
+        levels,
+        alpha,
+        robust,
+    })
+}
+
+fn json(value: &serde_json::Value) -> String {
+    value.to_string()
+}
+
+/// Wavelet variance of each column (METHODS §1, §2): the `gmwm wv --json` document.
+#[pyfunction]
+#[pyo3(signature = (arrays, names, freq, robust=false, eff=0.6, robust_convention="exact", filter="haar", transform="modwt", levels=None, alpha=0.05))]
+#[allow(clippy::too_many_arguments)]
+fn wv(
+    py: Python<'_>,
+    arrays: Borrowed<'_>,
+    names: Vec<String>,
+    freq: f64,
+    robust: bool,
+    eff: f64,
+    robust_convention: &str,
+    filter: &str,
+    transform: &str,
+    levels: Option<usize>,
+    alpha: f64,
+) -> PyResult<String> {
+    check_columns(&arrays, &names)?;
+    check_freq(freq)?;
+    let opts = wv_options(
+        robust,
+        eff,
+        robust_convention,
+        filter,
+        transform,
+        levels,
+        alpha,
+    )?;
+    let cols = columns_of(&arrays);
+    let items = py.detach(|| {
+        names
+            .iter()
+            .zip(&cols)
+            .map(|(n, x)| {
+                wavelet_variance(x, freq, &opts)
+                    .map(|w| (n.clone(), w))
+                    .map_err(|e| (n.clone(), e))
+            })
+            .collect::<Result<Vec<_>, _>>()
+    });
+    let items = items.map_err(|(n, e)| err(format!("column {n}: {e}")))?;
+    Ok(json(&gmwm::document::series(&items)))
+}
+
+/// Allan, modified Allan or Hadamard variance of each column (METHODS §3): the
+/// `gmwm avar --json` document.
+#[pyfunction]
+#[pyo3(signature = (arrays, names, freq, kind="overlapping", convention="textbook", alpha=0.05))]
+fn avar(
+    py: Python<'_>,
+    arrays: Borrowed<'_>,
+    names: Vec<String>,
+    freq: f64,
+    kind: &str,
+    convention: &str,
+    alpha: f64,
+) -> PyResult<String> {
+    check_columns(&arrays, &names)?;
+    check_freq(freq)?;
+    let opts = AllanOptions {
+        kind: match kind {
+            "overlapping" => AllanKind::Overlapping,
+            "non-overlapping" => AllanKind::NonOverlapping,
+            "modified" => AllanKind::Modified,
+            "hadamard" => AllanKind::Hadamard,
+            "hadamard-non-overlapping" => AllanKind::HadamardNonOverlapping,
+            other => return Err(err(format!("invalid kind {other:?}: \"overlapping\", \"non-overlapping\", \"modified\", \"hadamard\" or \"hadamard-non-overlapping\""))),
+        },
+        convention: match convention {
+            "textbook" => AvConvention::Textbook,
+            "package" => AvConvention::Package,
+            other => return Err(err(format!("invalid convention {other:?}: \"textbook\" or \"package\""))),
+        },
+        alpha,
+    };
+    let cols = columns_of(&arrays);
+    let items = py
+        .detach(|| {
+            names
+                .iter()
+                .zip(&cols)
+                .map(|(n, x)| {
+                    allan_variance(x, freq, &opts)
+                        .map(|a| (n.clone(), a))
+                        .map_err(|e| (n.clone(), e))
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(|(n, e)| err(format!("column {n}: {e}")))?;
+    Ok(json(&gmwm::document::series(&items)))
+}
+
+/// The implied WV of a fully specified model and of each process (METHODS §4): the
+/// `gmwm implied --json` document.
+#[pyfunction]
+#[pyo3(signature = (model, levels, freq=1.0))]
+fn implied(model: &str, levels: usize, freq: f64) -> PyResult<String> {
+    check_freq(freq)?;
+    let model: Model = model.parse().map_err(engine)?;
+    let implied = model.implied_wv(levels, freq).map_err(engine)?;
+    serde_json::to_string(&implied).map_err(err)
+}
+
+/// A seeded simulation of a fully specified model (METHODS §10): the sum and, with
+/// `components`, each process.
+#[pyfunction]
+#[pyo3(signature = (model, n, freq=1.0, seed=0, components=false))]
+fn simulate<'py>(
+    py: Python<'py>,
+    model: &str,
+    n: usize,
+    freq: f64,
+    seed: u64,
+    components: bool,
+) -> PyResult<(
+    Bound<'py, PyArray1<f64>>,
+    Vec<(String, Bound<'py, PyArray1<f64>>)>,
+)> {
+    check_freq(freq)?;
+    if n == 0 {
+        return Err(err("invalid n 0: simulate at least one sample"));
+    }
+    let model: Model = model.parse().map_err(engine)?;
+    let k = model.components().len();
+    let result = py.detach(|| -> Result<(Vec<f64>, Vec<Vec<f64>>), gmwm::Error> {
+        let mut sim = gmwm::sim::Simulator::for_model(&model, freq, seed)?;
+        if !components {
+            let mut x = vec![0.0; n];
+            sim.fill(&mut x);
+            return Ok((x, Vec::new()));
+        }
+        let mut parts = vec![vec![0.0; n]; k];
+        sim.fill_components(&mut parts)?;
+        let x = (0..n).map(|i| parts.iter().map(|p| p[i]).sum()).collect();
+        Ok((x, parts))
+    });
+    let (x, parts) = result.map_err(engine)?;
+    let names: Vec<String> = model.components().iter().map(|c| c.to_string()).collect();
+    Ok((
+        PyArray1::from_vec(py, x),
+        names
+            .into_iter()
+            .zip(parts)
+            .map(|(name, p)| (name, PyArray1::from_vec(py, p)))
+            .collect(),
+    ))
+}
+
+/// A Python callable told `(done, total)`; errors inside it are ignored (progress must never
+/// stop a computation).
+struct PyProgress {
+    callback: Option<Py<PyAny>>,
+    total: AtomicUsize,
+}
+
+impl Progress for PyProgress {
+    fn start(&self, total: usize) {
+        self.total.store(total, Ordering::Relaxed);
+        self.advance(0);
+    }
+
+    fn advance(&self, done: usize) {
+        if let Some(cb) = &self.callback {
+            let total = self.total.load(Ordering::Relaxed);
+            Python::attach(|py| {
+                let _ = cb.call1(py, (done, total));
+            });
+        }
+    }
+}
+
+/// GMWM fit of a model on each column (METHODS §5, §7 with `inference`): the
+/// `gmwm fit --json` document.
+#[pyfunction]
+#[pyo3(signature = (arrays, names, freq, model, weights="fast", draws=None, seed=1337, inference=false, bootstrap=None, robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn fit(
+    py: Python<'_>,
+    arrays: Borrowed<'_>,
+    names: Vec<String>,
+    freq: f64,
+    model: &str,
+    weights: &str,
+    draws: Option<usize>,
+    seed: u64,
+    inference: bool,
+    bootstrap: Option<usize>,
+    robust: bool,
+    eff: f64,
+    robust_convention: &str,
+    levels: Option<usize>,
+    alpha: f64,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<String> {
+    check_columns(&arrays, &names)?;
+    check_freq(freq)?;
+    let wv_opts = wv_options(
+        robust,
+        eff,
+        robust_convention,
+        "haar",
+        "modwt",
+        levels,
+        alpha,
+    )?;
+    let model: Model = model.parse().map_err(engine)?;
+    let mut gmwm = Gmwm::new(model)
+        .with_seed(seed)
+        .with_weighting(match weights {
+            "fast" => Weighting::Fast,
+            "diag" => Weighting::Diag,
+            "bootstrap" => Weighting::Bootstrap,
+            other => {
+                return Err(err(format!(
+                    "invalid weights {other:?}: \"fast\", \"diag\" or \"bootstrap\""
+                )))
+            }
+        });
+    if let Some(g) = draws {
+        if g == 0 {
+            return Err(err("invalid draws 0: at least one starting-value draw"));
+        }
+        gmwm = gmwm.with_draws(g);
+    }
+    if bootstrap.is_some_and(|b| b < 2) {
+        return Err(err("invalid bootstrap: at least 2 replicates"));
+    }
+    let cols = columns_of(&arrays);
+    let reporter = PyProgress {
+        callback: progress,
+        total: AtomicUsize::new(0),
+    };
+    let out = py.detach(|| -> Result<String, String> {
+        let mut fits = Vec::new();
+        for (n, x) in names.iter().zip(&cols) {
+            let f = gmwm
+                .fit(x, freq, &wv_opts)
+                .map_err(|e| format!("column {n}: {e}"))?;
+            fits.push(f);
+        }
+        let canonicals = fits
+            .iter()
+            .zip(&names)
+            .map(|(f, n)| f.canonical().map_err(|e| format!("column {n}: {e}")))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut inferences = Vec::new();
+        if inference {
+            let opts = InferenceOptions {
+                alpha,
+                bootstrap,
+                ..InferenceOptions::default()
+            };
+            for ((f, n), x) in fits.iter().zip(&names).zip(&cols) {
+                let wv = f.empirical.as_ref().ok_or("the fit carries no WV")?;
+                let this_wv = WvOptions {
+                    levels: Some(wv.levels()),
+                    ..wv_opts
+                };
+                let i = infer_with_progress(&gmwm, f, x.len(), &this_wv, &opts, &|d| {
+                    reporter.advance(d)
+                })
+                .map_err(|e| format!("column {n}: {e}"))?;
+                inferences.push(i);
+            }
+        }
+        let items: Vec<gmwm::document::FitItem<'_>> = names
+            .iter()
+            .zip(&fits)
+            .zip(&canonicals)
+            .enumerate()
+            .map(|(k, ((column, fit), canonical))| gmwm::document::FitItem {
+                column,
+                fit,
+                canonical,
+                inference: inferences.get(k),
+            })
+            .collect();
+        Ok(json(&gmwm::document::fits(&items)))
+    });
+    out.map_err(err)
+}
+
+/// WIC model selection on each column (METHODS §8): the `gmwm select --json` document.
+#[pyfunction]
+#[pyo3(signature = (arrays, names, freq, model=None, candidates=None, bootstrap=50, optimism="asymptotic", convention="corrected", rule="navigation", draws=None, seed=1337, robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn select(
+    py: Python<'_>,
+    arrays: Borrowed<'_>,
+    names: Vec<String>,
+    freq: f64,
+    model: Option<&str>,
+    candidates: Option<Vec<String>>,
+    bootstrap: usize,
+    optimism: &str,
+    convention: &str,
+    rule: &str,
+    draws: Option<usize>,
+    seed: u64,
+    robust: bool,
+    eff: f64,
+    robust_convention: &str,
+    levels: Option<usize>,
+    alpha: f64,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<String> {
+    check_columns(&arrays, &names)?;
+    check_freq(freq)?;
+    if bootstrap < 2 {
+        return Err(err(format!(
+            "invalid bootstrap {bootstrap}: at least 2 (a covariance needs two replicates)"
+        )));
+    }
+    let wv_opts = wv_options(
+        robust,
+        eff,
+        robust_convention,
+        "haar",
+        "modwt",
+        levels,
+        alpha,
+    )?;
+    let mut wic = match (candidates, model) {
+        (Some(mut list), m) => {
+            list.extend(m.map(str::to_string));
+            Wic::parse_list(&list).map_err(engine)?
+        }
+        (None, Some(m)) => Wic::nested(m.parse::<Model>().map_err(engine)?).map_err(engine)?,
+        (None, None) => return Err(err("give model (a full model) or candidates (a list)")),
+    };
+    wic = wic
+        .with_bootstrap(bootstrap)
+        .with_seed(seed)
+        .with_wv_options(wv_opts)
+        .with_optimism(match optimism {
+            "asymptotic" => OptimismMethod::Asymptotic,
+            "bootstrap" => OptimismMethod::Bootstrap,
+            other => {
+                return Err(err(format!(
+                    "invalid optimism {other:?}: \"asymptotic\" or \"bootstrap\""
+                )))
+            }
+        })
+        .with_convention(match convention {
+            "corrected" => OptimismConvention::Corrected,
+            "package" => OptimismConvention::Package,
+            other => {
+                return Err(err(format!(
+                    "invalid convention {other:?}: \"corrected\" or \"package\""
+                )))
+            }
+        })
+        .with_rule(rule_of(rule)?);
+    if let Some(g) = draws {
+        if g == 0 {
+            return Err(err("invalid draws 0: at least one starting-value draw"));
+        }
+        wic = wic.with_draws(g);
+    }
+    let cols = columns_of(&arrays);
+    let reporter = PyProgress {
+        callback: progress,
+        total: AtomicUsize::new(0),
+    };
+    let done = AtomicUsize::new(0);
+    let ticks = Ticks {
+        inner: &reporter,
+        done: &done,
+    };
+    reporter.start(names.len() * wic.candidates().len());
+    let results = py
+        .detach(|| {
+            names
+                .iter()
+                .zip(&cols)
+                .map(|(n, x)| {
+                    wic.select_with_progress(x, freq, &ticks)
+                        .map(|s| (n.clone(), s))
+                        .map_err(|e| format!("column {n}: {e}"))
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(err)?;
+    Ok(json(&gmwm::document::selections(&results)))
+}
+
+/// Counts the engine's per-candidate ticks across columns into one running total.
+struct Ticks<'a> {
+    inner: &'a PyProgress,
+    done: &'a AtomicUsize,
+}
+
+impl Progress for Ticks<'_> {
+    fn start(&self, _total: usize) {}
+    fn advance(&self, _done: usize) {
+        let d = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        self.inner.advance(d);
+    }
+}
+
+fn rule_of(rule: &str) -> PyResult<SelectionRule> {
+    Ok(match rule {
+        "navigation" => SelectionRule::Navigation,
+        "parsimonious" => SelectionRule::Parsimonious,
+        "wic-minimum" => SelectionRule::WicMinimum,
+        other => {
+            return Err(err(format!(
+                "invalid rule {other:?}: \"navigation\", \"parsimonious\" or \"wic-minimum\""
+            )))
+        }
+    })
+}
+
+/// The read options of the keywords (the input flags of the CLI).
+#[allow(clippy::too_many_arguments)]
+fn read_options(
+    columns: Option<Vec<String>>,
+    freq: Option<f64>,
+    format: &str,
+    ncols: Option<usize>,
+    header: &str,
+    time_column: Option<String>,
+    time_unit: Option<&str>,
+) -> PyResult<ReadOptions> {
+    if let Some(f) = freq {
+        check_freq(f)?;
+    }
+    let selector = |t: &str| match t.trim().parse::<usize>() {
+        Ok(i) => ColumnSelector::Index(i),
+        Err(_) => ColumnSelector::Name(t.trim().to_string()),
+    };
+    Ok(ReadOptions {
+        format: match format {
+            "auto" => InputFormat::Auto,
+            other => other.parse::<InputFormat>().map_err(|_| {
+                err(format!("invalid format {other:?}: auto, csv, tsv, f64, f32, imar, ln200, ln200ig, ixsea, navchip-int or navchip-flt"))
+            })?,
+        },
+        header: match header {
+            "auto" => HeaderMode::Auto,
+            "yes" => HeaderMode::Present,
+            "no" => HeaderMode::Absent,
+            other => return Err(err(format!("invalid header {other:?}: \"auto\", \"yes\" or \"no\""))),
+        },
+        time_column: time_column.as_deref().map(selector),
+        time_unit: match time_unit {
+            None => None,
+            Some("s") => Some(TimeUnit::Seconds),
+            Some("ms") => Some(TimeUnit::Milliseconds),
+            Some("us") => Some(TimeUnit::Microseconds),
+            Some("ns") => Some(TimeUnit::Nanoseconds),
+            Some(other) => return Err(err(format!("invalid time_unit {other:?}: s, ms, us or ns"))),
+        },
+        columns: columns.unwrap_or_default().iter().map(|c| selector(c)).collect(),
+        ncols,
+        freq_hz: freq,
+    })
+}
+
+/// Reads a recording as the CLI does (text, raw binary, binary IMU records, ROS): returns
+/// `(names, arrays, freq, units, notes)`; the arrays are handed to numpy without a copy.
+#[pyfunction]
+#[pyo3(signature = (path, columns=None, freq=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn read<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    columns: Option<Vec<String>>,
+    freq: Option<f64>,
+    format: &str,
+    ncols: Option<usize>,
+    header: &str,
+    time_column: Option<String>,
+    time_unit: Option<&str>,
+    topic: Option<String>,
+) -> PyResult<(
+    Vec<String>,
+    Vec<Bound<'py, PyArray1<f64>>>,
+    Option<f64>,
+    Vec<Option<String>>,
+    Vec<String>,
+)> {
+    let opts = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+    let ros = opts.format == InputFormat::Auto && gmwm::imu::ros::container_of(&path).is_some();
+    let read = py.detach(|| -> Result<_, gmwm::Error> {
+        if ros {
+            let rec = Recording::open(
+                &path,
+                &RecordingOptions {
+                    read: opts,
+                    topic: topic.clone(),
+                },
+            )?;
+            let freq = rec.imu.freq_hz();
+            let units: Vec<Option<String>> =
+                rec.imu.axes().iter().map(|a| a.info.unit.clone()).collect();
+            let cols = rec.imu.into_axes().into_iter().map(|a| a.column).collect();
+            return Ok((cols, Some(freq), units, rec.notes));
+        }
+        if let Some(t) = &topic {
+            return Err(gmwm::error::ParamError::new(
+                "topic",
+                t,
+                format!(
+                    "a topic of a ROS recording; {} is not one (ROS1 bag, MCAP, rosbag2 sqlite3)",
+                    path.display()
+                ),
+            )
+            .into());
+        }
+        let table = read_table(&path, &opts)?;
+        let units = SensorInfo::of_table(&table)
+            .into_iter()
+            .map(|i| i.unit)
+            .collect();
+        let mut notes = Vec::new();
+        if let Some(t) = &table.timing {
+            notes.push(t.to_string());
+        }
+        if !table.skipped.is_empty() {
+            notes.push(format!("not analysed: {}", table.skipped.join(", ")));
+        }
+        notes.extend(table.warnings.iter().map(ToString::to_string));
+        Ok((table.columns, table.freq_hz, units, notes))
+    });
+    let (cols, freq, units, notes) = read.map_err(engine)?;
+    let names = cols.iter().map(|c| c.name.clone()).collect();
+    let arrays = cols
+        .into_iter()
+        .map(|c| PyArray1::from_vec(py, c.values))
+        .collect();
+    Ok((names, arrays, freq, units, notes))
+}
+
+/// The calibration of an IMU (the pipeline of `gmwm calibrate`), returning the
+/// `gmwm calibrate --json` document: of the recording at `path` (read as the CLI reads it), or
+/// of `arrays` named `names` with `units` at `freq`.
+#[pyfunction]
+#[pyo3(signature = (path=None, arrays=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn calibrate(
+    py: Python<'_>,
+    path: Option<PathBuf>,
+    arrays: Option<Borrowed<'_>>,
+    names: Option<Vec<String>>,
+    units: Option<Vec<Option<String>>>,
+    freq: Option<f64>,
+    columns: Option<Vec<String>>,
+    format: &str,
+    ncols: Option<usize>,
+    header: &str,
+    time_column: Option<String>,
+    time_unit: Option<&str>,
+    topic: Option<String>,
+    gyro_unit: Option<&str>,
+    accel_unit: Option<&str>,
+    model: Option<&str>,
+    rule: &str,
+    bootstrap: usize,
+    draws: Option<usize>,
+    seed: u64,
+    eff: f64,
+    robust_convention: &str,
+    robust: bool,
+    alpha: f64,
+    axis_policy: &str,
+    inflate: Option<f64>,
+    conservative: bool,
+    rostopic: Option<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<String> {
+    if bootstrap < 2 {
+        return Err(err(format!(
+            "invalid bootstrap {bootstrap}: at least 2 (a covariance needs two replicates)"
+        )));
+    }
+    let unit = |u: Option<&str>, what: &str| -> PyResult<Option<gmwm::units::SignalUnit>> {
+        u.map(|t| {
+            t.parse().map_err(|_| {
+                err(format!(
+                    "invalid {what} {t:?}: rad/s, deg/s, deg/h (gyroscope) or m/s^2, g, mg (accelerometer)"
+                ))
+            })
+        })
+        .transpose()
+    };
+    let convention = match robust_convention {
+        "exact" => RobustConvention::Exact,
+        "package" => RobustConvention::Package,
+        other => {
+            return Err(err(format!(
+                "invalid robust_convention {other:?}: \"exact\" or \"package\""
+            )))
+        }
+    };
+    let wv = wv_options(robust, eff, robust_convention, "haar", "modwt", None, alpha)?;
+    let options = CalibrationOptions {
+        full_model: model
+            .unwrap_or(gmwm::calib::DEFAULT_FULL_MODEL)
+            .parse()
+            .map_err(engine)?,
+        wv,
+        bootstrap,
+        draws,
+        seed,
+        rule: rule_of(rule)?,
+        gyro_unit: unit(gyro_unit, "gyro_unit")?,
+        accel_unit: unit(accel_unit, "accel_unit")?,
+        robust_check: Some(RobustOptions::new(eff, convention).map_err(engine)?),
+    };
+    let policy = match axis_policy {
+        "worst" => AxisPolicy::Worst,
+        "mean" => AxisPolicy::Mean,
+        "per-axis" => AxisPolicy::PerAxis,
+        other => {
+            return Err(err(format!(
+                "invalid axis_policy {other:?}: \"worst\", \"mean\" or \"per-axis\""
+            )))
+        }
+    };
+    let adjustment = match (inflate, conservative) {
+        (Some(_), true) => return Err(err("give inflate or conservative, not both")),
+        (Some(k), false) => Adjustment::inflate(k).map_err(engine)?,
+        (None, true) => Adjustment::Conservative,
+        (None, false) => Adjustment::Estimate,
+    };
+    let reporter = PyProgress {
+        callback: progress,
+        total: AtomicUsize::new(0),
+    };
+    // the recording: a file read as the CLI reads it, or the given columns
+    let (imu, file, notes, topic_read) = match (path, arrays) {
+        (Some(path), None) => {
+            let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+            let opts = RecordingOptions { read, topic };
+            let rec = py
+                .detach(|| Recording::open(&path, &opts))
+                .map_err(engine)?;
+            (rec.imu, rec.path, rec.notes, rec.topic)
+        }
+        (None, Some(arrays)) => {
+            let names = names.ok_or_else(|| err("arrays need names"))?;
+            check_columns(&arrays, &names)?;
+            let freq = freq.ok_or_else(|| err("arrays need freq (Hz)"))?;
+            check_freq(freq)?;
+            let units = units.unwrap_or_else(|| vec![None; names.len()]);
+            if units.len() != names.len() {
+                return Err(err("one unit (or None) per column"));
+            }
+            let infos = names
+                .iter()
+                .zip(&units)
+                .map(|(n, u)| {
+                    let (sensor, axis) =
+                        SensorInfo::infer(n).unwrap_or((gmwm::imu::Sensor::Other, n.clone()));
+                    SensorInfo {
+                        sensor,
+                        axis,
+                        unit: u.clone(),
+                    }
+                })
+                .collect();
+            // the IMU owns its columns: one copy of each
+            let owned = names
+                .iter()
+                .zip(columns_of(&arrays))
+                .map(|(n, x)| gmwm::imu::Column {
+                    name: n.clone(),
+                    values: x.into_owned(),
+                })
+                .collect();
+            let imu = Imu::new(owned, infos, freq).map_err(engine)?;
+            (imu, PathBuf::from("<array>"), Vec::new(), None)
+        }
+        _ => return Err(err("give a path or arrays, not both")),
+    };
+    let rostopic = rostopic.or(topic_read);
+    let doc = py.detach(|| -> Result<String, gmwm::calib::CalibError> {
+        let report = Calibration::new(options).run_with_progress(&imu, &reporter)?;
+        let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
+        Ok(json(&gmwm::document::calibration(
+            &file, &notes, &report, &sets,
+        )))
+    });
+    doc.map_err(engine)
+}
+
+/// How many columns were copied because they were not contiguous float64 (zero-copy check).
+#[pyfunction]
+fn copies() -> usize {
+    COPIES.load(Ordering::Relaxed)
+}
+
+/// The engine's version.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+/// The module.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("GmwmError", m.py().get_type::<GmwmError>())?;
+    m.add_function(wrap_pyfunction!(wv, m)?)?;
+    m.add_function(wrap_pyfunction!(avar, m)?)?;
+    m.add_function(wrap_pyfunction!(implied, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(select, m)?)?;
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(copies, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    Ok(())
+}
