@@ -47,9 +47,9 @@ fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
 // ------------------------------------------------------------------------------------------
 // Slow, obviously correct oracles: direct double loops with compensated sums.
 
-/// Neumaier-compensated sum (the library's, itself unit-tested in `math::sum`).
+/// Neumaier-compensated sum.
 fn csum(values: impl IntoIterator<Item = f64>) -> f64 {
-    gmwm::math::sum::NeumaierSum::of(values)
+    crate::common::neumaier_sum(values)
 }
 
 /// `sum_i w_i * mean(x_{s_i} .. x_{s_i + m - 1})` for windows `(s_i, w_i)`, summed as one

@@ -3,6 +3,21 @@
 
 use std::path::PathBuf;
 
+/// Neumaier-compensated sum (the engine's own `math::sum` is crate-internal).
+pub fn neumaier_sum(values: impl IntoIterator<Item = f64>) -> f64 {
+    let (mut sum, mut comp) = (0.0f64, 0.0f64);
+    for v in values {
+        let t = sum + v;
+        comp += if sum.abs() >= v.abs() {
+            (sum - t) + v
+        } else {
+            (v - t) + sum
+        };
+        sum = t;
+    }
+    sum + comp
+}
+
 /// `../shared/data` beside the repository, or `$GMWM_DATA_DIR`.
 pub fn data_dir() -> PathBuf {
     match std::env::var_os("GMWM_DATA_DIR") {

@@ -2,10 +2,9 @@
 //! draws, recovery from guess mode, and the objective against the R package.
 
 use crate::common::{f64s, read_column, read_ref};
-use gmwm::fit::start::{condition1_phi, condition3_phi, dominance, PHI_MAX};
 use gmwm::fit::{
-    starting_values, Dominance, Gmwm, Objective, Parametrisation, PhiOrder, StartInputs,
-    StartOptions, TransformPreset, Weights,
+    starting_values, Gmwm, Objective, Parametrisation, PhiOrder, StartInputs, StartOptions,
+    TransformPreset, Weights,
 };
 use gmwm::model::Model;
 use gmwm::sim::simulate_model;
@@ -21,32 +20,6 @@ const SAME_Q_TOL: f64 = 1e-6;
 
 fn model(text: &str) -> Model {
     Model::parse(text).unwrap()
-}
-
-#[test]
-fn dominance_hand_values() {
-    assert_eq!(dominance(1.0, 0.2, 0.3), Dominance::Qn);
-    assert_eq!(dominance(1.0, 0.4, 0.6), Dominance::Wn);
-    assert_eq!(dominance(1.0, 0.6, 0.9), Dominance::Ar1);
-    // exact WN ratio 1/2 inside the CI
-    assert_eq!(dominance(1.0, 0.45, 0.55), Dominance::Wn);
-    // non-finite input: no panic, WN
-    assert_eq!(dominance(0.0, 0.4, 0.6), Dominance::Wn);
-}
-
-#[test]
-fn condition_phi_ranges() {
-    assert_eq!(condition1_phi(0.0), 0.0);
-    assert!((condition1_phi(1.0 / 3.0) - 0.2).abs() < 1e-15);
-    for k in 0..=100 {
-        let u = k as f64 / 300.0;
-        let p1 = condition1_phi(u);
-        assert!((0.0..=0.2 + 1e-15).contains(&p1), "{p1}");
-        let p3 = condition3_phi(u, 0.9);
-        assert!((0.9..=PHI_MAX).contains(&p3), "{p3}");
-    }
-    assert!((condition3_phi(0.0, 0.9) - PHI_MAX).abs() < 1e-15);
-    assert!((condition3_phi(1.0 / 3.0, 0.9) - 0.9).abs() < 1e-15);
 }
 
 fn ar1_wn_rw_wv(n: usize, seed: u64) -> (Vec<f64>, gmwm::WaveletVariance) {

@@ -9,7 +9,6 @@ mod canonical;
 mod common;
 mod contamination;
 mod export;
-mod fit;
 mod fit_mc;
 mod fit_ref;
 mod fit_start;

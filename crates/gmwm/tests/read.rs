@@ -11,7 +11,6 @@ use gmwm::imu::{
     InputFormat, ReadError, ReadOptions, ReadWarning, Sensor, SeriesWriter, Sidecar, SidecarColumn,
     TimeUnit, TimingWarning, UnitSource,
 };
-use gmwm::math::sum::NeumaierSum;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -685,11 +684,7 @@ fn imu_record_errors() {
 // ---------------------------------------------------------------- shared recordings
 
 fn mean(x: &[f64]) -> f64 {
-    let mut s = NeumaierSum::default();
-    for &v in x {
-        s.add(v);
-    }
-    s.total() / x.len() as f64
+    crate::common::neumaier_sum(x.iter().copied()) / x.len() as f64
 }
 
 #[test]

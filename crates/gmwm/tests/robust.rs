@@ -1,8 +1,7 @@
-//! Robust wavelet variance (METHODS §2) and Brent's methods (METHODS §12): reference values,
-//! Monte Carlo checks and bad input.
+//! Robust wavelet variance (METHODS §2): reference values, Monte Carlo checks and bad input.
+//! (Brent's methods, METHODS §12, are crate-internal and tested in `math::brent`.)
 
 use gmwm::error::{Error, SeriesError};
-use gmwm::math::brent::{find_root, minimize, OPTIMIZE_TOL};
 use gmwm::variance::robust::{
     a_of_c, efficiency, package_efficiency, robust_ci, robust_scale, truncated_normal_moments,
     tuning_constant, RobustConvention, RobustOptions,
@@ -39,44 +38,6 @@ const C_PACKAGE_06: f64 = 4.973361;
 
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
-}
-
-// ---- Brent (METHODS §12) ----
-
-#[test]
-fn brent_minimize_finds_parabola_vertex() {
-    let m = minimize(|x| (x - 2.0) * (x - 2.0), 0.0, 5.0, OPTIMIZE_TOL).unwrap();
-    assert!((m.x - 2.0).abs() < OPTIMIZE_TOL, "{m:?}");
-    assert!(m.evaluations < 50);
-}
-
-#[test]
-fn brent_minimize_finds_cos_minimum_at_pi() {
-    let m = minimize(f64::cos, 3.0, 4.0, 1e-10).unwrap();
-    // cos is flat at pi: x is found to about sqrt(eps) relative
-    assert!((m.x - std::f64::consts::PI).abs() < 1e-7, "{m:?}");
-    assert!((m.fx + 1.0).abs() < 1e-14);
-}
-
-#[test]
-fn brent_minimize_respects_interval_ends() {
-    // minimum outside the interval: iterate approaches the nearest end within tolerance
-    let m = minimize(|x| x, 1.0, 3.0, OPTIMIZE_TOL).unwrap();
-    assert!(m.x > 1.0 && m.x - 1.0 < 2.0 * OPTIMIZE_TOL, "{m:?}");
-}
-
-#[test]
-fn brent_find_root_finds_cube_root_of_two() {
-    let r = find_root(|x| x * x * x - 2.0, 0.0, 2.0, 1e-14).unwrap();
-    assert!((r.x - 2f64.cbrt()).abs() < 1e-13, "{r:?}");
-    let r = find_root(f64::cos, 1.0, 2.0, 1e-15).unwrap();
-    assert!((r.x - std::f64::consts::FRAC_PI_2).abs() < 1e-14, "{r:?}");
-}
-
-#[test]
-fn brent_find_root_rejects_same_sign_bracket() {
-    assert!(find_root(|x| x * x + 1.0, -1.0, 1.0, 1e-12).is_err());
-    assert!(find_root(|x| x, 1.0, -1.0, 1e-12).is_err());
 }
 
 // ---- §2.2 / §2.3 constants ----
@@ -452,47 +413,4 @@ fn robust_scale_reports_missing_root() {
         ),
         "{err}"
     );
-}
-
-#[test]
-fn robust_scale_long_finds_the_direct_root() {
-    // METHODS §2.4: the windowed route (subsample root, one power-sum pass, Brent on the
-    // window) and the direct fixed point from the exact MAD start solve the same equation to
-    // ~1e-14 in s; 1e-11 on s^2 leaves room for the different summation orders. Cases: clean
-    // Gaussian, 2% gross outliers, a heavy-tailed mixture (MAD start far from the root), and a
-    // window that must slide (a subsample that misses the contaminated stretch).
-    use gmwm::variance::robust::robust_scale_long;
-    let c = tuning_constant(0.6, RobustConvention::Exact).unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(77);
-    let n = 100_000;
-    let gauss: Vec<f64> = (0..n)
-        .map(|_| rng.sample::<f64, _>(StandardNormal))
-        .collect();
-    let mut outliers = gauss.clone();
-    for v in outliers.iter_mut().step_by(50) {
-        *v = 100.0;
-    }
-    let mixture: Vec<f64> = gauss
-        .iter()
-        .enumerate()
-        .map(|(i, v)| if i % 5 == 0 { 6.0 * v } else { *v })
-        .collect();
-    let mut stretch = gauss.clone();
-    // every 12th value (the subsample's stride is n / 8192 = 12) is left clean; the rest of
-    // one third of the series is wider: the subsample sees a narrower distribution
-    for (i, v) in stretch.iter_mut().enumerate().take(n / 3) {
-        if i % 12 != 0 {
-            *v *= 3.0;
-        }
-    }
-    for (y, what) in [
-        (&gauss, "gaussian"),
-        (&outliers, "outliers"),
-        (&mixture, "mixture"),
-        (&stretch, "stretch"),
-    ] {
-        let long = robust_scale_long(y, c).unwrap();
-        let direct = robust_scale(y, c, RobustConvention::Exact).unwrap();
-        assert!(rel(long, direct) < 1e-11, "{what}: {long} vs {direct}");
-    }
 }

@@ -1,10 +1,7 @@
 //! Wavelet transforms (METHODS §1.1–§1.4, §1.10): fast pyramids against the direct-convolution
 //! oracle for every filter, METHODS test values, closed forms, identities and bad input.
 
-use gmwm::wavelet::{
-    dwt_boundary, modwt_boundary, naive, Dwt, Modwt, WaveletCoefficients, WaveletFilter,
-    WaveletScratch,
-};
+use gmwm::wavelet::{Dwt, Modwt, WaveletCoefficients, WaveletFilter, WaveletScratch};
 use gmwm::{Error, SeriesError};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
@@ -48,124 +45,6 @@ fn assert_close(a: &[f64], b: &[f64], floor: f64, what: &str) {
 
 fn sum_sq(x: &[f64]) -> f64 {
     x.iter().map(|v| v * v).sum()
-}
-
-/// The transform under test, both entry points driven by one harness.
-#[derive(Clone, Copy, Debug)]
-enum Kind {
-    Modwt,
-    Dwt,
-}
-
-/// Runs `kind` on `x` through `transform` and through `transform_with_scratch` with the given
-/// (dirty) buffers, checks both agree with the oracle, boundary counts and `V_J`.
-fn check_transform(
-    kind: Kind,
-    filter: WaveletFilter,
-    levels: usize,
-    x: &[f64],
-    out: &mut WaveletCoefficients,
-    scratch: &mut WaveletScratch,
-) {
-    let what = format!("{kind:?} {filter} J = {levels} N = {}", x.len());
-    let (fresh, oracle) = match kind {
-        Kind::Modwt => {
-            let plan = Modwt::new(filter, levels).unwrap();
-            plan.transform_with_scratch(x, out, scratch).unwrap();
-            (plan.transform(x).unwrap(), naive::modwt(filter, levels, x))
-        }
-        Kind::Dwt => {
-            let plan = Dwt::new(filter, levels).unwrap();
-            plan.transform_with_scratch(x, out, scratch).unwrap();
-            (plan.transform(x).unwrap(), naive::dwt(filter, levels, x))
-        }
-    };
-    assert_eq!(&fresh, out, "{what}: scratch and fresh runs differ");
-    assert_eq!(out.levels(), levels, "{what}");
-    let floor = scale(x);
-    for j in 1..=levels {
-        let w = &out.w[j - 1];
-        assert_close(w, &oracle.w[j - 1], floor, &format!("{what} level {j}"));
-        let (len, boundary) = match kind {
-            Kind::Modwt => (x.len(), modwt_boundary(filter.len(), j)),
-            Kind::Dwt => (x.len() >> j, dwt_boundary(filter.len(), j)),
-        };
-        assert_eq!(
-            (w.len(), out.boundary[j - 1]),
-            (len, boundary),
-            "{what} level {j}"
-        );
-        assert_eq!(out.kept(j), &w[boundary..], "{what} level {j}");
-        assert!(!out.kept(j).is_empty(), "{what} level {j}");
-    }
-    assert_close(
-        scratch.scaling(),
-        &oracle.scaling,
-        floor,
-        &format!("{what} V_J"),
-    );
-}
-
-/// METHODS §1.2: the pyramid equals direct circular convolution with the level-j equivalent
-/// filter, for every filter, several lengths (powers of two and not) and level counts, reusing
-/// dirty output and scratch buffers throughout.
-#[test]
-fn modwt_matches_naive() {
-    let mut out = WaveletCoefficients::default();
-    let mut scratch = WaveletScratch::new();
-    for (i, filter) in WaveletFilter::ALL.into_iter().enumerate() {
-        let x = series(256, i as u64);
-        let max = Modwt::max_levels(filter, 256);
-        assert!(max >= 2, "{filter}");
-        for levels in (1..=max).filter(|j| (4..=6).contains(j) || *j == max) {
-            check_transform(Kind::Modwt, filter, levels, &x, &mut out, &mut scratch);
-        }
-        let x = series(2048, 100 + i as u64);
-        check_transform(Kind::Modwt, filter, 6, &x, &mut out, &mut scratch);
-        let x = series(250, 200 + i as u64);
-        let max = Modwt::max_levels(filter, 250);
-        check_transform(Kind::Modwt, filter, max, &x, &mut out, &mut scratch);
-        check_transform(
-            Kind::Modwt,
-            filter,
-            1,
-            &x[..filter.len()],
-            &mut out,
-            &mut scratch,
-        );
-    }
-}
-
-/// METHODS §1.4: the pyramid equals decimated direct convolution with the level-j equivalent
-/// filter, for every filter, including levels shorter than the filter (multiple wrap-around).
-#[test]
-fn dwt_matches_naive() {
-    let mut out = WaveletCoefficients::default();
-    let mut scratch = WaveletScratch::new();
-    for (i, filter) in WaveletFilter::ALL.into_iter().enumerate() {
-        for (n, seed) in [(256usize, 300), (2048, 400), (96, 500), (8, 600), (24, 700)] {
-            let x = series(n, seed + i as u64);
-            let max = Dwt::max_levels(filter, n);
-            for levels in (1..=max).filter(|j| *j <= 2 || (4..=6).contains(j) || *j == max) {
-                check_transform(Kind::Dwt, filter, levels, &x, &mut out, &mut scratch);
-            }
-        }
-    }
-}
-
-/// The oracle really can fail: a one-ulp-scale perturbation is tolerated, a 1e-9 one is not.
-#[test]
-fn modwt_oracle_comparison_detects_errors() {
-    let x = series(64, 1);
-    let w = Modwt::new(WaveletFilter::D4, 2)
-        .unwrap()
-        .transform(&x)
-        .unwrap();
-    let oracle = naive::modwt(WaveletFilter::D4, 2, &x);
-    let mut bad = w.w[1].clone();
-    bad[40] += 1e-9 * scale(&x);
-    let r = std::panic::catch_unwind(|| assert_close(&bad, &oracle.w[1], scale(&x), "bad"));
-    assert!(r.is_err());
 }
 
 /// Periodic MODWT and DWT preserve energy (METHODS §1.2, §1.4):

@@ -13,18 +13,22 @@ pub mod auto;
 pub mod canonical;
 pub mod gmwm;
 pub mod objective;
-pub mod optimize;
+pub(crate) mod optimize;
 pub mod report;
-pub mod revive;
+pub(crate) mod revive;
 pub mod start;
 pub mod transform;
 pub mod weights;
+
+#[cfg(test)]
+mod tests_groundwork;
 
 pub use active::{SubModel, NEGLIGIBLE_WV_SHARE};
 pub use canonical::{CanonicalModel, CanonicalTerm, Reading, SEPARATION_LIMIT};
 pub use gmwm::{Gmwm, GmwmFit, DEFAULT_BOOTSTRAP_REPLICATES};
 pub use objective::Objective;
-pub use optimize::{minimize, Convergence, LmOptions, Minimum, StopReason, STALL_COSINE};
+pub(crate) use optimize::minimize;
+pub use optimize::{Convergence, LmOptions, StopReason};
 pub use report::{Ar1GmForms, NavParameter, ParameterEstimate};
 pub use start::{starting_values, Dominance, StartInputs, StartOptions, StartValues};
 

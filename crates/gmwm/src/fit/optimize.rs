@@ -135,7 +135,7 @@ const MAX_RESTARTS: usize = 3;
 /// Gradient cosine above which a step-tolerance stop that followed rejected trials counts as
 /// [`StopReason::Stalled`]. At a true minimum the cosine is rounding noise (below ~1e-7 in the
 /// tests, where `Q` is known to ~1e-16 relative); 1e-4 leaves three decades of margin.
-pub const STALL_COSINE: f64 = 1e-4;
+pub(crate) const STALL_COSINE: f64 = 1e-4;
 
 /// Influence below which a log-scale parameter whose descent direction points to zero counts
 /// as collapsed onto its boundary (theta -> 0, u -> -inf); likewise a bounded coefficient
@@ -148,7 +148,7 @@ pub const STALL_COSINE: f64 = 1e-4;
 /// of steps, so while it stays collapsed it is held fixed, the first-order test runs over the
 /// other parameters (the fit reports its component, `GmwmFit::collapsed`). It is released as
 /// soon as the gradient points back inside.
-pub const COLLAPSE_INFLUENCE: f64 = 1e-7;
+pub(crate) const COLLAPSE_INFLUENCE: f64 = 1e-7;
 
 /// Where a parameter's boundary lies in `u` (see [`COLLAPSE_INFLUENCE`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -188,17 +188,17 @@ fn collapsed_params(ev: &Eval, u: &[f64], levels: usize, p: usize, edge: &[Edge]
 
 /// The minimiser found by [`minimize`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Minimum {
+pub(crate) struct Minimum {
     /// Unconstrained parameters at the end.
-    pub u: Vec<f64>,
+    pub(crate) u: Vec<f64>,
     /// Model parameters `theta(u)` (original parametrisation).
-    pub theta: Vec<f64>,
+    pub(crate) theta: Vec<f64>,
     /// `Q` at the end (METHODS §5.1).
-    pub objective: f64,
+    pub(crate) objective: f64,
     /// Implied WV at the end.
-    pub implied_wv: Vec<f64>,
+    pub(crate) implied_wv: Vec<f64>,
     /// How it ended.
-    pub convergence: Convergence,
+    pub(crate) convergence: Convergence,
 }
 
 /// Cholesky solve of the symmetric positive definite `m x = b` (row-major n x n), in place in
@@ -245,7 +245,11 @@ fn sum_sq(r: &[f64]) -> f64 {
 /// # Errors
 /// [`FitError::Length`] if `u0` has the wrong length; [`FitError::BadStart`] if theta(u0) is not
 /// a valid model; [`FitError::NonFiniteStart`] if its implied WV overflows.
-pub fn minimize(objective: &Objective, u0: &[f64], opts: &LmOptions) -> Result<Minimum, FitError> {
+pub(crate) fn minimize(
+    objective: &Objective,
+    u0: &[f64],
+    opts: &LmOptions,
+) -> Result<Minimum, FitError> {
     let p = objective.n_params();
     let levels = objective.levels();
     if u0.len() != p {

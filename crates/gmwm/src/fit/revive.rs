@@ -26,11 +26,11 @@ use super::FitError;
 use crate::model::{Component, ImpliedWv, Model, ProcessKind};
 
 /// Revivals per fit at most (each one a further minimisation).
-pub const MAX_REVIVALS: usize = 3;
+pub(crate) const MAX_REVIVALS: usize = 3;
 
 /// Smallest relative fall of the objective that revives a component. Below it the boundary
 /// point is a minimum for every practical purpose.
-pub const REVIVAL_MIN_GAIN: f64 = 1e-6;
+pub(crate) const REVIVAL_MIN_GAIN: f64 = 1e-6;
 
 /// A start with the inactive component of `fitted` whose return lowers the objective most
 /// (see the module docs), or `None` when none lowers it by more than [`REVIVAL_MIN_GAIN`] of

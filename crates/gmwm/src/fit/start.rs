@@ -26,15 +26,15 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 /// Draws evaluated together; the early-stop check runs after each batch.
-pub const BATCH_DRAWS: usize = 1000;
+pub(crate) const BATCH_DRAWS: usize = 1000;
 /// The early stop is not considered before this many draws (five batches), so that a
 /// lucky or unlucky first batch cannot end the search.
 pub const MIN_DRAWS: usize = 5000;
 /// A batch that improves the best `F` by at most this fraction counts as no improvement
 /// (F is a sum of squared relative errors; 1e-6 of it is far below what stage 1 resolves).
-pub const EARLY_STOP_REL: f64 = 1e-6;
+pub(crate) const EARLY_STOP_REL: f64 = 1e-6;
 /// Upper end of the AR1 phi draws (METHODS §6.3).
-pub const PHI_MAX: f64 = 0.999995;
+pub(crate) const PHI_MAX: f64 = 0.999995;
 /// AR coefficient bounds of the §6.5 ARMA draws (the package's constants).
 const ARMA_LO: f64 = -0.99999999;
 const ARMA_HI: f64 = 0.999999999;
@@ -114,7 +114,7 @@ pub enum Dominance {
 /// METHODS §6.2: slopes `ln(b / nu2_hat_1) / ln 4` for `b` in the level-2 CI bounds
 /// `(lo2, hi2)`: both below -1/2 gives [`Dominance::Qn`], both above [`Dominance::Ar1`],
 /// otherwise [`Dominance::Wn`] (also for non-finite inputs).
-pub fn dominance(nu1: f64, lo2: f64, hi2: f64) -> Dominance {
+pub(crate) fn dominance(nu1: f64, lo2: f64, hi2: f64) -> Dominance {
     let s = |b: f64| (b / nu1).ln() / 4f64.ln();
     let (a, b) = (s(lo2), s(hi2));
     if !(a.is_finite() && b.is_finite()) {
@@ -131,13 +131,13 @@ pub fn dominance(nu1: f64, lo2: f64, hi2: f64) -> Dominance {
 
 /// METHODS §6.3 condition 1: `phi = (1 - sqrt(1 - 3U)) / 5` for `U` in `[0, 1/3]`
 /// (0 at `U = 0`, 0.2 at `U = 1/3`).
-pub fn condition1_phi(u: f64) -> f64 {
+pub(crate) fn condition1_phi(u: f64) -> f64 {
     (1.0 - (1.0 - 3.0 * u).max(0.0).sqrt()) / 5.0
 }
 
 /// METHODS §6.3 condition 3: `phi = last_phi + (0.999995 - last_phi) sqrt(1 - 3U)` for `U`
 /// in `[0, 1/3]`.
-pub fn condition3_phi(u: f64, last_phi: f64) -> f64 {
+pub(crate) fn condition3_phi(u: f64, last_phi: f64) -> f64 {
     last_phi + (PHI_MAX - last_phi) * (1.0 - 3.0 * u).max(0.0).sqrt()
 }
 
@@ -485,5 +485,31 @@ mod tests {
         // AR1 with a = 0.5: sum psi_k^2 = 1 / (1 - 0.25)
         assert!((psi_norm(&[0.5], &[]) - 4.0 / 3.0).abs() < 1e-12);
         assert!((psi_norm(&[], &[0.5]) - 1.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn dominance_hand_values() {
+        assert_eq!(dominance(1.0, 0.2, 0.3), Dominance::Qn);
+        assert_eq!(dominance(1.0, 0.4, 0.6), Dominance::Wn);
+        assert_eq!(dominance(1.0, 0.6, 0.9), Dominance::Ar1);
+        // exact WN ratio 1/2 inside the CI
+        assert_eq!(dominance(1.0, 0.45, 0.55), Dominance::Wn);
+        // non-finite input: no panic, WN
+        assert_eq!(dominance(0.0, 0.4, 0.6), Dominance::Wn);
+    }
+
+    #[test]
+    fn condition_phi_ranges() {
+        assert_eq!(condition1_phi(0.0), 0.0);
+        assert!((condition1_phi(1.0 / 3.0) - 0.2).abs() < 1e-15);
+        for k in 0..=100 {
+            let u = k as f64 / 300.0;
+            let p1 = condition1_phi(u);
+            assert!((0.0..=0.2 + 1e-15).contains(&p1), "{p1}");
+            let p3 = condition3_phi(u, 0.9);
+            assert!((0.9..=PHI_MAX).contains(&p3), "{p3}");
+        }
+        assert!((condition3_phi(0.0, 0.9) - PHI_MAX).abs() < 1e-15);
+        assert!((condition3_phi(1.0 / 3.0, 0.9) - 0.9).abs() < 1e-15);
     }
 }

@@ -10,7 +10,7 @@ use crate::error::ParamError;
 
 /// R's `optimize` default tolerance `.Machine$double.eps^0.25` (METHODS §2.3): `2^-52` to the
 /// quarter power is exactly `2^-13`.
-pub const OPTIMIZE_TOL: f64 = 1.220_703_125e-4;
+pub(crate) const OPTIMIZE_TOL: f64 = 1.220_703_125e-4;
 
 /// Square of the golden-section ratio, `(3 - sqrt 5) / 2` (Brent 1973, ch. 5).
 const GOLDEN: f64 = 0.381_966_011_250_105_1;
@@ -18,28 +18,28 @@ const GOLDEN: f64 = 0.381_966_011_250_105_1;
 /// Safety cap on the number of steps of either method. Brent's methods terminate on their own
 /// (at worst about `(log2((b - a) / tol))^2` steps); the cap only guards against a function that
 /// returns inconsistent values.
-pub const MAX_STEPS: usize = 10_000;
+pub(crate) const MAX_STEPS: usize = 10_000;
 
 /// Result of [`minimize`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Minimum {
+pub(crate) struct Minimum {
     /// Abscissa of the (local) minimum.
-    pub x: f64,
+    pub(crate) x: f64,
     /// Function value at `x` (non-finite values were replaced by `f64::MAX`).
-    pub fx: f64,
+    pub(crate) fx: f64,
     /// Number of function evaluations.
-    pub evaluations: usize,
+    pub(crate) evaluations: usize,
 }
 
 /// Result of [`find_root`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Root {
+pub(crate) struct Root {
     /// Abscissa of the root (the bracket end with the smaller `|f|` at termination).
-    pub x: f64,
+    pub(crate) x: f64,
     /// Function value at `x`.
-    pub fx: f64,
+    pub(crate) fx: f64,
     /// Number of function evaluations.
-    pub evaluations: usize,
+    pub(crate) evaluations: usize,
 }
 
 fn check_interval(lower: f64, upper: f64, tol: f64) -> Result<(), ParamError> {
@@ -74,13 +74,8 @@ fn check_interval(lower: f64, upper: f64, tol: f64) -> Result<(), ParamError> {
 /// # Errors
 /// [`ParamError`] if the interval is not finite with `lower < upper`, or `tol` is not positive.
 ///
-/// # Examples
-/// ```
-/// use gmwm::math::brent::{minimize, OPTIMIZE_TOL};
-/// let m = minimize(|x| (x - 2.0) * (x - 2.0), 0.0, 5.0, OPTIMIZE_TOL).unwrap();
-/// assert!((m.x - 2.0).abs() < 1e-4);
-/// ```
-pub fn minimize<F: FnMut(f64) -> f64>(
+/// Examples: the unit tests below (the module is crate-internal).
+pub(crate) fn minimize<F: FnMut(f64) -> f64>(
     mut f: F,
     lower: f64,
     upper: f64,
@@ -204,13 +199,8 @@ pub fn minimize<F: FnMut(f64) -> f64>(
 /// `f` is not finite at an end point or inside, or `f(lower)` and `f(upper)` have the same
 /// strict sign (no bracket).
 ///
-/// # Examples
-/// ```
-/// use gmwm::math::brent::find_root;
-/// let r = find_root(|x| x * x * x - 2.0, 0.0, 2.0, 1e-14).unwrap();
-/// assert!((r.x - 2f64.cbrt()).abs() < 1e-13);
-/// ```
-pub fn find_root<F: FnMut(f64) -> f64>(
+/// Examples: the unit tests below (the module is crate-internal).
+pub(crate) fn find_root<F: FnMut(f64) -> f64>(
     mut f: F,
     lower: f64,
     upper: f64,
@@ -344,6 +334,7 @@ mod tests {
         let err = find_root(|x| x * x + 1.0, -1.0, 1.0, 1e-12).unwrap_err();
         assert_eq!(err.name, "bracket");
         assert!(find_root(|x| 1.0 / x - 1.0, 0.0, 2.0, 1e-12).is_err());
+        assert!(find_root(|x| x, 1.0, -1.0, 1e-12).is_err());
     }
 
     #[test]
@@ -352,5 +343,35 @@ mod tests {
         assert_eq!(r.x, 1.0);
         let r = find_root(|x| x - 2.0, 1.0, 2.0, 1e-12).unwrap();
         assert_eq!(r.x, 2.0);
+    }
+
+    #[test]
+    fn brent_minimize_finds_parabola_vertex() {
+        let m = minimize(|x| (x - 2.0) * (x - 2.0), 0.0, 5.0, OPTIMIZE_TOL).unwrap();
+        assert!((m.x - 2.0).abs() < OPTIMIZE_TOL, "{m:?}");
+        assert!(m.evaluations < 50);
+    }
+
+    #[test]
+    fn brent_minimize_finds_cos_minimum_at_pi() {
+        let m = minimize(f64::cos, 3.0, 4.0, 1e-10).unwrap();
+        // cos is flat at pi: x is found to about sqrt(eps) relative
+        assert!((m.x - std::f64::consts::PI).abs() < 1e-7, "{m:?}");
+        assert!((m.fx + 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn brent_minimize_respects_interval_ends() {
+        // minimum outside the interval: iterate approaches the nearest end within tolerance
+        let m = minimize(|x| x, 1.0, 3.0, OPTIMIZE_TOL).unwrap();
+        assert!(m.x > 1.0 && m.x - 1.0 < 2.0 * OPTIMIZE_TOL, "{m:?}");
+    }
+
+    #[test]
+    fn brent_find_root_finds_cube_root_of_two() {
+        let r = find_root(|x| x * x * x - 2.0, 0.0, 2.0, 1e-14).unwrap();
+        assert!((r.x - 2f64.cbrt()).abs() < 1e-13, "{r:?}");
+        let r = find_root(f64::cos, 1.0, 2.0, 1e-15).unwrap();
+        assert!((r.x - std::f64::consts::FRAC_PI_2).abs() < 1e-14, "{r:?}");
     }
 }

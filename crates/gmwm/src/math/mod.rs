@@ -1,6 +1,6 @@
 //! Numerical building blocks (METHODS §12): compensated sums, 1-D minimisation and root finding,
 //! special functions.
 
-pub mod brent;
-pub mod special;
-pub mod sum;
+pub(crate) mod brent;
+pub(crate) mod special;
+pub(crate) mod sum;

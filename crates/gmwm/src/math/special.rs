@@ -11,14 +11,8 @@
 /// asymptotic series `1/x + 1/(2x^2) + sum_k B_2k / x^(2k+1)` (Bernoulli numbers
 /// `1/6, -1/30, 1/42, -1/30, 5/66, -691/2730, 7/6`; Abramowitz & Stegun 6.4.12) whose first
 /// omitted term at `x = 10`, `|B_16| / 10^17 ~ 7e-17`, is below the rounding of the sum.
-///
-/// ```
-/// use gmwm::math::special::trigamma;
-/// let pi2 = std::f64::consts::PI * std::f64::consts::PI;
-/// assert!((trigamma(1.0) - pi2 / 6.0).abs() < 1e-14);
-/// assert!((trigamma(0.5) - pi2 / 2.0).abs() < 1e-13);
-/// ```
-pub fn trigamma(x: f64) -> f64 {
+/// Test values `psi'(1) = pi^2 / 6`, `psi'(1/2) = pi^2 / 2` (unit tests).
+pub(crate) fn trigamma(x: f64) -> f64 {
     if !(x > 0.0 && x.is_finite()) {
         return f64::NAN;
     }

@@ -3,7 +3,7 @@
 /// Neumaier's compensated sum (improved Kahan–Babuška): error independent of the number of terms
 /// to first order, which keeps long accumulations (10^9 squared coefficients) accurate.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct NeumaierSum {
+pub(crate) struct NeumaierSum {
     sum: f64,
     compensation: f64,
 }
@@ -11,7 +11,7 @@ pub struct NeumaierSum {
 impl NeumaierSum {
     /// Adds one term.
     #[inline]
-    pub fn add(&mut self, v: f64) {
+    pub(crate) fn add(&mut self, v: f64) {
         let t = self.sum + v;
         if self.sum.abs() >= v.abs() {
             self.compensation += (self.sum - t) + v;
@@ -22,7 +22,7 @@ impl NeumaierSum {
     }
 
     /// Compensated sum of all `values`.
-    pub fn of(values: impl IntoIterator<Item = f64>) -> f64 {
+    pub(crate) fn of(values: impl IntoIterator<Item = f64>) -> f64 {
         let mut s = Self::default();
         values.into_iter().for_each(|v| s.add(v));
         s.total()
@@ -30,7 +30,7 @@ impl NeumaierSum {
 
     /// The compensated total.
     #[inline]
-    pub fn total(&self) -> f64 {
+    pub(crate) fn total(&self) -> f64 {
         self.sum + self.compensation
     }
 }

@@ -356,15 +356,15 @@ fn mean_psi2(y: &[f64], inv_s: f64, c: f64) -> f64 {
 
 /// Standard normal quantile at 0.75, `Phi^{-1}(3/4)`: MAD / this is consistent for the
 /// standard deviation at the Gaussian (METHODS §2.4 "Port").
-pub const MAD_CONSISTENCY: f64 = 0.674_489_750_196_081_7;
+pub(crate) const MAD_CONSISTENCY: f64 = 0.674_489_750_196_081_7;
 
 /// Relative change of `s^2` between fixed-point iterates at which the port stops (METHODS §2.4:
 /// the test values were produced at 1e-12).
-pub const FIXED_POINT_TOL: f64 = 1e-12;
+pub(crate) const FIXED_POINT_TOL: f64 = 1e-12;
 
 /// Iteration cap of the fixed point; Gaussian-like levels converge in a few dozen steps, and
 /// beyond the cap the bracketing fallback takes over (METHODS §2.4).
-pub const FIXED_POINT_MAX_ITER: usize = 500;
+pub(crate) const FIXED_POINT_MAX_ITER: usize = 500;
 
 /// Robust variance `s^2` of zero-mean coefficients `y` (METHODS §2.1, §2.4), for a tuning
 /// constant `c` from [`tuning_constant`].
@@ -482,7 +482,7 @@ fn scale_exact(y: &[f64], c: f64, a: f64) -> Result<f64, Error> {
 
 /// Coefficient series at least this long take the windowed route of [`robust_scale_long`];
 /// shorter ones the direct iteration (a few dozen passes over at most 32 Ki values).
-pub const LONG_MIN: usize = 1 << 15;
+pub(crate) const LONG_MIN: usize = 1 << 15;
 /// Target size of the strided subsample that locates the root for [`robust_scale_long`]: its
 /// root is within about 1% of the full one for Gaussian-like levels (sd of the eff-0.6 scale
 /// estimate from 8 Ki values, ~0.9%), well inside [`WINDOW`].
@@ -518,7 +518,10 @@ const U_POWER_MAX: f64 = 0.36;
 ///
 /// # Errors
 /// As [`robust_scale`].
-pub fn robust_scale_long(y: &[f64], c: f64) -> Result<f64, Error> {
+// The standalone route, kept as the reference the per-level passes of `haar_robust` follow and
+// tested against the direct root.
+#[cfg_attr(not(test), allow(dead_code))]
+pub(crate) fn robust_scale_long(y: &[f64], c: f64) -> Result<f64, Error> {
     check_c(c)?;
     let n = y.len();
     if n < LONG_MIN {
@@ -569,7 +572,7 @@ pub(crate) enum WindowOutcome {
 /// `L = 0.36 (c s_lo)^2`, have `u < 0.36` on the whole window: their share is
 /// `sum_m coef_m (L k2)^m T_m` with `T_m = sum (y^2 / L)^m` (compensated sums). Values with
 /// `y^2 > (c s_hi)^2` contribute 0 on the window. The rest are kept and evaluated one by one.
-pub struct PowerWindow {
+pub(crate) struct PowerWindow {
     c: f64,
     n: f64,
     below: f64,
@@ -581,7 +584,7 @@ pub struct PowerWindow {
 /// The pass behind [`PowerWindow`], fed in pieces (e.g. by the blocks of a pyramid) and merged
 /// in a fixed order (METHODS §2.1; see [`robust_scale_long`]).
 #[derive(Debug, Clone)]
-pub struct PowerAccumulator {
+pub(crate) struct PowerAccumulator {
     c: f64,
     n: usize,
     below: f64,
@@ -597,7 +600,7 @@ pub struct PowerAccumulator {
 impl PowerAccumulator {
     /// An empty pass for the window `[s_lo, s_hi]` on values `y = scale2.sqrt() v` given as `v`
     /// (`scale2` multiplies the squares; a power of 4 keeps them exact).
-    pub fn new(c: f64, s_lo: f64, s_hi: f64, scale2: f64) -> Self {
+    pub(crate) fn new(c: f64, s_lo: f64, s_hi: f64, scale2: f64) -> Self {
         let below = U_POWER_MAX * (c * s_lo) * (c * s_lo);
         Self {
             c,
@@ -614,7 +617,7 @@ impl PowerAccumulator {
     }
 
     /// Adds values (see [`new`](Self::new) for their scale).
-    pub fn push(&mut self, v: &[f64]) {
+    pub(crate) fn push(&mut self, v: &[f64]) {
         let (above, inv_below, scale2) = (self.above, self.inv_below, self.scale2);
         let mut scratch = [0.0f64; POWER_BLOCK];
         for block in v.chunks(POWER_BLOCK) {
@@ -662,7 +665,7 @@ impl PowerAccumulator {
     }
 
     /// Appends `other` (a later piece of the same series and window).
-    pub fn merge(&mut self, other: &Self) {
+    pub(crate) fn merge(&mut self, other: &Self) {
         for (t, o) in self.totals.iter_mut().zip(&other.totals) {
             t.add(o.total());
         }
@@ -673,7 +676,7 @@ impl PowerAccumulator {
     }
 
     /// The window, `None` if some square was not finite or nothing was pushed.
-    pub fn finish(self) -> Option<PowerWindow> {
+    pub(crate) fn finish(self) -> Option<PowerWindow> {
         let sum_squares = self.totals[5].total();
         if self.n == 0 || !self.probe.is_finite() || !sum_squares.is_finite() {
             return None;
@@ -757,14 +760,15 @@ fn lane_sum(v: &[f64], f: impl Fn(f64) -> f64) -> f64 {
 impl PowerWindow {
     /// One pass over `y` for the window `[s_lo, s_hi]` (`0 < s_lo < s_hi`); `None` if some
     /// `y^2` is not finite.
-    pub fn new(y: &[f64], c: f64, s_lo: f64, s_hi: f64) -> Option<Self> {
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) fn new(y: &[f64], c: f64, s_lo: f64, s_hi: f64) -> Option<Self> {
         let mut acc = PowerAccumulator::new(c, s_lo, s_hi, 1.0);
         acc.push(y);
         acc.finish()
     }
 
     /// `mean(psi_c(y/s)^2)` at `s` in the window (METHODS §2.1).
-    pub fn mean_psi2(&self, s: f64) -> f64 {
+    pub(crate) fn mean_psi2(&self, s: f64) -> f64 {
         let k2 = 1.0 / ((self.c * s) * (self.c * s));
         let kappa = self.below * k2;
         let mut below = 0.0;
@@ -814,13 +818,8 @@ impl PowerWindow {
     }
 
     /// Mean of `y^2` over the whole pass (the classical WV of the level, METHODS §1.5).
-    pub fn mean_square(&self) -> f64 {
+    pub(crate) fn mean_square(&self) -> f64 {
         self.sum_squares / self.n
-    }
-
-    /// Number of values evaluated one by one.
-    pub fn kept_len(&self) -> usize {
-        self.kept.len()
     }
 }
 
@@ -996,6 +995,9 @@ pub fn robust_ci(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::StandardNormal;
 
     #[test]
     fn robust_options_validates_eff() {
@@ -1102,5 +1104,50 @@ mod tests {
         assert_eq!(lo, 0.3);
         let (lo, _) = robust_ci(2.0, 1.0, 0.1, 3.0, 0.5, Some(5.0));
         assert_eq!(lo, 1.0);
+    }
+
+    #[test]
+    fn robust_scale_long_finds_the_direct_root() {
+        // METHODS §2.4: the windowed route (subsample root, one power-sum pass, Brent on the
+        // window) and the direct fixed point from the exact MAD start solve the same equation to
+        // ~1e-14 in s; 1e-11 on s^2 leaves room for the different summation orders. Cases: clean
+        // Gaussian, 2% gross outliers, a heavy-tailed mixture (MAD start far from the root), and a
+        // window that must slide (a subsample that misses the contaminated stretch).
+        let c = tuning_constant(0.6, RobustConvention::Exact).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(77);
+        let n = 100_000;
+        let gauss: Vec<f64> = (0..n)
+            .map(|_| rng.sample::<f64, _>(StandardNormal))
+            .collect();
+        let mut outliers = gauss.clone();
+        for v in outliers.iter_mut().step_by(50) {
+            *v = 100.0;
+        }
+        let mixture: Vec<f64> = gauss
+            .iter()
+            .enumerate()
+            .map(|(i, v)| if i % 5 == 0 { 6.0 * v } else { *v })
+            .collect();
+        let mut stretch = gauss.clone();
+        // every 12th value (the subsample's stride is n / 8192 = 12) is left clean; the rest of
+        // one third of the series is wider: the subsample sees a narrower distribution
+        for (i, v) in stretch.iter_mut().enumerate().take(n / 3) {
+            if i % 12 != 0 {
+                *v *= 3.0;
+            }
+        }
+        for (y, what) in [
+            (&gauss, "gaussian"),
+            (&outliers, "outliers"),
+            (&mixture, "mixture"),
+            (&stretch, "stretch"),
+        ] {
+            let long = robust_scale_long(y, c).unwrap();
+            let direct = robust_scale(y, c, RobustConvention::Exact).unwrap();
+            assert!(
+                ((long - direct) / direct).abs() < 1e-11,
+                "{what}: {long} vs {direct}"
+            );
+        }
     }
 }

@@ -23,7 +23,10 @@ use crate::error::ParamError;
 mod dwt;
 mod filter;
 mod modwt;
-pub mod naive;
+#[cfg(test)]
+pub(crate) mod naive;
+#[cfg(test)]
+mod tests_oracle;
 
 pub use dwt::Dwt;
 pub use filter::{quadrature_mirror, WaveletFilter};
