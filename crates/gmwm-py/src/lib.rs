@@ -295,11 +295,15 @@ fn simulate<'py>(
     ))
 }
 
-/// A Python callable told `(done, total)`; errors inside it are ignored (progress must never
-/// stop a computation).
+/// A Python callable told `(done, total)`, in increasing `done` (the engine's threads finish
+/// out of order; a stale count is not passed on); errors inside it are ignored (progress must
+/// never stop a computation).
 struct PyProgress {
     callback: Option<Py<PyAny>>,
     total: AtomicUsize,
+    /// The last count passed on; held while calling so that calls arrive in order (lock
+    /// order: this mutex, then the GIL).
+    reported: std::sync::Mutex<usize>,
 }
 
 impl Progress for PyProgress {
@@ -310,6 +314,14 @@ impl Progress for PyProgress {
 
     fn advance(&self, done: usize) {
         if let Some(cb) = &self.callback {
+            let mut last = match self.reported.lock() {
+                Ok(guard) => guard,
+                Err(poisoned) => poisoned.into_inner(),
+            };
+            if done > 0 && *last >= done {
+                return;
+            }
+            *last = done;
             let total = self.total.load(Ordering::Relaxed);
             Python::attach(|py| {
                 let _ = cb.call1(py, (done, total));
@@ -378,6 +390,7 @@ fn fit(
     let reporter = PyProgress {
         callback: progress,
         total: AtomicUsize::new(0),
+        reported: std::sync::Mutex::new(0),
     };
     let out = py.detach(|| -> Result<String, String> {
         let mut fits = Vec::new();
@@ -510,6 +523,7 @@ fn select(
     let reporter = PyProgress {
         callback: progress,
         total: AtomicUsize::new(0),
+        reported: std::sync::Mutex::new(0),
     };
     let done = AtomicUsize::new(0);
     let ticks = Ticks {
@@ -776,6 +790,7 @@ fn calibrate(
     let reporter = PyProgress {
         callback: progress,
         total: AtomicUsize::new(0),
+        reported: std::sync::Mutex::new(0),
     };
     // the recording: a file read as the CLI reads it, or the given columns
     let (imu, file, notes, topic_read) = match (path, arrays) {
