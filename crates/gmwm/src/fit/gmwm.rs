@@ -9,8 +9,8 @@ use super::{
     StartOptions, TransformPreset, Weighting, Weights,
 };
 use crate::error::ParamError;
-use crate::inference::wv_bootstrap;
 use crate::model::{ImpliedWv, Model};
+use crate::sim::bootstrap::wv_bootstrap;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use serde::Serialize;
 

@@ -3,7 +3,9 @@
 //! [`Simulator`] streams any sum of the processes of METHODS §10.1 over plain, per-sample
 //! parameters ([`Generator`]); [`simulate_model`] and [`Simulator::for_model`] simulate a [`Model`](crate::model::Model);
 //! [`DemoSensor`] is the known truth behind `gmwm demo`.
+//! [`bootstrap`] simulates parametric-bootstrap replicates and their wavelet variances (METHODS §7.4).
 
+pub mod bootstrap;
 pub mod demo;
 pub mod generator;
 pub mod model;
