@@ -183,11 +183,11 @@ fn wv(
             .map(|(n, x)| {
                 wavelet_variance(x, freq, &opts)
                     .map(|w| (n.clone(), w))
-                    .map_err(|e| (n.clone(), e))
+                    .map_err(|e| format!("column {n}: {e}"))
             })
             .collect::<Result<Vec<_>, _>>()
     });
-    let items = items.map_err(|(n, e)| err(format!("column {n}: {e}")))?;
+    let items = items.map_err(err)?;
     Ok(json(&gmwm::document::series(&items)))
 }
 
@@ -231,11 +231,11 @@ fn avar(
                 .map(|(n, x)| {
                     allan_variance(x, freq, &opts)
                         .map(|a| (n.clone(), a))
-                        .map_err(|e| (n.clone(), e))
+                        .map_err(|e| format!("column {n}: {e}"))
                 })
                 .collect::<Result<Vec<_>, _>>()
         })
-        .map_err(|(n, e)| err(format!("column {n}: {e}")))?;
+        .map_err(err)?;
     Ok(json(&gmwm::document::series(&items)))
 }
 
@@ -250,6 +250,12 @@ fn implied(model: &str, levels: usize, freq: f64) -> PyResult<String> {
     serde_json::to_string(&implied).map_err(err)
 }
 
+/// A simulated series and its named components.
+type Simulated<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Vec<(String, Bound<'py, PyArray1<f64>>)>,
+);
+
 /// A seeded simulation of a fully specified model (METHODS §10): the sum and, with
 /// `components`, each process.
 #[pyfunction]
@@ -261,10 +267,7 @@ fn simulate<'py>(
     freq: f64,
     seed: u64,
     components: bool,
-) -> PyResult<(
-    Bound<'py, PyArray1<f64>>,
-    Vec<(String, Bound<'py, PyArray1<f64>>)>,
-)> {
+) -> PyResult<Simulated<'py>> {
     check_freq(freq)?;
     if n == 0 {
         return Err(err("invalid n 0: simulate at least one sample"));
