@@ -32,7 +32,7 @@ pub enum StopReason {
     MaxEvaluations,
     /// Trial steps kept failing (no reduction of `Q`, or an invalid model) until the damping
     /// made them vanish, away from a stationary point (gradient cosine above
-    /// [`STALL_COSINE`]): **not converged**.
+    /// `1e-4`): **not converged**.
     Stalled,
 }
 
@@ -83,7 +83,7 @@ impl fmt::Display for Convergence {
     }
 }
 
-/// Options of [`minimize`]; the defaults suit the GMWM problem (a few to ~20 parameters).
+/// Options of the Levenberg–Marquardt optimiser ([`crate::Gmwm::with_options`]); the defaults suit the GMWM problem (a few to ~20 parameters).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LmOptions {
     /// Maximum accepted steps; default 2000 (LM typically needs 10–200 here, more when a

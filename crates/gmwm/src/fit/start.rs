@@ -6,11 +6,11 @@
 //!
 //! Reproducibility: draw `g` uses its own `ChaCha8Rng` seeded with
 //! [`replicate_seed`]`(seed, g)`, and draws are evaluated in fixed batches of
-//! [`BATCH_DRAWS`], so the result does not depend on the number of rayon threads.
+//! 1000 draws, so the result does not depend on the number of rayon threads.
 //!
 //! Early stop (port, allowed by §6.4): after each batch the search stops when at least
 //! [`MIN_DRAWS`] draws were made and the batch lowered the best `F` by no more than
-//! [`EARLY_STOP_REL`] (relative). The default G ([`default_draws`]) is 20000 for
+//! 1e-6 (relative). The default G ([`default_draws`]) is 20000 for
 //! `N <= 1e4`, else 100000 (the package uses 1e6 for long series; the early stop and the
 //! stage-1/stage-2 optimisation make the larger count unnecessary).
 //!

@@ -374,8 +374,7 @@ pub(crate) const FIXED_POINT_MAX_ITER: usize = 500;
 ///
 /// - [`RobustConvention::Exact`] (§2.4 "Port"): start from `s0 = median|y| / 0.6744898` (MAD
 ///   about 0, no centring), iterate `s^2 <- s^2 mean(psi_c(y/s)^2) / a(c)` until the relative
-///   change is below 1e-12 ([`FIXED_POINT_TOL`]); if the iteration stalls (no convergence in
-///   [`FIXED_POINT_MAX_ITER`] steps, or all residuals fall outside `[-c, c]`), find the root of
+///   change is below 1e-12; if the iteration stalls (no convergence in 500 steps, or all residuals fall outside `[-c, c]`), find the root of
 ///   `mean(psi_c(y/s)^2) - a(c)` in `s` by Brent–Dekker on the sign-changing bracket (from `+`
 ///   below to `-` above, the stable root) nearest `s0` on a geometric grid.
 /// - [`RobustConvention::Package`] (§2.4 steps 1–3): `x = y / sd(y)`, minimise

@@ -122,7 +122,7 @@ impl WaveletVariance {
     /// For the classical estimator `eta_j nu2_hat_j / nu2_j` is approximately chi-square with
     /// `eta_j` degrees of freedom (the approximation behind the intervals, METHODS §1.7), and
     /// the log of a chi-square variable with `eta` degrees of freedom has variance
-    /// `psi'(eta / 2)` (trigamma, [`trigamma`]): `2 / eta` for large `eta`, 1.64 at
+    /// `psi'(eta / 2)` (the trigamma function): `2 / eta` for large `eta`, 1.64 at
     /// `eta = 2`, 4.93 at `eta = 1`. The robust estimator's is `1 / eff` times larger (the
     /// factor by which its intervals widen, METHODS §2.5).
     ///

@@ -6,7 +6,8 @@
 //!   pyramid algorithm on any number of series (§1.2, §1.4).
 //! - [`WaveletCoefficients`]: every coefficient of every level plus the count of leading boundary
 //!   coefficients to drop (the "brick wall", §1.3, §1.4).
-//! - [`naive`]: slow direct-convolution twins of both transforms, the test oracle.
+//! - `naive` (crate-internal, test builds only): slow direct-convolution twins of both
+//!   transforms, the test oracle.
 //!
 //! Deviation from the R package (METHODS §1.3, §13.1): when exactly one boundary-free
 //! coefficient remains at a level, it is **kept** (the package keeps none and returns a NaN
