@@ -18,7 +18,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let runs: usize = args.next().map_or(Ok(7), |a| a.parse())?;
     let truth: Model = TRUTH.parse()?;
     let x = simulate_model(&truth, n, 100.0, 1)?;
-    let gmwm = Gmwm::new("AR1()+WN()+RW()".parse()?).with_draws(2000).with_seed(1337);
+    let gmwm = Gmwm::new("AR1()+WN()+RW()".parse()?)
+        .with_draws(2000)
+        .with_seed(1337);
     let mut times = Vec::with_capacity(runs);
     for _ in 0..runs {
         let t = Instant::now();
