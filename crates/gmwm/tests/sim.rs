@@ -633,9 +633,14 @@ fn simulator_rejects_bad_parameters() {
     )
     .unwrap_err();
     assert_eq!(e.name, "ar");
+    // a variance of 0 is refused as the process itself refuses it (issue 13: one domain for
+    // the simulator and the model), naming the parameter
+    let e = Simulator::new(vec![Generator::Wn { sigma2: 0.0 }], 1).unwrap_err();
+    assert_eq!(e.name, "sigma2");
+    assert!(gmwm::process::Wn::new(0.0).is_err());
     // Boundary values that are valid.
     for g in [
-        Generator::Wn { sigma2: 0.0 },
+        Generator::Wn { sigma2: 1e-300 },
         Generator::Ar1 {
             phi: -0.999999,
             sigma2: 1.0,

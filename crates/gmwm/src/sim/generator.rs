@@ -320,12 +320,11 @@ fn bad(name: &'static str, value: f64, expected: &str) -> ParamError {
     ParamError::new(name, value, expected)
 }
 
+/// A variance of a simulated process: the same domain as the process's own (finite and > 0,
+/// [`crate::process`]), so that anything the simulator accepts is a model the estimators
+/// accept too; a zero-variance component is no process (leave it out of the model).
 fn check_variance(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(bad(name, v, "must be a finite variance >= 0"))
-    }
+    crate::process::check_positive(name, v)
 }
 
 fn check_finite(name: &'static str, v: f64) -> Result<(), ParamError> {
