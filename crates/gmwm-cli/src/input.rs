@@ -187,36 +187,29 @@ pub fn check_wv_estimator(file: &Path, e: &WvEstimatorArgs) -> Result<()> {
     Ok(())
 }
 
-/// Keeps the first `j` levels of a WV.
-fn truncate_levels(wv: &mut WaveletVariance, j: usize) {
-    wv.tau.truncate(j);
-    wv.tau_s.truncate(j);
-    wv.wv.truncate(j);
-    wv.ci_low.truncate(j);
-    wv.ci_high.truncate(j);
-    wv.n_coefficients.truncate(j);
-    wv.eta.truncate(j);
-}
-
 /// Reads a saved wavelet variance: the series `--columns` selects (names or 1-based indices),
 /// the rate from `--freq` or the file, the first `levels` levels.
 pub fn load_wv(args: &InputArgs, levels: Option<usize>) -> Result<Vec<(String, WaveletVariance)>> {
     let file = &args.file;
     let selectors: Vec<ColumnSelector> = args.columns.iter().map(|c| selector(c)).collect();
-    let mut series = select_series(file, read_wv_json(file, args.freq)?, &selectors)?;
-    if let Some(j) = levels {
-        for (name, wv) in &mut series {
-            anyhow::ensure!(
-                j >= 1 && j <= wv.levels(),
-                "{}: series {}: --levels {j} is outside 1..={}",
-                file.display(),
-                quote(name),
-                wv.levels()
-            );
-            truncate_levels(wv, j);
-        }
-    }
-    Ok(series)
+    let series = select_series(file, read_wv_json(file, args.freq)?, &selectors)?;
+    let Some(j) = levels else {
+        return Ok(series);
+    };
+    series
+        .into_iter()
+        .map(|(name, wv)| {
+            let total = wv.levels();
+            let cut = wv.truncated(j).map_err(|_| {
+                anyhow::anyhow!(
+                    "{}: series {}: --levels {j} is outside 1..={total}",
+                    file.display(),
+                    quote(&name)
+                )
+            })?;
+            Ok((name, cut))
+        })
+        .collect()
 }
 
 /// Adds "FILE: column NAME" to a per-column engine error (the name cut to 40 characters).

@@ -417,10 +417,7 @@ fn fit(
             };
             for ((f, n), x) in fits.iter().zip(&names).zip(&cols) {
                 let wv = f.empirical.as_ref().ok_or("the fit carries no WV")?;
-                let this_wv = WvOptions {
-                    levels: Some(wv.levels()),
-                    ..wv_opts
-                };
+                let this_wv = wv.options();
                 let i = infer_with_progress(&gmwm, f, x.len(), &this_wv, &opts, &|d| {
                     reporter.advance(d)
                 })

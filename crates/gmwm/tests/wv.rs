@@ -474,3 +474,32 @@ fn in_memory_wv_is_exact_to_1e_9_on_a_biased_random_walk() {
     // in-memory kernel) at a length with several parts, partial blocks and stage-B levels
     check_in_memory_exact(3_000_001);
 }
+
+/// Issue 13: a WV says how it was computed (recomputing with its options gives it back) and
+/// cuts its levels together, refusing a count outside 1..=J.
+#[test]
+fn wv_options_recompute_it_and_truncation_cuts_every_level() {
+    let x = crate::common::white_noise(4096, 2.0, 9);
+    let opts = WvOptions {
+        robust: Some(gmwm::RobustOptions::default()),
+        alpha: 0.1,
+        ..WvOptions::default()
+    };
+    let wv = wavelet_variance(&x, 50.0, &opts).unwrap();
+    assert_eq!(wavelet_variance(&x, 50.0, &wv.options()).unwrap(), wv);
+    let cut = wv.clone().truncated(3).unwrap();
+    assert_eq!(cut.levels(), 3);
+    for len in [
+        cut.tau.len(),
+        cut.tau_s.len(),
+        cut.ci_low.len(),
+        cut.ci_high.len(),
+        cut.eta.len(),
+        cut.n_coefficients.len(),
+    ] {
+        assert_eq!(len, 3);
+    }
+    assert_eq!(cut.wv[..], wv.wv[..3]);
+    assert_eq!(wv.clone().truncated(0).unwrap_err().name, "levels");
+    assert!(wv.clone().truncated(wv.levels() + 1).is_err());
+}

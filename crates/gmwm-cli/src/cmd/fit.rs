@@ -42,22 +42,13 @@ fn fit_wv_file(args: &FitArgs, gmwm: &Gmwm) -> Result<Vec<(String, GmwmFit)>> {
         .collect()
 }
 
-/// The WV settings behind a fit (for the bootstrap replicates).
+/// The series length and WV settings behind a fit (for the bootstrap replicates).
 fn wv_options_of(fit: &GmwmFit) -> Result<(usize, WvOptions)> {
     let wv = fit
         .empirical
         .as_ref()
         .ok_or_else(|| anyhow::anyhow!("the fit carries no wavelet variance"))?;
-    Ok((
-        wv.n,
-        WvOptions {
-            transform: wv.transform,
-            filter: wv.filter,
-            levels: Some(wv.levels()),
-            alpha: wv.alpha,
-            robust: wv.robust,
-        },
-    ))
+    Ok((wv.n, wv.options()))
 }
 
 /// METHODS §7 on one column's fit, with a progress bar on a terminal.

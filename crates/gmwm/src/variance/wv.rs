@@ -115,6 +115,44 @@ impl WaveletVariance {
         self.wv.len()
     }
 
+    /// The options that computed this WV (its transform, filter, level count, alpha and
+    /// robust settings): what a bootstrap replicate of it is computed with.
+    pub fn options(&self) -> WvOptions {
+        WvOptions {
+            transform: self.transform,
+            filter: self.filter,
+            levels: Some(self.levels()),
+            alpha: self.alpha,
+            robust: self.robust,
+        }
+    }
+
+    /// The first `levels` levels (every per-level vector cut together).
+    ///
+    /// # Errors
+    /// [`ParamError`] naming `levels` unless it is in `1..=self.levels()`.
+    pub fn truncated(mut self, levels: usize) -> Result<Self, ParamError> {
+        if levels == 0 || levels > self.levels() {
+            return Err(ParamError::new(
+                "levels",
+                levels,
+                format!("in 1..={}", self.levels()),
+            ));
+        }
+        for v in [
+            &mut self.tau,
+            &mut self.tau_s,
+            &mut self.wv,
+            &mut self.ci_low,
+            &mut self.ci_high,
+            &mut self.eta,
+        ] {
+            v.truncate(levels);
+        }
+        self.n_coefficients.truncate(levels);
+        Ok(self)
+    }
+
     /// The variance of `ln nu2_hat_j` at each level: the noise of each estimate on the log
     /// scale of its plot, whatever the level's size.
     ///
