@@ -9,11 +9,23 @@ once, in the order of ``paths``: nothing is reported twice or dropped.
 
 from __future__ import annotations
 
+import multiprocessing
 import os
+import uuid
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Dict, List, Optional, Sequence
 
+from ._native import GmwmError
 from ._results import CalibrationResult, summary_rows
+
+
+class FleetError(GmwmError):
+    """An engine error raised in a worker process, carried back with its message.
+
+    ``GmwmError`` itself is created by the native module under the name ``_native.GmwmError``,
+    which cannot be imported back, so ``pickle`` cannot send it from a worker process (the
+    process pool then reported the pickling failure instead of the engine's message). This
+    subclass lives in an importable module and pickles as ``(message,)``."""
 
 
 def _unit_name(path: str) -> str:
@@ -29,7 +41,10 @@ def calibrate_one(path: str, options: Dict[str, Any]) -> Dict[str, Any]:
     """One recording's calibration document (what a worker runs; plain data, picklable)."""
     from . import calibrate
 
-    return calibrate(path, **options).to_dict()
+    try:
+        return calibrate(path, **options).to_dict()
+    except GmwmError as e:
+        raise FleetError(str(e)) from None
 
 
 class FleetResult:
@@ -69,7 +84,8 @@ def calibrate_many(
     """Calibrates every recording of ``paths`` with the same ``options`` (those of
     :func:`gmwm.calibrate`). With a ``dask.distributed.Client`` each recording is a task
     (``retries`` more attempts on an exception; a lost worker's tasks are rescheduled by Dask);
-    without one, a ``ProcessPoolExecutor`` of ``max_workers`` processes runs them. A recording
+    without one, a ``ProcessPoolExecutor`` of ``max_workers`` spawned processes runs them (so a
+    script calling this at import time needs the ``if __name__ == "__main__":`` guard). A recording
     that fails is reported in ``errors`` with the engine's message, not raised, so that one bad
     unit does not lose the fleet."""
     paths = [os.fspath(p) for p in paths]
@@ -79,11 +95,14 @@ def calibrate_many(
     docs: List[Optional[Dict[str, Any]]] = [None] * len(paths)
     errors: Dict[str, str] = {}
     if client is not None:
+        # one token per call: a key already known to the scheduler (an earlier call on the same
+        # client whose futures are not yet released) would be reused with its old result
+        token = uuid.uuid4().hex
         futures = client.map(
             calibrate_one,
             paths,
             [options] * len(paths),
-            key=[f"gmwm-calibrate-{i}-{u}" for i, u in enumerate(units)],
+            key=[f"gmwm-calibrate-{i}-{u}-{token}" for i, u in enumerate(units)],
             retries=retries,
             pure=False,
         )
@@ -93,7 +112,11 @@ def calibrate_many(
             except Exception as e:  # noqa: BLE001 - reported per unit, not raised
                 errors[units[i]] = str(e)
     else:
-        with ProcessPoolExecutor(max_workers=max_workers) as pool:
+        # spawned, not forked: the engine's thread pool (rayon) does not survive a fork, so a
+        # pool forked from a process that has already run the engine once (a single
+        # `gmwm.calibrate` before this call) deadlocks in its workers
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=max_workers, mp_context=context) as pool:
             futures = [pool.submit(calibrate_one, p, options) for p in paths]
             for i, f in enumerate(futures):
                 try:
