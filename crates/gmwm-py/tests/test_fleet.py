@@ -16,6 +16,7 @@ import logging
 import math
 import multiprocessing
 import os
+import sys
 import threading
 import time
 from pathlib import Path
@@ -303,7 +304,19 @@ def _wait(predicate, what: str, timeout: float = TIMEOUT, every: float = 0.02):
         time.sleep(every)
 
 
-def test_dask_worker_killed_mid_run(tmp_path):
+@pytest.fixture
+def by_value():
+    """The helpers of this module sent to workers by value, whatever pytest's import mode (a
+    worker need not be able to import this file)."""
+    import cloudpickle
+
+    module = sys.modules[__name__]
+    cloudpickle.register_pickle_by_value(module)
+    yield
+    cloudpickle.unregister_pickle_by_value(module)
+
+
+def test_dask_worker_killed_mid_run(tmp_path, by_value):
     from dask.distributed import Client
 
     slow = _recordings(tmp_path / "slow", "slow")
