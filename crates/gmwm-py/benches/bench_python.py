@@ -18,9 +18,13 @@
     native call and the wrapper on its very series and model. Nothing is added to Rust.
 (b) Fleet scaling. 8 recordings calibrated by ``gmwm.calibrate_many`` on a
     ``dask.distributed.LocalCluster`` of 1 worker and of 2 workers (processes, 1 thread each),
-    and for comparison in the process pool of ``max_workers`` 1 and 2; wall times (medians) and
+    and with ``--pool`` in the process pool of ``max_workers`` 1 and 2; wall times (medians) and
     the speed-up. The workers are started and warmed up (gmwm imported, one calibration done)
-    before the clock starts; reading the CSV files is part of each calibration.
+    before the clock starts; reading the CSV files is part of each calibration. The engine runs
+    its own threads within a calibration (rayon, every core), so this is done twice: as it comes,
+    and with ``RAYON_NUM_THREADS=1`` in every process. Baselines: the 8 calibrations one after the
+    other in one process, in this environment and in the environment a dask nanny gives its
+    workers (``MALLOC_TRIM_THRESHOLD_=65536`` etc., which costs the engine time).
 
 Run from ``crates/gmwm-py`` with the package installed (``pip install 'gmwm[test]'``)::
 
@@ -287,20 +291,6 @@ def _interleaved_values(fns: Dict[str, Callable[[], float]], repeats: int) -> Di
     return out
 
 
-@contextlib.contextmanager
-def _environ(env: Dict[str, str]):
-    saved = {k: os.environ.get(k) for k in env}
-    os.environ.update(env)
-    try:
-        yield
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
 _SERIAL = """
 import json, sys, time, gmwm
 paths, options = json.loads(sys.argv[1]), json.loads(sys.argv[2])
@@ -314,11 +304,11 @@ print(json.dumps({"one_wall": one_wall, "one_cpu": one_cpu, "serial": time.perf_
 
 
 def _serial(paths, options, env: Dict[str, str]) -> dict:
-    """In a fresh process with `env`: one calibration's wall and CPU time (the first, which is
-    also the warm-up), then the calibrations one after the other."""
+    """In a fresh process with exactly `env`: one calibration's wall and CPU time (the first,
+    which is also the warm-up), then the calibrations one after the other."""
     out = subprocess.run(
         [sys.executable, "-c", _SERIAL, json.dumps(paths), json.dumps(options)],
-        env={**os.environ, **env}, capture_output=True, text=True, check=True,
+        env=env, capture_output=True, text=True, check=True,
     )
     return json.loads(out.stdout)
 
@@ -327,11 +317,40 @@ def _rayon_threads():
     return os.environ.get("RAYON_NUM_THREADS")
 
 
-def bench_fleet(repeats: int, units: int, n: int, bootstrap: int, pool: bool) -> Dict[str, dict]:
-    """Per engine-thread setting: the serial baseline and the runners with 1 and 2 workers."""
+def _dask_worker_env() -> Dict[str, str]:
+    """What a dask nanny sets in its worker's environment (``distributed.nanny.pre-spawn-environ``,
+    e.g. MALLOC_TRIM_THRESHOLD_=65536)."""
+    import dask
+
+    cfg = dask.config.get("distributed.nanny.pre-spawn-environ")
+    return {k: str(v) for k, v in cfg.items() if v is not None}
+
+
+@contextlib.contextmanager
+def _exact_environ(env: Dict[str, str]):
+    """os.environ is exactly `env` inside, and what it was before afterwards (a nanny writes its
+    worker variables into the environment of the process that starts it and leaves them there,
+    where spawned pool processes and subprocesses would inherit them)."""
+    saved = dict(os.environ)
+    os.environ.clear()
+    os.environ.update(env)
+    try:
+        yield
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+
+
+def bench_fleet(repeats: int, units: int, n: int, bootstrap: int, pool: bool, malloc_trim: bool) -> Dict[str, dict]:
+    """Per engine-thread setting: the serial baselines and the runners with 1 and 2 workers."""
+    import dask
     from dask.distributed import Client, LocalCluster
 
     options = dict(model=MODEL, bootstrap=bootstrap, G=1000)
+    clean = dict(os.environ)
+    cfg = {} if malloc_trim else {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+    with dask.config.set(cfg):
+        worker_env = _dask_worker_env()
     report: Dict[str, dict] = {}
     with tempfile.TemporaryDirectory(prefix="gmwm-bench-") as tmp:
         paths = _write_fleet(Path(tmp), units, n)
@@ -339,10 +358,12 @@ def bench_fleet(repeats: int, units: int, n: int, bootstrap: int, pool: bool) ->
         # the engine parallelizes within a calibration (rayon, on every core unless
         # RAYON_NUM_THREADS says otherwise): measured as it comes, and with one thread a worker
         for threads, env in (("all cores", {}), ("1", {"RAYON_NUM_THREADS": "1"})):
-            base = _serial(paths, options, env)
+            base = _serial(paths, options, {**clean, **env})
+            base_dask_env = _serial(paths, options, {**clean, **worker_env, **env})
             ref = {Path(p).stem: d for p, d in base["docs"].items()}
+            assert {Path(p).stem: d for p, d in base_dask_env["docs"].items()} == ref
             runners: Dict[str, Callable[[], float]] = {}
-            with contextlib.ExitStack() as stack:
+            with _exact_environ(clean), dask.config.set(cfg), contextlib.ExitStack() as stack:
                 # both clusters up at once, their runs taken in turns with the pool's, so that
                 # other load on the machine falls on every configuration alike
                 for workers in (1, 2):
@@ -356,13 +377,16 @@ def bench_fleet(repeats: int, units: int, n: int, bootstrap: int, pool: bool) ->
                     gmwm.calibrate_many(warm * workers, client, **{**options, "bootstrap": 10})
                     runners[f"dask {workers}"] = functools.partial(_run_fleet, paths, options, ref, client=client)
                 if pool:
-                    stack.enter_context(_environ(env))  # the spawned pool processes inherit it
+                    # the pool's spawned processes inherit this process' environment: the clean
+                    # one, not the nanny's leftovers
+                    stack.enter_context(_exact_environ({**clean, **env}))
                     for workers in (1, 2):
                         runners[f"pool {workers}"] = functools.partial(
                             _run_fleet, paths, options, ref, max_workers=workers)
                 results = _interleaved_values(runners, repeats)
-            report[threads] = {"base": base, "times": results}
+            report[threads] = {"base": base, "base_dask_env": base_dask_env, "times": results}
 
+    trim = worker_env.get("MALLOC_TRIM_THRESHOLD_")
     rows = []
     for threads, r in report.items():
         base, results = r["base"], r["times"]
@@ -370,11 +394,13 @@ def bench_fleet(repeats: int, units: int, n: int, bootstrap: int, pool: bool) ->
         order = sorted(results, key=lambda k: (k.split()[0] != "dask", k))
         rows.append([threads, f"{base['one_wall']:.3f} s / {base['one_cpu']:.3f} s",
                      "serial, one process", "-", _fmt_s(base["serial"]), "", ""])
+        rows.append(["", f"{r['base_dask_env']['one_wall']:.3f} s / {r['base_dask_env']['one_cpu']:.3f} s",
+                     "serial, dask worker env", "-", _fmt_s(r["base_dask_env"]["serial"]), "", ""])
         for k in order:
             v = results[k]
             kind, w = k.split()
             rows.append([
-                threads, "", "dask LocalCluster" if kind == "dask" else "process pool (spawn)", w,
+                "", "", "dask LocalCluster" if kind == "dask" else "process pool (spawn)", w,
                 _fmt_s(med[k]), " ".join(f"{t:.2f}" for t in v), f"{med[f'{kind} 1'] / med[k]:.2f}x",
             ])
         r["medians"] = med
@@ -386,6 +412,11 @@ def bench_fleet(repeats: int, units: int, n: int, bootstrap: int, pool: bool) ->
          "speed-up 1 -> 2"],
         rows,
     )
+    print("  serial, one process: this environment; serial, dask worker env: with what a dask nanny "
+          f"sets for its workers ({', '.join(f'{k}={v}' for k, v in worker_env.items())})")
+    if trim is not None:
+        print(f"  (MALLOC_TRIM_THRESHOLD_={trim} makes glibc map and unmap the engine's large buffers on "
+              "every allocation; --no-malloc-trim starts the workers without it)")
     return report
 
 
@@ -398,6 +429,8 @@ def main(argv=None) -> int:
     ap.add_argument("--fleet-bootstrap", type=int, default=2000,
                     help="bootstrap of each fleet calibration (default 2000: ~1 s a recording)")
     ap.add_argument("--pool", action="store_true", help="also the process pool (no client) in (b)")
+    ap.add_argument("--no-malloc-trim", action="store_true",
+                    help="(b): start the dask workers without dask's MALLOC_TRIM_THRESHOLD_")
     ap.add_argument("--no-overhead", action="store_true", help="skip (a)")
     ap.add_argument("--no-fleet", action="store_true", help="skip (b)")
     ap.add_argument("--no-rust", action="store_true", help="skip the Rust example (cargo run) in (a)")
@@ -417,7 +450,7 @@ def main(argv=None) -> int:
         bench_criterion(repeats, args.cargo_target_dir)
     if not args.no_fleet:
         bench_fleet(fleet_repeats, units=8, n=2**15,
-                    bootstrap=200 if args.quick else args.fleet_bootstrap, pool=args.pool)
+                    bootstrap=200 if args.quick else args.fleet_bootstrap, pool=args.pool, malloc_trim=not args.no_malloc_trim)
     print(f"\nload average {os.getloadavg()[0]:.2f} at the end (other work on the machine skews the times)")
     return 0
 
