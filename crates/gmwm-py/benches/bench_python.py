@@ -181,9 +181,9 @@ def bench_overhead(repeats: int, G: int, n: int, tiny_n: int, tiny_rounds: int, 
             engine = _rust_example(n, repeats)
         else:
             print(f"(the Rust example fits with G={EXAMPLE_G}: not compared at G={G})")
-    if engine is not None:
-        big_rows.insert(0, [f"n={n:.0e}: Rust API Gmwm::fit (examples/fit_timing)", _fmt_s(engine[0]),
-                            f"min {_fmt_s(engine[1])}", f"{100 * engine[0] / big['wrapper']:.1f} %"])
+    for i, (what, (median, low)) in enumerate((engine or {}).items()):
+        big_rows.insert(i, [f"n={n:.0e}: Rust API, examples/fit_timing: {what}", _fmt_s(median),
+                            f"min {_fmt_s(low)}", f"{100 * median / big['wrapper']:.1f} %"])
     rows = big_rows + tiny_rows + [
         ["_native.version() (floor of any call)", _fmt_s(statistics.median(floor)),
          f"{_fmt_s(min(floor))} .. {_fmt_s(max(floor))}", ""]
@@ -195,12 +195,14 @@ def bench_overhead(repeats: int, G: int, n: int, tiny_n: int, tiny_rounds: int, 
         ["call", "median", "range", "share of gmwm.fit"],
         rows,
     )
-    return {"big": big, "tiny": tiny, "floor": statistics.median(floor), "rust": engine[0] if engine else None}
+    return {"big": big, "tiny": tiny, "floor": statistics.median(floor), "rust": engine}
 
 
-def _rust_example(n: int, runs: int) -> Optional[Tuple[float, float]]:
-    """Median and minimum seconds of the engine's fit in `examples/fit_timing.rs` (same series,
-    model, G and seeds as (a), timed in its own process); None when it cannot be built or run."""
+def _rust_example(n: int, runs: int) -> Optional[Dict[str, Tuple[float, float]]]:
+    """Median and minimum seconds of each timing `examples/fit_timing.rs` prints (the fit, and
+    the fit with its canonical reading and JSON document; same series, model, G and seeds as
+    (a), timed in its own process; the example prints 0.1 ms steps); None when it cannot be
+    built or run."""
     root = Path(__file__).resolve().parents[3]
     cmd = ["cargo", "run", "--release", "--quiet", "-p", "gmwm", "--example", "fit_timing", "--", str(n), str(runs)]
     print(f"running: {' '.join(cmd)}  (in {root})", flush=True)
@@ -209,11 +211,11 @@ def _rust_example(n: int, runs: int) -> Optional[Tuple[float, float]]:
     except (OSError, subprocess.TimeoutExpired) as e:
         print(f"the Rust example did not run: {e}")
         return None
-    hit = re.search(r"median ([\d.]+) s, min ([\d.]+) s", p.stdout)
-    if p.returncode != 0 or not hit:
+    hits = re.findall(r"^rust (.+?): .*median ([\d.]+) s, min ([\d.]+) s", p.stdout, re.M)
+    if p.returncode != 0 or not hits:
         print(f"the Rust example failed (exit {p.returncode}):\n" + "\n".join((p.stdout + p.stderr).splitlines()[-10:]))
         return None
-    return float(hit.group(1)), float(hit.group(2))
+    return {what: (float(median), float(low)) for what, median, low in hits}
 
 
 def bench_criterion(repeats: int, target_dir: Optional[str]) -> Optional[Dict[str, float]]:
