@@ -24,7 +24,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 create_exception!(
-    _native,
+    gmwm._native,
     GmwmError,
     PyValueError,
     "An input or computation the engine refuses; the message names what is wrong."

@@ -215,6 +215,17 @@ def test_bad_input_raises_a_clear_exception(call, needle):
     assert needle in str(e.value)
 
 
+def test_engine_errors_pickle_with_their_message():
+    # a worker process sends its exceptions back pickled (the fleet relies on it)
+    import pickle
+
+    with pytest.raises(gmwm.GmwmError) as e:
+        gmwm.wv(np.zeros(100), freq=-1)
+    back = pickle.loads(pickle.dumps(e.value))
+    assert type(back) is gmwm.GmwmError and str(back) == str(e.value)
+    assert type(back).__module__ == "gmwm._native"
+
+
 def test_unknown_keywords_are_type_errors():
     with pytest.raises(TypeError):
         gmwm.wv(np.ones(64), freq=1, robustt=True)

@@ -15,17 +15,7 @@ import uuid
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Dict, List, Optional, Sequence
 
-from ._native import GmwmError
 from ._results import CalibrationResult, summary_rows
-
-
-class FleetError(GmwmError):
-    """An engine error raised in a worker process, carried back with its message.
-
-    ``GmwmError`` itself is created by the native module under the name ``_native.GmwmError``,
-    which cannot be imported back, so ``pickle`` cannot send it from a worker process (the
-    process pool then reported the pickling failure instead of the engine's message). This
-    subclass lives in an importable module and pickles as ``(message,)``."""
 
 
 def _unit_name(path: str) -> str:
@@ -41,10 +31,7 @@ def calibrate_one(path: str, options: Dict[str, Any]) -> Dict[str, Any]:
     """One recording's calibration document (what a worker runs; plain data, picklable)."""
     from . import calibrate
 
-    try:
-        return calibrate(path, **options).to_dict()
-    except GmwmError as e:
-        raise FleetError(str(e)) from None
+    return calibrate(path, **options).to_dict()
 
 
 class FleetResult:
