@@ -28,10 +28,15 @@ def _unit_name(path: str) -> str:
 
 
 def calibrate_one(path: str, options: Dict[str, Any]) -> Dict[str, Any]:
-    """One recording's calibration document (what a worker runs; plain data, picklable)."""
-    from . import calibrate
+    """One recording's calibration document (what a worker runs; plain data, picklable), or
+    ``{"error": message}`` when the engine refuses the recording: that answer is deterministic,
+    so it is returned rather than raised, and Dask does not retry it."""
+    from . import GmwmError, calibrate
 
-    return calibrate(path, **options).to_dict()
+    try:
+        return calibrate(path, **options).to_dict()
+    except GmwmError as e:
+        return {"error": str(e)}
 
 
 class FleetResult:
@@ -70,7 +75,8 @@ def calibrate_many(
 ) -> FleetResult:
     """Calibrates every recording of ``paths`` with the same ``options`` (those of
     :func:`gmwm.calibrate`). With a ``dask.distributed.Client`` each recording is a task
-    (``retries`` more attempts on an exception; a lost worker's tasks are rescheduled by Dask);
+    (``retries`` more attempts on an unexpected exception; an error of the engine on the
+    recording is deterministic and not retried; a lost worker's tasks are rescheduled by Dask);
     without one, a ``ProcessPoolExecutor`` of ``max_workers`` spawned processes runs them (so a
     script calling this at import time needs the ``if __name__ == "__main__":`` guard). A recording
     that fails is reported in ``errors`` with the engine's message, not raised, so that one bad
@@ -98,6 +104,9 @@ def calibrate_many(
                 docs[i] = f.result()
             except Exception as e:  # noqa: BLE001 - reported per unit, not raised
                 errors[units[i]] = str(e)
+            if docs[i] is not None and "error" in docs[i]:
+                errors[units[i]] = docs[i].pop("error")
+                docs[i] = None
     else:
         # spawned, not forked: the engine's thread pool (rayon) does not survive a fork, so a
         # pool forked from a process that has already run the engine once (a single
@@ -110,4 +119,7 @@ def calibrate_many(
                     docs[i] = f.result()
                 except Exception as e:  # noqa: BLE001
                     errors[units[i]] = str(e)
+                if docs[i] is not None and "error" in docs[i]:
+                    errors[units[i]] = docs[i].pop("error")
+                    docs[i] = None
     return FleetResult(units, docs, errors)
