@@ -69,6 +69,24 @@ fn columns_of<'a>(arrays: &'a Borrowed<'_>) -> Vec<Cow<'a, [f64]>> {
         .collect()
 }
 
+/// `f` on every column in parallel (the engine's [`gmwm::variance::per_column`], as the CLI),
+/// each result named by its column; the first failure as one line naming the column.
+fn per_column<T: Send, E: std::fmt::Display + Send>(
+    names: &[String],
+    cols: &[Cow<'_, [f64]>],
+    f: impl Fn(&[f64]) -> Result<T, E> + Sync + Send,
+) -> Result<Vec<(String, T)>, String> {
+    let slices: Vec<&[f64]> = cols.iter().map(|c| c.as_ref()).collect();
+    names
+        .iter()
+        .zip(gmwm::variance::per_column(&slices, f))
+        .map(|(n, r)| {
+            r.map(|t| (n.clone(), t))
+                .map_err(|e| format!("column {n}: {e}"))
+        })
+        .collect()
+}
+
 fn check_columns(arrays: &Borrowed<'_>, names: &[String]) -> PyResult<()> {
     if arrays.len() != names.len() {
         return Err(err(format!(
@@ -176,18 +194,9 @@ fn wv(
         alpha,
     )?;
     let cols = columns_of(&arrays);
-    let items = py.detach(|| {
-        names
-            .iter()
-            .zip(&cols)
-            .map(|(n, x)| {
-                wavelet_variance(x, freq, &opts)
-                    .map(|w| (n.clone(), w))
-                    .map_err(|e| format!("column {n}: {e}"))
-            })
-            .collect::<Result<Vec<_>, _>>()
-    });
-    let items = items.map_err(err)?;
+    let items = py
+        .detach(|| per_column(&names, &cols, |x| wavelet_variance(x, freq, &opts)))
+        .map_err(err)?;
     Ok(json(&gmwm::document::series(&items)))
 }
 
@@ -224,17 +233,7 @@ fn avar(
     };
     let cols = columns_of(&arrays);
     let items = py
-        .detach(|| {
-            names
-                .iter()
-                .zip(&cols)
-                .map(|(n, x)| {
-                    allan_variance(x, freq, &opts)
-                        .map(|a| (n.clone(), a))
-                        .map_err(|e| format!("column {n}: {e}"))
-                })
-                .collect::<Result<Vec<_>, _>>()
-        })
+        .detach(|| per_column(&names, &cols, |x| allan_variance(x, freq, &opts)))
         .map_err(err)?;
     Ok(json(&gmwm::document::series(&items)))
 }
@@ -396,13 +395,10 @@ fn fit(
         reported: std::sync::Mutex::new(0),
     };
     let out = py.detach(|| -> Result<String, String> {
-        let mut fits = Vec::new();
-        for (n, x) in names.iter().zip(&cols) {
-            let f = gmwm
-                .fit(x, freq, &wv_opts)
-                .map_err(|e| format!("column {n}: {e}"))?;
-            fits.push(f);
-        }
+        let fits: Vec<_> = per_column(&names, &cols, |x| gmwm.fit(x, freq, &wv_opts))?
+            .into_iter()
+            .map(|(_, f)| f)
+            .collect();
         let canonicals = fits
             .iter()
             .zip(&names)
@@ -532,17 +528,7 @@ fn select(
     };
     reporter.start(names.len() * wic.candidates().len());
     let results = py
-        .detach(|| {
-            names
-                .iter()
-                .zip(&cols)
-                .map(|(n, x)| {
-                    wic.select_with_progress(x, freq, &ticks)
-                        .map(|s| (n.clone(), s))
-                        .map_err(|e| format!("column {n}: {e}"))
-                })
-                .collect::<Result<Vec<_>, _>>()
-        })
+        .detach(|| per_column(&names, &cols, |x| wic.select_with_progress(x, freq, &ticks)))
         .map_err(err)?;
     Ok(json(&gmwm::document::selections(&results)))
 }
