@@ -36,6 +36,38 @@ pub enum Error {
     Export(#[from] crate::calib::export::ExportError),
 }
 
+/// A computation on data and a model could not run: the series, a parameter or the model is
+/// unusable.
+///
+/// It is the error of the computations every stage builds on (wavelet and Allan variances,
+/// implied wavelet variances, simulation, the bootstrap of V). The stage errors
+/// ([`crate::fit::FitError`], [`crate::selection::SelectionError`],
+/// [`crate::calib::CalibError`]) hold one; it holds none of them, so the error types are
+/// siblings that all convert into [`enum@Error`], never a loop.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum InputError {
+    /// The series is unusable.
+    #[error(transparent)]
+    Series(#[from] SeriesError),
+    /// A parameter or option has an impossible value.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// The model breaks a rule of METHODS §0.2 or has an invalid value.
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
+}
+
+impl From<InputError> for Error {
+    fn from(e: InputError) -> Self {
+        match e {
+            InputError::Series(e) => Error::Series(e),
+            InputError::Param(e) => Error::Param(e),
+            InputError::Model(e) => Error::Model(e),
+        }
+    }
+}
+
 /// A series that cannot be analysed.
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]

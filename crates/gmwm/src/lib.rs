@@ -39,7 +39,7 @@ pub mod units;
 pub mod variance;
 pub mod wavelet;
 
-pub use error::{Error, ParamError, SeriesError};
+pub use error::{Error, InputError, ParamError, SeriesError};
 pub use fit::{FitError, Gmwm, GmwmFit, Weighting, Weights};
 pub use selection::{auto_imu, ModelSelection, SelectionError, Wic};
 pub use variance::allan::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};

@@ -72,6 +72,6 @@ pub fn compute(args: &AvarArgs) -> Result<Vec<(String, AllanVariance)>> {
     }
     let loaded = load(&args.input)?;
     analyse_columns(&loaded, &args.input.file, |x| {
-        allan_variance(x, loaded.freq_hz, &opts)
+        Ok(allan_variance(x, loaded.freq_hz, &opts)?)
     })
 }

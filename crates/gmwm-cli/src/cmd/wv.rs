@@ -120,7 +120,7 @@ fn stream_column(
     while let Some(chunk) = chunks.next_chunk()? {
         acc.push(chunk)?;
     }
-    acc.finish(freq_hz, opts.alpha)
+    Ok(acc.finish(freq_hz, opts.alpha)?)
 }
 
 /// A `--columns` entry of a raw binary file: a 1-based index, a name of the sidecar, or
@@ -208,7 +208,7 @@ pub fn compute(args: &WvArgs) -> Result<Vec<(String, WaveletVariance)>> {
     }
     let loaded = load(&args.input)?;
     let items = analyse_columns(&loaded, &args.input.file, |x| {
-        wavelet_variance(x, loaded.freq_hz, &opts)
+        Ok(wavelet_variance(x, loaded.freq_hz, &opts)?)
     })?;
     for (name, wv) in &items {
         for w in &wv.warnings {

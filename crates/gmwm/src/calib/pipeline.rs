@@ -129,7 +129,7 @@ pub enum CalibError {
         /// Column.
         column: String,
         /// Cause.
-        source: Box<crate::Error>,
+        source: crate::InputError,
     },
 }
 
@@ -518,9 +518,9 @@ impl Calibration {
             (Some(_), Some(k)) => SignalUnit::si(k).symbol().to_string(),
             _ => "u".to_string(),
         };
-        let engine = |source: crate::Error| CalibError::Engine {
+        let engine = |source: crate::InputError| CalibError::Engine {
             column: column.to_string(),
-            source: Box::new(source),
+            source,
         };
         let fit_error = |source: FitError| CalibError::Fit {
             column: column.to_string(),

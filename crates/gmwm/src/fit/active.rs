@@ -83,7 +83,7 @@ impl GmwmFit {
             Some(sub) => Ok(sub
                 .model
                 .with_values(&sub.start)
-                .map_err(crate::Error::from)?),
+                ?),
             None => Ok(self.model.clone()),
         }
     }
@@ -92,7 +92,7 @@ impl GmwmFit {
     /// none is: a model fitted to nothing is kept whole).
     ///
     /// # Errors
-    /// [`FitError::Engine`] if the sub-model cannot be built (it always can: its components
+    /// [`FitError::Input`] if the sub-model cannot be built (it always can: its components
     /// are a subset of a valid model's).
     pub fn active_sub_model(&self) -> Result<Option<SubModel>, FitError> {
         let keep = self.active_parameters();
@@ -107,7 +107,7 @@ impl GmwmFit {
             }
             at += c.kind.n_params();
         }
-        let model = Model::new(components).map_err(crate::Error::from)?;
+        let model = Model::new(components)?;
         let start = keep.iter().map(|&k| self.theta[k]).collect();
         Ok(Some(SubModel { model, keep, start }))
     }

@@ -17,7 +17,7 @@ impl Gmwm {
     /// starting values unless the model is fully specified. Works with every weighting.
     ///
     /// # Errors
-    /// As [`wavelet_variance`] (in [`FitError::Engine`]), [`Weights::new`],
+    /// As [`wavelet_variance`] (in [`FitError::Input`]), [`Weights::new`],
     /// [`starting_values`] and [`Gmwm::fit_weighted`].
     pub fn fit(&self, x: &[f64], freq_hz: f64, wv_opts: &WvOptions) -> Result<GmwmFit, FitError> {
         super::check_haar(wv_opts.filter)?;
@@ -57,9 +57,9 @@ impl Gmwm {
                 found: self.given.len(),
             })?;
             at += n;
-            comps.push(Component::new(c.kind, values.to_vec()).map_err(crate::Error::from)?);
+            comps.push(Component::new(c.kind, values.to_vec())?);
         }
-        Ok(Model::new(comps).map_err(crate::Error::from)?)
+        Ok(Model::new(comps)?)
     }
 
     /// The search and two-stage fit on given weights (no bootstrap rounds, nothing attached).

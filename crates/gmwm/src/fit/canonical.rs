@@ -630,13 +630,13 @@ impl GmwmFit {
     /// reductions).
     ///
     /// # Errors
-    /// [`FitError::Engine`] with a [`crate::ParamError`] for a limit that is not a finite
+    /// [`FitError::Input`] with a [`crate::ParamError`] for a limit that is not a finite
     /// number >= 0, or for a fit without an empirical WV (a bare [`Gmwm::fit_weighted`]: the
     /// separation is measured in the noise of that WV); errors of the refits' set-up. A refit
     /// that fails to converge only makes its reduction fail the test.
     pub fn canonical_with(&self, limit: f64) -> Result<CanonicalModel, FitError> {
         if !(limit.is_finite() && limit >= 0.0) {
-            return Err(crate::Error::from(crate::ParamError::new(
+            return Err(FitError::from(crate::ParamError::new(
                 "separation limit",
                 limit,
                 "a finite number of standard errors >= 0",
@@ -644,7 +644,7 @@ impl GmwmFit {
             .into());
         }
         let Some(wv) = &self.empirical else {
-            return Err(crate::Error::from(crate::ParamError::new(
+            return Err(FitError::from(crate::ParamError::new(
                 "fit",
                 "without an empirical wavelet variance",
                 "a fit that carries its WV (Gmwm::fit, fit_from_wv, fit_series, fit_wv): the \
@@ -669,7 +669,7 @@ impl GmwmFit {
                         c.kind,
                         self.theta[at..at + n].iter().map(|&v| Some(v)).collect(),
                     )
-                    .map_err(crate::Error::from)?,
+                    ?,
                     from: vec![i],
                 });
             } else {
@@ -764,7 +764,6 @@ impl GmwmFit {
         let terms_parts = canonical_order(terms_parts, freq);
         let guess = |parts: &[Part]| {
             Model::new(parts.iter().map(|p| Component::guess(p.kind())).collect())
-                .map_err(crate::Error::from)
         };
         let model = guess(&terms_parts)?;
         let reduced = guess(&canonical_order(state.parts.clone(), freq))?;
@@ -954,7 +953,7 @@ impl GmwmFit {
                         c.kind,
                         fit.theta[at..at + n].iter().map(|&v| Some(v)).collect(),
                     )
-                    .map_err(crate::Error::from)?,
+                    ?,
                     from: p.from,
                 });
             }
@@ -977,7 +976,7 @@ impl GmwmFit {
 }
 
 fn bad_value(what: &str, value: f64) -> FitError {
-    crate::Error::from(crate::ParamError::new(
+    FitError::from(crate::ParamError::new(
         "canonical model",
         value,
         format!("a positive finite {what} variance"),
@@ -1000,7 +999,7 @@ fn falls_everywhere(implied: &ImpliedWv, k: usize) -> bool {
 }
 
 /// The model of the parts, with their values.
-fn model_of(parts: &[Part]) -> Result<Model, crate::Error> {
+fn model_of(parts: &[Part]) -> Result<Model, crate::model::ModelError> {
     Ok(Model::new(
         parts.iter().map(|p| p.component.clone()).collect(),
     )?)

@@ -195,7 +195,7 @@ impl Gmwm {
     /// fits as [`Gmwm::fit_wv`]; works with every [`Weighting`].
     ///
     /// # Errors
-    /// As [`wavelet_variance`] (wrapped in [`FitError::Engine`]) and [`Gmwm::fit_wv`].
+    /// As [`wavelet_variance`] (wrapped in [`FitError::Input`]) and [`Gmwm::fit_wv`].
     pub fn fit_series(
         &self,
         x: &[f64],
@@ -312,7 +312,7 @@ impl Gmwm {
         let mut revivals = 0;
         let (theta, fitted, implied_wv) = loop {
             let theta = Parametrisation::canonical_order(&self.model, &min.theta)?;
-            let fitted = self.model.with_values(&theta).map_err(crate::Error::from)?;
+            let fitted = self.model.with_values(&theta)?;
             let implied = fitted.implied_wv(nu_hat.len(), freq_hz)?;
             let revived = if revivals < MAX_REVIVALS {
                 revival_start(

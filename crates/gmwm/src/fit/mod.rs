@@ -113,7 +113,7 @@ pub enum FitError {
     },
     /// The implied WV cannot be evaluated at the start.
     #[error("the starting values cannot be evaluated: {0}")]
-    BadStart(#[source] Box<crate::Error>),
+    BadStart(#[source] crate::InputError),
     /// The implied WV at the start is not finite (e.g. an enormous variance overflowed).
     #[error("level {level}: the implied wavelet variance at the start is {value}; choose a smaller start")]
     NonFiniteStart {
@@ -134,10 +134,22 @@ pub enum FitError {
         /// The filter of the WV.
         filter: WaveletFilter,
     },
-    /// An engine computation the fit relies on failed (e.g. the diag covariance of a bad series).
+    /// A computation the fit builds on could not run: the series, a parameter or the model is
+    /// unusable.
     #[error(transparent)]
-    Engine(Box<crate::Error>),
+    Input(#[from] crate::InputError),
 }
+
+macro_rules! input_error_from {
+    ($($t:ty),*) => {$(
+        impl From<$t> for FitError {
+            fn from(e: $t) -> Self {
+                FitError::Input(e.into())
+            }
+        }
+    )*};
+}
+input_error_from!(crate::ParamError, crate::SeriesError, crate::model::ModelError);
 
 /// Refuses a wavelet variance with another filter than Haar ([`FitError::NotHaar`]).
 ///
@@ -151,8 +163,3 @@ pub(crate) fn check_haar(filter: WaveletFilter) -> Result<(), FitError> {
     }
 }
 
-impl From<crate::Error> for FitError {
-    fn from(e: crate::Error) -> Self {
-        FitError::Engine(Box::new(e))
-    }
-}

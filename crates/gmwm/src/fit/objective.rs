@@ -193,7 +193,7 @@ impl Objective {
         theta: &[f64],
         nu: &mut [f64],
         a: Option<&mut [f64]>,
-    ) -> Result<(), crate::Error> {
+    ) -> Result<(), crate::InputError> {
         let levels = self.levels();
         let processes = self.model.with_values(theta)?.processes(self.freq_hz)?;
         nu.fill(0.0);
@@ -235,7 +235,7 @@ impl Objective {
         u: &[f64],
         ev: &mut Eval,
         with_jacobian: bool,
-    ) -> Result<(), crate::Error> {
+    ) -> Result<(), crate::InputError> {
         let p = self.n_params();
         self.param.eval(
             u,
@@ -298,7 +298,7 @@ impl Objective {
     /// (original parametrisation). No factor N.
     ///
     /// # Errors
-    /// [`FitError::Length`]; [`FitError::Engine`] when theta is not a valid model.
+    /// [`FitError::Length`]; [`FitError::Input`] when theta is not a valid model.
     pub fn value_at_theta(&self, theta: &[f64]) -> Result<f64, FitError> {
         if theta.len() != self.n_params() {
             return Err(FitError::Length {
@@ -326,7 +326,7 @@ impl Objective {
     /// METHODS §5.1: `Q(theta(u))`.
     ///
     /// # Errors
-    /// [`FitError::Length`]; [`FitError::Engine`] when theta(u) is not a valid model (e.g. a
+    /// [`FitError::Length`]; [`FitError::Input`] when theta(u) is not a valid model (e.g. a
     /// transformed variance that underflowed to 0).
     pub fn value(&self, u: &[f64]) -> Result<f64, FitError> {
         self.check_u(u)?;

@@ -264,7 +264,7 @@ pub(crate) fn minimize(
     let mut u = u0.to_vec();
     objective
         .evaluate(&u, &mut cur, true)
-        .map_err(|e| FitError::BadStart(Box::new(e)))?;
+        .map_err(FitError::BadStart)?;
     if let Some(j) = cur.r.iter().position(|v| !v.is_finite()) {
         return Err(FitError::NonFiniteStart {
             level: j + 1,

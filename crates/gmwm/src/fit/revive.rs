@@ -58,8 +58,8 @@ pub(crate) fn revival_start(
                     c.kind,
                     unit.iter().copied().map(Some).collect(),
                 )
-                .map_err(crate::Error::from)?])
-                .map_err(crate::Error::from)?;
+                ?])
+                ?;
                 let s = one.implied_wv(levels, freq_hz)?.wv;
                 let (mut sr, mut ss) = (0.0, 0.0);
                 for l in 0..levels {

@@ -186,10 +186,10 @@ impl Parametrisation {
         let n_ordered = model.count(ProcessKind::Ar1) + model.count(ProcessKind::Gm);
         let chain = order == PhiOrder::Ordered && n_ordered >= 2;
         if model.uses_gm() && !(freq_hz.is_finite() && freq_hz > 0.0) {
-            return Err(FitError::BadStart(Box::new(
+            return Err(FitError::BadStart(
                 crate::ParamError::new("freq", freq_hz, "must be a positive number of hertz")
                     .into(),
-            )));
+            ));
         }
         let mut single = Vec::with_capacity(model.n_params());
         let mut ordered = Vec::new();

@@ -82,7 +82,7 @@ impl Weights {
     /// Cost: one MODWT of `x` and one FFT per level.
     ///
     /// # Errors
-    /// [`FitError::Engine`] wrapping the error of [`wv_diag_covariance`]; [`FitError::BadWeight`] for a zero or non-finite `V_jj`.
+    /// [`FitError::Input`] wrapping the error of [`wv_diag_covariance`]; [`FitError::BadWeight`] for a zero or non-finite `V_jj`.
     pub fn diag(x: &[f64], wv: &WaveletVariance) -> Result<Self, FitError> {
         let mut v = wv_diag_covariance(x, wv.filter, wv.levels(), DiagDivisor::Level)?;
         if let Some(r) = wv.robust {

@@ -91,7 +91,7 @@ pub const PINV_RCOND: f64 = 1e-12;
 /// exactly the inverse.
 ///
 /// # Errors
-/// [`FitError::Length`] for inconsistent sizes; [`FitError::Engine`] when a column of `A` has
+/// [`FitError::Length`] for inconsistent sizes; [`FitError::Input`] when a column of `A` has
 /// zero or non-finite `Omega`-norm (a parameter without influence on the WV: its variance is not
 /// identified).
 pub fn sandwich(
@@ -114,7 +114,7 @@ pub fn sandwich(
     for k in 0..p {
         let x = b[(k, k)].sqrt();
         if !(x.is_finite() && x > 0.0) {
-            return Err(crate::Error::from(ParamError::new(
+            return Err(FitError::from(ParamError::new(
                 "theta",
                 k,
                 "has no influence on the implied WV at the estimate, so its variance is not identified",
@@ -133,7 +133,7 @@ pub fn sandwich(
         .count();
     let pinv = svd
         .pseudo_inverse(PINV_RCOND * max_sv)
-        .map_err(|e| crate::Error::from(ParamError::new("A' Omega A", e, "an SVD")))?;
+        .map_err(|e| FitError::from(ParamError::new("A' Omega A", e, "an SVD")))?;
     // (A' Omega A)^+ = S^{-1} Bs^+ S^{-1}
     let binv = DMatrix::from_fn(p, p, |i, j| pinv[(i, j)] / (s[i] * s[j]));
     let h = binv * a.transpose() * omega;

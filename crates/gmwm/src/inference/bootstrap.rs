@@ -8,7 +8,7 @@
 //! one series buffer: memory is `threads x N` samples plus what the caller keeps per replicate.
 
 use super::progress::Progress;
-use crate::error::{Error, ParamError};
+use crate::error::ParamError;
 use crate::fit::{FitError, Gmwm, GmwmFit, StartInputs, Weighting, Weights};
 pub use crate::sim::bootstrap::{map_replicates, wv_bootstrap, WvBootstrap};
 use crate::sim::replicate_seed;
@@ -94,7 +94,7 @@ pub struct FitBootstrapOptions {
 /// Cost: B x (simulation + WV + one stage-2 fit [+ G draws and a two-stage fit]).
 ///
 /// # Errors
-/// [`FitError::Engine`] with a [`ParamError`] for fewer than 2 replicates or `n == 0`; errors of
+/// [`FitError::Input`] with a [`ParamError`] for fewer than 2 replicates or `n == 0`; errors of
 /// the simulation, the WV, the weights and the replicate fits (the first one met).
 pub fn fit_bootstrap(
     gmwm: &Gmwm,
@@ -110,7 +110,7 @@ pub fn fit_bootstrap(
         gof_draws,
     } = *settings;
     if replicates < 2 {
-        return Err(Error::from(ParamError::new(
+        return Err(FitError::from(ParamError::new(
             "replicates",
             replicates,
             "must be at least 2 for a bootstrap covariance",

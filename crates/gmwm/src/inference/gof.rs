@@ -72,7 +72,7 @@ pub fn hartlap_factor(replicates: usize, levels: usize) -> Option<f64> {
 ///
 /// # Errors
 /// [`FitError::Length`] when `v` is not J x J; [`FitError::BadWeight`] when `v` is not
-/// positive definite ([`FullWeights::from_covariance`]); [`FitError::Engine`] with a
+/// positive definite ([`FullWeights::from_covariance`]); [`FitError::Input`] with a
 /// [`ParamError`] when `J <= p` (no degrees of freedom); errors of the fit's parametrisation
 /// and optimiser.
 pub fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, FitError> {
@@ -92,7 +92,7 @@ pub fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, Fit
         });
     }
     if levels <= p {
-        return Err(crate::Error::from(ParamError::new(
+        return Err(FitError::from(ParamError::new(
             "levels",
             levels,
             format!("the J-test needs more levels than the {p} parameters (df = J - p >= 1)"),

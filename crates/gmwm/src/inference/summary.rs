@@ -26,7 +26,7 @@ use super::asymptotic::{sandwich, scales, z_value, IntervalScale, ZConvention};
 use super::bootstrap::{fit_bootstrap, map_replicates, FitBootstrapOptions, WvBootstrap};
 use super::gof::{hartlap_factor, j_test, JTest};
 use super::progress::{NoProgress, Progress};
-use crate::error::{Error, ParamError};
+use crate::error::ParamError;
 use crate::fit::{FitError, Gmwm, GmwmFit};
 use crate::variance::wv::WvOptions;
 use nalgebra::{DMatrix, DVector};
@@ -267,7 +267,7 @@ pub struct Inference {
 /// (simulation + WV + stage-2 fit [+ G draws and a two-stage fit]).
 ///
 /// # Errors
-/// [`FitError::Engine`] for a bad `alpha`, `n == 0` or fewer than 2 replicates; errors of the
+/// [`FitError::Input`] for a bad `alpha`, `n == 0` or fewer than 2 replicates; errors of the
 /// simulation, the WV, the sandwich and the fits.
 pub fn infer(
     gmwm: &Gmwm,
@@ -300,7 +300,7 @@ pub fn infer_with_progress(
 /// without simulating again. `opts.bootstrap` and `opts.v_replicates` are ignored.
 ///
 /// # Errors
-/// As [`infer`]; [`FitError::Engine`] if `v` is not `J x J` for the fit's `J` levels.
+/// As [`infer`]; [`FitError::Input`] if `v` is not `J x J` for the fit's `J` levels.
 pub fn infer_with_covariance(
     gmwm: &Gmwm,
     fit: &GmwmFit,
@@ -311,7 +311,7 @@ pub fn infer_with_covariance(
 ) -> Result<Inference, FitError> {
     let levels = fit.nu_hat.len();
     if v.nrows() != levels || v.ncols() != levels {
-        return Err(Error::from(ParamError::new(
+        return Err(FitError::from(ParamError::new(
             "v",
             format!("{} x {}", v.nrows(), v.ncols()),
             format!("a {levels} x {levels} covariance (one row per level of the fit)"),
@@ -343,7 +343,7 @@ fn infer_impl(
     given_v: Option<(&DMatrix<f64>, usize)>,
 ) -> Result<Inference, FitError> {
     crate::fit::check_haar(wv_opts.filter)?;
-    let z = z_value(opts.alpha, opts.z).map_err(Error::from)?;
+    let z = z_value(opts.alpha, opts.z)?;
     let levels = fit.nu_hat.len();
     let p = fit.theta.len();
     let wv_opts = WvOptions {
@@ -521,7 +521,7 @@ fn bootstrap_v(
 ) -> Result<(DMatrix<f64>, usize), FitError> {
     let h = opts.v_replicates;
     if h < 2 {
-        return Err(Error::from(ParamError::new(
+        return Err(FitError::from(ParamError::new(
             "v_replicates",
             h,
             "must be at least 2 for a covariance",
@@ -539,7 +539,7 @@ fn bootstrap_v(
         opts.seed,
         |_, wv, _| {
             progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
-            Ok::<_, Error>(wv.wv.clone())
+            Ok::<_, crate::InputError>(wv.wv.clone())
         },
     )?;
     let v = WvBootstrap::from_samples(&samples)?.cov;

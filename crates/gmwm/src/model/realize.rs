@@ -2,7 +2,7 @@
 //! implied Haar wavelet variance and the derivatives with respect to theta (§4.1–§4.6).
 
 use super::{Component, Model, ProcessKind};
-use crate::error::{check_freq, Error, ParamError};
+use crate::error::{check_freq, InputError, ParamError};
 use crate::process::{Ar1, Arma, Arma11, Dr, Gm, LatentProcess, Ma1, Process, Qn, Rw, Wn};
 use serde::Serialize;
 use std::fmt;
@@ -14,7 +14,7 @@ impl Component {
     /// # Errors
     /// [`ParamError`] naming the first missing value, or the process constructor's error for an
     /// invalid one (e.g. a non-stationary AR polynomial).
-    pub fn process(&self, freq_hz: f64) -> Result<Process, Error> {
+    pub fn process(&self, freq_hz: f64) -> Result<Process, InputError> {
         let names = self.kind.param_names();
         let v: Vec<f64> = self
             .values
@@ -53,7 +53,7 @@ impl Model {
     ///
     /// # Errors
     /// As [`Component::process`].
-    pub fn processes(&self, freq_hz: f64) -> Result<Vec<Process>, Error> {
+    pub fn processes(&self, freq_hz: f64) -> Result<Vec<Process>, InputError> {
         check_freq(freq_hz)?;
         self.components()
             .iter()
@@ -66,7 +66,7 @@ impl Model {
     ///
     /// # Errors
     /// As [`Model::processes`]; `levels` must be in 1..=60.
-    pub fn implied_wv(&self, levels: usize, freq_hz: f64) -> Result<ImpliedWv, Error> {
+    pub fn implied_wv(&self, levels: usize, freq_hz: f64) -> Result<ImpliedWv, InputError> {
         check_levels(levels)?;
         let processes = self.processes(freq_hz)?;
         let per: Vec<ComponentWv> = self
@@ -97,7 +97,7 @@ impl Model {
     ///
     /// # Errors
     /// As [`Model::implied_wv`].
-    pub fn jacobian(&self, levels: usize, freq_hz: f64) -> Result<Vec<Vec<f64>>, Error> {
+    pub fn jacobian(&self, levels: usize, freq_hz: f64) -> Result<Vec<Vec<f64>>, InputError> {
         check_levels(levels)?;
         let blocks: Vec<Vec<Vec<f64>>> = self
             .processes(freq_hz)?
@@ -119,7 +119,7 @@ impl Model {
     ///
     /// # Errors
     /// As [`Model::implied_wv`].
-    pub fn hessian(&self, levels: usize, freq_hz: f64) -> Result<Vec<Vec<Vec<f64>>>, Error> {
+    pub fn hessian(&self, levels: usize, freq_hz: f64) -> Result<Vec<Vec<Vec<f64>>>, InputError> {
         check_levels(levels)?;
         let p = self.n_params();
         let mut out = vec![vec![vec![0.0; p]; p]; levels];

@@ -190,13 +190,19 @@ pub enum SelectionError {
         #[source]
         source: Box<SelectionError>,
     },
-    /// An engine computation failed (WV of the series, bootstrap of V).
+    /// A computation the selection builds on could not run: the series, a parameter or the model is
+    /// unusable.
     #[error(transparent)]
-    Engine(Box<crate::Error>),
+    Input(#[from] crate::InputError),
 }
 
-impl From<crate::Error> for SelectionError {
-    fn from(e: crate::Error) -> Self {
-        SelectionError::Engine(Box::new(e))
-    }
+macro_rules! input_error_from {
+    ($($t:ty),*) => {$(
+        impl From<$t> for SelectionError {
+            fn from(e: $t) -> Self {
+                SelectionError::Input(e.into())
+            }
+        }
+    )*};
 }
+input_error_from!(crate::ParamError, crate::SeriesError, crate::model::ModelError);

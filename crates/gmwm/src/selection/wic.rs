@@ -318,8 +318,8 @@ impl Wic {
         progress: &dyn Progress,
     ) -> Result<ModelSelection, SelectionError> {
         self.check_settings()?;
-        check_freq(freq_hz).map_err(crate::Error::from)?;
-        crate::fit::check_haar(self.wv_options.filter).map_err(crate::Error::from)?;
+        check_freq(freq_hz)?;
+        check_haar(self.wv_options.filter)?;
         let wv = wavelet_variance(x, freq_hz, &self.wv_options)?;
         self.select_from(&wv, StartInputs::from_series(x), progress)
     }
@@ -348,8 +348,8 @@ impl Wic {
         progress: &dyn Progress,
     ) -> Result<ModelSelection, SelectionError> {
         self.check_settings()?;
-        check_freq(wv.freq_hz).map_err(crate::Error::from)?;
-        crate::fit::check_haar(wv.filter).map_err(crate::Error::from)?;
+        check_freq(wv.freq_hz)?;
+        check_haar(wv.filter)?;
         self.select_from(wv, StartInputs::from_wv(wv), progress)
     }
 
@@ -1075,4 +1075,15 @@ impl fmt::Display for ModelSelection {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.table(0))
     }
+}
+
+/// Refuses a wavelet variance with another filter than Haar: every implied WV is the Haar one
+/// (METHODS §1.8, §4), as [`crate::fit::FitError::NotHaar`] says for a single fit.
+fn check_haar(filter: crate::WaveletFilter) -> Result<(), SelectionError> {
+    crate::fit::check_haar(filter).map_err(|_| SelectionError::Setting {
+        name: "filter",
+        value: filter.to_string(),
+        expected: "haar: every model's implied wavelet variance is the Haar one (METHODS §1.8, \
+                   §4); other filters are for display only",
+    })
 }

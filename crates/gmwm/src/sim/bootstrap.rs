@@ -10,7 +10,7 @@
 //! thread count or on the order in which rayon runs the replicates. Each worker thread reuses
 //! one series buffer: memory is `threads x N` samples plus what the caller keeps per replicate.
 
-use crate::error::{Error, ParamError};
+use crate::error::{InputError, ParamError};
 use crate::model::Model;
 use crate::sim::{replicate_seed, Simulator};
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
@@ -36,11 +36,11 @@ pub fn map_replicates<T, E, F>(
 ) -> Result<Vec<T>, E>
 where
     T: Send,
-    E: From<Error> + Send,
+    E: From<InputError> + Send,
     F: Fn(usize, &WaveletVariance, &[f64]) -> Result<T, E> + Sync + Send,
 {
     if replicates == 0 {
-        return Err(Error::from(ParamError::new(
+        return Err(InputError::from(ParamError::new(
             "replicates",
             replicates,
             "must be at least 1",
@@ -48,7 +48,7 @@ where
         .into());
     }
     if n == 0 {
-        return Err(Error::from(ParamError::new("n", n, "must be at least 1")).into());
+        return Err(InputError::from(ParamError::new("n", n, "must be at least 1")).into());
     }
     // fail early (and once) on a model that cannot be simulated
     Simulator::for_model(model, freq_hz, seed).map_err(E::from)?;
@@ -82,7 +82,7 @@ impl WvBootstrap {
     ///
     /// # Errors
     /// [`ParamError`] when fewer than two vectors are given or their lengths differ.
-    pub fn from_samples(samples: &[Vec<f64>]) -> Result<Self, Error> {
+    pub fn from_samples(samples: &[Vec<f64>]) -> Result<Self, InputError> {
         let h = samples.len();
         if h < 2 {
             return Err(
@@ -135,7 +135,7 @@ pub fn wv_bootstrap(
     wv_opts: &WvOptions,
     replicates: usize,
     seed: u64,
-) -> Result<WvBootstrap, Error> {
+) -> Result<WvBootstrap, InputError> {
     if replicates < 2 {
         return Err(ParamError::new(
             "replicates",
@@ -145,7 +145,7 @@ pub fn wv_bootstrap(
         .into());
     }
     let samples = map_replicates(model, n, freq_hz, wv_opts, replicates, seed, |_, wv, _| {
-        Ok::<_, Error>(wv.wv.clone())
+        Ok::<_, InputError>(wv.wv.clone())
     })?;
     WvBootstrap::from_samples(&samples)
 }

@@ -1,7 +1,7 @@
 //! The built-in demo sensor behind `gmwm demo`: a known truth to simulate, analyse and (once
 //! estimation lands) recover (METHODS §5.10, §10).
 
-use crate::error::Error;
+use crate::error::InputError;
 use crate::model::Model;
 use serde::Serialize;
 
@@ -40,7 +40,7 @@ impl DemoSensor {
     ///
     /// # Errors
     /// `n == 0`.
-    pub fn simulate(&self, n: usize, seed: u64) -> Result<Vec<f64>, Error> {
+    pub fn simulate(&self, n: usize, seed: u64) -> Result<Vec<f64>, InputError> {
         super::simulate_model(&self.model, n, self.freq_hz, seed)
     }
 }

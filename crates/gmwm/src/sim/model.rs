@@ -3,7 +3,7 @@
 //! summed by one [`Simulator`].
 
 use super::{Generator, Simulator};
-use crate::error::Error;
+use crate::error::InputError;
 use crate::model::Model;
 use crate::process::Process;
 
@@ -50,7 +50,7 @@ impl Simulator {
     ///
     /// # Errors
     /// A model that is not fully specified or has invalid values ([`Model::processes`]).
-    pub fn for_model(model: &Model, freq_hz: f64, seed: u64) -> Result<Self, Error> {
+    pub fn for_model(model: &Model, freq_hz: f64, seed: u64) -> Result<Self, InputError> {
         let generators = model
             .processes(freq_hz)?
             .iter()
@@ -64,7 +64,7 @@ impl Simulator {
 ///
 /// # Errors
 /// As [`Simulator::for_model`]; `n` must be at least 1.
-pub fn simulate_model(model: &Model, n: usize, freq_hz: f64, seed: u64) -> Result<Vec<f64>, Error> {
+pub fn simulate_model(model: &Model, n: usize, freq_hz: f64, seed: u64) -> Result<Vec<f64>, InputError> {
     if n == 0 {
         return Err(crate::error::ParamError::new("n", n, "must be at least 1").into());
     }

@@ -27,7 +27,7 @@
 //! O(N) per cluster length through prefix sums (and prefix sums of prefix sums for the modified
 //! AV), O(N log N) for all octaves; cluster lengths are computed in parallel with rayon.
 
-use crate::error::{check_series, Error, ParamError, SeriesError};
+use crate::error::{check_series, InputError, ParamError, SeriesError};
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, interval_unchecked};
 use rayon::prelude::*;
@@ -321,7 +321,7 @@ pub fn allan_variance(
     x: &[f64],
     freq_hz: f64,
     opts: &AllanOptions,
-) -> Result<AllanVariance, Error> {
+) -> Result<AllanVariance, InputError> {
     check_series(x)?;
     crate::error::check_freq(freq_hz)?;
     check_alpha(opts.alpha)?;

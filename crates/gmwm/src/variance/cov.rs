@@ -1,6 +1,6 @@
 //! Asymptotic diagonal covariance of the wavelet variance ("diag", Percival 1995; METHODS §1.10).
 
-use crate::error::{check_series, Error};
+use crate::error::{check_series, InputError};
 use crate::wavelet::{Modwt, WaveletFilter};
 use rustfft::{num_complex::Complex, FftPlanner};
 use serde::{Deserialize, Serialize};
@@ -52,7 +52,7 @@ pub fn wv_diag_covariance(
     filter: WaveletFilter,
     levels: usize,
     divisor: DiagDivisor,
-) -> Result<Vec<f64>, Error> {
+) -> Result<Vec<f64>, InputError> {
     check_series(x)?;
     let coefs = Modwt::new(filter, levels)?.transform(x)?;
     let n1 = coefs.kept(1).len() as f64;

@@ -13,7 +13,7 @@
 //!    [`LONG_MIN`](crate::variance::robust::LONG_MIN), the level's coefficients are collected
 //!    and [`robust_scale`] decides — the direct route, same root.
 
-use crate::error::{Error, SeriesError};
+use crate::error::{InputError, SeriesError};
 use crate::math::sum::NeumaierSum;
 use crate::variance::haar::{haar_pass, LevelSink};
 use crate::variance::robust::{
@@ -72,7 +72,7 @@ pub(crate) fn haar_robust_levels(
     levels: usize,
     offset: f64,
     c: f64,
-) -> Vec<(f64, Result<f64, Error>, usize)> {
+) -> Vec<(f64, Result<f64, InputError>, usize)> {
     use rayon::prelude::*;
     let n = x.len();
     let a = a_of_c(c);
@@ -106,7 +106,7 @@ pub(crate) fn haar_robust_levels(
             None => LevelState::Collect(Vec::new()),
         })
         .collect();
-    let mut results: Vec<Option<(f64, Result<f64, Error>)>> = (0..levels).map(|_| None).collect();
+    let mut results: Vec<Option<(f64, Result<f64, InputError>)>> = (0..levels).map(|_| None).collect();
     for round in 0..=WINDOW_SLIDES {
         if states.iter().all(|s| matches!(s, LevelState::Idle)) {
             break;

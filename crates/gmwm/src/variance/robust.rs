@@ -15,7 +15,7 @@
 //! Callers compute `c` once per call ([`tuning_constant`]) and pass it to [`robust_scale`] for
 //! every level.
 
-use crate::error::{Error, ParamError, SeriesError};
+use crate::error::{InputError, ParamError, SeriesError};
 use crate::math::brent::{find_root, minimize, OPTIMIZE_TOL};
 use crate::math::sum::NeumaierSum;
 use serde::{Deserialize, Serialize};
@@ -402,7 +402,7 @@ pub(crate) const FIXED_POINT_MAX_ITER: usize = 500;
 /// let s2 = robust_scale(&y, 4.400278, RobustConvention::Exact).unwrap();
 /// assert!((s2 - 0.6909524).abs() < 1e-6);
 /// ```
-pub fn robust_scale(y: &[f64], c: f64, convention: RobustConvention) -> Result<f64, Error> {
+pub fn robust_scale(y: &[f64], c: f64, convention: RobustConvention) -> Result<f64, InputError> {
     check_c(c)?;
     if y.is_empty() {
         return Err(SeriesError::Empty.into());
@@ -442,7 +442,7 @@ fn median_abs(y: &[f64]) -> f64 {
     }
 }
 
-fn scale_exact(y: &[f64], c: f64, a: f64) -> Result<f64, Error> {
+fn scale_exact(y: &[f64], c: f64, a: f64) -> Result<f64, InputError> {
     let mad = median_abs(y);
     // Quantised sensors give many exactly-zero coefficients at fine levels: with more than half
     // of them zero the MAD is 0 and only serves as no start; the root-mean-square then starts
@@ -520,7 +520,7 @@ const U_POWER_MAX: f64 = 0.36;
 // The standalone route, kept as the reference the per-level passes of `haar_robust` follow and
 // tested against the direct root.
 #[cfg_attr(not(test), allow(dead_code))]
-pub(crate) fn robust_scale_long(y: &[f64], c: f64) -> Result<f64, Error> {
+pub(crate) fn robust_scale_long(y: &[f64], c: f64) -> Result<f64, InputError> {
     check_c(c)?;
     let n = y.len();
     if n < LONG_MIN {
@@ -802,7 +802,7 @@ impl PowerWindow {
     /// Brent–Dekker to 1e-14 relative in `s` (METHODS §2.4), or, when `h` does not go from `+`
     /// to `-` across it, the next window towards the root in the direction the fixed point
     /// moves (down where `h(lo) <= 0`, up otherwise), twice as wide.
-    pub(crate) fn solve(&self, a: f64, lo: f64, hi: f64) -> Result<WindowOutcome, Error> {
+    pub(crate) fn solve(&self, a: f64, lo: f64, hi: f64) -> Result<WindowOutcome, InputError> {
         let h = |s: f64| self.mean_psi2(s) - a;
         let (h_lo, h_hi) = (h(lo), h(hi));
         if h_lo > 0.0 && h_hi <= 0.0 {
@@ -861,7 +861,7 @@ const S_ROOT_RTOL: f64 = 1e-14;
 /// down-crossing (`h > 0` below, `h <= 0` above; the root the fixed point is attracted to)
 /// nearest `s0`. `h < 0` both for `s -> 0` and `s -> inf`.
 #[cold]
-fn scale_exact_bracketed(y: &[f64], c: f64, a: f64, s0: f64) -> Result<f64, Error> {
+fn scale_exact_bracketed(y: &[f64], c: f64, a: f64, s0: f64) -> Result<f64, InputError> {
     let h = |s: f64| mean_psi2(y, 1.0 / s, c) - a;
     let mut bracket = None;
     let mut best_distance = i32::MAX;
@@ -899,7 +899,7 @@ fn scale_exact_bracketed(y: &[f64], c: f64, a: f64, s0: f64) -> Result<f64, Erro
 /// Upper end of the package's search interval for `s2 = s^2 / var(y)` (METHODS §2.4 step 2).
 const PACKAGE_S2_MAX: f64 = 2.0;
 
-fn scale_package(y: &[f64], c: f64, a: f64) -> Result<f64, Error> {
+fn scale_package(y: &[f64], c: f64, a: f64) -> Result<f64, InputError> {
     let n = y.len();
     if n < 2 {
         return Err(SeriesError::TooShort {

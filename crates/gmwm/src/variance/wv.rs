@@ -5,7 +5,7 @@
 //! [`HaarWvAccumulator`], a streaming O(N·J) pass that never stores the coefficients and can
 //! consume its input in chunks.
 
-use crate::error::{check_finite, check_freq, check_series, Error, ParamError, SeriesError};
+use crate::error::{check_finite, check_freq, check_series, InputError, ParamError, SeriesError};
 use crate::math::special::trigamma;
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, eta3, interval_unchecked};
@@ -319,7 +319,7 @@ fn level_fits(
 }
 
 /// Validates a requested level count against the series length.
-fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<(), Error> {
+fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<(), InputError> {
     if levels == 0 || levels > MAX_LEVELS {
         return Err(
             ParamError::new("levels", levels, format!("must be in 1..={MAX_LEVELS}")).into(),
@@ -367,7 +367,7 @@ pub fn wavelet_variance(
     x: &[f64],
     freq_hz: f64,
     opts: &WvOptions,
-) -> Result<WaveletVariance, Error> {
+) -> Result<WaveletVariance, InputError> {
     if x.len() == 1 {
         return Err(SeriesError::TooShort {
             n: 1,
@@ -378,7 +378,7 @@ pub fn wavelet_variance(
     }
     let n = x.len();
     // Checks that do not read the data first; a series error still takes precedence over them.
-    let params = (|| -> Result<usize, Error> {
+    let params = (|| -> Result<usize, InputError> {
         check_alpha(opts.alpha)?;
         check_freq(freq_hz)?;
         // With no level keeping two coefficients, ask for one so that check_levels reports the
@@ -440,14 +440,14 @@ pub fn wavelet_variance(
             let robust = match (c, opts.robust) {
                 (Some(c), Some(r)) => match robust_scale(kept, c, r.convention) {
                     Ok(s2) => Some(s2 / scale),
-                    Err(Error::Series(SeriesError::NoRobustScale { .. })) => Some(f64::NAN),
+                    Err(InputError::Series(SeriesError::NoRobustScale { .. })) => Some(f64::NAN),
                     Err(e) => return Err(e),
                 },
                 _ => None,
             };
             Ok((mean_square(kept) / scale, robust, kept.len()))
         })
-        .collect::<Result<_, Error>>()?;
+        .collect::<Result<_, InputError>>()?;
     from_levels(n, freq_hz, opts, &per_level)
 }
 
@@ -459,7 +459,7 @@ fn from_levels(
     freq_hz: f64,
     opts: &WvOptions,
     per_level: &[(f64, Option<f64>, usize)],
-) -> Result<WaveletVariance, Error> {
+) -> Result<WaveletVariance, InputError> {
     let classical: Vec<f64> = per_level.iter().map(|l| l.0).collect();
     check_finite_result(&classical, "wavelet variance")?;
     let robust: Vec<f64> = per_level.iter().filter_map(|l| l.1).collect();
@@ -493,7 +493,7 @@ fn haar_robust_in_memory(
     levels: usize,
     freq_hz: f64,
     opts: &WvOptions,
-) -> Result<WaveletVariance, Error> {
+) -> Result<WaveletVariance, InputError> {
     let n = x.len();
     let r = opts.robust.expect("robust options");
     let c = tuning_constant(r.eff, r.convention)?;
@@ -504,12 +504,12 @@ fn haar_robust_in_memory(
         .map(|(classical, robust, kept)| {
             let robust = match robust {
                 Ok(s2) => s2,
-                Err(Error::Series(SeriesError::NoRobustScale { .. })) => f64::NAN,
+                Err(InputError::Series(SeriesError::NoRobustScale { .. })) => f64::NAN,
                 Err(e) => return Err(e),
             };
             Ok((classical, Some(robust), kept))
         })
-        .collect::<Result<Vec<_>, Error>>()?;
+        .collect::<Result<Vec<_>, InputError>>()?;
     from_levels(n, freq_hz, opts, &per_level)
 }
 
@@ -745,7 +745,7 @@ impl HaarWvAccumulator {
     /// # Errors
     /// [`SeriesError`] when nothing was pushed, the series is constant, or it is too short for
     /// the levels requested; [`ParamError`] for a bad `freq_hz` or `alpha`.
-    pub fn finish(self, freq_hz: f64, alpha: f64) -> Result<WaveletVariance, Error> {
+    pub fn finish(self, freq_hz: f64, alpha: f64) -> Result<WaveletVariance, InputError> {
         check_alpha(alpha)?;
         check_freq(freq_hz)?;
         let n = self.n as usize;
@@ -796,7 +796,7 @@ fn haar_wv_in_memory(
     levels: usize,
     freq_hz: f64,
     alpha: f64,
-) -> Result<WaveletVariance, Error> {
+) -> Result<WaveletVariance, InputError> {
     let first = x[0];
     if first.is_finite() && x.iter().all(|&v| v == first) {
         return Err(SeriesError::Constant { value: first }.into());
@@ -842,7 +842,7 @@ fn haar_wv_parallel(
     levels: usize,
     freq_hz: f64,
     alpha: f64,
-) -> Result<WaveletVariance, Error> {
+) -> Result<WaveletVariance, InputError> {
     use rayon::prelude::*;
     let n = x.len();
     let offset = mean(x);
@@ -859,7 +859,7 @@ fn haar_wv_parallel(
             acc.push(&x[bounds[p]..bounds[p + 1]])?;
             Ok(acc)
         })
-        .collect::<Result<_, Error>>()?;
+        .collect::<Result<_, InputError>>()?;
     let mut parts = partial.into_iter();
     let mut total = parts.next().expect("at least one part");
     for part in parts {

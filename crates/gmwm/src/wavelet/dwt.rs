@@ -1,6 +1,6 @@
 //! Decimated DWT by the pyramid algorithm, periodic boundary (METHODS §1.4).
 
-use crate::error::{Error, ParamError, SeriesError};
+use crate::error::{InputError, ParamError, SeriesError};
 
 use super::filter::Taps;
 use super::{
@@ -65,7 +65,7 @@ impl Dwt {
     /// [`ParamError`] named `levels` if `2^J` does not divide `n` (the message gives the largest
     /// valid `J` and the nearest valid lengths); [`SeriesError::TooShort`] naming the first level
     /// without a boundary-free coefficient.
-    pub fn check_len(&self, n: usize) -> Result<(), Error> {
+    pub fn check_len(&self, n: usize) -> Result<(), InputError> {
         if n == 0 {
             return Err(SeriesError::Empty.into());
         }
@@ -97,7 +97,7 @@ impl Dwt {
     ///
     /// # Errors
     /// As [`check_len`](Self::check_len).
-    pub fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, Error> {
+    pub fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, InputError> {
         let mut out = WaveletCoefficients::default();
         self.transform_with_scratch(x, &mut out, &mut WaveletScratch::new())?;
         Ok(out)
@@ -118,7 +118,7 @@ impl Dwt {
         x: &[f64],
         out: &mut WaveletCoefficients,
         scratch: &mut WaveletScratch,
-    ) -> Result<(), Error> {
+    ) -> Result<(), InputError> {
         self.check_len(x.len())?;
         let n = x.len();
         let taps = Taps::new(self.filter, 1.0);

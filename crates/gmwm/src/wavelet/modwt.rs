@@ -1,6 +1,6 @@
 //! Maximal-overlap DWT by the pyramid algorithm, periodic boundary (METHODS §1.2, §1.3).
 
-use crate::error::{Error, ParamError, SeriesError};
+use crate::error::{InputError, ParamError, SeriesError};
 
 use super::filter::Taps;
 use super::{
@@ -85,7 +85,7 @@ impl Modwt {
     ///
     /// # Errors
     /// As [`check_len`](Self::check_len).
-    pub fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, Error> {
+    pub fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, InputError> {
         let mut out = WaveletCoefficients::default();
         self.transform_with_scratch(x, &mut out, &mut WaveletScratch::new())?;
         Ok(out)
@@ -106,7 +106,7 @@ impl Modwt {
         x: &[f64],
         out: &mut WaveletCoefficients,
         scratch: &mut WaveletScratch,
-    ) -> Result<(), Error> {
+    ) -> Result<(), InputError> {
         self.check_len(x.len())?;
         let n = x.len();
         let len = self.filter.len();
