@@ -113,7 +113,7 @@ pub enum CalibError {
         /// Column.
         column: String,
         /// Cause.
-        source: SelectionError,
+        source: Box<SelectionError>,
     },
     /// Fitting or inference on one axis failed.
     #[error("column {column}: {source}")]
@@ -373,7 +373,7 @@ impl Calibration {
             .candidates_per_axis()
             .map_err(|source| CalibError::Selection {
                 column: axes[0].column.name.clone(),
-                source,
+                source: Box::new(source),
             })?;
         progress.start(axes.len() * per_axis);
         let done = AtomicUsize::new(0);
@@ -529,7 +529,7 @@ impl Calibration {
         let mut wic = Wic::nested(self.options.full_model.clone())
             .map_err(|source| CalibError::Selection {
                 column: column.to_string(),
-                source,
+                source: Box::new(source),
             })?
             .with_bootstrap(self.options.bootstrap)
             .with_seed(self.options.seed)
@@ -542,7 +542,7 @@ impl Calibration {
             .select_with_progress(x, freq_hz, progress)
             .map_err(|source| CalibError::Selection {
                 column: column.to_string(),
-                source,
+                source: Box::new(source),
             })?;
         let wv = selection.fit.empirical.clone().ok_or_else(|| {
             fit_error(FitError::Length {

@@ -636,20 +636,20 @@ impl GmwmFit {
     /// that fails to converge only makes its reduction fail the test.
     pub fn canonical_with(&self, limit: f64) -> Result<CanonicalModel, FitError> {
         if !(limit.is_finite() && limit >= 0.0) {
-            return Err(FitError::from(crate::ParamError::new(
+            return Err(crate::ParamError::new(
                 "separation limit",
                 limit,
                 "a finite number of standard errors >= 0",
-            ))
+            )
             .into());
         }
         let Some(wv) = &self.empirical else {
-            return Err(FitError::from(crate::ParamError::new(
+            return Err(crate::ParamError::new(
                 "fit",
                 "without an empirical wavelet variance",
                 "a fit that carries its WV (Gmwm::fit, fit_from_wv, fit_series, fit_wv): the \
                  separation is measured in that WV's noise",
-            ))
+            )
             .into());
         };
         let log_variance = wv.log_variance();
@@ -668,8 +668,7 @@ impl GmwmFit {
                     component: Component::new(
                         c.kind,
                         self.theta[at..at + n].iter().map(|&v| Some(v)).collect(),
-                    )
-                    ?,
+                    )?,
                     from: vec![i],
                 });
             } else {
@@ -762,9 +761,8 @@ impl GmwmFit {
             }
         }
         let terms_parts = canonical_order(terms_parts, freq);
-        let guess = |parts: &[Part]| {
-            Model::new(parts.iter().map(|p| Component::guess(p.kind())).collect())
-        };
+        let guess =
+            |parts: &[Part]| Model::new(parts.iter().map(|p| Component::guess(p.kind())).collect());
         let model = guess(&terms_parts)?;
         let reduced = guess(&canonical_order(state.parts.clone(), freq))?;
         let terms = terms_parts
@@ -952,8 +950,7 @@ impl GmwmFit {
                     component: Component::new(
                         c.kind,
                         fit.theta[at..at + n].iter().map(|&v| Some(v)).collect(),
-                    )
-                    ?,
+                    )?,
                     from: p.from,
                 });
             }
@@ -976,11 +973,11 @@ impl GmwmFit {
 }
 
 fn bad_value(what: &str, value: f64) -> FitError {
-    FitError::from(crate::ParamError::new(
+    crate::ParamError::new(
         "canonical model",
         value,
         format!("a positive finite {what} variance"),
-    ))
+    )
     .into()
 }
 
@@ -1000,9 +997,7 @@ fn falls_everywhere(implied: &ImpliedWv, k: usize) -> bool {
 
 /// The model of the parts, with their values.
 fn model_of(parts: &[Part]) -> Result<Model, crate::model::ModelError> {
-    Ok(Model::new(
-        parts.iter().map(|p| p.component.clone()).collect(),
-    )?)
+    Model::new(parts.iter().map(|p| p.component.clone()).collect())
 }
 
 /// Canonical term order: AR1/GM by decreasing correlation time (phi decreasing), then WN, QN,

@@ -114,11 +114,11 @@ pub fn sandwich(
     for k in 0..p {
         let x = b[(k, k)].sqrt();
         if !(x.is_finite() && x > 0.0) {
-            return Err(FitError::from(ParamError::new(
+            return Err(ParamError::new(
                 "theta",
                 k,
                 "has no influence on the implied WV at the estimate, so its variance is not identified",
-            ))
+            )
             .into());
         }
         s.push(x);

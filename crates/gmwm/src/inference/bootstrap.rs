@@ -110,11 +110,11 @@ pub fn fit_bootstrap(
         gof_draws,
     } = *settings;
     if replicates < 2 {
-        return Err(FitError::from(ParamError::new(
+        return Err(ParamError::new(
             "replicates",
             replicates,
             "must be at least 2 for a bootstrap covariance",
-        ))
+        )
         .into());
     }
     let levels = fit.nu_hat.len();

@@ -92,11 +92,11 @@ pub fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, Fit
         });
     }
     if levels <= p {
-        return Err(FitError::from(ParamError::new(
+        return Err(ParamError::new(
             "levels",
             levels,
             format!("the J-test needs more levels than the {p} parameters (df = J - p >= 1)"),
-        ))
+        )
         .into());
     }
     let weights = FullWeights::from_covariance(v)?;

@@ -311,11 +311,11 @@ pub fn infer_with_covariance(
 ) -> Result<Inference, FitError> {
     let levels = fit.nu_hat.len();
     if v.nrows() != levels || v.ncols() != levels {
-        return Err(FitError::from(ParamError::new(
+        return Err(ParamError::new(
             "v",
             format!("{} x {}", v.nrows(), v.ncols()),
             format!("a {levels} x {levels} covariance (one row per level of the fit)"),
-        ))
+        )
         .into());
     }
     let opts = InferenceOptions {
@@ -521,12 +521,9 @@ fn bootstrap_v(
 ) -> Result<(DMatrix<f64>, usize), FitError> {
     let h = opts.v_replicates;
     if h < 2 {
-        return Err(FitError::from(ParamError::new(
-            "v_replicates",
-            h,
-            "must be at least 2 for a covariance",
-        ))
-        .into());
+        return Err(
+            ParamError::new("v_replicates", h, "must be at least 2 for a covariance").into(),
+        );
     }
     let done = AtomicUsize::new(0);
     progress.start(h);

@@ -64,7 +64,12 @@ impl Simulator {
 ///
 /// # Errors
 /// As [`Simulator::for_model`]; `n` must be at least 1.
-pub fn simulate_model(model: &Model, n: usize, freq_hz: f64, seed: u64) -> Result<Vec<f64>, InputError> {
+pub fn simulate_model(
+    model: &Model,
+    n: usize,
+    freq_hz: f64,
+    seed: u64,
+) -> Result<Vec<f64>, InputError> {
     if n == 0 {
         return Err(crate::error::ParamError::new("n", n, "must be at least 1").into());
     }
