@@ -1,5 +1,6 @@
-//! Raw command-line arguments (clap derive). Validation into engine types happens in
-//! `config.rs`-style helpers of each subcommand, before any heavy work.
+//! Raw command-line arguments: the clap definition only (derive structs, value enums, and the
+//! value parsers that refuse a value outside its domain with a usage error). `config.rs` turns
+//! them into one validated configuration per subcommand, in `main`, before any file is read.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;

@@ -1,11 +1,10 @@
-//! Turning `InputArgs` into engine read options and loaded columns, and printing what the
+//! Reading the input an [`InputConfig`] names into loaded columns, and printing what the
 //! reader found (time column, skipped columns, warnings) once per file on stderr.
 
-use crate::args::{FormatArg, HeaderArg, InputArgs, TimeUnitArg, WvEstimatorArgs};
+use crate::config::InputConfig;
 use anyhow::{Context, Result};
 use gmwm::imu::{
-    is_wv_json, quote, read_table, read_wv_json, select_series, ColumnSelector, HeaderMode,
-    ImuRecordType, InputFormat, ReadOptions, ReadWarning, Table, TimeUnit,
+    is_wv_json, quote, read_table, read_wv_json, select_series, InputFormat, ReadWarning, Table,
 };
 use gmwm::WaveletVariance;
 use std::path::Path;
@@ -18,69 +17,10 @@ pub struct Loaded {
     pub freq_hz: f64,
 }
 
-/// `--columns` entries: all digits → a 1-based index, anything else a name.
-pub fn selector(text: &str) -> ColumnSelector {
-    match text.trim().parse::<usize>() {
-        Ok(i) => ColumnSelector::Index(i),
-        Err(_) => ColumnSelector::Name(text.trim().to_string()),
-    }
-}
-
-/// The engine format of `--format`.
-pub fn format(arg: FormatArg) -> InputFormat {
-    match arg {
-        FormatArg::Auto => InputFormat::Auto,
-        FormatArg::Csv => InputFormat::Csv,
-        FormatArg::Tsv => InputFormat::Tsv,
-        FormatArg::Imar => InputFormat::ImuRecord(ImuRecordType::Imar),
-        FormatArg::Ln200 => InputFormat::ImuRecord(ImuRecordType::Ln200),
-        FormatArg::Ln200ig => InputFormat::ImuRecord(ImuRecordType::Ln200Ig),
-        FormatArg::Ixsea => InputFormat::ImuRecord(ImuRecordType::Ixsea),
-        FormatArg::NavchipInt => InputFormat::ImuRecord(ImuRecordType::NavchipInt),
-        FormatArg::NavchipFlt => InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
-        FormatArg::F64 => InputFormat::F64,
-        FormatArg::F32 => InputFormat::F32,
-    }
-}
-
-/// Checks the input flags and turns them into engine read options.
-pub fn options(args: &InputArgs) -> Result<ReadOptions> {
-    if let Some(f) = args.freq {
-        anyhow::ensure!(
-            f.is_finite() && f > 0.0,
-            "invalid --freq {f}: must be a positive number of hertz"
-        );
-    }
-    if let Some(k) = args.ncols {
-        anyhow::ensure!(
-            k >= 1,
-            "invalid --ncols 0: a binary file has at least one column"
-        );
-    }
-    Ok(ReadOptions {
-        format: format(args.format),
-        header: match args.header {
-            HeaderArg::Auto => HeaderMode::Auto,
-            HeaderArg::Yes => HeaderMode::Present,
-            HeaderArg::No => HeaderMode::Absent,
-        },
-        time_column: args.time_column.as_deref().map(selector),
-        time_unit: args.time_unit.map(|u| match u {
-            TimeUnitArg::S => TimeUnit::Seconds,
-            TimeUnitArg::Ms => TimeUnit::Milliseconds,
-            TimeUnitArg::Us => TimeUnit::Microseconds,
-            TimeUnitArg::Ns => TimeUnit::Nanoseconds,
-        }),
-        columns: args.columns.iter().map(|c| selector(c)).collect(),
-        ncols: args.ncols,
-        freq_hz: args.freq,
-    })
-}
-
 /// Whether FILE is a wavelet variance saved by `gmwm wv --json` (by name or content) rather
 /// than a recording; never with an explicit recording `--format`.
-pub fn is_wv(args: &InputArgs) -> bool {
-    args.format == FormatArg::Auto && is_wv_json(&args.file)
+pub fn is_wv(input: &InputConfig) -> bool {
+    input.read.format == InputFormat::Auto && is_wv_json(&input.file)
 }
 
 /// A rate for messages: 6 significant digits, trailing zeros dropped (`200`, `62.5`).
@@ -141,29 +81,29 @@ fn report(table: &Table) {
     }
 }
 
-/// Reads the file named by `args`; the rate comes from `--freq`, else the file (time column or
-/// sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in samples).
-/// The reader's notes and warnings are printed on stderr.
-pub fn load(args: &InputArgs) -> Result<Loaded> {
-    let opts = options(args)?;
-    if args.format == FormatArg::Auto && gmwm::imu::ros::container_of(&args.file).is_some() {
-        return load_ros(args, opts);
+/// Reads the file named by `input`; the rate comes from `--freq`, else the file (time column
+/// or sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in
+/// samples). The reader's notes and warnings are printed on stderr.
+pub fn load(input: &InputConfig) -> Result<Loaded> {
+    if input.read.format == InputFormat::Auto && gmwm::imu::ros::container_of(&input.file).is_some()
+    {
+        return load_ros(input);
     }
-    if let Some(topic) = &args.topic {
+    if let Some(topic) = &input.topic {
         return Err(crate::UsageError(format!(
             "invalid --topic {topic}: {} is not a ROS recording (ROS1 bag, MCAP, rosbag2 sqlite3)",
-            args.file.display()
+            input.file.display()
         ))
         .into());
     }
-    let table = read_table(&args.file, &opts)?;
+    let table = read_table(&input.file, &input.read)?;
     report(&table);
-    let freq_hz = match args.freq.or(table.freq_hz) {
+    let freq_hz = match input.read.freq_hz.or(table.freq_hz) {
         Some(f) => f,
         None => {
             eprintln!(
                 "gmwm: warning: {}: no sampling rate (no --freq, time column or JSON sidecar); using 1 Hz, so tau_s is in samples",
-                args.file.display()
+                input.file.display()
             );
             1.0
         }
@@ -171,28 +111,18 @@ pub fn load(args: &InputArgs) -> Result<Loaded> {
     Ok(Loaded { table, freq_hz })
 }
 
-/// Refuses estimator flags that need the series when FILE is a saved wavelet variance: it is
-/// used as it is (robust if it says so).
-pub fn check_wv_estimator(file: &Path, e: &WvEstimatorArgs) -> Result<()> {
-    anyhow::ensure!(
-        !e.robust,
-        "{}: --robust needs the series; a wavelet-variance file is used as it is (robust if it says so)",
-        file.display()
-    );
-    anyhow::ensure!(
-        e.filter == "haar" && e.transform == crate::args::TransformArg::Modwt,
-        "{}: --filter/--transform apply to a recording; a wavelet-variance file is used as it is",
-        file.display()
-    );
-    Ok(())
-}
-
 /// Reads a saved wavelet variance: the series `--columns` selects (names or 1-based indices),
 /// the rate from `--freq` or the file, the first `levels` levels.
-pub fn load_wv(args: &InputArgs, levels: Option<usize>) -> Result<Vec<(String, WaveletVariance)>> {
-    let file = &args.file;
-    let selectors: Vec<ColumnSelector> = args.columns.iter().map(|c| selector(c)).collect();
-    let series = select_series(file, read_wv_json(file, args.freq)?, &selectors)?;
+pub fn load_wv(
+    input: &InputConfig,
+    levels: Option<usize>,
+) -> Result<Vec<(String, WaveletVariance)>> {
+    let file = &input.file;
+    let series = select_series(
+        file,
+        read_wv_json(file, input.read.freq_hz)?,
+        &input.read.columns,
+    )?;
     let Some(j) = levels else {
         return Ok(series);
     };
@@ -268,14 +198,14 @@ pub struct LoadedRecording {
     pub notes: Vec<String>,
 }
 
-/// Opens the recording named by `args` as an IMU (the engine's `Recording`: text, raw binary,
-/// binary IMU records or a ROS recording).
-pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
+/// Opens the recording named by `input` as an IMU (the engine's `Recording`: text, raw
+/// binary, binary IMU records or a ROS recording).
+pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
     let opts = gmwm::imu::RecordingOptions {
-        read: options(args)?,
-        topic: args.topic.clone(),
+        read: input.read.clone(),
+        topic: input.topic.clone(),
     };
-    let rec = gmwm::imu::Recording::open(&args.file, &opts)?;
+    let rec = gmwm::imu::Recording::open(&input.file, &opts)?;
     Ok(LoadedRecording {
         path: rec.path,
         imu: rec.imu,
@@ -287,16 +217,16 @@ pub fn load_recording(args: &InputArgs) -> Result<LoadedRecording> {
 }
 
 /// A ROS recording read as a table: the IMU topic's six axes at the header stamps' rate.
-fn load_ros(args: &InputArgs, read: ReadOptions) -> Result<Loaded> {
+fn load_ros(input: &InputConfig) -> Result<Loaded> {
     let rec = gmwm::imu::Recording::open(
-        &args.file,
+        &input.file,
         &gmwm::imu::RecordingOptions {
-            read,
-            topic: args.topic.clone(),
+            read: input.read.clone(),
+            topic: input.topic.clone(),
         },
     )?;
     for n in &rec.notes {
-        note(&args.file, n);
+        note(&input.file, n);
     }
     let freq_hz = rec.imu.freq_hz();
     let table = Table {

@@ -1,34 +1,40 @@
-//! `gmwm`: command-line front end of the gmwm engine. Parses flags, runs one subcommand,
-//! renders its result; no numerics of its own.
+//! `gmwm`: command-line front end of the gmwm engine. Parses flags, validates them once into
+//! the subcommand's configuration (`config.rs`), runs the subcommand, renders its result; no
+//! numerics of its own.
 //!
 //! Exit codes: 0 success, 1 input or computation error (one line on stderr), 2 usage error.
 
 mod args;
 mod cmd;
+mod config;
 mod input;
 mod progress;
 mod render;
 
-use args::{Cli, Command};
+use args::Cli;
 use clap::Parser;
+use config::Config;
 use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 
+/// Validates the flags into the subcommand's configuration, before any file is read, then
+/// runs it.
 fn run(cli: &Cli) -> anyhow::Result<()> {
+    let config = Config::try_from(&cli.command)?;
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
-    match &cli.command {
-        Command::Demo(a) => cmd::demo::run(a, &mut out)?,
-        Command::Wv(a) => cmd::wv::run(a, &mut out)?,
-        Command::Avar(a) => cmd::avar::run(a, &mut out)?,
-        Command::Simulate(a) => cmd::simulate::run(a, &mut out)?,
-        Command::Implied(a) => cmd::implied::run(a, &mut out)?,
-        Command::Fit(a) => cmd::fit::run(a, &mut out)?,
-        Command::Select(a) => cmd::select::run(a, &mut out)?,
-        Command::Calibrate(a) => cmd::calibrate::run(a, &mut out)?,
-        Command::Topics(a) => cmd::topics::run(a, &mut out)?,
-        Command::Plot(a) => cmd::plot::run(a, &mut out)?,
-        Command::Report(a) => cmd::report::run(a, &mut out)?,
+    match &config {
+        Config::Demo(c) => cmd::demo::run(c, &mut out)?,
+        Config::Wv(c) => cmd::wv::run(c, &mut out)?,
+        Config::Avar(c) => cmd::avar::run(c, &mut out)?,
+        Config::Simulate(c) => cmd::simulate::run(c, &mut out)?,
+        Config::Implied(c) => cmd::implied::run(c, &mut out)?,
+        Config::Fit(c) => cmd::fit::run(c, &mut out)?,
+        Config::Select(c) => cmd::select::run(c, &mut out)?,
+        Config::Calibrate(c) => cmd::calibrate::run(c, &mut out)?,
+        Config::Topics(c) => cmd::topics::run(c, &mut out)?,
+        Config::Plot(c) => cmd::plot::run(c, &mut out)?,
+        Config::Report(c) => cmd::report::run(c, &mut out)?,
     }
     out.flush()?;
     Ok(())

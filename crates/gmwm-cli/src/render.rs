@@ -1,13 +1,12 @@
 //! Rendering results: human table (default), JSON (`--json`) and CSV (`--csv`).
 //! Machine formats carry full precision and seconds; CSV and JSON come from the same fields.
 
-use crate::args::OutputArgs;
 use anyhow::Result;
 use gmwm::{AllanVariance, WaveletVariance};
 use serde::Serialize;
 use std::io::Write;
 
-/// Output style selected by the flags.
+/// Output style selected by the flags (`--json`, `--csv`; see [`crate::config::OutputConfig`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Style {
     /// Aligned human table.
@@ -16,18 +15,6 @@ pub enum Style {
     Json,
     /// CSV rows.
     Csv,
-}
-
-impl From<&OutputArgs> for Style {
-    fn from(o: &OutputArgs) -> Self {
-        if o.json {
-            Style::Json
-        } else if o.csv {
-            Style::Csv
-        } else {
-            Style::Table
-        }
-    }
 }
 
 /// A result tagged with the series (column) it belongs to.

@@ -1,100 +1,37 @@
 //! `gmwm calibrate`: the engine's calibration pipeline on a recording, a readable summary, and
 //! the files a navigation filter reads.
 
-use crate::args::{AxisPolicyArg, CalibrateArgs, RuleArg};
-use crate::cmd::wv::options;
+use crate::config::CalibrateConfig;
 use crate::progress::{bar, Ticks};
 use crate::UsageError;
 use anyhow::{Context, Result};
 use gmwm::calib::export::{render, ExportFormat};
 use gmwm::calib::{
-    Adjustment, AxisCalibration, AxisPolicy, Calibration, CalibrationOptions, CalibrationReport,
-    Estimate, EstimateStatus, NavSet, DEFAULT_FULL_MODEL,
+    AxisCalibration, Calibration, CalibrationReport, Estimate, EstimateStatus, NavSet,
 };
 use gmwm::selection::SelectionRule;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// The validated options from the flags.
-fn calibration_options(args: &CalibrateArgs) -> Result<CalibrationOptions> {
-    let wv = options(&args.estimator)?;
-    crate::cmd::fit::check_haar_flag(&args.estimator.filter, &wv)?;
-    let full_model = args
-        .model
-        .as_deref()
-        .unwrap_or(DEFAULT_FULL_MODEL)
-        .parse()?;
-    Ok(CalibrationOptions {
-        full_model,
-        wv,
-        bootstrap: args.bootstrap,
-        draws: args.draws,
-        seed: args.seed,
-        rule: match args.rule {
-            RuleArg::Navigation => SelectionRule::Navigation,
-            RuleArg::Parsimonious => SelectionRule::Parsimonious,
-            RuleArg::WicMinimum => SelectionRule::WicMinimum,
-        },
-        gyro_unit: args.gyro_unit,
-        accel_unit: args.accel_unit,
-        // the contamination check compares with the robust WV at --eff
-        robust_check: Some(gmwm::RobustOptions::new(
-            args.estimator.eff,
-            crate::cmd::wv::robust_convention(args.estimator.robust_convention),
-        )?),
-    })
-}
-
-/// The files to write: (stack, path), Kalibr first.
-fn exports(args: &CalibrateArgs) -> Result<Vec<(ExportFormat, PathBuf)>> {
-    let mut out = Vec::new();
-    if let Some(p) = &args.kalibr {
-        out.push((ExportFormat::Kalibr, p.clone()));
-    }
-    for pair in args.export.chunks(2) {
-        let [stack, file] = pair else {
-            return Err(UsageError("--export takes two values: STACK FILE".into()).into());
-        };
-        let format: ExportFormat = stack.parse().map_err(|_| {
-            UsageError(format!(
-                "invalid --export {stack}: one of kalibr, openvins, vins, orbslam3, px4"
-            ))
-        })?;
-        out.push((format, PathBuf::from(file)));
-    }
-    Ok(out)
-}
-
 /// Runs the subcommand.
-pub fn run(args: &CalibrateArgs, out: &mut impl Write) -> Result<()> {
-    execute(args, args.report.as_deref(), true, out)
+pub fn run(config: &CalibrateConfig, out: &mut impl Write) -> Result<()> {
+    execute(config, config.report.as_deref(), true, out)
 }
 
 /// The calibration, its files, and the HTML report when `report` names one; the summary is
 /// printed when `print_summary`, else only what was written.
 pub fn execute(
-    args: &CalibrateArgs,
+    config: &CalibrateConfig,
     report_path: Option<&Path>,
     print_summary: bool,
     out: &mut impl Write,
 ) -> Result<()> {
-    let options = calibration_options(args)?;
-    let exports = exports(args)?;
-    let adjustment = match (args.inflate, args.conservative) {
-        (Some(k), _) => Adjustment::inflate(k)?,
-        (None, true) => Adjustment::Conservative,
-        (None, false) => Adjustment::Estimate,
-    };
-    let policy = match args.axis_policy {
-        AxisPolicyArg::Worst => AxisPolicy::Worst,
-        AxisPolicyArg::Mean => AxisPolicy::Mean,
-        AxisPolicyArg::PerAxis => AxisPolicy::PerAxis,
-    };
-    let recording = crate::input::load_recording(&args.input)?;
+    let exports = &config.exports;
+    let recording = crate::input::load_recording(&config.input)?;
     if !exports.is_empty() {
-        check_units_known(args, &recording)?;
+        check_units_known(config, &recording)?;
     }
-    let calibration = Calibration::new(options);
+    let calibration = Calibration::new(config.options.clone());
     let per_axis = calibration.candidates_per_axis()?;
     let axes = recording.imu.axes().len();
     let progress = bar((axes * per_axis) as u64, "calibrating", "candidate fits");
@@ -104,12 +41,12 @@ pub fn execute(
     progress.finish_and_clear();
     // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
     // says so in a comment
-    let rostopic = args.rostopic.clone().or_else(|| recording.topic.clone());
-    let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
+    let rostopic = config.rostopic.clone().or_else(|| recording.topic.clone());
+    let sets = report.nav_sets(config.policy, config.adjustment, rostopic.as_deref());
     // every file that can be written is, then the failures are reported together
     let mut written = Vec::new();
     let mut failed = Vec::new();
-    for (format, path) in &exports {
+    for (format, path) in exports {
         for set in &sets {
             let target = per_axis_path(path, &set.label);
             let result = render(*format, &set.noise)
@@ -121,10 +58,10 @@ pub fn execute(
             }
         }
     }
-    let json_to_stdout = args.json.as_deref() == Some(Path::new("-"));
+    let json_to_stdout = config.json.as_deref() == Some(Path::new("-"));
     let doc = gmwm::document::calibration(&recording.path, &recording.notes, &report, &sets);
     if let Some(path) = report_path {
-        match write_report(args, path, &recording, &report, &sets, &exports, &doc) {
+        match write_report(config, path, &recording, &report, &sets, &doc) {
             Ok(figures) => written.push(format!(
                 "{} (HTML report, {figures} figures)",
                 path.display()
@@ -132,7 +69,7 @@ pub fn execute(
             Err(e) => failed.push(format!("{} (HTML report): {e:#}", path.display())),
         }
     }
-    if let Some(path) = &args.json {
+    if let Some(path) = &config.json {
         if json_to_stdout {
             serde_json::to_writer_pretty(&mut *out, &doc)?;
             writeln!(out)?;
@@ -163,17 +100,16 @@ pub fn execute(
 /// The HTML report: the calibration rendered by gmwm-plot with the filter files as exported
 /// (Kalibr's always, for the page, and every one asked for) and the JSON of `--json`; returns
 /// the number of figures.
-#[allow(clippy::too_many_arguments)]
 fn write_report(
-    args: &CalibrateArgs,
+    config: &CalibrateConfig,
     path: &Path,
     recording: &crate::input::LoadedRecording,
     report: &CalibrationReport,
     sets: &[NavSet],
-    exports: &[(ExportFormat, PathBuf)],
     doc: &serde_json::Value,
 ) -> Result<usize> {
-    let mut formats: Vec<(ExportFormat, Option<&Path>)> = exports
+    let mut formats: Vec<(ExportFormat, Option<&Path>)> = config
+        .exports
         .iter()
         .map(|(f, p)| (*f, Some(p.as_path())))
         .collect();
@@ -195,7 +131,7 @@ fn write_report(
         }
     }
     let ctx = gmwm_plot::report::ReportContext {
-        file: args.input.file.display().to_string(),
+        file: config.input.file.display().to_string(),
         source: match &recording.source {
             gmwm::imu::RecordingSource::Records { record_type } => {
                 format!("binary IMU records ({record_type})")
@@ -238,14 +174,15 @@ fn command_line() -> String {
 /// Exported files are SI: every gyroscope and accelerometer axis needs a unit the engine
 /// understands, from the recording or the flags; said before any computation.
 fn check_units_known(
-    args: &CalibrateArgs,
+    config: &CalibrateConfig,
     recording: &crate::input::LoadedRecording,
 ) -> Result<()> {
     use gmwm::imu::Sensor;
+    let options = &config.options;
     for a in recording.imu.axes() {
         let (given, flag) = match a.sensor() {
-            Sensor::Gyroscope => (args.gyro_unit.is_some(), "--gyro-unit rad/s|deg/s|deg/h"),
-            Sensor::Accelerometer => (args.accel_unit.is_some(), "--accel-unit m/s^2|g|mg"),
+            Sensor::Gyroscope => (options.gyro_unit.is_some(), "--gyro-unit rad/s|deg/s|deg/h"),
+            Sensor::Accelerometer => (options.accel_unit.is_some(), "--accel-unit m/s^2|g|mg"),
             _ => continue,
         };
         let known = a

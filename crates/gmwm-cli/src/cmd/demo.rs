@@ -2,8 +2,7 @@
 //! (METHODS §5.10), compute its wavelet variance, fit the truth's model structure
 //! `3*GM()+WN()+QN()+RW()` by GMWM in guess mode, and show truth against estimate.
 
-use crate::args::DemoArgs;
-use crate::cmd::wv::options;
+use crate::config::DemoConfig;
 use crate::render::Style;
 use anyhow::Result;
 use gmwm::model::ImpliedWv;
@@ -35,15 +34,11 @@ struct TruthVsEstimate {
 }
 
 /// Runs the subcommand.
-pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
-    let opts = options(&args.estimator)?;
-    anyhow::ensure!(
-        opts.filter == gmwm::WaveletFilter::Haar && opts.transform == gmwm::Transform::Modwt,
-        "gmwm demo compares with the implied WV of METHODS §4, which exists for the Haar MODWT only; drop --filter/--transform"
-    );
+pub fn run(config: &DemoConfig, out: &mut impl Write) -> Result<()> {
+    let opts = &config.wv;
     let sensor = DemoSensor::default();
-    let x = sensor.simulate(args.n, args.seed)?;
-    let wv = wavelet_variance(&x, sensor.freq_hz, &opts)?;
+    let x = sensor.simulate(config.n, config.seed)?;
+    let wv = wavelet_variance(&x, sensor.freq_hz, opts)?;
     let implied = sensor.model.implied_wv(wv.levels(), sensor.freq_hz)?;
     let started = std::time::Instant::now();
     let fit = Gmwm::new(sensor.model.without_values())
@@ -66,14 +61,14 @@ pub fn run(args: &DemoArgs, out: &mut impl Write) -> Result<()> {
     let report = DemoReport {
         truth: sensor.model.to_string(),
         freq_hz: sensor.freq_hz,
-        n: args.n,
-        seed: args.seed,
+        n: config.n,
+        seed: config.seed,
         empirical: &wv,
         implied: &implied,
         parameters,
         fit: &fit,
     };
-    match Style::from(&args.output) {
+    match config.output {
         Style::Json => {
             serde_json::to_writer_pretty(&mut *out, &report)?;
             writeln!(out)?;

@@ -1,34 +1,26 @@
 //! `gmwm fit`: GMWM estimation of a latent error model on each selected column (METHODS §5).
 
-use crate::args::{FitArgs, WeightsArg};
-use crate::cmd::wv::options;
-use crate::input::{analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv};
+use crate::config::FitConfig;
+use crate::input::{analyse_columns, column_context, is_wv, load, load_wv};
 use crate::progress::bar;
 use crate::render::Style;
-use crate::UsageError;
 use anyhow::Result;
 use gmwm::fit::{CanonicalModel, StartInputs};
 use gmwm::inference::{infer_with_progress, Inference, InferenceOptions};
-use gmwm::model::Model;
-use gmwm::{Gmwm, GmwmFit, WaveletFilter, WaveletVariance, Weighting, WvOptions};
+use gmwm::{GmwmFit, WaveletVariance};
 use rayon::prelude::*;
 use std::io::Write;
 
 /// Fits every series of a WV JSON file (`gmwm wv --json`) selected by `--columns` (names or
 /// 1-based indices).
-fn fit_wv_file(args: &FitArgs, gmwm: &Gmwm) -> Result<Vec<(String, GmwmFit)>> {
-    let file = &args.input.file;
-    check_wv_estimator(file, &args.estimator)?;
-    anyhow::ensure!(
-        args.weights != WeightsArg::Diag,
-        "{}: --weights diag needs the series; use fast or bootstrap with a wavelet-variance file",
-        file.display()
-    );
-    let series = load_wv(&args.input, args.estimator.levels)?;
+fn fit_wv_file(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
+    let file = &config.input.file;
+    config.saved_wv.check(file)?;
+    let series = load_wv(&config.input, config.wv.levels)?;
     let wvs: Vec<&WaveletVariance> = series.iter().map(|(_, w)| w).collect();
     let fits: Vec<_> = wvs
         .par_iter()
-        .map(|wv| gmwm.fit_from_wv(wv, StartInputs::from_wv(wv)))
+        .map(|wv| config.gmwm.fit_from_wv(wv, StartInputs::from_wv(wv)))
         .collect();
     series
         .iter()
@@ -42,76 +34,48 @@ fn fit_wv_file(args: &FitArgs, gmwm: &Gmwm) -> Result<Vec<(String, GmwmFit)>> {
         .collect()
 }
 
-/// The series length and WV settings behind a fit (for the bootstrap replicates).
-fn wv_options_of(fit: &GmwmFit) -> Result<(usize, WvOptions)> {
+/// METHODS §7 on one column's fit, at the series length and WV settings the fit carries, with
+/// a progress bar on a terminal.
+fn inference(
+    config: &FitConfig,
+    opts: &InferenceOptions,
+    column: &str,
+    fit: &GmwmFit,
+) -> Result<Inference> {
     let wv = fit
         .empirical
         .as_ref()
         .ok_or_else(|| anyhow::anyhow!("the fit carries no wavelet variance"))?;
-    Ok((wv.n, wv.options()))
-}
-
-/// METHODS §7 on one column's fit, with a progress bar on a terminal.
-fn inference(args: &FitArgs, gmwm: &Gmwm, column: &str, fit: &GmwmFit) -> Result<Inference> {
-    if let Some(b) = args.bootstrap {
-        anyhow::ensure!(b >= 2, "invalid --bootstrap {b}: at least 2 replicates");
-    }
-    let (n, wv_opts) = wv_options_of(fit)?;
-    let opts = InferenceOptions {
-        alpha: args.estimator.alpha,
-        bootstrap: args.bootstrap,
-        ..InferenceOptions::default()
-    };
-    let total = args.bootstrap.unwrap_or(opts.v_replicates) as u64;
+    let total = opts.bootstrap.unwrap_or(opts.v_replicates) as u64;
     let bar = bar(total, &format!("inference on {column}"), "replicates");
     let progress = |done: usize| bar.set_position(done as u64);
-    let result = infer_with_progress(gmwm, fit, n, &wv_opts, &opts, &progress);
+    let result = infer_with_progress(&config.gmwm, fit, wv.n, &wv.options(), opts, &progress);
     bar.finish_and_clear();
-    column_context(result.map_err(gmwm::Error::from), &args.input.file, column)
-}
-
-/// Refuses a non-Haar `--filter` for the estimation commands (fit, select): every model's
-/// implied WV is the Haar one (METHODS §1.8, §4); the engine refuses it too.
-pub fn check_haar_flag(name: &str, opts: &WvOptions) -> Result<()> {
-    if opts.filter != WaveletFilter::Haar {
-        return Err(UsageError(format!(
-            "invalid --filter {name}: every model's implied wavelet variance is the Haar one \
-             (METHODS §1.8, §4), so fits and selections use --filter haar (the default); other \
-             filters are for gmwm wv"
-        ))
-        .into());
-    }
-    Ok(())
+    column_context(
+        result.map_err(gmwm::Error::from),
+        &config.input.file,
+        column,
+    )
 }
 
 /// Runs the subcommand.
-pub fn run(args: &FitArgs, out: &mut impl Write) -> Result<()> {
-    let (gmwm, fits) = compute(args)?;
-    render_fits(args, &gmwm, &fits, out)
+pub fn run(config: &FitConfig, out: &mut impl Write) -> Result<()> {
+    let fits = compute(config)?;
+    render_fits(config, &fits, out)
 }
 
-/// The estimator from the flags and its fit on every selected column (convergence warnings
+/// The fit of the configured estimator on every selected column (convergence warnings
 /// printed).
-pub fn compute(args: &FitArgs) -> Result<(Gmwm, Vec<(String, GmwmFit)>)> {
-    let model: Model = args.model.parse()?;
-    let wv_opts = options(&args.estimator)?;
-    check_haar_flag(&args.estimator.filter, &wv_opts)?;
-    let mut gmwm = Gmwm::new(model).with_weighting(match args.weights {
-        WeightsArg::Fast => Weighting::Fast,
-        WeightsArg::Diag => Weighting::Diag,
-        WeightsArg::Bootstrap => Weighting::Bootstrap,
-    });
-    gmwm = gmwm.with_seed(args.seed);
-    if let Some(g) = args.draws {
-        anyhow::ensure!(g >= 1, "invalid --G 0: at least one starting-value draw");
-        gmwm = gmwm.with_draws(g);
-    }
-    let fits = if is_wv(&args.input) {
-        fit_wv_file(args, &gmwm)?
+pub fn compute(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
+    let file = &config.input.file;
+    let fits = if is_wv(&config.input) {
+        fit_wv_file(config)?
     } else {
-        let loaded = load(&args.input)?;
-        analyse_columns(&loaded, &args.input.file, |x| {
-            gmwm.fit(x, loaded.freq_hz, &wv_opts)
+        let loaded = load(&config.input)?;
+        analyse_columns(&loaded, file, |x| {
+            config
+                .gmwm
+                .fit(x, loaded.freq_hz, &config.wv)
                 .map_err(gmwm::Error::from)
         })?
     };
@@ -119,38 +83,33 @@ pub fn compute(args: &FitArgs) -> Result<(Gmwm, Vec<(String, GmwmFit)>)> {
         if !fit.convergence.converged {
             eprintln!(
                 "gmwm: warning: {}: column {name}: the optimiser did not converge ({})",
-                args.input.file.display(),
+                file.display(),
                 fit.convergence
             );
         }
     }
-    Ok((gmwm, fits))
+    Ok(fits)
 }
 
-fn render_fits(
-    args: &FitArgs,
-    gmwm: &Gmwm,
-    fits: &[(String, GmwmFit)],
-    out: &mut impl Write,
-) -> Result<()> {
+fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Write) -> Result<()> {
     let canonicals: Vec<CanonicalModel> = fits
         .par_iter()
         .map(|(column, fit)| {
             column_context(
                 fit.canonical().map_err(gmwm::Error::from),
-                &args.input.file,
+                &config.input.file,
                 column,
             )
         })
         .collect::<Result<_>>()?;
-    let inferences: Vec<Option<Inference>> = if args.inference {
-        fits.iter()
-            .map(|(column, fit)| inference(args, gmwm, column, fit).map(Some))
-            .collect::<Result<_>>()?
-    } else {
-        fits.iter().map(|_| None).collect()
+    let inferences: Vec<Option<Inference>> = match &config.inference {
+        Some(opts) => fits
+            .iter()
+            .map(|(column, fit)| inference(config, opts, column, fit).map(Some))
+            .collect::<Result<_>>()?,
+        None => fits.iter().map(|_| None).collect(),
     };
-    match Style::from(&args.output) {
+    match config.output {
         Style::Json => {
             let items: Vec<gmwm::document::FitItem<'_>> = fits
                 .iter()

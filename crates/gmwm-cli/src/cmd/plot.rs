@@ -1,20 +1,18 @@
 //! `gmwm plot`: one figure of the matching command's results (gmwm-plot renders; the numbers
 //! are those `gmwm wv|avar|fit|select --json` gives).
 
-use crate::args::{FigureArgs, InputArgs, KindArg, OutputArgs, PlotArgs, PlotCommand};
+use crate::config::{FigureConfig, InputConfig, PlotConfig, PlotKind};
 use crate::input::is_wv;
-use crate::UsageError;
 use anyhow::{Context, Result};
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{Sensor, SensorInfo};
 use gmwm::units::SignalUnit;
-use gmwm::{RobustOptions, WvOptions};
-use gmwm_plot::{Column, Figure, ImageFormat, Layout};
+use gmwm_plot::{Column, Figure};
 use std::io::Write;
 
 /// The unit of each column for axis labels and legends: the one its name or the sidecar
 /// states (SI for ROS recordings and binary IMU records), as its symbol; `u` when unknown.
-fn column_units(input: &InputArgs, names: &[String]) -> Vec<String> {
+fn column_units(input: &InputConfig, names: &[String]) -> Vec<String> {
     let ros = gmwm::imu::ros::container_of(&input.file).is_some();
     let sidecar = if ros || is_wv(input) {
         None
@@ -22,14 +20,12 @@ fn column_units(input: &InputArgs, names: &[String]) -> Vec<String> {
         gmwm::imu::find_sidecar(&input.file).ok().flatten()
     };
     // binary IMU records by --format or by the sidecar's format, as the reader resolves it
-    let record = matches!(
-        crate::input::format(input.format),
-        gmwm::imu::InputFormat::ImuRecord(_)
-    ) || sidecar
-        .as_ref()
-        .and_then(|s| s.format.as_deref())
-        .and_then(|f| f.parse::<gmwm::imu::InputFormat>().ok())
-        .is_some_and(|f| matches!(f, gmwm::imu::InputFormat::ImuRecord(_)));
+    let record = matches!(input.read.format, gmwm::imu::InputFormat::ImuRecord(_))
+        || sidecar
+            .as_ref()
+            .and_then(|s| s.format.as_deref())
+            .and_then(|f| f.parse::<gmwm::imu::InputFormat>().ok())
+            .is_some_and(|f| matches!(f, gmwm::imu::InputFormat::ImuRecord(_)));
     names
         .iter()
         .map(|name| {
@@ -57,17 +53,6 @@ fn column_units(input: &InputArgs, names: &[String]) -> Vec<String> {
         .collect()
 }
 
-/// `--json`/`--csv` belong to the tables; a figure refuses them instead of ignoring them.
-fn no_table_output(output: &OutputArgs) -> Result<()> {
-    if output.json || output.csv {
-        return Err(UsageError(
-            "gmwm plot draws a figure: --json and --csv belong to gmwm wv|avar|fit|select".into(),
-        )
-        .into());
-    }
-    Ok(())
-}
-
 fn columns<'a, T>(items: &'a [(String, T)], units: &'a [String]) -> Vec<Column<'a, T>> {
     items
         .iter()
@@ -76,30 +61,10 @@ fn columns<'a, T>(items: &'a [(String, T)], units: &'a [String]) -> Vec<Column<'
         .collect()
 }
 
-fn layout(figure: &FigureArgs) -> Layout {
-    if figure.overlay {
-        Layout::Overlay
-    } else {
-        Layout::Grid
-    }
-}
-
-/// A figure file name the renderer can write, checked before any computation.
-fn check_output(figure: &FigureArgs) -> Result<()> {
-    ImageFormat::of(&figure.output)
-        .map(|_| ())
-        .map_err(|e| UsageError(format!("invalid --output {e}")).into())
-}
-
 /// Writes `fig` at the requested size and says where.
-fn save(fig: Figure, args: &FigureArgs, out: &mut impl Write) -> Result<()> {
+fn save(fig: Figure, args: &FigureConfig, out: &mut impl Write) -> Result<()> {
     let (w, h) = fig.size;
-    let size = (
-        args.width
-            .map_or(w, |v| u32::try_from(v).unwrap_or(u32::MAX)),
-        args.height
-            .map_or(h, |v| u32::try_from(v).unwrap_or(u32::MAX)),
-    );
+    let size = (args.width.unwrap_or(w), args.height.unwrap_or(h));
     let fig = fig.with_size(size);
     fig.save(&args.output).map_err(|e| match e {
         // a write error names the file already
@@ -123,145 +88,77 @@ fn names<T>(items: &[(String, T)]) -> Vec<String> {
 
 /// Draws `items` with `build` in the columns' units and writes the figure.
 fn draw<T>(
-    input: &InputArgs,
+    input: &InputConfig,
     items: &[(String, T)],
     build: impl Fn(&[Column<'_, T>]) -> Figure,
-    figure: &FigureArgs,
+    figure: &FigureConfig,
     out: &mut impl Write,
 ) -> Result<()> {
     let units = column_units(input, &names(items));
     save(build(&columns(items, &units)), figure, out)
 }
 
-/// Flags the figure cannot honour, refused before any computation.
-fn check_flags(command: &PlotCommand) -> Result<()> {
-    let (output, figure) = match command {
-        PlotCommand::Wv { args, figure } | PlotCommand::Compare { args, figure } => {
-            (&args.output, figure)
-        }
-        PlotCommand::Avar { args, figure } => (&args.output, figure),
-        PlotCommand::Ieee { args, figure } => {
-            if args.kind != KindArg::Overlapping {
-                return Err(UsageError(
-                    "gmwm plot ieee reads the overlapping Allan variance (IEEE Std 952): drop --kind"
-                        .into(),
-                )
-                .into());
-            }
-            (&args.output, figure)
-        }
-        PlotCommand::Fit { args, figure } => {
-            if args.inference {
-                return Err(UsageError(
-                    "gmwm plot fit draws the fit: --inference belongs to gmwm fit".into(),
-                )
-                .into());
-            }
-            (&args.output, figure)
-        }
-        PlotCommand::Select { args, figure } => (&args.output, figure),
-    };
-    no_table_output(output)?;
-    let layered = matches!(command, PlotCommand::Wv { .. } | PlotCommand::Avar { .. });
-    if figure.overlay && !layered {
-        return Err(UsageError(
-            "--overlay lays out the axes of gmwm plot wv and avar; this figure has one panel per column"
-                .into(),
-        )
-        .into());
-    }
-    let too_large = |v: Option<usize>| v.is_some_and(|v| v > gmwm_plot::MAX_SIDE as usize);
-    if too_large(figure.width) || too_large(figure.height) {
-        return Err(UsageError(format!(
-            "invalid --width/--height: at most {} px a side",
-            gmwm_plot::MAX_SIDE
-        ))
-        .into());
-    }
-    if let (Some(w), Some(h)) = (figure.width, figure.height) {
-        if (w as u64) * (h as u64) > gmwm_plot::MAX_PIXELS {
-            return Err(UsageError(format!(
-                "invalid --width {w} --height {h}: at most {} megapixels",
-                gmwm_plot::MAX_PIXELS / 1_000_000
-            ))
-            .into());
-        }
-    }
-    check_output(figure)
-}
-
 /// Runs the subcommand.
-pub fn run(args: &PlotArgs, out: &mut impl Write) -> Result<()> {
-    check_flags(&args.figure)?;
-    match &args.figure {
-        PlotCommand::Wv { args, figure } => {
-            let items = crate::cmd::wv::compute(args)?;
-            let layout = layout(figure);
+pub fn run(config: &PlotConfig, out: &mut impl Write) -> Result<()> {
+    let figure = &config.figure;
+    let layout = figure.layout;
+    match &config.kind {
+        PlotKind::Wv(c) => {
+            let items = crate::cmd::wv::compute(c)?;
             draw(
-                &args.input,
+                &c.input,
                 &items,
-                |c| gmwm_plot::wv_figure(c, layout),
+                |cols| gmwm_plot::wv_figure(cols, layout),
                 figure,
                 out,
             )
         }
-        PlotCommand::Avar { args, figure } => {
-            let items = crate::cmd::avar::compute(args)?;
-            let layout = layout(figure);
+        PlotKind::Avar(c) => {
+            let items = crate::cmd::avar::compute(c)?;
             draw(
-                &args.input,
+                &c.input,
                 &items,
-                |c| gmwm_plot::allan_figure(c, layout),
+                |cols| gmwm_plot::allan_figure(cols, layout),
                 figure,
                 out,
             )
         }
-        PlotCommand::Compare { args, figure } => {
+        PlotKind::Compare(c) => {
+            let input = &c.input;
             anyhow::ensure!(
-                !is_wv(&args.input),
+                !is_wv(input),
                 "{}: classical against robust needs the samples, not a saved wavelet variance",
-                args.input.file.display()
+                input.file.display()
             );
-            let classical_opts = WvOptions {
-                robust: None,
-                ..crate::cmd::wv::options(&args.estimator)?
-            };
-            let robust_opts = WvOptions {
-                robust: Some(RobustOptions::new(
-                    args.estimator.eff,
-                    crate::cmd::wv::robust_convention(args.estimator.robust_convention),
-                )?),
-                ..classical_opts
-            };
-            let loaded = crate::input::load(&args.input)?;
-            let items = crate::input::analyse_columns(&loaded, &args.input.file, |x| {
+            let loaded = crate::input::load(input)?;
+            let items = crate::input::analyse_columns(&loaded, &input.file, |x| {
                 Ok((
-                    gmwm::wavelet_variance(x, loaded.freq_hz, &classical_opts)?,
-                    gmwm::wavelet_variance(x, loaded.freq_hz, &robust_opts)?,
+                    gmwm::wavelet_variance(x, loaded.freq_hz, &c.classical)?,
+                    gmwm::wavelet_variance(x, loaded.freq_hz, &c.robust)?,
                 ))
             })?;
-            draw(&args.input, &items, gmwm_plot::compare_figure, figure, out)
+            draw(input, &items, gmwm_plot::compare_figure, figure, out)
         }
-        PlotCommand::Fit { args, figure } => {
-            let (_, fits) = crate::cmd::fit::compute(args)?;
-            draw(&args.input, &fits, gmwm_plot::fit_figure, figure, out)
+        PlotKind::Fit(c) => {
+            let fits = crate::cmd::fit::compute(c)?;
+            draw(&c.input, &fits, gmwm_plot::fit_figure, figure, out)
         }
-        PlotCommand::Select { args, figure } => {
-            let selections = crate::cmd::select::compute(args)?;
-            let top = args.top;
-            let build = |c: &[Column<'_, _>]| gmwm_plot::selection_figure(c, top);
-            draw(&args.input, &selections, build, figure, out)
+        PlotKind::Select(c) => {
+            let selections = crate::cmd::select::compute(c)?;
+            let top = c.top;
+            let build = |cols: &[Column<'_, _>]| gmwm_plot::selection_figure(cols, top);
+            draw(&c.input, &selections, build, figure, out)
         }
-        PlotCommand::Ieee { args, figure } => {
-            let items = crate::cmd::avar::compute(args)?;
+        PlotKind::Ieee(c) => {
+            let items = crate::cmd::avar::compute(c)?;
             let mut pairs = Vec::with_capacity(items.len());
             for (name, av) in items {
                 let readoff = ieee_readoff(&av)
                     .map_err(gmwm::Error::from)
-                    .with_context(|| format!("{}: column {name}", args.input.file.display()))?;
+                    .with_context(|| format!("{}: column {name}", c.input.file.display()))?;
                 pairs.push((name, (av, readoff)));
             }
-            draw(&args.input, &pairs, gmwm_plot::ieee_figure, figure, out)
+            draw(&c.input, &pairs, gmwm_plot::ieee_figure, figure, out)
         }
     }
 }

@@ -1,69 +1,15 @@
 //! `gmwm select`: model selection by the Wavelet Information Criterion on each selected column
 //! (METHODS §8), the candidates folded by canonical model.
 
-use crate::args::{OptimismArg, OptimismConventionArg, RuleArg, SelectArgs};
-use crate::cmd::wv::options;
-use crate::input::{analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv};
+use crate::config::SelectConfig;
+use crate::input::{analyse_columns, column_context, is_wv, load, load_wv};
 use crate::progress::{bar, Ticks};
 use crate::render::Style;
 use anyhow::Result;
 use gmwm::model::Model;
-use gmwm::selection::{OptimismConvention, OptimismMethod, RowStatus, SelectionRule};
-use gmwm::{ModelSelection, Wic};
+use gmwm::selection::RowStatus;
+use gmwm::ModelSelection;
 use std::io::Write;
-
-/// The validated selection settings from the flags.
-fn wic(args: &SelectArgs) -> Result<Wic> {
-    let mut wic = match &args.candidates {
-        Some(list) => {
-            let mut texts: Vec<String> = list
-                .split(';')
-                .map(str::trim)
-                .filter(|t| !t.is_empty())
-                .map(String::from)
-                .collect();
-            if let Some(m) = &args.model {
-                texts.push(m.clone());
-            }
-            anyhow::ensure!(
-                !texts.is_empty(),
-                "invalid --candidates {list:?}: give models separated by ';', e.g. \"AR1()+WN();2*AR1()+WN()\""
-            );
-            Wic::parse_list(&texts)?
-        }
-        None => {
-            let text = args
-                .model
-                .as_deref()
-                .ok_or_else(|| anyhow::anyhow!("give --model or --candidates"))?;
-            let model: Model = text.parse()?;
-            Wic::nested(model)?
-        }
-    };
-    let wv_options = options(&args.estimator)?;
-    crate::cmd::fit::check_haar_flag(&args.estimator.filter, &wv_options)?;
-    wic = wic
-        .with_bootstrap(args.bootstrap)
-        .with_seed(args.seed)
-        .with_optimism(match args.optimism {
-            OptimismArg::Asymptotic => OptimismMethod::Asymptotic,
-            OptimismArg::Bootstrap => OptimismMethod::Bootstrap,
-        })
-        .with_convention(match args.convention {
-            OptimismConventionArg::Corrected => OptimismConvention::Corrected,
-            OptimismConventionArg::Package => OptimismConvention::Package,
-        })
-        .with_rule(match args.rule {
-            RuleArg::Navigation => SelectionRule::Navigation,
-            RuleArg::Parsimonious => SelectionRule::Parsimonious,
-            RuleArg::WicMinimum => SelectionRule::WicMinimum,
-        })
-        .with_wv_options(wv_options);
-    if let Some(g) = args.draws {
-        wic = wic.with_draws(g);
-    }
-    Ok(wic)
-}
 
 /// CSV: one line per row of each column's table.
 const CSV_HEADER: &str = "column,rank,canonical_model,candidate,members,objective,optimism,wic,\
@@ -101,19 +47,19 @@ fn write_csv(results: &[(String, ModelSelection)], out: &mut impl Write) -> Resu
 }
 
 /// Runs the subcommand.
-pub fn run(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
-    let results = compute(args)?;
-    render_selections(args, &results, out)
+pub fn run(config: &SelectConfig, out: &mut impl Write) -> Result<()> {
+    let results = compute(config)?;
+    render_selections(config, &results, out)
 }
 
 /// The WIC selection on every selected column (convergence warnings printed).
-pub fn compute(args: &SelectArgs) -> Result<Vec<(String, ModelSelection)>> {
-    let wic = wic(args)?;
-    let file = &args.input.file;
-    let results: Result<Vec<(String, ModelSelection)>> = if is_wv(&args.input) {
+pub fn compute(config: &SelectConfig) -> Result<Vec<(String, ModelSelection)>> {
+    let wic = &config.wic;
+    let file = &config.input.file;
+    let results: Result<Vec<(String, ModelSelection)>> = if is_wv(&config.input) {
         // a saved wavelet variance: selected as it is, the bootstrap V simulated at its n
-        check_wv_estimator(file, &args.estimator)?;
-        let series = load_wv(&args.input, args.estimator.levels)?;
+        config.saved_wv.check(file)?;
+        let series = load_wv(&config.input, config.wv.levels)?;
         let progress = bar(
             (series.len() * wic.candidates().len()) as u64,
             "WIC selection",
@@ -132,7 +78,7 @@ pub fn compute(args: &SelectArgs) -> Result<Vec<(String, ModelSelection)>> {
         progress.finish_and_clear();
         results
     } else {
-        let loaded = load(&args.input)?;
+        let loaded = load(&config.input)?;
         let columns = loaded.table.columns.len();
         let progress = bar(
             (columns * wic.candidates().len()) as u64,
@@ -152,7 +98,7 @@ pub fn compute(args: &SelectArgs) -> Result<Vec<(String, ModelSelection)>> {
         if !s.fit.convergence.converged {
             eprintln!(
                 "gmwm: warning: {}: column {name}: the optimiser did not converge for the selected model {} ({})",
-                args.input.file.display(),
+                file.display(),
                 s.selected,
                 s.fit.convergence
             );
@@ -162,11 +108,11 @@ pub fn compute(args: &SelectArgs) -> Result<Vec<(String, ModelSelection)>> {
 }
 
 fn render_selections(
-    args: &SelectArgs,
+    config: &SelectConfig,
     results: &[(String, ModelSelection)],
     out: &mut impl Write,
 ) -> Result<()> {
-    match Style::from(&args.output) {
+    match config.output {
         Style::Json => {
             serde_json::to_writer_pretty(&mut *out, &gmwm::document::selections(results))?;
             writeln!(out)?;
@@ -178,7 +124,7 @@ fn render_selections(
                     writeln!(out)?;
                 }
                 writeln!(out, "{column}")?;
-                writeln!(out, "{}", s.table(args.top))?;
+                writeln!(out, "{}", s.table(config.top))?;
             }
         }
     }

@@ -1,11 +1,10 @@
 //! `gmwm simulate`: seeded simulation of a fully specified model, streamed to CSV on stdout or
 //! to a file in the format of its name (CSV, TSV, gzip, raw f64/f32) with a sidecar.
 
-use crate::args::SimulateArgs;
+use crate::config::SimulateConfig;
 use anyhow::{Context, Result};
 use gmwm::imu::write::{write_csv_header, write_csv_rows, write_sidecar};
 use gmwm::imu::{SeriesWriter, Sidecar, SidecarColumn};
-use gmwm::model::Model;
 use gmwm::sim::Simulator;
 use std::io::Write;
 
@@ -29,23 +28,17 @@ impl Sink<'_> {
 }
 
 /// Runs the subcommand.
-pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
-    let model: Model = args.model.parse()?;
-    anyhow::ensure!(args.n >= 1, "invalid --n 0: simulate at least one sample");
-    anyhow::ensure!(
-        args.freq.is_finite() && args.freq > 0.0,
-        "invalid --freq {}: must be a positive number of hertz",
-        args.freq
-    );
-    let mut sim = Simulator::for_model(&model, args.freq, args.seed)?;
+pub fn run(config: &SimulateConfig, stdout: &mut impl Write) -> Result<()> {
+    let model = &config.model;
+    let mut sim = Simulator::for_model(model, config.freq_hz, config.seed)?;
     let k = model.components().len();
     let mut names = vec!["x".to_string()];
-    if args.components {
+    if config.components {
         names.extend(model.components().iter().map(|c| c.to_string()));
     }
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
     // Create the file first so a bad path or an unknown extension fails before any work.
-    let mut sink = match &args.output {
+    let mut sink = match &config.output {
         Some(p) => Sink::File(Box::new(
             SeriesWriter::create(p, &refs)
                 .with_context(|| "cannot create the output file".to_string())?,
@@ -59,11 +52,11 @@ pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
     };
     let mut parts: Vec<Vec<f64>> = vec![Vec::new(); k];
     let mut total = Vec::new();
-    let mut left = args.n;
+    let mut left = config.n;
     while left > 0 {
         let len = left.min(CHUNK);
         total.resize(len, 0.0);
-        if args.components {
+        if config.components {
             for p in parts.iter_mut() {
                 p.resize(len, 0.0);
             }
@@ -85,14 +78,17 @@ pub fn run(args: &SimulateArgs, stdout: &mut impl Write) -> Result<()> {
         Sink::File(w) => {
             let format = w.format();
             w.finish()?;
-            let path = args.output.as_deref().unwrap_or(std::path::Path::new(""));
+            let path = config.output.as_deref().unwrap_or(std::path::Path::new(""));
             let sidecar = Sidecar {
                 name: path.file_name().map(|f| f.to_string_lossy().into_owned()),
-                sensor: Some(format!("simulated by gmwm: {} (seed {})", model, args.seed)),
-                sampling_frequency_hz: Some(args.freq),
+                sensor: Some(format!(
+                    "simulated by gmwm: {} (seed {})",
+                    model, config.seed
+                )),
+                sampling_frequency_hz: Some(config.freq_hz),
                 format: Some(format.sidecar_name().to_string()),
                 n_columns: Some(names.len()),
-                n_rows: Some(args.n as u64),
+                n_rows: Some(config.n as u64),
                 columns: names
                     .iter()
                     .map(|n| SidecarColumn {

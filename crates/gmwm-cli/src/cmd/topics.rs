@@ -1,6 +1,6 @@
 //! `gmwm topics`: the topics of a ROS recording, with the IMU topics marked.
 
-use crate::args::TopicsArgs;
+use crate::config::TopicsConfig;
 use anyhow::Result;
 use gmwm::imu::ros::{choose_topic, list_topics, RosContainer, TopicInfo};
 use serde::Serialize;
@@ -25,11 +25,11 @@ struct TopicsDoc<'a> {
 }
 
 /// Runs the subcommand.
-pub fn run(args: &TopicsArgs, out: &mut impl Write) -> Result<()> {
-    let (container, topics) = list_topics(&args.file)?;
-    if args.json {
+pub fn run(config: &TopicsConfig, out: &mut impl Write) -> Result<()> {
+    let (container, topics) = list_topics(&config.file)?;
+    if config.json {
         let doc = TopicsDoc {
-            file: &args.file,
+            file: &config.file,
             container,
             topics: topics
                 .iter()
@@ -44,7 +44,7 @@ pub fn run(args: &TopicsArgs, out: &mut impl Write) -> Result<()> {
         serde_json::to_writer_pretty(&mut *out, &doc)?;
         writeln!(out)?;
     } else {
-        table(out, &args.file, container, &topics)?;
+        table(out, &config.file, container, &topics)?;
     }
     Ok(())
 }

@@ -1,50 +1,15 @@
 //! `gmwm wv`: wavelet variance of each selected column.
 
-use crate::args::{RobustConventionArg, TransformArg, WvArgs, WvEstimatorArgs};
-use crate::input::{
-    analyse_columns, check_wv_estimator, column_context, is_wv, load, load_wv, named, note,
-    options as read_options, selector,
-};
-use crate::render::{self, Style};
+use crate::config::{InputConfig, WvConfig};
+use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named, note};
+use crate::render;
 use anyhow::Result;
 use gmwm::imu::{binary_layout, BinaryChunks, BinaryLayout, ColumnSelector, InputFormat};
 use gmwm::variance::default_levels;
 use gmwm::{
-    wavelet_variance, HaarWvAccumulator, RobustConvention, RobustOptions, Transform, WaveletFilter,
-    WaveletVariance, WvOptions,
+    wavelet_variance, HaarWvAccumulator, Transform, WaveletFilter, WaveletVariance, WvOptions,
 };
 use std::io::Write;
-
-/// The engine convention of `--robust-convention`.
-pub fn robust_convention(arg: RobustConventionArg) -> RobustConvention {
-    match arg {
-        RobustConventionArg::Exact => RobustConvention::Exact,
-        RobustConventionArg::Package => RobustConvention::Package,
-    }
-}
-
-/// Validated estimator options from the flags.
-pub fn options(a: &WvEstimatorArgs) -> Result<WvOptions> {
-    let robust = if a.robust {
-        Some(RobustOptions::new(
-            a.eff,
-            robust_convention(a.robust_convention),
-        )?)
-    } else {
-        None
-    };
-    gmwm::variance::ci::check_alpha(a.alpha)?;
-    Ok(WvOptions {
-        transform: match a.transform {
-            TransformArg::Modwt => Transform::Modwt,
-            TransformArg::Dwt => Transform::Dwt,
-        },
-        filter: a.filter.parse::<WaveletFilter>()?,
-        levels: a.levels,
-        alpha: a.alpha,
-        robust,
-    })
-}
 
 /// Samples per read of the streaming path: 1 Mi values (8 MiB) per chunk.
 const STREAM_CHUNK: usize = 1 << 20;
@@ -53,16 +18,16 @@ const STREAM_CHUNK: usize = 1 << 20;
 /// estimator and no time column streams: each selected column is read in chunks through
 /// [`HaarWvAccumulator`], never materialised, so memory stays at the accumulator's `8 · 2^J`
 /// bytes plus one chunk whatever the file size.
-fn streamable(args: &WvArgs, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
-    if args.input.time_column.is_some()
-        || gmwm::imu::ros::container_of(&args.input.file).is_some()
+fn streamable(input: &InputConfig, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
+    if input.read.time_column.is_some()
+        || gmwm::imu::ros::container_of(&input.file).is_some()
         || opts.robust.is_some()
         || opts.transform != Transform::Modwt
         || opts.filter != WaveletFilter::Haar
     {
         return Ok(None);
     }
-    let layout = binary_layout(&args.input.file, &read_options(&args.input)?)?;
+    let layout = binary_layout(&input.file, &input.read)?;
     // a column named like a time column is a time column: the in-memory reader handles it
     Ok(layout.filter(|l| {
         l.names
@@ -72,21 +37,21 @@ fn streamable(args: &WvArgs, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
 }
 
 fn run_streaming(
-    args: &WvArgs,
+    input: &InputConfig,
     layout: &BinaryLayout,
     opts: &WvOptions,
 ) -> Result<Vec<(String, WaveletVariance)>> {
-    let input = &args.input;
-    let columns: Vec<usize> = if input.columns.is_empty() {
+    let columns: Vec<usize> = if input.read.columns.is_empty() {
         (1..=layout.ncols).collect()
     } else {
         input
+            .read
             .columns
             .iter()
             .map(|c| binary_column_index(c, layout))
             .collect::<Result<_>>()?
     };
-    let freq_hz = match input.freq {
+    let freq_hz = match input.read.freq_hz {
         Some(f) => f,
         None => stream_freq(&input.file)?,
     };
@@ -125,15 +90,15 @@ fn stream_column(
 
 /// A `--columns` entry of a raw binary file: a 1-based index, a name of the sidecar, or
 /// `colK`.
-fn binary_column_index(text: &str, layout: &BinaryLayout) -> Result<usize> {
-    let t = text.trim();
+fn binary_column_index(column: &ColumnSelector, layout: &BinaryLayout) -> Result<usize> {
+    let t = column.to_string();
     let ncols = layout.ncols;
-    let index = match selector(t) {
-        ColumnSelector::Index(i) => Some(i),
+    let index = match column {
+        ColumnSelector::Index(i) => Some(*i),
         ColumnSelector::Name(n) => layout
             .names
             .iter()
-            .position(|m| *m == n)
+            .position(|m| m == n)
             .map(|k| k + 1)
             .or_else(|| n.strip_prefix("col").and_then(|k| k.parse().ok())),
     };
@@ -165,20 +130,21 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
 }
 
 /// A saved wavelet variance as it is (no recomputation).
-fn run_saved(args: &WvArgs) -> Result<Vec<(String, WaveletVariance)>> {
-    let file = &args.input.file;
-    check_wv_estimator(file, &args.estimator)?;
-    let series = load_wv(&args.input, args.estimator.levels)?;
+fn run_saved(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
+    let file = &config.input.file;
+    config.saved_wv.check(file)?;
+    let alpha = config.wv.alpha;
+    let series = load_wv(&config.input, config.wv.levels)?;
     if let Some((name, wv)) = series
         .iter()
-        .find(|(_, wv)| (wv.alpha - args.estimator.alpha).abs() > 1e-12)
+        .find(|(_, wv)| (wv.alpha - alpha).abs() > 1e-12)
     {
         anyhow::ensure!(
-            args.estimator.alpha == 0.05,
+            alpha == 0.05,
             "{}: series {}: --alpha {} needs the series; the file's intervals are at alpha {}",
             file.display(),
             gmwm::imu::quote(name),
-            args.estimator.alpha,
+            alpha,
             wv.alpha
         );
     }
@@ -190,31 +156,30 @@ fn run_saved(args: &WvArgs) -> Result<Vec<(String, WaveletVariance)>> {
 }
 
 /// Runs the subcommand.
-pub fn run(args: &WvArgs, out: &mut impl Write) -> Result<()> {
-    let items = compute(args)?;
-    render::series(out, &named(&items), Style::from(&args.output))
+pub fn run(config: &WvConfig, out: &mut impl Write) -> Result<()> {
+    let items = compute(config)?;
+    render::series(out, &named(&items), config.output)
 }
 
 /// The wavelet variance of every selected column: read from a saved WV, streamed from raw
 /// binary, or computed from the loaded columns (warnings printed).
-pub fn compute(args: &WvArgs) -> Result<Vec<(String, WaveletVariance)>> {
-    let opts = options(&args.estimator)?;
-    read_options(&args.input)?;
-    if is_wv(&args.input) {
-        return run_saved(args);
+pub fn compute(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
+    let (input, opts) = (&config.input, &config.wv);
+    if is_wv(input) {
+        return run_saved(config);
     }
-    if let Some(layout) = streamable(args, &opts)? {
-        return run_streaming(args, &layout, &opts);
+    if let Some(layout) = streamable(input, opts)? {
+        return run_streaming(input, &layout, opts);
     }
-    let loaded = load(&args.input)?;
-    let items = analyse_columns(&loaded, &args.input.file, |x| {
-        Ok(wavelet_variance(x, loaded.freq_hz, &opts)?)
+    let loaded = load(input)?;
+    let items = analyse_columns(&loaded, &input.file, |x| {
+        Ok(wavelet_variance(x, loaded.freq_hz, opts)?)
     })?;
     for (name, wv) in &items {
         for w in &wv.warnings {
             eprintln!(
                 "gmwm: warning: {}: column {name}: {w}",
-                args.input.file.display()
+                input.file.display()
             );
         }
     }

@@ -1,0 +1,1513 @@
+//! Flags become a validated configuration once: one typed configuration per subcommand, built
+//! from its clap arguments ([`crate::args`]) by `main` before any file is read or any work
+//! starts. Every check that needs the flags alone happens here, with the one-line message the
+//! CLI prints; the commands take the configuration, never the raw arguments. Checks that need
+//! the data (a column exists, levels against the series length, what FILE turns out to be) stay
+//! with the data, in the commands and `input.rs`; what a saved wavelet variance cannot honour is
+//! decided here from the flags ([`SavedWvCheck`]) and raised there once FILE is known to be one.
+
+use crate::args::{
+    AvarArgs, AxisPolicyArg, CalibrateArgs, Command, ConventionArg, DemoArgs, FigureArgs, FitArgs,
+    FormatArg, HeaderArg, ImpliedArgs, InputArgs, KindArg, OptimismArg, OptimismConventionArg,
+    OutputArgs, PlotArgs, PlotCommand, ReportArgs, RobustConventionArg, RuleArg, SelectArgs,
+    SimulateArgs, TimeUnitArg, TopicsArgs, TransformArg, WeightsArg, WvArgs, WvEstimatorArgs,
+};
+use crate::render::Style;
+use crate::UsageError;
+use anyhow::Result;
+use gmwm::calib::export::ExportFormat;
+use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, DEFAULT_FULL_MODEL};
+use gmwm::imu::{ColumnSelector, HeaderMode, ImuRecordType, InputFormat, ReadOptions, TimeUnit};
+use gmwm::inference::InferenceOptions;
+use gmwm::model::Model;
+use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
+use gmwm::{
+    AllanKind, AllanOptions, AvConvention, Gmwm, RobustConvention, RobustOptions, Transform,
+    WaveletFilter, Weighting, Wic, WvOptions,
+};
+use gmwm_plot::{ImageFormat, Layout};
+use std::path::{Path, PathBuf};
+
+/// The configuration of one run: the subcommand's, validated.
+#[derive(Debug)]
+pub enum Config {
+    /// `gmwm demo`.
+    Demo(DemoConfig),
+    /// `gmwm wv`.
+    Wv(WvConfig),
+    /// `gmwm avar`.
+    Avar(AvarConfig),
+    /// `gmwm simulate`.
+    Simulate(SimulateConfig),
+    /// `gmwm implied`.
+    Implied(ImpliedConfig),
+    /// `gmwm fit`.
+    Fit(FitConfig),
+    /// `gmwm select`.
+    Select(SelectConfig),
+    /// `gmwm calibrate`.
+    Calibrate(CalibrateConfig),
+    /// `gmwm topics`.
+    Topics(TopicsConfig),
+    /// `gmwm plot`.
+    Plot(PlotConfig),
+    /// `gmwm report`.
+    Report(ReportConfig),
+}
+
+impl TryFrom<&Command> for Config {
+    type Error = anyhow::Error;
+
+    fn try_from(command: &Command) -> Result<Self> {
+        Ok(match command {
+            Command::Demo(a) => Self::Demo(a.try_into()?),
+            Command::Wv(a) => Self::Wv(a.try_into()?),
+            Command::Avar(a) => Self::Avar(a.try_into()?),
+            Command::Simulate(a) => Self::Simulate(a.try_into()?),
+            Command::Implied(a) => Self::Implied(a.try_into()?),
+            Command::Fit(a) => Self::Fit(a.try_into()?),
+            Command::Select(a) => Self::Select(a.try_into()?),
+            Command::Calibrate(a) => Self::Calibrate(a.try_into()?),
+            Command::Topics(a) => Self::Topics(a.into()),
+            Command::Plot(a) => Self::Plot(a.try_into()?),
+            Command::Report(a) => Self::Report(a.try_into()?),
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shared parts
+
+/// Where the data come from and how to read them: FILE and the engine's read options
+/// (`--columns`, `--freq`, `--format`, `--ncols`, `--header`, `--time-column`, `--time-unit`),
+/// and the ROS topic (`--topic`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputConfig {
+    /// The data file (or rosbag2 folder).
+    pub file: PathBuf,
+    /// The engine's read options; `read.freq_hz` is `--freq`, `read.columns` is `--columns`.
+    pub read: ReadOptions,
+    /// `--topic`: the IMU topic of a ROS recording.
+    pub topic: Option<String>,
+}
+
+/// `--columns` entries: all digits → a 1-based index, anything else a name.
+fn selector(text: &str) -> ColumnSelector {
+    match text.trim().parse::<usize>() {
+        Ok(i) => ColumnSelector::Index(i),
+        Err(_) => ColumnSelector::Name(text.trim().to_string()),
+    }
+}
+
+/// The engine format of `--format`.
+fn input_format(arg: FormatArg) -> InputFormat {
+    match arg {
+        FormatArg::Auto => InputFormat::Auto,
+        FormatArg::Csv => InputFormat::Csv,
+        FormatArg::Tsv => InputFormat::Tsv,
+        FormatArg::Imar => InputFormat::ImuRecord(ImuRecordType::Imar),
+        FormatArg::Ln200 => InputFormat::ImuRecord(ImuRecordType::Ln200),
+        FormatArg::Ln200ig => InputFormat::ImuRecord(ImuRecordType::Ln200Ig),
+        FormatArg::Ixsea => InputFormat::ImuRecord(ImuRecordType::Ixsea),
+        FormatArg::NavchipInt => InputFormat::ImuRecord(ImuRecordType::NavchipInt),
+        FormatArg::NavchipFlt => InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
+        FormatArg::F64 => InputFormat::F64,
+        FormatArg::F32 => InputFormat::F32,
+    }
+}
+
+impl TryFrom<&InputArgs> for InputConfig {
+    type Error = anyhow::Error;
+
+    /// Checks the input flags (also for arguments not parsed by clap, whose value parsers
+    /// refuse these values first) and turns them into engine read options.
+    fn try_from(a: &InputArgs) -> Result<Self> {
+        if let Some(f) = a.freq {
+            anyhow::ensure!(
+                f.is_finite() && f > 0.0,
+                "invalid --freq {f}: must be a positive number of hertz"
+            );
+        }
+        if let Some(k) = a.ncols {
+            anyhow::ensure!(
+                k >= 1,
+                "invalid --ncols 0: a binary file has at least one column"
+            );
+        }
+        let read = ReadOptions {
+            format: input_format(a.format),
+            header: match a.header {
+                HeaderArg::Auto => HeaderMode::Auto,
+                HeaderArg::Yes => HeaderMode::Present,
+                HeaderArg::No => HeaderMode::Absent,
+            },
+            time_column: a.time_column.as_deref().map(selector),
+            time_unit: a.time_unit.map(|u| match u {
+                TimeUnitArg::S => TimeUnit::Seconds,
+                TimeUnitArg::Ms => TimeUnit::Milliseconds,
+                TimeUnitArg::Us => TimeUnit::Microseconds,
+                TimeUnitArg::Ns => TimeUnit::Nanoseconds,
+            }),
+            columns: a.columns.iter().map(|c| selector(c)).collect(),
+            ncols: a.ncols,
+            freq_hz: a.freq,
+        };
+        Ok(Self {
+            file: a.file.clone(),
+            read,
+            topic: a.topic.clone(),
+        })
+    }
+}
+
+/// The output style of `--json` / `--csv` (a table otherwise): the output configuration of the
+/// analysis commands.
+pub type OutputConfig = Style;
+
+impl From<&OutputArgs> for OutputConfig {
+    fn from(o: &OutputArgs) -> Self {
+        if o.json {
+            Style::Json
+        } else if o.csv {
+            Style::Csv
+        } else {
+            Style::Table
+        }
+    }
+}
+
+/// What a saved wavelet variance (FILE written by `gmwm wv --json`, used as it is) cannot
+/// honour among the flags: decided from the flags alone, raised by [`SavedWvCheck::check`] once
+/// FILE turns out to be one.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct SavedWvCheck {
+    /// The first refusal, without the file name.
+    refusal: Option<String>,
+}
+
+impl SavedWvCheck {
+    /// This check, or else `next` when this one refuses nothing.
+    fn or_else(self, next: impl FnOnce() -> Option<String>) -> Self {
+        match self.refusal {
+            Some(_) => self,
+            None => Self { refusal: next() },
+        }
+    }
+
+    /// Refuses the flags for `file`, a saved wavelet variance, if they ask what it cannot give.
+    pub fn check(&self, file: &Path) -> Result<()> {
+        match &self.refusal {
+            Some(r) => Err(anyhow::anyhow!("{}: {r}", file.display())),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The engine convention of `--robust-convention`.
+fn robust_convention(arg: RobustConventionArg) -> RobustConvention {
+    match arg {
+        RobustConventionArg::Exact => RobustConvention::Exact,
+        RobustConventionArg::Package => RobustConvention::Package,
+    }
+}
+
+/// The engine's estimator options of the wavelet-variance flags (`--robust`, `--eff`,
+/// `--robust-convention`, `--filter`, `--transform`, `--levels`, `--alpha`).
+fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
+    let robust = if a.robust {
+        Some(robust_at_eff(a)?)
+    } else {
+        None
+    };
+    gmwm::variance::ci::check_alpha(a.alpha)?;
+    Ok(WvOptions {
+        transform: match a.transform {
+            TransformArg::Modwt => Transform::Modwt,
+            TransformArg::Dwt => Transform::Dwt,
+        },
+        filter: a.filter.parse::<WaveletFilter>()?,
+        levels: a.levels,
+        alpha: a.alpha,
+        robust,
+    })
+}
+
+/// The robust estimator at `--eff` and `--robust-convention`, whether or not `--robust` is
+/// given (the contamination check of calibrate, the robust series of plot compare).
+fn robust_at_eff(a: &WvEstimatorArgs) -> Result<RobustOptions> {
+    Ok(RobustOptions::new(
+        a.eff,
+        robust_convention(a.robust_convention),
+    )?)
+}
+
+/// Refuses a non-Haar `--filter` for the estimation commands (fit, select, calibrate): every
+/// model's implied WV is the Haar one (METHODS §1.8, §4); the engine refuses it too.
+fn check_haar(a: &WvEstimatorArgs, opts: &WvOptions) -> Result<()> {
+    if opts.filter != WaveletFilter::Haar {
+        return Err(UsageError(format!(
+            "invalid --filter {}: every model's implied wavelet variance is the Haar one \
+             (METHODS §1.8, §4), so fits and selections use --filter haar (the default); other \
+             filters are for gmwm wv",
+            a.filter
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// Estimator flags that need the series when FILE is a saved wavelet variance: it is used as
+/// it is (robust if it says so).
+fn estimator_saved_wv_check(a: &WvEstimatorArgs) -> SavedWvCheck {
+    SavedWvCheck::default()
+        .or_else(|| {
+            a.robust.then(|| {
+                "--robust needs the series; a wavelet-variance file is used as it is (robust if \
+                 it says so)"
+                    .to_string()
+            })
+        })
+        .or_else(|| {
+            (a.filter != "haar" || a.transform != TransformArg::Modwt).then(|| {
+                "--filter/--transform apply to a recording; a wavelet-variance file is used as \
+                 it is"
+                    .to_string()
+            })
+        })
+}
+
+/// The engine rule of `--rule`.
+fn selection_rule(arg: RuleArg) -> SelectionRule {
+    match arg {
+        RuleArg::Navigation => SelectionRule::Navigation,
+        RuleArg::Parsimonious => SelectionRule::Parsimonious,
+        RuleArg::WicMinimum => SelectionRule::WicMinimum,
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per subcommand
+
+/// `gmwm demo`: the simulation and the (Haar MODWT) estimator.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DemoConfig {
+    /// `--n`: samples to simulate.
+    pub n: usize,
+    /// `--seed`: seed of the simulation.
+    pub seed: u64,
+    /// The estimator of the empirical WV (Haar MODWT: the implied WV exists for it only).
+    pub wv: WvOptions,
+    /// Table, JSON or CSV.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&DemoArgs> for DemoConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &DemoArgs) -> Result<Self> {
+        let wv = wv_options(&a.estimator)?;
+        anyhow::ensure!(
+            wv.filter == WaveletFilter::Haar && wv.transform == Transform::Modwt,
+            "gmwm demo compares with the implied WV of METHODS §4, which exists for the Haar MODWT only; drop --filter/--transform"
+        );
+        Ok(Self {
+            n: a.n,
+            seed: a.seed,
+            wv,
+            output: (&a.output).into(),
+        })
+    }
+}
+
+/// `gmwm wv`: the input, the estimator, the output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WvConfig {
+    /// What to read.
+    pub input: InputConfig,
+    /// The estimator.
+    pub wv: WvOptions,
+    /// Estimator flags a saved wavelet variance cannot honour.
+    pub saved_wv: SavedWvCheck,
+    /// Table, JSON or CSV.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&WvArgs> for WvConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &WvArgs) -> Result<Self> {
+        let wv = wv_options(&a.estimator)?;
+        Ok(Self {
+            input: (&a.input).try_into()?,
+            wv,
+            saved_wv: estimator_saved_wv_check(&a.estimator),
+            output: (&a.output).into(),
+        })
+    }
+}
+
+/// `gmwm avar`: the input, the Allan-type variance, the output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AvarConfig {
+    /// What to read.
+    pub input: InputConfig,
+    /// Kind, convention and interval level.
+    pub allan: AllanOptions,
+    /// A kind or convention other than the overlapping textbook one, which a saved wavelet
+    /// variance cannot give.
+    pub saved_wv: SavedWvCheck,
+    /// Table, JSON or CSV.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&AvarArgs> for AvarConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &AvarArgs) -> Result<Self> {
+        gmwm::variance::ci::check_alpha(a.alpha)?;
+        let allan = AllanOptions {
+            kind: match a.kind {
+                KindArg::Overlapping => AllanKind::Overlapping,
+                KindArg::NonOverlapping => AllanKind::NonOverlapping,
+                KindArg::Modified => AllanKind::Modified,
+                KindArg::Hadamard => AllanKind::Hadamard,
+                KindArg::HadamardNonOverlapping => AllanKind::HadamardNonOverlapping,
+            },
+            alpha: a.alpha,
+            convention: match a.convention {
+                ConventionArg::Textbook => AvConvention::Textbook,
+                ConventionArg::Package => AvConvention::Package,
+            },
+        };
+        // METHODS §3.4, AV(m) = 2 WV(2m), holds for the overlapping textbook estimator only
+        let saved_wv = SavedWvCheck::default().or_else(|| {
+            (allan.kind != AllanKind::Overlapping || allan.convention != AvConvention::Textbook)
+                .then(|| {
+                    format!(
+                        "--kind {} --convention {} needs the raw recording; a saved wavelet \
+                         variance gives only the overlapping textbook Allan variance \
+                         (AV(m) = 2 WV(2m), METHODS §3.4)",
+                        allan.kind,
+                        allan.convention.name()
+                    )
+                })
+        });
+        Ok(Self {
+            input: (&a.input).try_into()?,
+            allan,
+            saved_wv,
+            output: (&a.output).into(),
+        })
+    }
+}
+
+/// `gmwm simulate`: the fully specified model, the length, rate and seed, where to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulateConfig {
+    /// The model to simulate.
+    pub model: Model,
+    /// `--n`: samples.
+    pub n: usize,
+    /// `--freq`: sampling rate in Hz.
+    pub freq_hz: f64,
+    /// `--seed`.
+    pub seed: u64,
+    /// `-o`: the file, in the format of its name (`None`: CSV on stdout).
+    pub output: Option<PathBuf>,
+    /// `--components`: each component as its own column too.
+    pub components: bool,
+}
+
+impl TryFrom<&SimulateArgs> for SimulateConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SimulateArgs) -> Result<Self> {
+        let model: Model = a.model.parse()?;
+        anyhow::ensure!(a.n >= 1, "invalid --n 0: simulate at least one sample");
+        anyhow::ensure!(
+            a.freq.is_finite() && a.freq > 0.0,
+            "invalid --freq {}: must be a positive number of hertz",
+            a.freq
+        );
+        Ok(Self {
+            model,
+            n: a.n,
+            freq_hz: a.freq,
+            seed: a.seed,
+            output: a.output.clone(),
+            components: a.components,
+        })
+    }
+}
+
+/// `gmwm implied`: the fully specified model, its levels and rate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImpliedConfig {
+    /// The model.
+    pub model: Model,
+    /// `--levels`: J.
+    pub levels: usize,
+    /// `--freq`: sampling rate in Hz.
+    pub freq_hz: f64,
+    /// `--json` instead of a table.
+    pub json: bool,
+}
+
+impl TryFrom<&ImpliedArgs> for ImpliedConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &ImpliedArgs) -> Result<Self> {
+        Ok(Self {
+            model: a.model.parse()?,
+            levels: a.levels,
+            freq_hz: a.freq,
+            json: a.json,
+        })
+    }
+}
+
+/// `gmwm fit`: the input, the estimator (model, weighting, search) with its WV settings, the
+/// inference, the output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitConfig {
+    /// What to read.
+    pub input: InputConfig,
+    /// The GMWM estimator: model, weighting, seed, draws.
+    pub gmwm: Gmwm,
+    /// The wavelet variance it fits (Haar).
+    pub wv: WvOptions,
+    /// `--inference` (and `--bootstrap B`): METHODS §7 on each fit; `None` without.
+    pub inference: Option<InferenceOptions>,
+    /// Flags a saved wavelet variance cannot honour (`--robust`, `--filter`/`--transform`,
+    /// `--weights diag`).
+    pub saved_wv: SavedWvCheck,
+    /// Table, JSON or CSV.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&FitArgs> for FitConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &FitArgs) -> Result<Self> {
+        let model: Model = a.model.parse()?;
+        let wv = wv_options(&a.estimator)?;
+        check_haar(&a.estimator, &wv)?;
+        let mut gmwm = Gmwm::new(model)
+            .with_weighting(match a.weights {
+                WeightsArg::Fast => Weighting::Fast,
+                WeightsArg::Diag => Weighting::Diag,
+                WeightsArg::Bootstrap => Weighting::Bootstrap,
+            })
+            .with_seed(a.seed);
+        if let Some(g) = a.draws {
+            anyhow::ensure!(g >= 1, "invalid --G 0: at least one starting-value draw");
+            gmwm = gmwm.with_draws(g);
+        }
+        let input = (&a.input).try_into()?;
+        let inference = if a.inference {
+            if let Some(b) = a.bootstrap {
+                anyhow::ensure!(b >= 2, "invalid --bootstrap {b}: at least 2 replicates");
+            }
+            Some(InferenceOptions {
+                alpha: a.estimator.alpha,
+                bootstrap: a.bootstrap,
+                ..InferenceOptions::default()
+            })
+        } else {
+            None
+        };
+        let saved_wv = estimator_saved_wv_check(&a.estimator).or_else(|| {
+            (a.weights == WeightsArg::Diag).then(|| {
+                "--weights diag needs the series; use fast or bootstrap with a wavelet-variance \
+                 file"
+                    .to_string()
+            })
+        });
+        Ok(Self {
+            input,
+            gmwm,
+            wv,
+            inference,
+            saved_wv,
+            output: (&a.output).into(),
+        })
+    }
+}
+
+/// `gmwm select`: the input, the WIC selection (candidates, optimism, rule, bootstrap, search,
+/// WV settings), the rows shown, the output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectConfig {
+    /// What to read.
+    pub input: InputConfig,
+    /// The selection.
+    pub wic: Wic,
+    /// The wavelet variance it selects on (Haar; also inside `wic`).
+    pub wv: WvOptions,
+    /// Estimator flags a saved wavelet variance cannot honour.
+    pub saved_wv: SavedWvCheck,
+    /// `--top`: rows of the table per column (0: all).
+    pub top: usize,
+    /// Table, JSON or CSV.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&SelectArgs> for SelectConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SelectArgs) -> Result<Self> {
+        let wic = match &a.candidates {
+            Some(list) => {
+                let mut texts: Vec<String> = list
+                    .split(';')
+                    .map(str::trim)
+                    .filter(|t| !t.is_empty())
+                    .map(String::from)
+                    .collect();
+                if let Some(m) = &a.model {
+                    texts.push(m.clone());
+                }
+                anyhow::ensure!(
+                    !texts.is_empty(),
+                    "invalid --candidates {list:?}: give models separated by ';', e.g. \"AR1()+WN();2*AR1()+WN()\""
+                );
+                Wic::parse_list(&texts)?
+            }
+            None => {
+                let text = a
+                    .model
+                    .as_deref()
+                    .ok_or_else(|| anyhow::anyhow!("give --model or --candidates"))?;
+                let model: Model = text.parse()?;
+                Wic::nested(model)?
+            }
+        };
+        let wv = wv_options(&a.estimator)?;
+        check_haar(&a.estimator, &wv)?;
+        let mut wic = wic
+            .with_bootstrap(a.bootstrap)
+            .with_seed(a.seed)
+            .with_optimism(match a.optimism {
+                OptimismArg::Asymptotic => OptimismMethod::Asymptotic,
+                OptimismArg::Bootstrap => OptimismMethod::Bootstrap,
+            })
+            .with_convention(match a.convention {
+                OptimismConventionArg::Corrected => OptimismConvention::Corrected,
+                OptimismConventionArg::Package => OptimismConvention::Package,
+            })
+            .with_rule(selection_rule(a.rule))
+            .with_wv_options(wv);
+        if let Some(g) = a.draws {
+            wic = wic.with_draws(g);
+        }
+        Ok(Self {
+            input: (&a.input).try_into()?,
+            wic,
+            wv,
+            saved_wv: estimator_saved_wv_check(&a.estimator),
+            top: a.top,
+            output: (&a.output).into(),
+        })
+    }
+}
+
+/// `gmwm calibrate`: the recording, the engine's calibration options, and what to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrateConfig {
+    /// The recording.
+    pub input: InputConfig,
+    /// The calibration: full model, WV settings, bootstrap, search, rule, units, robust check.
+    pub options: CalibrationOptions,
+    /// The navigation-filter files to write, (stack, path), `--kalibr` first then each
+    /// `--export` in order.
+    pub exports: Vec<(ExportFormat, PathBuf)>,
+    /// `--inflate K` or `--conservative` (the estimates otherwise).
+    pub adjustment: Adjustment,
+    /// `--axis-policy`.
+    pub policy: AxisPolicy,
+    /// `--json FILE` (`-` for standard output).
+    pub json: Option<PathBuf>,
+    /// `--rostopic` written to the Kalibr/OpenVINS files.
+    pub rostopic: Option<String>,
+    /// `--report FILE`: the HTML report too.
+    pub report: Option<PathBuf>,
+}
+
+/// The files of `--kalibr` and `--export STACK FILE`, Kalibr first.
+fn exports(a: &CalibrateArgs) -> Result<Vec<(ExportFormat, PathBuf)>> {
+    let mut out = Vec::new();
+    if let Some(p) = &a.kalibr {
+        out.push((ExportFormat::Kalibr, p.clone()));
+    }
+    for pair in a.export.chunks(2) {
+        let [stack, file] = pair else {
+            return Err(UsageError("--export takes two values: STACK FILE".into()).into());
+        };
+        let format: ExportFormat = stack.parse().map_err(|_| {
+            UsageError(format!(
+                "invalid --export {stack}: one of kalibr, openvins, vins, orbslam3, px4"
+            ))
+        })?;
+        out.push((format, PathBuf::from(file)));
+    }
+    Ok(out)
+}
+
+impl TryFrom<&CalibrateArgs> for CalibrateConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &CalibrateArgs) -> Result<Self> {
+        let wv = wv_options(&a.estimator)?;
+        check_haar(&a.estimator, &wv)?;
+        let full_model = a.model.as_deref().unwrap_or(DEFAULT_FULL_MODEL).parse()?;
+        let options = CalibrationOptions {
+            full_model,
+            wv,
+            bootstrap: a.bootstrap,
+            draws: a.draws,
+            seed: a.seed,
+            rule: selection_rule(a.rule),
+            gyro_unit: a.gyro_unit,
+            accel_unit: a.accel_unit,
+            // the contamination check compares with the robust WV at --eff
+            robust_check: Some(robust_at_eff(&a.estimator)?),
+        };
+        let exports = exports(a)?;
+        let adjustment = match (a.inflate, a.conservative) {
+            (Some(k), _) => Adjustment::inflate(k)?,
+            (None, true) => Adjustment::Conservative,
+            (None, false) => Adjustment::Estimate,
+        };
+        Ok(Self {
+            input: (&a.input).try_into()?,
+            options,
+            exports,
+            adjustment,
+            policy: match a.axis_policy {
+                AxisPolicyArg::Worst => AxisPolicy::Worst,
+                AxisPolicyArg::Mean => AxisPolicy::Mean,
+                AxisPolicyArg::PerAxis => AxisPolicy::PerAxis,
+            },
+            json: a.json.clone(),
+            rostopic: a.rostopic.clone(),
+            report: a.report.clone(),
+        })
+    }
+}
+
+/// `gmwm report`: the calibration, as `gmwm calibrate`, and the HTML file it is written to.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReportConfig {
+    /// The calibration.
+    pub calibrate: CalibrateConfig,
+    /// The HTML file: `-o`, else `--report`, else the recording's name with `.report.html`.
+    pub output: PathBuf,
+}
+
+/// The default report file: the recording's name without its data extensions, with
+/// `.report.html`, in the current folder (`imu.csv.gz` gives `imu.report.html`).
+fn default_report(file: &Path) -> PathBuf {
+    let name = file
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "gmwm".to_string());
+    let mut stem = name.as_str();
+    for ext in [
+        ".gz", ".csv", ".tsv", ".txt", ".bag", ".mcap", ".db3", ".bin", ".f64", ".f32",
+    ] {
+        stem = stem.strip_suffix(ext).unwrap_or(stem);
+    }
+    let stem = stem.trim_end_matches('/');
+    PathBuf::from(format!(
+        "{}.report.html",
+        if stem.is_empty() { "gmwm" } else { stem }
+    ))
+}
+
+impl TryFrom<&ReportArgs> for ReportConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &ReportArgs) -> Result<Self> {
+        if let (Some(o), Some(r)) = (&a.output, &a.calibrate.report) {
+            return Err(UsageError(format!(
+                "give the report's file once: -o {} or --report {}",
+                o.display(),
+                r.display()
+            ))
+            .into());
+        }
+        let output = a
+            .output
+            .clone()
+            .or_else(|| a.calibrate.report.clone())
+            .unwrap_or_else(|| default_report(&a.calibrate.input.file));
+        Ok(Self {
+            calibrate: (&a.calibrate).try_into()?,
+            output,
+        })
+    }
+}
+
+/// `gmwm topics`: the ROS recording and the output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicsConfig {
+    /// The recording.
+    pub file: PathBuf,
+    /// `--json` instead of a list.
+    pub json: bool,
+}
+
+impl From<&TopicsArgs> for TopicsConfig {
+    fn from(a: &TopicsArgs) -> Self {
+        Self {
+            file: a.file.clone(),
+            json: a.json,
+        }
+    }
+}
+
+/// `gmwm plot`: the figure file and what it draws.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlotConfig {
+    /// File, layout and size.
+    pub figure: FigureConfig,
+    /// The figure and the configuration of the command whose results it draws.
+    pub kind: PlotKind,
+}
+
+/// The figure of `gmwm plot` with the configuration of its data.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PlotKind {
+    /// `plot wv`: as `gmwm wv`.
+    Wv(WvConfig),
+    /// `plot avar`: as `gmwm avar`.
+    Avar(AvarConfig),
+    /// `plot compare`: classical against robust wavelet variance.
+    Compare(CompareConfig),
+    /// `plot fit`: as `gmwm fit` (without inference).
+    Fit(FitConfig),
+    /// `plot select`: as `gmwm select`.
+    Select(SelectConfig),
+    /// `plot ieee`: the overlapping Allan variance, as `gmwm avar`.
+    Ieee(AvarConfig),
+}
+
+/// `gmwm plot compare`: one recording, two estimators.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareConfig {
+    /// What to read (the samples; not a saved wavelet variance).
+    pub input: InputConfig,
+    /// The classical estimator (the flags without `--robust`).
+    pub classical: WvOptions,
+    /// The robust estimator at `--eff` and `--robust-convention`.
+    pub robust: WvOptions,
+}
+
+/// Where a figure goes and how it is laid out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FigureConfig {
+    /// `-o`: the .svg or .png file.
+    pub output: PathBuf,
+    /// Grid of panels, or the axes overlaid (`--overlay`).
+    pub layout: Layout,
+    /// `--width` in pixels (default: by the figure's panels).
+    pub width: Option<u32>,
+    /// `--height` in pixels (default: by the figure's panels).
+    pub height: Option<u32>,
+}
+
+/// `--json`/`--csv` belong to the tables; a figure refuses them instead of ignoring them.
+fn no_table_output(output: &OutputArgs) -> Result<()> {
+    if output.json || output.csv {
+        return Err(UsageError(
+            "gmwm plot draws a figure: --json and --csv belong to gmwm wv|avar|fit|select".into(),
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// Flags the figure cannot honour.
+fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
+    let (output, figure) = match command {
+        PlotCommand::Wv { args, figure } | PlotCommand::Compare { args, figure } => {
+            (&args.output, figure)
+        }
+        PlotCommand::Avar { args, figure } => (&args.output, figure),
+        PlotCommand::Ieee { args, figure } => {
+            if args.kind != KindArg::Overlapping {
+                return Err(UsageError(
+                    "gmwm plot ieee reads the overlapping Allan variance (IEEE Std 952): drop --kind"
+                        .into(),
+                )
+                .into());
+            }
+            (&args.output, figure)
+        }
+        PlotCommand::Fit { args, figure } => {
+            if args.inference {
+                return Err(UsageError(
+                    "gmwm plot fit draws the fit: --inference belongs to gmwm fit".into(),
+                )
+                .into());
+            }
+            (&args.output, figure)
+        }
+        PlotCommand::Select { args, figure } => (&args.output, figure),
+    };
+    no_table_output(output)?;
+    let layered = matches!(command, PlotCommand::Wv { .. } | PlotCommand::Avar { .. });
+    if figure.overlay && !layered {
+        return Err(UsageError(
+            "--overlay lays out the axes of gmwm plot wv and avar; this figure has one panel per column"
+                .into(),
+        )
+        .into());
+    }
+    figure.try_into()
+}
+
+impl TryFrom<&FigureArgs> for FigureConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(figure: &FigureArgs) -> Result<Self> {
+        let too_large = |v: Option<usize>| v.is_some_and(|v| v > gmwm_plot::MAX_SIDE as usize);
+        if too_large(figure.width) || too_large(figure.height) {
+            return Err(UsageError(format!(
+                "invalid --width/--height: at most {} px a side",
+                gmwm_plot::MAX_SIDE
+            ))
+            .into());
+        }
+        if let (Some(w), Some(h)) = (figure.width, figure.height) {
+            if (w as u64) * (h as u64) > gmwm_plot::MAX_PIXELS {
+                return Err(UsageError(format!(
+                    "invalid --width {w} --height {h}: at most {} megapixels",
+                    gmwm_plot::MAX_PIXELS / 1_000_000
+                ))
+                .into());
+            }
+        }
+        // a file name the renderer can write
+        ImageFormat::of(&figure.output).map_err(|e| UsageError(format!("invalid --output {e}")))?;
+        let side = |v: Option<usize>| v.map(|v| u32::try_from(v).unwrap_or(u32::MAX));
+        Ok(Self {
+            output: figure.output.clone(),
+            layout: if figure.overlay {
+                Layout::Overlay
+            } else {
+                Layout::Grid
+            },
+            width: side(figure.width),
+            height: side(figure.height),
+        })
+    }
+}
+
+impl TryFrom<&PlotArgs> for PlotConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &PlotArgs) -> Result<Self> {
+        let figure = figure_config(&a.figure)?;
+        let kind = match &a.figure {
+            PlotCommand::Wv { args, .. } => PlotKind::Wv(args.try_into()?),
+            PlotCommand::Avar { args, .. } => PlotKind::Avar(args.try_into()?),
+            PlotCommand::Compare { args, .. } => {
+                let classical = WvOptions {
+                    robust: None,
+                    ..wv_options(&args.estimator)?
+                };
+                let robust = WvOptions {
+                    robust: Some(robust_at_eff(&args.estimator)?),
+                    ..classical
+                };
+                PlotKind::Compare(CompareConfig {
+                    input: (&args.input).try_into()?,
+                    classical,
+                    robust,
+                })
+            }
+            PlotCommand::Fit { args, .. } => PlotKind::Fit(args.try_into()?),
+            PlotCommand::Select { args, .. } => PlotKind::Select(args.try_into()?),
+            PlotCommand::Ieee { args, .. } => PlotKind::Ieee(args.try_into()?),
+        };
+        Ok(Self { figure, kind })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::args::Cli;
+    use clap::Parser;
+
+    /// The arguments clap parses from `gmwm ARGV`.
+    fn parse(argv: &[&str]) -> Command {
+        Cli::try_parse_from(std::iter::once("gmwm").chain(argv.iter().copied()))
+            .unwrap_or_else(|e| panic!("clap refuses {argv:?}: {e}"))
+            .command
+    }
+
+    fn config(argv: &[&str]) -> Config {
+        Config::try_from(&parse(argv)).unwrap_or_else(|e| panic!("{argv:?}: {e:#}"))
+    }
+
+    /// The error of `gmwm ARGV`'s configuration and whether it is a usage error (exit code 2).
+    fn refusal(argv: &[&str]) -> (String, bool) {
+        let e = Config::try_from(&parse(argv)).expect_err("refused");
+        (format!("{e:#}"), e.downcast_ref::<UsageError>().is_some())
+    }
+
+    const HAAR_ONLY: &str = "invalid --filter la8: every model's implied wavelet variance is \
+        the Haar one (METHODS §1.8, §4), so fits and selections use --filter haar (the \
+        default); other filters are for gmwm wv";
+
+    #[test]
+    fn estimation_commands_refuse_a_non_haar_filter_as_a_usage_error() {
+        for argv in [
+            &["fit", "x.csv", "--model", "WN()", "--filter", "la8"][..],
+            &["select", "x.csv", "--model", "WN()", "--filter", "la8"],
+            &["calibrate", "x.csv", "--filter", "la8"],
+            &["report", "x.csv", "--filter", "la8"],
+            &[
+                "plot", "fit", "x.csv", "--model", "WN()", "--filter", "la8", "-o", "f.svg",
+            ],
+        ] {
+            assert_eq!(refusal(argv), (HAAR_ONLY.to_string(), true), "{argv:?}");
+        }
+        // gmwm wv takes any filter; an unknown one is the engine's error (exit code 1)
+        assert!(matches!(
+            config(&["wv", "x.csv", "--filter", "la8"]),
+            Config::Wv(c) if c.wv.filter == WaveletFilter::La8
+        ));
+        let (msg, usage) = refusal(&["wv", "x.csv", "--filter", "nope"]);
+        assert!(msg.contains("nope") && !usage, "{msg}");
+        let (msg, usage) = refusal(&["demo", "--transform", "dwt"]);
+        assert!(msg.starts_with("gmwm demo compares with the implied WV") && !usage);
+    }
+
+    #[test]
+    fn wv_flags_give_the_engine_options() {
+        let Config::Wv(c) = config(&["wv", "x.csv"]) else {
+            panic!()
+        };
+        assert_eq!(c.wv, WvOptions::default());
+        assert_eq!(c.input.read, ReadOptions::default());
+        assert_eq!(c.input.file, PathBuf::from("x.csv"));
+        assert_eq!(c.output, Style::Table);
+        assert_eq!(c.saved_wv, SavedWvCheck::default());
+        let Config::Wv(c) = config(&[
+            "wv",
+            "x.bin",
+            "--robust",
+            "--eff",
+            "0.8",
+            "--robust-convention",
+            "package",
+            "--transform",
+            "dwt",
+            "--filter",
+            "d4",
+            "--levels",
+            "5",
+            "--alpha",
+            "0.1",
+            "--columns",
+            "gyro_x,3",
+            "--freq",
+            "200",
+            "--format",
+            "f32",
+            "--ncols",
+            "6",
+            "--header",
+            "no",
+            "--time-column",
+            "1",
+            "--time-unit",
+            "ms",
+            "--topic",
+            "/imu0",
+            "--csv",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(
+            c.wv,
+            WvOptions {
+                transform: Transform::Dwt,
+                filter: WaveletFilter::D4,
+                levels: Some(5),
+                alpha: 0.1,
+                robust: Some(RobustOptions::new(0.8, RobustConvention::Package).unwrap()),
+            }
+        );
+        assert_eq!(
+            c.input.read,
+            ReadOptions {
+                format: InputFormat::F32,
+                header: HeaderMode::Absent,
+                time_column: Some(ColumnSelector::Index(1)),
+                time_unit: Some(TimeUnit::Milliseconds),
+                columns: vec![
+                    ColumnSelector::Name("gyro_x".into()),
+                    ColumnSelector::Index(3)
+                ],
+                ncols: Some(6),
+                freq_hz: Some(200.0),
+            }
+        );
+        assert_eq!(c.input.topic.as_deref(), Some("/imu0"));
+        assert_eq!(c.output, Style::Csv);
+        let refused = c.saved_wv.check(Path::new("wv.json")).unwrap_err();
+        assert_eq!(
+            refused.to_string(),
+            "wv.json: --robust needs the series; a wavelet-variance file is used as it is \
+             (robust if it says so)"
+        );
+    }
+
+    #[test]
+    fn input_checks_hold_without_clap() {
+        let mut args = InputArgs {
+            file: "x.csv".into(),
+            columns: Vec::new(),
+            freq: Some(-5.0),
+            format: FormatArg::Auto,
+            ncols: None,
+            header: HeaderArg::Auto,
+            time_column: None,
+            time_unit: None,
+            topic: None,
+        };
+        assert_eq!(
+            InputConfig::try_from(&args).unwrap_err().to_string(),
+            "invalid --freq -5: must be a positive number of hertz"
+        );
+        args.freq = None;
+        args.ncols = Some(0);
+        assert_eq!(
+            InputConfig::try_from(&args).unwrap_err().to_string(),
+            "invalid --ncols 0: a binary file has at least one column"
+        );
+        args.format = FormatArg::Ln200ig;
+        args.ncols = None;
+        assert_eq!(
+            InputConfig::try_from(&args).unwrap().read.format,
+            InputFormat::ImuRecord(ImuRecordType::Ln200Ig)
+        );
+    }
+
+    #[test]
+    fn saved_wv_refusals_are_decided_from_the_flags() {
+        let file = Path::new("wv.json");
+        let check = |argv: &[&str]| match config(argv) {
+            Config::Wv(c) => c.saved_wv.check(file),
+            Config::Fit(c) => c.saved_wv.check(file),
+            Config::Select(c) => c.saved_wv.check(file),
+            Config::Avar(c) => c.saved_wv.check(file),
+            _ => unreachable!(),
+        };
+        let refused = |argv: &[&str]| check(argv).unwrap_err().to_string();
+        let filter = "wv.json: --filter/--transform apply to a recording; a wavelet-variance \
+                      file is used as it is";
+        assert_eq!(refused(&["wv", "x", "--filter", "d4"]), filter);
+        assert_eq!(
+            refused(&["select", "x", "--model", "WN()", "--transform", "dwt"]),
+            filter
+        );
+        assert_eq!(
+            refused(&["fit", "x", "--model", "WN()", "--weights", "diag"]),
+            "wv.json: --weights diag needs the series; use fast or bootstrap with a \
+             wavelet-variance file"
+        );
+        // the estimator's refusal comes first
+        assert!(refused(&[
+            "fit",
+            "x",
+            "--model",
+            "WN()",
+            "--weights",
+            "diag",
+            "--robust"
+        ])
+        .contains("--robust needs the series"));
+        assert_eq!(
+            refused(&["avar", "x", "--kind", "modified"]),
+            "wv.json: --kind modified --convention textbook needs the raw recording; a saved \
+             wavelet variance gives only the overlapping textbook Allan variance \
+             (AV(m) = 2 WV(2m), METHODS §3.4)"
+        );
+        assert!(refused(&["avar", "x", "--convention", "package"]).contains("--kind overlapping"));
+        for ok in [
+            &["wv", "x", "--levels", "4", "--alpha", "0.1"][..],
+            &["fit", "x", "--model", "WN()", "--weights", "bootstrap"],
+            &["select", "x", "--model", "WN()", "--filter", "haar"],
+            &["avar", "x", "--json"],
+        ] {
+            assert!(check(ok).is_ok(), "{ok:?}");
+        }
+    }
+
+    #[test]
+    fn fit_flags_give_the_estimator_and_the_inference() {
+        let Config::Fit(c) = config(&[
+            "fit",
+            "x.csv",
+            "--model",
+            "AR1()+WN()",
+            "--weights",
+            "bootstrap",
+            "--G",
+            "500",
+            "--seed",
+            "7",
+            "--alpha",
+            "0.1",
+            "--inference",
+            "--bootstrap",
+            "20",
+            "--json",
+        ]) else {
+            panic!()
+        };
+        let model: Model = "AR1()+WN()".parse().unwrap();
+        assert_eq!(
+            c.gmwm,
+            Gmwm::new(model)
+                .with_weighting(Weighting::Bootstrap)
+                .with_seed(7)
+                .with_draws(500)
+        );
+        assert_eq!(c.wv.alpha, 0.1);
+        assert_eq!(
+            c.inference,
+            Some(InferenceOptions {
+                alpha: 0.1,
+                bootstrap: Some(20),
+                ..InferenceOptions::default()
+            })
+        );
+        assert_eq!(c.output, Style::Json);
+        let Config::Fit(c) = config(&["fit", "x.csv", "--model", "WN()"]) else {
+            panic!()
+        };
+        assert_eq!(c.inference, None);
+        assert_eq!(c.gmwm.weighting(), Weighting::Fast);
+        let (msg, usage) = refusal(&["fit", "x.csv", "--model", "AR1("]);
+        assert!(msg.contains("AR1(") && !usage, "{msg}");
+    }
+
+    #[test]
+    fn fit_counts_are_checked_without_clap() {
+        let Command::Fit(mut args) = parse(&["fit", "x.csv", "--model", "WN()", "--inference"])
+        else {
+            panic!()
+        };
+        args.draws = Some(0);
+        assert_eq!(
+            FitConfig::try_from(&args).unwrap_err().to_string(),
+            "invalid --G 0: at least one starting-value draw"
+        );
+        args.draws = None;
+        args.bootstrap = Some(1);
+        assert_eq!(
+            FitConfig::try_from(&args).unwrap_err().to_string(),
+            "invalid --bootstrap 1: at least 2 replicates"
+        );
+    }
+
+    #[test]
+    fn select_flags_give_the_wic() {
+        let Config::Select(c) = config(&[
+            "select",
+            "x.csv",
+            "--model",
+            "2*AR1()+WN()",
+            "--bootstrap",
+            "30",
+            "--optimism",
+            "bootstrap",
+            "--convention",
+            "package",
+            "--rule",
+            "parsimonious",
+            "--G",
+            "100",
+            "--seed",
+            "3",
+            "--top",
+            "0",
+        ]) else {
+            panic!()
+        };
+        let full: Model = "2*AR1()+WN()".parse().unwrap();
+        let expected = Wic::nested(full)
+            .unwrap()
+            .with_bootstrap(30)
+            .with_seed(3)
+            .with_optimism(OptimismMethod::Bootstrap)
+            .with_convention(OptimismConvention::Package)
+            .with_rule(SelectionRule::Parsimonious)
+            .with_wv_options(WvOptions::default())
+            .with_draws(100);
+        assert_eq!(c.wic, expected);
+        assert_eq!(c.top, 0);
+        let Config::Select(c) = config(&["select", "x.csv", "--candidates", "AR1()+WN();WN()"])
+        else {
+            panic!()
+        };
+        assert_eq!(c.wic.candidates().len(), 2);
+        let (msg, usage) = refusal(&["select", "x.csv", "--candidates", " ; "]);
+        assert_eq!(
+            msg,
+            "invalid --candidates \" ; \": give models separated by ';', e.g. \
+             \"AR1()+WN();2*AR1()+WN()\""
+        );
+        assert!(!usage);
+    }
+
+    #[test]
+    fn calibrate_flags_give_the_calibration_and_the_files() {
+        let Config::Calibrate(c) = config(&[
+            "calibrate",
+            "imu.csv",
+            "--gyro-unit",
+            "deg/s",
+            "--kalibr",
+            "k.yaml",
+            "--export",
+            "px4",
+            "p.sdf",
+            "--export",
+            "openvins",
+            "o.yaml",
+            "--inflate",
+            "2",
+            "--axis-policy",
+            "per-axis",
+            "--rule",
+            "wic-minimum",
+            "--eff",
+            "0.7",
+            "--json",
+            "-",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(
+            c.options,
+            CalibrationOptions {
+                rule: SelectionRule::WicMinimum,
+                gyro_unit: Some("deg/s".parse().unwrap()),
+                robust_check: Some(RobustOptions::new(0.7, RobustConvention::Exact).unwrap()),
+                ..CalibrationOptions::default()
+            }
+        );
+        assert_eq!(
+            c.exports,
+            [
+                (ExportFormat::Kalibr, PathBuf::from("k.yaml")),
+                (ExportFormat::Px4, PathBuf::from("p.sdf")),
+                (ExportFormat::OpenVins, PathBuf::from("o.yaml")),
+            ]
+        );
+        assert_eq!(c.adjustment, Adjustment::Inflate(2.0));
+        assert_eq!(c.policy, AxisPolicy::PerAxis);
+        assert_eq!(c.json.as_deref(), Some(Path::new("-")));
+        let Config::Calibrate(c) = config(&["calibrate", "imu.csv", "--conservative"]) else {
+            panic!()
+        };
+        assert_eq!(c.adjustment, Adjustment::Conservative);
+        assert_eq!(c.policy, AxisPolicy::Worst);
+        assert_eq!(
+            refusal(&["calibrate", "imu.csv", "--export", "rovio", "x.yaml"]),
+            (
+                "invalid --export rovio: one of kalibr, openvins, vins, orbslam3, px4".into(),
+                true
+            )
+        );
+    }
+
+    #[test]
+    fn report_names_its_file_once() {
+        assert_eq!(
+            refusal(&["report", "imu.csv", "-o", "a.html", "--report", "b.html"]),
+            (
+                "give the report's file once: -o a.html or --report b.html".into(),
+                true
+            )
+        );
+        for (argv, file) in [
+            (&["report", "data/imu.csv.gz"][..], "imu.report.html"),
+            (&["report", "run.bag", "--report", "r.html"], "r.html"),
+            (&["report", "rosbag2_x/", "-o", "o.html"], "o.html"),
+            (&["report", "rosbag2_x/"], "rosbag2_x.report.html"),
+        ] {
+            let Config::Report(c) = config(argv) else {
+                panic!()
+            };
+            assert_eq!(c.output, PathBuf::from(file), "{argv:?}");
+        }
+    }
+
+    #[test]
+    fn plot_refuses_what_a_figure_cannot_honour() {
+        for (argv, msg) in [
+            (
+                &["plot", "wv", "x.csv", "-o", "f.jpg"][..],
+                "invalid --output ",
+            ),
+            (
+                &["plot", "avar", "x.csv", "--csv", "-o", "f.svg"],
+                "gmwm plot draws a figure: --json and --csv belong to gmwm wv|avar|fit|select",
+            ),
+            (
+                &["plot", "ieee", "x.csv", "--kind", "modified", "-o", "f.svg"],
+                "gmwm plot ieee reads the overlapping Allan variance (IEEE Std 952): drop --kind",
+            ),
+            (
+                &[
+                    "plot",
+                    "fit",
+                    "x.csv",
+                    "--model",
+                    "WN()",
+                    "--inference",
+                    "-o",
+                    "f.svg",
+                ],
+                "gmwm plot fit draws the fit: --inference belongs to gmwm fit",
+            ),
+            (
+                &[
+                    "plot",
+                    "select",
+                    "x.csv",
+                    "--model",
+                    "WN()",
+                    "--overlay",
+                    "-o",
+                    "f.svg",
+                ],
+                "--overlay lays out the axes of gmwm plot wv and avar; this figure has one \
+                 panel per column",
+            ),
+            (
+                &["plot", "wv", "x.csv", "--width", "30000", "-o", "f.svg"],
+                "invalid --width/--height: at most 20000 px a side",
+            ),
+            (
+                &[
+                    "plot", "wv", "x.csv", "--width", "10000", "--height", "10000", "-o", "f.svg",
+                ],
+                "invalid --width 10000 --height 10000: at most 40 megapixels",
+            ),
+        ] {
+            let (text, usage) = refusal(argv);
+            assert!(text.starts_with(msg) && usage, "{argv:?}: {text}");
+        }
+        // the figure's checks come before the data flags'
+        assert!(refusal(&[
+            "plot",
+            "fit",
+            "x",
+            "--model",
+            "AR1(",
+            "--inference",
+            "-o",
+            "f.svg"
+        ])
+        .0
+        .contains("--inference"));
+    }
+
+    #[test]
+    fn plot_flags_give_the_figure_and_its_data() {
+        let Config::Plot(c) = config(&[
+            "plot",
+            "wv",
+            "x.csv",
+            "--overlay",
+            "--width",
+            "800",
+            "-o",
+            "f.PNG",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(
+            c.figure,
+            FigureConfig {
+                output: "f.PNG".into(),
+                layout: Layout::Overlay,
+                width: Some(800),
+                height: None,
+            }
+        );
+        assert!(matches!(c.kind, PlotKind::Wv(_)));
+        let Config::Plot(c) = config(&[
+            "plot", "compare", "x.csv", "--eff", "0.7", "--robust", "-o", "f.svg",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.figure.layout, Layout::Grid);
+        let PlotKind::Compare(k) = c.kind else {
+            panic!()
+        };
+        assert_eq!(k.classical, WvOptions::default());
+        assert_eq!(
+            k.robust,
+            WvOptions {
+                robust: Some(RobustOptions::new(0.7, RobustConvention::Exact).unwrap()),
+                ..WvOptions::default()
+            }
+        );
+    }
+
+    #[test]
+    fn model_commands_parse_their_model() {
+        let Config::Simulate(c) = config(&[
+            "simulate",
+            "--model",
+            "WN(sigma2=1)",
+            "--n",
+            "10",
+            "--freq",
+            "100",
+            "--components",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.model, "WN(sigma2=1)".parse::<Model>().unwrap());
+        assert_eq!((c.n, c.freq_hz, c.seed, c.components), (10, 100.0, 0, true));
+        let Config::Implied(c) = config(&["implied", "--model", "WN(sigma2=2)", "--levels", "4"])
+        else {
+            panic!()
+        };
+        assert_eq!((c.levels, c.freq_hz, c.json), (4, 1.0, false));
+        let (msg, usage) = refusal(&["implied", "--model", "XX()", "--levels", "4"]);
+        assert!(msg.contains("XX") && !usage, "{msg}");
+        let Command::Simulate(mut args) =
+            parse(&["simulate", "--model", "WN(sigma2=1)", "--n", "1"])
+        else {
+            panic!()
+        };
+        args.n = 0;
+        assert_eq!(
+            SimulateConfig::try_from(&args).unwrap_err().to_string(),
+            "invalid --n 0: simulate at least one sample"
+        );
+    }
+
+    #[test]
+    fn output_flags_give_the_style() {
+        let style = |argv: &[&str]| match config(argv) {
+            Config::Avar(c) => c.output,
+            _ => unreachable!(),
+        };
+        assert_eq!(style(&["avar", "x"]), Style::Table);
+        assert_eq!(style(&["avar", "x", "--json"]), Style::Json);
+        assert_eq!(style(&["avar", "x", "--csv"]), Style::Csv);
+    }
+}
