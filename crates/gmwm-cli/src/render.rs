@@ -37,17 +37,17 @@ pub trait CsvRows {
 impl CsvRows for WaveletVariance {
     const HEADER: &'static str = "series,level,tau,tau_s,wv,ci_low,ci_high";
     fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()> {
-        for j in 0..self.wv.len() {
+        for j in 0..self.wv().len() {
             writeln!(
                 out,
                 "{},{},{},{:e},{:e},{:e},{:e}",
                 csv_field(name),
                 j + 1,
-                self.tau[j],
-                self.tau_s[j],
-                self.wv[j],
-                self.ci_low[j],
-                self.ci_high[j]
+                self.tau()[j],
+                self.tau_s()[j],
+                self.wv()[j],
+                self.ci_low()[j],
+                self.ci_high()[j]
             )?;
         }
         Ok(())

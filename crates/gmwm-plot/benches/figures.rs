@@ -20,7 +20,7 @@ fn bench(c: &mut Criterion) {
     let figure = fit_figure(&[Column::new("gyro_x", "rad/s", &fit)]);
     c.bench_function("fit_figure_svg", |b| b.iter(|| figure.svg().unwrap()));
     c.bench_function("fit_figure_png", |b| b.iter(|| figure.png().unwrap()));
-    let wv = fit.empirical.clone().unwrap();
+    let wv = fit.empirical().cloned().unwrap();
     let names = [
         "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
     ];

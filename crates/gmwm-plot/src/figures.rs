@@ -220,13 +220,13 @@ pub fn wv_figure(columns: &[Column<'_, WaveletVariance>], layout: Layout) -> Fig
             name: c.name,
             place: c.place(),
             unit: c.unit,
-            tau_s: c.data.tau_s.clone(),
-            value: c.data.wv.clone(),
-            low: c.data.ci_low.clone(),
-            high: c.data.ci_high.clone(),
+            tau_s: c.data.tau_s().to_vec(),
+            value: c.data.wv().to_vec(),
+            low: c.data.ci_low().to_vec(),
+            high: c.data.ci_high().to_vec(),
         })
         .collect();
-    let what = match columns.first().map(|c| c.data.robust.is_some()) {
+    let what = match columns.first().map(|c| c.data.robust().is_some()) {
         Some(true) => "robust WV",
         _ => "WV",
     };
@@ -278,20 +278,20 @@ pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]
         .iter()
         .map(|c| {
             let (classical, robust) = c.data;
-            let eff = robust.robust.map_or(0.6, |r| r.eff);
-            let level = 100.0 * (1.0 - classical.alpha);
+            let eff = robust.robust().map_or(0.6, |r| r.eff);
+            let level = 100.0 * (1.0 - classical.alpha());
             let [cb, cp] = estimate_series(
-                &classical.tau_s,
-                &classical.wv,
-                &classical.ci_low,
-                &classical.ci_high,
+                classical.tau_s(),
+                classical.wv(),
+                classical.ci_low(),
+                classical.ci_high(),
                 Some(4),
             );
             let [rb, rp] = estimate_series(
-                &robust.tau_s,
-                &robust.wv,
-                &robust.ci_low,
-                &robust.ci_high,
+                robust.tau_s(),
+                robust.wv(),
+                robust.ci_low(),
+                robust.ci_high(),
                 Some(5),
             );
             Panel {
@@ -313,7 +313,7 @@ pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]
 /// The legend entry of one fitted component: its process and the values a filter uses, in the
 /// data unit (continuous time; METHODS §14.2, through the engine's read-off).
 fn component_label(fit: &GmwmFit, index: usize, unit: &str) -> String {
-    let component = &fit.model.components()[index];
+    let component = &fit.model().components()[index];
     let kind = component.kind.name();
     let values: Vec<String> = fit
         .navigation(Some(unit))
@@ -345,16 +345,16 @@ fn component_label(fit: &GmwmFit, index: usize, unit: &str) -> String {
 
 /// The empirical WV with its band and the fitted model's implied WV (total, thick), as series.
 fn empirical_and_model(fit: &GmwmFit, model_label: &str) -> Vec<Series> {
-    let implied = &fit.implied_wv;
+    let implied = &fit.implied_wv();
     let mut series = Vec::new();
-    if let Some(wv) = &fit.empirical {
-        let level = 100.0 * (1.0 - wv.alpha);
-        let [band, points] = estimate_series(&wv.tau_s, &wv.wv, &wv.ci_low, &wv.ci_high, None);
+    if let Some(wv) = &fit.empirical() {
+        let level = 100.0 * (1.0 - wv.alpha());
+        let [band, points] = estimate_series(wv.tau_s(), wv.wv(), wv.ci_low(), wv.ci_high(), None);
         series.push(band.labelled(format!("{level:.0}% interval")));
         series.push(points.labelled("empirical WV"));
     } else {
         series.push(
-            Series::new(Mark::LinePoints, &implied.tau_s, &fit.nu_hat).labelled("empirical WV"),
+            Series::new(Mark::LinePoints, &implied.tau_s, fit.nu_hat()).labelled("empirical WV"),
         );
     }
     series.push(
@@ -382,15 +382,15 @@ pub fn fit_figure(columns: &[Column<'_, GmwmFit>]) -> Figure {
         .map(|c| {
             let fit = c.data;
             let mut series = empirical_and_model(fit, "model (implied WV)");
-            if fit.implied_wv.processes.len() > 1 {
-                for (k, p) in fit.implied_wv.processes.iter().enumerate() {
+            if fit.implied_wv().processes.len() > 1 {
+                for (k, p) in fit.implied_wv().processes.iter().enumerate() {
                     series.push(
                         Series::new(
                             Mark::Line {
                                 width: 2,
                                 dashed: false,
                             },
-                            &fit.implied_wv.tau_s,
+                            &fit.implied_wv().tau_s,
                             &p.wv,
                         )
                         .coloured(k + 1)
@@ -400,7 +400,7 @@ pub fn fit_figure(columns: &[Column<'_, GmwmFit>]) -> Figure {
                 }
             }
             Panel {
-                title: format!("{}: {}", c.name, fit.model.without_values()),
+                title: format!("{}: {}", c.name, fit.model().without_values()),
                 x_label: WV_SCALE.to_string(),
                 y_label: wv_label(c.unit),
                 kind: PanelKind::LogLog(series),

@@ -400,7 +400,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
         &format!(
             "{}: the identified fit {}, its implied WV and each process's (values in {unit}).",
             a.column,
-            a.fit.model.without_values()
+            a.fit.model().without_values()
         ),
     )?);
 
@@ -457,7 +457,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
                 &format!(
                     "{}: classical and robust (efficiency {}) WV with their intervals.",
                     a.column,
-                    c.robust.robust.map_or(0.6, |r| r.eff)
+                    c.robust.robust().map_or(0.6, |r| r.eff)
                 ),
             )?);
         }

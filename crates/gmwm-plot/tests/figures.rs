@@ -9,7 +9,7 @@ use gmwm::imu::{read_table, read_wv_json, ReadOptions};
 use gmwm::{allan_variance, AllanOptions, Gmwm, RobustOptions, WaveletVariance, Wic, WvOptions};
 use gmwm_plot::{
     allan_figure, compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column,
-    Figure, Layout,
+    Figure, Layout, PanelKind,
 };
 use std::path::PathBuf;
 
@@ -69,6 +69,25 @@ fn parse(svg: &str) -> Svg {
 }
 
 /// Renders both formats, checks the PNG's size, saves them when asked; returns the SVG counts.
+/// `wv` with level `j` (0-based) undefined, as a saved wavelet variance with `null` there
+/// reads back (the engine's WV file reader).
+fn with_undefined_level(wv: &WaveletVariance, j: usize) -> WaveletVariance {
+    let mut series = serde_json::to_value(wv).unwrap();
+    for key in ["wv", "ci_low", "ci_high"] {
+        series[key][j] = serde_json::Value::Null;
+    }
+    series["name"] = "gyro_x".into();
+    let doc = serde_json::json!({ "freq_hz": wv.freq_hz(), "series": [series] });
+    let path = std::env::temp_dir().join(format!(
+        "gmwm_plot_undefined_level_{}_{j}.json",
+        std::process::id()
+    ));
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let read = read_wv_json(&path, None);
+    std::fs::remove_file(&path).ok();
+    read.unwrap().remove(0).1
+}
+
 fn render(figure: &Figure, name: &str) -> Svg {
     let svg = figure.svg().unwrap();
     let png = figure.png().unwrap();
@@ -176,10 +195,9 @@ fn figures_classical_against_robust_shows_the_contamination() {
 fn figures_compare_with_an_undefined_robust_level_splits_its_band() {
     let (cols, freq) = recording("cont_imu1.csv.gz", 1 << 16);
     let x = &cols[0].1;
-    let (classical, mut robust) = (wv(x, freq, false), wv(x, freq, true));
-    for v in [&mut robust.wv, &mut robust.ci_low, &mut robust.ci_high] {
-        v[4] = f64::NAN;
-    }
+    let (classical, robust) = (wv(x, freq, false), wv(x, freq, true));
+    let robust = with_undefined_level(&robust, 4);
+    assert!(robust.wv()[4].is_nan() && robust.ci_low()[4].is_nan());
     let levels = classical.levels();
     let pair = (classical, robust);
     let svg = render(
@@ -237,14 +255,20 @@ fn figures_fit_decomposition_names_every_process_with_its_value() {
 #[test]
 fn figures_fit_with_a_component_below_the_plot_says_so() {
     let (cols, freq) = recording("adis_16405_imu1.csv.gz", 1 << 16);
-    let mut fit = Gmwm::new("AR1()+WN()".parse().unwrap())
+    let fit = Gmwm::new("AR1()+WN()".parse().unwrap())
         .with_seed(1)
         .fit(&cols[0].1, freq, &WvOptions::default())
         .unwrap();
-    for v in &mut fit.implied_wv.processes[0].wv {
-        *v *= 1e-12;
-    }
-    let figure = fit_figure(&[Column::new("gyro_x", "deg/s", &fit)]);
+    let mut figure = fit_figure(&[Column::new("gyro_x", "deg/s", &fit)]);
+    // the AR1 component's line, moved twelve decades down
+    let PanelKind::LogLog(series) = &mut figure.panels[0].kind else {
+        panic!("the fit panel is a log-log panel")
+    };
+    let ar1 = series
+        .iter_mut()
+        .find(|s| s.label.as_deref().is_some_and(|l| l.starts_with("AR1: ")))
+        .expect("an AR1 component line");
+    ar1.y.iter_mut().for_each(|v| *v *= 1e-12);
     let svg = render(&figure, "fit_component_below");
     assert!(
         svg.texts

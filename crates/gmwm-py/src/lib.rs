@@ -412,7 +412,7 @@ fn fit(
                 ..InferenceOptions::default()
             };
             for ((f, n), x) in fits.iter().zip(&names).zip(&cols) {
-                let wv = f.empirical.as_ref().ok_or("the fit carries no WV")?;
+                let wv = f.empirical().ok_or("the fit carries no WV")?;
                 let this_wv = wv.options();
                 let i = infer_with_progress(&gmwm, f, x.len(), &this_wv, &opts, &|d| {
                     reporter.advance(d)

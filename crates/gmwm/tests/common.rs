@@ -89,3 +89,27 @@ pub fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
         })
         .collect()
 }
+
+/// `wv` edited as its JSON document (`gmwm wv --json`: `null` for an undefined value) and read
+/// back by the engine's WV file reader: the public way to a wavelet variance computed elsewhere,
+/// used here to fabricate edge cases (an undefined level, exact values, more degrees of freedom).
+pub fn edited_wv(
+    wv: &gmwm::WaveletVariance,
+    edit: impl FnOnce(&mut serde_json::Value),
+) -> gmwm::WaveletVariance {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    let mut series = serde_json::to_value(wv).unwrap();
+    series["name"] = "edited".into();
+    edit(&mut series);
+    let doc = serde_json::json!({ "freq_hz": wv.freq_hz(), "series": [series] });
+    let path = std::env::temp_dir().join(format!(
+        "gmwm_edited_wv_{}_{}.json",
+        std::process::id(),
+        CALLS.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let read = gmwm::imu::read_wv_json(&path, None);
+    std::fs::remove_file(&path).ok();
+    read.unwrap().remove(0).1
+}

@@ -65,11 +65,13 @@ fn contamination_outliers_inflate_the_first_scales() {
 #[test]
 fn contamination_undefined_robust_level_is_named_not_compared() {
     let x = white_noise(1 << 12, 3);
-    let (c, mut r) = pair(&x);
-    r.wv[2] = f64::NAN;
-    r.ci_low[2] = f64::NAN;
-    r.ci_high[2] = f64::NAN;
-    let levels = c.wv.len();
+    let (c, r) = pair(&x);
+    let r = crate::common::edited_wv(&r, |doc| {
+        for key in ["wv", "ci_low", "ci_high"] {
+            doc[key][2] = serde_json::Value::Null;
+        }
+    });
+    let levels = c.wv().len();
     let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
     assert_eq!(check.undefined_levels, vec![3]);
     assert_eq!(check.levels, levels - 1);
@@ -106,8 +108,9 @@ fn contamination_advice_follows_the_estimator_the_fit_used() {
 #[test]
 fn contamination_nothing_to_compare_says_so() {
     let x = white_noise(1 << 10, 9);
-    let (c, mut r) = pair(&x);
-    r.wv.iter_mut().for_each(|v| *v = f64::NAN);
+    let (c, r) = pair(&x);
+    let undefined = vec![serde_json::Value::Null; r.levels()];
+    let r = crate::common::edited_wv(&r, |doc| doc["wv"] = serde_json::json!(undefined));
     let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
     assert_eq!(check.levels, 0);
     assert!(!check.matters);

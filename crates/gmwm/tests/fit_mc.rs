@@ -34,8 +34,8 @@ fn replicate_fits(
                 .with_draws(draws)
                 .fit(&x, freq, &WvOptions::default())
                 .unwrap_or_else(|e| panic!("replicate {i}: {e}"));
-            assert!(fit.convergence.converged, "replicate {i}: {fit}");
-            fit.theta
+            assert!(fit.convergence().converged, "replicate {i}: {fit}");
+            fit.theta().to_vec()
         })
         .collect()
 }
@@ -146,8 +146,8 @@ fn robust_fit_resists_outliers() {
             let est = Gmwm::parse("AR1()+WN()").unwrap().with_draws(5000);
             let r = est.fit(&x, 1.0, &robust).unwrap();
             let c = est.fit(&x, 1.0, &WvOptions::default()).unwrap();
-            assert!(r.convergence.converged, "{r}");
-            (r.theta, c.theta)
+            assert!(r.convergence().converged, "{r}");
+            (r.theta().to_vec(), c.theta().to_vec())
         })
         .collect();
     for (r, c) in &results {

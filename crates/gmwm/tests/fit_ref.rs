@@ -36,15 +36,15 @@ fn objective_never_above_the_r_package_on_adis_imu1() {
                 .fit_from_wv(wv, StartInputs::from_series(&x))
                 .unwrap();
             let r_obj = f["gm"]["obj_fun"].as_f64().unwrap();
-            assert!(ours.convergence.converged, "{column} {key}: {ours}");
+            assert!(ours.convergence().converged, "{column} {key}: {ours}");
             assert!(
-                ours.objective <= r_obj * (1.0 + 1e-6),
+                ours.objective() <= r_obj * (1.0 + 1e-6),
                 "{column} {key}: ours Q = {} > R's {r_obj}\n{ours}",
-                ours.objective
+                ours.objective()
             );
             // the same weights as the package (its omega_diag), to the WV parity (1e-9)
             let omega = crate::common::f64s(&f["gm"]["omega_diag"]);
-            for (j, (a, b)) in ours.weights.omega.iter().zip(&omega).enumerate() {
+            for (j, (a, b)) in ours.weights().omega.iter().zip(&omega).enumerate() {
                 assert!(
                     crate::common::rel_diff(*a, *b) < 1e-8,
                     "{column} {key}: omega level {}: {a} vs {b}",
@@ -79,30 +79,30 @@ fn bootstrap_weighting_refits_with_bootstrap_variances() {
             .unwrap()
     };
     let boot = bootstrap_fit();
-    assert!(boot.convergence.converged, "{boot}");
-    assert_eq!(boot.weighting, Weighting::Bootstrap);
-    assert_eq!(boot.bootstrap_replicates, Some(60));
-    assert_eq!(boot.org_v.as_deref(), Some(&fast.weights.v[..]));
-    assert_ne!(boot.weights.v, fast.weights.v);
+    assert!(boot.convergence().converged, "{boot}");
+    assert_eq!(boot.weighting(), Weighting::Bootstrap);
+    assert_eq!(boot.bootstrap_replicates(), Some(60));
+    assert_eq!(boot.org_v(), Some(&fast.weights().v[..]));
+    assert_ne!(boot.weights().v, fast.weights().v);
     // both estimators are consistent: estimates within a few of the fast fit's sampling spread
     assert!(
-        (boot.theta[0] - fast.theta[0]).abs() < 0.02,
+        (boot.theta()[0] - fast.theta()[0]).abs() < 0.02,
         "{boot}\n{fast}"
     );
     assert!(
-        (boot.theta[2] / fast.theta[2] - 1.0).abs() < 0.05,
+        (boot.theta()[2] / fast.theta()[2] - 1.0).abs() < 0.05,
         "{boot}\n{fast}"
     );
     // the squared fast CI width overstates Var(nu2_hat) by (2 z)^2 ~ 15 at large eta: the
     // bootstrap variances are ~15x smaller (a factor, not an error; only Omega's shape matters)
-    let ratio = fast.weights.v[0] / boot.weights.v[0];
+    let ratio = fast.weights().v[0] / boot.weights().v[0];
     assert!(
         ratio > 5.0 && ratio < 40.0,
         "fast / bootstrap V at level 1: {ratio}"
     );
     // same seed, same answer
     let again = bootstrap_fit();
-    assert_eq!(again.theta, boot.theta);
+    assert_eq!(again.theta(), boot.theta());
     assert!(Gmwm::parse("WN()").unwrap().with_bootstrap(1, 1).is_err());
     assert!(Gmwm::parse("WN()").unwrap().with_bootstrap(10, 0).is_err());
 }
@@ -121,15 +121,15 @@ fn update_refits_on_the_stored_wv() {
     let small = Gmwm::parse("AR1()+WN()").unwrap().with_draws(3000);
     let updated = small.update(&full).unwrap();
     let direct = small.fit(&x, 1.0, &WvOptions::default()).unwrap();
-    assert_eq!(updated.theta, direct.theta);
-    assert_eq!(updated.objective, direct.objective);
-    assert_eq!(updated.empirical, full.empirical);
+    assert_eq!(updated.theta(), direct.theta());
+    assert_eq!(updated.objective(), direct.objective());
+    assert_eq!(updated.empirical(), full.empirical());
     // dropping RW from the truth cannot fit better
-    assert!(updated.objective >= full.objective);
+    assert!(updated.objective() >= full.objective());
     // a bare fit_weighted result has no stored WV
-    let nu = full.nu_hat.clone();
+    let nu = full.nu_hat().to_vec();
     let bare = small
-        .fit_weighted(&nu, full.weights.clone(), 1.0, &[0.99, 0.01, 1.0])
+        .fit_weighted(&nu, full.weights().clone(), 1.0, &[0.99, 0.01, 1.0])
         .unwrap();
     assert!(matches!(
         small.update(&bare).unwrap_err(),
@@ -149,28 +149,28 @@ fn wv_json_round_trip_and_refusals() {
     let wv = wavelet_variance(&x, 10.0, &WvOptions::default()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let full = dir.path().join("full.json");
-    let doc = serde_json::json!({ "series": [ { "name": "x", "n": wv.n, "freq_hz": 10.0,
-        "tau": wv.tau, "wv": wv.wv, "ci_low": wv.ci_low, "ci_high": wv.ci_high,
-        "n_coefficients": wv.n_coefficients, "eta": wv.eta } ] });
+    let doc = serde_json::json!({ "series": [ { "name": "x", "n": wv.n(), "freq_hz": 10.0,
+        "tau": wv.tau(), "wv": wv.wv(), "ci_low": wv.ci_low(), "ci_high": wv.ci_high(),
+        "n_coefficients": wv.n_coefficients(), "eta": wv.eta() } ] });
     std::fs::write(&full, doc.to_string()).unwrap();
     let read = gmwm::imu::read_wv_json(&full, None).unwrap();
     assert_eq!(read[0].0, "x");
-    assert_eq!(read[0].1.wv, wv.wv);
-    assert_eq!(read[0].1.eta, wv.eta);
+    assert_eq!(read[0].1.wv(), wv.wv());
+    assert_eq!(read[0].1.eta(), wv.eta());
     let minimal = dir.path().join("min.json");
-    let doc = serde_json::json!({ "freq_hz": 10.0, "series": [ { "name": "x", "n": wv.n,
-        "tau": wv.tau, "wv": wv.wv, "ci_low": wv.ci_low, "ci_high": wv.ci_high } ] });
+    let doc = serde_json::json!({ "freq_hz": 10.0, "series": [ { "name": "x", "n": wv.n(),
+        "tau": wv.tau(), "wv": wv.wv(), "ci_low": wv.ci_low(), "ci_high": wv.ci_high() } ] });
     std::fs::write(&minimal, doc.to_string()).unwrap();
     let min = gmwm::imu::read_wv_json(&minimal, None).unwrap();
     // counts and eta3 are recomputed from n exactly as the estimator does
-    assert_eq!(min[0].1.n_coefficients, wv.n_coefficients);
-    assert_eq!(min[0].1.eta, wv.eta);
+    assert_eq!(min[0].1.n_coefficients(), wv.n_coefficients());
+    assert_eq!(min[0].1.eta(), wv.eta());
     let est = Gmwm::parse("AR1()+WN()").unwrap().with_draws(2000);
     let a = est
         .fit_from_wv(&min[0].1, StartInputs::from_wv(&wv))
         .unwrap();
     let b = est.fit_from_wv(&wv, StartInputs::from_wv(&wv)).unwrap();
-    assert_eq!(a.theta, b.theta);
+    assert_eq!(a.theta(), b.theta());
     let bad = |doc: serde_json::Value, needle: &str| {
         let p = dir.path().join("bad.json");
         std::fs::write(&p, doc.to_string()).unwrap();
@@ -285,6 +285,6 @@ fn section_5_7_refusals_and_power_of_two() {
         .with_draws(2000)
         .fit(&x, 1.0, &opts)
         .unwrap();
-    assert_eq!(fit.nu_hat.len(), 11);
-    assert!(fit.convergence.converged, "{fit}");
+    assert_eq!(fit.nu_hat().len(), 11);
+    assert!(fit.convergence().converged, "{fit}");
 }

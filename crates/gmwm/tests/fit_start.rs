@@ -83,15 +83,17 @@ fn recovery_ar1_wn_rw_guess_mode() {
     ))
     .fit(&x, 1.0, &opts)
     .unwrap();
-    assert_eq!(exact.start, vec![0.99, 0.01, 1.0, 1e-4]);
+    assert_eq!(exact.start(), vec![0.99, 0.01, 1.0, 1e-4]);
     eprintln!(
         "AR1+WN+RW: guess Q = {:e} theta {:?}, exact-start Q = {:e}",
-        guess.objective, guess.theta, exact.objective
+        guess.objective(),
+        guess.theta(),
+        exact.objective()
     );
-    assert!(guess.objective <= exact.objective * GUESS_FACTOR);
+    assert!(guess.objective() <= exact.objective() * GUESS_FACTOR);
     // loose bounds: phi within 0.01, sigma2 and WN within 30 %, RW within a factor 10 (the
     // RW is seen only at the last few, noisy levels)
-    let t = &guess.theta;
+    let t = &guess.theta();
     assert!((t[0] - 0.99).abs() < 0.01, "{t:?}");
     assert!((t[1] / 0.01 - 1.0).abs() < 0.3, "{t:?}");
     assert!((t[2] - 1.0).abs() < 0.3, "{t:?}");
@@ -110,11 +112,14 @@ fn recovery_two_gm_wn_guess_mode() {
     let exact = Gmwm::new(truth).fit(&x, freq, &opts).unwrap();
     eprintln!(
         "2GM+WN: guess Q = {:e} theta {:?}, exact-start Q = {:e} theta {:?}",
-        guess.objective, guess.theta, exact.objective, exact.theta
+        guess.objective(),
+        guess.theta(),
+        exact.objective(),
+        exact.theta()
     );
-    assert!(guess.objective <= exact.objective * GUESS_FACTOR);
+    assert!(guess.objective() <= exact.objective() * GUESS_FACTOR);
     // loose bounds: rates within a factor 3, variances within a factor 3, WN within 30 %
-    let t = &guess.theta;
+    let t = &guess.theta();
     let within = |v: f64, truth: f64, f: f64| v > truth / f && v < truth * f;
     assert!(within(t[0], 0.5, 3.0), "{t:?}");
     assert!(within(t[1], 1e-4, 3.0), "{t:?}");
@@ -137,8 +142,8 @@ fn reference_ar1_wn_rw_vs_r() {
         .unwrap();
     // same objective definition: our WV and our Q at R's exact-start estimate
     let wv_r = f64s(&run["fit_guess"]["wv_empir"]);
-    assert_eq!(fit.nu_hat.len(), wv_r.len());
-    for (a, b) in fit.nu_hat.iter().zip(&wv_r) {
+    assert_eq!(fit.nu_hat().len(), wv_r.len());
+    for (a, b) in fit.nu_hat().iter().zip(&wv_r) {
         assert!((a / b - 1.0).abs() < SAME_Q_TOL, "{a} vs {b}");
     }
     let est = f64s(&run["fit_exact_start"]["estimate"]);
@@ -146,21 +151,26 @@ fn reference_ar1_wn_rw_vs_r() {
     let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
     let weights = Weights::fast(&wv).unwrap();
     let param = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Ordered, 1.0).unwrap();
-    let ours_at_r = Objective::new(&m, param, &wv.wv, &weights, 1.0)
+    let ours_at_r = Objective::new(&m, param, wv.wv(), &weights, 1.0)
         .unwrap()
         .value_at_theta(&est)
         .unwrap();
     eprintln!(
         "ref N=1e5: ours Q = {:e} (theta {:?}, start {:?}); R guess {:e}, R exact-start {:e}, \
          our Q at R's exact-start estimate {:e}",
-        fit.objective, fit.theta, fit.start, r_guess, r_exact, ours_at_r
+        fit.objective(),
+        fit.theta(),
+        fit.start(),
+        r_guess,
+        r_exact,
+        ours_at_r
     );
     assert!(
         (ours_at_r / r_exact - 1.0).abs() < 1e-4,
         "{ours_at_r} vs {r_exact}"
     );
-    assert!(fit.objective <= r_exact * R_FACTOR);
-    assert!(fit.objective <= r_guess);
+    assert!(fit.objective() <= r_exact * R_FACTOR);
+    assert!(fit.objective() <= r_guess);
 }
 
 #[test]
@@ -172,8 +182,8 @@ fn fit_from_precomputed_wv() {
     let from_wv = g.fit_from_wv(&wv, StartInputs::from_wv(&wv)).unwrap();
     let from_x = g.fit(&x, 1.0, &WvOptions::default()).unwrap();
     // the range R only feeds DR draws (none here), so both searches are identical
-    assert_eq!(from_wv.start, from_x.start);
-    assert_eq!(from_wv.objective, from_x.objective);
+    assert_eq!(from_wv.start(), from_x.start());
+    assert_eq!(from_wv.objective(), from_x.objective());
     assert_eq!(StartInputs::from_wv(&wv).range, 0.0);
     // the diag weighting needs the series: an error, not a panic
     let diag = Gmwm::new(model("AR1()+WN()+RW()")).with_weighting(gmwm::fit::Weighting::Diag);
@@ -215,10 +225,11 @@ fn reference_ar1_wn_rw_small_n_vs_r() {
         let r_exact = run["fit_exact_start"]["obj_fun"].as_f64().unwrap();
         eprintln!(
             "{n}: ours Q = {:e} theta {:?}; R guess {r_guess:e}, R exact-start {r_exact:e}",
-            fit.objective, fit.theta
+            fit.objective(),
+            fit.theta()
         );
-        assert!(fit.objective <= r_exact * R_FACTOR, "{n}");
-        assert!(fit.objective <= r_guess, "{n}");
+        assert!(fit.objective() <= r_exact * R_FACTOR, "{n}");
+        assert!(fit.objective() <= r_guess, "{n}");
     }
 }
 
@@ -252,24 +263,24 @@ fn reference_gm3_guess_mode_vs_r() {
         let m = model("3*GM()");
         let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
         let param = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Free, 1.0).unwrap();
-        let ours_at_r = Objective::new(&m, param, &wv.wv, &Weights::fast(&wv).unwrap(), 1.0)
+        let ours_at_r = Objective::new(&m, param, wv.wv(), &Weights::fast(&wv).unwrap(), 1.0)
             .unwrap()
             .value_at_theta(&f64s(&run["fit_exact_start"]["estimate"]))
             .unwrap();
         eprintln!(
             "{n}: ours Q = {:e}; R guess {r_guess:e}, R exact-start {r_exact:e}, our Q at R's \
              exact-start estimate {ours_at_r:e}",
-            fit.objective
+            fit.objective()
         );
         assert!(
             (ours_at_r / r_exact - 1.0).abs() < 1e-4,
             "{ours_at_r} vs {r_exact}"
         );
         assert!(
-            fit.objective <= r_exact * R_FACTOR,
+            fit.objective() <= r_exact * R_FACTOR,
             "{n}: {} vs {r_exact}",
-            fit.objective
+            fit.objective()
         );
-        assert!(fit.objective <= r_guess, "{n}");
+        assert!(fit.objective() <= r_guess, "{n}");
     }
 }

@@ -50,15 +50,15 @@ fn ar_correlated(v_diag: &[f64], rho: f64) -> DMatrix<f64> {
 fn j_test_with_the_fit_weights_is_the_fit_objective() {
     // V = diag(fast V): the efficient refit is the fit itself, so T = Q(theta_hat)
     let (gmwm, fit, _, _) = simulated_fit("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)", 5000, 10, 3);
-    let v = DMatrix::from_diagonal(&DVector::from_vec(fit.weights.v.clone()));
+    let v = DMatrix::from_diagonal(&DVector::from_vec(fit.weights().v.clone()));
     let t = j_test(&gmwm, &fit, &v).unwrap();
     assert_eq!(t.df, 10 - 3);
     // both minima are converged to ~1e-15 relative in Q; 1e-9 allows for the LM stop rule
     assert!(
-        rel(t.statistic, fit.objective) < 1e-9,
+        rel(t.statistic, fit.objective()) < 1e-9,
         "{} vs {}",
         t.statistic,
-        fit.objective
+        fit.objective()
     );
     assert_eq!(t.p_value, chi_square_upper_tail(t.statistic, t.df));
 }
@@ -68,12 +68,12 @@ fn j_test_matches_generalised_least_squares_on_a_linear_model() {
     // WN + RW: the implied WV is linear in (sigma2, gamma2), so the efficient-weight estimate
     // is GLS, theta = (A' W A)^{-1} A' W nu_hat with W = V^{-1}, and T = r' W r (closed form).
     let (gmwm, fit, _, _) = simulated_fit("WN(sigma2=1)+RW(gamma2=0.001)", 4000, 9, 5);
-    let v = ar_correlated(&fit.weights.v, 0.6);
+    let v = ar_correlated(&fit.weights().v, 0.6);
     let t = j_test(&gmwm, &fit, &v).unwrap();
-    let a = fit.model.jacobian(9, 1.0).unwrap();
+    let a = fit.model().jacobian(9, 1.0).unwrap();
     let a = DMatrix::from_fn(9, 2, |i, j| a[i][j]);
     let w = v.clone().try_inverse().unwrap();
-    let nu = DVector::from_vec(fit.nu_hat.clone());
+    let nu = DVector::from_vec(fit.nu_hat().to_vec());
     let ata = a.transpose() * &w * &a;
     let theta = ata.try_inverse().unwrap() * a.transpose() * &w * &nu;
     assert!(
@@ -162,7 +162,7 @@ fn j_test_rejects_bad_input() {
     let bad = DMatrix::from_element(8, 8, 1.0); // rank 1
     assert!(j_test(&gmwm, &fit, &bad).is_err());
     let (gmwm, fit, _, _) = simulated_fit("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)", 3000, 3, 3);
-    let v = DMatrix::from_diagonal(&DVector::from_vec(fit.weights.v.clone()));
+    let v = DMatrix::from_diagonal(&DVector::from_vec(fit.weights().v.clone()));
     let e = j_test(&gmwm, &fit, &v).unwrap_err();
     assert!(e.to_string().contains("df"), "{e}");
 }
@@ -486,20 +486,20 @@ fn gm_inference_is_in_gm_units() {
     };
     let inf = infer(&g, &fit, 20_000, &opts, &o).unwrap();
     // the same fit written as an AR1: phi = exp(-beta / freq), sigma2 = sigma2_gm (1 - phi^2)
-    let (b, s) = (fit.theta[0], fit.theta[1]);
+    let (b, s) = (fit.theta()[0], fit.theta()[1]);
     let phi = (-b / freq).exp();
     let ar = Gmwm::new(model("AR1()+WN()"));
     let ar_fit = ar
         .fit_weighted(
-            &fit.nu_hat,
-            fit.weights.clone(),
+            fit.nu_hat(),
+            fit.weights().clone(),
             freq,
-            &[phi, s * (1.0 - phi * phi), fit.theta[2]],
+            &[phi, s * (1.0 - phi * phi), fit.theta()[2]],
         )
         .unwrap();
     let ar_inf = infer(&ar, &ar_fit, 20_000, &opts, &o).unwrap();
     // d(beta, sigma2_gm) / d(phi, sigma2): beta = -freq ln phi, sigma2_gm = sigma2 / (1 - phi^2)
-    let s2 = ar_fit.theta[1];
+    let s2 = ar_fit.theta()[1];
     let jac = DMatrix::from_row_slice(
         2,
         2,
@@ -550,14 +550,15 @@ fn check_boundary_inference(seed: u64, big: &str, small: &str, boundary: &[&str]
     let (gb, fb) = fit_of(big);
     let (gs, fs) = fit_of(small);
     assert_eq!(
-        fb.collapsed, boundary,
+        fb.collapsed(),
+        boundary,
         "the case needs these components at 0"
     );
     let at: Vec<usize> = boundary
         .iter()
-        .map(|b| fb.param_names.iter().position(|n| n == b).unwrap())
+        .map(|b| fb.param_names().iter().position(|n| n == b).unwrap())
         .collect();
-    assert_eq!(fb.active_parameters().len(), fs.theta.len());
+    assert_eq!(fb.active_parameters().len(), fs.theta().len());
     for bootstrap in [None, Some(20)] {
         let o = InferenceOptions {
             bootstrap,
@@ -626,7 +627,7 @@ fn inference_and_refits_survive_estimates_on_the_edge() {
         .unwrap()
         .with_draws(500);
     let f = g.fit_from_wv(&wv, StartInputs::from_series(&x)).unwrap();
-    assert!(f.convergence.converged, "{:?}", f.convergence);
+    assert!(f.convergence().converged, "{:?}", f.convergence());
     for bootstrap in [None, Some(20)] {
         let o = InferenceOptions {
             bootstrap,
@@ -636,10 +637,10 @@ fn inference_and_refits_survive_estimates_on_the_edge() {
         assert!(i.gof.is_some());
     }
     // a start with the second phi and the drift exactly on their edges (0) is accepted
-    let mut edge = f.theta.clone();
+    let mut edge = f.theta().to_vec();
     edge[2] = 0.0;
     edge[6] = 0.0;
-    assert!(g.fit_wv(&wv, 100.0, &f.theta).is_ok());
+    assert!(g.fit_wv(&wv, 100.0, f.theta()).is_ok());
     let refit = g.fit_wv(&wv, 100.0, &edge).unwrap();
-    assert!(refit.objective.is_finite() && refit.convergence.converged);
+    assert!(refit.objective().is_finite() && refit.convergence().converged);
 }

@@ -440,8 +440,8 @@ fn selection_is_deterministic_and_consistent() {
         assert!((0.0..=1.0).contains(&p), "{c:?}");
     }
     assert_eq!(s.selected, s.candidates[0].model);
-    assert_eq!(s.fit.model.without_values(), s.selected);
-    assert_eq!(s.fit.objective, s.candidates[0].objective);
+    assert_eq!(s.fit.model().without_values(), s.selected);
+    assert_eq!(s.fit.objective(), s.candidates[0].objective);
     // the full model's row is the full fit against the same WV
     let full = s
         .candidates
@@ -452,7 +452,7 @@ fn selection_is_deterministic_and_consistent() {
         .with_draws(400)
         .fit(&x, 100.0, &gmwm::WvOptions::default())
         .unwrap();
-    assert_eq!(full.objective, direct.objective);
+    assert_eq!(full.objective, direct.objective());
     // white noise alone cannot follow the AR1 bump around tau ~ 40 samples
     let wn = s
         .candidates
@@ -521,7 +521,7 @@ fn bootstrap_optimism_refits_a_candidate_whose_drift_collapsed() {
         .with_draws(300)
         .fit(&x, 1.0, &gmwm::WvOptions::default())
         .unwrap();
-    assert_eq!(dr_fit.theta[3], 0.0);
+    assert_eq!(dr_fit.theta()[3], 0.0);
     let s = Wic::parse_list(&["AR1()+WN()", "AR1()+WN()+DR()"])
         .unwrap()
         .with_draws(300)
@@ -577,18 +577,18 @@ fn excess_loss(truth: &Model, candidate: &str, n: usize, reps: usize) -> (f64, f
                 .with_draws(2000)
                 .fit_from_wv(&wv, StartInputs::from_series(&x))
                 .unwrap();
-            let w = &fit.weights.omega;
+            let w = &fit.weights().omega;
             let q_new: f64 = (0..levels)
-                .map(|j| w[j] * (wv_new.wv[j] - fit.implied_wv.wv[j]).powi(2))
+                .map(|j| w[j] * (wv_new.wv()[j] - fit.implied_wv().wv[j]).powi(2))
                 .sum();
-            let jac = fit.model.jacobian(levels, freq).unwrap();
-            let p = fit.theta.len();
+            let jac = fit.model().jacobian(levels, freq).unwrap();
+            let p = fit.theta().len();
             let a = DMatrix::from_fn(levels, p, |j, k| jac[j][k]);
             let omega = DMatrix::from_diagonal(&DVector::from_column_slice(w));
-            let h = fit.model.hessian(levels, freq).unwrap();
-            let d = d_matrix(&h, &omega, &fit.implied_wv.wv, &fit.nu_hat).unwrap();
+            let h = fit.model().hessian(levels, freq).unwrap();
+            let d = d_matrix(&h, &omega, &fit.implied_wv().wv, fit.nu_hat()).unwrap();
             let o = asymptotic_optimism(&a, &d, &omega, &v, OptimismConvention::Corrected).unwrap();
-            (q_new - fit.objective, o)
+            (q_new - fit.objective(), o)
         })
         .collect();
     let k = reps as f64;
@@ -817,9 +817,9 @@ fn auto_imu_gyro_x_objectives_are_no_worse_than_the_r_package() {
         "AR1(phi={}, sigma2={})+AR1(phi={}, sigma2={})+RW(gamma2={})",
         est[0], est[1], est[2], est[3], est[4]
     ));
-    let implied = r_model.implied_wv(s.fit.nu_hat.len(), 100.0).unwrap().wv;
+    let implied = r_model.implied_wv(s.fit.nu_hat().len(), 100.0).unwrap().wv;
     let q: f64 = (0..implied.len())
-        .map(|j| s.fit.weights.omega[j] * (s.fit.nu_hat[j] - implied[j]).powi(2))
+        .map(|j| s.fit.weights().omega[j] * (s.fit.nu_hat()[j] - implied[j]).powi(2))
         .sum();
     let r_q = sel["obj_fun"].as_f64().unwrap();
     // the estimates are printed to 16 digits; 1e-6 relative covers their rounding in Q
@@ -920,8 +920,8 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
             .unwrap();
         let close = |m: &Model| {
             gmwm::fit::canonical::wv_separation(
-                &fit_of(m).implied_wv.wv,
-                &fit_of(best).implied_wv.wv,
+                &fit_of(m).implied_wv().wv,
+                &fit_of(best).implied_wv().wv,
                 &log_variance,
             ) <= gmwm::fit::SEPARATION_LIMIT
         };
@@ -966,7 +966,7 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
     assert!(sel.delta_wic <= sel.delta_wic_se, "{sel:?}");
     assert_eq!(sel.score.canonical_model, s.selected_canonical.model);
     assert_eq!(sel.score.model, s.selected);
-    assert_eq!(s.fit.model.without_values(), s.selected);
+    assert_eq!(s.fit.model().without_values(), s.selected);
     assert_eq!(
         s.selected_canonical.model.to_string(),
         "AR1()+WN()+RW()",
@@ -1231,19 +1231,21 @@ fn asymptotic_optimism_is_calibrated_for_the_fast_weights_only() {
                 let g = Gmwm::new(cand.clone()).with_draws(2000);
                 let start = g.fit_from_wv(&wv, StartInputs::from_series(&x)).unwrap();
                 let weights = Weights::new(w, &wv, Some(&x)).unwrap();
-                let f = g.fit_weighted(&wv.wv, weights, freq, &start.theta).unwrap();
-                let om = &f.weights.omega;
+                let f = g
+                    .fit_weighted(wv.wv(), weights, freq, start.theta())
+                    .unwrap();
+                let om = &f.weights().omega;
                 let q_new: f64 = (0..levels)
-                    .map(|j| om[j] * (wv_new.wv[j] - f.implied_wv.wv[j]).powi(2))
+                    .map(|j| om[j] * (wv_new.wv()[j] - f.implied_wv().wv[j]).powi(2))
                     .sum();
-                let jac = f.model.jacobian(levels, freq).unwrap();
-                let a = DMatrix::from_fn(levels, f.theta.len(), |j, k| jac[j][k]);
+                let jac = f.model().jacobian(levels, freq).unwrap();
+                let a = DMatrix::from_fn(levels, f.theta().len(), |j, k| jac[j][k]);
                 let omega = DMatrix::from_diagonal(&DVector::from_column_slice(om));
-                let h = f.model.hessian(levels, freq).unwrap();
-                let d = d_matrix(&h, &omega, &f.implied_wv.wv, &f.nu_hat).unwrap();
+                let h = f.model().hessian(levels, freq).unwrap();
+                let d = d_matrix(&h, &omega, &f.implied_wv().wv, f.nu_hat()).unwrap();
                 let o =
                     asymptotic_optimism(&a, &d, &omega, &v, OptimismConvention::Corrected).unwrap();
-                (q_new - f.objective, o)
+                (q_new - f.objective(), o)
             })
             .collect();
         let k = reps as f64;

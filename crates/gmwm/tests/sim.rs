@@ -484,7 +484,7 @@ fn simulate_wv_matches_closed_forms() {
             let x = simulate(std::slice::from_ref(g), n, replicate_seed(SEED, r)).unwrap();
             let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
             for j in 0..levels {
-                per_level[j].push(wv.wv[j]);
+                per_level[j].push(wv.wv()[j]);
             }
         }
         for j in 0..levels {
@@ -504,7 +504,7 @@ fn simulate_wv_matches_closed_forms() {
         let x = simulate(&sum, n, replicate_seed(SEED, r)).unwrap();
         let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
         for j in 0..levels {
-            per_level[j].push(wv.wv[j]);
+            per_level[j].push(wv.wv()[j]);
         }
     }
     for j in 0..levels {
@@ -533,9 +533,9 @@ fn simulate_drift_wv_is_exact() {
         let tau = 2f64.powi(j as i32 + 1);
         let truth = closed_form_wv(&g, tau);
         assert!(
-            (wv.wv[j] - truth).abs() <= 1e-9 * truth,
+            (wv.wv()[j] - truth).abs() <= 1e-9 * truth,
             "tau {tau}: {} vs {truth}",
-            wv.wv[j]
+            wv.wv()[j]
         );
     }
 }
@@ -705,8 +705,8 @@ fn simulated_models_match_their_implied_wv() {
             };
             let wv = wavelet_variance(&x, freq, &opts).unwrap();
             for j in 0..levels {
-                sum[j] += wv.wv[j];
-                sum_sq[j] += wv.wv[j] * wv.wv[j];
+                sum[j] += wv.wv()[j];
+                sum_sq[j] += wv.wv()[j] * wv.wv()[j];
             }
         }
         for j in 0..levels {

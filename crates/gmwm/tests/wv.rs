@@ -23,12 +23,12 @@ fn wv_matches_r_package_on_adis_imu1() {
             f64s(&r["ci_high"]),
         );
         assert_eq!(wv.levels(), v.len(), "{}: level count", col.name);
-        assert_eq!(wv.tau_s, f64s(&r["scales_seconds"]), "{}", col.name);
+        assert_eq!(wv.tau_s(), f64s(&r["scales_seconds"]), "{}", col.name);
         for j in 0..v.len() {
             for (ours, theirs, what) in [
-                (wv.wv[j], v[j], "wv"),
-                (wv.ci_low[j], lo[j], "ci_low"),
-                (wv.ci_high[j], hi[j], "ci_high"),
+                (wv.wv()[j], v[j], "wv"),
+                (wv.ci_low()[j], lo[j], "ci_low"),
+                (wv.ci_high()[j], hi[j], "ci_high"),
             ] {
                 assert!(
                     rel_diff(ours, theirs) < PARITY,
@@ -55,7 +55,7 @@ fn streaming_wv_is_chunk_invariant_on_real_data() {
     for j in 0..whole.levels() {
         // Level 19 averages 2^18 samples and its WV is ~1e4 times below the sample variance, so
         // the different offsets (first sample vs mean) show at ~5e-12; parity needs 1e-9.
-        let d = rel_diff(streamed.wv[j], whole.wv[j]);
+        let d = rel_diff(streamed.wv()[j], whole.wv()[j]);
         assert!(d < 1e-10, "level {}: {d:e}", j + 1);
     }
 }
@@ -76,11 +76,11 @@ fn robust_wv_is_below_classical_on_contaminated_gyro() {
     .unwrap();
     for j in 0..3 {
         assert!(
-            robust.wv[j] < classical.ci_low[j],
+            robust.wv()[j] < classical.ci_low()[j],
             "level {}: robust {:e} not below classical CI [{:e}, ..]",
             j + 1,
-            robust.wv[j],
-            classical.ci_low[j]
+            robust.wv()[j],
+            classical.ci_low()[j]
         );
     }
 }
@@ -100,12 +100,12 @@ fn robust_wv_agrees_with_classical_on_clean_gaussian_data() {
     .unwrap();
     for j in 0..classical.levels() {
         assert!(
-            classical.ci_low[j] <= robust.wv[j] && robust.wv[j] <= classical.ci_high[j],
+            classical.ci_low()[j] <= robust.wv()[j] && robust.wv()[j] <= classical.ci_high()[j],
             "level {}: robust {:e} outside classical CI [{:e}, {:e}]",
             j + 1,
-            robust.wv[j],
-            classical.ci_low[j],
-            classical.ci_high[j]
+            robust.wv()[j],
+            classical.ci_low()[j],
+            classical.ci_high()[j]
         );
     }
 }
@@ -123,18 +123,18 @@ fn robust_wv_resists_one_percent_gross_outliers() {
     };
     let clean_wv = wavelet_variance(&clean, 1.0, &WvOptions::default())
         .unwrap()
-        .wv[0];
+        .wv()[0];
     let classical_dirty = wavelet_variance(&dirty, 1.0, &WvOptions::default())
         .unwrap()
-        .wv[0];
+        .wv()[0];
     let robust_all = wavelet_variance(&dirty, 1.0, &robust).unwrap();
-    let robust_dirty = robust_all.wv[0];
+    let robust_dirty = robust_all.wv()[0];
     // From level 5 on, a filter of 2^j >= 32 samples spans an outlier in >= 32% of positions,
     // past the ~29% share at which the eff-0.6 biweight scale equation loses its root
     // ((1 - share) * max_t E psi_c^2(Z/t) < a(c)): those levels are reported, never filled.
-    for w in &robust_all.warnings {
+    for w in robust_all.warnings() {
         let gmwm::variance::wv::WvWarning::NoRobustScale { level } = w;
-        assert!(*level >= 5 && robust_all.wv[level - 1].is_nan(), "{w}");
+        assert!(*level >= 5 && robust_all.wv()[level - 1].is_nan(), "{w}");
     }
     assert!(
         rel_diff(robust_dirty, clean_wv) < 0.08,
@@ -161,9 +161,9 @@ fn package_convention_matches_r_robust_wv_on_adis_imu1() {
         let r = &reference["columns"][&col.name]["robust_eff_0.6"];
         let wv = wavelet_variance(&col.values, 100.0, &opts).unwrap();
         for (ours, key) in [
-            (&wv.wv, "variance"),
-            (&wv.ci_low, "ci_low"),
-            (&wv.ci_high, "ci_high"),
+            (&wv.wv(), "variance"),
+            (&wv.ci_low(), "ci_low"),
+            (&wv.ci_high(), "ci_high"),
         ] {
             let theirs = f64s(&r[key]);
             assert_eq!(ours.len(), theirs.len());
@@ -221,8 +221,8 @@ fn eta3_ci_covers_white_noise_wv_at_nominal_rate() {
         };
         let wv = wavelet_variance(&x, 1.0, &opts).unwrap();
         for j in 0..levels {
-            let truth = sigma2 / wv.tau[j];
-            if wv.ci_low[j] <= truth && truth <= wv.ci_high[j] {
+            let truth = sigma2 / wv.tau()[j];
+            if wv.ci_low()[j] <= truth && truth <= wv.ci_high()[j] {
                 covered[j] += 1;
             }
         }
@@ -261,7 +261,7 @@ proptest! {
         let a = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
         let b = wavelet_variance(&cx, 1.0, &WvOptions::default()).unwrap();
         for j in 0..a.levels() {
-            prop_assert!(rel_diff(b.wv[j], c * c * a.wv[j]) < 1e-12);
+            prop_assert!(rel_diff(b.wv()[j], c * c * a.wv()[j]) < 1e-12);
         }
     }
 
@@ -278,8 +278,8 @@ proptest! {
         let (wx, wy) = (wavelet_variance(&x, 1.0, &o).unwrap(), wavelet_variance(&y, 1.0, &o).unwrap());
         let (ws, wd) = (wavelet_variance(&sum, 1.0, &o).unwrap(), wavelet_variance(&diff, 1.0, &o).unwrap());
         for j in 0..wx.levels() {
-            let lhs = ws.wv[j] + wd.wv[j];
-            let rhs = 2.0 * (wx.wv[j] + wy.wv[j]);
+            let lhs = ws.wv()[j] + wd.wv()[j];
+            let rhs = 2.0 * (wx.wv()[j] + wy.wv()[j]);
             prop_assert!(rel_diff(lhs, rhs) < 1e-12);
         }
     }
@@ -351,11 +351,11 @@ fn check_exact(n: usize, in_memory: bool) {
         }
         let kept = (n + 1 - 2 * m) as f64;
         let exact = total as f64 / (4.0 * (m * m) as f64 * 4096.0 * kept);
-        let d = rel_diff(wv.wv[j - 1], exact);
+        let d = rel_diff(wv.wv()[j - 1], exact);
         assert!(
             d < 1e-9,
             "N = {n}, level {j}: {:e} vs exact {exact:e} ({d:e})",
-            wv.wv[j - 1]
+            wv.wv()[j - 1]
         );
     }
 }
@@ -394,7 +394,7 @@ fn check_robust_matches_direct_route(x: &[f64], what: &str) {
             Err(gmwm::InputError::Series(gmwm::SeriesError::NoRobustScale { .. })) => f64::NAN,
             Err(e) => panic!("{what} level {j}: {e}"),
         };
-        let ours = fast.wv[j - 1];
+        let ours = fast.wv()[j - 1];
         if direct.is_nan() {
             assert!(ours.is_nan(), "{what} level {j}: {ours:e} vs no root");
             continue;
@@ -490,16 +490,16 @@ fn wv_options_recompute_it_and_truncation_cuts_every_level() {
     let cut = wv.clone().truncated(3).unwrap();
     assert_eq!(cut.levels(), 3);
     for len in [
-        cut.tau.len(),
-        cut.tau_s.len(),
-        cut.ci_low.len(),
-        cut.ci_high.len(),
-        cut.eta.len(),
-        cut.n_coefficients.len(),
+        cut.tau().len(),
+        cut.tau_s().len(),
+        cut.ci_low().len(),
+        cut.ci_high().len(),
+        cut.eta().len(),
+        cut.n_coefficients().len(),
     ] {
         assert_eq!(len, 3);
     }
-    assert_eq!(cut.wv[..], wv.wv[..3]);
+    assert_eq!(cut.wv()[..], wv.wv()[..3]);
     assert_eq!(wv.clone().truncated(0).unwrap_err().name, "levels");
     assert!(wv.clone().truncated(wv.levels() + 1).is_err());
 }

@@ -18,13 +18,13 @@ fn run_saved(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
     let mut items = Vec::with_capacity(series.len());
     for (name, wv) in &series {
         anyhow::ensure!(
-            (wv.alpha - opts.alpha).abs() <= 1e-12 || opts.alpha == 0.05,
+            (wv.alpha() - opts.alpha).abs() <= 1e-12 || opts.alpha == 0.05,
             "{}: series {}: --alpha {} needs the raw recording; the file's intervals are at \
              alpha {}",
             file.display(),
             gmwm::imu::quote(name),
             opts.alpha,
-            wv.alpha
+            wv.alpha()
         );
         let av = allan_from_wv(wv).map_err(gmwm::Error::from);
         items.push((name.clone(), column_context(av, file, name)?));

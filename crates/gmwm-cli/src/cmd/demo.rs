@@ -48,10 +48,10 @@ pub fn run(config: &DemoConfig, out: &mut impl Write) -> Result<()> {
     let truth: Vec<f64> = sensor.model.values().into_iter().flatten().collect();
     let truth = gmwm::fit::Parametrisation::canonical_order(&sensor.model, &truth)?;
     let parameters = fit
-        .param_names
+        .param_names()
         .iter()
         .zip(&truth)
-        .zip(&fit.theta)
+        .zip(fit.theta())
         .map(|((name, t), e)| TruthVsEstimate {
             name: name.clone(),
             truth: *t,
@@ -83,13 +83,13 @@ pub fn run(config: &DemoConfig, out: &mut impl Write) -> Result<()> {
                     out,
                     "{},{},{:e},{:e},{:e},{:e},{:e},{:e}",
                     j + 1,
-                    wv.tau[j],
-                    wv.tau_s[j],
-                    wv.wv[j],
-                    wv.ci_low[j],
-                    wv.ci_high[j],
+                    wv.tau()[j],
+                    wv.tau_s()[j],
+                    wv.wv()[j],
+                    wv.ci_low()[j],
+                    wv.ci_high()[j],
                     implied.wv[j],
-                    fit.implied_wv.wv[j]
+                    fit.implied_wv().wv[j]
                 )?;
             }
         }
@@ -114,7 +114,7 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     writeln!(out, "  truth: {}", r.truth)?;
     writeln!(out, "  {} Hz, N = {}, seed {}", r.freq_hz, r.n, r.seed)?;
     writeln!(out)?;
-    let kind = match wv.robust {
+    let kind = match wv.robust() {
         Some(ro) => format!("robust (eff {}) WV", ro.eff),
         None => "WV".to_string(),
     };
@@ -130,16 +130,16 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     )?;
     let mut inside = 0;
     for j in 0..wv.levels() {
-        let hit = wv.ci_low[j] <= implied.wv[j] && implied.wv[j] <= wv.ci_high[j];
+        let hit = wv.ci_low()[j] <= implied.wv[j] && implied.wv[j] <= wv.ci_high()[j];
         inside += usize::from(hit);
         writeln!(
             out,
             "{:>5} {:>12.4} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e}  {}",
             j + 1,
-            wv.tau_s[j],
-            wv.wv[j],
-            wv.ci_low[j],
-            wv.ci_high[j],
+            wv.tau_s()[j],
+            wv.wv()[j],
+            wv.ci_low()[j],
+            wv.ci_high()[j],
             implied.wv[j],
             if hit { "yes" } else { "no" }
         )?;
@@ -147,14 +147,14 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     writeln!(
         out,
         "\nthe implied WV of the truth lies inside the {:.0}% CI at {inside} of {} levels",
-        100.0 * (1.0 - wv.alpha),
+        100.0 * (1.0 - wv.alpha()),
         wv.levels()
     )?;
     writeln!(out)?;
     writeln!(
         out,
         "GMWM fit of {} (guess mode, seed 1337): truth against estimate",
-        r.fit.model.without_values()
+        r.fit.model().without_values()
     )?;
     writeln!(
         out,
@@ -174,13 +174,14 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     writeln!(
         out,
         "objective Q = {:.6e}; optimiser: {}",
-        r.fit.objective, r.fit.convergence
+        r.fit.objective(),
+        r.fit.convergence()
     )?;
-    if !r.fit.collapsed.is_empty() {
+    if !r.fit.collapsed().is_empty() {
         writeln!(
             out,
             "at the boundary, fitted to nothing (not supported by the data): {}",
-            r.fit.collapsed.join(", ")
+            r.fit.collapsed().join(", ")
         )?;
     }
     writeln!(

@@ -43,13 +43,12 @@ fn inference(
     fit: &GmwmFit,
 ) -> Result<Inference> {
     let wv = fit
-        .empirical
-        .as_ref()
+        .empirical()
         .ok_or_else(|| anyhow::anyhow!("the fit carries no wavelet variance"))?;
     let total = opts.bootstrap.unwrap_or(opts.v_replicates) as u64;
     let bar = bar(total, &format!("inference on {column}"), "replicates");
     let progress = |done: usize| bar.set_position(done as u64);
-    let result = infer_with_progress(&config.gmwm, fit, wv.n, &wv.options(), opts, &progress);
+    let result = infer_with_progress(&config.gmwm, fit, wv.n(), &wv.options(), opts, &progress);
     bar.finish_and_clear();
     column_context(
         result.map_err(gmwm::Error::from),
@@ -80,11 +79,11 @@ pub fn compute(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
         })?
     };
     for (name, fit) in &fits {
-        if !fit.convergence.converged {
+        if !fit.convergence().converged {
             eprintln!(
                 "gmwm: warning: {}: column {name}: the optimiser did not converge ({})",
                 file.display(),
-                fit.convergence
+                fit.convergence()
             );
         }
     }
@@ -161,7 +160,7 @@ fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Wr
                     writeln!(out, "{inf}")?;
                 }
                 writeln!(out, "{canonical}")?;
-                if canonical.reduced != fit.model.without_values() {
+                if canonical.reduced != fit.model().without_values() {
                     writeln!(
                         out,
                         "  (the data cannot tell this fit from one of {}: fit that model for \

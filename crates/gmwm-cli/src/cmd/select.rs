@@ -95,12 +95,12 @@ pub fn compute(config: &SelectConfig) -> Result<Vec<(String, ModelSelection)>> {
     };
     let results = results?;
     for (name, s) in &results {
-        if !s.fit.convergence.converged {
+        if !s.fit.convergence().converged {
             eprintln!(
                 "gmwm: warning: {}: column {name}: the optimiser did not converge for the selected model {} ({})",
                 file.display(),
                 s.selected,
-                s.fit.convergence
+                s.fit.convergence()
             );
         }
     }

@@ -137,7 +137,7 @@ fn run_saved(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
     let series = load_wv(&config.input, config.wv.levels)?;
     if let Some((name, wv)) = series
         .iter()
-        .find(|(_, wv)| (wv.alpha - alpha).abs() > 1e-12)
+        .find(|(_, wv)| (wv.alpha() - alpha).abs() > 1e-12)
     {
         anyhow::ensure!(
             alpha == 0.05,
@@ -145,7 +145,7 @@ fn run_saved(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
             file.display(),
             gmwm::imu::quote(name),
             alpha,
-            wv.alpha
+            wv.alpha()
         );
     }
     note(
@@ -176,7 +176,7 @@ pub fn compute(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
         Ok(wavelet_variance(x, loaded.freq_hz, opts)?)
     })?;
     for (name, wv) in &items {
-        for w in &wv.warnings {
+        for w in wv.warnings() {
             eprintln!(
                 "gmwm: warning: {}: column {name}: {w}",
                 input.file.display()

@@ -30,8 +30,8 @@ pub const DEFAULT_BOOTSTRAP_REPLICATES: usize = 100;
 /// let fit = Gmwm::new(Model::parse("AR1()+WN()").unwrap())
 ///     .fit_wv(&wv, 1.0, &[0.5, 0.5, 0.5])
 ///     .unwrap();
-/// assert!(fit.convergence.converged);
-/// assert!((fit.theta[0] - 0.9).abs() < 0.05);
+/// assert!(fit.convergence().converged);
+/// assert!((fit.theta()[0] - 0.9).abs() < 0.05);
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Gmwm {
@@ -264,7 +264,7 @@ impl Gmwm {
     /// let full = Gmwm::parse("AR1()+WN()+RW()").unwrap().with_draws(2000);
     /// let fit = full.fit(&x, 1.0, &WvOptions::default()).unwrap();
     /// let small = Gmwm::parse("AR1()+WN()").unwrap().with_draws(2000).update(&fit).unwrap();
-    /// assert_eq!(small.empirical, fit.empirical);
+    /// assert_eq!(small.empirical(), fit.empirical());
     /// ```
     ///
     /// # Errors
@@ -389,43 +389,140 @@ impl Gmwm {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GmwmFit {
     /// The model with the estimates.
-    pub model: Model,
+    pub(crate) model: Model,
     /// Estimates in model order (original parametrisation).
-    pub theta: Vec<f64>,
+    pub(crate) theta: Vec<f64>,
     /// Labels of `theta`, `KIND[component].name`.
-    pub param_names: Vec<String>,
+    pub(crate) param_names: Vec<String>,
     /// The starting values used (after the §5.6 ordering).
-    pub start: Vec<f64>,
+    pub(crate) start: Vec<f64>,
     /// `Q(theta_hat)` (METHODS §5.1).
-    pub objective: f64,
+    pub(crate) objective: f64,
     /// How the optimiser ended.
-    pub convergence: Convergence,
+    pub(crate) convergence: Convergence,
     /// The empirical WV fitted.
-    pub nu_hat: Vec<f64>,
+    pub(crate) nu_hat: Vec<f64>,
     /// Implied WV at the estimates, per component too (§5.5 step 11).
-    pub implied_wv: ImpliedWv,
+    pub(crate) implied_wv: ImpliedWv,
     /// The weights (V and Omega diagonals).
-    pub weights: Weights,
+    pub(crate) weights: Weights,
     /// Sampling rate in Hz.
-    pub freq_hz: f64,
+    pub(crate) freq_hz: f64,
     /// Transform preset used.
-    pub preset: TransformPreset,
+    pub(crate) preset: TransformPreset,
     /// AR1/GM parametrisation used.
-    pub phi_order: PhiOrder,
+    pub(crate) phi_order: PhiOrder,
     /// Which weighting produced `weights` (METHODS §5.2).
-    pub weighting: Weighting,
+    pub(crate) weighting: Weighting,
     /// The fast V of the first fit when the bootstrap weighting replaced it (the package's
     /// `orgV`); `None` otherwise (then `weights.v` is `orgV`).
-    pub org_v: Option<Vec<f64>>,
+    pub(crate) org_v: Option<Vec<f64>>,
     /// Replicates H of the bootstrap weighting, when used.
-    pub bootstrap_replicates: Option<usize>,
+    pub(crate) bootstrap_replicates: Option<usize>,
     /// The empirical WV fitted, with its CI (`None` only for a bare [`Gmwm::fit_weighted`]).
-    pub empirical: Option<WaveletVariance>,
+    pub(crate) empirical: Option<WaveletVariance>,
     /// Series length and range behind the starting values (METHODS §6.1), kept for `update`.
-    pub inputs: Option<StartInputs>,
+    pub(crate) inputs: Option<StartInputs>,
     /// Labels of the parameters of the components fitted to nothing (implied WV below
     /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level,
     /// [`GmwmFit::active_parameters`]): the fit is a boundary point and a smaller model fits as
     /// well. Inference reports these parameters without a standard error.
-    pub collapsed: Vec<String>,
+    pub(crate) collapsed: Vec<String>,
+}
+
+/// Read access to the results; the fields are the engine's own.
+impl GmwmFit {
+    /// The model with the estimates.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// Estimates in model order (original parametrisation).
+    pub fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+
+    /// Labels of `theta`, `KIND[component].name`.
+    pub fn param_names(&self) -> &[String] {
+        &self.param_names
+    }
+
+    /// The starting values used (after the §5.6 ordering).
+    pub fn start(&self) -> &[f64] {
+        &self.start
+    }
+
+    /// `Q(theta_hat)` (METHODS §5.1).
+    pub fn objective(&self) -> f64 {
+        self.objective
+    }
+
+    /// How the optimiser ended.
+    pub fn convergence(&self) -> Convergence {
+        self.convergence
+    }
+
+    /// The empirical WV fitted.
+    pub fn nu_hat(&self) -> &[f64] {
+        &self.nu_hat
+    }
+
+    /// Implied WV at the estimates, per component too (§5.5 step 11).
+    pub fn implied_wv(&self) -> &ImpliedWv {
+        &self.implied_wv
+    }
+
+    /// The weights (V and Omega diagonals).
+    pub fn weights(&self) -> &Weights {
+        &self.weights
+    }
+
+    /// Sampling rate in Hz.
+    pub fn freq_hz(&self) -> f64 {
+        self.freq_hz
+    }
+
+    /// Transform preset used.
+    pub fn preset(&self) -> TransformPreset {
+        self.preset
+    }
+
+    /// AR1/GM parametrisation used.
+    pub fn phi_order(&self) -> PhiOrder {
+        self.phi_order
+    }
+
+    /// Which weighting produced `weights` (METHODS §5.2).
+    pub fn weighting(&self) -> Weighting {
+        self.weighting
+    }
+
+    /// The fast V of the first fit when the bootstrap weighting replaced it (the package's
+    /// `orgV`); `None` otherwise (then `weights.v` is `orgV`).
+    pub fn org_v(&self) -> Option<&[f64]> {
+        self.org_v.as_deref()
+    }
+
+    /// Replicates H of the bootstrap weighting, when used.
+    pub fn bootstrap_replicates(&self) -> Option<usize> {
+        self.bootstrap_replicates
+    }
+
+    /// The empirical WV fitted, with its CI (`None` only for a bare [`Gmwm::fit_weighted`]).
+    pub fn empirical(&self) -> Option<&WaveletVariance> {
+        self.empirical.as_ref()
+    }
+
+    /// Series length and range behind the starting values (METHODS §6.1), kept for `update`.
+    pub fn inputs(&self) -> Option<StartInputs> {
+        self.inputs
+    }
+
+    /// Labels of the parameters of the components fitted to nothing (implied WV below
+    /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level,
+    /// [`GmwmFit::active_parameters`]): the fit is a boundary point and a smaller model fits as
+    /// well. Inference reports these parameters without a standard error.
+    pub fn collapsed(&self) -> &[String] {
+        &self.collapsed
+    }
 }

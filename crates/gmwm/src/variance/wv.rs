@@ -55,33 +55,106 @@ impl Default for WvOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WaveletVariance {
     /// Length of the series.
-    pub n: usize,
+    pub(crate) n: usize,
     /// Sampling rate in Hz (labels `tau_s` only).
-    pub freq_hz: f64,
+    pub(crate) freq_hz: f64,
     /// Transform used.
-    pub transform: Transform,
+    pub(crate) transform: Transform,
     /// Filter used.
-    pub filter: WaveletFilter,
+    pub(crate) filter: WaveletFilter,
     /// Confidence level of the intervals.
-    pub alpha: f64,
+    pub(crate) alpha: f64,
     /// Robust options, `None` for the classical estimator.
-    pub robust: Option<RobustOptions>,
+    pub(crate) robust: Option<RobustOptions>,
     /// Scale `tau_j = 2^j` in samples (METHODS §0.1).
-    pub tau: Vec<f64>,
+    pub(crate) tau: Vec<f64>,
     /// Scale in seconds, `2^j / freq_hz`.
-    pub tau_s: Vec<f64>,
+    pub(crate) tau_s: Vec<f64>,
     /// Wavelet variance `nu2_j`.
-    pub wv: Vec<f64>,
+    pub(crate) wv: Vec<f64>,
     /// Lower confidence bound.
-    pub ci_low: Vec<f64>,
+    pub(crate) ci_low: Vec<f64>,
     /// Upper confidence bound.
-    pub ci_high: Vec<f64>,
+    pub(crate) ci_high: Vec<f64>,
     /// Number of boundary-free coefficients `M_j` behind each estimate.
-    pub n_coefficients: Vec<usize>,
+    pub(crate) n_coefficients: Vec<usize>,
     /// Equivalent degrees of freedom of the chi-square interval.
-    pub eta: Vec<f64>,
+    pub(crate) eta: Vec<f64>,
     /// Soft problems met on the way (the affected values are NaN, `null` in JSON).
-    pub warnings: Vec<WvWarning>,
+    pub(crate) warnings: Vec<WvWarning>,
+}
+
+/// Read access to the results; the fields are the engine's own.
+impl WaveletVariance {
+    /// Length of the series.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Sampling rate in Hz (labels `tau_s` only).
+    pub fn freq_hz(&self) -> f64 {
+        self.freq_hz
+    }
+
+    /// Transform used.
+    pub fn transform(&self) -> Transform {
+        self.transform
+    }
+
+    /// Filter used.
+    pub fn filter(&self) -> WaveletFilter {
+        self.filter
+    }
+
+    /// Confidence level of the intervals.
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// Robust options, `None` for the classical estimator.
+    pub fn robust(&self) -> Option<RobustOptions> {
+        self.robust
+    }
+
+    /// Scale `tau_j = 2^j` in samples (METHODS §0.1).
+    pub fn tau(&self) -> &[f64] {
+        &self.tau
+    }
+
+    /// Scale in seconds, `2^j / freq_hz`.
+    pub fn tau_s(&self) -> &[f64] {
+        &self.tau_s
+    }
+
+    /// Wavelet variance `nu2_j`.
+    pub fn wv(&self) -> &[f64] {
+        &self.wv
+    }
+
+    /// Lower confidence bound.
+    pub fn ci_low(&self) -> &[f64] {
+        &self.ci_low
+    }
+
+    /// Upper confidence bound.
+    pub fn ci_high(&self) -> &[f64] {
+        &self.ci_high
+    }
+
+    /// Number of boundary-free coefficients `M_j` behind each estimate.
+    pub fn n_coefficients(&self) -> &[usize] {
+        &self.n_coefficients
+    }
+
+    /// Equivalent degrees of freedom of the chi-square interval.
+    pub fn eta(&self) -> &[f64] {
+        &self.eta
+    }
+
+    /// Soft problems met on the way (the affected values are NaN, `null` in JSON).
+    pub fn warnings(&self) -> &[WvWarning] {
+        &self.warnings
+    }
 }
 
 /// A soft problem of a wavelet-variance computation: the result exists, some levels are missing.
@@ -170,7 +243,7 @@ impl WaveletVariance {
     /// let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
     /// let v = wv.log_variance();
     /// // level 1 keeps 4095 coefficients, eta = 2047.5: about 2 / eta
-    /// assert!((v[0] * wv.eta[0] / 2.0 - 1.0).abs() < 1e-3);
+    /// assert!((v[0] * wv.eta()[0] / 2.0 - 1.0).abs() < 1e-3);
     /// ```
     pub fn log_variance(&self) -> Vec<f64> {
         let widen = self.robust.map_or(1.0, |r| 1.0 / r.eff);
