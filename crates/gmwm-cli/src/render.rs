@@ -57,17 +57,17 @@ impl CsvRows for WaveletVariance {
 impl CsvRows for AllanVariance {
     const HEADER: &'static str = "series,tau,tau_s,avar,adev,ci_low,ci_high";
     fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()> {
-        for k in 0..self.avar.len() {
+        for k in 0..self.avar().len() {
             writeln!(
                 out,
                 "{},{},{:e},{:e},{:e},{:e},{:e}",
                 csv_field(name),
-                self.tau[k],
-                self.tau_s[k],
-                self.avar[k],
-                self.adev[k],
-                self.ci_low[k],
-                self.ci_high[k]
+                self.tau()[k],
+                self.tau_s()[k],
+                self.avar()[k],
+                self.adev()[k],
+                self.ci_low()[k],
+                self.ci_high()[k]
             )?;
         }
         Ok(())

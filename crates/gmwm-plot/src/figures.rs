@@ -242,13 +242,13 @@ pub fn allan_figure(columns: &[Column<'_, AllanVariance>], layout: Layout) -> Fi
             name: c.name,
             place: c.place(),
             unit: c.unit,
-            tau_s: c.data.tau_s.clone(),
-            value: c.data.adev.clone(),
-            low: c.data.ci_low.iter().map(|v| v.sqrt()).collect(),
-            high: c.data.ci_high.iter().map(|v| v.sqrt()).collect(),
+            tau_s: c.data.tau_s().to_vec(),
+            value: c.data.adev().to_vec(),
+            low: c.data.ci_low().iter().map(|v| v.sqrt()).collect(),
+            high: c.data.ci_high().iter().map(|v| v.sqrt()).collect(),
         })
         .collect();
-    let (what, quantity) = match columns.first().map(|c| c.data.kind) {
+    let (what, quantity) = match columns.first().map(|c| c.data.kind()) {
         Some(AllanKind::Modified) => ("modified Allan deviation", "modified Allan deviation"),
         Some(AllanKind::Hadamard | AllanKind::HadamardNonOverlapping) => {
             ("Hadamard deviation", "Hadamard deviation")
@@ -425,19 +425,19 @@ pub fn selection_figure(columns: &[Column<'_, ModelSelection>], rows: usize) -> 
     let mut panels = Vec::new();
     for c in columns {
         let s = c.data;
-        let selected = s.selected_canonical.model.to_string();
+        let selected = s.selected_canonical().model.to_string();
         panels.push(Panel {
             title: format!("{}: selected {}", c.name, short_model(&selected)),
             x_label: WV_SCALE.to_string(),
             y_label: wv_label(c.unit),
-            kind: PanelKind::LogLog(empirical_and_model(&s.fit, "selected model (implied WV)")),
+            kind: PanelKind::LogLog(empirical_and_model(s.fit(), "selected model (implied WV)")),
         });
         let selected_row = s
-            .rows
+            .rows()
             .iter()
             .position(|r| r.status == gmwm::selection::RowStatus::Selected);
-        let limit = if rows == 0 { s.rows.len() } else { rows };
-        let mut shown: Vec<usize> = (0..s.rows.len().min(limit)).collect();
+        let limit = if rows == 0 { s.rows().len() } else { rows };
+        let mut shown: Vec<usize> = (0..s.rows().len().min(limit)).collect();
         if let Some(i) = selected_row {
             if !shown.contains(&i) {
                 shown.pop();
@@ -447,7 +447,7 @@ pub fn selection_figure(columns: &[Column<'_, ModelSelection>], rows: usize) -> 
         let rows = shown
             .iter()
             .map(|&i| {
-                let r = &s.rows[i];
+                let r = &s.rows()[i];
                 BarRow {
                     label: short_model(&r.score.canonical_model.to_string()),
                     first: r.score.objective,
@@ -493,18 +493,18 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
         .iter()
         .map(|c| {
             let (av, readoff) = c.data;
-            let level = 100.0 * (1.0 - av.alpha);
-            let low: Vec<f64> = av.ci_low.iter().map(|v| v.sqrt()).collect();
-            let high: Vec<f64> = av.ci_high.iter().map(|v| v.sqrt()).collect();
-            let [band, points] = estimate_series(&av.tau_s, &av.adev, &low, &high, None);
+            let level = 100.0 * (1.0 - av.alpha());
+            let low: Vec<f64> = av.ci_low().iter().map(|v| v.sqrt()).collect();
+            let high: Vec<f64> = av.ci_high().iter().map(|v| v.sqrt()).collect();
+            let [band, points] = estimate_series(av.tau_s(), av.adev(), &low, &high, None);
             let mut series = vec![
                 band.labelled(format!("{level:.0}% interval")),
                 points.labelled("Allan deviation"),
             ];
             // each line spans the observed cluster times and the read-off time
             let xs = [
-                av.tau_s.first().copied().unwrap_or(1.0).min(1.0) / 2.0,
-                av.tau_s.last().copied().unwrap_or(1.0).max(3.0) * 2.0,
+                av.tau_s().first().copied().unwrap_or(1.0).min(1.0) / 2.0,
+                av.tau_s().last().copied().unwrap_or(1.0).max(3.0) * 2.0,
             ];
             let u = pretty(c.unit);
             let terms = [

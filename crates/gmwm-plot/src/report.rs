@@ -313,7 +313,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
         ],
     );
     out.push_str("<tbody>\n");
-    for (i, r) in a.selection.rows.iter().enumerate() {
+    for (i, r) in a.selection.rows().iter().enumerate() {
         if i >= TABLE_ROWS && r.status == RowStatus::Separable {
             continue;
         }
@@ -336,7 +336,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
         }
         out.push_str("</tr>\n");
     }
-    let _ = writeln!(out, "</tbody></table><p class=\"small\">{} canonical models from {} candidates; rows beyond the best {TABLE_ROWS} that are neither selected nor equivalent are left out (they are in the JSON).</p>", a.selection.rows.len(), a.selection.candidates.len());
+    let _ = writeln!(out, "</tbody></table><p class=\"small\">{} canonical models from {} candidates; rows beyond the best {TABLE_ROWS} that are neither selected nor equivalent are left out (they are in the JSON).</p>", a.selection.rows().len(), a.selection.candidates().len());
 
     // estimates
     out.push_str("<h3>Estimates</h3><table>\n");
@@ -377,7 +377,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
         ],
     );
     out.push_str("<tbody>\n");
-    for p in &a.inference.parameters {
+    for p in a.inference.parameters() {
         let opt = |v: Option<f64>| v.map_or("—".to_string(), number);
         let interval = match (p.ci_low, p.ci_high) {
             (Some(lo), Some(hi)) => format!("[{}, {}]", number(lo), number(hi)),

@@ -167,7 +167,7 @@ fn figures_allan_deviation_of_a_precomputed_wv_and_the_recording() {
     let av = allan_variance(&cols[0].1, freq, &AllanOptions::default()).unwrap();
     let figure = allan_figure(&[Column::new(&cols[0].0, "deg/s", &av)], Layout::Grid);
     let svg = render(&figure, "avar_adis_gyro_x");
-    assert_eq!(svg.circles, av.tau_s.len());
+    assert_eq!(svg.circles, av.tau_s().len());
     assert!(svg.texts.iter().any(|t| t.contains("Allan deviation")));
     assert!(
         svg.texts.iter().any(|t| t.contains("cluster time")),
@@ -316,7 +316,7 @@ fn figures_selection_and_ieee_on_the_adis_gyroscope() {
     );
     assert_eq!(figure.grid, (1, 2));
     let svg = render(&figure, "select_adis_gyro_x");
-    let shown = selection.rows.len().min(gmwm_plot::WIC_ROWS);
+    let shown = selection.rows().len().min(gmwm_plot::WIC_ROWS);
     // two segments per shown row, the bar legend's two swatches, the fit legend's band swatch
     // and the white background
     assert!(

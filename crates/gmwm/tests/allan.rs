@@ -161,39 +161,39 @@ fn allan_variance_matches_methods_3_test_values() {
     // x = (1,3,2,5,4,6,8,7): package AV_to (tau 2, 4) = (2.125, 6.125)
     let x8 = [1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0];
     let to = av(&x8, AllanKind::NonOverlapping, PACKAGE);
-    assert_eq!(to.tau, vec![2.0, 4.0]);
+    assert_eq!(to.tau(), vec![2.0, 4.0]);
     assert!(
-        close(to.avar[0], 2.125) && close(to.avar[1], 6.125),
+        close(to.avar()[0], 2.125) && close(to.avar()[1], 6.125),
         "{:?}",
-        to.avar
+        to.avar()
     );
     // package AV_mo = (1.475, 0.0): the sum at tau = 4 has no term
     let mo = av(&x8, AllanKind::Overlapping, PACKAGE);
-    assert_eq!(mo.tau, vec![2.0, 4.0]);
+    assert_eq!(mo.tau(), vec![2.0, 4.0]);
     assert!(
-        close(mo.avar[0], 1.475) && mo.avar[1] == 0.0,
+        close(mo.avar()[0], 1.475) && mo.avar()[1] == 0.0,
         "{:?}",
-        mo.avar
+        mo.avar()
     );
     // textbook (complete sum) AV_mo(2) = 2.1 = 2 x 1.05 (§3.4)
     let tb = av(&x8, AllanKind::Overlapping, TEXTBOOK);
-    assert_eq!(tb.tau, vec![1.0, 2.0, 4.0]);
-    assert!(close(tb.avar[1], 2.1), "{:?}", tb.avar);
+    assert_eq!(tb.tau(), vec![1.0, 2.0, 4.0]);
+    assert!(close(tb.avar()[1], 2.1), "{:?}", tb.avar());
     // error column, T = 8, tau = 2
-    assert!(close(to.error[0], 0.4082483) && close(package_error(8, 2), 0.4082483));
+    assert!(close(to.error()[0], 0.4082483) && close(package_error(8, 2), 0.4082483));
 
     // 16 values: package AV_mo (tau 2, 4, 8) = (2.173077, 7.100694, 0.0)
     let x16 = [
         1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0, 9.0, 12.0, 10.0, 11.0, 15.0, 13.0, 14.0, 18.0,
     ];
     let mo = av(&x16, AllanKind::Overlapping, PACKAGE);
-    assert_eq!(mo.tau, vec![2.0, 4.0, 8.0]);
+    assert_eq!(mo.tau(), vec![2.0, 4.0, 8.0]);
     assert!(
-        close(mo.avar[0], 2.173077) && close(mo.avar[1], 7.100694),
+        close(mo.avar()[0], 2.173077) && close(mo.avar()[1], 7.100694),
         "{:?}",
-        mo.avar
+        mo.avar()
     );
-    assert_eq!(mo.avar[2], 0.0);
+    assert_eq!(mo.avar()[2], 0.0);
 
     // T = 27: HV_to(3) = 6.851852. Block means 10/3, 6, 11/3 | 17/3, 13/3, 10/3 | 14/3, 10/3, 6,
     // squared second differences of the M = 3 disjoint triples 25, 1/9, 16, summed and divided by
@@ -204,12 +204,12 @@ fn allan_variance_matches_methods_3_test_values() {
         5.0, 3.0, 6.0, 0.0, 2.0, 8.0, 7.0, 4.0, 7.0,
     ];
     let hv = av(&x27, AllanKind::HadamardNonOverlapping, PACKAGE);
-    assert_eq!(hv.tau, vec![3.0]);
-    assert!(close(hv.avar[0], 6.851852), "{:?}", hv.avar);
-    assert!(close(hv.avar[0], (25.0 + 1.0 / 9.0 + 16.0) / 6.0));
+    assert_eq!(hv.tau(), vec![3.0]);
+    assert!(close(hv.avar()[0], 6.851852), "{:?}", hv.avar());
+    assert!(close(hv.avar()[0], (25.0 + 1.0 / 9.0 + 16.0) / 6.0));
     let hv_tb = av(&x27, AllanKind::HadamardNonOverlapping, TEXTBOOK);
-    assert_eq!(hv_tb.tau, vec![1.0, 3.0, 9.0]);
-    assert!(close(hv_tb.avar[1], slow_hv_nonoverlap(&x27, 3, false)));
+    assert_eq!(hv_tb.tau(), vec![1.0, 3.0, 9.0]);
+    assert!(close(hv_tb.avar()[1], slow_hv_nonoverlap(&x27, 3, false)));
 }
 
 // ------------------------------------------------------------------------------------------
@@ -234,7 +234,7 @@ fn allan_variance_matches_slow_oracle() {
                 let Ok(fast) = allan_variance(&x, 1.0, &opts(kind, convention)) else {
                     continue;
                 };
-                for (&m, &v) in fast.tau.iter().zip(&fast.avar) {
+                for (&m, &v) in fast.tau().iter().zip(fast.avar()) {
                     let s = slow(&x, m as usize, kind, convention);
                     assert!(
                         (v - s).abs() <= TOL_ORACLE * s.abs().max(1e-300),
@@ -251,7 +251,7 @@ fn allan_variance_matches_slow_oracle() {
 #[test]
 fn allan_variance_cluster_sets_are_documented_ones() {
     let x = white_noise(1000, 1.0, SEED);
-    let taus = |k, c| av(&x, k, c).tau;
+    let taus = |k, c| av(&x, k, c).tau().to_vec();
     let pow2: Vec<f64> = (0..9).map(|i| f64::from(1u32 << i)).collect(); // 2m <= 1000
     assert_eq!(taus(AllanKind::Overlapping, TEXTBOOK), pow2);
     assert_eq!(taus(AllanKind::NonOverlapping, TEXTBOOK), pow2);
@@ -271,8 +271,8 @@ fn allan_variance_cluster_sets_are_documented_ones() {
     );
     let a = av(&x, AllanKind::Overlapping, TEXTBOOK);
     assert_eq!(
-        a.terms,
-        a.tau
+        a.terms(),
+        a.tau()
             .iter()
             .map(|&m| 1001 - 2 * m as usize)
             .collect::<Vec<_>>()
@@ -290,8 +290,8 @@ fn allan_variance_overlapping_is_twice_haar_wv() {
             .map(|v| v + offset)
             .collect();
         let a = av(&x, AllanKind::Overlapping, TEXTBOOK);
-        assert_eq!(a.tau.len(), (n as f64).log2().floor() as usize); // J = floor(log2 N) levels
-        for (&m, &v) in a.tau.iter().zip(&a.avar) {
+        assert_eq!(a.tau().len(), (n as f64).log2().floor() as usize); // J = floor(log2 N) levels
+        for (&m, &v) in a.tau().iter().zip(a.avar()) {
             let wv2 = 2.0 * haar_wv_direct(&x, m as usize);
             assert!(
                 rel_diff(v, wv2) <= TOL_ORACLE,
@@ -301,18 +301,21 @@ fn allan_variance_overlapping_is_twice_haar_wv() {
             // the CI is the eta3 interval of the Haar WV at tau = 2m (§1.7 through §3.4)
             let j = (2.0 * m).log2() as usize;
             let eta = gmwm::variance::ci::eta3(n - 2 * m as usize + 1, j);
-            let k = a.tau.iter().position(|&t| t == m).unwrap();
-            assert!((a.edf[k] - eta).abs() < 1e-12);
+            let k = a.tau().iter().position(|&t| t == m).unwrap();
+            assert!((a.edf()[k] - eta).abs() < 1e-12);
             // (statrs returns NaN for some bounds at eta near 1; ours then falls back to bisection)
             let (lo, hi) = gmwm::variance::ci::chi_square_interval(v, eta, 0.05).unwrap();
-            assert!(a.ci_low[k].is_finite() && a.ci_high[k].is_finite(), "m {m}");
-            assert!(a.ci_low[k] < v && v < a.ci_high[k], "m {m}");
             assert!(
-                !lo.is_finite() || rel_diff(a.ci_low[k], lo) < 1e-8,
+                a.ci_low()[k].is_finite() && a.ci_high()[k].is_finite(),
+                "m {m}"
+            );
+            assert!(a.ci_low()[k] < v && v < a.ci_high()[k], "m {m}");
+            assert!(
+                !lo.is_finite() || rel_diff(a.ci_low()[k], lo) < 1e-8,
                 "m {m}: {lo}"
             );
             assert!(
-                !hi.is_finite() || rel_diff(a.ci_high[k], hi) < 1e-8,
+                !hi.is_finite() || rel_diff(a.ci_high()[k], hi) < 1e-8,
                 "m {m}: {hi}"
             );
         }
@@ -382,31 +385,31 @@ fn check_against_package(reference: &serde_json::Value, x: &[f64], kind: AllanKi
     };
     assert_all_close(
         &format!("{what} clusters"),
-        &a.tau,
+        a.tau(),
         &f64s(&reference["clusters"]),
         0.0,
     );
     assert_all_close(
         &format!("{what} tau_s"),
-        &a.tau_s,
+        a.tau_s(),
         &f64s(&reference["tau_seconds"]),
         1e-15,
     );
     assert_all_close(
         &format!("{what} {var}"),
-        &a.avar,
+        a.avar(),
         &f64s(&reference[var]),
         TOL_REF,
     );
     assert_all_close(
         &format!("{what} errors"),
-        &a.error,
+        a.error(),
         &f64s(&reference["errors"]),
         TOL_REF,
     );
     assert_all_close(
         &format!("{what} {dev}"),
-        &a.adev,
+        a.adev(),
         &f64s(&reference[dev]),
         TOL_REF,
     );
@@ -463,18 +466,18 @@ fn allan_variance_textbook_matches_allantools() {
             .as_array()
             .unwrap();
         let a = allan_variance(column(name), 100.0, &AllanOptions::default()).unwrap();
-        assert_eq!(a.tau.len(), rows.len(), "{name}: octave taus");
+        assert_eq!(a.tau().len(), rows.len(), "{name}: octave taus");
         for (k, row) in rows.iter().enumerate() {
-            assert_eq!(a.tau[k], row["m"].as_f64().unwrap());
-            assert_eq!(a.terms[k] as u64, row["n_terms"].as_u64().unwrap());
+            assert_eq!(a.tau()[k], row["m"].as_f64().unwrap());
+            assert_eq!(a.terms()[k] as u64, row["n_terms"].as_u64().unwrap());
             let oavar = row["allantools_oavar"].as_f64().unwrap();
             assert!(
-                rel_diff(a.avar[k], oavar) <= TOL_REF,
+                rel_diff(a.avar()[k], oavar) <= TOL_REF,
                 "{name} m {}: ours {} allantools {oavar}",
-                a.tau[k],
-                a.avar[k]
+                a.tau()[k],
+                a.avar()[k]
             );
-            assert!(rel_diff(a.tau_s[k], row["tau_s"].as_f64().unwrap()) < 1e-15);
+            assert!(rel_diff(a.tau_s()[k], row["tau_s"].as_f64().unwrap()) < 1e-15);
         }
     }
 }
@@ -488,9 +491,9 @@ fn allan_variance_package_differs_from_textbook_as_documented() {
         // "mo": one term short of the textbook sum, same divisor: 0 <= 1 - ratio <= 2e-4
         let tb = av(x, AllanKind::Overlapping, TEXTBOOK);
         let pk = av(x, AllanKind::Overlapping, PACKAGE);
-        for (k, &m) in pk.tau.iter().enumerate() {
-            let t = tb.tau.iter().position(|&v| v == m).unwrap();
-            let ratio = pk.avar[k] / tb.avar[t];
+        for (k, &m) in pk.tau().iter().enumerate() {
+            let t = tb.tau().iter().position(|&v| v == m).unwrap();
+            let ratio = pk.avar()[k] / tb.avar()[t];
             assert!(
                 (0.9998..=1.0).contains(&ratio),
                 "{name} mo m {m}: ratio {ratio}"
@@ -498,12 +501,12 @@ fn allan_variance_package_differs_from_textbook_as_documented() {
         }
         // Hadamard "to": divisor 6(M-2) instead of 6M for the same disjoint triples
         let pk = av(x, AllanKind::HadamardNonOverlapping, PACKAGE);
-        for (k, &m) in pk.tau.iter().enumerate() {
+        for (k, &m) in pk.tau().iter().enumerate() {
             let triples = (x.len() / (3 * m as usize)) as f64;
-            let textbook_disjoint = pk.avar[k] * (triples - 2.0) / triples;
-            assert!(textbook_disjoint < pk.avar[k]);
+            let textbook_disjoint = pk.avar()[k] * (triples - 2.0) / triples;
+            assert!(textbook_disjoint < pk.avar()[k]);
             assert!(
-                pk.avar[k] / textbook_disjoint <= 5.0 / 3.0 + 1e-12,
+                pk.avar()[k] / textbook_disjoint <= 5.0 / 3.0 + 1e-12,
                 "{name} to m {m}"
             );
         }
@@ -511,10 +514,10 @@ fn allan_variance_package_differs_from_textbook_as_documented() {
         // within the textbook chi-square interval at every cluster length
         let tb = av(x, AllanKind::NonOverlapping, TEXTBOOK);
         let pk = av(x, AllanKind::NonOverlapping, PACKAGE);
-        for (k, &m) in pk.tau.iter().enumerate() {
-            let t = tb.tau.iter().position(|&v| v == m).unwrap();
+        for (k, &m) in pk.tau().iter().enumerate() {
+            let t = tb.tau().iter().position(|&v| v == m).unwrap();
             assert!(
-                pk.avar[k] > tb.ci_low[t] && pk.avar[k] < tb.ci_high[t],
+                pk.avar()[k] > tb.ci_low()[t] && pk.avar()[k] < tb.ci_high()[t],
                 "{name} to m {m}"
             );
         }
@@ -546,8 +549,8 @@ fn allan_variance_white_noise_is_sigma2_over_m() {
     assert!((mvar_white_noise(1, 1.0) - 1.0).abs() < 1e-15); // MVAR(1) = AVAR(1)
     for kind in AllanKind::ALL {
         let a = av(&x, kind, TEXTBOOK);
-        for k in 0..a.tau.len() {
-            let m = a.tau[k] as usize;
+        for k in 0..a.tau().len() {
+            let m = a.tau()[k] as usize;
             if m > n / 64 {
                 break;
             }
@@ -557,14 +560,14 @@ fn allan_variance_white_noise_is_sigma2_over_m() {
                 sigma2 / m as f64 // AV, HV of white noise (METHODS §3; no m dependence beyond 1/m)
             };
             // five standard errors of a chi-square estimate with edf degrees of freedom
-            let bound = 5.0 * (2.0 / a.edf[k]).sqrt();
-            let rel = (a.avar[k] - truth) / truth;
+            let bound = 5.0 * (2.0 / a.edf()[k]).sqrt();
+            let rel = (a.avar()[k] - truth) / truth;
             assert!(
                 rel.abs() < bound,
                 "{kind} m {m}: {} vs {truth} ({rel})",
-                a.avar[k]
+                a.avar()[k]
             );
-            assert!(a.ci_low[k] < a.avar[k] && a.avar[k] < a.ci_high[k]);
+            assert!(a.ci_low()[k] < a.avar()[k] && a.avar()[k] < a.ci_high()[k]);
         }
     }
     // the modified AV of white noise tends to half the AV (Riley's ratio for white FM)
@@ -589,9 +592,9 @@ fn allan_variance_nonoverlapping_edf_matches_monte_carlo() {
         for r in 0..b {
             let x = white_noise(1024, 1.0, SEED + 1000 + r as u64);
             let a = av(&x, kind, convention);
-            let k = a.tau.iter().position(|&t| t == m as f64).unwrap();
-            values.push(a.avar[k]);
-            edf = a.edf[k];
+            let k = a.tau().iter().position(|&t| t == m as f64).unwrap();
+            values.push(a.avar()[k]);
+            edf = a.edf()[k];
             mean_truth = 1.0 / m as f64;
             if convention == PACKAGE && kind.is_hadamard() {
                 let triples = (1024 / (3 * m)) as f64;
@@ -667,7 +670,10 @@ fn allan_variance_rejects_bad_input() {
     }
     // the shortest textbook Allan series: two distinct samples
     let a = allan_variance(&[0.0, 1.0], 1.0, &ok).unwrap();
-    assert_eq!((a.tau.clone(), a.avar.clone()), (vec![1.0], vec![0.5]));
+    assert_eq!(
+        (a.tau().to_vec(), a.avar().to_vec()),
+        (vec![1.0], vec![0.5])
+    );
 }
 
 #[test]
@@ -676,7 +682,7 @@ fn allan_variance_display_is_a_table() {
     let a = allan_variance(&x, 100.0, &AllanOptions::default()).unwrap();
     let text = a.to_string();
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines.len(), a.tau.len() + 2);
+    assert_eq!(lines.len(), a.tau().len() + 2);
     assert!(
         lines[1].contains("tau_s") && lines[1].contains("adev") && lines[1].contains("ci_high")
     );
@@ -704,7 +710,7 @@ fn allan_variance_every_short_length_matches_oracle() {
             for convention in [TEXTBOOK, PACKAGE] {
                 match allan_variance(&x, 1.0, &opts(kind, convention)) {
                     Ok(fast) => {
-                        for (&m, &v) in fast.tau.iter().zip(&fast.avar) {
+                        for (&m, &v) in fast.tau().iter().zip(fast.avar()) {
                             let s = slow(&x, m as usize, kind, convention);
                             assert!(
                                 (v - s).abs() <= TOL_ORACLE * s.abs().max(1e-300),

@@ -289,9 +289,9 @@ fn calibration_bounds_an_undetected_random_walk() {
     // the bound is the tightest sqrt(3 AV_high(tau) / tau) of the axis's Allan variance
     let tightest = a
         .allan
-        .ci_high
+        .ci_high()
         .iter()
-        .zip(&a.allan.tau_s)
+        .zip(a.allan.tau_s())
         .map(|(h, t)| (3.0 * h / t).sqrt())
         .fold(f64::INFINITY, f64::min);
     assert!((k.value / tightest - 1.0).abs() < 1e-12);

@@ -93,7 +93,7 @@ fn recovery_ar1_wn_rw_guess_mode() {
     assert!(guess.objective() <= exact.objective() * GUESS_FACTOR);
     // loose bounds: phi within 0.01, sigma2 and WN within 30 %, RW within a factor 10 (the
     // RW is seen only at the last few, noisy levels)
-    let t = &guess.theta();
+    let t = guess.theta();
     assert!((t[0] - 0.99).abs() < 0.01, "{t:?}");
     assert!((t[1] / 0.01 - 1.0).abs() < 0.3, "{t:?}");
     assert!((t[2] - 1.0).abs() < 0.3, "{t:?}");
@@ -119,7 +119,7 @@ fn recovery_two_gm_wn_guess_mode() {
     );
     assert!(guess.objective() <= exact.objective() * GUESS_FACTOR);
     // loose bounds: rates within a factor 3, variances within a factor 3, WN within 30 %
-    let t = &guess.theta();
+    let t = guess.theta();
     let within = |v: f64, truth: f64, f: f64| v > truth / f && v < truth * f;
     assert!(within(t[0], 0.5, 3.0), "{t:?}");
     assert!(within(t[1], 1e-4, 3.0), "{t:?}");

@@ -3,9 +3,10 @@
 
 use crate::common::{read_column, rel_diff};
 use gmwm::calib::ieee::{ieee_readoff, IeeeReadoff, DOMINANCE};
+use gmwm::imu::{allan_from_wv, read_wv_json};
 use gmwm::sim::{simulate, Generator};
 use gmwm::units::{to_datasheet, NoiseTerm, SignalKind, SignalUnit};
-use gmwm::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
+use gmwm::{allan_variance, AllanKind, AllanOptions, AllanVariance};
 
 /// A pure power law is read back through logarithms of a few dozen numbers: rounding only.
 const TOL_POWER_LAW: f64 = 1e-9;
@@ -26,30 +27,49 @@ const SEED: u64 = 20_261_124;
 /// at 100 Hz, with a constant band `[AV / BAND, AV * BAND]` and the edf of a long overlapping
 /// estimate (`3 (n / m)` for n = 1e9: large at short tau, small at long tau).
 fn closed_form(avar: impl Fn(f64) -> f64) -> AllanVariance {
+    closed_form_with(|_, t| Some(avar(t)))
+}
+
+/// As [`closed_form`], built the public way: a wavelet variance file (`null` for an undefined
+/// value) read by the engine and turned into its Allan variance, `AV(m) = 2 nu2(tau = 2m)`
+/// (METHODS §3.4); `avar(k, tau_s)` gives the AV at octave `k` (`None`: undefined).
+fn closed_form_with(avar: impl Fn(usize, f64) -> Option<f64>) -> AllanVariance {
     let n = 1_000_000_000usize;
     let m: Vec<f64> = (0..20).map(|k| f64::from(1u32 << k)).collect();
-    let tau_s: Vec<f64> = m.iter().map(|m| m / FREQ_HZ).collect();
-    let av: Vec<f64> = tau_s.iter().map(|&t| avar(t)).collect();
-    AllanVariance {
-        kind: AllanKind::Overlapping,
-        convention: AvConvention::Textbook,
-        n,
-        freq_hz: FREQ_HZ,
-        alpha: 0.05,
-        adev: av.iter().map(|v| v.sqrt()).collect(),
-        ci_low: av.iter().map(|v| v / BAND).collect(),
-        ci_high: av.iter().map(|v| v * BAND).collect(),
-        edf: m.iter().map(|m| 3.0 * n as f64 / m).collect(),
-        terms: m.iter().map(|m| n - 2 * *m as usize + 1).collect(),
-        error: m
-            .iter()
-            .map(|m| 1.0 / (2.0 * (n as f64 / m - 1.0)).sqrt())
-            .collect(),
-        tau: m,
-        tau_s,
-        avar: av,
-    }
+    let av: Vec<Option<f64>> = m
+        .iter()
+        .enumerate()
+        .map(|(k, m)| avar(k, m / FREQ_HZ))
+        .collect();
+    let wv = |scale: f64| -> Vec<Option<f64>> {
+        av.iter().map(|v| v.map(|v| v * scale / 2.0)).collect()
+    };
+    let doc = serde_json::json!({
+        "freq_hz": FREQ_HZ,
+        "series": [{
+            "name": "closed form",
+            "n": n,
+            "tau": m.iter().map(|m| 2.0 * m).collect::<Vec<f64>>(),
+            "wv": wv(1.0),
+            "ci_low": wv(1.0 / BAND),
+            "ci_high": wv(BAND),
+            "eta": m.iter().map(|m| 3.0 * n as f64 / m).collect::<Vec<f64>>(),
+        }]
+    });
+    let path = std::env::temp_dir().join(format!(
+        "gmwm_ieee_closed_form_{}_{}.json",
+        std::process::id(),
+        CLOSED_FORMS.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let read = read_wv_json(&path, None);
+    std::fs::remove_file(&path).ok();
+    let av = allan_from_wv(&read.unwrap()[0].1).unwrap();
+    assert_eq!(av.terms()[0], n - 1, "N - 2m + 1 terms at m = 1");
+    av
 }
+
+static CLOSED_FORMS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// METHODS §14.2 derivation check: the AV of each term at cluster time `t` seconds.
 fn wn(n: f64) -> impl Fn(f64) -> f64 {
@@ -189,10 +209,10 @@ fn ieee_refuses_other_variances_and_survives_bad_values() {
         assert!(e.to_string().contains("Allan variance"), "{e}");
     }
     // NaN, zero and negative entries are skipped; one usable scale gives no value, no panic
-    let mut av = closed_form(wn(1e-3));
-    for i in 1..20 {
-        av.avar[i] = [f64::NAN, 0.0, -1.0][i % 3];
-    }
+    let av = closed_form_with(|k, t| match k {
+        0 => Some(wn(1e-3)(t)),
+        _ => [None, Some(0.0), Some(-1.0)][k % 3],
+    });
     let ro = ieee_readoff(&av).unwrap();
     for (_, _, r) in ro.rows() {
         assert!(r.value.is_none(), "{ro}");

@@ -271,8 +271,8 @@ fn coverage(
         .collect();
     let mut covered = vec![0; theta0.len()];
     for inf in &runs {
-        assert_eq!(inf.method, InferenceMethod::Asymptotic);
-        for (k, p) in inf.parameters.iter().enumerate() {
+        assert_eq!(inf.method(), InferenceMethod::Asymptotic);
+        for (k, p) in inf.parameters().iter().enumerate() {
             let (lo, hi) = (p.ci_low.unwrap(), p.ci_high.unwrap());
             if lo <= theta0[k] && theta0[k] <= hi {
                 covered[k] += 1;
@@ -281,7 +281,7 @@ fn coverage(
     }
     let pvals = runs
         .iter()
-        .map(|i| i.gof.as_ref().unwrap().p_value)
+        .map(|i| i.gof().as_ref().unwrap().p_value)
         .collect();
     (covered, pvals)
 }
@@ -373,11 +373,11 @@ fn bootstrap_inference_does_not_depend_on_thread_count() {
     };
     let one = run(1);
     assert_eq!(one, run(2));
-    assert_eq!(one.method, InferenceMethod::Bootstrap);
-    assert_eq!(one.bootstrap_replicates, Some(12));
+    assert_eq!(one.method(), InferenceMethod::Bootstrap);
+    assert_eq!(one.bootstrap_replicates(), Some(12));
     // a different seed gives different replicates
     let other = infer(&gmwm, &fit, 2000, &opts, &InferenceOptions { seed: 6, ..o }).unwrap();
-    assert_ne!(one.parameters[0].se, other.parameters[0].se);
+    assert_ne!(one.parameters()[0].se, other.parameters()[0].se);
 }
 
 #[test]
@@ -394,15 +394,15 @@ fn bootstrap_gof_p_value_lies_in_its_interval() {
         40,
         "progress must hear of every replicate"
     );
-    let g = inf.bootstrap_gof.as_ref().expect("bootstrap GoF asked");
+    let g = inf.bootstrap_gof().expect("bootstrap GoF asked");
     assert_eq!(g.replicates, 40);
     assert!((0.0..=1.0).contains(&g.p_value));
     assert!(g.ci_low <= g.p_value && g.p_value <= g.ci_high, "{g:?}");
     // the p-value is a share of 40 replicates
     assert!(((g.p_value * 40.0) - (g.p_value * 40.0).round()).abs() < 1e-12);
     // the J-test uses the V of the 40 replicates (40 > J + 2 = 10)
-    assert_eq!(inf.gof.as_ref().unwrap().df, 5);
-    for p in &inf.parameters {
+    assert_eq!(inf.gof().as_ref().unwrap().df, 5);
+    for p in inf.parameters() {
         let (se, lo, hi) = (p.se.unwrap(), p.ci_low.unwrap(), p.ci_high.unwrap());
         assert!(se > 0.0 && lo < p.estimate && p.estimate < hi, "{p:?}");
     }
@@ -455,9 +455,9 @@ fn bootstrap_se_agrees_with_the_sandwich() {
         },
     )
     .unwrap();
-    assert!(boot.bootstrap_gof.is_none());
+    assert!(boot.bootstrap_gof().is_none());
     let tol = 3.0 * (1.0 / 598.0 + 1.0 / 798.0f64).sqrt();
-    for (b, a) in boot.parameters.iter().zip(&asym.parameters) {
+    for (b, a) in boot.parameters().iter().zip(asym.parameters()) {
         let (bs, asy) = (b.se.unwrap(), a.se.unwrap());
         eprintln!("{}: bootstrap SE {bs} sandwich SE {asy}", b.name);
         assert!(rel(bs, asy) < tol, "{}: {bs} vs {asy}", b.name);
@@ -510,18 +510,18 @@ fn gm_inference_is_in_gm_units() {
             1.0 / (1.0 - phi * phi),
         ],
     );
-    let c = DMatrix::from_fn(2, 2, |i, k| ar_inf.covariance[i][k].unwrap());
+    let c = DMatrix::from_fn(2, 2, |i, k| ar_inf.covariance()[i][k].unwrap());
     let mapped = &jac * c * jac.transpose();
     for k in 0..2 {
         // the two fits agree to the optimiser tolerance; the simulated V is identical (same
         // seed and fitted model): 1e-5 relative
         assert!(
-            rel(inf.parameters[k].se.unwrap(), mapped[(k, k)].sqrt()) < 1e-5,
+            rel(inf.parameters()[k].se.unwrap(), mapped[(k, k)].sqrt()) < 1e-5,
             "{k}"
         );
     }
     // transformed intervals stay positive and bracket the estimate
-    for p in &inf.parameters {
+    for p in inf.parameters() {
         let (lo, hi) = (p.ci_low.unwrap(), p.ci_high.unwrap());
         assert!(lo > 0.0 && lo < p.estimate && p.estimate < hi, "{p:?}");
     }
@@ -567,28 +567,28 @@ fn check_boundary_inference(seed: u64, big: &str, small: &str, boundary: &[&str]
         let ib = infer(&gb, &fb, x.len(), &opts, &o).unwrap();
         let is = infer(&gs, &fs, x.len(), &opts, &o).unwrap();
         for &k in &at {
-            let p = &ib.parameters[k];
+            let p = &ib.parameters()[k];
             assert_eq!((p.se, p.ci_low, p.ci_high), (None, None, None));
-            assert!(ib.covariance[k].iter().all(Option::is_none));
+            assert!(ib.covariance()[k].iter().all(Option::is_none));
         }
-        assert!(ib.warnings.contains(&InferenceWarning::AtBoundary {
+        assert!(ib.warnings().contains(&InferenceWarning::AtBoundary {
             parameters: boundary.iter().map(|b| b.to_string()).collect()
         }));
         // the other parameters: the inference of the small model (V simulated from the same
         // fitted process with the same seed; fits equal to the optimiser tolerance, 1e-6)
         let kept = ib
-            .parameters
+            .parameters()
             .iter()
             .enumerate()
             .filter(|(k, _)| !at.contains(k));
-        for ((_, a), b) in kept.zip(&is.parameters) {
+        for ((_, a), b) in kept.zip(is.parameters()) {
             assert!(
                 rel(a.se.unwrap(), b.se.unwrap()) < 1e-6,
                 "{bootstrap:?} {a:?} {b:?}"
             );
             assert!(rel(a.ci_low.unwrap(), b.ci_low.unwrap()) < 1e-6);
         }
-        let (jb, js) = (ib.gof.unwrap(), is.gof.unwrap());
+        let (jb, js) = (ib.gof().unwrap(), is.gof().unwrap());
         assert_eq!(jb.df, js.df);
         assert!(rel(jb.statistic, js.statistic) < 1e-6);
     }
@@ -634,7 +634,7 @@ fn inference_and_refits_survive_estimates_on_the_edge() {
             ..InferenceOptions::default()
         };
         let i = infer(&g, &f, x.len(), &opts, &o).unwrap();
-        assert!(i.gof.is_some());
+        assert!(i.gof().is_some());
     }
     // a start with the second phi and the drift exactly on their edges (0) is accepted
     let mut edge = f.theta().to_vec();

@@ -1342,18 +1342,18 @@ fn wv_json_series_by_name_or_index_and_allan_by_methods_3_4() {
     let wv = wavelet_variance(&x, 10.0, &WvOptions::default()).unwrap();
     let av = allan_variance(&x, 10.0, &AllanOptions::default()).unwrap();
     let conv = allan_from_wv(&wv).unwrap();
-    let levels = conv.tau.len();
-    assert_eq!(conv.tau[..], av.tau[..levels]);
+    let levels = conv.tau().len();
+    assert_eq!(conv.tau()[..], av.tau()[..levels]);
     for j in 0..levels {
         for (a, b) in [
-            (conv.avar[j], av.avar[j]),
-            (conv.ci_low[j], av.ci_low[j]),
-            (conv.ci_high[j], av.ci_high[j]),
-            (conv.edf[j], av.edf[j]),
+            (conv.avar()[j], av.avar()[j]),
+            (conv.ci_low()[j], av.ci_low()[j]),
+            (conv.ci_high()[j], av.ci_high()[j]),
+            (conv.edf()[j], av.edf()[j]),
         ] {
             assert!((a - b).abs() <= 1e-9 * b.abs(), "level {j}: {a} vs {b}");
         }
-        assert_eq!(conv.terms[j], av.terms[j]);
+        assert_eq!(conv.terms()[j], av.terms()[j]);
     }
     let robust = wavelet_variance(
         &x,
@@ -1399,6 +1399,6 @@ fn wic_select_wv_equals_select_on_the_series() {
     let from_series = wic.select(&x, 10.0).unwrap();
     let wv = wavelet_variance(&x, 10.0, &WvOptions::default()).unwrap();
     let from_wv = wic.select_wv(&wv).unwrap();
-    assert_eq!(from_wv.selected, from_series.selected);
-    assert_eq!(from_wv.candidates, from_series.candidates);
+    assert_eq!(from_wv.selected(), from_series.selected());
+    assert_eq!(from_wv.candidates(), from_series.candidates());
 }

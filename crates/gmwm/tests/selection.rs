@@ -426,40 +426,40 @@ fn selection_is_deterministic_and_consistent() {
         run(1),
         "same seed, same result, whatever the thread count"
     );
-    assert_eq!(s.candidates.len(), 15);
+    assert_eq!(s.candidates().len(), 15);
     // sorted by WIC; within a tie (WIC_TIE_REL) the smaller model comes first
     assert!(s
-        .candidates
+        .candidates()
         .windows(2)
         .all(|w| w[0].wic <= w[1].wic * (1.0 + WIC_TIE_REL)));
-    for c in &s.candidates {
+    for c in s.candidates() {
         assert_eq!(c.wic, c.objective + c.optimism);
         assert!(c.optimism > 0.0, "{c:?}");
         // J = 11 levels, B = 30 > J + 2: every candidate has a J-test p-value in [0, 1]
         let p = c.gof_p_value.unwrap();
         assert!((0.0..=1.0).contains(&p), "{c:?}");
     }
-    assert_eq!(s.selected, s.candidates[0].model);
-    assert_eq!(s.fit.model().without_values(), s.selected);
-    assert_eq!(s.fit.objective(), s.candidates[0].objective);
+    assert_eq!(*s.selected(), s.candidates()[0].model);
+    assert_eq!(s.fit().model().without_values(), *s.selected());
+    assert_eq!(s.fit().objective(), s.candidates()[0].objective);
     // the full model's row is the full fit against the same WV
     let full = s
-        .candidates
+        .candidates()
         .iter()
-        .find(|c| c.model == s.full_model)
+        .find(|c| c.model == *s.full_model())
         .unwrap();
-    let direct = gmwm::Gmwm::new(s.full_model.clone())
+    let direct = gmwm::Gmwm::new(s.full_model().clone())
         .with_draws(400)
         .fit(&x, 100.0, &gmwm::WvOptions::default())
         .unwrap();
     assert_eq!(full.objective, direct.objective());
     // white noise alone cannot follow the AR1 bump around tau ~ 40 samples
     let wn = s
-        .candidates
+        .candidates()
         .iter()
         .find(|c| terms(&c.model) == "WN")
         .unwrap();
-    assert!(wn.wic > s.candidates[0].wic + 1.0, "{wn:?}");
+    assert!(wn.wic > s.candidates()[0].wic + 1.0, "{wn:?}");
     // the package's formula gives other optimism values on the same fits
     let pkg = wic
         .clone()
@@ -467,10 +467,10 @@ fn selection_is_deterministic_and_consistent() {
         .select(&x, 100.0)
         .unwrap();
     let (a, b) = (
-        &s.candidates[0],
-        pkg.candidates
+        &s.candidates()[0],
+        pkg.candidates()
             .iter()
-            .find(|c| c.model == s.candidates[0].model)
+            .find(|c| c.model == s.candidates()[0].model)
             .unwrap(),
     );
     assert_eq!(a.objective, b.objective);
@@ -490,7 +490,7 @@ fn bootstrap_optimism_agrees_with_the_asymptotic_one() {
         .with_bootstrap_draws(200)
         .select(&x, 1.0)
         .unwrap();
-    let (a, b) = (&asym.candidates[0], &boot.candidates[0]);
+    let (a, b) = (&asym.candidates()[0], &boot.candidates()[0]);
     assert_eq!(a.objective, b.objective);
     // 200 replicates: a covariance estimate with ~10% relative error; allow 30%
     assert!(
@@ -531,19 +531,19 @@ fn bootstrap_optimism_refits_a_candidate_whose_drift_collapsed() {
         .select(&x, 1.0)
         .unwrap();
     let with_dr = s
-        .candidates
+        .candidates()
         .iter()
         .find(|c| c.model.n_components() == 3)
         .unwrap();
     let without = s
-        .candidates
+        .candidates()
         .iter()
         .find(|c| c.model.n_components() == 2)
         .unwrap();
     // the drift is inactive: same objective as the sub-model (optimiser tolerance)
     assert!(close(with_dr.objective, without.objective, 1e-6));
     assert!(with_dr.optimism.is_finite() && with_dr.optimism > 0.0);
-    assert_eq!(s.selected.to_string(), "AR1()+WN()");
+    assert_eq!(s.selected().to_string(), "AR1()+WN()");
 }
 
 /// The expected excess of the out-of-sample loss over the in-sample loss, by Monte Carlo:
@@ -639,7 +639,7 @@ fn selection_mc(
     for r in 0..reps {
         let x = simulate_model(truth, n, 100.0, 1000 + r as u64).unwrap();
         let s = wic.select(&x, 100.0).unwrap();
-        let sel = s.selected.kinds();
+        let sel = s.selected().kinds();
         if sel == kinds {
             hits += 1;
         } else if sel.len() < kinds.len() && sel.iter().all(|k| kinds.contains(k)) {
@@ -795,10 +795,10 @@ fn auto_imu_gyro_x_objectives_are_no_worse_than_the_r_package() {
         .map(|v| v.as_str().unwrap())
         .collect();
     let obj = f64s(&rc["obj_fun"]);
-    assert_eq!(s.candidates.len(), names.len());
+    assert_eq!(s.candidates().len(), names.len());
     for (name, r_obj) in names.iter().zip(&obj) {
         let ours = s
-            .candidates
+            .candidates()
             .iter()
             .find(|c| terms(&c.model) == *name)
             .unwrap();
@@ -817,9 +817,12 @@ fn auto_imu_gyro_x_objectives_are_no_worse_than_the_r_package() {
         "AR1(phi={}, sigma2={})+AR1(phi={}, sigma2={})+RW(gamma2={})",
         est[0], est[1], est[2], est[3], est[4]
     ));
-    let implied = r_model.implied_wv(s.fit.nu_hat().len(), 100.0).unwrap().wv;
+    let implied = r_model
+        .implied_wv(s.fit().nu_hat().len(), 100.0)
+        .unwrap()
+        .wv;
     let q: f64 = (0..implied.len())
-        .map(|j| s.fit.weights().omega[j] * (s.fit.nu_hat()[j] - implied[j]).powi(2))
+        .map(|j| s.fit().weights().omega[j] * (s.fit().nu_hat()[j] - implied[j]).powi(2))
         .sum();
     let r_q = sel["obj_fun"].as_f64().unwrap();
     // the estimates are printed to 16 digits; 1e-6 relative covers their rounding in Q
@@ -845,23 +848,23 @@ fn auto_imu_adis_six_axes() {
     for a in &s.axes {
         let full = a
             .selection
-            .candidates
+            .candidates()
             .iter()
-            .find(|c| c.model == a.selection.full_model)
+            .find(|c| c.model == *a.selection.full_model())
             .unwrap();
         eprintln!(
             "{}: selected {} (WIC {:.6}, objective {:.6}); full model WIC {:.6}",
             a.axis,
-            a.selection.selected,
-            a.selection.candidates[0].wic,
-            a.selection.candidates[0].objective,
+            a.selection.selected(),
+            a.selection.candidates()[0].wic,
+            a.selection.candidates()[0].objective,
             full.wic
         );
-        assert_eq!(a.selection.candidates.len(), 63);
+        assert_eq!(a.selection.candidates().len(), 63);
         // the full model is a candidate: the winner is no worse, up to the tie rule (a
         // smaller model within WIC_TIE_REL of a larger one ranks first)
         assert!(
-            a.selection.candidates[0].wic <= full.wic * (1.0 + gmwm::selection::wic::WIC_TIE_REL)
+            a.selection.candidates()[0].wic <= full.wic * (1.0 + gmwm::selection::wic::WIC_TIE_REL)
         );
     }
     let tags: Vec<&str> = s.axes.iter().map(|a| a.axis.as_str()).collect();
@@ -886,7 +889,7 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
         .unwrap();
     // one row per canonical model; the rows' members partition the candidates
     let keys: Vec<String> = s
-        .rows
+        .rows()
         .iter()
         .map(|r| r.score.canonical_model.to_string())
         .collect();
@@ -895,18 +898,18 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
     unique.dedup();
     assert_eq!(unique.len(), keys.len(), "{keys:?}");
     let mut members: Vec<String> = s
-        .rows
+        .rows()
         .iter()
         .flat_map(|r| r.members.iter().map(Model::to_string))
         .collect();
     members.sort();
-    let mut all: Vec<String> = s.candidates.iter().map(|c| c.model.to_string()).collect();
+    let mut all: Vec<String> = s.candidates().iter().map(|c| c.model.to_string()).collect();
     all.sort();
     assert_eq!(members, all);
     let log_variance = gmwm::wavelet_variance(&x, 100.0, &gmwm::WvOptions::default())
         .unwrap()
         .log_variance();
-    for row in &s.rows {
+    for row in s.rows() {
         // the row shows its best member's scores, or those of a smaller member whose fit the
         // data cannot tell from the best one's (the smallest such); each member reads as the row
         let fit_of = |m: &Model| s.candidate_fit(m).unwrap();
@@ -914,7 +917,7 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
             .members
             .iter()
             .min_by(|a, b| {
-                let wic = |m: &Model| s.candidates.iter().find(|c| &c.model == m).unwrap().wic;
+                let wic = |m: &Model| s.candidates().iter().find(|c| &c.model == m).unwrap().wic;
                 wic(a).total_cmp(&wic(b))
             })
             .unwrap();
@@ -936,13 +939,13 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
             }
         }
         for m in &row.members {
-            let c = s.candidates.iter().find(|c| &c.model == m).unwrap();
+            let c = s.candidates().iter().find(|c| &c.model == m).unwrap();
             assert_eq!(c.canonical_model, row.score.canonical_model);
             let f = s.candidate_fit(m).unwrap();
             assert_eq!(f.canonical().unwrap().model, row.score.canonical_model);
         }
         let c = s
-            .candidates
+            .candidates()
             .iter()
             .find(|c| c.model == row.score.model)
             .unwrap();
@@ -952,23 +955,23 @@ fn selection_rows_fold_the_candidates_by_canonical_model() {
     // sorted by WIC; the first row is the minimum, exactly one row is selected, and it is
     // the minimum or within one standard error of it
     assert!(s
-        .rows
+        .rows()
         .windows(2)
         .all(|w| w[0].score.wic <= w[1].score.wic * (1.0 + WIC_TIE_REL)));
-    assert_eq!(s.rows[0].delta_wic, 0.0);
+    assert_eq!(s.rows()[0].delta_wic, 0.0);
     let selected: Vec<_> = s
-        .rows
+        .rows()
         .iter()
         .filter(|r| r.status == RowStatus::Selected)
         .collect();
     assert_eq!(selected.len(), 1);
     let sel = selected[0];
     assert!(sel.delta_wic <= sel.delta_wic_se, "{sel:?}");
-    assert_eq!(sel.score.canonical_model, s.selected_canonical.model);
-    assert_eq!(sel.score.model, s.selected);
-    assert_eq!(s.fit.model().without_values(), s.selected);
+    assert_eq!(sel.score.canonical_model, s.selected_canonical().model);
+    assert_eq!(sel.score.model, *s.selected());
+    assert_eq!(s.fit().model().without_values(), *s.selected());
     assert_eq!(
-        s.selected_canonical.model.to_string(),
+        s.selected_canonical().model.to_string(),
         "AR1()+WN()+RW()",
         "{s}"
     );
@@ -1051,13 +1054,13 @@ fn bootstrap_gof_p_value_is_a_bound_when_no_replicate_exceeds() {
         .select(&x, 1.0)
         .unwrap();
     let wn = s
-        .candidates
+        .candidates()
         .iter()
         .find(|c| terms(&c.model) == "WN")
         .unwrap();
     assert!(wn.gof_p_value_upper_bound, "{wn:?}");
     assert_eq!(wn.gof_p_value, Some(1.0 / (b as f64 + 1.0)));
-    let row = s.rows.iter().find(|r| r.score.model == wn.model).unwrap();
+    let row = s.rows().iter().find(|r| r.score.model == wn.model).unwrap();
     assert!(row.score.gof_p_value_upper_bound);
     assert!(
         s.to_string()
@@ -1101,7 +1104,7 @@ fn issue_10_mc(full: &str, reps: usize) -> Issue10 {
         .map(|r| {
             let x = simulate_model(&truth, 100_000, 100.0, 1000 + r as u64).unwrap();
             let s = wic.select(&x, 100.0).unwrap();
-            let c = &s.selected_canonical;
+            let c = &s.selected_canonical();
             let t = s.candidate_fit(&true_model).unwrap().canonical().unwrap();
             let density =
                 |m: &gmwm::fit::CanonicalModel, k, name| m.physical(k, name).unwrap_or(0.0);
@@ -1282,9 +1285,9 @@ fn issue_10_candidates_with_one_fit_have_one_gof_p_value() {
         .select(&x, 100.0)
         .unwrap();
     // B = 50 > J + 2: every candidate has a J-test
-    assert!(s.candidates.iter().all(|c| c.gof_p_value.is_some()));
-    for a in &s.candidates {
-        for b in &s.candidates {
+    assert!(s.candidates().iter().all(|c| c.gof_p_value.is_some()));
+    for a in s.candidates() {
+        for b in s.candidates() {
             if a.canonical_model == b.canonical_model
                 && (a.objective - b.objective).abs() <= 1e-9 * a.objective
             {

@@ -161,9 +161,9 @@ fn package_convention_matches_r_robust_wv_on_adis_imu1() {
         let r = &reference["columns"][&col.name]["robust_eff_0.6"];
         let wv = wavelet_variance(&col.values, 100.0, &opts).unwrap();
         for (ours, key) in [
-            (&wv.wv(), "variance"),
-            (&wv.ci_low(), "ci_low"),
-            (&wv.ci_high(), "ci_high"),
+            (wv.wv(), "variance"),
+            (wv.ci_low(), "ci_low"),
+            (wv.ci_high(), "ci_high"),
         ] {
             let theirs = f64s(&r[key]);
             assert_eq!(ours.len(), theirs.len());

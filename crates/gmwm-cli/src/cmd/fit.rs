@@ -132,7 +132,7 @@ fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Wr
                 for (k, p) in fit.parameters().into_iter().enumerate() {
                     let (se, lo, hi) = match inf {
                         Some(i) => {
-                            let q = &i.parameters[k];
+                            let q = &i.parameters()[k];
                             let cell =
                                 |x: Option<f64>| x.map(|x| format!("{x:e}")).unwrap_or_default();
                             (cell(q.se), cell(q.ci_low), cell(q.ci_high))

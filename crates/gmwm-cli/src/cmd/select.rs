@@ -19,7 +19,7 @@ fn write_csv(results: &[(String, ModelSelection)], out: &mut impl Write) -> Resu
     writeln!(out, "{CSV_HEADER}")?;
     let cell = |x: Option<f64>| x.map(|x| format!("{x:e}")).unwrap_or_default();
     for (column, s) in results {
-        for (r, row) in s.rows.iter().enumerate() {
+        for (r, row) in s.rows().iter().enumerate() {
             let members: Vec<String> = row.members.iter().map(Model::to_string).collect();
             let status = match row.status {
                 RowStatus::Selected => "selected",
@@ -95,12 +95,12 @@ pub fn compute(config: &SelectConfig) -> Result<Vec<(String, ModelSelection)>> {
     };
     let results = results?;
     for (name, s) in &results {
-        if !s.fit.convergence().converged {
+        if !s.fit().convergence().converged {
             eprintln!(
                 "gmwm: warning: {}: column {name}: the optimiser did not converge for the selected model {} ({})",
                 file.display(),
-                s.selected,
-                s.fit.convergence()
+                s.selected(),
+                s.fit().convergence()
             );
         }
     }

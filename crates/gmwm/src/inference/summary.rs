@@ -228,32 +228,101 @@ impl fmt::Display for InferenceWarning {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Inference {
     /// Asymptotic or bootstrap.
-    pub method: InferenceMethod,
+    pub(crate) method: InferenceMethod,
     /// The `alpha` of the intervals (`1 - alpha` two-sided, `1 - 2 alpha` with the package z).
-    pub alpha: f64,
+    pub(crate) alpha: f64,
     /// The normal quantile used.
-    pub z: f64,
+    pub(crate) z: f64,
     /// Its convention.
-    pub z_convention: ZConvention,
+    pub(crate) z_convention: ZConvention,
     /// Interval scale.
-    pub scale: IntervalScale,
+    pub(crate) scale: IntervalScale,
     /// Replicates behind the WV covariance V (H, or B in bootstrap mode).
-    pub v_replicates: usize,
+    pub(crate) v_replicates: usize,
     /// B in bootstrap mode.
-    pub bootstrap_replicates: Option<usize>,
+    pub(crate) bootstrap_replicates: Option<usize>,
     /// Per parameter, model order.
-    pub parameters: Vec<ParameterInference>,
+    pub(crate) parameters: Vec<ParameterInference>,
     /// Covariance of the estimates (sandwich `Psi` or bootstrap), rows; `None` in the rows and
     /// columns of a parameter at the boundary.
-    pub covariance: Vec<Vec<Option<f64>>>,
+    pub(crate) covariance: Vec<Vec<Option<f64>>>,
     /// `Q(theta_hat)` of the fit.
-    pub objective: f64,
+    pub(crate) objective: f64,
     /// The J-test (METHODS §7.3).
-    pub gof: Option<JTest>,
+    pub(crate) gof: Option<JTest>,
     /// The bootstrap GoF test (METHODS §7.4), when run.
-    pub bootstrap_gof: Option<BootstrapGof>,
+    pub(crate) bootstrap_gof: Option<BootstrapGof>,
     /// Soft problems.
-    pub warnings: Vec<InferenceWarning>,
+    pub(crate) warnings: Vec<InferenceWarning>,
+}
+
+/// Read access to the results; the fields are the engine's own.
+impl Inference {
+    /// Asymptotic or bootstrap.
+    pub fn method(&self) -> InferenceMethod {
+        self.method
+    }
+
+    /// The `alpha` of the intervals (`1 - alpha` two-sided, `1 - 2 alpha` with the package z).
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// The normal quantile used.
+    pub fn z(&self) -> f64 {
+        self.z
+    }
+
+    /// Its convention.
+    pub fn z_convention(&self) -> ZConvention {
+        self.z_convention
+    }
+
+    /// Interval scale.
+    pub fn scale(&self) -> IntervalScale {
+        self.scale
+    }
+
+    /// Replicates behind the WV covariance V (H, or B in bootstrap mode).
+    pub fn v_replicates(&self) -> usize {
+        self.v_replicates
+    }
+
+    /// B in bootstrap mode.
+    pub fn bootstrap_replicates(&self) -> Option<usize> {
+        self.bootstrap_replicates
+    }
+
+    /// Per parameter, model order.
+    pub fn parameters(&self) -> &[ParameterInference] {
+        &self.parameters
+    }
+
+    /// Covariance of the estimates (sandwich `Psi` or bootstrap), rows; `None` in the rows and
+    /// columns of a parameter at the boundary.
+    pub fn covariance(&self) -> &[Vec<Option<f64>>] {
+        &self.covariance
+    }
+
+    /// `Q(theta_hat)` of the fit.
+    pub fn objective(&self) -> f64 {
+        self.objective
+    }
+
+    /// The J-test (METHODS §7.3).
+    pub fn gof(&self) -> Option<&JTest> {
+        self.gof.as_ref()
+    }
+
+    /// The bootstrap GoF test (METHODS §7.4), when run.
+    pub fn bootstrap_gof(&self) -> Option<&BootstrapGof> {
+        self.bootstrap_gof.as_ref()
+    }
+
+    /// Soft problems.
+    pub fn warnings(&self) -> &[InferenceWarning] {
+        &self.warnings
+    }
 }
 
 /// METHODS §7.5: inference on `fit` (a fit by `gmwm` of a series of length `n`, WV computed

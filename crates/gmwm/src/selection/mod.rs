@@ -75,13 +75,13 @@
 //!     .with_draws(500)
 //!     .with_bootstrap(20);
 //! let s = wic.select(&x, 1.0).unwrap();
-//! assert_eq!(s.candidates.len(), 7);
+//! assert_eq!(s.candidates().len(), 7);
 //! // one row per canonical model; the selected one is the minimum or within one standard
 //! // error of it, and it names the canonical model it stands for
 //! let row = s.selected_row();
 //! assert!(row.delta_wic <= row.delta_wic_se);
-//! assert_eq!(row.score.canonical_model, s.selected_canonical.model);
-//! assert!(s.rows.iter().all(|r| r.score.wic >= s.rows[0].score.wic * (1.0 - 1e-6)));
+//! assert_eq!(row.score.canonical_model, s.selected_canonical().model);
+//! assert!(s.rows().iter().all(|r| r.score.wic >= s.rows()[0].score.wic * (1.0 - 1e-6)));
 //! ```
 
 pub mod candidates;

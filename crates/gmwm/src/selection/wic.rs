@@ -898,35 +898,105 @@ pub struct SelectionRow {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ModelSelection {
     /// The full model (guess mode).
-    pub full_model: Model,
+    pub(crate) full_model: Model,
     /// Optimism estimator.
-    pub method: OptimismMethod,
+    pub(crate) method: OptimismMethod,
     /// Asymptotic formula.
-    pub convention: OptimismConvention,
+    pub(crate) convention: OptimismConvention,
     /// Bootstrap replicates B.
-    pub bootstrap: usize,
+    pub(crate) bootstrap: usize,
     /// How the selected row was chosen.
-    pub rule: SelectionRule,
+    pub(crate) rule: SelectionRule,
     /// Separation below which a fit and its canonical reduction are not told apart.
-    pub separation_limit: f64,
+    pub(crate) separation_limit: f64,
     /// One row per canonical model, sorted by WIC.
-    pub rows: Vec<SelectionRow>,
+    pub(crate) rows: Vec<SelectionRow>,
     /// Every candidate, sorted by WIC ascending.
-    pub candidates: Vec<CandidateScore>,
+    pub(crate) candidates: Vec<CandidateScore>,
     /// The selected candidate (guess mode, as fitted).
-    pub selected: Model,
+    pub(crate) selected: Model,
     /// Its canonical model.
-    pub selected_canonical: CanonicalModel,
+    pub(crate) selected_canonical: CanonicalModel,
     /// The selected candidate's fit.
-    pub fit: GmwmFit,
+    pub(crate) fit: GmwmFit,
     /// Every candidate's fit, in the order of `candidates` (not serialised).
     #[serde(skip)]
-    pub candidate_fits: Vec<GmwmFit>,
+    pub(crate) candidate_fits: Vec<GmwmFit>,
     /// The bootstrap covariance V of the WV (`bootstrap` replicates simulated from the full
     /// model's fit, which nests every candidate), for inference on the selected fit without
     /// simulating again ([`crate::inference::infer_with_covariance`]); not serialised.
     #[serde(skip)]
-    pub wv_covariance: DMatrix<f64>,
+    pub(crate) wv_covariance: DMatrix<f64>,
+}
+
+/// Read access to the results; the fields are the engine's own.
+impl ModelSelection {
+    /// The full model (guess mode).
+    pub fn full_model(&self) -> &Model {
+        &self.full_model
+    }
+
+    /// Optimism estimator.
+    pub fn method(&self) -> OptimismMethod {
+        self.method
+    }
+
+    /// Asymptotic formula.
+    pub fn convention(&self) -> OptimismConvention {
+        self.convention
+    }
+
+    /// Bootstrap replicates B.
+    pub fn bootstrap(&self) -> usize {
+        self.bootstrap
+    }
+
+    /// How the selected row was chosen.
+    pub fn rule(&self) -> SelectionRule {
+        self.rule
+    }
+
+    /// Separation below which a fit and its canonical reduction are not told apart.
+    pub fn separation_limit(&self) -> f64 {
+        self.separation_limit
+    }
+
+    /// One row per canonical model, sorted by WIC.
+    pub fn rows(&self) -> &[SelectionRow] {
+        &self.rows
+    }
+
+    /// Every candidate, sorted by WIC ascending.
+    pub fn candidates(&self) -> &[CandidateScore] {
+        &self.candidates
+    }
+
+    /// The selected candidate (guess mode, as fitted).
+    pub fn selected(&self) -> &Model {
+        &self.selected
+    }
+
+    /// Its canonical model.
+    pub fn selected_canonical(&self) -> &CanonicalModel {
+        &self.selected_canonical
+    }
+
+    /// The selected candidate's fit.
+    pub fn fit(&self) -> &GmwmFit {
+        &self.fit
+    }
+
+    /// Every candidate's fit, in the order of `candidates` (not serialised).
+    pub fn candidate_fits(&self) -> &[GmwmFit] {
+        &self.candidate_fits
+    }
+
+    /// The bootstrap covariance V of the WV (`bootstrap` replicates simulated from the full
+    /// model's fit, which nests every candidate), for inference on the selected fit without
+    /// simulating again ([`crate::inference::infer_with_covariance`]); not serialised.
+    pub fn wv_covariance(&self) -> &DMatrix<f64> {
+        &self.wv_covariance
+    }
 }
 
 impl ModelSelection {

@@ -176,35 +176,110 @@ impl Default for AllanOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AllanVariance {
     /// Which variance (METHODS §3).
-    pub kind: AllanKind,
+    pub(crate) kind: AllanKind,
     /// Estimator convention used (METHODS §13.8–§13.10).
-    pub convention: AvConvention,
+    pub(crate) convention: AvConvention,
     /// Number of samples of the series.
-    pub n: usize,
+    pub(crate) n: usize,
     /// Sampling rate in Hz.
-    pub freq_hz: f64,
+    pub(crate) freq_hz: f64,
     /// Confidence level of the intervals.
-    pub alpha: f64,
+    pub(crate) alpha: f64,
     /// Cluster lengths `m` in samples (METHODS §3.1: `tau` samples).
-    pub tau: Vec<f64>,
+    pub(crate) tau: Vec<f64>,
     /// Cluster lengths in seconds, `m / freq_hz`.
-    pub tau_s: Vec<f64>,
+    pub(crate) tau_s: Vec<f64>,
     /// The variance estimate (Allan, modified Allan or Hadamard variance; METHODS §3.1–§3.6).
-    pub avar: Vec<f64>,
+    pub(crate) avar: Vec<f64>,
     /// Its square root (Allan / Hadamard deviation, METHODS §3.3).
-    pub adev: Vec<f64>,
+    pub(crate) adev: Vec<f64>,
     /// Lower chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
-    pub ci_low: Vec<f64>,
+    pub(crate) ci_low: Vec<f64>,
     /// Upper chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
-    pub ci_high: Vec<f64>,
+    pub(crate) ci_high: Vec<f64>,
     /// Equivalent degrees of freedom of the chi-square interval (see [`allan_variance`]).
-    pub edf: Vec<f64>,
+    pub(crate) edf: Vec<f64>,
     /// Number of terms (squared differences) summed by the estimator.
-    pub terms: Vec<usize>,
+    pub(crate) terms: Vec<usize>,
     /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))` (METHODS §3.3), in both
     /// conventions; its deviation band is [`AllanVariance::package_band`]. The package itself
     /// calls this band "known to be incorrect"; prefer `ci_low`/`ci_high`.
-    pub error: Vec<f64>,
+    pub(crate) error: Vec<f64>,
+}
+
+/// Read access to the results; the fields are the engine's own.
+impl AllanVariance {
+    /// Which variance (METHODS §3).
+    pub fn kind(&self) -> AllanKind {
+        self.kind
+    }
+
+    /// Estimator convention used (METHODS §13.8–§13.10).
+    pub fn convention(&self) -> AvConvention {
+        self.convention
+    }
+
+    /// Number of samples of the series.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Sampling rate in Hz.
+    pub fn freq_hz(&self) -> f64 {
+        self.freq_hz
+    }
+
+    /// Confidence level of the intervals.
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// Cluster lengths `m` in samples (METHODS §3.1: `tau` samples).
+    pub fn tau(&self) -> &[f64] {
+        &self.tau
+    }
+
+    /// Cluster lengths in seconds, `m / freq_hz`.
+    pub fn tau_s(&self) -> &[f64] {
+        &self.tau_s
+    }
+
+    /// The variance estimate (Allan, modified Allan or Hadamard variance; METHODS §3.1–§3.6).
+    pub fn avar(&self) -> &[f64] {
+        &self.avar
+    }
+
+    /// Its square root (Allan / Hadamard deviation, METHODS §3.3).
+    pub fn adev(&self) -> &[f64] {
+        &self.adev
+    }
+
+    /// Lower chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
+    pub fn ci_low(&self) -> &[f64] {
+        &self.ci_low
+    }
+
+    /// Upper chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
+    pub fn ci_high(&self) -> &[f64] {
+        &self.ci_high
+    }
+
+    /// Equivalent degrees of freedom of the chi-square interval (see [`allan_variance`]).
+    pub fn edf(&self) -> &[f64] {
+        &self.edf
+    }
+
+    /// Number of terms (squared differences) summed by the estimator.
+    pub fn terms(&self) -> &[usize] {
+        &self.terms
+    }
+
+    /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))` (METHODS §3.3), in both
+    /// conventions; its deviation band is [`AllanVariance::package_band`]. The package itself
+    /// calls this band "known to be incorrect"; prefer `ci_low`/`ci_high`.
+    pub fn error(&self) -> &[f64] {
+        &self.error
+    }
 }
 
 impl AllanVariance {
@@ -314,8 +389,8 @@ impl fmt::Display for AllanVariance {
 /// // METHODS §3.4 test values: x = (1,3,2,5,4,6,8,7), textbook overlapping AV(2) = 2.1
 /// let x = [1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0];
 /// let av = allan_variance(&x, 1.0, &AllanOptions::default()).unwrap();
-/// assert_eq!(av.tau, vec![1.0, 2.0, 4.0]);
-/// assert!((av.avar[1] - 2.1).abs() < 1e-12);
+/// assert_eq!(av.tau(), [1.0, 2.0, 4.0]);
+/// assert!((av.avar()[1] - 2.1).abs() < 1e-12);
 /// ```
 pub fn allan_variance(
     x: &[f64],
