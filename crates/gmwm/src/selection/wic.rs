@@ -299,7 +299,7 @@ impl Wic {
     /// fits per candidate on top).
     ///
     /// # Errors
-    /// [`SelectionError::Setting`] for B < 2 or G = 0; [`SelectionError::Engine`] for an
+    /// [`SelectionError::Setting`] for B < 2 or G = 0; [`SelectionError::Input`] for an
     /// unusable series or rate, or a non-Haar wavelet filter; [`SelectionError::Fit`] naming
     /// the candidate whose fit, optimism or GoF failed.
     pub fn select(&self, x: &[f64], freq_hz: f64) -> Result<ModelSelection, SelectionError> {
