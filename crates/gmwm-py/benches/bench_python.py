@@ -16,6 +16,10 @@
     (``--no-rust`` skips it; it needs cargo). With ``--criterion``, also the criterion cell
     ``fit/3gm/classical/G=1000/1000000`` of ``cargo bench -p gmwm --bench fit`` against the
     native call and the wrapper on its very series and model. Nothing is added to Rust.
+(a') CPU time per fit: the same fit in a Python process (``_native.fit``) and in a Rust process
+    (the example), each process run with few and with many fits so that start-up cancels; the
+    CPU time (user + system over every thread, from the child's rusage) does not count the time
+    a loaded machine gives to other work, which wall times do.
 (b) Fleet scaling. 8 recordings calibrated by ``gmwm.calibrate_many`` on a
     ``dask.distributed.LocalCluster`` of 1 worker and of 2 workers (processes, 1 thread each),
     and with ``--pool`` in the process pool of ``max_workers`` 1 and 2; wall times (medians) and
@@ -216,6 +220,71 @@ def _rust_example(n: int, runs: int) -> Optional[Dict[str, Tuple[float, float]]]
         print(f"the Rust example failed (exit {p.returncode}):\n" + "\n".join((p.stdout + p.stderr).splitlines()[-10:]))
         return None
     return {what: (float(median), float(low)) for what, median, low in hits}
+
+
+_PY_FITS = """
+import sys
+import numpy as np
+import gmwm
+from gmwm import _native
+calls = int(sys.argv[1])
+x = np.ascontiguousarray(gmwm.simulate(%r, n=%d, freq=%r, seed=%d), dtype=np.float64)
+for _ in range(calls):
+    _native.fit([x], ["x"], %r, %r, draws=%d)
+"""
+
+
+def _child_cpu(cmd: List[str], cwd: Optional[Path] = None) -> float:
+    """CPU seconds (user + system, every thread) of one child process, from its rusage."""
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed: {p.stderr.strip()[-500:]}")
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def bench_cpu(repeats: int, n: int, fits: int) -> Optional[Dict[str, float]]:
+    """(a') CPU time per fit, Python native call against the Rust API, each in its own process.
+
+    Wall times on a loaded machine mix in other work; the CPU time a process spends does not
+    (only its cache and frequency conditions). Each side runs twice, with few and with many
+    fits, and the difference over the extra fits is the CPU time of one fit: process start,
+    imports, simulating the series and building the example cancel. The Rust example fits
+    twice per run (the second time with the canonical reading and JSON document); the Python
+    call always returns the document."""
+    root = Path(__file__).resolve().parents[3]
+    example = root / "target" / "release" / "examples" / "fit_timing"
+    build = subprocess.run(["cargo", "build", "--release", "--quiet", "-p", "gmwm", "--example", "fit_timing"],
+                           cwd=root, capture_output=True, text=True)
+    if build.returncode != 0 or not example.exists():
+        print(f"(a') skipped: the Rust example did not build: {build.stderr.strip()[-300:]}")
+        return None
+    script = _PY_FITS % (TRUTH, n, FREQ, SERIES_SEED, FREQ, MODEL, EXAMPLE_G)
+    runs = fits // 2
+    rust, py = [], []
+    for _ in range(repeats):
+        r0 = _child_cpu([str(example), str(n), "1"])
+        r1 = _child_cpu([str(example), str(n), str(runs + 1)])
+        p0 = _child_cpu([sys.executable, "-c", script, "0"])
+        p1 = _child_cpu([sys.executable, "-c", script, str(2 * runs)])
+        rust.append((r1 - r0) / (2 * runs))
+        py.append((p1 - p0) / (2 * runs))
+    ratios = [p / r for p, r in zip(py, rust)]
+    rows = [
+        ["Rust API (examples/fit_timing)", _fmt_s(statistics.median(rust)), f"{_fmt_s(min(rust))} .. {_fmt_s(max(rust))}", ""],
+        ["Python _native.fit", _fmt_s(statistics.median(py)), f"{_fmt_s(min(py))} .. {_fmt_s(max(py))}",
+         f"{100 * (statistics.median(ratios) - 1):+.1f} % (runs {', '.join(f'{100 * (r - 1):+.1f}' for r in ratios)})"],
+    ]
+    _table(
+        f"(a') CPU time per fit (user + system, all threads), n={n:.0e}, model {MODEL}, G={EXAMPLE_G}: "
+        f"{2 * runs} extra fits per process, {repeats} pairs of processes in turns",
+        ["call", "median", "range", "Python against Rust"],
+        rows,
+    )
+    return {"rust": statistics.median(rust), "python": statistics.median(py), "ratio": statistics.median(ratios)}
 
 
 def bench_criterion(repeats: int, target_dir: Optional[str]) -> Optional[Dict[str, float]]:
@@ -448,6 +517,8 @@ def main(argv=None) -> int:
     if not args.no_overhead:
         bench_overhead(repeats, args.G, n=1_000_000, tiny_n=512, tiny_rounds=50 if args.quick else 400,
                        rust=not args.no_rust)
+        if not args.no_rust:
+            bench_cpu(max(3, repeats // 2), n=1_000_000, fits=10 if args.quick else 40)
     if args.criterion:
         bench_criterion(repeats, args.cargo_target_dir)
     if not args.no_fleet:
