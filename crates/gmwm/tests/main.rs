@@ -19,6 +19,7 @@ mod process;
 mod read;
 mod robust;
 mod ros;
+mod scale;
 mod selection;
 mod sim;
 mod units;

@@ -674,10 +674,14 @@ pub struct HaarWvAccumulator {
     sums: Vec<NeumaierSum>,
     scratch_in: Vec<f64>,
     scratch_out: Vec<f64>,
+    /// Samples pushed but not yet run through the pyramid: blocks start at multiples of
+    /// [`BLOCK`] in the series, whatever the chunks, so the roundings do not depend on them.
+    pending: Vec<f64>,
 }
 
 impl HaarWvAccumulator {
-    /// A new accumulator for `levels` levels; the offset is the first sample pushed.
+    /// A new accumulator for `levels` levels; the offset is the mean of the first block of
+    /// samples (as [`wavelet_variance`] takes it, so the two agree to the last bits).
     ///
     /// # Errors
     /// [`ParamError`] when `levels` is 0 or above [`MAX_LEVELS`].
@@ -699,6 +703,7 @@ impl HaarWvAccumulator {
             sums: vec![NeumaierSum::default(); levels],
             scratch_in: Vec::with_capacity(BLOCK),
             scratch_out: Vec::with_capacity(BLOCK),
+            pending: Vec::with_capacity(BLOCK),
         })
     }
 
@@ -755,7 +760,7 @@ impl HaarWvAccumulator {
 
     /// Number of samples pushed so far.
     pub fn n(&self) -> u64 {
-        self.n
+        self.n + self.pending.len() as u64
     }
 
     /// Number of levels.
@@ -768,18 +773,47 @@ impl HaarWvAccumulator {
     /// # Errors
     /// [`SeriesError::NonFinite`] with the global 0-based index of the first NaN/Inf sample; the
     /// accumulator is then unusable for a meaningful result.
+    ///
+    /// The samples run through the pyramid in blocks that start at multiples of [`BLOCK`] in
+    /// the series, so any chunking gives the same bits; a non-finite sample is reported by the
+    /// push (or [`finish`](Self::finish)) that completes its block.
     pub fn push(&mut self, chunk: &[f64]) -> Result<(), SeriesError> {
-        for block in chunk.chunks(BLOCK) {
+        let mut rest = chunk;
+        if !self.pending.is_empty() {
+            let take = (BLOCK - self.pending.len()).min(rest.len());
+            self.pending.extend_from_slice(&rest[..take]);
+            rest = &rest[take..];
+            if self.pending.len() < BLOCK {
+                return Ok(());
+            }
+            self.flush()?;
+        }
+        let whole = rest.len() / BLOCK * BLOCK;
+        for block in rest[..whole].chunks(BLOCK) {
             self.push_block(block)?;
         }
+        self.pending.extend_from_slice(&rest[whole..]);
         Ok(())
+    }
+
+    /// Runs the pending samples through the pyramid (a partial block only at the end).
+    fn flush(&mut self) -> Result<(), SeriesError> {
+        let pending = std::mem::take(&mut self.pending);
+        let result = self.push_block(&pending);
+        self.pending = pending;
+        self.pending.clear();
+        result
     }
 
     fn push_block(&mut self, block: &[f64]) -> Result<(), SeriesError> {
         let Some(&head) = block.first() else {
             return Ok(());
         };
-        let offset = *self.offset.get_or_insert(head);
+        // the mean of the series' first samples, computed as `haar_wv_in_memory` does
+        let offset = *self.offset.get_or_insert_with(|| {
+            let head = &block[..block.len().min(crate::variance::haar::BLOCK)];
+            head.iter().sum::<f64>() / head.len() as f64
+        });
         self.first.get_or_insert(head);
         let mut input = std::mem::take(&mut self.scratch_in);
         let mut output = std::mem::take(&mut self.scratch_out);
@@ -818,9 +852,10 @@ impl HaarWvAccumulator {
     /// # Errors
     /// [`SeriesError`] when nothing was pushed, the series is constant, or it is too short for
     /// the levels requested; [`ParamError`] for a bad `freq_hz` or `alpha`.
-    pub fn finish(self, freq_hz: f64, alpha: f64) -> Result<WaveletVariance, InputError> {
+    pub fn finish(mut self, freq_hz: f64, alpha: f64) -> Result<WaveletVariance, InputError> {
         check_alpha(alpha)?;
         check_freq(freq_hz)?;
+        self.flush()?;
         let n = self.n as usize;
         // Level-1 coefficients are halved differences of consecutive samples: they are all zero
         // exactly when the series is constant.
@@ -930,6 +965,7 @@ fn haar_wv_parallel(
         .map(|p| {
             let mut acc = HaarWvAccumulator::primed(levels, offset, &x[..bounds[p]])?;
             acc.push(&x[bounds[p]..bounds[p + 1]])?;
+            acc.flush()?;
             Ok(acc)
         })
         .collect::<Result<_, InputError>>()?;
@@ -1239,7 +1275,20 @@ mod tests {
             wavelet_variance(&x, 1.0, &WvOptions { alpha: 1.5, ..o }),
             Err(InputError::Param(_))
         ));
+        // a non-finite sample is named by the push that completes its block, or by finish
         let mut acc = HaarWvAccumulator::new(2).unwrap();
-        assert!(acc.push(&[1.0, f64::NAN]).is_err());
+        acc.push(&[1.0, f64::NAN]).unwrap();
+        assert!(matches!(
+            acc.finish(1.0, 0.05),
+            Err(InputError::Series(SeriesError::NonFinite { index: 1, .. }))
+        ));
+        let mut acc = HaarWvAccumulator::new(2).unwrap();
+        let mut x = vec![1.0; 3 * BLOCK];
+        x[BLOCK + 7] = f64::INFINITY;
+        acc.push(&x[..10]).unwrap();
+        assert!(matches!(
+            acc.push(&x[10..]),
+            Err(SeriesError::NonFinite { index, .. }) if index == BLOCK + 7
+        ));
     }
 }
