@@ -4,7 +4,7 @@
 use crate::common::{data_dir, f64s, read_ref, rel_diff};
 use gmwm::variance::allan::package_error;
 use gmwm::{
-    allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention, Error, SeriesError,
+    allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention, InputError, SeriesError,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -621,28 +621,28 @@ fn allan_variance_rejects_bad_input() {
     let ok = AllanOptions::default();
     assert!(matches!(
         allan_variance(&[], 1.0, &ok),
-        Err(Error::Series(SeriesError::Empty))
+        Err(InputError::Series(SeriesError::Empty))
     ));
     let mut nan = x.clone();
     nan[3] = f64::NAN;
     assert!(matches!(
         allan_variance(&nan, 1.0, &ok),
-        Err(Error::Series(SeriesError::NonFinite { index: 3, .. }))
+        Err(InputError::Series(SeriesError::NonFinite { index: 3, .. }))
     ));
     assert!(matches!(
         allan_variance(&[1.0; 10], 1.0, &ok),
-        Err(Error::Series(SeriesError::Constant { .. }))
+        Err(InputError::Series(SeriesError::Constant { .. }))
     ));
     for f in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         match allan_variance(&x, f, &ok) {
-            Err(Error::Param(p)) => assert_eq!(p.name, "freq"),
+            Err(InputError::Param(p)) => assert_eq!(p.name, "freq"),
             other => panic!("freq {f}: {other:?}"),
         }
     }
     for alpha in [0.0, 1.0, -0.5, f64::NAN] {
         let o = AllanOptions { alpha, ..ok };
         match allan_variance(&x, 1.0, &o) {
-            Err(Error::Param(p)) => assert_eq!(p.name, "alpha"),
+            Err(InputError::Param(p)) => assert_eq!(p.name, "alpha"),
             other => panic!("alpha {alpha}: {other:?}"),
         }
     }
@@ -654,7 +654,7 @@ fn allan_variance_rejects_bad_input() {
         (AllanKind::HadamardNonOverlapping, PACKAGE, 26, 27),
     ] {
         match allan_variance(&x[..n], 1.0, &opts(kind, convention)) {
-            Err(Error::Series(SeriesError::TooShort {
+            Err(InputError::Series(SeriesError::TooShort {
                 n: got,
                 needed: need,
                 ..
@@ -712,7 +712,7 @@ fn allan_variance_every_short_length_matches_oracle() {
                             );
                         }
                     }
-                    Err(Error::Series(SeriesError::TooShort { needed, .. })) => {
+                    Err(InputError::Series(SeriesError::TooShort { needed, .. })) => {
                         assert!(n < needed, "{kind} {convention} n {n}")
                     }
                     Err(e) => panic!("{kind} {convention} n {n}: {e}"),

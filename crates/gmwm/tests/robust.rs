@@ -1,7 +1,7 @@
 //! Robust wavelet variance (METHODS §2): reference values, Monte Carlo checks and bad input.
 //! (Brent's methods, METHODS §12, are crate-internal and tested in `math::brent`.)
 
-use gmwm::error::{Error, SeriesError};
+use gmwm::error::{InputError, SeriesError};
 use gmwm::variance::robust::{
     a_of_c, efficiency, package_efficiency, robust_ci, robust_scale, truncated_normal_moments,
     tuning_constant, RobustConvention, RobustOptions,
@@ -350,7 +350,7 @@ fn robust_scale_rejects_empty_and_zero_input() {
     for conv in [RobustConvention::Exact, RobustConvention::Package] {
         assert!(matches!(
             robust_scale(&[], C_EXACT_06, conv),
-            Err(Error::Series(SeriesError::Empty))
+            Err(InputError::Series(SeriesError::Empty))
         ));
         // all-zero coefficients (e.g. a level of a period-2 series): the exact estimator's scale
         // is 0, like the classical WV; the package's route divides by sd = 0 and fails
@@ -360,17 +360,17 @@ fn robust_scale_rejects_empty_and_zero_input() {
             }
             _ => assert!(matches!(
                 robust_scale(&[0.0; 8], C_EXACT_06, conv),
-                Err(Error::Series(SeriesError::Constant { .. }))
+                Err(InputError::Series(SeriesError::Constant { .. }))
             )),
         }
         assert!(matches!(
             robust_scale(&[1.0, f64::NAN], C_EXACT_06, conv),
-            Err(Error::Series(SeriesError::NonFinite { index: 1, .. }))
+            Err(InputError::Series(SeriesError::NonFinite { index: 1, .. }))
         ));
         for bad_c in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
             assert!(matches!(
                 robust_scale(&Y10, bad_c, conv),
-                Err(Error::Param(ref p)) if p.name == "c"
+                Err(InputError::Param(ref p)) if p.name == "c"
             ));
         }
     }
@@ -409,7 +409,7 @@ fn robust_scale_reports_missing_root() {
     assert!(
         matches!(
             err,
-            gmwm::Error::Series(gmwm::SeriesError::NoRobustScale { .. })
+            gmwm::InputError::Series(gmwm::SeriesError::NoRobustScale { .. })
         ),
         "{err}"
     );

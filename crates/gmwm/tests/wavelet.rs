@@ -2,7 +2,7 @@
 //! oracle for every filter, METHODS test values, closed forms, identities and bad input.
 
 use gmwm::wavelet::{Dwt, Modwt, WaveletCoefficients, WaveletFilter, WaveletScratch};
-use gmwm::{Error, SeriesError};
+use gmwm::{InputError, SeriesError};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -202,7 +202,7 @@ fn wavelet_empty_series_rejected() {
         Modwt::new(WaveletFilter::Haar, 1).unwrap().transform(&[]),
         Dwt::new(WaveletFilter::Haar, 1).unwrap().transform(&[]),
     ] {
-        assert!(matches!(e, Err(Error::Series(SeriesError::Empty))), "{e:?}");
+        assert!(matches!(e, Err(InputError::Series(SeriesError::Empty))), "{e:?}");
     }
 }
 
@@ -212,7 +212,7 @@ fn modwt_too_short_rejected() {
     let x = [1.0, 2.0, 3.0, 5.0, 4.0, 6.0, 8.0];
     let e = Modwt::new(WaveletFilter::Haar, 3).unwrap().transform(&x);
     match e {
-        Err(Error::Series(SeriesError::TooShort { n, needed, what })) => {
+        Err(InputError::Series(SeriesError::TooShort { n, needed, what })) => {
             assert_eq!((n, needed), (7, 8));
             assert_eq!(what, "a 3-level MODWT");
         }
@@ -230,7 +230,7 @@ fn modwt_level_without_kept_coefficient_rejected() {
     let x = series(21, 14);
     // la8: L_2 = 3 * 7 + 1 = 22 > 21, though 2^2 <= 21
     match Modwt::new(WaveletFilter::La8, 2).unwrap().transform(&x) {
-        Err(Error::Series(SeriesError::TooShort { n, needed, what })) => {
+        Err(InputError::Series(SeriesError::TooShort { n, needed, what })) => {
             assert_eq!((n, needed), (21, 22));
             assert!(what.contains("level 2") && what.contains("la8"), "{what}");
         }
@@ -253,7 +253,7 @@ fn dwt_not_divisible_rejected() {
         .transform(&x)
         .unwrap_err();
     match &e {
-        Error::Param(p) => {
+        InputError::Param(p) => {
             assert_eq!(p.name, "levels");
             assert!(p.expected.contains("at most 2 levels"), "{e}");
             assert!(p.expected.contains("96 or 104 samples"), "{e}");
@@ -275,7 +275,7 @@ fn dwt_too_short_rejected() {
     assert!(
         matches!(
             e,
-            Err(Error::Series(SeriesError::TooShort {
+            Err(InputError::Series(SeriesError::TooShort {
                 n: 4,
                 needed: 8,
                 ..
@@ -288,7 +288,7 @@ fn dwt_too_short_rejected() {
         .unwrap()
         .transform(&series(16, 16));
     match e {
-        Err(Error::Series(SeriesError::TooShort { n, needed, what })) => {
+        Err(InputError::Series(SeriesError::TooShort { n, needed, what })) => {
             assert_eq!((n, needed), (16, 24));
             assert!(what.contains("level 2"), "{what}");
         }

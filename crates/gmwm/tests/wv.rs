@@ -391,7 +391,7 @@ fn check_robust_matches_direct_route(x: &[f64], what: &str) {
     for j in 1..=fast.levels() {
         let direct = match robust_scale(coefs.kept(j), c, RobustConvention::Exact) {
             Ok(s2) => s2,
-            Err(gmwm::Error::Series(gmwm::SeriesError::NoRobustScale { .. })) => f64::NAN,
+            Err(gmwm::InputError::Series(gmwm::SeriesError::NoRobustScale { .. })) => f64::NAN,
             Err(e) => panic!("{what} level {j}: {e}"),
         };
         let ours = fast.wv[j - 1];
