@@ -723,3 +723,121 @@ fn simulated_models_match_their_implied_wv() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Pinned bits
+
+/// FNV-1a over the bits of a series: a fingerprint of every sample.
+fn fingerprint(x: &[f64]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for v in x {
+        for b in v.to_bits().to_le_bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
+
+/// The simulated bits of every process kind, in both start modes, are pinned: the seeding
+/// scheme (one ChaCha8 stream per component), the initial draws and the ARMA burn-ins may not
+/// change silently. Each line is `model, mode, column (or "sum"), first sample bits, last
+/// sample bits, fingerprint of all 2000 samples` (drawn in two chunks of 1000).
+#[test]
+fn simulated_bits_are_pinned() {
+    use gmwm::model::Model;
+    let models: [(&str, f64); 6] = [
+        (
+            "WN(sigma2=2)+QN(q2=0.5)+RW(gamma2=0.1)+DR(omega=0.01)+AR1(phi=0.9, sigma2=1)\
+             +AR1(phi=-0.5, sigma2=0.3)+MA1(theta=0.5, sigma2=1)",
+            1.0,
+        ),
+        (
+            "GM(beta=2, sigma2_gm=1)+ARMA11(phi=0.8, theta=-0.3, sigma2=1)",
+            100.0,
+        ),
+        ("AR(2)(ar1=1.3, ar2=-0.4, sigma2=1)", 1.0),
+        ("MA(2)(ma1=0.5, ma2=0.2, sigma2=0.5)", 1.0),
+        ("ARMA(2,1)(ar1=0.5, ar2=-0.2, ma1=0.3, sigma2=0.5)", 1.0),
+        ("ARMA(1,2)(ar1=0.5, ma1=0.3, ma2=0.2, sigma2=1)", 1.0),
+    ];
+    let mut got = Vec::new();
+    for (i, (text, freq)) in models.iter().enumerate() {
+        let model: Model = text.parse().unwrap();
+        for mode in [StartMode::Stationary, StartMode::Zero] {
+            let seed = 1000 + i as u64;
+            let sim = Simulator::for_model(&model, *freq, seed)
+                .unwrap()
+                .with_start(mode);
+            let k = model.n_components();
+            let mut cols = vec![Vec::new(); k];
+            let mut by_parts = sim.clone();
+            let mut chunk = vec![vec![0.0; 1000]; k];
+            for _ in 0..2 {
+                by_parts.fill_components(&mut chunk).unwrap();
+                for (c, part) in cols.iter_mut().zip(&chunk) {
+                    c.extend_from_slice(part);
+                }
+            }
+            let mut sum = vec![0.0; 2000];
+            let mut whole = sim.clone();
+            whole.fill(&mut sum[..1000]);
+            whole.fill(&mut sum[1000..]);
+            let mut line = |name: String, x: &[f64]| {
+                got.push(format!(
+                    "{i} {mode:?} {name} {:016x} {:016x} {:016x}",
+                    x[0].to_bits(),
+                    x[x.len() - 1].to_bits(),
+                    fingerprint(x)
+                ))
+            };
+            for (c, col) in cols.iter().enumerate() {
+                line(format!("{c}"), col);
+            }
+            line("sum".to_string(), &sum);
+        }
+    }
+    let got = got.join("\n");
+    assert_eq!(got, PINNED.trim(), "\nactual:\n{got}\n");
+}
+
+const PINNED: &str = "
+0 Stationary 0 3fff4044e392333b c00717002fadb927 41864c0d5603a7c2
+0 Stationary 1 bfdf89c91453e8c7 bff5a4bd25589d7c ed2663bdf848845a
+0 Stationary 2 3fb090ad7908e895 c00c11aace888a0d 681205c65f7bc6d4
+0 Stationary 3 3f847ae147ae147b 4034000000000000 42c5fe425b6ee089
+0 Stationary 4 bfef742b7b394e86 bfe7e245d8a73632 4f1aaa5403010da3
+0 Stationary 5 3feb8cbb140871b8 3fc3dd62694938a8 b676bd135489b733
+0 Stationary 6 bfe67adc85d6c3a2 bfddf9c4cfd24681 51ebca2fe36876c7
+0 Stationary sum 3fe6bd598432a706 402662c0a1637ad0 9a10f3d8356dee11
+0 Zero 0 3fff4044e392333b c00717002fadb927 41864c0d5603a7c2
+0 Zero 1 bfdf89c91453e8c7 bff5a4bd25589d7c ed2663bdf848845a
+0 Zero 2 3fb090ad7908e895 c00c11aace888a0d 681205c65f7bc6d4
+0 Zero 3 3f847ae147ae147b 4034000000000000 42c5fe425b6ee089
+0 Zero 4 bfec8a841d4c46f4 bff5345666a25f86 579759ff14ff6cf2
+0 Zero 5 bfe0687a3c107afa 3f712ea9ebd38540 fec1f142b6945a19
+0 Zero 6 bfe67adc85d6c3a2 bfddf9c4cfd24681 51ebca2fe36876c7
+0 Zero sum bfe24e346df93e1a 4024ed0a7db1f7d0 7d5e0d94b09f7765
+1 Stationary 0 3fd8f40b80c7d2b6 40006495f11c9fa3 56498407c2fd904a
+1 Stationary 1 3fc03da2b1d44389 3ff23ab3e9888027 8c6f420913c02dea
+1 Stationary sum 3fe0896e6cd8fa3d 400981efe5e0dfb6 370c523ee3ef0a26
+1 Zero 0 3fb7d4cd98426e41 3ffc679f941f9b78 5ad9bf04124332dc
+1 Zero 1 3fd18e7ebc3a6b66 3fe5e284c3d2d291 2a4d4d9c228d7b1d
+1 Zero sum 3fd783b2224b06f6 4003ac70fb048260 157eb4c58eff7597
+2 Stationary 0 bfe6551528f555d0 c00fbfdc2c8c76c6 f7924565a4e95d95
+2 Stationary sum bfe6551528f555d0 c00fbfdc2c8c76c6 f7924565a4e95d95
+2 Zero 0 c0184b17043dcecc c01729031632dc49 a1a96b96ffa16052
+2 Zero sum c0184b17043dcecc c01729031632dc49 a1a96b96ffa16052
+3 Stationary 0 bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
+3 Stationary sum bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
+3 Zero 0 bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
+3 Zero sum bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
+4 Stationary 0 3ffe556de6cf57ea bfd3df8e5bef7c9f c462641dded51d63
+4 Stationary sum 3ffe556de6cf57ea bfd3df8e5bef7c9f c462641dded51d63
+4 Zero 0 bff2f4be4c3697a0 3fe8be29343e27a5 e4f39df4bd5aa386
+4 Zero sum bff2f4be4c3697a0 3fe8be29343e27a5 e4f39df4bd5aa386
+5 Stationary 0 3fdcb6f3fac30042 3feab02e12c4d7fa d8aef821e0f7b439
+5 Stationary sum 3fdcb6f3fac30042 3feab02e12c4d7fa d8aef821e0f7b439
+5 Zero 0 3fc5a1bbd646c016 bfecb62b81ca5d13 5265c9561ed40360
+5 Zero sum 3fc5a1bbd646c016 bfecb62b81ca5d13 5265c9561ed40360
+";
