@@ -1135,19 +1135,19 @@ mod tests {
         let o = WvOptions::default();
         assert!(matches!(
             wavelet_variance(&[], 1.0, &o),
-            Err(Error::Series(SeriesError::Empty))
+            Err(InputError::Series(SeriesError::Empty))
         ));
         assert!(matches!(
             wavelet_variance(&[1.0, f64::INFINITY, 2.0], 1.0, &o),
-            Err(Error::Series(SeriesError::NonFinite { index: 1, .. }))
+            Err(InputError::Series(SeriesError::NonFinite { index: 1, .. }))
         ));
         assert!(matches!(
             wavelet_variance(&[3.0; 16], 1.0, &o),
-            Err(Error::Series(SeriesError::Constant { .. }))
+            Err(InputError::Series(SeriesError::Constant { .. }))
         ));
         assert!(matches!(
             wavelet_variance(&[1.0], 1.0, &o),
-            Err(Error::Series(SeriesError::TooShort { .. }))
+            Err(InputError::Series(SeriesError::TooShort { .. }))
         ));
         let x = [1.0, 2.0, 4.0, 3.0];
         let too_many = WvOptions {
@@ -1156,15 +1156,15 @@ mod tests {
         };
         assert!(matches!(
             wavelet_variance(&x, 1.0, &too_many),
-            Err(Error::Series(SeriesError::TooShort { .. }))
+            Err(InputError::Series(SeriesError::TooShort { .. }))
         ));
         assert!(matches!(
             wavelet_variance(&x, 0.0, &o),
-            Err(Error::Param(_))
+            Err(InputError::Param(_))
         ));
         assert!(matches!(
             wavelet_variance(&x, 1.0, &WvOptions { alpha: 1.5, ..o }),
-            Err(Error::Param(_))
+            Err(InputError::Param(_))
         ));
         let mut acc = HaarWvAccumulator::new(2).unwrap();
         assert!(acc.push(&[1.0, f64::NAN]).is_err());
