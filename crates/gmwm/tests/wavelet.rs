@@ -202,7 +202,10 @@ fn wavelet_empty_series_rejected() {
         Modwt::new(WaveletFilter::Haar, 1).unwrap().transform(&[]),
         Dwt::new(WaveletFilter::Haar, 1).unwrap().transform(&[]),
     ] {
-        assert!(matches!(e, Err(InputError::Series(SeriesError::Empty))), "{e:?}");
+        assert!(
+            matches!(e, Err(InputError::Series(SeriesError::Empty))),
+            "{e:?}"
+        );
     }
 }
 

@@ -80,10 +80,7 @@ impl GmwmFit {
     /// As [`GmwmFit::active_sub_model`].
     pub fn active_model(&self) -> Result<Model, FitError> {
         match self.active_sub_model()? {
-            Some(sub) => Ok(sub
-                .model
-                .with_values(&sub.start)
-                ?),
+            Some(sub) => Ok(sub.model.with_values(&sub.start)?),
             None => Ok(self.model.clone()),
         }
     }

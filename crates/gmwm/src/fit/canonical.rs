@@ -668,8 +668,7 @@ impl GmwmFit {
                     component: Component::new(
                         c.kind,
                         self.theta[at..at + n].iter().map(|&v| Some(v)).collect(),
-                    )
-                    ?,
+                    )?,
                     from: vec![i],
                 });
             } else {
@@ -762,9 +761,8 @@ impl GmwmFit {
             }
         }
         let terms_parts = canonical_order(terms_parts, freq);
-        let guess = |parts: &[Part]| {
-            Model::new(parts.iter().map(|p| Component::guess(p.kind())).collect())
-        };
+        let guess =
+            |parts: &[Part]| Model::new(parts.iter().map(|p| Component::guess(p.kind())).collect());
         let model = guess(&terms_parts)?;
         let reduced = guess(&canonical_order(state.parts.clone(), freq))?;
         let terms = terms_parts
@@ -952,8 +950,7 @@ impl GmwmFit {
                     component: Component::new(
                         c.kind,
                         fit.theta[at..at + n].iter().map(|&v| Some(v)).collect(),
-                    )
-                    ?,
+                    )?,
                     from: p.from,
                 });
             }

@@ -149,7 +149,11 @@ macro_rules! input_error_from {
         }
     )*};
 }
-input_error_from!(crate::ParamError, crate::SeriesError, crate::model::ModelError);
+input_error_from!(
+    crate::ParamError,
+    crate::SeriesError,
+    crate::model::ModelError
+);
 
 /// Refuses a wavelet variance with another filter than Haar ([`FitError::NotHaar`]).
 ///
@@ -162,4 +166,3 @@ pub(crate) fn check_haar(filter: WaveletFilter) -> Result<(), FitError> {
         Err(FitError::NotHaar { filter })
     }
 }
-

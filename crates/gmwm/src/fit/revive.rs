@@ -57,9 +57,7 @@ pub(crate) fn revival_start(
                 let one = Model::new(vec![Component::new(
                     c.kind,
                     unit.iter().copied().map(Some).collect(),
-                )
-                ?])
-                ?;
+                )?])?;
                 let s = one.implied_wv(levels, freq_hz)?.wv;
                 let (mut sr, mut ss) = (0.0, 0.0);
                 for l in 0..levels {

@@ -205,4 +205,8 @@ macro_rules! input_error_from {
         }
     )*};
 }
-input_error_from!(crate::ParamError, crate::SeriesError, crate::model::ModelError);
+input_error_from!(
+    crate::ParamError,
+    crate::SeriesError,
+    crate::model::ModelError
+);

@@ -106,7 +106,8 @@ pub(crate) fn haar_robust_levels(
             None => LevelState::Collect(Vec::new()),
         })
         .collect();
-    let mut results: Vec<Option<(f64, Result<f64, InputError>)>> = (0..levels).map(|_| None).collect();
+    let mut results: Vec<Option<(f64, Result<f64, InputError>)>> =
+        (0..levels).map(|_| None).collect();
     for round in 0..=WINDOW_SLIDES {
         if states.iter().all(|s| matches!(s, LevelState::Idle)) {
             break;
