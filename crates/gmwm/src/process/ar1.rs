@@ -16,9 +16,42 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
-    LatentProcess,
+    LatentProcess, Occurs, Params, Spec,
 };
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+
+/// `AR1(phi, sigma2)`: may repeat (`k*AR1()`), not with GM.
+pub(crate) const AR1_SPEC: Spec = Spec {
+    name: "AR1",
+    syntax: "AR1()",
+    params: Params::Fixed(
+        &[
+            ("phi", ParamDomain::UnitInterval),
+            ("sigma2", ParamDomain::Variance),
+        ],
+        (1, 0),
+    ),
+    orders: None,
+    occurs: Occurs::Repeats,
+    build: |_, v, _| Ok(Ar1::new(v[0], v[1])?.into()),
+};
+
+/// `GM(beta, sigma2_gm)` at the model's sampling rate: may repeat (`k*GM()`), not with AR1.
+pub(crate) const GM_SPEC: Spec = Spec {
+    name: "GM",
+    syntax: "GM()",
+    params: Params::Fixed(
+        &[
+            ("beta", ParamDomain::Rate),
+            ("sigma2_gm", ParamDomain::Variance),
+        ],
+        (0, 0),
+    ),
+    orders: None,
+    occurs: Occurs::Repeats,
+    build: |_, v, freq_hz| Ok(Gm::new(v[0], v[1], freq_hz)?.into()),
+};
 
 /// Below this `x = m L = -m ln(phi)` the series of the module doc is used: there the closed form
 /// loses about `-2 log10(x)` digits, the series (terms bounded by `1.5^k/k!`) none.
@@ -274,10 +307,10 @@ impl Ar1 {
 
 impl LatentProcess for Ar1 {
     fn name(&self) -> &'static str {
-        "AR1"
+        AR1_SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["phi", "sigma2"]
+        AR1_SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.phi, self.sigma2]
@@ -325,10 +358,10 @@ impl Gm {
 
 impl LatentProcess for Gm {
     fn name(&self) -> &'static str {
-        "GM"
+        GM_SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["beta", "sigma2_gm"]
+        GM_SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.beta, self.sigma2_gm]

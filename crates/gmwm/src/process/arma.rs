@@ -4,8 +4,72 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{autocovariance_wv, check_positive, LatentProcess};
+use super::{
+    autocovariance_wv, check_positive, LatentProcess, Occurs, Orders, Params, Process, Spec,
+};
 use crate::error::ParamError;
+use crate::model::ProcessKind;
+
+/// `AR(p)`, `p` from 1 to [`MAX_ORDER`](crate::model::MAX_ORDER): of the ARMA family.
+pub(crate) const AR_SPEC: Spec = Spec {
+    name: "AR",
+    syntax: "AR(p)",
+    params: Params::Arma,
+    orders: Some(Orders {
+        ar: true,
+        ma: false,
+        min: 1,
+        expected: "an order from 1 to 100",
+        all_zero: "an order from 1 to 100",
+        example: "AR(2)",
+        make: |p, _| ProcessKind::Ar(p),
+    }),
+    occurs: Occurs::ArmaFamily,
+    build,
+};
+
+/// `MA(q)`, `q` from 1 to [`MAX_ORDER`](crate::model::MAX_ORDER): of the ARMA family.
+pub(crate) const MA_SPEC: Spec = Spec {
+    name: "MA",
+    syntax: "MA(q)",
+    params: Params::Arma,
+    orders: Some(Orders {
+        ar: false,
+        ma: true,
+        min: 1,
+        expected: "an order from 1 to 100",
+        all_zero: "an order from 1 to 100",
+        example: "MA(2)",
+        make: |_, q| ProcessKind::Ma(q),
+    }),
+    occurs: Occurs::ArmaFamily,
+    build,
+};
+
+/// `ARMA(p,q)`, each order from 0 to [`MAX_ORDER`](crate::model::MAX_ORDER), `p + q >= 1`
+/// (the package's `SARIMA` without seasonal part): of the ARMA family.
+pub(crate) const ARMA_SPEC: Spec = Spec {
+    name: "ARMA",
+    syntax: "ARMA(p,q)",
+    params: Params::Arma,
+    orders: Some(Orders {
+        ar: true,
+        ma: true,
+        min: 0,
+        expected: "orders from 0 to 100",
+        all_zero: "p + q >= 1 (ARMA(0,0) is white noise: use WN)",
+        example: "ARMA(2,1)",
+        make: ProcessKind::Arma,
+    }),
+    occurs: Occurs::ArmaFamily,
+    build,
+};
+
+/// The [`Arma`] of an order kind from `ar1..arp, ma1..maq, sigma2`.
+fn build(kind: ProcessKind, v: &[f64], _freq_hz: f64) -> Result<Process, ParamError> {
+    let (p, q) = kind.orders();
+    Ok(Arma::new(v[..p].to_vec(), v[p..p + q].to_vec(), v[p + q])?.into())
+}
 
 /// General ARMA(p, q): `x_t = sum ar_i x_{t-i} + w_t + sum ma_i w_{t-i}`, `Var w_t = sigma2`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -327,7 +391,7 @@ const HESSIAN_STEP: f64 = 1e-3;
 
 impl LatentProcess for Arma {
     fn name(&self) -> &'static str {
-        "ARMA"
+        ARMA_SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
         const AR: [&str; 12] = [

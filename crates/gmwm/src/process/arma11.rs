@@ -13,9 +13,27 @@ use serde::{Deserialize, Serialize};
 use super::ar1::ar1_wv_jet;
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
-    LatentProcess,
+    LatentProcess, Occurs, Params, Spec,
 };
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+
+/// `ARMA11(phi, theta, sigma2)`: of the ARMA family.
+pub(crate) const SPEC: Spec = Spec {
+    name: "ARMA11",
+    syntax: "ARMA11()",
+    params: Params::Fixed(
+        &[
+            ("phi", ParamDomain::UnitInterval),
+            ("theta", ParamDomain::UnitInterval),
+            ("sigma2", ParamDomain::Variance),
+        ],
+        (1, 1),
+    ),
+    orders: None,
+    occurs: Occurs::ArmaFamily,
+    build: |_, v, _| Ok(Arma11::new(v[0], v[1], v[2])?.into()),
+};
 
 /// From this `phi` on, the WN + AR1 decomposition of the module doc is used (it divides by
 /// `phi`, so it is not used near 0, where the closed form has no cancellation).
@@ -78,10 +96,10 @@ pub(crate) fn arma11_wv_jet<const N: usize>(
 
 impl LatentProcess for Arma11 {
     fn name(&self) -> &'static str {
-        "ARMA11"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["phi", "theta", "sigma2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.phi, self.theta, self.sigma2]

@@ -2,8 +2,19 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{add_scaled, half_widths, LatentProcess};
+use super::{add_scaled, half_widths, LatentProcess, Occurs, Params, Spec};
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+
+/// `DR(omega)`: may appear once in a model; `omega` has any sign.
+pub(crate) const SPEC: Spec = Spec {
+    name: "DR",
+    syntax: "DR()",
+    params: Params::Fixed(&[("omega", ParamDomain::Finite)], (0, 0)),
+    orders: None,
+    occurs: Occurs::Once,
+    build: |_, v, _| Ok(Dr::new(v[0])?.into()),
+};
 
 /// Deterministic drift: the ramp `x_t = omega (t + 1)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -33,10 +44,10 @@ fn unit_wv(m: f64) -> f64 {
 
 impl LatentProcess for Dr {
     fn name(&self) -> &'static str {
-        "DR"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["omega"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.omega]

@@ -4,8 +4,26 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, Jet, LatentProcess,
+    Occurs, Params, Spec,
 };
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+
+/// `MA1(theta, sigma2)`: an ARMA(0, 1), of the ARMA family.
+pub(crate) const SPEC: Spec = Spec {
+    name: "MA1",
+    syntax: "MA1()",
+    params: Params::Fixed(
+        &[
+            ("theta", ParamDomain::UnitInterval),
+            ("sigma2", ParamDomain::Variance),
+        ],
+        (0, 1),
+    ),
+    orders: None,
+    occurs: Occurs::ArmaFamily,
+    build: |_, v, _| Ok(Ma1::new(v[0], v[1])?.into()),
+};
 
 /// First-order moving average `x_t = w_t + theta w_{t-1}`, `Var w_t = sigma2`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -43,10 +61,10 @@ pub(crate) fn ma1_wv_jet<const N: usize>(theta: Jet<N>, sigma2: Jet<N>, m: f64) 
 
 impl LatentProcess for Ma1 {
     fn name(&self) -> &'static str {
-        "MA1"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["theta", "sigma2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.theta, self.sigma2]

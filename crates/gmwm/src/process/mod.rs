@@ -20,6 +20,7 @@ pub mod ma1;
 pub mod qn;
 pub mod rw;
 pub mod spectral;
+mod table;
 pub mod wn;
 
 pub use ar1::{Ar1, Gm};
@@ -30,6 +31,8 @@ pub use ma1::Ma1;
 pub use qn::Qn;
 pub use rw::Rw;
 pub use wn::Wn;
+
+pub(crate) use table::{spec, Occurs, Orders, Params, Spec, KINDS};
 
 use crate::error::ParamError;
 

@@ -2,8 +2,19 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{add_scaled, check_positive, half_widths, LatentProcess};
+use super::{add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Spec};
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+
+/// `WN(sigma2)`: may appear once in a model.
+pub(crate) const SPEC: Spec = Spec {
+    name: "WN",
+    syntax: "WN()",
+    params: Params::Fixed(&[("sigma2", ParamDomain::Variance)], (0, 0)),
+    orders: None,
+    occurs: Occurs::Once,
+    build: |_, v, _| Ok(Wn::new(v[0])?.into()),
+};
 
 /// White noise: independent samples of variance `sigma2`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -31,10 +42,10 @@ fn unit_wv(m: f64) -> f64 {
 
 impl LatentProcess for Wn {
     fn name(&self) -> &'static str {
-        "WN"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["sigma2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.sigma2]
