@@ -12,14 +12,17 @@
 //! is evaluated with `exp_m1` (its condition number there is below ~12). Derivatives are exact
 //! derivatives of this evaluation (forward-mode jets), so they inherit its accuracy.
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
-    LatentProcess, Occurs, Params, Spec,
+    LatentProcess, Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
 use crate::model::ParamDomain;
+use crate::sim::sampler::{normal, Sampler, Step};
+use crate::sim::StartMode;
 
 /// `AR1(phi, sigma2)`: may repeat (`k*AR1()`), not with GM.
 pub(crate) const AR1_SPEC: Spec = Spec {
@@ -386,6 +389,60 @@ impl LatentProcess for Gm {
         let l = self.beta / self.freq_hz;
         let ar = self.to_ar1();
         Some(ar1_spectrum(-(-l).exp_m1(), ar.phi, ar.sigma2, f))
+    }
+}
+
+/// METHODS §10.1: `x_t = phi x_{t-1} + w_t`, `w ~ N(0, sigma2)`; `x` is the last value.
+#[derive(Debug, Clone)]
+struct Ar1Sampler {
+    rng: ChaCha8Rng,
+    phi: f64,
+    sd: f64,
+    x: f64,
+}
+
+impl Step for Ar1Sampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        self.x = self.phi * self.x + self.sd * normal(&mut self.rng);
+        self.x
+    }
+}
+
+impl Simulate for Ar1 {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.phi, self.sigma2).map(drop)
+    }
+    /// [`StartMode::Stationary`]: `x_{-1} ~ N(0, sigma2 / (1 - phi^2))` is drawn first, so
+    /// every kept value is stationary; [`StartMode::Zero`]: `x_{-1} = 0` (the package's
+    /// `x_0 = 0`, dropped).
+    fn sampler(
+        &self,
+        mut rng: ChaCha8Rng,
+        start: StartMode,
+    ) -> Result<Box<dyn Sampler>, ParamError> {
+        let (phi, sigma2) = (self.phi, self.sigma2);
+        let x = if start == StartMode::Stationary {
+            (sigma2 / (1.0 - phi * phi)).sqrt() * normal(&mut rng)
+        } else {
+            0.0
+        };
+        Ok(Box::new(Ar1Sampler {
+            rng,
+            phi,
+            sd: sigma2.sqrt(),
+            x,
+        }))
+    }
+}
+
+impl Simulate for Gm {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.beta, self.sigma2_gm, self.freq_hz).map(drop)
+    }
+    /// Simulated as its exact per-sample AR1 ([`Gm::to_ar1`], METHODS §4.3).
+    fn sampler(&self, rng: ChaCha8Rng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        self.to_ar1().sampler(rng, start)
     }
 }
 

@@ -4,9 +4,14 @@
 //! Each kind's facts are declared once, in its own module next to its struct, as a [`Spec`]:
 //! its name in the model language, its parameters with their domains (METHODS §0.2), how often
 //! it may appear in a model, and its constructor (which validates). The implied WV and its
-//! derivatives are the struct's [`LatentProcess`](super::LatentProcess) impl. [`spec`] is the
-//! only map from a kind to its facts: the parser, the metadata methods of [`ProcessKind`] and
-//! [`Component::process`] read it instead of matching on kinds.
+//! derivatives are the struct's [`LatentProcess`](super::LatentProcess) impl, its simulation
+//! its [`Simulate`](super::Simulate) impl. [`spec`] is the only map from a kind to its facts:
+//! the parser, the metadata methods of [`ProcessKind`], [`Component::process`] and the
+//! simulator read it instead of matching on kinds.
+//!
+//! A new process is its module (struct, validating `new`, `LatentProcess`, `Simulate`,
+//! `SPEC`), its variant in [`ProcessKind`] and in the `processes!` list of [`super::Process`],
+//! and one line of the table below.
 //!
 //! [`Component::process`]: crate::model::Component::process
 
