@@ -1,27 +1,20 @@
 //! Criterion bench of the streaming simulator (STYLE §7, METHODS §10): 10^7 samples of the
-//! NavChip-like truth 3*AR1 + WN + QN + RW (per-sample parameters, METHODS §5.10), simulator
+//! NavChip-like truth 3*AR1 + WN + QN + RW (per-sample parameters, METHODS §5.10, as
+//! processes), simulator
 //! built outside the timed loop, output buffer reused.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use gmwm::sim::{Generator, Simulator};
+use gmwm::process::{Ar1, Process, Qn, Rw, Wn};
+use gmwm::sim::Simulator;
 
-fn navchip() -> Vec<Generator> {
+fn navchip() -> Vec<Process> {
     vec![
-        Generator::Ar1 {
-            phi: 0.9990005,
-            sigma2: 1.414585e-11,
-        },
-        Generator::Ar1 {
-            phi: 0.9999749,
-            sigma2: 6.430559e-13,
-        },
-        Generator::Ar1 {
-            phi: 0.9666488,
-            sigma2: 4.250234e-10,
-        },
-        Generator::Wn { sigma2: 6.94e-7 },
-        Generator::Qn { q2: 2.29e-6 },
-        Generator::Rw { gamma2: 3.90e-14 },
+        Ar1::new(0.9990005, 1.414585e-11).unwrap().into(),
+        Ar1::new(0.9999749, 6.430559e-13).unwrap().into(),
+        Ar1::new(0.9666488, 4.250234e-10).unwrap().into(),
+        Wn::new(6.94e-7).unwrap().into(),
+        Qn::new(2.29e-6).unwrap().into(),
+        Rw::new(3.90e-14).unwrap().into(),
     ]
 }
 

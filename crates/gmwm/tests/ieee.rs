@@ -4,7 +4,8 @@
 use crate::common::{read_column, rel_diff};
 use gmwm::calib::ieee::{ieee_readoff, IeeeReadoff, DOMINANCE};
 use gmwm::imu::{allan_from_wv, read_wv_json};
-use gmwm::sim::{simulate, Generator};
+use gmwm::process::{Process, Rw, Wn};
+use gmwm::sim::simulate;
 use gmwm::units::{to_datasheet, NoiseTerm, SignalKind, SignalUnit};
 use gmwm::{allan_variance, AllanKind, AllanOptions, AllanVariance};
 
@@ -230,12 +231,12 @@ fn ieee_refuses_other_variances_and_survives_bad_values() {
 fn ieee_simulated_white_noise_and_random_walk() {
     let (n, k) = (1e-3, 1e-4);
     let gens = [
-        Generator::Wn {
+        Process::Wn(Wn {
             sigma2: n * n * FREQ_HZ,
-        },
-        Generator::Rw {
+        }),
+        Process::Rw(Rw {
             gamma2: k * k / FREQ_HZ,
-        },
+        }),
     ];
     let x = simulate(&gens, 1_000_000, SEED).unwrap();
     let av = allan_variance(&x, FREQ_HZ, &AllanOptions::default()).unwrap();

@@ -50,6 +50,7 @@ pub use builder::{
 pub use parse::{ModelParseError, ParseErrorKind};
 pub use realize::{ComponentWv, ImpliedWv};
 
+use crate::process::{spec, Occurs, Params, KINDS};
 use std::fmt;
 use thiserror::Error;
 
@@ -136,29 +137,19 @@ impl ParamDomain {
 impl ProcessKind {
     /// The canonical name: `"WN"`, `"AR1"`, `"AR(2)"`, `"ARMA(2,1)"` (METHODS §0.2).
     pub fn name(&self) -> String {
-        match self {
-            ProcessKind::Ar(p) => format!("AR({p})"),
-            ProcessKind::Ma(q) => format!("MA({q})"),
-            ProcessKind::Arma(p, q) => format!("ARMA({p},{q})"),
-            other => other.base_name().to_string(),
+        let spec = spec(*self);
+        match &spec.orders {
+            None => spec.name.to_string(),
+            Some(o) => {
+                let orders: Vec<String> = o.written(self.orders()).map(|v| v.to_string()).collect();
+                format!("{}({})", spec.name, orders.join(","))
+            }
         }
     }
 
     /// The name without orders: `"AR"` for `AR(2)`, `"WN"` for `WN`.
     pub fn base_name(&self) -> &'static str {
-        match self {
-            ProcessKind::Wn => "WN",
-            ProcessKind::Qn => "QN",
-            ProcessKind::Rw => "RW",
-            ProcessKind::Dr => "DR",
-            ProcessKind::Ar1 => "AR1",
-            ProcessKind::Gm => "GM",
-            ProcessKind::Ma1 => "MA1",
-            ProcessKind::Arma11 => "ARMA11",
-            ProcessKind::Ar(_) => "AR",
-            ProcessKind::Ma(_) => "MA",
-            ProcessKind::Arma(..) => "ARMA",
-        }
+        spec(*self).name
     }
 
     /// Parameter names in `theta` order (METHODS §0.2): WN `sigma2`; QN `q2`; RW `gamma2`;
@@ -166,37 +157,27 @@ impl ProcessKind {
     /// `phi, theta, sigma2`; AR(p) `ar1..arp, sigma2`; MA(q) `ma1..maq, sigma2`; ARMA(p,q)
     /// `ar1..arp, ma1..maq, sigma2`.
     pub fn param_names(&self) -> Vec<String> {
-        let fixed: &[&str] = match self {
-            ProcessKind::Wn => &["sigma2"],
-            ProcessKind::Qn => &["q2"],
-            ProcessKind::Rw => &["gamma2"],
-            ProcessKind::Dr => &["omega"],
-            ProcessKind::Ar1 => &["phi", "sigma2"],
-            ProcessKind::Gm => &["beta", "sigma2_gm"],
-            ProcessKind::Ma1 => &["theta", "sigma2"],
-            ProcessKind::Arma11 => &["phi", "theta", "sigma2"],
-            ProcessKind::Ar(_) | ProcessKind::Ma(_) | ProcessKind::Arma(..) => &[],
-        };
-        if !fixed.is_empty() {
-            return fixed.iter().map(|s| s.to_string()).collect();
+        match spec(*self).params {
+            Params::Fixed(list, _) => list.iter().map(|(n, _)| n.to_string()).collect(),
+            Params::Arma => {
+                let (p, q) = self.orders();
+                (1..=p)
+                    .map(|i| format!("ar{i}"))
+                    .chain((1..=q).map(|i| format!("ma{i}")))
+                    .chain(std::iter::once("sigma2".to_string()))
+                    .collect()
+            }
         }
-        let (p, q) = self.orders();
-        (1..=p)
-            .map(|i| format!("ar{i}"))
-            .chain((1..=q).map(|i| format!("ma{i}")))
-            .chain(std::iter::once("sigma2".to_string()))
-            .collect()
     }
 
     /// Number of parameters, `param_names().len()`.
     pub fn n_params(&self) -> usize {
-        match self {
-            ProcessKind::Wn | ProcessKind::Qn | ProcessKind::Rw | ProcessKind::Dr => 1,
-            ProcessKind::Ar1 | ProcessKind::Gm | ProcessKind::Ma1 => 2,
-            ProcessKind::Arma11 => 3,
-            ProcessKind::Ar(p) => p.saturating_add(1),
-            ProcessKind::Ma(q) => q.saturating_add(1),
-            ProcessKind::Arma(p, q) => p.saturating_add(*q).saturating_add(1),
+        match spec(*self).params {
+            Params::Fixed(list, _) => list.len(),
+            Params::Arma => {
+                let (p, q) = self.orders();
+                p.saturating_add(q).saturating_add(1)
+            }
         }
     }
 
@@ -209,54 +190,40 @@ impl ProcessKind {
 
     /// The basic domain of parameter `index` (see [`ParamDomain`]); `None` past the end.
     pub fn param_domain(&self, index: usize) -> Option<ParamDomain> {
-        let n = self.n_params();
-        if index >= n {
-            return None;
+        match spec(*self).params {
+            Params::Fixed(list, _) => list.get(index).map(|(_, d)| *d),
+            // coefficients are any finite number, the innovation variance comes last
+            Params::Arma => match self.n_params() {
+                n if index + 1 == n => Some(ParamDomain::Variance),
+                n if index < n => Some(ParamDomain::Finite),
+                _ => None,
+            },
         }
-        if index == n - 1 {
-            // the last parameter is a variance for every kind but DR
-            return Some(match self {
-                ProcessKind::Dr => ParamDomain::Finite,
-                _ => ParamDomain::Variance,
-            });
-        }
-        Some(match self {
-            ProcessKind::Gm => ParamDomain::Rate,
-            ProcessKind::Ar1 | ProcessKind::Ma1 | ProcessKind::Arma11 => ParamDomain::UnitInterval,
-            _ => ParamDomain::Finite,
-        })
     }
 
     /// The AR and MA orders `(p, q)` of the ARMA-family kinds; `(0, 0)` for the others except
     /// AR1 `(1, 0)`, MA1 `(0, 1)`, ARMA11 `(1, 1)`.
     pub fn orders(&self) -> (usize, usize) {
-        match self {
-            ProcessKind::Ar1 => (1, 0),
-            ProcessKind::Ma1 => (0, 1),
-            ProcessKind::Arma11 => (1, 1),
-            ProcessKind::Ar(p) => (*p, 0),
-            ProcessKind::Ma(q) => (0, *q),
-            ProcessKind::Arma(p, q) => (*p, *q),
-            _ => (0, 0),
+        match *self {
+            ProcessKind::Ar(p) => (p, 0),
+            ProcessKind::Ma(q) => (0, q),
+            ProcessKind::Arma(p, q) => (p, q),
+            other => match spec(other).params {
+                Params::Fixed(_, orders) => orders,
+                Params::Arma => (0, 0),
+            },
         }
     }
 
     /// Whether the kind may repeat in a model (`k*GM()`, `k*AR1()`; METHODS §0.2).
     pub fn may_repeat(&self) -> bool {
-        matches!(self, ProcessKind::Gm | ProcessKind::Ar1)
+        spec(*self).occurs == Occurs::Repeats
     }
 
     /// Whether the kind belongs to the ARMA family (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)), of
     /// which a model holds at most one term.
     pub fn is_arma_family(&self) -> bool {
-        matches!(
-            self,
-            ProcessKind::Ma1
-                | ProcessKind::Arma11
-                | ProcessKind::Ar(_)
-                | ProcessKind::Ma(_)
-                | ProcessKind::Arma(..)
-        )
+        spec(*self).occurs == Occurs::ArmaFamily
     }
 
     /// Checks the orders of `AR(p)`, `MA(q)`, `ARMA(p,q)` (1..=[`MAX_ORDER`], `p + q >= 1`).
@@ -264,6 +231,9 @@ impl ProcessKind {
     /// # Errors
     /// [`ModelError::BadOrder`].
     pub fn check_orders(&self) -> Result<(), ModelError> {
+        let Some(o) = &spec(*self).orders else {
+            return Ok(());
+        };
         let bad = |order: usize, expected: &'static str| {
             Err(ModelError::BadOrder {
                 kind: *self,
@@ -271,15 +241,14 @@ impl ProcessKind {
                 expected,
             })
         };
-        match *self {
-            ProcessKind::Ar(p) | ProcessKind::Ma(p) if p == 0 || p > MAX_ORDER => {
-                bad(p, "an order from 1 to 100")
-            }
-            ProcessKind::Arma(p, _) if p > MAX_ORDER => bad(p, "orders from 0 to 100"),
-            ProcessKind::Arma(_, q) if q > MAX_ORDER => bad(q, "orders from 0 to 100"),
-            ProcessKind::Arma(0, 0) => bad(0, "p + q >= 1 (ARMA(0,0) is white noise: use WN)"),
-            _ => Ok(()),
+        let (p, q) = self.orders();
+        if let Some(order) = o.written((p, q)).find(|v| !(o.min..=MAX_ORDER).contains(v)) {
+            return bad(order, o.expected);
         }
+        if p == 0 && q == 0 {
+            return bad(0, o.all_zero);
+        }
+        Ok(())
     }
 }
 
@@ -405,10 +374,7 @@ impl fmt::Display for Component {
     /// the given values are written, by name, in the shortest text that parses back to the same
     /// bits ([`format_value`]).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let has_orders = matches!(
-            self.kind,
-            ProcessKind::Ar(_) | ProcessKind::Ma(_) | ProcessKind::Arma(..)
-        );
+        let has_orders = spec(self.kind).orders.is_some();
         f.write_str(&self.kind.name())?;
         if has_orders && self.is_guess() {
             return Ok(());
@@ -575,13 +541,9 @@ pub(crate) fn validate(components: &[Component]) -> Result<(), (usize, ModelErro
     for (i, c) in components.iter().enumerate() {
         c.check(i).map_err(|e| (i, e))?;
     }
-    // WN, QN, RW, DR at most once: report at the second occurrence.
-    for kind in [
-        ProcessKind::Wn,
-        ProcessKind::Qn,
-        ProcessKind::Rw,
-        ProcessKind::Dr,
-    ] {
+    // WN, QN, RW, DR (the kinds that occur once) at most once, checked in table order: report
+    // at the second occurrence.
+    for &kind in KINDS.iter().filter(|&&k| spec(k).occurs == Occurs::Once) {
         let at: Vec<usize> = (0..components.len())
             .filter(|&i| components[i].kind == kind)
             .collect();

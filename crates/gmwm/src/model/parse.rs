@@ -36,6 +36,7 @@
 
 use super::Model;
 use super::{validate, Component, ModelError, ProcessKind, MAX_MULTIPLIER, MAX_ORDER};
+use crate::process::{spec, Orders, KINDS};
 use std::fmt;
 
 /// What went wrong in [`Model::parse`]; the position and the expected/found texts are in
@@ -178,25 +179,24 @@ impl std::error::Error for ModelParseError {
     }
 }
 
-/// Process names the parser knows, with the syntax shown in suggestions.
-const PROCESSES: [(&str, &str); 11] = [
-    ("WN", "WN()"),
-    ("QN", "QN()"),
-    ("RW", "RW()"),
-    ("DR", "DR()"),
-    ("AR1", "AR1()"),
-    ("GM", "GM()"),
-    ("MA1", "MA1()"),
-    ("ARMA11", "ARMA11()"),
-    ("AR", "AR(p)"),
-    ("MA", "MA(q)"),
-    ("ARMA", "ARMA(p,q)"),
-];
-
 const NUMBER: &str = "a number such as 0.5, -2 or 7.08e-9";
 
-const PROCESS_LIST: &str =
-    "a process (WN, QN, RW, DR, AR1, GM, MA1, ARMA11, AR(p), MA(q), ARMA(p,q))";
+/// `a process (WN, QN, ..., AR(p), MA(q), ARMA(p,q))`: the kinds of the table, order kinds with
+/// their syntax.
+fn process_list() -> String {
+    let names: Vec<&str> = KINDS
+        .iter()
+        .map(|&k| {
+            let s = spec(k);
+            if s.orders.is_some() {
+                s.syntax
+            } else {
+                s.name
+            }
+        })
+        .collect();
+    format!("a process ({})", names.join(", "))
+}
 
 struct Parser<'a> {
     text: &'a str,
@@ -407,35 +407,27 @@ impl<'a> Parser<'a> {
             self.skip_ws();
         }
         let Some((name_at, name)) = self.ident() else {
-            return Err(self.unexpected(self.pos, PROCESS_LIST));
+            return Err(self.unexpected(self.pos, &process_list()));
         };
         let upper = name.to_ascii_uppercase();
-        let kind = match upper.as_str() {
-            "WN" => ProcessKind::Wn,
-            "QN" => ProcessKind::Qn,
-            "RW" => ProcessKind::Rw,
-            "DR" => ProcessKind::Dr,
-            "AR1" => ProcessKind::Ar1,
-            "GM" => ProcessKind::Gm,
-            "MA1" => ProcessKind::Ma1,
-            "ARMA11" => ProcessKind::Arma11,
-            "AR" | "MA" | "ARMA" => {
-                let example = match upper.as_str() {
-                    "AR" => "AR(2)",
-                    "MA" => "MA(2)",
-                    _ => "ARMA(2,1)",
-                };
+        let Some(&listed) = KINDS.iter().find(|&&k| spec(k).name == upper) else {
+            return Err(self.unknown_process(name_at, name));
+        };
+        let kind = match &spec(listed).orders {
+            None => listed,
+            Some(o) => {
+                let example = o.example;
                 self.expect(b'(', &format!("\"(\" and the order, as in {example}"))?;
-                let p_or_q = self.order(&upper, example)?;
-                let kind = match upper.as_str() {
-                    "AR" => ProcessKind::Ar(p_or_q),
-                    "MA" => ProcessKind::Ma(p_or_q),
-                    _ => {
+                let first = self.order(o)?;
+                let (p, q) = match (o.ar, o.ma) {
+                    (true, true) => {
                         self.expect(b',', &format!("\",\" and the MA order, as in {example}"))?;
-                        let q = self.order(&upper, example)?;
-                        ProcessKind::Arma(p_or_q, q)
+                        (first, self.order(o)?)
                     }
+                    (true, false) => (first, 0),
+                    _ => (0, first),
                 };
+                let kind = (o.make)(p, q);
                 self.expect(b')', "\")\" after the order")?;
                 if let Err(e) = kind.check_orders() {
                     let (expected, found) = ("orders with p + q >= 1".to_string(), kind.name());
@@ -449,7 +441,6 @@ impl<'a> Parser<'a> {
                 }
                 kind
             }
-            _ => return Err(self.unknown_process(name_at, name)),
         };
         let mut values = vec![None; kind.n_params()];
         let after_name = self.pos;
@@ -463,16 +454,14 @@ impl<'a> Parser<'a> {
         Ok((k, Component { kind, values }))
     }
 
-    /// One order of AR/MA/ARMA: 1..=MAX_ORDER (0..=MAX_ORDER for ARMA).
-    fn order(&mut self, upper: &str, example: &str) -> Res<usize> {
+    /// One order of an order kind (AR/MA/ARMA): `o.min..=MAX_ORDER`.
+    fn order(&mut self, o: &Orders) -> Res<usize> {
         self.skip_ws();
         let at = self.pos;
-        let lo = usize::from(upper != "ARMA");
-        let expected = if lo == 1 {
-            format!("an order from 1 to {MAX_ORDER}, as in {example}")
-        } else {
-            format!("an order from 0 to {MAX_ORDER}, as in {example}")
-        };
+        let expected = format!(
+            "an order from {} to {MAX_ORDER}, as in {}",
+            o.min, o.example
+        );
         if !self.peek().is_some_and(|b| b.is_ascii_digit()) {
             return Err(self.unexpected(at, &expected));
         }
@@ -489,22 +478,19 @@ impl<'a> Parser<'a> {
         let order = self.text[at..self.pos]
             .parse::<usize>()
             .unwrap_or(usize::MAX);
-        if (lo..=MAX_ORDER).contains(&order) {
+        if (o.min..=MAX_ORDER).contains(&order) {
             return Ok(order);
         }
-        let kind = match upper {
-            "AR" => ProcessKind::Ar(order),
-            "MA" => ProcessKind::Ma(order),
-            _ => ProcessKind::Arma(order, 0),
+        // the kind as far as read: the bad order in the first written slot
+        let kind = if o.ar {
+            (o.make)(order, 0)
+        } else {
+            (o.make)(0, order)
         };
         let rule = ModelError::BadOrder {
             kind,
             order,
-            expected: if lo == 1 {
-                "an order from 1 to 100"
-            } else {
-                "orders from 0 to 100"
-            },
+            expected: o.expected,
         };
         Err(self.error(at, ParseErrorKind::Rule(rule), &expected, None))
     }
@@ -527,12 +513,13 @@ impl<'a> Parser<'a> {
         } else if upper == "SARIMA" {
             Some("ARMA(p,q)".to_string())
         } else {
-            PROCESSES
+            KINDS
                 .iter()
-                .map(|(n, syntax)| {
+                .map(|&k| {
+                    let (n, syntax) = (spec(k).name, spec(k).syntax);
                     // ties go to the name with the same first letter ("GN" -> GM, not WN)
                     let other_start = upper.as_bytes().first() != n.as_bytes().first();
-                    (edit_distance(&upper, n), other_start, *syntax)
+                    (edit_distance(&upper, n), other_start, syntax)
                 })
                 .filter(|(d, _, _)| *d <= 2)
                 .min_by_key(|(d, o, _)| (*d, *o))
@@ -545,7 +532,7 @@ impl<'a> Parser<'a> {
                 name: name.to_string(),
                 suggestion,
             },
-            PROCESS_LIST.to_string(),
+            process_list(),
             format!("{name:?}"),
             hint,
         )

@@ -1,9 +1,9 @@
 //! From a fully specified model to numbers: its latent processes (METHODS §0.2, §4.3), its
 //! implied Haar wavelet variance and the derivatives with respect to theta (§4.1–§4.6).
 
-use super::{Component, Model, ProcessKind};
+use super::{Component, Model};
 use crate::error::{check_freq, InputError, ParamError};
-use crate::process::{Ar1, Arma, Arma11, Dr, Gm, LatentProcess, Ma1, Process, Qn, Rw, Wn};
+use crate::process::{spec, LatentProcess, Process};
 use serde::Serialize;
 use std::fmt;
 
@@ -30,21 +30,7 @@ impl Component {
                 })
             })
             .collect::<Result<_, _>>()?;
-        Ok(match self.kind {
-            ProcessKind::Wn => Wn::new(v[0])?.into(),
-            ProcessKind::Qn => Qn::new(v[0])?.into(),
-            ProcessKind::Rw => Rw::new(v[0])?.into(),
-            ProcessKind::Dr => Dr::new(v[0])?.into(),
-            ProcessKind::Ar1 => Ar1::new(v[0], v[1])?.into(),
-            ProcessKind::Gm => Gm::new(v[0], v[1], freq_hz)?.into(),
-            ProcessKind::Ma1 => Ma1::new(v[0], v[1])?.into(),
-            ProcessKind::Arma11 => Arma11::new(v[0], v[1], v[2])?.into(),
-            ProcessKind::Ar(p) => Arma::new(v[..p].to_vec(), Vec::new(), v[p])?.into(),
-            ProcessKind::Ma(q) => Arma::new(Vec::new(), v[..q].to_vec(), v[q])?.into(),
-            ProcessKind::Arma(p, q) => {
-                Arma::new(v[..p].to_vec(), v[p..p + q].to_vec(), v[p + q])?.into()
-            }
-        })
+        Ok((spec(self.kind).build)(self.kind, &v, freq_hz)?)
     }
 }
 

@@ -12,13 +12,49 @@
 //! is evaluated with `exp_m1` (its condition number there is below ~12). Derivatives are exact
 //! derivatives of this evaluation (forward-mode jets), so they inherit its accuracy.
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
-    LatentProcess,
+    LatentProcess, Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+use crate::sim::sampler::{normal, Sampler, Step};
+use crate::sim::StartMode;
+
+/// `AR1(phi, sigma2)`: may repeat (`k*AR1()`), not with GM.
+pub(crate) const AR1_SPEC: Spec = Spec {
+    name: "AR1",
+    syntax: "AR1()",
+    params: Params::Fixed(
+        &[
+            ("phi", ParamDomain::UnitInterval),
+            ("sigma2", ParamDomain::Variance),
+        ],
+        (1, 0),
+    ),
+    orders: None,
+    occurs: Occurs::Repeats,
+    build: |_, v, _| Ok(Ar1::new(v[0], v[1])?.into()),
+};
+
+/// `GM(beta, sigma2_gm)` at the model's sampling rate: may repeat (`k*GM()`), not with AR1.
+pub(crate) const GM_SPEC: Spec = Spec {
+    name: "GM",
+    syntax: "GM()",
+    params: Params::Fixed(
+        &[
+            ("beta", ParamDomain::Rate),
+            ("sigma2_gm", ParamDomain::Variance),
+        ],
+        (0, 0),
+    ),
+    orders: None,
+    occurs: Occurs::Repeats,
+    build: |_, v, freq_hz| Ok(Gm::new(v[0], v[1], freq_hz)?.into()),
+};
 
 /// Below this `x = m L = -m ln(phi)` the series of the module doc is used: there the closed form
 /// loses about `-2 log10(x)` digits, the series (terms bounded by `1.5^k/k!`) none.
@@ -274,10 +310,10 @@ impl Ar1 {
 
 impl LatentProcess for Ar1 {
     fn name(&self) -> &'static str {
-        "AR1"
+        AR1_SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["phi", "sigma2"]
+        AR1_SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.phi, self.sigma2]
@@ -325,10 +361,10 @@ impl Gm {
 
 impl LatentProcess for Gm {
     fn name(&self) -> &'static str {
-        "GM"
+        GM_SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["beta", "sigma2_gm"]
+        GM_SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.beta, self.sigma2_gm]
@@ -353,6 +389,60 @@ impl LatentProcess for Gm {
         let l = self.beta / self.freq_hz;
         let ar = self.to_ar1();
         Some(ar1_spectrum(-(-l).exp_m1(), ar.phi, ar.sigma2, f))
+    }
+}
+
+/// METHODS §10.1: `x_t = phi x_{t-1} + w_t`, `w ~ N(0, sigma2)`; `x` is the last value.
+#[derive(Debug, Clone)]
+struct Ar1Sampler {
+    rng: ChaCha8Rng,
+    phi: f64,
+    sd: f64,
+    x: f64,
+}
+
+impl Step for Ar1Sampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        self.x = self.phi * self.x + self.sd * normal(&mut self.rng);
+        self.x
+    }
+}
+
+impl Simulate for Ar1 {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.phi, self.sigma2).map(drop)
+    }
+    /// [`StartMode::Stationary`]: `x_{-1} ~ N(0, sigma2 / (1 - phi^2))` is drawn first, so
+    /// every kept value is stationary; [`StartMode::Zero`]: `x_{-1} = 0` (the package's
+    /// `x_0 = 0`, dropped).
+    fn sampler(
+        &self,
+        mut rng: ChaCha8Rng,
+        start: StartMode,
+    ) -> Result<Box<dyn Sampler>, ParamError> {
+        let (phi, sigma2) = (self.phi, self.sigma2);
+        let x = if start == StartMode::Stationary {
+            (sigma2 / (1.0 - phi * phi)).sqrt() * normal(&mut rng)
+        } else {
+            0.0
+        };
+        Ok(Box::new(Ar1Sampler {
+            rng,
+            phi,
+            sd: sigma2.sqrt(),
+            x,
+        }))
+    }
+}
+
+impl Simulate for Gm {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.beta, self.sigma2_gm, self.freq_hz).map(drop)
+    }
+    /// Simulated as its exact per-sample AR1 ([`Gm::to_ar1`], METHODS §4.3).
+    fn sampler(&self, rng: ChaCha8Rng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        self.to_ar1().sampler(rng, start)
     }
 }
 

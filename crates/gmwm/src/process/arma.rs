@@ -2,10 +2,78 @@
 //! as special cases. R sign convention: AR polynomial `1 - sum ar_i B^i`, MA polynomial
 //! `1 + sum ma_i B^i`.
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{autocovariance_wv, check_positive, LatentProcess};
+use super::{
+    autocovariance_wv, check_positive, LatentProcess, Occurs, Orders, Params, Process, Simulate,
+    Spec,
+};
 use crate::error::ParamError;
+use crate::model::ProcessKind;
+use crate::sim::sampler::{normal, Sampler, Step};
+use crate::sim::StartMode;
+
+/// `AR(p)`, `p` from 1 to [`MAX_ORDER`](crate::model::MAX_ORDER): of the ARMA family.
+pub(crate) const AR_SPEC: Spec = Spec {
+    name: "AR",
+    syntax: "AR(p)",
+    params: Params::Arma,
+    orders: Some(Orders {
+        ar: true,
+        ma: false,
+        min: 1,
+        expected: "an order from 1 to 100",
+        all_zero: "an order from 1 to 100",
+        example: "AR(2)",
+        make: |p, _| ProcessKind::Ar(p),
+    }),
+    occurs: Occurs::ArmaFamily,
+    build,
+};
+
+/// `MA(q)`, `q` from 1 to [`MAX_ORDER`](crate::model::MAX_ORDER): of the ARMA family.
+pub(crate) const MA_SPEC: Spec = Spec {
+    name: "MA",
+    syntax: "MA(q)",
+    params: Params::Arma,
+    orders: Some(Orders {
+        ar: false,
+        ma: true,
+        min: 1,
+        expected: "an order from 1 to 100",
+        all_zero: "an order from 1 to 100",
+        example: "MA(2)",
+        make: |_, q| ProcessKind::Ma(q),
+    }),
+    occurs: Occurs::ArmaFamily,
+    build,
+};
+
+/// `ARMA(p,q)`, each order from 0 to [`MAX_ORDER`](crate::model::MAX_ORDER), `p + q >= 1`
+/// (the package's `SARIMA` without seasonal part): of the ARMA family.
+pub(crate) const ARMA_SPEC: Spec = Spec {
+    name: "ARMA",
+    syntax: "ARMA(p,q)",
+    params: Params::Arma,
+    orders: Some(Orders {
+        ar: true,
+        ma: true,
+        min: 0,
+        expected: "orders from 0 to 100",
+        all_zero: "p + q >= 1 (ARMA(0,0) is white noise: use WN)",
+        example: "ARMA(2,1)",
+        make: ProcessKind::Arma,
+    }),
+    occurs: Occurs::ArmaFamily,
+    build,
+};
+
+/// The [`Arma`] of an order kind from `ar1..arp, ma1..maq, sigma2`.
+fn build(kind: ProcessKind, v: &[f64], _freq_hz: f64) -> Result<Process, ParamError> {
+    let (p, q) = kind.orders();
+    Ok(Arma::new(v[..p].to_vec(), v[p..p + q].to_vec(), v[p + q])?.into())
+}
 
 /// General ARMA(p, q): `x_t = sum ar_i x_{t-i} + w_t + sum ma_i w_{t-i}`, `Var w_t = sigma2`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -327,7 +395,7 @@ const HESSIAN_STEP: f64 = 1e-3;
 
 impl LatentProcess for Arma {
     fn name(&self) -> &'static str {
-        "ARMA"
+        ARMA_SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
         const AR: [&str; 12] = [
@@ -415,5 +483,222 @@ impl LatentProcess for Arma {
             re * re + im * im
         };
         Some(self.sigma2 * gain(&self.ma, 1.0) / gain(&self.ar, -1.0))
+    }
+}
+
+// ------------------------------------------------------------------------------------------
+// Simulation (METHODS §10.1)
+
+/// Relative size of the AR transient left after the burn-in of a stationary-mode ARMA(p, q):
+/// below the 53-bit resolution of most downstream sums, so the start is stationary for every
+/// practical purpose (METHODS §10.1 port).
+const STATIONARY_BURN_IN_TOL: f64 = 1e-12;
+
+/// R's `arima.sim` burn-in constant: `n0 = p + q + ceil(6 / ln(min root modulus))`, a transient
+/// of `e^-6 ≈ 2.5e-3` relative (METHODS §10.1).
+const R_BURN_IN_LOG: f64 = 6.0;
+
+/// Longest burn-in a generic ARMA may need (AR root moduli down to about `1 + 2.8e-7`);
+/// beyond it, starting would take seconds to minutes and the model is numerically a unit root.
+const MAX_BURN_IN: usize = 100_000_000;
+
+/// Whether the AR polynomial `1 - sum ar_i B^i` has every root outside the unit circle,
+/// by the Schur–Cohn (step-down Levinson) test: every reflection coefficient `|k| < 1`
+/// (METHODS §10.1, §12). Exact up to rounding; an empty `ar` is stationary.
+///
+/// # Formula
+/// `k_p = ar_p`; `ar'_i = (ar_i + k_p ar_{p-i}) / (1 - k_p^2)`, i = 1..p-1; repeat on `ar'`.
+pub(crate) fn ar_is_stationary(ar: &[f64]) -> bool {
+    if ar.iter().any(|a| !a.is_finite()) {
+        return false;
+    }
+    let mut a = ar.to_vec();
+    while let Some(&k) = a.last() {
+        if k.abs() >= 1.0 {
+            return false;
+        }
+        let p = a.len();
+        let d = 1.0 - k * k;
+        let next: Vec<f64> = (0..p - 1).map(|i| (a[i] + k * a[p - 2 - i]) / d).collect();
+        a = next;
+    }
+    true
+}
+
+/// Largest modulus `rho` of the inverse roots of the AR polynomial `1 - sum ar_i B^i` (the
+/// roots of `lambda^p - ar_1 lambda^{p-1} - ... - ar_p`), by bisection on `r` with the
+/// Schur–Cohn test: the coefficients `ar_i / r^i` are stationary iff `r > rho`. Robust to
+/// repeated and complex roots; returns an upper bracket (a conservative burn-in), to about
+/// 1e-15 for simple roots and 1e-6 for a double root. Used only to size burn-ins.
+fn inverse_root_radius(ar: &[f64]) -> f64 {
+    let m = ar.iter().rposition(|&a| a != 0.0).map_or(0, |i| i + 1);
+    let a = &ar[..m];
+    match m {
+        0 => return 0.0,
+        1 => return a[0].abs(),
+        _ => {}
+    }
+    // Cauchy bound: every inverse root has modulus < 1 + max |ar_i|.
+    let mut hi = 1.0 + a.iter().fold(0.0f64, |b, x| b.max(x.abs()));
+    let mut lo = 0.0f64;
+    let mut scaled = vec![0.0; m];
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        let mut rk = 1.0;
+        for (s, &ai) in scaled.iter_mut().zip(a) {
+            rk *= mid;
+            *s = ai / rk;
+        }
+        if ar_is_stationary(&scaled) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
+/// Burn-in length of a generic ARMA in each start mode (METHODS §10.1).
+fn arma_burn_in(ar: &[f64], q: usize, mode: StartMode) -> Result<usize, ParamError> {
+    let p = ar.len();
+    let rho = inverse_root_radius(ar);
+    let log_len = match mode {
+        StartMode::Stationary => -STATIONARY_BURN_IN_TOL.ln(),
+        StartMode::Zero => R_BURN_IN_LOG,
+    };
+    let extra = if p == 0 || rho == 0.0 {
+        0.0
+    } else {
+        // ln(min root modulus) = -ln(rho).
+        (log_len / -rho.ln()).ceil()
+    };
+    if !(extra.is_finite() && extra >= 0.0 && extra <= MAX_BURN_IN as f64) {
+        return Err(ParamError::new(
+            "ar",
+            format!("{ar:?}"),
+            format!(
+                "AR roots far enough from the unit circle for a burn-in of at most \
+                 {MAX_BURN_IN} samples (largest inverse root modulus {rho})"
+            ),
+        ));
+    }
+    Ok(p + q + extra as usize)
+}
+
+/// Generic ARMA(p, q) state: `xs[i] = x_{t-1-i}`, `es[k] = e_{t-1-k}`.
+#[derive(Debug, Clone)]
+struct ArmaState {
+    rng: ChaCha8Rng,
+    ar: Vec<f64>,
+    ma: Vec<f64>,
+    sd: f64,
+    xs: Vec<f64>,
+    es: Vec<f64>,
+    /// MA outputs still to be set to 0 (R's `x[seq_along(ma)] <- 0`).
+    ma_zeros: usize,
+}
+
+impl Step for ArmaState {
+    /// METHODS §10.1 (ARMA(p, q), R's `arima.sim`): `y_t = e_t + sum_k ma_k e_{t-k}` (0 for
+    /// the first q), `x_t = y_t + sum_i ar_i x_{t-i}`.
+    #[inline]
+    fn step(&mut self) -> f64 {
+        let e = self.sd * normal(&mut self.rng);
+        let y = if self.ma_zeros > 0 {
+            self.ma_zeros -= 1;
+            0.0
+        } else {
+            e + self
+                .ma
+                .iter()
+                .zip(&self.es)
+                .map(|(m, w)| m * w)
+                .sum::<f64>()
+        };
+        let x = y + self
+            .ar
+            .iter()
+            .zip(&self.xs)
+            .map(|(a, v)| a * v)
+            .sum::<f64>();
+        if !self.es.is_empty() {
+            self.es.rotate_right(1);
+            self.es[0] = e;
+        }
+        if !self.xs.is_empty() {
+            self.xs.rotate_right(1);
+            self.xs[0] = x;
+        }
+        x
+    }
+}
+
+impl Simulate for Arma {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.ar.clone(), self.ma.clone(), self.sigma2).map(drop)
+    }
+    /// Runs the burn-in of [`arma_burn_in`] first, from zeros with the first `q` MA outputs
+    /// set to 0 (R's `arima.sim`), in both start modes; only its length depends on the mode.
+    fn sampler(&self, rng: ChaCha8Rng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        let n0 = arma_burn_in(&self.ar, self.ma.len(), start)?;
+        let mut s = ArmaState {
+            rng,
+            ar: self.ar.clone(),
+            ma: self.ma.clone(),
+            sd: self.sigma2.sqrt(),
+            xs: vec![0.0; self.ar.len()],
+            es: vec![0.0; self.ma.len()],
+            ma_zeros: self.ma.len(),
+        };
+        for _ in 0..n0 {
+            s.step();
+        }
+        Ok(Box::new(s))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ar_is_stationary_matches_known_cases() {
+        assert!(ar_is_stationary(&[]));
+        assert!(ar_is_stationary(&[0.9]));
+        assert!(!ar_is_stationary(&[1.0]));
+        assert!(ar_is_stationary(&[0.5, 0.3]));
+        assert!(!ar_is_stationary(&[0.5, 0.6]));
+        assert!(ar_is_stationary(&[1.8, -0.81])); // double root at 1/0.9
+        assert!(!ar_is_stationary(&[2.0, -1.0])); // double unit root
+        assert!(ar_is_stationary(&[0.0, 0.0, 0.5]));
+        assert!(!ar_is_stationary(&[f64::NAN]));
+    }
+
+    #[test]
+    fn inverse_root_radius_matches_hand_values() {
+        assert_eq!(inverse_root_radius(&[]), 0.0);
+        assert_eq!(inverse_root_radius(&[-0.7, 0.0]), 0.7);
+        // (1 - 0.5B)(1 - 0.8B) = 1 - 1.3B + 0.4B^2
+        assert!((inverse_root_radius(&[1.3, -0.4]) - 0.8).abs() < 1e-10);
+        // complex pair of modulus 0.9: lambda^2 - 2*0.9 cos(1) lambda + 0.81
+        let c = 2.0 * 0.9 * 1f64.cos();
+        assert!((inverse_root_radius(&[c, -0.81]) - 0.9).abs() < 1e-10);
+        // double root 0.9: rounding in the Schur–Cohn step blurs the boundary to ~1e-6, on the
+        // conservative side (longer burn-in)
+        let r = inverse_root_radius(&[1.8, -0.81]);
+        assert!((0.9..0.9 + 1e-5).contains(&r), "{r}");
+    }
+
+    #[test]
+    fn arma_burn_in_follows_r_and_tolerance() {
+        // R: p + q + ceil(6 / ln(1 / 0.5)) = 1 + 1 + 9
+        assert_eq!(arma_burn_in(&[0.5], 1, StartMode::Zero).unwrap(), 11);
+        // stationary: 1 + 0 + ceil(27.63 / ln 2) = 41
+        assert_eq!(arma_burn_in(&[0.5], 0, StartMode::Stationary).unwrap(), 41);
+        assert_eq!(arma_burn_in(&[], 3, StartMode::Stationary).unwrap(), 3);
+        assert!(arma_burn_in(&[1.0 - 1e-12], 0, StartMode::Stationary).is_err());
     }
 }

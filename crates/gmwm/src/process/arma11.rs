@@ -8,14 +8,35 @@
 //! and the AR1 part uses the stable evaluation of [`super::ar1`]. This is used for
 //! `phi > 1/2`; below, the closed form is used as written.
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::ar1::ar1_wv_jet;
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
-    LatentProcess,
+    LatentProcess, Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+use crate::sim::sampler::{normal, Sampler, Step};
+use crate::sim::StartMode;
+
+/// `ARMA11(phi, theta, sigma2)`: of the ARMA family.
+pub(crate) const SPEC: Spec = Spec {
+    name: "ARMA11",
+    syntax: "ARMA11()",
+    params: Params::Fixed(
+        &[
+            ("phi", ParamDomain::UnitInterval),
+            ("theta", ParamDomain::UnitInterval),
+            ("sigma2", ParamDomain::Variance),
+        ],
+        (1, 1),
+    ),
+    orders: None,
+    occurs: Occurs::ArmaFamily,
+    build: |_, v, _| Ok(Arma11::new(v[0], v[1], v[2])?.into()),
+};
 
 /// From this `phi` on, the WN + AR1 decomposition of the module doc is used (it divides by
 /// `phi`, so it is not used near 0, where the closed form has no cancellation).
@@ -78,10 +99,10 @@ pub(crate) fn arma11_wv_jet<const N: usize>(
 
 impl LatentProcess for Arma11 {
     fn name(&self) -> &'static str {
-        "ARMA11"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["phi", "theta", "sigma2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.phi, self.theta, self.sigma2]
@@ -102,5 +123,58 @@ impl LatentProcess for Arma11 {
         let num = (1.0 + t) * (1.0 + t) - 4.0 * t * s2;
         let den = (1.0 - p) * (1.0 - p) + 4.0 * p * s2;
         Some(self.sigma2 * num / den)
+    }
+}
+
+/// METHODS §10.1: `x_t = phi x_{t-1} + w_t + theta w_{t-1}`; `(x, w)` are the last values.
+#[derive(Debug, Clone)]
+struct Arma11Sampler {
+    rng: ChaCha8Rng,
+    phi: f64,
+    theta: f64,
+    sd: f64,
+    x: f64,
+    w: f64,
+}
+
+impl Step for Arma11Sampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        let next = self.sd * normal(&mut self.rng);
+        self.x = self.phi * self.x + next + self.theta * self.w;
+        self.w = next;
+        self.x
+    }
+}
+
+impl Simulate for Arma11 {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.phi, self.theta, self.sigma2).map(drop)
+    }
+    /// Draws `w_{-1}`, then in [`StartMode::Stationary`] `x_{-1}` from the stationary joint law
+    /// (`Cov(x, w) = sigma2`, `Var x = gamma_0`: `x_{-1} = w_{-1} + N(0, gamma_0 - sigma2)`,
+    /// `gamma_0 - sigma2 = sigma2 (phi + theta)^2 / (1 - phi^2)`); in [`StartMode::Zero`]
+    /// `x_{-1} = 0`, so the first value is `w_0 + theta w_{-1}`.
+    fn sampler(
+        &self,
+        mut rng: ChaCha8Rng,
+        start: StartMode,
+    ) -> Result<Box<dyn Sampler>, ParamError> {
+        let (phi, theta, sigma2) = (self.phi, self.theta, self.sigma2);
+        let sd = sigma2.sqrt();
+        let w = sd * normal(&mut rng);
+        let x = if start == StartMode::Stationary {
+            w + (sigma2 / (1.0 - phi * phi)).sqrt() * (phi + theta).abs() * normal(&mut rng)
+        } else {
+            0.0
+        };
+        Ok(Box::new(Arma11Sampler {
+            rng,
+            phi,
+            theta,
+            sd,
+            x,
+            w,
+        }))
     }
 }

@@ -1,9 +1,23 @@
-//! Deterministic drift (METHODS §0.2, §4.2).
+//! Deterministic drift (METHODS §0.2, §4.2, §10.1).
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{add_scaled, half_widths, LatentProcess};
+use super::{add_scaled, half_widths, LatentProcess, Occurs, Params, Simulate, Spec};
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+use crate::sim::sampler::{Sampler, Step};
+use crate::sim::StartMode;
+
+/// `DR(omega)`: may appear once in a model; `omega` has any sign.
+pub(crate) const SPEC: Spec = Spec {
+    name: "DR",
+    syntax: "DR()",
+    params: Params::Fixed(&[("omega", ParamDomain::Finite)], (0, 0)),
+    orders: None,
+    occurs: Occurs::Once,
+    build: |_, v, _| Ok(Dr::new(v[0])?.into()),
+};
 
 /// Deterministic drift: the ramp `x_t = omega (t + 1)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -33,10 +47,10 @@ fn unit_wv(m: f64) -> f64 {
 
 impl LatentProcess for Dr {
     fn name(&self) -> &'static str {
-        "DR"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["omega"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.omega]
@@ -62,5 +76,32 @@ impl LatentProcess for Dr {
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let _ = f;
         None
+    }
+}
+
+/// METHODS §10.1: `x_t = omega (t + 1)`, t = 0, 1, ... across chunks (no randomness).
+#[derive(Debug, Clone)]
+struct DrSampler {
+    omega: f64,
+    t: u64,
+}
+
+impl Step for DrSampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        self.t += 1;
+        self.omega * self.t as f64
+    }
+}
+
+impl Simulate for Dr {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.omega).map(drop)
+    }
+    fn sampler(&self, _: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        Ok(Box::new(DrSampler {
+            omega: self.omega,
+            t: 0,
+        }))
     }
 }

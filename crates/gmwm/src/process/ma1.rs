@@ -1,11 +1,32 @@
-//! First-order moving average (METHODS §0.2, §4.2, §4.5, §4.6).
+//! First-order moving average (METHODS §0.2, §4.2, §4.5, §4.6, §10.1).
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, Jet, LatentProcess,
+    Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+use crate::sim::sampler::{normal, Sampler, Step};
+use crate::sim::StartMode;
+
+/// `MA1(theta, sigma2)`: an ARMA(0, 1), of the ARMA family.
+pub(crate) const SPEC: Spec = Spec {
+    name: "MA1",
+    syntax: "MA1()",
+    params: Params::Fixed(
+        &[
+            ("theta", ParamDomain::UnitInterval),
+            ("sigma2", ParamDomain::Variance),
+        ],
+        (0, 1),
+    ),
+    orders: None,
+    occurs: Occurs::ArmaFamily,
+    build: |_, v, _| Ok(Ma1::new(v[0], v[1])?.into()),
+};
 
 /// First-order moving average `x_t = w_t + theta w_{t-1}`, `Var w_t = sigma2`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -43,10 +64,10 @@ pub(crate) fn ma1_wv_jet<const N: usize>(theta: Jet<N>, sigma2: Jet<N>, m: f64) 
 
 impl LatentProcess for Ma1 {
     fn name(&self) -> &'static str {
-        "MA1"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["theta", "sigma2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.theta, self.sigma2]
@@ -64,5 +85,41 @@ impl LatentProcess for Ma1 {
         let s = (std::f64::consts::PI * f).sin();
         let t = self.theta;
         Some(self.sigma2 * ((1.0 + t) * (1.0 + t) - 4.0 * t * s * s))
+    }
+}
+
+/// METHODS §10.1: `x_t = w_t + theta w_{t-1}`, stationary in both start modes (one extra
+/// innovation `w` drawn first).
+#[derive(Debug, Clone)]
+struct Ma1Sampler {
+    rng: ChaCha8Rng,
+    theta: f64,
+    sd: f64,
+    w: f64,
+}
+
+impl Step for Ma1Sampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        let next = self.sd * normal(&mut self.rng);
+        let x = next + self.theta * self.w;
+        self.w = next;
+        x
+    }
+}
+
+impl Simulate for Ma1 {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.theta, self.sigma2).map(drop)
+    }
+    fn sampler(&self, mut rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        let sd = self.sigma2.sqrt();
+        let w = sd * normal(&mut rng);
+        Ok(Box::new(Ma1Sampler {
+            rng,
+            theta: self.theta,
+            sd,
+            w,
+        }))
     }
 }

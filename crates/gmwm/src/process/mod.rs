@@ -5,6 +5,12 @@
 //! `j = 1..=levels` at scales `tau_j = 2^j` samples, parameters are per sample (METHODS §0.1);
 //! only [`Gm`] carries a sampling rate (§4.3).
 //!
+//! Each process's module holds all of its facts: its name and parameters in the model language
+//! (with their domains), its validating constructor, its implied WV and derivatives, its
+//! spectral density, and how it is simulated (METHODS §10.1). One table maps a
+//! [`ProcessKind`](crate::model::ProcessKind) to those facts; the model language, the model's
+//! validation and the simulator ([`crate::sim`]) read it.
+//!
 //! Derivatives of the closed forms are exact (forward-mode automatic differentiation of the
 //! numerically stable evaluation, see [`ar1`]), so they stay accurate where the textbook quotient
 //! of §4.5 cancels (AR1/GM with `phi` near 1). The generic [`Arma`] is differentiated numerically
@@ -20,6 +26,7 @@ pub mod ma1;
 pub mod qn;
 pub mod rw;
 pub mod spectral;
+mod table;
 pub mod wn;
 
 pub use ar1::{Ar1, Gm};
@@ -31,7 +38,12 @@ pub use qn::Qn;
 pub use rw::Rw;
 pub use wn::Wn;
 
+pub(crate) use table::{spec, Occurs, Orders, Params, Spec, KINDS};
+
 use crate::error::ParamError;
+use crate::sim::sampler::Sampler;
+use crate::sim::StartMode;
+use rand_chacha::ChaCha8Rng;
 
 /// A latent process with an implied Haar wavelet variance (METHODS §4). Object safe.
 pub trait LatentProcess {
@@ -61,42 +73,80 @@ pub trait LatentProcess {
     fn spectral_density(&self, f: f64) -> Option<f64>;
 }
 
-/// One latent process of a model (METHODS §0.2).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub enum Process {
+/// What the engine needs of a process beyond [`LatentProcess`]: its validation, again, and its
+/// simulation (METHODS §10.1). Implemented by every process next to its implied WV.
+pub(crate) trait Simulate: LatentProcess {
+    /// Checks the values through the process's own constructor (the fields are public, so a
+    /// value may have been built without it).
+    fn check(&self) -> Result<(), ParamError>;
+    /// The simulation state on `rng`, the component's own stream; initial draws come first in
+    /// it, per `start` for the autoregressive processes.
+    ///
+    /// # Errors
+    /// [`ParamError`] only for a generic ARMA whose burn-in would be too long.
+    fn sampler(&self, rng: ChaCha8Rng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError>;
+}
+
+/// Declares [`Process`] over the process structs (one line each), with its dispatch and the
+/// `From` conversions.
+macro_rules! processes {
+    ($($(#[doc = $doc:literal])* $v:ident,)*) => {
+        /// One latent process of a model (METHODS §0.2).
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        pub enum Process {
+            $($(#[doc = $doc])* $v($v),)*
+        }
+
+        impl Process {
+            fn inner(&self) -> &dyn Simulate {
+                match self {
+                    $(Process::$v(p) => p,)*
+                }
+            }
+        }
+
+        $(impl From<$v> for Process {
+            fn from(p: $v) -> Self {
+                Process::$v(p)
+            }
+        })*
+    };
+}
+
+processes! {
     /// White noise.
-    Wn(Wn),
+    Wn,
     /// Quantisation noise.
-    Qn(Qn),
+    Qn,
     /// Random walk.
-    Rw(Rw),
+    Rw,
     /// Deterministic drift.
-    Dr(Dr),
+    Dr,
     /// First-order autoregression.
-    Ar1(Ar1),
+    Ar1,
     /// Gauss–Markov (AR1 at a sampling rate).
-    Gm(Gm),
+    Gm,
     /// First-order moving average.
-    Ma1(Ma1),
+    Ma1,
     /// ARMA(1,1).
-    Arma11(Arma11),
+    Arma11,
     /// General ARMA(p, q).
-    Arma(Arma),
+    Arma,
 }
 
 impl Process {
-    fn inner(&self) -> &dyn LatentProcess {
-        match self {
-            Process::Wn(p) => p,
-            Process::Qn(p) => p,
-            Process::Rw(p) => p,
-            Process::Dr(p) => p,
-            Process::Ar1(p) => p,
-            Process::Gm(p) => p,
-            Process::Ma1(p) => p,
-            Process::Arma11(p) => p,
-            Process::Arma(p) => p,
-        }
+    /// [`Simulate::check`].
+    pub(crate) fn check(&self) -> Result<(), ParamError> {
+        self.inner().check()
+    }
+
+    /// [`Simulate::sampler`].
+    pub(crate) fn sampler(
+        &self,
+        rng: ChaCha8Rng,
+        start: StartMode,
+    ) -> Result<Box<dyn Sampler>, ParamError> {
+        self.inner().sampler(rng, start)
     }
 }
 
@@ -126,17 +176,6 @@ impl LatentProcess for Process {
         self.inner().spectral_density(f)
     }
 }
-
-macro_rules! impl_from_process {
-    ($($v:ident),*) => {
-        $(impl From<$v> for Process {
-            fn from(p: $v) -> Self {
-                Process::$v(p)
-            }
-        })*
-    };
-}
-impl_from_process!(Wn, Qn, Rw, Dr, Ar1, Gm, Ma1, Arma11, Arma);
 
 /// METHODS §4.1: Haar WV at `tau_j = 2^j`, `j = 1..=levels`, from autocovariances
 /// `gamma_0, gamma_1, ...`:

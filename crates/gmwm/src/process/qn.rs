@@ -1,9 +1,28 @@
-//! Quantisation noise (METHODS §0.2, §4.2).
+//! Quantisation noise (METHODS §0.2, §4.2, §10.1).
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{add_scaled, check_positive, half_widths, LatentProcess};
+use super::{
+    add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Simulate, Spec,
+};
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+use crate::sim::sampler::{uniform, Sampler, Step};
+use crate::sim::StartMode;
+
+/// `QN(q2)`: may appear once in a model.
+pub(crate) const SPEC: Spec = Spec {
+    name: "QN",
+    syntax: "QN()",
+    params: Params::Fixed(&[("q2", ParamDomain::Variance)], (0, 0)),
+    orders: None,
+    occurs: Occurs::Once,
+    build: |_, v, _| Ok(Qn::new(v[0])?.into()),
+};
+
+/// `sqrt(12)`: scales `U(0, 1)` to variance 1 for quantisation noise (METHODS §10.1).
+const SQRT_12: f64 = 3.464_101_615_137_754_6;
 
 /// Quantisation noise: first difference of white noise of variance `q2`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -31,10 +50,10 @@ fn unit_wv(m: f64) -> f64 {
 
 impl LatentProcess for Qn {
     fn name(&self) -> &'static str {
-        "QN"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["q2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.q2]
@@ -54,5 +73,44 @@ impl LatentProcess for Qn {
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let s = (std::f64::consts::PI * f).sin();
         Some(4.0 * self.q2 * s * s)
+    }
+}
+
+/// One QN value from consecutive uniforms (METHODS §10.1): `sqrt(q2) (u_{t+1} - u_t)`.
+#[inline]
+pub(crate) fn qn_value(sqrt_q2: f64, u_t: f64, u_next: f64) -> f64 {
+    sqrt_q2 * (u_next - u_t)
+}
+
+/// METHODS §10.1: `x_t = sqrt(q2) (u_{t+1} - u_t)`, `u ~ sqrt(12) U(0, 1)`; `u` is the last
+/// uniform drawn.
+#[derive(Debug, Clone)]
+struct QnSampler {
+    rng: ChaCha8Rng,
+    sqrt_q2: f64,
+    u: f64,
+}
+
+impl Step for QnSampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        let next = SQRT_12 * uniform(&mut self.rng);
+        let x = qn_value(self.sqrt_q2, self.u, next);
+        self.u = next;
+        x
+    }
+}
+
+impl Simulate for Qn {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.q2).map(drop)
+    }
+    fn sampler(&self, mut rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        let u = SQRT_12 * uniform(&mut rng);
+        Ok(Box::new(QnSampler {
+            rng,
+            sqrt_q2: self.q2.sqrt(),
+            u,
+        }))
     }
 }

@@ -1,9 +1,25 @@
-//! Random walk (METHODS §0.2, §4.2).
+//! Random walk (METHODS §0.2, §4.2, §10.1).
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{add_scaled, check_positive, half_widths, LatentProcess};
+use super::{
+    add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Simulate, Spec,
+};
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+use crate::sim::sampler::{normal, Sampler, Step};
+use crate::sim::StartMode;
+
+/// `RW(gamma2)`: may appear once in a model.
+pub(crate) const SPEC: Spec = Spec {
+    name: "RW",
+    syntax: "RW()",
+    params: Params::Fixed(&[("gamma2", ParamDomain::Variance)], (0, 0)),
+    orders: None,
+    occurs: Occurs::Once,
+    build: |_, v, _| Ok(Rw::new(v[0])?.into()),
+};
 
 /// Random walk: cumulative sum of white noise with increment variance `gamma2`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -31,10 +47,10 @@ fn unit_wv(m: f64) -> f64 {
 
 impl LatentProcess for Rw {
     fn name(&self) -> &'static str {
-        "RW"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["gamma2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.gamma2]
@@ -56,5 +72,35 @@ impl LatentProcess for Rw {
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let s = (std::f64::consts::PI * f).sin();
         Some(self.gamma2 / (4.0 * s * s))
+    }
+}
+
+/// METHODS §10.1: `x_t = sum_{i=0}^{t} w_i`, `w ~ N(0, gamma2)` (the first value is `w_0`,
+/// not 0).
+#[derive(Debug, Clone)]
+struct RwSampler {
+    rng: ChaCha8Rng,
+    sd: f64,
+    level: f64,
+}
+
+impl Step for RwSampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        self.level += self.sd * normal(&mut self.rng);
+        self.level
+    }
+}
+
+impl Simulate for Rw {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.gamma2).map(drop)
+    }
+    fn sampler(&self, rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        Ok(Box::new(RwSampler {
+            rng,
+            sd: self.gamma2.sqrt(),
+            level: 0.0,
+        }))
     }
 }

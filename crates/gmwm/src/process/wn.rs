@@ -1,9 +1,25 @@
-//! White noise (METHODS §0.2, §4.2).
+//! White noise (METHODS §0.2, §4.2, §10.1).
 
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{add_scaled, check_positive, half_widths, LatentProcess};
+use super::{
+    add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Simulate, Spec,
+};
 use crate::error::ParamError;
+use crate::model::ParamDomain;
+use crate::sim::sampler::{normal, Sampler, Step};
+use crate::sim::StartMode;
+
+/// `WN(sigma2)`: may appear once in a model.
+pub(crate) const SPEC: Spec = Spec {
+    name: "WN",
+    syntax: "WN()",
+    params: Params::Fixed(&[("sigma2", ParamDomain::Variance)], (0, 0)),
+    orders: None,
+    occurs: Occurs::Once,
+    build: |_, v, _| Ok(Wn::new(v[0])?.into()),
+};
 
 /// White noise: independent samples of variance `sigma2`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -31,10 +47,10 @@ fn unit_wv(m: f64) -> f64 {
 
 impl LatentProcess for Wn {
     fn name(&self) -> &'static str {
-        "WN"
+        SPEC.name
     }
     fn param_names(&self) -> Vec<&'static str> {
-        vec!["sigma2"]
+        SPEC.fixed_names()
     }
     fn params(&self) -> Vec<f64> {
         vec![self.sigma2]
@@ -56,5 +72,31 @@ impl LatentProcess for Wn {
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let _ = f;
         Some(self.sigma2)
+    }
+}
+
+/// METHODS §10.1: `x_t ~ N(0, sigma2)` i.i.d.
+#[derive(Debug, Clone)]
+struct WnSampler {
+    rng: ChaCha8Rng,
+    sd: f64,
+}
+
+impl Step for WnSampler {
+    #[inline]
+    fn step(&mut self) -> f64 {
+        self.sd * normal(&mut self.rng)
+    }
+}
+
+impl Simulate for Wn {
+    fn check(&self) -> Result<(), ParamError> {
+        Self::new(self.sigma2).map(drop)
+    }
+    fn sampler(&self, rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+        Ok(Box::new(WnSampler {
+            rng,
+            sd: self.sigma2.sqrt(),
+        }))
     }
 }
