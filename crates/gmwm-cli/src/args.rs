@@ -38,9 +38,9 @@ pub enum Command {
     /// Wavelet variance (classical or robust) with confidence intervals, per column.
     #[command(
         allow_negative_numbers = true,
-        after_long_help = "Examples:\n  gmwm wv imu.csv.gz\n  gmwm wv imu.csv.gz --columns gyro_x --robust --eff 0.6\n  gmwm wv imu.csv.gz --transform dwt --filter la8 --levels 6 --csv\n  gmwm wv log.f64 --format f64 --ncols 3 --freq 200 --json"
+        after_long_help = WV_EXAMPLES
     )]
-    Wv(WvArgs),
+    Wv(WvCommand),
     /// Allan, modified Allan or Hadamard variance with confidence intervals, per column.
     #[command(
         allow_negative_numbers = true,
@@ -73,7 +73,7 @@ pub enum Command {
     /// intervals, the noise density, bias instability and random walk in SI and datasheet
     /// units, the IEEE 952 read-off, and navigation-filter files (Kalibr, OpenVINS, ...).
     #[command(allow_negative_numbers = true, after_long_help = CALIBRATE_EXAMPLES)]
-    Calibrate(CalibrateArgs),
+    Calibrate(CalibrateCommand),
     /// Draw a figure (SVG or PNG, by the file name): wavelet or Allan variances, classical
     /// against robust, a fit with its decomposition, a model selection, the IEEE read-off.
     #[command(after_long_help = PLOT_EXAMPLES)]
@@ -93,13 +93,83 @@ const CALIBRATE_EXAMPLES: &str = "\
 Record the IMU at rest, warmed up, for at least a few hours: the longest scale the WV sees is
 about a quarter of the recording, and the bias instability and random walk live there.
 
+Many recordings (batch mode: several FILEs, a folder, a quoted glob, or --out-dir/--force):
+each is calibrated, in parallel, into <stem>.calibration.json (the document of --json FILE;
+<stem> is the file name without its data extensions) in --out-dir or beside it; --kalibr,
+--export and --report then name suffixes: --kalibr imu.yaml writes <stem>.imu.yaml, --report
+report.html writes <stem>.report.html. A recording whose outputs are all newer than it (and
+its sidecar) is skipped as up to date, --force redoes it; outputs are written atomically.
+One table at the end (--json - for JSON); exit code 1 if any recording failed.
+
 Examples:
   gmwm calibrate imu.csv.gz --gyro-unit deg/s --accel-unit g
   gmwm calibrate imu.csv.gz --kalibr imu.yaml --json calib.json
   gmwm calibrate flight.bag --topic /imu0 --kalibr imu.yaml --conservative
   gmwm calibrate run.mcap --export openvins kalibr_imu_chain.yaml --export px4 imu.sdf
   gmwm calibrate log.bin --format ln200 --axis-policy per-axis --kalibr imu.yaml
-  gmwm calibrate imu.csv.gz --model \"2*AR1()+WN()+RW()\" --inflate 2 --export vins vins.yaml";
+  gmwm calibrate imu.csv.gz --model \"2*AR1()+WN()+RW()\" --inflate 2 --export vins vins.yaml
+  gmwm calibrate runs/ --out-dir calib/ --kalibr imu.yaml      every recording in runs/
+  gmwm calibrate 'runs/*.csv.gz' a.bag --json summary.json      a glob (quoted) and a file";
+
+const WV_EXAMPLES: &str = "\
+Many recordings (batch mode: several FILEs, a folder, a quoted glob, or --out-dir/--force):
+each one's wavelet variance is written, in parallel, to <stem>.wv.json (the document of
+--json; <stem> is the file name without its data extensions) in --out-dir or beside it; a
+recording whose output is newer than it (and its sidecar) is skipped as up to date, --force
+redoes it. One table at the end (--json for JSON); exit code 1 if any recording failed.
+
+Examples:
+  gmwm wv imu.csv.gz
+  gmwm wv imu.csv.gz --columns gyro_x --robust --eff 0.6
+  gmwm wv imu.csv.gz --transform dwt --filter la8 --levels 6 --csv
+  gmwm wv log.f64 --format f64 --ncols 3 --freq 200 --json
+  gmwm wv runs/ --out-dir wv/                   every recording in runs/
+  gmwm wv 'runs/*.csv.gz' --robust --json       a quoted glob; the summary as JSON";
+
+/// `gmwm calibrate`: the calibration's flags and the batch flags.
+#[derive(Debug, Args)]
+pub struct CalibrateCommand {
+    /// The calibration.
+    #[command(flatten)]
+    pub args: CalibrateArgs,
+    /// More recordings.
+    #[command(flatten)]
+    pub batch: BatchArgs,
+}
+
+/// `gmwm wv`: the wavelet-variance flags and the batch flags.
+#[derive(Debug, Args)]
+pub struct WvCommand {
+    /// The wavelet variance.
+    #[command(flatten)]
+    pub args: WvArgs,
+    /// More recordings.
+    #[command(flatten)]
+    pub batch: BatchArgs,
+}
+
+/// What makes `gmwm calibrate` and `gmwm wv` run over many recordings.
+const BATCH_HELP: &str = "\
+More recordings: batch mode. Each FILE may be a recording, a folder (every recording directly
+inside it, by name: .csv .tsv .txt (also .gz), .bag .mcap .db3, .f64 .f32 (.f64le .f32le),
+.bin .dat .raw with a JSON sidecar or --format, and rosbag2 folders; sidecars and gmwm's
+outputs are skipped) or a quoted glob expanded by gmwm ('runs/*.csv.gz', the same choice
+among its matches). A folder holding metadata.yaml is one rosbag2 recording.";
+
+/// Batch mode: several recordings, folders or globs.
+#[derive(Debug, Args)]
+pub struct BatchArgs {
+    /// More recordings, folders of recordings or quoted globs (batch mode).
+    #[arg(value_name = "FILE", long_help = BATCH_HELP)]
+    pub more: Vec<PathBuf>,
+    /// Batch mode: write each recording's outputs to DIR (created if missing)
+    /// [default: beside each recording].
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
+    /// Batch mode: redo recordings whose outputs are up to date.
+    #[arg(long)]
+    pub force: bool,
+}
 
 /// `gmwm calibrate`.
 #[derive(Debug, Args)]

@@ -7,10 +7,11 @@
 //! decided here from the flags ([`SavedWvCheck`]) and raised there once FILE is known to be one.
 
 use crate::args::{
-    AvarArgs, AxisPolicyArg, CalibrateArgs, Command, ConventionArg, DemoArgs, FigureArgs, FitArgs,
-    FormatArg, HeaderArg, ImpliedArgs, InputArgs, KindArg, OptimismArg, OptimismConventionArg,
-    OutputArgs, PlotArgs, PlotCommand, ReportArgs, RobustConventionArg, RuleArg, SelectArgs,
-    SimulateArgs, TimeUnitArg, TopicsArgs, TransformArg, WeightsArg, WvArgs, WvEstimatorArgs,
+    AvarArgs, AxisPolicyArg, BatchArgs, CalibrateArgs, CalibrateCommand, Command, ConventionArg,
+    DemoArgs, FigureArgs, FitArgs, FormatArg, HeaderArg, ImpliedArgs, InputArgs, KindArg,
+    OptimismArg, OptimismConventionArg, OutputArgs, PlotArgs, PlotCommand, ReportArgs,
+    RobustConventionArg, RuleArg, SelectArgs, SimulateArgs, TimeUnitArg, TopicsArgs, TransformArg,
+    WeightsArg, WvArgs, WvCommand, WvEstimatorArgs,
 };
 use crate::render::Style;
 use crate::UsageError;
@@ -53,6 +54,8 @@ pub enum Config {
     Plot(PlotConfig),
     /// `gmwm report`.
     Report(ReportConfig),
+    /// `gmwm calibrate` or `gmwm wv` over many recordings.
+    Batch(BatchConfig),
 }
 
 impl TryFrom<&Command> for Config {
@@ -61,13 +64,13 @@ impl TryFrom<&Command> for Config {
     fn try_from(command: &Command) -> Result<Self> {
         Ok(match command {
             Command::Demo(a) => Self::Demo(a.try_into()?),
-            Command::Wv(a) => Self::Wv(a.try_into()?),
+            Command::Wv(a) => wv_or_batch(a)?,
             Command::Avar(a) => Self::Avar(a.try_into()?),
             Command::Simulate(a) => Self::Simulate(a.try_into()?),
             Command::Implied(a) => Self::Implied(a.try_into()?),
             Command::Fit(a) => Self::Fit(a.try_into()?),
             Command::Select(a) => Self::Select(a.try_into()?),
-            Command::Calibrate(a) => Self::Calibrate(a.try_into()?),
+            Command::Calibrate(a) => calibrate_or_batch(a)?,
             Command::Topics(a) => Self::Topics(a.into()),
             Command::Plot(a) => Self::Plot(a.try_into()?),
             Command::Report(a) => Self::Report(a.try_into()?),
@@ -693,6 +696,142 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             report: a.report.clone(),
         })
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Batch mode
+
+/// `gmwm calibrate` or `gmwm wv` over many recordings: the inputs as given (files, folders,
+/// globs; expanded by [`crate::batch`]), where the outputs go, and the job run on each.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BatchConfig {
+    /// FILE arguments as given.
+    pub inputs: Vec<PathBuf>,
+    /// `--out-dir`: where each recording's outputs go (beside it when `None`).
+    pub out_dir: Option<PathBuf>,
+    /// `--force`: redo recordings whose outputs are up to date.
+    pub force: bool,
+    /// The job run on each recording.
+    pub job: BatchJob,
+}
+
+/// The job of a batch, configured once; each recording runs it with its own FILE.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BatchJob {
+    /// `gmwm calibrate`: `json` is where the batch summary goes as JSON (`--json`, `-` for
+    /// standard output); the export and report files of `config` are suffixes of each
+    /// recording's stem (checked to be bare file names); `config.json` is unused.
+    Calibrate {
+        /// The calibration and its file suffixes.
+        config: CalibrateConfig,
+        /// `--json FILE|-`: the summary as JSON.
+        json: Option<PathBuf>,
+    },
+    /// `gmwm wv`: `json` prints the batch summary as JSON (`--json`).
+    Wv {
+        /// The estimator.
+        config: WvConfig,
+        /// `--json`: the summary as JSON.
+        json: bool,
+    },
+}
+
+/// A FILE argument that gmwm expands itself: it does not exist as written and holds a glob
+/// metacharacter (`*`, `?`, `[`).
+pub fn is_glob(path: &Path) -> bool {
+    !path.exists() && path.to_str().is_some_and(|s| s.contains(['*', '?', '[']))
+}
+
+/// A folder that is one ROS recording: a rosbag2 folder (it holds metadata.yaml).
+pub fn is_rosbag2_folder(path: &Path) -> bool {
+    path.is_dir() && path.join("metadata.yaml").is_file()
+}
+
+/// Batch mode: more than one FILE, a folder that is not a rosbag2 recording, a glob, or a
+/// batch flag (`--out-dir`, `--force`); one plain FILE runs as it always has.
+fn is_batch(file: &Path, b: &BatchArgs) -> bool {
+    !b.more.is_empty()
+        || b.out_dir.is_some()
+        || b.force
+        || is_glob(file)
+        || (file.is_dir() && !is_rosbag2_folder(file))
+}
+
+/// The FILE arguments of a batch, in order.
+fn batch_inputs(first: &Path, b: &BatchArgs) -> Vec<PathBuf> {
+    std::iter::once(first.to_path_buf())
+        .chain(b.more.iter().cloned())
+        .collect()
+}
+
+/// In batch mode a file flag names a suffix of every recording's stem: a file name, no folder.
+fn check_suffix(flag: &str, path: &Path) -> Result<()> {
+    let mut parts = path.components();
+    let bare = matches!(
+        (parts.next(), parts.next()),
+        (Some(std::path::Component::Normal(_)), None)
+    );
+    if bare {
+        return Ok(());
+    }
+    Err(UsageError(format!(
+        "invalid {flag} {}: in batch mode it names a suffix of each recording's files \
+         (imu.yaml writes <stem>.imu.yaml in --out-dir or beside the recording); give a file \
+         name without a folder",
+        path.display()
+    ))
+    .into())
+}
+
+fn calibrate_or_batch(a: &CalibrateCommand) -> Result<Config> {
+    let (args, batch) = (&a.args, &a.batch);
+    if !is_batch(&args.input.file, batch) {
+        return Ok(Config::Calibrate(args.try_into()?));
+    }
+    if let Some(k) = &args.kalibr {
+        check_suffix("--kalibr", k)?;
+    }
+    for pair in args.export.chunks(2) {
+        if let [stack, file] = pair {
+            check_suffix(&format!("--export {stack}"), Path::new(file))?;
+        }
+    }
+    if let Some(r) = &args.report {
+        check_suffix("--report", r)?;
+    }
+    let mut config: CalibrateConfig = args.try_into()?;
+    let json = config.json.take();
+    Ok(Config::Batch(BatchConfig {
+        inputs: batch_inputs(&args.input.file, batch),
+        out_dir: batch.out_dir.clone(),
+        force: batch.force,
+        job: BatchJob::Calibrate { config, json },
+    }))
+}
+
+fn wv_or_batch(a: &WvCommand) -> Result<Config> {
+    let (args, batch) = (&a.args, &a.batch);
+    if !is_batch(&args.input.file, batch) {
+        return Ok(Config::Wv(args.try_into()?));
+    }
+    if args.output.csv {
+        return Err(UsageError(
+            "--csv is for one recording: in batch mode gmwm wv writes each recording's \
+             wavelet variance as JSON (<stem>.wv.json), and --json prints the summary as JSON"
+                .into(),
+        )
+        .into());
+    }
+    let config: WvConfig = args.try_into()?;
+    Ok(Config::Batch(BatchConfig {
+        inputs: batch_inputs(&args.input.file, batch),
+        out_dir: batch.out_dir.clone(),
+        force: batch.force,
+        job: BatchJob::Wv {
+            json: config.output == Style::Json,
+            config,
+        },
+    }))
 }
 
 /// `gmwm report`: the calibration, as `gmwm calibrate`, and the HTML file it is written to.
@@ -1327,6 +1466,67 @@ mod tests {
                 true
             )
         );
+    }
+
+    #[test]
+    fn several_files_a_folder_or_a_batch_flag_give_a_batch() {
+        let batch = |argv: &[&str]| match config(argv) {
+            Config::Batch(b) => b,
+            c => panic!("{argv:?}: {c:?}"),
+        };
+        let b = batch(&[
+            "calibrate",
+            "a.csv",
+            "b.csv",
+            "--json",
+            "-",
+            "--report",
+            "r.html",
+        ]);
+        assert_eq!(b.inputs, [PathBuf::from("a.csv"), PathBuf::from("b.csv")]);
+        assert!(!b.force && b.out_dir.is_none());
+        let BatchJob::Calibrate { config: c, json } = b.job else {
+            panic!()
+        };
+        assert_eq!(json.as_deref(), Some(Path::new("-")));
+        assert_eq!(c.json, None);
+        assert_eq!(c.report.as_deref(), Some(Path::new("r.html")));
+        let dir = std::env::temp_dir();
+        let b = batch(&["wv", dir.to_str().unwrap(), "--json"]);
+        assert!(matches!(b.job, BatchJob::Wv { json: true, .. }));
+        let b = batch(&["wv", "a.csv", "--out-dir", "out", "--force"]);
+        assert_eq!((b.out_dir, b.force), (Some(PathBuf::from("out")), true));
+        assert!(matches!(
+            batch(&["wv", "no-such-dir/*.csv"]).job,
+            BatchJob::Wv { json: false, .. }
+        ));
+        // one plain file is the single-recording command
+        assert!(matches!(config(&["wv", "a.csv"]), Config::Wv(_)));
+        assert!(matches!(
+            config(&["calibrate", "a.csv", "--json", "-"]),
+            Config::Calibrate(_)
+        ));
+        for (argv, needle) in [
+            (
+                &["calibrate", "a.csv", "b.csv", "--kalibr", "k/imu.yaml"][..],
+                "invalid --kalibr k/imu.yaml: in batch mode",
+            ),
+            (
+                &["calibrate", "a.csv", "b.csv", "--export", "px4", "/x.sdf"],
+                "invalid --export px4 /x.sdf: in batch mode",
+            ),
+            (
+                &["calibrate", "a.csv", "--force", "--report", "../r.html"],
+                "invalid --report ../r.html: in batch mode",
+            ),
+            (
+                &["wv", "a.csv", "b.csv", "--csv"],
+                "--csv is for one recording",
+            ),
+        ] {
+            let (msg, usage) = refusal(argv);
+            assert!(msg.starts_with(needle) && usage, "{argv:?}: {msg}");
+        }
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! Exit codes: 0 success, 1 input or computation error (one line on stderr), 2 usage error.
 
 mod args;
+mod batch;
 mod cmd;
 mod config;
 mod input;
@@ -35,6 +36,7 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         Config::Topics(c) => cmd::topics::run(c, &mut out)?,
         Config::Plot(c) => cmd::plot::run(c, &mut out)?,
         Config::Report(c) => cmd::report::run(c, &mut out)?,
+        Config::Batch(c) => batch::run(c, &mut out)?,
     }
     out.flush()?;
     Ok(())

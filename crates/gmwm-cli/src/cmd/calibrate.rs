@@ -26,6 +26,52 @@ pub fn execute(
     print_summary: bool,
     out: &mut impl Write,
 ) -> Result<()> {
+    let mode = Mode {
+        print_summary,
+        batch: false,
+    };
+    execute_in(config, report_path, mode, out).map(|_| ())
+}
+
+/// How [`execute_in`] runs.
+#[derive(Debug, Clone, Copy)]
+pub struct Mode {
+    /// Print the summary (else only what was written).
+    pub print_summary: bool,
+    /// One recording of a batch: no progress bar of its own, and every file written
+    /// atomically (a temporary file renamed), so that an interrupted batch never leaves a
+    /// partial file that a later run would take as up to date.
+    pub batch: bool,
+}
+
+/// What a calibration gave.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Calibrated {
+    /// Axes calibrated.
+    pub axes: usize,
+    /// Axes whose selected model explains the wavelet variance within its band.
+    pub explained: usize,
+    /// The files written, in order (the JSON last).
+    pub written: Vec<PathBuf>,
+}
+
+/// Writes `bytes` to `path`: atomically in batch mode, else as it always has.
+fn write_file(path: &Path, bytes: &[u8], mode: Mode) -> std::io::Result<()> {
+    if mode.batch {
+        crate::batch::write_atomic(path, bytes)
+    } else {
+        std::fs::write(path, bytes)
+    }
+}
+
+/// [`execute`] with its mode; returns what was calibrated and written.
+pub fn execute_in(
+    config: &CalibrateConfig,
+    report_path: Option<&Path>,
+    mode: Mode,
+    out: &mut impl Write,
+) -> Result<Calibrated> {
+    let print_summary = mode.print_summary;
     let exports = &config.exports;
     let recording = crate::input::load_recording(&config.input)?;
     if !exports.is_empty() {
@@ -34,7 +80,11 @@ pub fn execute(
     let calibration = Calibration::new(config.options.clone());
     let per_axis = calibration.candidates_per_axis()?;
     let axes = recording.imu.axes().len();
-    let progress = bar((axes * per_axis) as u64, "calibrating", "candidate fits");
+    let progress = if mode.batch {
+        indicatif::ProgressBar::hidden()
+    } else {
+        bar((axes * per_axis) as u64, "calibrating", "candidate fits")
+    };
     let report = calibration
         .run_with_progress(&recording.imu, &Ticks(&progress))
         .with_context(|| recording.path.display().to_string())?;
@@ -45,15 +95,21 @@ pub fn execute(
     let sets = report.nav_sets(config.policy, config.adjustment, rostopic.as_deref());
     // every file that can be written is, then the failures are reported together
     let mut written = Vec::new();
+    let mut paths = Vec::new();
     let mut failed = Vec::new();
     for (format, path) in exports {
         for set in &sets {
             let target = per_axis_path(path, &set.label);
             let result = render(*format, &set.noise)
                 .map_err(anyhow::Error::from)
-                .and_then(|text| std::fs::write(&target, text).map_err(anyhow::Error::from));
+                .and_then(|text| {
+                    write_file(&target, text.as_bytes(), mode).map_err(anyhow::Error::from)
+                });
             match result {
-                Ok(()) => written.push(format!("{} ({format})", target.display())),
+                Ok(()) => {
+                    written.push(format!("{} ({format})", target.display()));
+                    paths.push(target);
+                }
                 Err(e) => failed.push(format!("{} ({format}): {e}", target.display())),
             }
         }
@@ -61,11 +117,14 @@ pub fn execute(
     let json_to_stdout = config.json.as_deref() == Some(Path::new("-"));
     let doc = gmwm::document::calibration(&recording.path, &recording.notes, &report, &sets);
     if let Some(path) = report_path {
-        match write_report(config, path, &recording, &report, &sets, &doc) {
-            Ok(figures) => written.push(format!(
-                "{} (HTML report, {figures} figures)",
-                path.display()
-            )),
+        match write_report(config, path, &recording, &report, &sets, &doc, mode) {
+            Ok(figures) => {
+                written.push(format!(
+                    "{} (HTML report, {figures} figures)",
+                    path.display()
+                ));
+                paths.push(path.to_path_buf());
+            }
             Err(e) => failed.push(format!("{} (HTML report): {e:#}", path.display())),
         }
     }
@@ -73,6 +132,12 @@ pub fn execute(
         if json_to_stdout {
             serde_json::to_writer_pretty(&mut *out, &doc)?;
             writeln!(out)?;
+        } else if mode.batch {
+            let bytes = serde_json::to_vec_pretty(&doc)?;
+            crate::batch::write_atomic(path, &bytes)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            written.push(format!("{} (JSON)", path.display()));
+            paths.push(path.clone());
         } else {
             let file = std::fs::File::create(path)
                 .with_context(|| format!("cannot write {}", path.display()))?;
@@ -80,6 +145,7 @@ pub fn execute(
             serde_json::to_writer_pretty(&mut w, &doc)?;
             w.flush()?;
             written.push(format!("{} (JSON)", path.display()));
+            paths.push(path.clone());
         }
     }
     if !json_to_stdout {
@@ -94,7 +160,11 @@ pub fn execute(
     if !failed.is_empty() {
         anyhow::bail!("not written: {}", failed.join("; "));
     }
-    Ok(())
+    Ok(Calibrated {
+        axes: report.axes.len(),
+        explained: report.axes.iter().filter(|a| a.verdict.explains_wv).count(),
+        written: paths,
+    })
 }
 
 /// The HTML report: the calibration rendered by gmwm-plot with the filter files as exported
@@ -107,6 +177,7 @@ fn write_report(
     report: &CalibrationReport,
     sets: &[NavSet],
     doc: &serde_json::Value,
+    mode: Mode,
 ) -> Result<usize> {
     let mut formats: Vec<(ExportFormat, Option<&Path>)> = config
         .exports
@@ -150,7 +221,8 @@ fn write_report(
     };
     let html = gmwm_plot::report::render(report, &ctx)?;
     let figures = html.matches("<figure>").count();
-    std::fs::write(path, html).with_context(|| format!("cannot write {}", path.display()))?;
+    write_file(path, html.as_bytes(), mode)
+        .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(figures)
 }
 
@@ -208,7 +280,7 @@ fn check_units_known(
 }
 
 /// `FILE` for one set, `FILE` with `.x` before its extension for a per-axis set.
-fn per_axis_path(path: &Path, label: &str) -> PathBuf {
+pub fn per_axis_path(path: &Path, label: &str) -> PathBuf {
     if label.is_empty() {
         return path.to_path_buf();
     }

@@ -1,0 +1,782 @@
+//! Batch mode of `gmwm calibrate` and `gmwm wv`: many recordings in one command.
+//!
+//! The FILE arguments (recordings, folders, quoted globs) are expanded into recordings; each
+//! gets its outputs under its stem (the file name without its data extensions) in `--out-dir`
+//! or beside it; recordings run in parallel, each with the single-file code path, and one
+//! summary (a table, or JSON) follows. A recording whose every output exists and is newer than
+//! it and its sidecar is skipped as up to date (`--force` redoes it); outputs are written
+//! atomically (a temporary file renamed), so an interrupted run leaves no partial output that
+//! a later run would take as up to date. A failure is reported by name with the one-line
+//! message a single run prints, after all the others completed; the exit code is then 1.
+
+use crate::cmd::calibrate::{execute_in, per_axis_path, Calibrated, Mode};
+use crate::config::{is_glob, is_rosbag2_folder, BatchConfig, BatchJob, CalibrateConfig, WvConfig};
+use crate::render::Style;
+use crate::UsageError;
+use anyhow::{Context, Result};
+use gmwm::imu::InputFormat;
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::SystemTime;
+
+/// Data extensions stripped from a file name to give its stem (`imu1.csv.gz` → `imu1`).
+const DATA_EXTENSIONS: &[&str] = &[
+    "gz", "csv", "tsv", "txt", "dat", "bin", "raw", "f64", "f32", "f64le", "f32le", "bag", "mcap",
+    "db3",
+];
+
+/// Extensions of files a folder or glob contributes as recordings, whatever else they hold.
+const RECORDING_EXTENSIONS: &[&str] = &[
+    "csv", "tsv", "txt", "bag", "mcap", "db3", "f64", "f32", "f64le", "f32le",
+];
+
+/// Raw binary extensions: a recording when a JSON sidecar (or `--format`) says how to read it.
+const RAW_EXTENSIONS: &[&str] = &["bin", "dat", "raw"];
+
+/// The stem of a recording: its file (or rosbag2 folder) name without its data extensions,
+/// stripped from the right (`imu1.csv.gz` → `imu1`, `log.f64le.bin` → `log`, `run` → `run`).
+pub fn stem(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "recording".to_string());
+    let mut stem = name.as_str();
+    while let Some((head, ext)) = stem.rsplit_once('.') {
+        if head.is_empty() || !DATA_EXTENSIONS.contains(&ext.to_ascii_lowercase().as_str()) {
+            break;
+        }
+        stem = head;
+    }
+    stem.to_string()
+}
+
+/// Whether a folder entry (or glob match) is a recording gmwm reads: by its name (see
+/// [`RECORDING_EXTENSIONS`], also `.gz` text; raw `.bin`/`.dat`/`.raw` with a sidecar or an
+/// explicit `--format`), or a rosbag2 folder. Hidden files, sidecars and other JSON (gmwm's own
+/// `.calibration.json` and `.wv.json` among them) are not.
+fn is_recording(path: &Path, format: InputFormat) -> bool {
+    let Some(name) = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+    else {
+        return false;
+    };
+    if name.starts_with('.') {
+        return false;
+    }
+    if path.is_dir() {
+        return is_rosbag2_folder(path);
+    }
+    let ext = |n: &str| n.rsplit_once('.').map(|(_, e)| e.to_string());
+    if let Some(text) = name.strip_suffix(".gz") {
+        return ext(text).is_some_and(|e| ["csv", "tsv", "txt"].contains(&e.as_str()));
+    }
+    match ext(&name) {
+        Some(e) if RECORDING_EXTENSIONS.contains(&e.as_str()) => true,
+        Some(e) if RAW_EXTENSIONS.contains(&e.as_str()) => {
+            format != InputFormat::Auto || sidecar_of(path).is_some()
+        }
+        _ => false,
+    }
+}
+
+/// The JSON sidecar a reader would use for `path`, if one exists.
+fn sidecar_of(path: &Path) -> Option<PathBuf> {
+    gmwm::imu::sidecar::sidecar_candidates(path)
+        .into_iter()
+        .find(|p| p.is_file())
+}
+
+/// A recording to run, and whether it was named on the command line (else a folder or a glob
+/// found it).
+#[derive(Debug, Clone)]
+struct Found {
+    path: PathBuf,
+    named: bool,
+}
+
+/// The recordings of a folder (not recursing), sorted by name.
+fn scan_folder(dir: &Path, format: InputFormat) -> Result<Vec<PathBuf>> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read folder {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| is_recording(p, format))
+        .collect();
+    found.sort();
+    anyhow::ensure!(
+        !found.is_empty(),
+        "{}: no recording in this folder (.csv, .tsv, .txt, .gz, .bag, .mcap, .db3, .f64, .f32, \
+         raw binary with a sidecar, rosbag2 folders)",
+        dir.display()
+    );
+    Ok(found)
+}
+
+/// The recordings among a glob's matches, sorted.
+fn expand_glob(pattern: &Path, format: InputFormat) -> Result<Vec<PathBuf>> {
+    let text = pattern.to_string_lossy();
+    let paths = glob::glob(&text)
+        .map_err(|e| UsageError(format!("invalid glob {text:?}: {e}")))?
+        .filter_map(|p| p.ok())
+        .filter(|p| is_recording(p, format));
+    let mut found: Vec<PathBuf> = paths.collect();
+    found.sort();
+    anyhow::ensure!(!found.is_empty(), "no recording matches {text:?}");
+    Ok(found)
+}
+
+/// A path to compare outputs and inputs by: the canonical folder and the file name.
+fn key(path: &Path) -> PathBuf {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let folder = parent
+        .canonicalize()
+        .or_else(|_| std::path::absolute(parent))
+        .unwrap_or_else(|_| parent.to_path_buf());
+    match path.file_name() {
+        Some(name) => folder.join(name),
+        None => folder,
+    }
+}
+
+/// Every FILE argument expanded: a named file (or rosbag2 folder) as it is, a folder into its
+/// recordings, a glob into the recordings among its matches; the same recording once.
+fn expand(inputs: &[PathBuf], format: InputFormat) -> Result<Vec<Found>> {
+    let mut out: Vec<Found> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for input in inputs {
+        let (paths, named) = if is_glob(input) {
+            (expand_glob(input, format)?, false)
+        } else if input.is_dir() && !is_rosbag2_folder(input) {
+            (scan_folder(input, format)?, false)
+        } else {
+            (vec![input.clone()], true)
+        };
+        for path in paths {
+            // by folder and name: two links to one file are two recordings with two stems
+            if seen.insert(key(&path)) {
+                out.push(Found { path, named });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// One recording of the batch and where its outputs go.
+#[derive(Debug, Clone)]
+struct Planned {
+    /// The recording.
+    recording: PathBuf,
+    /// Its outputs' folder.
+    dir: PathBuf,
+    /// Its stem.
+    stem: String,
+}
+
+impl Planned {
+    /// `DIR/STEM.suffix`.
+    fn output(&self, suffix: &str) -> PathBuf {
+        self.dir.join(format!("{}.{suffix}", self.stem))
+    }
+}
+
+/// The files a recording writes, known before it runs (a per-axis export adds its axis
+/// letters to these names).
+fn declared_outputs(job: &BatchJob, p: &Planned) -> Vec<PathBuf> {
+    match job {
+        BatchJob::Calibrate { config, .. } => {
+            let mut out: Vec<PathBuf> = config
+                .exports
+                .iter()
+                .map(|(_, f)| p.output(&f.to_string_lossy()))
+                .collect();
+            if let Some(r) = &config.report {
+                out.push(p.output(&r.to_string_lossy()));
+            }
+            out.push(p.output("calibration.json"));
+            out
+        }
+        BatchJob::Wv { .. } => vec![p.output("wv.json")],
+    }
+}
+
+/// The recordings with their output folders; a recording a folder or glob found that is
+/// another's output is dropped; two recordings writing the same file, or a named recording
+/// that another would overwrite, are refused in one line.
+fn plan(config: &BatchConfig, found: Vec<Found>) -> Result<Vec<Planned>> {
+    let planned: Vec<(Planned, bool)> = found
+        .into_iter()
+        .map(|f| {
+            let dir = match &config.out_dir {
+                Some(d) => d.clone(),
+                None => match f.path.parent() {
+                    Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+                    _ => PathBuf::from("."),
+                },
+            };
+            let p = Planned {
+                stem: stem(&f.path),
+                recording: f.path,
+                dir,
+            };
+            (p, f.named)
+        })
+        .collect();
+    let mut writers: HashMap<PathBuf, usize> = HashMap::new();
+    for (i, (p, _)) in planned.iter().enumerate() {
+        for o in declared_outputs(&config.job, p) {
+            if let Some(&j) = writers.get(&key(&o)) {
+                if j != i {
+                    return Err(UsageError(format!(
+                        "{} and {} both write {}: rename one or give them separate --out-dir",
+                        planned[j].0.recording.display(),
+                        p.recording.display(),
+                        o.display()
+                    ))
+                    .into());
+                }
+            }
+            writers.insert(key(&o), i);
+        }
+    }
+    let mut kept = Vec::new();
+    for (i, (p, named)) in planned.iter().enumerate() {
+        match writers.get(&key(&p.recording)) {
+            Some(&j) if j != i && *named => {
+                return Err(UsageError(format!(
+                    "{} is an output of {}: it would be overwritten",
+                    p.recording.display(),
+                    planned[j].0.recording.display()
+                ))
+                .into())
+            }
+            // gmwm's own output found by a folder or glob
+            Some(&j) if j != i => {}
+            _ => kept.push(p.clone()),
+        }
+    }
+    Ok(kept)
+}
+
+/// The modification time that outputs must be newer than: the recording's (the newest file
+/// of a rosbag2 folder) and its sidecar's.
+fn input_time(path: &Path) -> Option<SystemTime> {
+    let mtime = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let own = if path.is_dir() {
+        std::fs::read_dir(path)
+            .ok()?
+            .filter_map(|e| e.ok())
+            .filter_map(|e| mtime(&e.path()))
+            .max()
+    } else {
+        mtime(path)
+    }?;
+    Some(match sidecar_of(path).and_then(|s| mtime(&s)) {
+        Some(t) => own.max(t),
+        None => own,
+    })
+}
+
+/// Every output exists and is newer than the recording and its sidecar.
+fn all_newer(outputs: &[PathBuf], since: Option<SystemTime>) -> bool {
+    let Some(since) = since else {
+        return false;
+    };
+    outputs.iter().all(|o| {
+        std::fs::metadata(o)
+            .and_then(|m| m.modified())
+            .is_ok_and(|t| t > since)
+    })
+}
+
+/// Reads a JSON output, `None` when it is missing or unreadable.
+fn read_json(path: &Path) -> Option<serde_json::Value> {
+    serde_json::from_slice(&std::fs::read(path).ok()?).ok()
+}
+
+/// Writes `bytes` to `path` atomically: to a hidden temporary file in the same folder, then
+/// renamed over `path`; the temporary file is removed on failure.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::other("not a file name"))?;
+    let tmp = path.with_file_name(format!(
+        ".{}.{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let written = std::fs::File::create(&tmp).and_then(|mut f| {
+        f.write_all(bytes)?;
+        f.flush()
+    });
+    match written.and_then(|()| std::fs::rename(&tmp, path)) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+/// How a recording ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Status {
+    /// Computed now.
+    Done,
+    /// Skipped: its outputs are newer than it.
+    UpToDate,
+    /// Failed, with its message.
+    Failed,
+}
+
+/// What the summary shows of a recording beyond its status.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Detail {
+    /// calibrate: axes calibrated; wv: series.
+    count: Option<usize>,
+    /// calibrate: axes whose model explains the WV; wv: the most levels of a series.
+    second: Option<usize>,
+}
+
+/// A recording's outcome.
+#[derive(Debug, Clone)]
+struct Outcome {
+    file: PathBuf,
+    status: Status,
+    outputs: Vec<PathBuf>,
+    error: Option<String>,
+    detail: Detail,
+}
+
+/// The calibration of one recording of the batch, or `Ok` of an up-to-date one.
+fn calibrate_one(
+    config: &CalibrateConfig,
+    p: &Planned,
+    force: bool,
+) -> Result<(Status, Vec<PathBuf>, Detail)> {
+    let json = p.output("calibration.json");
+    let report = config
+        .report
+        .as_ref()
+        .map(|r| p.output(&r.to_string_lossy()));
+    let exports: Vec<_> = config
+        .exports
+        .iter()
+        .map(|(f, name)| (*f, p.output(&name.to_string_lossy())))
+        .collect();
+    if !force {
+        // the JSON, written last, names the export sets (per-axis letters) and the verdicts
+        if let Some(doc) = read_json(&json) {
+            let labels: Vec<String> = doc["exported"]
+                .as_array()
+                .map(|sets| {
+                    sets.iter()
+                        .map(|s| s["label"].as_str().unwrap_or_default().to_string())
+                        .collect()
+                })
+                .unwrap_or_default();
+            let mut outputs: Vec<PathBuf> = exports
+                .iter()
+                .flat_map(|(_, path)| labels.iter().map(|l| per_axis_path(path, l)))
+                .collect();
+            outputs.extend(report.clone());
+            outputs.push(json.clone());
+            let axes = doc["axes"].as_array();
+            let known = exports.is_empty() || !labels.is_empty();
+            if known && all_newer(&outputs, input_time(&p.recording)) {
+                let detail = Detail {
+                    count: axes.map(Vec::len),
+                    second: axes.map(|a| {
+                        a.iter()
+                            .filter(|x| x["verdict"]["explains_wv"].as_bool() == Some(true))
+                            .count()
+                    }),
+                };
+                return Ok((Status::UpToDate, outputs, detail));
+            }
+        }
+    }
+    let mut one = config.clone();
+    one.input.file = p.recording.clone();
+    one.exports = exports;
+    one.json = Some(json);
+    let mode = Mode {
+        print_summary: false,
+        batch: true,
+    };
+    let Calibrated {
+        axes,
+        explained,
+        written,
+    } = execute_in(&one, report.as_deref(), mode, &mut std::io::sink())?;
+    let detail = Detail {
+        count: Some(axes),
+        second: Some(explained),
+    };
+    Ok((Status::Done, written, detail))
+}
+
+/// Series count and the most levels of a `gmwm wv --json` document.
+fn wv_detail(doc: &serde_json::Value) -> Option<Detail> {
+    let series = doc["series"].as_array()?;
+    Some(Detail {
+        count: Some(series.len()),
+        second: series
+            .iter()
+            .filter_map(|s| s["wv"].as_array().map(Vec::len))
+            .max(),
+    })
+}
+
+/// The wavelet variance of one recording of the batch, or `Ok` of an up-to-date one.
+fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<PathBuf>, Detail)> {
+    let out = p.output("wv.json");
+    let outputs = vec![out.clone()];
+    if !force && all_newer(&outputs, input_time(&p.recording)) {
+        if let Some(detail) = read_json(&out).as_ref().and_then(wv_detail) {
+            return Ok((Status::UpToDate, outputs, detail));
+        }
+    }
+    let mut one = config.clone();
+    one.input.file = p.recording.clone();
+    one.output = Style::Json;
+    let items = crate::cmd::wv::compute(&one)?;
+    let mut doc = Vec::new();
+    crate::render::series(&mut doc, &crate::input::named(&items), Style::Json)?;
+    write_atomic(&out, &doc).with_context(|| format!("cannot write {}", out.display()))?;
+    let detail = Detail {
+        count: Some(items.len()),
+        second: items.iter().map(|(_, wv)| wv.wv().len()).max(),
+    };
+    Ok((Status::Done, outputs, detail))
+}
+
+/// Runs one recording; a failure (or a panic) becomes its outcome, never the batch's.
+fn run_one(config: &BatchConfig, p: &Planned) -> Outcome {
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match &config.job {
+        BatchJob::Calibrate { config: c, .. } => calibrate_one(c, p, config.force),
+        BatchJob::Wv { config: c, .. } => wv_one(c, p, config.force),
+    }))
+    .unwrap_or_else(|_| {
+        Err(anyhow::anyhow!(
+            "internal error (a panic; please report it)"
+        ))
+    });
+    match result {
+        Ok((status, outputs, detail)) => Outcome {
+            file: p.recording.clone(),
+            status,
+            outputs,
+            error: None,
+            detail,
+        },
+        Err(e) => Outcome {
+            file: p.recording.clone(),
+            status: Status::Failed,
+            outputs: Vec::new(),
+            error: Some(crate::one_line(&e)),
+            detail: Detail::default(),
+        },
+    }
+}
+
+/// The words of a job: its verb, its done status and its detail columns.
+struct Words {
+    verb: &'static str,
+    done: &'static str,
+    columns: [&'static str; 2],
+    keys: [&'static str; 2],
+}
+
+fn words(job: &BatchJob) -> Words {
+    match job {
+        BatchJob::Calibrate { .. } => Words {
+            verb: "calibrating",
+            done: "calibrated",
+            columns: ["axes", "fit ok"],
+            keys: ["axes", "axes_fit_ok"],
+        },
+        BatchJob::Wv { .. } => Words {
+            verb: "wavelet variance",
+            done: "computed",
+            columns: ["series", "levels"],
+            keys: ["series", "levels"],
+        },
+    }
+}
+
+/// Runs the batch: expands the inputs, runs every recording in parallel (workers pull the
+/// next recording; each one's own computation is parallel on the shared rayon pool), prints
+/// the summary; an error naming the failed recordings when any failed.
+pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
+    let format = match &config.job {
+        BatchJob::Calibrate { config, .. } => config.input.read.format,
+        BatchJob::Wv { config, .. } => config.input.read.format,
+    };
+    let planned = plan(config, expand(&config.inputs, format)?)?;
+    if let Some(dir) = &config.out_dir {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create --out-dir {}", dir.display()))?;
+    }
+    let w = words(&config.job);
+    let progress = crate::progress::bar(planned.len() as u64, w.verb, "recordings");
+    let outcomes: Vec<Mutex<Option<Outcome>>> = planned.iter().map(|_| Mutex::new(None)).collect();
+    let next = AtomicUsize::new(0);
+    // workers that are not rayon threads: a rayon worker waiting inside a calibration would
+    // steal the next recording, loading more recordings at once than there are workers
+    let workers = rayon::current_num_threads().clamp(1, planned.len().max(1));
+    std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(p) = planned.get(i) else {
+                    break;
+                };
+                let outcome = run_one(config, p);
+                if let Some(e) = &outcome.error {
+                    let file = p.recording.display().to_string();
+                    progress.suspend(|| {
+                        if e.contains(&file) {
+                            eprintln!("gmwm: error: {e}");
+                        } else {
+                            eprintln!("gmwm: error: {file}: {e}");
+                        }
+                    });
+                }
+                if let Ok(mut slot) = outcomes[i].lock() {
+                    *slot = Some(outcome);
+                }
+                progress.inc(1);
+            });
+        }
+    });
+    progress.finish_and_clear();
+    let outcomes: Vec<Outcome> = outcomes
+        .into_iter()
+        .filter_map(|m| m.into_inner().ok().flatten())
+        .collect();
+    let json_to = match &config.job {
+        BatchJob::Calibrate { json, .. } => json.clone(),
+        BatchJob::Wv { json: true, .. } => Some(PathBuf::from("-")),
+        BatchJob::Wv { json: false, .. } => None,
+    };
+    match json_to.as_deref() {
+        Some(p) if p == Path::new("-") => {
+            serde_json::to_writer_pretty(&mut *out, &summary_json(&outcomes, &w))?;
+            writeln!(out)?;
+        }
+        Some(p) => {
+            table(&outcomes, &w, out)?;
+            let mut text = serde_json::to_vec_pretty(&summary_json(&outcomes, &w))?;
+            text.push(b'\n');
+            std::fs::write(p, text).with_context(|| format!("cannot write {}", p.display()))?;
+            writeln!(out, "wrote {} (JSON summary)", p.display())?;
+        }
+        None => table(&outcomes, &w, out)?,
+    }
+    out.flush()?;
+    let failed: Vec<String> = outcomes
+        .iter()
+        .filter(|o| o.status == Status::Failed)
+        .map(|o| o.file.display().to_string())
+        .collect();
+    if !failed.is_empty() {
+        let mut names = failed
+            .iter()
+            .take(3)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join(", ");
+        if failed.len() > 3 {
+            names.push_str(", ...");
+        }
+        anyhow::bail!(
+            "{} of {} recordings failed: {names}",
+            failed.len(),
+            outcomes.len()
+        );
+    }
+    Ok(())
+}
+
+/// `N recordings: a calibrated, b up to date, c failed`.
+fn counts_line(outcomes: &[Outcome], w: &Words) -> String {
+    let n = |s: Status| outcomes.iter().filter(|o| o.status == s).count();
+    format!(
+        "{} recording{}: {} {}, {} up to date, {} failed",
+        outcomes.len(),
+        if outcomes.len() == 1 { "" } else { "s" },
+        n(Status::Done),
+        w.done,
+        n(Status::UpToDate),
+        n(Status::Failed)
+    )
+}
+
+/// The summary table: one row per recording (file, status, the job's two counts, the main
+/// output), a failure's message in place of the counts, then the counts.
+fn table(outcomes: &[Outcome], w: &Words, out: &mut impl Write) -> Result<()> {
+    let status = |o: &Outcome| match o.status {
+        Status::Done => w.done,
+        Status::UpToDate => "up to date",
+        Status::Failed => "failed",
+    };
+    let cell = |v: Option<usize>| v.map(|v| v.to_string()).unwrap_or_else(|| "-".into());
+    let files: Vec<String> = outcomes
+        .iter()
+        .map(|o| o.file.display().to_string())
+        .collect();
+    let fw = files
+        .iter()
+        .map(|f| f.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(9);
+    let sw = outcomes
+        .iter()
+        .map(|o| status(o).len())
+        .max()
+        .unwrap_or(0)
+        .max(6);
+    let c0 = w.columns[0].len();
+    let c1 = w.columns[1].len();
+    writeln!(
+        out,
+        "{:<fw$}  {:<sw$}  {:>c0$}  {:>c1$}  output",
+        "recording", "status", w.columns[0], w.columns[1]
+    )?;
+    for (o, file) in outcomes.iter().zip(&files) {
+        match &o.error {
+            Some(e) => writeln!(out, "{file:<fw$}  {:<sw$}  {e}", status(o))?,
+            None => writeln!(
+                out,
+                "{file:<fw$}  {:<sw$}  {:>c0$}  {:>c1$}  {}",
+                status(o),
+                cell(o.detail.count),
+                cell(o.detail.second),
+                o.outputs
+                    .last()
+                    .map(|p| p.display().to_string())
+                    .unwrap_or_default()
+            )?,
+        }
+    }
+    writeln!(out, "{}", counts_line(outcomes, w))?;
+    Ok(())
+}
+
+/// The summary as JSON: `{"recordings": [{file, status, outputs, error, <counts>}],
+/// "counts": {total, <done>, up_to_date, failed}}`.
+fn summary_json(outcomes: &[Outcome], w: &Words) -> serde_json::Value {
+    let rows: Vec<serde_json::Value> = outcomes
+        .iter()
+        .map(|o| {
+            let mut row = serde_json::Map::new();
+            row.insert("file".into(), o.file.display().to_string().into());
+            row.insert(
+                "status".into(),
+                match o.status {
+                    Status::Done => w.done,
+                    Status::UpToDate => "up_to_date",
+                    Status::Failed => "failed",
+                }
+                .into(),
+            );
+            row.insert(
+                "outputs".into(),
+                o.outputs
+                    .iter()
+                    .map(|p| serde_json::Value::from(p.display().to_string()))
+                    .collect(),
+            );
+            row.insert("error".into(), o.error.clone().into());
+            row.insert(w.keys[0].into(), o.detail.count.into());
+            row.insert(w.keys[1].into(), o.detail.second.into());
+            serde_json::Value::Object(row)
+        })
+        .collect();
+    let n = |s: Status| outcomes.iter().filter(|o| o.status == s).count();
+    serde_json::json!({
+        "recordings": rows,
+        "counts": {
+            "total": outcomes.len(),
+            w.done: n(Status::Done),
+            "up_to_date": n(Status::UpToDate),
+            "failed": n(Status::Failed),
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stems_drop_data_extensions() {
+        for (name, s) in [
+            ("runs/imu1.csv.gz", "imu1"),
+            ("a.b.f64le.bin", "a.b"),
+            ("run.bag", "run"),
+            ("rosbag2_x", "rosbag2_x"),
+            ("x.TSV", "x"),
+            (".csv", ".csv"),
+            ("x.wv.json", "x.wv.json"),
+        ] {
+            assert_eq!(stem(Path::new(name)), s, "{name}");
+        }
+    }
+
+    #[test]
+    fn recordings_are_chosen_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let touch = |n: &str| {
+            let p = dir.path().join(n);
+            std::fs::write(&p, b"").unwrap();
+            p
+        };
+        for (name, yes) in [
+            ("a.csv", true),
+            ("a.csv.gz", true),
+            ("a.txt", true),
+            ("a.bag", true),
+            ("a.f64", true),
+            ("a.json", false),
+            ("a.csv.json", false),
+            ("a.calibration.json", false),
+            ("a.report.html", false),
+            ("a.yaml", false),
+            ("a.gz", false),
+            (".a.csv", false),
+            ("raw.bin", false),
+        ] {
+            assert_eq!(is_recording(&touch(name), InputFormat::Auto), yes, "{name}");
+        }
+        let raw = dir.path().join("raw.bin");
+        assert!(is_recording(&raw, InputFormat::F64));
+        touch("raw.bin.json");
+        assert!(is_recording(&raw, InputFormat::Auto));
+        let bag = dir.path().join("bag2");
+        std::fs::create_dir(&bag).unwrap();
+        assert!(!is_recording(&bag, InputFormat::Auto));
+        std::fs::write(bag.join("metadata.yaml"), b"").unwrap();
+        assert!(is_recording(&bag, InputFormat::Auto));
+    }
+
+    #[test]
+    fn atomic_writes_replace_and_leave_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.json");
+        write_atomic(&p, b"one").unwrap();
+        write_atomic(&p, b"two").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"two");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert!(write_atomic(&dir.path().join("no/such/dir/x"), b"x").is_err());
+    }
+}
