@@ -144,14 +144,16 @@ fn demo_runs_and_compares_with_the_truth() {
     assert_eq!(doc["implied"]["processes"].as_array().unwrap().len(), 6);
     let params = doc["parameters"].as_array().unwrap();
     assert_eq!(params.len(), 9);
-    // the WN and QN dominate the first levels: recovered within 10% even at N = 8192
-    for p in &params[6..8] {
-        let (t, e) = (
-            p["truth"].as_f64().unwrap(),
-            p["estimate"].as_f64().unwrap(),
-        );
-        assert!((e / t - 1.0).abs() < 0.1, "{p}");
-    }
+    // the QN dominates the first level: recovered within 10% even at N = 8192, and the fitted
+    // model's WV there within 10% of the truth's. (The WN beside it is not: at this length
+    // the fit trades it against the QN, and about every other seed puts it at 0.)
+    let qn = &params[7];
+    assert_eq!(qn["name"], "QN[4].q2");
+    let ratio = qn["estimate"].as_f64().unwrap() / qn["truth"].as_f64().unwrap();
+    assert!((ratio - 1.0).abs() < 0.1, "{qn}");
+    let level_1 = |v: &serde_json::Value| v["wv"][0].as_f64().unwrap();
+    let ratio = level_1(&doc["fit"]["implied_wv"]) / level_1(&doc["implied"]);
+    assert!((ratio - 1.0).abs() < 0.1, "level 1: fitted / truth = {ratio}");
     assert!(doc["fit"]["convergence"]["converged"].as_bool().unwrap());
 }
 

@@ -229,6 +229,11 @@ fn ieee_refuses_other_variances_and_survives_bad_values() {
 /// K within 30% (its region is the last few octaves, each with a handful of edf).
 #[test]
 fn ieee_simulated_white_noise_and_random_walk() {
+    // five seeded series: N within 5% and inside its interval in every one; K within 30% and
+    // inside its interval wherever the read-off gives it. Its region is the last few octaves,
+    // each with a handful of edf, so a realisation whose top octaves bend up can hand them to
+    // the rate-ramp term, and the read-off then says the RW region is too short (no value);
+    // at most one of the five may.
     let (n, k) = (1e-3, 1e-4);
     let gens = [
         Process::Wn(Wn {
@@ -238,20 +243,29 @@ fn ieee_simulated_white_noise_and_random_walk() {
             gamma2: k * k / FREQ_HZ,
         }),
     ];
-    let x = simulate(&gens, 1_000_000, SEED).unwrap();
-    let av = allan_variance(&x, FREQ_HZ, &AllanOptions::default()).unwrap();
-    let ro = ieee_readoff(&av).unwrap();
-    println!("{ro}");
-    let (n_hat, k_hat) = (value(&ro.n), value(&ro.k));
-    println!("N {n_hat:e} (truth {n:e}), K {k_hat:e} (truth {k:e})");
-    assert!(rel_diff(n_hat, n) < 0.05, "{ro}");
-    assert!(rel_diff(k_hat, k) < 0.30, "{ro}");
-    for (r, truth) in [(&ro.n, n), (&ro.k, k)] {
+    let mut without_k = 0;
+    for seed in SEED..SEED + 5 {
+        let x = simulate(&gens, 1_000_000, seed).unwrap();
+        let av = allan_variance(&x, FREQ_HZ, &AllanOptions::default()).unwrap();
+        let ro = ieee_readoff(&av).unwrap();
+        println!("seed {seed}\n{ro}");
+        let n_hat = value(&ro.n);
+        assert!(rel_diff(n_hat, n) < 0.05, "seed {seed}\n{ro}");
         assert!(
-            r.ci_low.unwrap() < truth && truth < r.ci_high.unwrap(),
-            "{ro}"
+            ro.n.ci_low.unwrap() < n && n < ro.n.ci_high.unwrap(),
+            "seed {seed}\n{ro}"
+        );
+        let Some(k_hat) = ro.k.value else {
+            without_k += 1;
+            continue;
+        };
+        assert!(rel_diff(k_hat, k) < 0.30, "seed {seed}\n{ro}");
+        assert!(
+            ro.k.ci_low.unwrap() < k && k < ro.k.ci_high.unwrap(),
+            "seed {seed}\n{ro}"
         );
     }
+    assert!(without_k <= 1, "{without_k} of 5 series gave no K");
 }
 
 fn adis(column: &str, unit: SignalUnit) -> IeeeReadoff {

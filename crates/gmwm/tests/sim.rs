@@ -753,8 +753,8 @@ fn fingerprint(x: &[f64]) -> u64 {
 }
 
 /// The simulated bits of every process kind, in both start modes, are pinned: the seeding
-/// scheme (one ChaCha8 stream per component), the initial draws and the ARMA burn-ins may not
-/// change silently. Each line is `model, mode, column (or "sum"), first sample bits, last
+/// scheme (one xoshiro256++ stream per component), the initial draws and the ARMA burn-ins may not
+/// change silently (re-pinned when the generator became xoshiro256++). Each line is `model, mode, column (or "sum"), first sample bits, last
 /// sample bits, fingerprint of all 2000 samples` (drawn in two chunks of 1000).
 #[test]
 fn simulated_bits_are_pinned() {
@@ -815,42 +815,42 @@ fn simulated_bits_are_pinned() {
 }
 
 const PINNED: &str = "
-0 Stationary 0 3fff4044e392333b c00717002fadb927 41864c0d5603a7c2
-0 Stationary 1 bfdf89c91453e8c7 bff5a4bd25589d7c ed2663bdf848845a
-0 Stationary 2 3fb090ad7908e895 c00c11aace888a0d 681205c65f7bc6d4
+0 Stationary 0 400daa807253eb5d 3fecb8d1154da436 81f36d2767f896e1
+0 Stationary 1 3ff8ac9580549264 bfc2d6c73968814b baf06523ddd5a689
+0 Stationary 2 3fabb9753fda9467 40264b25cac7c042 8c45e73ac476994c
 0 Stationary 3 3f847ae147ae147b 4034000000000000 42c5fe425b6ee089
-0 Stationary 4 bfef742b7b394e86 bfe7e245d8a73632 4f1aaa5403010da3
-0 Stationary 5 3feb8cbb140871b8 3fc3dd62694938a8 b676bd135489b733
-0 Stationary 6 bfe67adc85d6c3a2 bfddf9c4cfd24681 51ebca2fe36876c7
-0 Stationary sum 3fe6bd598432a706 402662c0a1637ad0 9a10f3d8356dee11
-0 Zero 0 3fff4044e392333b c00717002fadb927 41864c0d5603a7c2
-0 Zero 1 bfdf89c91453e8c7 bff5a4bd25589d7c ed2663bdf848845a
-0 Zero 2 3fb090ad7908e895 c00c11aace888a0d 681205c65f7bc6d4
+0 Stationary 4 bffd961f431d0cf4 bff4da057891d4f4 b10e8d0fd7cb19f2
+0 Stationary 5 3fe190378b6180c2 3fe772d47af10dc5 6b04d3fb23a390a2
+0 Stationary 6 bfe426b0af246f69 3ff56baf7523210a 1346ff76b8e0ff7d
+0 Stationary sum 400b137dfe460ad2 4040552e919e0cb8 c73ef72e17273920
+0 Zero 0 400daa807253eb5d 3fecb8d1154da436 81f36d2767f896e1
+0 Zero 1 3ff8ac9580549264 bfc2d6c73968814b baf06523ddd5a689
+0 Zero 2 3fabb9753fda9467 40264b25cac7c042 8c45e73ac476994c
 0 Zero 3 3f847ae147ae147b 4034000000000000 42c5fe425b6ee089
-0 Zero 4 bfec8a841d4c46f4 bff5345666a25f86 579759ff14ff6cf2
-0 Zero 5 bfe0687a3c107afa 3f712ea9ebd38540 fec1f142b6945a19
-0 Zero 6 bfe67adc85d6c3a2 bfddf9c4cfd24681 51ebca2fe36876c7
-0 Zero sum bfe24e346df93e1a 4024ed0a7db1f7d0 7d5e0d94b09f7765
-1 Stationary 0 3fd8f40b80c7d2b6 40006495f11c9fa3 56498407c2fd904a
-1 Stationary 1 3fc03da2b1d44389 3ff23ab3e9888027 8c6f420913c02dea
-1 Stationary sum 3fe0896e6cd8fa3d 400981efe5e0dfb6 370c523ee3ef0a26
-1 Zero 0 3fb7d4cd98426e41 3ffc679f941f9b78 5ad9bf04124332dc
-1 Zero 1 3fd18e7ebc3a6b66 3fe5e284c3d2d291 2a4d4d9c228d7b1d
-1 Zero sum 3fd783b2224b06f6 4003ac70fb048260 157eb4c58eff7597
-2 Stationary 0 bfe6551528f555d0 c00fbfdc2c8c76c6 f7924565a4e95d95
-2 Stationary sum bfe6551528f555d0 c00fbfdc2c8c76c6 f7924565a4e95d95
-2 Zero 0 c0184b17043dcecc c01729031632dc49 a1a96b96ffa16052
-2 Zero sum c0184b17043dcecc c01729031632dc49 a1a96b96ffa16052
-3 Stationary 0 bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
-3 Stationary sum bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
-3 Zero 0 bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
-3 Zero sum bfdb9e28a3062e02 bff771a823394058 50067f7dbf769cb3
-4 Stationary 0 3ffe556de6cf57ea bfd3df8e5bef7c9f c462641dded51d63
-4 Stationary sum 3ffe556de6cf57ea bfd3df8e5bef7c9f c462641dded51d63
-4 Zero 0 bff2f4be4c3697a0 3fe8be29343e27a5 e4f39df4bd5aa386
-4 Zero sum bff2f4be4c3697a0 3fe8be29343e27a5 e4f39df4bd5aa386
-5 Stationary 0 3fdcb6f3fac30042 3feab02e12c4d7fa d8aef821e0f7b439
-5 Stationary sum 3fdcb6f3fac30042 3feab02e12c4d7fa d8aef821e0f7b439
-5 Zero 0 3fc5a1bbd646c016 bfecb62b81ca5d13 5265c9561ed40360
-5 Zero sum 3fc5a1bbd646c016 bfecb62b81ca5d13 5265c9561ed40360
+0 Zero 4 bff05bddca9d043c bfde0320763b4718 c160d3883994b03d
+0 Zero 5 3fe90605250cfbd4 bfadb541a07102ea b7aa64a9bc9101b4
+0 Zero 6 bfe426b0af246f69 3ff56baf7523210a 1346ff76b8e0ff7d
+0 Zero sum 4011c709107876f9 40405abfda22445a f87ac29de239678e
+1 Stationary 0 bff86aaef51acc9b 3fe391938c0fe82a bb885b04b076fa93
+1 Stationary 1 3ff36c24db89c60a 3ff48a029685456f c56c7ee4f5ca1846
+1 Stationary sum bfd3fa2866441a44 3ffe52cc5c8d3984 12b870f5e319748e
+1 Zero 0 bfd13914fc0c206f 3fe6976711d5e71a 518331a09a975dbc
+1 Zero 1 bfed4f68fefe60da 4000c15fa9cae87f 39918273c2d198ea
+1 Zero sum bff2f5f9be823889 400667396e406246 ff052d4590614b43
+2 Stationary 0 bfedc4a5d223fc24 4002acb8df272f43 02c664930f79c33a
+2 Stationary sum bfedc4a5d223fc24 4002acb8df272f43 02c664930f79c33a
+2 Zero 0 4013983dbbabc25c c0065ffb2a4ec1d7 c2fae1c92b8443f4
+2 Zero sum 4013983dbbabc25c c0065ffb2a4ec1d7 c2fae1c92b8443f4
+3 Stationary 0 bfda13876d21b0e0 3ff0f602cbc2e82f d6bf00bc51ce7483
+3 Stationary sum bfda13876d21b0e0 3ff0f602cbc2e82f d6bf00bc51ce7483
+3 Zero 0 bfda13876d21b0e0 3ff0f602cbc2e82f d6bf00bc51ce7483
+3 Zero sum bfda13876d21b0e0 3ff0f602cbc2e82f d6bf00bc51ce7483
+4 Stationary 0 bffd15c328aa7473 bfeea1019f906732 0fc285115d58a8ba
+4 Stationary sum bffd15c328aa7473 bfeea1019f906732 0fc285115d58a8ba
+4 Zero 0 bfee0e46891120cb 3fdcaf60ef1941b2 0b2075eb7fbb2f46
+4 Zero sum bfee0e46891120cb 3fdcaf60ef1941b2 0b2075eb7fbb2f46
+5 Stationary 0 bff2b6495af4026e bff39d09520e4b2d 9338a79697c3bc67
+5 Stationary sum bff2b6495af4026e bff39d09520e4b2d 9338a79697c3bc67
+5 Zero 0 bfd50b9774176fc8 bffe343abac79c2e 111ed4207e48ddd1
+5 Zero sum bfd50b9774176fc8 bffe343abac79c2e 111ed4207e48ddd1
 ";

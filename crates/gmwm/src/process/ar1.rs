@@ -12,7 +12,7 @@
 //! is evaluated with `exp_m1` (its condition number there is below ~12). Derivatives are exact
 //! derivatives of this evaluation (forward-mode jets), so they inherit its accuracy.
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -395,7 +395,7 @@ impl LatentProcess for Gm {
 /// METHODS §10.1: `x_t = phi x_{t-1} + w_t`, `w ~ N(0, sigma2)`; `x` is the last value.
 #[derive(Debug, Clone)]
 struct Ar1Sampler {
-    rng: ChaCha8Rng,
+    rng: SimRng,
     phi: f64,
     sd: f64,
     x: f64,
@@ -416,11 +416,7 @@ impl Simulate for Ar1 {
     /// [`StartMode::Stationary`]: `x_{-1} ~ N(0, sigma2 / (1 - phi^2))` is drawn first, so
     /// every kept value is stationary; [`StartMode::Zero`]: `x_{-1} = 0` (the package's
     /// `x_0 = 0`, dropped).
-    fn sampler(
-        &self,
-        mut rng: ChaCha8Rng,
-        start: StartMode,
-    ) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, mut rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         let (phi, sigma2) = (self.phi, self.sigma2);
         let x = if start == StartMode::Stationary {
             (sigma2 / (1.0 - phi * phi)).sqrt() * normal(&mut rng)
@@ -441,7 +437,7 @@ impl Simulate for Gm {
         Self::new(self.beta, self.sigma2_gm, self.freq_hz).map(drop)
     }
     /// Simulated as its exact per-sample AR1 ([`Gm::to_ar1`], METHODS §4.3).
-    fn sampler(&self, rng: ChaCha8Rng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         self.to_ar1().sampler(rng, start)
     }
 }

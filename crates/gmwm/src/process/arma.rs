@@ -2,7 +2,7 @@
 //! as special cases. R sign convention: AR polynomial `1 - sum ar_i B^i`, MA polynomial
 //! `1 + sum ma_i B^i`.
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -591,7 +591,7 @@ fn arma_burn_in(ar: &[f64], q: usize, mode: StartMode) -> Result<usize, ParamErr
 /// Generic ARMA(p, q) state: `xs[i] = x_{t-1-i}`, `es[k] = e_{t-1-k}`.
 #[derive(Debug, Clone)]
 struct ArmaState {
-    rng: ChaCha8Rng,
+    rng: SimRng,
     ar: Vec<f64>,
     ma: Vec<f64>,
     sd: f64,
@@ -642,7 +642,7 @@ impl Simulate for Arma {
     }
     /// Runs the burn-in of [`arma_burn_in`] first, from zeros with the first `q` MA outputs
     /// set to 0 (R's `arima.sim`), in both start modes; only its length depends on the mode.
-    fn sampler(&self, rng: ChaCha8Rng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         let n0 = arma_burn_in(&self.ar, self.ma.len(), start)?;
         let mut s = ArmaState {
             rng,

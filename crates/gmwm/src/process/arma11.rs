@@ -8,7 +8,7 @@
 //! and the AR1 part uses the stable evaluation of [`super::ar1`]. This is used for
 //! `phi > 1/2`; below, the closed form is used as written.
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::ar1::ar1_wv_jet;
@@ -129,7 +129,7 @@ impl LatentProcess for Arma11 {
 /// METHODS §10.1: `x_t = phi x_{t-1} + w_t + theta w_{t-1}`; `(x, w)` are the last values.
 #[derive(Debug, Clone)]
 struct Arma11Sampler {
-    rng: ChaCha8Rng,
+    rng: SimRng,
     phi: f64,
     theta: f64,
     sd: f64,
@@ -155,11 +155,7 @@ impl Simulate for Arma11 {
     /// (`Cov(x, w) = sigma2`, `Var x = gamma_0`: `x_{-1} = w_{-1} + N(0, gamma_0 - sigma2)`,
     /// `gamma_0 - sigma2 = sigma2 (phi + theta)^2 / (1 - phi^2)`); in [`StartMode::Zero`]
     /// `x_{-1} = 0`, so the first value is `w_0 + theta w_{-1}`.
-    fn sampler(
-        &self,
-        mut rng: ChaCha8Rng,
-        start: StartMode,
-    ) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, mut rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         let (phi, theta, sigma2) = (self.phi, self.theta, self.sigma2);
         let sd = sigma2.sqrt();
         let w = sd * normal(&mut rng);

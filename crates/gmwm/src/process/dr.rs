@@ -1,6 +1,6 @@
 //! Deterministic drift (METHODS §0.2, §4.2, §10.1).
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{add_scaled, half_widths, LatentProcess, Occurs, Params, Simulate, Spec};
@@ -98,7 +98,7 @@ impl Simulate for Dr {
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.omega).map(drop)
     }
-    fn sampler(&self, _: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, _: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         Ok(Box::new(DrSampler {
             omega: self.omega,
             t: 0,

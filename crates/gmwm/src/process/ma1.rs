@@ -1,6 +1,6 @@
 //! First-order moving average (METHODS §0.2, §4.2, §4.5, §4.6, §10.1).
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -92,7 +92,7 @@ impl LatentProcess for Ma1 {
 /// innovation `w` drawn first).
 #[derive(Debug, Clone)]
 struct Ma1Sampler {
-    rng: ChaCha8Rng,
+    rng: SimRng,
     theta: f64,
     sd: f64,
     w: f64,
@@ -112,7 +112,7 @@ impl Simulate for Ma1 {
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.theta, self.sigma2).map(drop)
     }
-    fn sampler(&self, mut rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, mut rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         let sd = self.sigma2.sqrt();
         let w = sd * normal(&mut rng);
         Ok(Box::new(Ma1Sampler {

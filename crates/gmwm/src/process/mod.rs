@@ -42,8 +42,8 @@ pub(crate) use table::{spec, Occurs, Orders, Params, Spec, KINDS};
 
 use crate::error::ParamError;
 use crate::sim::sampler::Sampler;
+use crate::sim::sampler::SimRng;
 use crate::sim::StartMode;
-use rand_chacha::ChaCha8Rng;
 
 /// A latent process with an implied Haar wavelet variance (METHODS §4). Object safe.
 pub trait LatentProcess {
@@ -84,7 +84,7 @@ pub(crate) trait Simulate: LatentProcess {
     ///
     /// # Errors
     /// [`ParamError`] only for a generic ARMA whose burn-in would be too long.
-    fn sampler(&self, rng: ChaCha8Rng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError>;
+    fn sampler(&self, rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError>;
 }
 
 /// Declares [`Process`] over the process structs (one line each), with its dispatch and the
@@ -143,7 +143,7 @@ impl Process {
     /// [`Simulate::sampler`].
     pub(crate) fn sampler(
         &self,
-        rng: ChaCha8Rng,
+        rng: SimRng,
         start: StartMode,
     ) -> Result<Box<dyn Sampler>, ParamError> {
         self.inner().sampler(rng, start)

@@ -1,6 +1,6 @@
 //! Quantisation noise (METHODS §0.2, §4.2, §10.1).
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -86,7 +86,7 @@ pub(crate) fn qn_value(sqrt_q2: f64, u_t: f64, u_next: f64) -> f64 {
 /// uniform drawn.
 #[derive(Debug, Clone)]
 struct QnSampler {
-    rng: ChaCha8Rng,
+    rng: SimRng,
     sqrt_q2: f64,
     u: f64,
 }
@@ -105,7 +105,7 @@ impl Simulate for Qn {
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.q2).map(drop)
     }
-    fn sampler(&self, mut rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, mut rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         let u = SQRT_12 * uniform(&mut rng);
         Ok(Box::new(QnSampler {
             rng,

@@ -1,6 +1,6 @@
 //! Random walk (METHODS §0.2, §4.2, §10.1).
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -79,7 +79,7 @@ impl LatentProcess for Rw {
 /// not 0).
 #[derive(Debug, Clone)]
 struct RwSampler {
-    rng: ChaCha8Rng,
+    rng: SimRng,
     sd: f64,
     level: f64,
 }
@@ -96,7 +96,7 @@ impl Simulate for Rw {
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.gamma2).map(drop)
     }
-    fn sampler(&self, rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         Ok(Box::new(RwSampler {
             rng,
             sd: self.gamma2.sqrt(),

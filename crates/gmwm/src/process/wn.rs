@@ -1,6 +1,6 @@
 //! White noise (METHODS §0.2, §4.2, §10.1).
 
-use rand_chacha::ChaCha8Rng;
+use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -78,7 +78,7 @@ impl LatentProcess for Wn {
 /// METHODS §10.1: `x_t ~ N(0, sigma2)` i.i.d.
 #[derive(Debug, Clone)]
 struct WnSampler {
-    rng: ChaCha8Rng,
+    rng: SimRng,
     sd: f64,
 }
 
@@ -93,7 +93,7 @@ impl Simulate for Wn {
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.sigma2).map(drop)
     }
-    fn sampler(&self, rng: ChaCha8Rng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
+    fn sampler(&self, rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         Ok(Box::new(WnSampler {
             rng,
             sd: self.sigma2.sqrt(),

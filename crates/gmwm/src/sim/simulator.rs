@@ -3,7 +3,7 @@
 //! A [`Simulator`] holds one small state per component (the last `p` values and `q`
 //! innovations of an ARMA, the last uniform of QN, the level of RW, the time of DR), built by
 //! the component's [`Process`] (each process says how it is simulated, next to its implied
-//! WV), and one ChaCha8 stream per component, derived from `(seed, component index)`. Because
+//! WV), and one xoshiro256++ stream per component, derived from `(seed, component index)`. Because
 //! no stream is shared, the output depends only on the seed and the sample index: splitting
 //! `n` samples across any number of [`Simulator::fill`] calls gives the same bits, and so does
 //! drawing the components separately with [`Simulator::fill_components`] and adding them in
