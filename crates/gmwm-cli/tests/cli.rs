@@ -153,7 +153,10 @@ fn demo_runs_and_compares_with_the_truth() {
     assert!((ratio - 1.0).abs() < 0.1, "{qn}");
     let level_1 = |v: &serde_json::Value| v["wv"][0].as_f64().unwrap();
     let ratio = level_1(&doc["fit"]["implied_wv"]) / level_1(&doc["implied"]);
-    assert!((ratio - 1.0).abs() < 0.1, "level 1: fitted / truth = {ratio}");
+    assert!(
+        (ratio - 1.0).abs() < 0.1,
+        "level 1: fitted / truth = {ratio}"
+    );
     assert!(doc["fit"]["convergence"]["converged"].as_bool().unwrap());
 }
 
