@@ -22,7 +22,9 @@ fn shared_data() -> PathBuf {
 }
 
 /// Every recording of the shared data: (file name, columns).
-fn recordings() -> Vec<(String, Vec<(String, Vec<f64>)>)> {
+type Columns = Vec<(String, Vec<f64>)>;
+
+fn recordings() -> Vec<(String, Columns)> {
     let mut names: Vec<String> = std::fs::read_dir(shared_data())
         .unwrap()
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
