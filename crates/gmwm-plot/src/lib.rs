@@ -14,6 +14,7 @@
 //! let svg = figure.svg().unwrap();
 //! assert!(svg.contains("gyro_x"));
 //! ```
+#![deny(missing_docs)]
 
 mod chart;
 mod figure;
