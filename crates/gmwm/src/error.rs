@@ -68,6 +68,29 @@ impl From<InputError> for Error {
     }
 }
 
+/// `From<ParamError | SeriesError | ModelError>` for a stage error with an `Input(InputError)`
+/// variant, so that `?` carries a leaf error into it.
+macro_rules! input_error_from {
+    ($stage:ident) => {
+        impl From<$crate::ParamError> for $stage {
+            fn from(e: $crate::ParamError) -> Self {
+                $stage::Input(e.into())
+            }
+        }
+        impl From<$crate::SeriesError> for $stage {
+            fn from(e: $crate::SeriesError) -> Self {
+                $stage::Input(e.into())
+            }
+        }
+        impl From<$crate::model::ModelError> for $stage {
+            fn from(e: $crate::model::ModelError) -> Self {
+                $stage::Input(e.into())
+            }
+        }
+    };
+}
+pub(crate) use input_error_from;
+
 /// A series that cannot be analysed.
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]

@@ -140,20 +140,7 @@ pub enum FitError {
     Input(#[from] crate::InputError),
 }
 
-macro_rules! input_error_from {
-    ($($t:ty),*) => {$(
-        impl From<$t> for FitError {
-            fn from(e: $t) -> Self {
-                FitError::Input(e.into())
-            }
-        }
-    )*};
-}
-input_error_from!(
-    crate::ParamError,
-    crate::SeriesError,
-    crate::model::ModelError
-);
+crate::error::input_error_from!(FitError);
 
 /// Refuses a wavelet variance with another filter than Haar ([`FitError::NotHaar`]).
 ///

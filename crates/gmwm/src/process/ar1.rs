@@ -399,7 +399,7 @@ impl LatentProcess for Gm {
 /// Blocks are fixed by the sample index, not by the chunks asked for, so any chunking gives the
 /// same bits.
 #[derive(Debug, Clone)]
-struct Ar1Sampler {
+pub(crate) struct Ar1Sampler {
     rng: SimRng,
     /// `phi, phi^2, phi^3, phi^4`.
     powers: [f64; 4],
@@ -413,7 +413,8 @@ struct Ar1Sampler {
 }
 
 impl Ar1Sampler {
-    fn new(rng: SimRng, phi: f64, sd: f64, x: f64) -> Self {
+    /// The sampler from `x` (the value before the first sample).
+    pub(crate) fn new(rng: SimRng, phi: f64, sd: f64, x: f64) -> Self {
         let p2 = phi * phi;
         Self {
             rng,

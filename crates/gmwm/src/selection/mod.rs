@@ -196,17 +196,4 @@ pub enum SelectionError {
     Input(#[from] crate::InputError),
 }
 
-macro_rules! input_error_from {
-    ($($t:ty),*) => {$(
-        impl From<$t> for SelectionError {
-            fn from(e: $t) -> Self {
-                SelectionError::Input(e.into())
-            }
-        }
-    )*};
-}
-input_error_from!(
-    crate::ParamError,
-    crate::SeriesError,
-    crate::model::ModelError
-);
+crate::error::input_error_from!(SelectionError);
