@@ -774,7 +774,7 @@ impl HaarWvAccumulator {
     /// [`SeriesError::NonFinite`] with the global 0-based index of the first NaN/Inf sample; the
     /// accumulator is then unusable for a meaningful result.
     ///
-    /// The samples run through the pyramid in blocks that start at multiples of [`BLOCK`] in
+    /// The samples run through the pyramid in blocks that start at multiples of 4096 samples in
     /// the series, so any chunking gives the same bits; a non-finite sample is reported by the
     /// push (or [`finish`](Self::finish)) that completes its block.
     pub fn push(&mut self, chunk: &[f64]) -> Result<(), SeriesError> {
