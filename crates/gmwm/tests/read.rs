@@ -538,6 +538,39 @@ fn binary_chunks_equal_full_read() {
 }
 
 #[test]
+fn binary_chunks_of_several_columns_in_one_pass() {
+    // three interleaved columns: a read of columns 3 and 1 gives each column's values, chunk
+    // by chunk, and a bad value is named by its row and column, the first in file order
+    let d = tempfile::tempdir().unwrap();
+    let rows = 37;
+    let mut data: Vec<f64> = (0..rows * 3).map(|i| i as f64).collect();
+    let p = write(&d, "c3.f64", &f64_bytes(&data));
+    let mut chunks = BinaryChunks::open(&p, InputFormat::F64, 3, 1, 10).unwrap();
+    let mut out = vec![Vec::new(), Vec::new()];
+    let (mut third, mut first) = (Vec::new(), Vec::new());
+    while let Some(n) = chunks.next_chunk_of(&[3, 1], &mut out).unwrap() {
+        assert_eq!(out[0].len(), n);
+        third.extend_from_slice(&out[0]);
+        first.extend_from_slice(&out[1]);
+    }
+    assert_eq!(
+        third,
+        (0..rows).map(|r| (3 * r + 2) as f64).collect::<Vec<_>>()
+    );
+    assert_eq!(first, (0..rows).map(|r| (3 * r) as f64).collect::<Vec<_>>());
+    data[3 * 21 + 2] = f64::NAN;
+    data[3 * 22] = f64::INFINITY;
+    let p = write(&d, "bad.f64", &f64_bytes(&data));
+    let mut chunks = BinaryChunks::open(&p, InputFormat::F64, 3, 1, 40).unwrap();
+    let e = chunks.next_chunk_of(&[1, 3], &mut out).unwrap_err();
+    assert!(
+        e.to_string().contains("sample 21 (0-based) of column 3"),
+        "{e}"
+    );
+    assert!(chunks.next_chunk_of(&[4], &mut out).is_err());
+}
+
+#[test]
 fn binary_chunks_errors() {
     let d = tempfile::tempdir().unwrap();
     let mut data = vec![1.0; 100];

@@ -4,7 +4,7 @@ use crate::config::{InputConfig, WvConfig};
 use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named, note};
 use crate::render;
 use anyhow::Result;
-use gmwm::imu::{binary_layout, BinaryChunks, BinaryLayout, ColumnSelector, InputFormat};
+use gmwm::imu::{binary_layout, BinaryChunks, BinaryLayout, ColumnSelector};
 use gmwm::variance::default_levels;
 use gmwm::{
     wavelet_variance, HaarWvAccumulator, Transform, WaveletFilter, WaveletVariance, WvOptions,
@@ -55,37 +55,54 @@ fn run_streaming(
         Some(f) => f,
         None => stream_freq(&input.file)?,
     };
-    let mut results = Vec::with_capacity(columns.len());
-    for &col in &columns {
-        let name = layout.names[col - 1].clone();
-        let wv = column_context(
-            stream_column(&input.file, layout.format, layout.ncols, col, opts, freq_hz),
-            &input.file,
-            &name,
-        )?;
-        results.push((name, wv));
-    }
-    Ok(results)
+    let names: Vec<String> = columns
+        .iter()
+        .map(|&c| layout.names[c - 1].clone())
+        .collect();
+    // a read error names the file (and the column of a bad value) itself
+    let wvs = stream_columns(&input.file, layout, &columns, opts, freq_hz)?;
+    names
+        .into_iter()
+        .zip(wvs)
+        .map(|(name, wv)| Ok((name.clone(), column_context(wv, &input.file, &name)?)))
+        .collect()
 }
 
-fn stream_column(
+/// The WV of each streamed column, or why it has none.
+type ColumnWvs = Vec<Result<WaveletVariance, gmwm::Error>>;
+
+/// One pass over the file for every selected column: each chunk of rows is read once and its
+/// columns are pushed into their own accumulators in parallel (memory: one chunk of rows and
+/// the accumulators' rings, whatever N). The outer error is the file's; each column's WV
+/// carries its own (a constant column, say).
+fn stream_columns(
     path: &std::path::Path,
-    format: InputFormat,
-    ncols: usize,
-    column: usize,
+    layout: &BinaryLayout,
+    columns: &[usize],
     opts: &WvOptions,
     freq_hz: f64,
-) -> Result<WaveletVariance, gmwm::Error> {
-    let mut chunks = BinaryChunks::open(path, format, ncols, column, STREAM_CHUNK)?;
+) -> Result<ColumnWvs, gmwm::Error> {
+    use rayon::prelude::*;
+    let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, STREAM_CHUNK)?;
     let n = usize::try_from(chunks.rows()).unwrap_or(usize::MAX);
     let levels = opts
         .levels
         .unwrap_or_else(|| default_levels(n, Transform::Modwt, WaveletFilter::Haar).max(1));
-    let mut acc = HaarWvAccumulator::new(levels)?;
-    while let Some(chunk) = chunks.next_chunk()? {
-        acc.push(chunk)?;
+    let mut accumulators = columns
+        .iter()
+        .map(|_| HaarWvAccumulator::new(levels))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut buffers = vec![Vec::with_capacity(STREAM_CHUNK); columns.len()];
+    while chunks.next_chunk_of(columns, &mut buffers)?.is_some() {
+        accumulators
+            .par_iter_mut()
+            .zip(&buffers)
+            .try_for_each(|(acc, values)| acc.push(values))?;
     }
-    Ok(acc.finish(freq_hz, opts.alpha)?)
+    Ok(accumulators
+        .into_iter()
+        .map(|acc| Ok(acc.finish(freq_hz, opts.alpha)?))
+        .collect())
 }
 
 /// A `--columns` entry of a raw binary file: a 1-based index, a name of the sidecar, or

@@ -299,6 +299,63 @@ impl BinaryChunks {
         self.row += n as u64;
         Ok(Some(&self.values))
     }
+
+    /// The next chunk of several columns at once (1-based `columns`, each in range), one
+    /// read of the rows for all of them: `out[k]` receives column `columns[k]`. Returns the
+    /// number of rows read, `None` after the last chunk. The column given to
+    /// [`open`](Self::open) is not used by this call.
+    ///
+    /// # Errors
+    /// [`ReadError::ColumnOutOfRange`] for a column outside `1..=ncols`; as
+    /// [`next_chunk`](Self::next_chunk), with the first non-finite value in file order.
+    pub fn next_chunk_of(
+        &mut self,
+        columns: &[usize],
+        out: &mut [Vec<f64>],
+    ) -> Result<Option<usize>, ReadError> {
+        if let Some(&bad) = columns.iter().find(|c| !(1..=self.ncols).contains(*c)) {
+            return Err(ReadError::ColumnOutOfRange {
+                path: self.path.clone(),
+                index: bad,
+                ncols: self.ncols,
+            });
+        }
+        let left = self.rows - self.row;
+        if left == 0 {
+            return Ok(None);
+        }
+        let n = usize::try_from(left).map_or(self.chunk_len, |l| l.min(self.chunk_len));
+        let record = self.width * self.ncols;
+        self.bytes.resize(n * record, 0);
+        self.reader
+            .read_exact(&mut self.bytes)
+            .map_err(|e| io_error(&self.path, e))?;
+        let width = self.width;
+        for (&column, values) in columns.iter().zip(out.iter_mut()) {
+            let offset = (column - 1) * width;
+            values.clear();
+            values.extend(
+                self.bytes
+                    .chunks_exact(record)
+                    .map(|r| decode(&r[offset..], width)),
+            );
+        }
+        if out.iter().any(|v| v.iter().any(|x| !x.is_finite())) {
+            // the first one in file order: row first, then column
+            let (i, column, value) = (0..n)
+                .flat_map(|i| {
+                    columns
+                        .iter()
+                        .zip(out.iter())
+                        .map(move |(&c, v)| (i, c, v[i]))
+                })
+                .find(|(_, _, v)| !v.is_finite())
+                .expect("a non-finite value exists");
+            return Err(non_finite(&self.path, self.row as usize + i, column, value));
+        }
+        self.row += n as u64;
+        Ok(Some(n))
+    }
 }
 
 /// Calls `f` on consecutive chunks of one column of a raw binary file (see [`BinaryChunks`]);
