@@ -11,8 +11,9 @@ use gmwm::{
 };
 use std::io::Write;
 
-/// Samples per read of the streaming path: 1 Mi values (8 MiB) per chunk.
-const STREAM_CHUNK: usize = 1 << 20;
+/// Rows per read of the streaming path: 64 Ki rows (512 KiB a column), small enough to stay
+/// in cache between the read and the pyramid.
+const STREAM_CHUNK: usize = 1 << 16;
 
 /// Raw binary input (from `--format`, the name or the sidecar) with the classical Haar MODWT
 /// estimator and no time column streams: each selected column is read in chunks through
