@@ -269,16 +269,10 @@ impl BinaryChunks {
     /// [`ReadError::Io`] (including a file truncated while reading) and
     /// [`ReadError::BinaryNonFinite`] with the 0-based sample index.
     pub fn next_chunk(&mut self) -> Result<Option<&[f64]>, ReadError> {
-        let left = self.rows - self.row;
-        if left == 0 {
+        let Some(n) = self.read_rows()? else {
             return Ok(None);
-        }
-        let n = usize::try_from(left).map_or(self.chunk_len, |l| l.min(self.chunk_len));
+        };
         let record = self.width * self.ncols;
-        self.bytes.resize(n * record, 0);
-        self.reader
-            .read_exact(&mut self.bytes)
-            .map_err(|e| io_error(&self.path, e))?;
         self.values.clear();
         let offset = self.column * self.width;
         let width = self.width;
@@ -298,6 +292,21 @@ impl BinaryChunks {
         }
         self.row += n as u64;
         Ok(Some(&self.values))
+    }
+
+    /// Reads the bytes of the next chunk of rows into `self.bytes`: the number of rows, `None`
+    /// after the last one (`self.row` is advanced by the caller once the values are checked).
+    fn read_rows(&mut self) -> Result<Option<usize>, ReadError> {
+        let left = self.rows - self.row;
+        if left == 0 {
+            return Ok(None);
+        }
+        let n = usize::try_from(left).map_or(self.chunk_len, |l| l.min(self.chunk_len));
+        self.bytes.resize(n * self.width * self.ncols, 0);
+        self.reader
+            .read_exact(&mut self.bytes)
+            .map_err(|e| io_error(&self.path, e))?;
+        Ok(Some(n))
     }
 
     /// The next chunk of several columns at once (1-based `columns`, each in range), one
@@ -320,16 +329,10 @@ impl BinaryChunks {
                 ncols: self.ncols,
             });
         }
-        let left = self.rows - self.row;
-        if left == 0 {
+        let Some(n) = self.read_rows()? else {
             return Ok(None);
-        }
-        let n = usize::try_from(left).map_or(self.chunk_len, |l| l.min(self.chunk_len));
+        };
         let record = self.width * self.ncols;
-        self.bytes.resize(n * record, 0);
-        self.reader
-            .read_exact(&mut self.bytes)
-            .map_err(|e| io_error(&self.path, e))?;
         let width = self.width;
         for (&column, values) in columns.iter().zip(out.iter_mut()) {
             let offset = (column - 1) * width;
