@@ -85,6 +85,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
@@ -211,17 +212,25 @@ def run_once(t: Timed, outdir: Path, timeout: float, verbose: bool) -> Optional[
     out_path, err_path = outdir / f"{stem}.out", outdir / f"{stem}.err"
     t.out_path = out_path
     with open(out_path, "wb") as out, open(err_path, "wb") as err:
+        # No `timeout=` on the wait: with one, CPython polls the child with sleeps of up to
+        # 50 ms, which rounds every time up to its polling grid. A timer kills a runaway
+        # command instead, and the wait itself blocks until the child exits.
         start = time.perf_counter()
         try:
-            p = subprocess.run(t.argv, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
-                               timeout=timeout, cwd=t.cwd)
-        except subprocess.TimeoutExpired:
-            t.status, t.error = "failed", f"timed out after {timeout:g} s"
-            return None
+            p = subprocess.Popen(t.argv, stdout=out, stderr=err, stdin=subprocess.DEVNULL, cwd=t.cwd)
         except OSError as e:
             t.status, t.error = "failed", f"could not start: {e}"
             return None
+        killer = threading.Timer(timeout, p.kill)
+        killer.start()
+        try:
+            p.wait()
+        finally:
+            killer.cancel()
         wall = time.perf_counter() - start
+        if wall >= timeout:
+            t.status, t.error = "failed", f"timed out after {timeout:g} s"
+            return None
     t.rc = p.returncode
     if p.returncode != 0:
         tail = err_path.read_text(errors="replace").strip().splitlines()[-5:]
