@@ -654,11 +654,12 @@ fn sum_squares(x: &[f64]) -> f64 {
 /// Level j keeps a ring of the last `2^{j-1}` values of the level-(j-1) scaling coefficients,
 /// so memory is `8 · 2^J` bytes whatever N and the chunk sizes; time is O(N·J).
 ///
-/// Numerical care: a constant offset (the series mean for [`wavelet_variance`], the first sample
-/// by default here) is subtracted before the pyramid — the Haar wavelet filter annihilates
-/// constants, so this changes nothing mathematically but keeps an accelerometer's −1 g bias from
-/// eating digits — and the squared coefficients are summed per block, block sums then added with
-/// Neumaier's compensated sum.
+/// Numerical care: a constant offset (the mean of the first 2048 samples, as
+/// [`wavelet_variance`] takes it) is subtracted before the pyramid — the Haar wavelet filter
+/// annihilates constants, so this changes nothing mathematically but keeps an accelerometer's
+/// −1 g bias from eating digits — and the squared coefficients are summed per block of 4096
+/// samples (blocks fixed by the sample index, so any chunking gives the same bits), block sums
+/// then added with Neumaier's compensated sum.
 ///
 /// # Formula
 /// `V_{j,t} = (V_{j-1,t} + V_{j-1,t-m}) / 2`, `W_{j,t} = (V_{j-1,t} - V_{j-1,t-m}) / 2`,
