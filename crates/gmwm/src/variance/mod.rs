@@ -6,6 +6,7 @@ pub mod ci;
 pub mod cov;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
+pub mod implied_cov;
 pub mod robust;
 pub mod wv;
 
