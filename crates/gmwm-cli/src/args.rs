@@ -195,9 +195,14 @@ pub struct CalibrateArgs {
     /// Wavelet-variance settings.
     #[command(flatten)]
     pub estimator: WvEstimatorArgs,
-    /// Bootstrap replicates of the WV covariance behind the WIC and every interval.
+    /// Bootstrap replicates of a simulated WV covariance V (see --covariance).
     #[arg(long, value_name = "B", default_value_t = 50, value_parser = at_least_2)]
     pub bootstrap: usize,
+    /// How V, the covariance of the WV behind the WIC and every interval, is obtained: exact
+    /// from the model (no simulation, any length) when it has only WN, QN, RW, DR, AR1/GM,
+    /// MA1 or ARMA11 terms, else simulated (auto); always exact; or simulated as the R package.
+    #[arg(long, value_enum, default_value_t = CovarianceArg::Auto)]
+    pub covariance: CovarianceArg,
     /// Number of starting-value draws of every fit [default: 20000 for N <= 1e4, else 100000,
     /// with early stop].
     #[arg(long = "G", value_name = "N", value_parser = at_least_1)]
@@ -417,11 +422,15 @@ pub struct SelectArgs {
     /// denominator is added if absent and plays the full model (METHODS §8.5).
     #[arg(long, value_name = "M1;M2;...")]
     pub candidates: Option<String>,
-    /// Bootstrap replicates B: of the covariance V of the WV, simulated from the full model's
-    /// estimate (asymptotic optimism, standard errors of WIC differences), and per candidate
-    /// with --optimism bootstrap.
+    /// Bootstrap replicates B: of the covariance V of the WV when it is simulated from the
+    /// full model's estimate (see --covariance), and per candidate with --optimism bootstrap.
     #[arg(long, value_name = "B", default_value_t = 50, value_parser = at_least_2)]
     pub bootstrap: usize,
+    /// How V, the covariance of the WV behind the WIC and every interval, is obtained: exact
+    /// from the model (no simulation, any length) when it has only WN, QN, RW, DR, AR1/GM,
+    /// MA1 or ARMA11 terms, else simulated (auto); always exact; or simulated as the R package.
+    #[arg(long, value_enum, default_value_t = CovarianceArg::Auto)]
+    pub covariance: CovarianceArg,
     /// Optimism estimator (METHODS §8.2, §8.3).
     #[arg(long, value_enum, default_value_t = OptimismArg::Asymptotic)]
     pub optimism: OptimismArg,
@@ -507,9 +516,14 @@ pub struct FitArgs {
     #[arg(long, value_name = "S", default_value_t = 1337, value_parser = seed)]
     pub seed: u64,
     /// Add inference (METHODS §7): standard errors, 1 - alpha intervals and the J-test
-    /// goodness of fit, from the sandwich with a parametric-bootstrap V (100 replicates).
+    /// goodness of fit, from the sandwich with the WV covariance V (see --covariance).
     #[arg(long)]
     pub inference: bool,
+    /// With --inference: how V is obtained: exact from the fitted model when it has only WN,
+    /// QN, RW, DR, AR1/GM, MA1 or ARMA11 terms, else simulated (auto); always exact; or
+    /// simulated from it, 100 replicates, as the R package.
+    #[arg(long, value_enum, default_value_t = CovarianceArg::Auto, requires = "inference")]
+    pub covariance: CovarianceArg,
     /// With --inference: parametric-bootstrap inference with B replicates instead of the
     /// sandwich (bootstrap SE/CI and the bootstrap goodness-of-fit p-value).
     #[arg(long, value_name = "B", requires = "inference", value_parser = at_least_2)]
@@ -517,6 +531,27 @@ pub struct FitArgs {
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,
+}
+
+/// `--covariance`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CovarianceArg {
+    /// Exact when the model is covered, else simulated.
+    Auto,
+    /// Exact (an error for a model it does not cover).
+    Exact,
+    /// Parametric bootstrap, as the R package.
+    Bootstrap,
+}
+
+impl From<CovarianceArg> for gmwm::inference::CovarianceMethod {
+    fn from(a: CovarianceArg) -> Self {
+        match a {
+            CovarianceArg::Auto => Self::Auto,
+            CovarianceArg::Exact => Self::Exact,
+            CovarianceArg::Bootstrap => Self::Bootstrap,
+        }
+    }
 }
 
 /// `--weights`.

@@ -514,6 +514,7 @@ impl TryFrom<&FitArgs> for FitConfig {
             Some(InferenceOptions {
                 alpha: a.estimator.alpha,
                 bootstrap: a.bootstrap,
+                v_method: a.covariance.into(),
                 ..InferenceOptions::default()
             })
         } else {
@@ -589,6 +590,7 @@ impl TryFrom<&SelectArgs> for SelectConfig {
         check_haar(&a.estimator, &wv)?;
         let mut wic = wic
             .with_bootstrap(a.bootstrap)
+            .with_covariance(a.covariance.into())
             .with_seed(a.seed)
             .with_optimism(match a.optimism {
                 OptimismArg::Asymptotic => OptimismMethod::Asymptotic,
@@ -666,6 +668,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
         let options = CalibrationOptions {
             full_model,
             wv,
+            covariance: a.covariance.into(),
             bootstrap: a.bootstrap,
             draws: a.draws,
             seed: a.seed,

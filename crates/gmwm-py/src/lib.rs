@@ -8,7 +8,7 @@ use gmwm::imu::{
     read_table, ColumnSelector, HeaderMode, Imu, InputFormat, ReadOptions, Recording,
     RecordingOptions, SensorInfo, TimeUnit,
 };
-use gmwm::inference::{infer_with_progress, InferenceOptions, Progress};
+use gmwm::inference::{infer_with_progress, CovarianceMethod, InferenceOptions, Progress};
 use gmwm::model::Model;
 use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
 use gmwm::{
@@ -335,7 +335,7 @@ impl Progress for PyProgress {
 /// GMWM fit of a model on each column (METHODS §5, §7 with `inference`): the
 /// `gmwm fit --json` document.
 #[pyfunction]
-#[pyo3(signature = (arrays, names, freq, model, weights="fast", draws=None, seed=1337, inference=false, bootstrap=None, robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
+#[pyo3(signature = (arrays, names, freq, model, weights="fast", draws=None, seed=1337, inference=false, bootstrap=None, covariance="auto", robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -348,6 +348,7 @@ fn fit(
     seed: u64,
     inference: bool,
     bootstrap: Option<usize>,
+    covariance: &str,
     robust: bool,
     eff: f64,
     robust_convention: &str,
@@ -388,6 +389,7 @@ fn fit(
     if bootstrap.is_some_and(|b| b < 2) {
         return Err(err("invalid bootstrap: at least 2 replicates"));
     }
+    let v_method = covariance_of(covariance)?;
     let cols = columns_of(&arrays);
     let reporter = PyProgress {
         callback: progress,
@@ -409,6 +411,7 @@ fn fit(
             let opts = InferenceOptions {
                 alpha,
                 bootstrap,
+                v_method,
                 ..InferenceOptions::default()
             };
             for ((f, n), x) in fits.iter().zip(&names).zip(&cols) {
@@ -440,7 +443,7 @@ fn fit(
 
 /// WIC model selection on each column (METHODS §8): the `gmwm select --json` document.
 #[pyfunction]
-#[pyo3(signature = (arrays, names, freq, model=None, candidates=None, bootstrap=50, optimism="asymptotic", convention="corrected", rule="navigation", draws=None, seed=1337, robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
+#[pyo3(signature = (arrays, names, freq, model=None, candidates=None, bootstrap=50, covariance="auto", optimism="asymptotic", convention="corrected", rule="navigation", draws=None, seed=1337, robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn select(
     py: Python<'_>,
@@ -450,6 +453,7 @@ fn select(
     model: Option<&str>,
     candidates: Option<Vec<String>>,
     bootstrap: usize,
+    covariance: &str,
     optimism: &str,
     convention: &str,
     rule: &str,
@@ -488,6 +492,7 @@ fn select(
     };
     wic = wic
         .with_bootstrap(bootstrap)
+        .with_covariance(covariance_of(covariance)?)
         .with_seed(seed)
         .with_wv_options(wv_opts)
         .with_optimism(match optimism {
@@ -545,6 +550,20 @@ impl Progress for Ticks<'_> {
         let d = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         self.inner.advance(d);
     }
+}
+
+/// `covariance`: how V, the covariance of the WV, is obtained.
+fn covariance_of(text: &str) -> PyResult<CovarianceMethod> {
+    Ok(match text {
+        "auto" => CovarianceMethod::Auto,
+        "exact" => CovarianceMethod::Exact,
+        "bootstrap" => CovarianceMethod::Bootstrap,
+        other => {
+            return Err(err(format!(
+                "invalid covariance {other:?}: \"auto\", \"exact\" or \"bootstrap\""
+            )))
+        }
+    })
 }
 
 fn rule_of(rule: &str) -> PyResult<SelectionRule> {
@@ -685,7 +704,7 @@ fn read<'py>(
 /// `gmwm calibrate --json` document: of the recording at `path` (read as the CLI reads it), or
 /// of `arrays` named `names` with `units` at `freq`.
 #[pyfunction]
-#[pyo3(signature = (path=None, arrays=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, progress=None))]
+#[pyo3(signature = (path=None, arrays=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn calibrate(
     py: Python<'_>,
@@ -706,6 +725,7 @@ fn calibrate(
     model: Option<&str>,
     rule: &str,
     bootstrap: usize,
+    covariance: &str,
     draws: Option<usize>,
     seed: u64,
     eff: f64,
@@ -749,6 +769,7 @@ fn calibrate(
             .parse()
             .map_err(engine)?,
         wv,
+        covariance: covariance_of(covariance)?,
         bootstrap,
         draws,
         seed,

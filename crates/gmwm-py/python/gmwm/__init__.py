@@ -188,8 +188,8 @@ def fit(
     **options,
 ) -> FitResult:
     """GMWM estimate of ``model`` on each column (METHODS §5): ``weights`` (fast, diag,
-    bootstrap), ``G`` (starting-value draws), ``seed``, ``inference`` and ``bootstrap``
-    (METHODS §7), ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``."""
+    bootstrap), ``G`` (starting-value draws), ``seed``, ``inference``, ``bootstrap`` and
+    ``covariance`` (METHODS §7; "auto", "exact" or "bootstrap": how V is obtained), ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``."""
     read_options, options = _split(options)
     arrays, cols, rate = _columns(data, freq, names, read_options)
     doc = _native.fit(arrays, cols, rate, model, draws=G, progress=progress, **options)
@@ -209,7 +209,7 @@ def select(
 ) -> SelectionResult:
     """Model selection by the Wavelet Information Criterion on each column (METHODS §8):
     ``model`` (every sub-model is a candidate) or ``candidates`` (a list, or text separated by
-    ``;``), ``bootstrap``, ``optimism``, ``convention``, ``rule``, ``G``, ``seed``, and the WV
+    ``;``), ``bootstrap``, ``covariance``, ``optimism``, ``convention``, ``rule``, ``G``, ``seed``, and the WV
     settings."""
     read_options, options = _split(options)
     arrays, cols, rate = _columns(data, freq, names, read_options)
@@ -234,7 +234,7 @@ def calibrate(
     """The calibration pipeline of ``gmwm calibrate`` (per axis: WV, WIC selection, the
     identified fit with intervals, N/B/K in SI and datasheet units, the IEEE 952 read-off, the
     verdict, the contamination check, the navigation sets): ``gyro_unit``, ``accel_unit``,
-    ``model``, ``rule``, ``bootstrap``, ``G``, ``seed``, ``eff``, ``robust``, ``alpha``,
+    ``model``, ``rule``, ``bootstrap``, ``covariance``, ``G``, ``seed``, ``eff``, ``robust``, ``alpha``,
     ``axis_policy``, ``inflate``, ``conservative``, ``rostopic``; for a path also the read
     options (``columns``, ``format``, ``topic``, ...)."""
     if _is_path(data):

@@ -29,12 +29,13 @@ def simulate(model: str, n: int, freq: float = ..., seed: int = ..., components:
 
 def fit(arrays: Sequence[F64], names: Sequence[str], freq: float, model: str, weights: str = ...,
         draws: Optional[int] = ..., seed: int = ..., inference: bool = ..., bootstrap: Optional[int] = ...,
-        robust: bool = ..., eff: float = ..., robust_convention: str = ..., levels: Optional[int] = ...,
+        covariance: str = ..., robust: bool = ..., eff: float = ..., robust_convention: str = ..., levels: Optional[int] = ...,
         alpha: float = ..., progress: Progress = ...) -> str:
     """GMWM fit of `model` on each column (METHODS §5, §7)."""
 
 def select(arrays: Sequence[F64], names: Sequence[str], freq: float, model: Optional[str] = ...,
-           candidates: Optional[Sequence[str]] = ..., bootstrap: int = ..., optimism: str = ...,
+           candidates: Optional[Sequence[str]] = ..., bootstrap: int = ..., covariance: str = ...,
+           optimism: str = ...,
            convention: str = ..., rule: str = ..., draws: Optional[int] = ..., seed: int = ...,
            robust: bool = ..., eff: float = ..., robust_convention: str = ..., levels: Optional[int] = ...,
            alpha: float = ..., progress: Progress = ...) -> str:
@@ -51,7 +52,8 @@ def calibrate(path: Optional[str] = ..., arrays: Optional[Sequence[F64]] = ..., 
               columns: Optional[Sequence[str]] = ..., format: str = ..., ncols: Optional[int] = ...,
               header: str = ..., time_column: Optional[str] = ..., time_unit: Optional[str] = ...,
               topic: Optional[str] = ..., gyro_unit: Optional[str] = ..., accel_unit: Optional[str] = ...,
-              model: Optional[str] = ..., rule: str = ..., bootstrap: int = ..., draws: Optional[int] = ...,
+              model: Optional[str] = ..., rule: str = ..., bootstrap: int = ..., covariance: str = ...,
+              draws: Optional[int] = ...,
               seed: int = ..., eff: float = ..., robust_convention: str = ..., robust: bool = ...,
               alpha: float = ..., axis_policy: str = ..., inflate: Optional[float] = ...,
               conservative: bool = ..., rostopic: Optional[str] = ..., progress: Progress = ...) -> str:

@@ -7,7 +7,9 @@ use super::ieee::{ieee_readoff, IeeeReadoff};
 use crate::fit::canonical::long_run_variance;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
 use crate::imu::{Imu, Sensor};
-use crate::inference::{infer_with_covariance, Inference, InferenceOptions, Progress};
+use crate::inference::{
+    infer_with_covariance, CovarianceMethod, Inference, InferenceOptions, Progress,
+};
 use crate::model::{Model, ProcessKind};
 use crate::process::{Ar1, Gm};
 use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
@@ -51,8 +53,12 @@ pub struct CalibrationOptions {
     pub full_model: Model,
     /// Wavelet-variance settings (default classical Haar MODWT, 95% intervals).
     pub wv: WvOptions,
-    /// Bootstrap replicates of the WV covariance V behind the WIC and the intervals (default
-    /// 50, the selection's default: enough for a J x J covariance with J up to 47).
+    /// How the WV covariance V behind the WIC and the intervals is obtained (default
+    /// [`CovarianceMethod::Auto`]: exact when the full model is covered, which the default
+    /// one is).
+    pub covariance: CovarianceMethod,
+    /// Bootstrap replicates of a bootstrap V (default 50, the selection's default: enough for
+    /// a J x J covariance with J up to 47).
     pub bootstrap: usize,
     /// Starting-value draws of every fit (default `None`: the selection's size-dependent G).
     pub draws: Option<usize>,
@@ -76,6 +82,7 @@ impl Default for CalibrationOptions {
                 .parse()
                 .expect("the default full model parses"),
             wv: WvOptions::default(),
+            covariance: CovarianceMethod::Auto,
             bootstrap: 50,
             draws: None,
             seed: 1337,
@@ -532,6 +539,7 @@ impl Calibration {
                 source: Box::new(source),
             })?
             .with_bootstrap(self.options.bootstrap)
+            .with_covariance(self.options.covariance)
             .with_seed(self.options.seed)
             .with_rule(self.options.rule)
             .with_wv_options(self.options.wv);
@@ -569,7 +577,7 @@ impl Calibration {
             &gmwm,
             &fit,
             &selection.wv_covariance,
-            selection.bootstrap,
+            selection.v_replicates,
             &self.options.wv,
             &InferenceOptions {
                 alpha: self.options.wv.alpha,

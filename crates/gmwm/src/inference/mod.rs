@@ -1,11 +1,13 @@
 //! Inference on a GMWM fit (METHODS §7): the parametric bootstrap of the wavelet variance and
-//! of the fit ([`bootstrap`], §7.4), on which the bootstrap weighting (§5.2), the bootstrap
+//! of the fit ([`bootstrap`], §7.4), and the covariance V of the WV, exact or bootstrapped
+//! ([`covariance`]), on which the bootstrap weighting (§5.2), the bootstrap
 //! covariance of the estimates and the WIC optimism (§8) rest; the sandwich covariance and
 //! intervals ([`asymptotic`], §7.1, §7.2, §7.6); the J-test ([`gof`], §7.3); and one entry
 //! point, [`infer`] ([`summary`], §7.5).
 
 pub mod asymptotic;
 pub mod bootstrap;
+pub mod covariance;
 pub mod gof;
 pub mod progress;
 pub mod summary;
@@ -14,6 +16,7 @@ pub use asymptotic::{sandwich, wald_interval, z_value, IntervalScale, Sandwich, 
 pub use bootstrap::{
     fit_bootstrap, map_replicates, wv_bootstrap, FitBootstrap, FitBootstrapOptions, WvBootstrap,
 };
+pub use covariance::{wv_covariance, CovarianceMethod, WvCovariance};
 pub use gof::{j_test, JTest};
 pub use progress::{NoProgress, Progress};
 pub use summary::{

@@ -3,14 +3,16 @@
 //! of fit, asymptotic or by parametric bootstrap.
 //!
 //! # Choices (documented deviations from the package)
-//! - **V of the sandwich** (asymptotic mode): the *full* parametric-bootstrap covariance of the
-//!   WV vector from the fitted model, `H = 100` replicates. Adjacent WV levels are strongly
-//!   correlated, and the sandwich `H V H'` is linear in V, so the full sample covariance is an
-//!   unbiased estimate of the right matrix (its noise, ~`sqrt(2/H)` relative per entry, passes
-//!   to `Psi` linearly). The package uses the diagonal when N > 1e4; [`VShape::Diagonal`]
-//!   reproduces that.
+//! - **V of the sandwich** (asymptotic mode): the *full* covariance of the WV vector at the
+//!   fitted model, exact by default ([`super::covariance`]; the bootstrap's limit, without its
+//!   Monte Carlo noise), or the parametric bootstrap with `H = 100` replicates
+//!   ([`CovarianceMethod::Bootstrap`], and for models the exact formulas do not cover).
+//!   Adjacent WV levels are strongly correlated, and the sandwich `H V H'` is linear in V, so
+//!   the full bootstrap covariance is an unbiased estimate of the right matrix (its noise,
+//!   ~`sqrt(2/H)` relative per entry, passes to `Psi` linearly). The package uses the
+//!   diagonal bootstrap V when N > 1e4; [`VShape::Diagonal`] with the bootstrap reproduces that.
 //! - **J-test V**: the statistic needs `V^{-1}`; the inverse of a sample covariance of H
-//!   replicates of a J-vector is biased up by `(H - 1)/(H - J - 2)`, so the bootstrap V is
+//!   replicates of a J-vector is biased up by `(H - 1)/(H - J - 2)`, so a bootstrap V is
 //!   scaled by the inverse Hartlap factor ([`super::gof::hartlap_factor`]) first; with
 //!   `H <= J + 2` (or `J <= p`) no J-test is reported (`gof` is null).
 //! - **Intervals**: two-sided `z = Phi^{-1}(1 - alpha/2)` and log/atanh scales by default
@@ -23,7 +25,8 @@
 //!   from 1000 resamples (lower order statistic, as the package).
 
 use super::asymptotic::{sandwich, scales, z_value, IntervalScale, ZConvention};
-use super::bootstrap::{fit_bootstrap, map_replicates, FitBootstrapOptions, WvBootstrap};
+use super::bootstrap::{fit_bootstrap, FitBootstrapOptions};
+use super::covariance::{wv_covariance, CovarianceMethod};
 use super::gof::{hartlap_factor, j_test, JTest};
 use super::progress::{NoProgress, Progress};
 use crate::error::ParamError;
@@ -34,7 +37,6 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use std::fmt;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Whether the asymptotic sandwich uses the full or the diagonal bootstrap V.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -55,7 +57,10 @@ pub struct InferenceOptions {
     /// `Some(B)`: parametric-bootstrap inference with B replicates (§7.4); `None` (default):
     /// asymptotic sandwich (§7.1).
     pub bootstrap: Option<usize>,
-    /// Replicates H of the bootstrap V of the asymptotic mode (default 100, as the package).
+    /// How the asymptotic mode's V is obtained (default [`CovarianceMethod::Auto`]: exact
+    /// when the model is covered, [`super::covariance`]).
+    pub v_method: CovarianceMethod,
+    /// Replicates H of a bootstrap V of the asymptotic mode (default 100, as the package).
     pub v_replicates: usize,
     /// Full or diagonal V in the sandwich (default full).
     pub v_shape: VShape,
@@ -76,6 +81,7 @@ impl Default for InferenceOptions {
         Self {
             alpha: 0.05,
             bootstrap: None,
+            v_method: CovarianceMethod::Auto,
             v_replicates: 100,
             v_shape: VShape::Full,
             seed: 1342,
@@ -167,8 +173,8 @@ pub enum InferenceWarning {
         levels: usize,
         /// Parameters p.
         params: usize,
-        /// Replicates behind V.
-        replicates: usize,
+        /// Replicates behind V (`None`: exact).
+        replicates: Option<usize>,
     },
 }
 
@@ -208,11 +214,18 @@ impl fmt::Display for InferenceWarning {
                 levels,
                 params,
                 replicates,
-            } => write!(
-                f,
-                "no J-test: it needs J > p ({levels} levels, {params} parameters) and more \
-                 replicates than J + 2 ({replicates}); raise the replicates"
-            ),
+            } => match replicates {
+                Some(h) => write!(
+                    f,
+                    "no J-test: it needs J > p ({levels} levels, {params} parameters) and more \
+                     replicates than J + 2 ({h}); raise the replicates"
+                ),
+                None => write!(
+                    f,
+                    "no J-test: it needs more levels than parameters ({levels} levels, \
+                     {params} parameters)"
+                ),
+            },
         }
     }
 }
@@ -220,7 +233,8 @@ impl fmt::Display for InferenceWarning {
 /// Inference on a GMWM fit (METHODS §7).
 ///
 /// Wire format: `method` ("asymptotic" | "bootstrap"), `alpha`, `z`, `z_convention`, `scale`,
-/// `v_replicates` (replicates behind V), `bootstrap_replicates` (B or null), `parameters`
+/// `v_method` ("exact" | "bootstrap"), `v_replicates` (replicates behind V, null when exact),
+/// `bootstrap_replicates` (B or null), `parameters`
 /// (per parameter `name`, `estimate`, `se`, `ci_low`, `ci_high`), `covariance` (p x p rows;
 /// null for a parameter at the boundary), `objective`, `gof` (`statistic`, `df`, `p_value`,
 /// or null), `bootstrap_gof` (`objective`, `p_value`, `ci_low`, `ci_high`, `replicates`, or
@@ -237,8 +251,10 @@ pub struct Inference {
     pub(crate) z_convention: ZConvention,
     /// Interval scale.
     pub(crate) scale: IntervalScale,
-    /// Replicates behind the WV covariance V (H, or B in bootstrap mode).
-    pub(crate) v_replicates: usize,
+    /// How V was obtained: `"exact"` or `"bootstrap"`.
+    pub(crate) v_method: &'static str,
+    /// Replicates behind the WV covariance V (H, or B in bootstrap mode); `None` when exact.
+    pub(crate) v_replicates: Option<usize>,
     /// B in bootstrap mode.
     pub(crate) bootstrap_replicates: Option<usize>,
     /// Per parameter, model order.
@@ -283,8 +299,13 @@ impl Inference {
         self.scale
     }
 
-    /// Replicates behind the WV covariance V (H, or B in bootstrap mode).
-    pub fn v_replicates(&self) -> usize {
+    /// How V was obtained: `"exact"` or `"bootstrap"`.
+    pub fn v_method(&self) -> &'static str {
+        self.v_method
+    }
+
+    /// Replicates behind the WV covariance V (H, or B in bootstrap mode); `None` when exact.
+    pub fn v_replicates(&self) -> Option<usize> {
         self.v_replicates
     }
 
@@ -364,9 +385,10 @@ pub fn infer_with_progress(
 }
 
 /// Asymptotic inference on `fit` (METHODS §7.1–§7.3) with a WV covariance `v` the caller
-/// already has (e.g. the bootstrap V of a model selection, simulated from the full model,
-/// which nests `fit`'s model), from `v_replicates` replicates: the sandwich and the J-test
-/// without simulating again. `opts.bootstrap` and `opts.v_replicates` are ignored.
+/// already has (e.g. the V of a model selection, at the full model's estimate, which nests
+/// `fit`'s model), exact or from `v_replicates` bootstrap replicates: the sandwich and the
+/// J-test without computing V again. `opts.bootstrap`, `opts.v_method` and
+/// `opts.v_replicates` are ignored.
 ///
 /// # Errors
 /// As [`infer`]; [`FitError::Input`] if `v` is not `J x J` for the fit's `J` levels.
@@ -374,7 +396,7 @@ pub fn infer_with_covariance(
     gmwm: &Gmwm,
     fit: &GmwmFit,
     v: &DMatrix<f64>,
-    v_replicates: usize,
+    v_replicates: Option<usize>,
     wv_opts: &WvOptions,
     opts: &InferenceOptions,
 ) -> Result<Inference, FitError> {
@@ -409,7 +431,7 @@ fn infer_impl(
     wv_opts: &WvOptions,
     opts: &InferenceOptions,
     progress: &dyn Progress,
-    given_v: Option<(&DMatrix<f64>, usize)>,
+    given_v: Option<(&DMatrix<f64>, Option<usize>)>,
 ) -> Result<Inference, FitError> {
     crate::fit::check_haar(wv_opts.filter)?;
     let z = z_value(opts.alpha, opts.z)?;
@@ -467,7 +489,19 @@ fn infer_impl(
         None => {
             let (v, h) = match given_v {
                 Some((v, h)) => (v.clone(), h),
-                None => bootstrap_v(fit, n, &wv_opts, opts, progress)?,
+                None => {
+                    let c = wv_covariance(
+                        &fit.active_model()?,
+                        n,
+                        fit.freq_hz,
+                        &wv_opts,
+                        opts.v_method,
+                        opts.v_replicates,
+                        opts.seed,
+                        progress,
+                    )?;
+                    (c.v, c.replicates)
+                }
             };
             let v_sand = match opts.v_shape {
                 VShape::Full => v.clone(),
@@ -530,7 +564,7 @@ fn infer_impl(
             (
                 InferenceMethod::Bootstrap,
                 fb.v.clone(),
-                b,
+                Some(b),
                 rows(&cov),
                 fb.sd.clone(),
                 se_g,
@@ -538,7 +572,12 @@ fn infer_impl(
             )
         }
     };
-    let gof = match hartlap_factor(v_replicates, levels) {
+    // an exact V needs no correction of its inverse
+    let factor = match v_replicates {
+        Some(h) => hartlap_factor(h, levels),
+        None => Some(1.0),
+    };
+    let gof = match factor {
         Some(f) if levels > q => Some(j_test(gmwm, fit, &(&v / f))?),
         _ => {
             warnings.push(InferenceWarning::NoJTest {
@@ -568,6 +607,11 @@ fn infer_impl(
         z,
         z_convention: opts.z,
         scale: opts.scale,
+        v_method: if v_replicates.is_some() {
+            "bootstrap"
+        } else {
+            "exact"
+        },
         v_replicates,
         bootstrap_replicates: opts.bootstrap,
         parameters,
@@ -577,39 +621,6 @@ fn infer_impl(
         bootstrap_gof,
         warnings,
     })
-}
-
-/// The bootstrap V of the asymptotic mode: `opts.v_replicates` series of length `n` simulated
-/// from the fit (METHODS §7.4 `cov_bootstrapper`), and the replicate count.
-fn bootstrap_v(
-    fit: &GmwmFit,
-    n: usize,
-    wv_opts: &WvOptions,
-    opts: &InferenceOptions,
-    progress: &dyn Progress,
-) -> Result<(DMatrix<f64>, usize), FitError> {
-    let h = opts.v_replicates;
-    if h < 2 {
-        return Err(
-            ParamError::new("v_replicates", h, "must be at least 2 for a covariance").into(),
-        );
-    }
-    let done = AtomicUsize::new(0);
-    progress.start(h);
-    let samples = map_replicates(
-        &fit.active_model()?,
-        n,
-        fit.freq_hz,
-        wv_opts,
-        h,
-        opts.seed,
-        |_, wv, _| {
-            progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
-            Ok::<_, crate::InputError>(wv.wv.clone())
-        },
-    )?;
-    let v = WvBootstrap::from_samples(&samples)?.cov;
-    Ok((v, h))
 }
 
 /// The p x p matrix with `m` (q x q) at the `keep` rows and columns and NaN elsewhere.
@@ -675,14 +686,16 @@ impl fmt::Display for Inference {
             ZConvention::TwoSided => 1.0 - self.alpha,
             ZConvention::Package => 1.0 - 2.0 * self.alpha,
         };
-        let how = match self.method {
-            InferenceMethod::Asymptotic => format!(
-                "asymptotic (sandwich, V from {} bootstrap replicates)",
-                self.v_replicates
-            ),
-            InferenceMethod::Bootstrap => format!(
+        let how = match (self.method, self.v_replicates) {
+            (InferenceMethod::Asymptotic, Some(h)) => {
+                format!("asymptotic (sandwich, V from {h} bootstrap replicates)")
+            }
+            (InferenceMethod::Asymptotic, None) => {
+                "asymptotic (sandwich, exact V at the estimate)".to_string()
+            }
+            (InferenceMethod::Bootstrap, _) => format!(
                 "parametric bootstrap, {} replicates",
-                self.bootstrap_replicates.unwrap_or(self.v_replicates)
+                self.bootstrap_replicates.or(self.v_replicates).unwrap_or(0)
             ),
         };
         writeln!(

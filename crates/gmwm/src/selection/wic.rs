@@ -9,10 +9,11 @@ use super::SelectionError;
 use crate::error::check_freq;
 use crate::fit::canonical::wv_separation;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
+use crate::inference::covariance::{wv_covariance, CovarianceMethod};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{NoProgress, Progress};
 use crate::model::{Model, ProcessKind};
-use crate::sim::bootstrap::{map_replicates, wv_bootstrap};
+use crate::sim::bootstrap::map_replicates;
 use crate::sim::replicate_seed;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use nalgebra::{DMatrix, DVector};
@@ -42,6 +43,7 @@ pub struct Wic {
     method: OptimismMethod,
     convention: OptimismConvention,
     bootstrap: usize,
+    covariance: CovarianceMethod,
     seed: u64,
     draws: Option<usize>,
     bootstrap_draws: usize,
@@ -92,6 +94,7 @@ impl Wic {
             method: OptimismMethod::default(),
             convention: OptimismConvention::default(),
             bootstrap: DEFAULT_BOOTSTRAP,
+            covariance: CovarianceMethod::Auto,
             seed: DEFAULT_SEED,
             draws: None,
             bootstrap_draws: DEFAULT_BOOTSTRAP_DRAWS,
@@ -169,10 +172,18 @@ impl Wic {
         self
     }
 
-    /// Sets the bootstrap replicates B (of V for the asymptotic optimism, per candidate for the
-    /// bootstrap one); default [`DEFAULT_BOOTSTRAP`]; at least 2.
+    /// Sets the bootstrap replicates B (of a bootstrap V for the asymptotic optimism, per
+    /// candidate for the bootstrap one); default [`DEFAULT_BOOTSTRAP`]; at least 2.
     pub fn with_bootstrap(mut self, replicates: usize) -> Self {
         self.bootstrap = replicates;
+        self
+    }
+
+    /// Sets how V, the covariance of the WV at the full model's estimate, is obtained
+    /// (default [`CovarianceMethod::Auto`]: exact when the model is covered;
+    /// [`CovarianceMethod::Bootstrap`] simulates B series, as the package).
+    pub fn with_covariance(mut self, method: CovarianceMethod) -> Self {
+        self.covariance = method;
         self
     }
 
@@ -274,9 +285,9 @@ impl Wic {
     /// Runs the selection on the series `x` sampled at `freq_hz` (METHODS §8.6):
     ///
     /// 1. the WV of `x`, its fast weights, and the full model fitted in guess mode;
-    /// 2. asymptotic optimism: `V` = full covariance of the WV over B series simulated from
-    ///    the full model's estimate (reused for every candidate, a package design choice,
-    ///    §13.15);
+    /// 2. asymptotic optimism: `V` = full covariance of the WV at the full model's estimate
+    ///    (reused for every candidate, a package design choice, §13.15), exact or over B
+    ///    series simulated from it ([`Wic::with_covariance`]);
     /// 3. every candidate (in parallel; each search seeded with `seed`) fitted in guess mode
     ///    against the same WV and weights; objective, optimism, WIC, GoF p-value (the J-test of
     ///    §7.3 with `V`, or with the bootstrap optimism the bootstrap p-value of §7.4);
@@ -294,7 +305,8 @@ impl Wic {
     /// the smaller one's optimism plus a random `|N(0, obj/10)|` draw; here every optimism is
     /// the formula's.
     ///
-    /// Cost: one WV of `x`, B simulations and WVs of length N, one fit per candidate plus the
+    /// Cost: one WV of `x`, V (exact: O(J^2); bootstrap: B simulations and WVs of length N),
+    /// one fit per candidate plus the
     /// refits of its canonical reading (with the bootstrap optimism, B simulations, WVs and two
     /// fits per candidate on top).
     ///
@@ -383,15 +395,17 @@ impl Wic {
         };
         // V of the full model: the asymptotic optimism's, and with either optimism the
         // sampling covariance behind the WIC differences' standard errors (step 5)
-        let v = wv_bootstrap(
+        let covariance = wv_covariance(
             &full_fit.active_model().map_err(fit_error(&self.full))?,
             wv.n,
             freq_hz,
             &replicate_opts,
+            self.covariance,
             self.bootstrap,
             self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET),
-        )?
-        .cov;
+            &NoProgress,
+        )?;
+        let v = covariance.v;
         let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&full_fit.weights.omega));
         let context = Context {
             wic: self,
@@ -399,6 +413,7 @@ impl Wic {
             inputs,
             omega: &omega,
             v: (self.method == OptimismMethod::Asymptotic).then_some(&v),
+            v_replicates: covariance.replicates,
             replicate_opts: &replicate_opts,
         };
         let done = AtomicUsize::new(0);
@@ -424,7 +439,12 @@ impl Wic {
             .zip(self.candidates.par_iter())
             .map(|(r, c)| r.map_err(fit_error(c)))
             .collect::<Result<_, _>>()?;
-        Ok(self.assemble(scored, &full_fit.weights.omega, &v, &wv.log_variance()))
+        Ok(self.assemble(
+            scored,
+            &full_fit.weights.omega,
+            (&v, covariance.replicates),
+            &wv.log_variance(),
+        ))
     }
 
     /// Steps 4 and 5 of [`Wic::select`]: folds the scored candidates into rows of canonical
@@ -433,7 +453,7 @@ impl Wic {
         &self,
         mut scored: Vec<Scored>,
         omega: &[f64],
-        v: &DMatrix<f64>,
+        (v, v_replicates): (&DMatrix<f64>, Option<usize>),
         log_variance: &[f64],
     ) -> ModelSelection {
         // candidates with one canonical model and one objective (within WIC_TIE_REL) are one
@@ -589,6 +609,12 @@ impl Wic {
             selected_canonical: chosen.canonical.clone(),
             fit: chosen.fit.clone(),
             candidate_fits,
+            v_method: if v_replicates.is_some() {
+                "bootstrap"
+            } else {
+                "exact"
+            },
+            v_replicates,
             wv_covariance: v.clone(),
         }
     }
@@ -687,6 +713,8 @@ struct Context<'a> {
     inputs: StartInputs,
     omega: &'a DMatrix<f64>,
     v: Option<&'a DMatrix<f64>>,
+    /// Replicates behind V; `None` when exact.
+    v_replicates: Option<usize>,
     replicate_opts: &'a WvOptions,
 }
 
@@ -729,10 +757,10 @@ impl Context<'_> {
         asymptotic_optimism(&a, &d, self.omega, v, self.wic.convention)
     }
 
-    /// METHODS §7.3 with the full model's V, debiased for its inversion by the Hartlap
-    /// factor ([`hartlap_factor`]); `None` when `J <= p` (no degrees of freedom), when B is
-    /// too small for an invertible estimate (`B <= J + 2`), V is not positive definite or the
-    /// estimate lies on the boundary of its transform domain.
+    /// METHODS §7.3 with the full model's V, a bootstrap one debiased for its inversion by the
+    /// Hartlap factor ([`hartlap_factor`]); `None` when `J <= p` (no degrees of freedom), when
+    /// B is too small for an invertible estimate (`B <= J + 2`), V is not positive definite or
+    /// the estimate lies on the boundary of its transform domain.
     fn j_test_p_value(
         &self,
         candidate: &Model,
@@ -740,7 +768,11 @@ impl Context<'_> {
         v: &DMatrix<f64>,
     ) -> Result<Option<f64>, FitError> {
         let levels = fit.nu_hat.len();
-        let Some(factor) = hartlap_factor(self.wic.bootstrap, levels) else {
+        let factor = match self.v_replicates {
+            Some(b) => hartlap_factor(b, levels),
+            None => Some(1.0),
+        };
+        let Some(factor) = factor else {
             return Ok(None);
         };
         if levels <= fit.active_parameters().len() {
@@ -889,7 +921,8 @@ pub struct SelectionRow {
 /// The result of a WIC selection (METHODS §8.6).
 ///
 /// Wire format: `full_model`, `method` (`asymptotic`/`bootstrap`), `convention`
-/// (`corrected`/`package`, used by the asymptotic optimism), `bootstrap` (B), `rule`
+/// (`corrected`/`package`, used by the asymptotic optimism), `bootstrap` (B), `v_method`
+/// (`exact`/`bootstrap`: how V was obtained), `v_replicates` (B, or null when exact), `rule`
 /// ([`SelectionRule`]), `separation_limit` (of the canonical readings), `rows`
 /// ([`SelectionRow`], one per canonical model,
 /// sorted by `wic`), `candidates` ([`CandidateScore`], every candidate, sorted by `wic`
@@ -905,6 +938,10 @@ pub struct ModelSelection {
     pub(crate) convention: OptimismConvention,
     /// Bootstrap replicates B.
     pub(crate) bootstrap: usize,
+    /// How V was obtained: `"exact"` or `"bootstrap"`.
+    pub(crate) v_method: &'static str,
+    /// Replicates behind V; `None` when exact.
+    pub(crate) v_replicates: Option<usize>,
     /// How the selected row was chosen.
     pub(crate) rule: SelectionRule,
     /// Separation below which a fit and its canonical reduction are not told apart.
@@ -922,9 +959,10 @@ pub struct ModelSelection {
     /// Every candidate's fit, in the order of `candidates` (not serialised).
     #[serde(skip)]
     pub(crate) candidate_fits: Vec<GmwmFit>,
-    /// The bootstrap covariance V of the WV (`bootstrap` replicates simulated from the full
-    /// model's fit, which nests every candidate), for inference on the selected fit without
-    /// simulating again ([`crate::inference::infer_with_covariance`]); not serialised.
+    /// The covariance V of the WV at the full model's fit, which nests every candidate (exact,
+    /// or over `bootstrap` replicates simulated from it), for inference on the selected fit
+    /// without computing it again ([`crate::inference::infer_with_covariance`]); not
+    /// serialised.
     #[serde(skip)]
     pub(crate) wv_covariance: DMatrix<f64>,
 }
@@ -991,11 +1029,22 @@ impl ModelSelection {
         &self.candidate_fits
     }
 
-    /// The bootstrap covariance V of the WV (`bootstrap` replicates simulated from the full
-    /// model's fit, which nests every candidate), for inference on the selected fit without
-    /// simulating again ([`crate::inference::infer_with_covariance`]); not serialised.
+    /// The covariance V of the WV at the full model's fit, which nests every candidate (exact,
+    /// or over `bootstrap` replicates simulated from it), for inference on the selected fit
+    /// without computing it again ([`crate::inference::infer_with_covariance`]); not
+    /// serialised.
     pub fn wv_covariance(&self) -> &DMatrix<f64> {
         &self.wv_covariance
+    }
+
+    /// How V was obtained: `"exact"` or `"bootstrap"`.
+    pub fn v_method(&self) -> &'static str {
+        self.v_method
+    }
+
+    /// Replicates behind V; `None` when exact.
+    pub fn v_replicates(&self) -> Option<usize> {
+        self.v_replicates
     }
 }
 

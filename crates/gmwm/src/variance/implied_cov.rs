@@ -292,11 +292,9 @@ impl Parts {
     }
 }
 
-/// One pair of levels `(j, k)`: the 3 x 3 tap offsets and the pair counts.
+/// One pair of levels `(j, k)`.
 struct Pair<'a> {
     parts: &'a Parts,
-    /// `(a - b, c_a c_b)` for `a in A_j`, `b in A_k`.
-    taps: [(i64, f64); 9],
     /// `1 / (L_j L_k)`
     scale: f64,
     mu2: f64,
@@ -392,7 +390,6 @@ fn pair_covariance(parts: &Parts, n: usize, j: usize, k: usize) -> f64 {
     }
     let pair = Pair {
         parts,
-        taps,
         scale: 1.0 / (lj as f64 * lk as f64),
         mu2: parts.dr * parts.dr * (lj as f64) * (lk as f64) / 16.0,
         n,
@@ -480,7 +477,7 @@ pub(crate) fn exact_covariance_of(
 /// docs give the formulas). Divide by the efficiency for a robust WV.
 ///
 /// ```
-/// use gmwm::Model;
+/// use gmwm::model::Model;
 /// use gmwm::variance::implied_cov::exact_wv_covariance;
 /// let model = Model::parse("WN(sigma2=1)").unwrap();
 /// let v = exact_wv_covariance(&model, 4096, 1.0, 3).unwrap();
@@ -656,7 +653,6 @@ mod tests {
                 }
                 let pair = Pair {
                     parts: &parts,
-                    taps,
                     scale: 1.0 / (lj * lk) as f64,
                     mu2: parts.dr * parts.dr * (lj * lk) as f64 / 16.0,
                     n: n as i64,
