@@ -186,8 +186,10 @@ pub fn named<T>(items: &[(String, T)]) -> Vec<crate::render::Named<'_, T>> {
 pub struct LoadedRecording {
     /// The file.
     pub path: std::path::PathBuf,
-    /// Its axes.
-    pub imu: gmwm::imu::Imu,
+    /// Its columns and what each measures.
+    pub columns: Vec<(String, gmwm::imu::SensorInfo)>,
+    /// Its samples; `None` for a recording the calibration streams from the file.
+    pub imu: Option<gmwm::imu::Imu>,
     /// The ROS topic read, if any.
     pub topic: Option<String>,
     /// What it was read from.
@@ -208,11 +210,32 @@ pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
     let rec = gmwm::imu::Recording::open(&input.file, &opts)?;
     Ok(LoadedRecording {
         path: rec.path,
-        imu: rec.imu,
+        columns: rec
+            .imu
+            .axes()
+            .iter()
+            .map(|a| (a.column.name.clone(), a.info.clone()))
+            .collect(),
+        imu: Some(rec.imu),
         topic: rec.topic,
         source: rec.source,
         timing: rec.timing,
         notes: rec.notes,
+    })
+}
+
+/// A raw binary recording the calibration streams ([`gmwm::calib::Calibration::streams`]):
+/// its columns and what each measures from the sidecar, no samples read.
+pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
+    let columns = gmwm::calib::streamed::columns(&input.file, &input.read)?;
+    Ok(LoadedRecording {
+        path: input.file.clone(),
+        columns,
+        imu: None,
+        topic: None,
+        source: gmwm::imu::RecordingSource::Table,
+        timing: None,
+        notes: Vec::new(),
     })
 }
 

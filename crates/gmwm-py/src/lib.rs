@@ -777,6 +777,7 @@ fn calibrate(
         gyro_unit: unit(gyro_unit, "gyro_unit")?,
         accel_unit: unit(accel_unit, "accel_unit")?,
         robust_check: Some(RobustOptions::new(eff, convention).map_err(engine)?),
+        ..CalibrationOptions::default()
     };
     let policy = match axis_policy {
         "worst" => AxisPolicy::Worst,

@@ -22,6 +22,7 @@ mod ros;
 mod scale;
 mod selection;
 mod sim;
+mod streamed;
 mod units;
 mod wavelet;
 mod wv;

@@ -73,21 +73,32 @@ pub fn execute_in(
 ) -> Result<Calibrated> {
     let print_summary = mode.print_summary;
     let exports = &config.exports;
-    let recording = crate::input::load_recording(&config.input)?;
+    let calibration = Calibration::new(config.options.clone());
+    // a long raw binary recording is calibrated while streamed from the file (bounded memory)
+    let streamed = config.input.topic.is_none()
+        && calibration.streams(&config.input.file, &config.input.read)?;
+    let recording = if streamed {
+        crate::input::streamed_recording(&config.input)?
+    } else {
+        crate::input::load_recording(&config.input)?
+    };
     if !exports.is_empty() {
         check_units_known(config, &recording)?;
     }
-    let calibration = Calibration::new(config.options.clone());
     let per_axis = calibration.candidates_per_axis()?;
-    let axes = recording.imu.axes().len();
+    let axes = recording.columns.len();
     let progress = if mode.batch {
         indicatif::ProgressBar::hidden()
     } else {
         bar((axes * per_axis) as u64, "calibrating", "candidate fits")
     };
-    let report = calibration
-        .run_with_progress(&recording.imu, &Ticks(&progress))
-        .with_context(|| recording.path.display().to_string())?;
+    let report = match &recording.imu {
+        Some(imu) => calibration
+            .run_with_progress(imu, &Ticks(&progress))
+            .map_err(gmwm::Error::from),
+        None => calibration.run_file(&config.input.file, &config.input.read, &Ticks(&progress)),
+    }
+    .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();
     // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
     // says so in a comment
@@ -251,14 +262,13 @@ fn check_units_known(
 ) -> Result<()> {
     use gmwm::imu::Sensor;
     let options = &config.options;
-    for a in recording.imu.axes() {
-        let (given, flag) = match a.sensor() {
+    for (name, info) in &recording.columns {
+        let (given, flag) = match info.sensor {
             Sensor::Gyroscope => (options.gyro_unit.is_some(), "--gyro-unit rad/s|deg/s|deg/h"),
             Sensor::Accelerometer => (options.accel_unit.is_some(), "--accel-unit m/s^2|g|mg"),
             _ => continue,
         };
-        let known = a
-            .info
+        let known = info
             .unit
             .as_deref()
             .is_some_and(|u| u.parse::<gmwm::units::SignalUnit>().is_ok());
@@ -266,9 +276,8 @@ fn check_units_known(
             return Err(UsageError(format!(
                 "{}: the unit of column {} is unknown{} and the exported files are SI: give {flag}",
                 recording.path.display(),
-                a.column.name,
-                a.info
-                    .unit
+                name,
+                info.unit
                     .as_deref()
                     .map(|u| format!(" ({})", gmwm::imu::quote(u)))
                     .unwrap_or_default()

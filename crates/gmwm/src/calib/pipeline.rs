@@ -6,7 +6,7 @@ use super::contamination::{compare_classical_robust, Contamination, FitUses};
 use super::ieee::{ieee_readoff, IeeeReadoff};
 use crate::fit::canonical::long_run_variance;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
-use crate::imu::{Imu, Sensor};
+use crate::imu::{allan_from_wv, Imu, Sensor, SensorInfo};
 use crate::inference::{
     infer_with_covariance, CovarianceMethod, Inference, InferenceOptions, Progress,
 };
@@ -73,6 +73,9 @@ pub struct CalibrationOptions {
     /// The robust estimator the classical WV is compared with to tell whether contamination
     /// matters (paper Fig. 2; default `eff = 0.6`, the package's; `None` skips the check).
     pub robust_check: Option<RobustOptions>,
+    /// Samples per column from which [`Calibration::run_file`] streams a raw binary recording
+    /// instead of reading it into memory (default [`crate::calib::STREAM_FROM`], 2^24).
+    pub stream_from: u64,
 }
 
 impl Default for CalibrationOptions {
@@ -90,6 +93,7 @@ impl Default for CalibrationOptions {
             gyro_unit: None,
             accel_unit: None,
             robust_check: Some(RobustOptions::default()),
+            stream_from: crate::calib::STREAM_FROM,
         }
     }
 }
@@ -361,52 +365,74 @@ impl Calibration {
         imu: &Imu,
         progress: &dyn Progress,
     ) -> Result<CalibrationReport, CalibError> {
-        let axes: Vec<_> = imu
+        let axes: Vec<InputAxis<'_>> = imu
             .axes()
             .iter()
-            .filter(|a| a.sensor() != Sensor::Other)
+            .map(|a| InputAxis {
+                column: &a.column.name,
+                info: &a.info,
+                data: AxisData::Series(a.values()),
+            })
+            .collect();
+        self.run_axes(
+            imu.name(),
+            imu.freq_hz(),
+            imu.len(),
+            axes,
+            Vec::new(),
+            progress,
+        )
+    }
+
+    /// The pipeline on the inertial axes among `axes` of a recording of `samples` samples per
+    /// axis at `freq_hz`; `checks` are recording-level lines of the caller.
+    pub(crate) fn run_axes(
+        &self,
+        name: Option<&str>,
+        freq_hz: f64,
+        samples: usize,
+        all: Vec<InputAxis<'_>>,
+        mut checks: Vec<String>,
+        progress: &dyn Progress,
+    ) -> Result<CalibrationReport, CalibError> {
+        let columns = all.iter().map(|a| a.column).collect::<Vec<_>>().join(", ");
+        let axes: Vec<InputAxis<'_>> = all
+            .into_iter()
+            .filter(|a| a.info.sensor != Sensor::Other)
             .collect();
         if axes.is_empty() {
-            return Err(CalibError::NoInertialAxis {
-                columns: imu
-                    .axes()
-                    .iter()
-                    .map(|a| a.column.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            });
+            return Err(CalibError::NoInertialAxis { columns });
         }
         let per_axis = self
             .candidates_per_axis()
             .map_err(|source| CalibError::Selection {
-                column: axes[0].column.name.clone(),
+                column: axes[0].column.to_string(),
                 source: Box::new(source),
             })?;
         progress.start(axes.len() * per_axis);
         let done = AtomicUsize::new(0);
         let shared = |_: usize| progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
         let results: Vec<Result<AxisCalibration, CalibError>> = axes
-            .par_iter()
+            .into_par_iter()
             .map(|axis| {
-                let kind = match axis.sensor() {
+                let kind = match axis.info.sensor {
                     Sensor::Gyroscope => Some(SignalKind::Gyroscope),
                     Sensor::Accelerometer => Some(SignalKind::Accelerometer),
                     Sensor::Other => None,
                 };
                 self.axis(
-                    &axis.column.name,
+                    axis.column,
                     &axis.info.axis,
                     kind,
                     axis.info.unit.as_deref(),
-                    axis.values(),
-                    imu.freq_hz(),
+                    axis.data,
+                    freq_hz,
                     &shared,
                 )
             })
             .collect();
         // an axis that cannot be calibrated (a dead, constant channel, say) is left out with a
         // check line; only when none can is the calibration an error
-        let mut checks = Vec::new();
         let mut axes = Vec::new();
         let mut first_error = None;
         for r in results {
@@ -425,7 +451,7 @@ impl Calibration {
                 return Err(e);
             }
         }
-        let duration_s = imu.len() as f64 / imu.freq_hz();
+        let duration_s = samples as f64 / freq_hz;
         if let Some(longest) = axes
             .iter()
             .filter_map(|a| a.wv.tau_s.last().copied())
@@ -440,9 +466,9 @@ impl Calibration {
             }
         }
         Ok(CalibrationReport {
-            name: imu.name().map(str::to_string),
-            freq_hz: imu.freq_hz(),
-            samples: imu.len(),
+            name: name.map(str::to_string),
+            freq_hz,
+            samples,
             duration_s,
             full_model: self.options.full_model.to_string(),
             rule: self.options.rule,
@@ -506,17 +532,30 @@ impl Calibration {
         axis_label: &str,
         kind: Option<SignalKind>,
         recorded_unit: Option<&str>,
-        values: &[f64],
+        data: AxisData<'_>,
         freq_hz: f64,
         progress: &dyn Progress,
     ) -> Result<AxisCalibration, CalibError> {
         let mut notes = Vec::new();
         let unit = self.unit_of(column, kind, recorded_unit, &mut notes)?;
-        // every result in SI: the samples are converted once, before any statistic
-        let si_values: Option<Vec<f64>> = unit
-            .filter(|u| u.to_si() != 1.0)
-            .map(|u| values.iter().map(|v| v * u.to_si()).collect());
-        let x = si_values.as_deref().unwrap_or(values);
+        // every result in SI: the samples (or the streamed WVs) are converted once, before any
+        // statistic
+        let to_si = unit.map_or(1.0, |u| u.to_si());
+        let si_values: Option<Vec<f64>> = match data {
+            AxisData::Series(values) if to_si != 1.0 => {
+                Some(values.iter().map(|v| v * to_si).collect())
+            }
+            _ => None,
+        };
+        let data = match (&si_values, data) {
+            (Some(x), _) => AxisData::Series(x),
+            (None, AxisData::Streamed { wv, robust }) if to_si != 1.0 => AxisData::Streamed {
+                wv: Box::new(wv.scaled(to_si * to_si)),
+                robust: robust.map(|r| r.map(|w| Box::new(w.scaled(to_si * to_si)))),
+            },
+            (None, d) => d,
+        };
+        let samples = data.samples();
         // a kind without a known unit reads in the data unit: no SI names, no datasheet forms
         let unit_kind = kind.filter(|_| unit.is_some());
         // results of an axis whose unit is not understood are in the data unit, named "u" (the
@@ -546,12 +585,14 @@ impl Calibration {
         if let Some(g) = self.options.draws {
             wic = wic.with_draws(g);
         }
-        let selection = wic
-            .select_with_progress(x, freq_hz, progress)
-            .map_err(|source| CalibError::Selection {
-                column: column.to_string(),
-                source: Box::new(source),
-            })?;
+        let selection = match &data {
+            AxisData::Series(x) => wic.select_with_progress(x, freq_hz, progress),
+            AxisData::Streamed { wv, .. } => wic.select_wv_with_progress(wv, progress),
+        }
+        .map_err(|source| CalibError::Selection {
+            column: column.to_string(),
+            source: Box::new(source),
+        })?;
         let wv = selection.fit.empirical.clone().ok_or_else(|| {
             fit_error(FitError::Length {
                 what: "stored WV",
@@ -589,15 +630,19 @@ impl Calibration {
         let canonical = fit
             .canonical_with(selection.separation_limit)
             .map_err(fit_error)?;
-        let allan = allan_variance(
-            x,
-            freq_hz,
-            &AllanOptions {
-                alpha: self.options.wv.alpha,
-                ..AllanOptions::default()
-            },
-        )
-        .map_err(engine)?;
+        let allan = match &data {
+            AxisData::Series(x) => allan_variance(
+                x,
+                freq_hz,
+                &AllanOptions {
+                    alpha: self.options.wv.alpha,
+                    ..AllanOptions::default()
+                },
+            )
+            .map_err(engine)?,
+            // METHODS §3.4: the overlapping AV is twice the classical Haar WV, exactly
+            AxisData::Streamed { wv, .. } => allan_from_wv(wv).map_err(|e| engine(e.into()))?,
+        };
         let ieee = ieee_readoff(&allan).map_err(|e| engine(e.into()))?;
         let z = inference.z;
         let readoff = Readoff {
@@ -668,7 +713,7 @@ impl Calibration {
             }
         }
         notes.extend(readings);
-        let contamination = self.contamination(x, freq_hz, &wv, &mut notes);
+        let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
         Ok(AxisCalibration {
             column: column.to_string(),
             kind,
@@ -677,7 +722,7 @@ impl Calibration {
                 .map(|u| u.symbol().to_string())
                 .or_else(|| recorded_unit.map(str::to_string)),
             unit: unit_label,
-            samples: values.len(),
+            samples,
             model: selection.selected.to_string(),
             canonical_model: canonical.model.to_string(),
             identified_model: fit.model.without_values().to_string(),
@@ -700,16 +745,38 @@ impl Calibration {
         })
     }
 
-    /// The classical WV of `x` against the robust one ([`compare_classical_robust`]); `wv` is
-    /// the axis' WV, classical or robust as the options ask, so only the other is computed.
+    /// The classical WV of the axis against the robust one ([`compare_classical_robust`]);
+    /// `wv` is the axis' WV, classical or robust as the options ask, so only the other is
+    /// computed (a streamed axis brings its robust WV).
     fn contamination(
         &self,
-        x: &[f64],
+        data: &AxisData<'_>,
         freq_hz: f64,
         wv: &WaveletVariance,
         notes: &mut Vec<String>,
     ) -> Option<Contamination> {
         let robust_options = self.options.robust_check?;
+        let alpha = self.options.wv.alpha;
+        let x = match data {
+            AxisData::Series(x) => *x,
+            AxisData::Streamed { robust, .. } => {
+                return match robust {
+                    Some(Ok(r)) => Some(compare_classical_robust(
+                        wv.clone(),
+                        (**r).clone(),
+                        FitUses::Classical,
+                        alpha,
+                    )),
+                    Some(Err(e)) => {
+                        notes.push(format!(
+                            "the classical and robust WVs could not be compared: {e}"
+                        ));
+                        None
+                    }
+                    None => None,
+                };
+            }
+        };
         let other = WvOptions {
             levels: Some(wv.levels()),
             robust: match wv.robust {
@@ -718,7 +785,6 @@ impl Calibration {
             },
             ..self.options.wv
         };
-        let alpha = self.options.wv.alpha;
         match wavelet_variance(x, freq_hz, &other) {
             Ok(w) => Some(match wv.robust {
                 Some(_) => compare_classical_robust(w, wv.clone(), FitUses::Robust, alpha),
@@ -730,6 +796,35 @@ impl Calibration {
                 ));
                 None
             }
+        }
+    }
+}
+
+/// One column of a recording, as the pipeline takes it.
+pub(crate) struct InputAxis<'a> {
+    pub(crate) column: &'a str,
+    pub(crate) info: &'a SensorInfo,
+    pub(crate) data: AxisData<'a>,
+}
+
+/// What one axis is calibrated from: its samples in memory, or its WVs computed while the
+/// recording was streamed (bounded memory at any length).
+#[derive(Debug, Clone)]
+pub(crate) enum AxisData<'a> {
+    /// The samples.
+    Series(&'a [f64]),
+    /// The classical WV and, for the contamination check, the robust one (`None`: no check).
+    Streamed {
+        wv: Box<WaveletVariance>,
+        robust: Option<Result<Box<WaveletVariance>, String>>,
+    },
+}
+
+impl AxisData<'_> {
+    fn samples(&self) -> usize {
+        match self {
+            AxisData::Series(x) => x.len(),
+            AxisData::Streamed { wv, .. } => wv.n,
         }
     }
 }

@@ -113,17 +113,21 @@ impl SensorInfo {
         table
             .columns
             .iter()
-            .map(|c| {
-                let inferred = SensorInfo::infer(&c.name).or_else(|| {
-                    sidecar
-                        .and_then(|s| s.meaning(&c.name))
-                        .and_then(SensorInfo::infer)
-                });
-                let (sensor, axis) = inferred.unwrap_or((Sensor::Other, c.name.clone()));
-                let unit = SensorInfo::column_unit(&c.name, sensor, sidecar, record);
-                SensorInfo { sensor, axis, unit }
-            })
+            .map(|c| SensorInfo::of_column(&c.name, sidecar, record))
             .collect()
+    }
+
+    /// What the column `name` measures: [`SensorInfo::infer`] on its name, else on the
+    /// sidecar's meaning of it, with [`SensorInfo::column_unit`] (`record`: binary IMU records).
+    pub fn of_column(name: &str, sidecar: Option<&Sidecar>, record: bool) -> SensorInfo {
+        let inferred = SensorInfo::infer(name).or_else(|| {
+            sidecar
+                .and_then(|s| s.meaning(name))
+                .and_then(SensorInfo::infer)
+        });
+        let (sensor, axis) = inferred.unwrap_or((Sensor::Other, name.to_string()));
+        let unit = SensorInfo::column_unit(name, sensor, sidecar, record);
+        SensorInfo { sensor, axis, unit }
     }
 
     /// The unit of a column, as text: the one its name states, else the sidecar's for its

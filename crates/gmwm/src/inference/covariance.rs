@@ -74,6 +74,9 @@ impl WvCovariance {
 /// [`InputError`] for a model without values, a bad rate or levels; with
 /// [`CovarianceMethod::Exact`], a process or estimator the formulas do not cover; with the
 /// bootstrap, fewer than 2 replicates or a failed simulation.
+// the bootstrap's own settings (replicates, seed, progress) sit beside the model's; a struct
+// for them would be used by this function alone
+#[allow(clippy::too_many_arguments)]
 pub fn wv_covariance(
     model: &Model,
     n: usize,

@@ -253,9 +253,21 @@ impl WaveletVariance {
             .collect()
     }
 
+    /// The WV of the series times `sqrt(factor)` (a unit conversion): estimates and interval
+    /// ends times `factor`, counts and degrees of freedom unchanged.
+    pub(crate) fn scaled(&self, factor: f64) -> Self {
+        let times = |v: &[f64]| v.iter().map(|x| x * factor).collect();
+        Self {
+            wv: times(&self.wv),
+            ci_low: times(&self.ci_low),
+            ci_high: times(&self.ci_high),
+            ..self.clone()
+        }
+    }
+
     /// Assembles the result from per-level estimates and counts: scales, chi-square intervals
     /// (METHODS §1.7) and, for robust estimates, the robust intervals of §2.5.
-    fn assemble(
+    pub(crate) fn assemble(
         n: usize,
         freq_hz: f64,
         opts: &WvOptions,

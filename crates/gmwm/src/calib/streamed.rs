@@ -1,0 +1,404 @@
+//! Calibration of a raw binary recording streamed from its file, in memory bounded whatever
+//! its length (a day at 1 kHz is 8.6·10^7 samples an axis).
+//!
+//! The pipeline of [`Calibration::run`] needs the samples only for four things, and each has a
+//! streamed form:
+//! - **the classical Haar WV**: accumulated chunk by chunk ([`crate::HaarWvAccumulator`]), one
+//!   pass over the file for every axis; identical to the in-memory estimate within 1e-12;
+//! - **the Allan variance**: `AV(m) = 2 nu2(2m)`, exact from that WV (METHODS §3.4,
+//!   [`allan_from_wv`](crate::imu::allan_from_wv));
+//! - **the model selection and the fit**: they use the WV only ([`crate::Wic::select_wv`]);
+//!   the starting values then come from the WV alone (no series range for drift draws), and
+//!   V is the exact covariance ([`crate::variance::implied_cov`]), which needs no series;
+//! - **the contamination check**: the robust WV is a root per level over all the level's
+//!   coefficients, which an exact streamed computation would need several passes and the
+//!   coefficients near the root for. Here it is estimated on consecutive blocks of
+//!   [`ROBUST_BLOCK`] samples, in memory one block at a time: per level, the blocks' robust
+//!   estimates averaged with weights their coefficient counts, at the levels up to
+//!   [`ROBUST_LEVELS`] (scales of at most `2^15` samples, where a block holds at least 64
+//!   windows). The interval is the robust one (METHODS §2.5) for the pooled count. The error
+//!   of this approximation against the robust WV of the whole series is measured in the
+//!   tests (`streamed_robust_matches_whole_series`); contamination (spikes, steps) shows at
+//!   the fine scales, which the check covers.
+//!
+//! Memory: a chunk of rows, the accumulators (`8 · 2^J` bytes per axis for their rings) and
+//! one block per axis for the robust check.
+
+use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
+use crate::error::{Error, ParamError};
+use crate::imu::{
+    binary_layout, find_sidecar, BinaryChunks, BinaryLayout, ColumnSelector, ReadError,
+    ReadOptions, SensorInfo,
+};
+use crate::inference::Progress;
+use crate::variance::ci::eta3;
+use crate::variance::default_levels;
+use crate::variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};
+use crate::wavelet::{Transform, WaveletFilter};
+use rayon::prelude::*;
+use std::path::Path;
+
+/// Default samples per axis from which [`Calibration::run_file`] streams a raw binary
+/// recording instead of reading it (2^24, 128 MiB an axis in f64;
+/// [`CalibrationOptions::stream_from`](super::CalibrationOptions::stream_from)).
+pub const STREAM_FROM: u64 = 1 << 24;
+/// Samples per block of the streamed robust check (2^21).
+pub const ROBUST_BLOCK: usize = 1 << 21;
+/// Levels of the streamed robust check: scales up to `2^15` samples, at least 64 windows a
+/// block.
+pub const ROBUST_LEVELS: usize = 15;
+/// Rows per read of the classical pass.
+const CHUNK_ROWS: usize = 1 << 16;
+
+impl Calibration {
+    /// Whether [`Calibration::run_file`] streams `path`: a raw binary f64/f32 file (by
+    /// `read.format`, its name or its sidecar) of at least `stream_from` rows whose columns
+    /// have no time column, calibrated with the classical Haar MODWT WV.
+    ///
+    /// # Errors
+    /// As [`binary_layout`] and [`BinaryChunks::open`].
+    pub fn streams(&self, path: &Path, read: &ReadOptions) -> Result<bool, Error> {
+        Ok(self.stream_layout(path, read)?.is_some())
+    }
+
+    fn stream_layout(
+        &self,
+        path: &Path,
+        read: &ReadOptions,
+    ) -> Result<Option<(BinaryLayout, u64)>, Error> {
+        let wv = &self.options().wv;
+        if read.time_column.is_some()
+            || wv.robust.is_some()
+            || wv.transform != Transform::Modwt
+            || wv.filter != WaveletFilter::Haar
+        {
+            return Ok(None);
+        }
+        let Some(layout) = binary_layout(path, read)? else {
+            return Ok(None);
+        };
+        if layout
+            .names
+            .iter()
+            .any(|n| crate::imu::time_column_unit(n).is_some())
+        {
+            return Ok(None);
+        }
+        let rows = BinaryChunks::open(path, layout.format, layout.ncols, 1, 1)?.rows();
+        Ok((rows >= self.options().stream_from.max(1)).then_some((layout, rows)))
+    }
+
+    /// Calibrates the raw binary recording `path` streamed from the file (module docs): the
+    /// same report as [`Calibration::run`] on the recording read into memory, up to the
+    /// contamination check (on blocks, at the fine scales) and the starting values (from the
+    /// WV), in memory bounded whatever the length.
+    ///
+    /// # Errors
+    /// [`ParamError`] (as [`Error`]) when `path` is not a raw binary file of at least
+    /// `stream_from` rows ([`Calibration::streams`]); read errors naming the file (a
+    /// non-finite value with its sample index, a truncated file); no rate known; the errors of
+    /// [`Calibration::run`].
+    pub fn run_file(
+        &self,
+        path: &Path,
+        read: &ReadOptions,
+        progress: &dyn Progress,
+    ) -> Result<CalibrationReport, Error> {
+        let Some((layout, rows)) = self.stream_layout(path, read)? else {
+            return Err(ParamError::new(
+                "input",
+                path.display().to_string(),
+                format!(
+                    "a raw binary f64/f32 recording of at least {} samples per column without a time column, for a streamed calibration",
+                    self.options().stream_from
+                ),
+            )
+            .into());
+        };
+        let sidecar = find_sidecar(path)?;
+        let (columns, infos) = selected(path, &layout, read)?;
+        let freq_hz = read
+            .freq_hz
+            .or_else(|| sidecar.as_ref().and_then(|s| s.sampling_frequency_hz))
+            .ok_or_else(|| ReadError::FreqNotDerivable {
+                path: path.to_path_buf(),
+                reason: "no freq_hz given and no sampling_frequency_hz in a sidecar",
+            })?;
+        crate::error::check_freq(freq_hz)?;
+        // only the inertial axes are streamed; the pipeline names the others if none is
+        let inertial: Vec<usize> = (0..columns.len())
+            .filter(|&k| infos[k].sensor != crate::imu::Sensor::Other)
+            .collect();
+        let streamed: Vec<usize> = inertial.iter().map(|&k| columns[k]).collect();
+        let n = usize::try_from(rows)
+            .map_err(|_| ParamError::new("rows", rows, "at most usize::MAX samples per column"))?;
+        let levels = self
+            .options()
+            .wv
+            .levels
+            .unwrap_or_else(|| default_levels(n, Transform::Modwt, WaveletFilter::Haar));
+        let classical = if streamed.is_empty() {
+            Vec::new()
+        } else {
+            classical_pass(
+                path,
+                &layout,
+                &streamed,
+                levels,
+                freq_hz,
+                self.options().wv.alpha,
+            )?
+        };
+        let robust = match (self.options().robust_check, streamed.is_empty()) {
+            (Some(r), false) => Some(robust_pass(
+                path,
+                &layout,
+                &streamed,
+                &classical,
+                &WvOptions {
+                    levels: Some(levels.min(ROBUST_LEVELS)),
+                    robust: Some(r),
+                    ..self.options().wv
+                },
+            )?),
+            _ => None,
+        };
+        // an axis whose WV fails (a constant column, say) is left out with a check line, as
+        // the in-memory pipeline does; only when every axis fails is that an error
+        let mut checks = Vec::new();
+        let mut data: Vec<Option<AxisData<'_>>> = (0..columns.len()).map(|_| None).collect();
+        let mut failed = Vec::new();
+        let mut first_error = None;
+        for (i, (&k, wv)) in inertial.iter().zip(classical).enumerate() {
+            match wv {
+                Ok(wv) => {
+                    data[k] = Some(AxisData::Streamed {
+                        wv: Box::new(wv),
+                        robust: robust.as_ref().map(|r| r[i].clone()),
+                    })
+                }
+                Err(e) => {
+                    let column = &layout.names[columns[k] - 1];
+                    checks.push(format!("not calibrated: column {column}: {e}"));
+                    failed.push(k);
+                    first_error.get_or_insert(crate::calib::CalibError::Engine {
+                        column: column.clone(),
+                        source: e,
+                    });
+                }
+            }
+        }
+        if !inertial.is_empty() && failed.len() == inertial.len() {
+            if let Some(e) = first_error {
+                return Err(e.into());
+            }
+        }
+        let axes: Vec<InputAxis<'_>> = columns
+            .iter()
+            .zip(&infos)
+            .zip(data)
+            .enumerate()
+            .filter(|(k, _)| !failed.contains(k))
+            .map(|(_, ((&c, info), data))| InputAxis {
+                column: &layout.names[c - 1],
+                info,
+                // a column that is not inertial is only named, never calibrated
+                data: data.unwrap_or(AxisData::Series(&[])),
+            })
+            .collect();
+        let name = sidecar
+            .as_ref()
+            .and_then(|s| s.name.clone())
+            .or_else(|| path.file_name().map(|f| f.to_string_lossy().into_owned()));
+        checks.push(format!(
+            "streamed from the file ({n} samples per axis, at least {}): the Allan variance from the WV (exact), starting values from the WV; the contamination check compares the scales up to {} samples with a robust WV estimated on blocks of {ROBUST_BLOCK} samples",
+            self.options().stream_from,
+            1usize << levels.min(ROBUST_LEVELS)
+        ));
+        Ok(self.run_axes(name.as_deref(), freq_hz, n, axes, checks, progress)?)
+    }
+}
+
+/// The selected columns of the raw binary recording `path` (all without a selection) and what
+/// each measures (by its name, else the sidecar's meaning; units from the name or sidecar),
+/// without reading the samples.
+///
+/// # Errors
+/// A file that is not raw binary f64/f32 ([`ParamError`]); a sidecar that cannot be read; a
+/// selected column the file does not have.
+pub fn columns(path: &Path, read: &ReadOptions) -> Result<Vec<(String, SensorInfo)>, Error> {
+    let layout = binary_layout(path, read)?.ok_or_else(|| {
+        ParamError::new(
+            "input",
+            path.display().to_string(),
+            "a raw binary f64/f32 recording (by --format, its name or its sidecar)",
+        )
+    })?;
+    let (columns, infos) = selected(path, &layout, read)?;
+    Ok(columns
+        .into_iter()
+        .zip(infos)
+        .map(|(c, info)| (layout.names[c - 1].clone(), info))
+        .collect())
+}
+
+/// The selected 1-based columns and what each measures.
+fn selected(
+    path: &Path,
+    layout: &BinaryLayout,
+    read: &ReadOptions,
+) -> Result<(Vec<usize>, Vec<SensorInfo>), Error> {
+    let sidecar = find_sidecar(path)?;
+    let columns = selected_columns(path, layout, &read.columns)?;
+    let infos = columns
+        .iter()
+        .map(|&c| SensorInfo::of_column(&layout.names[c - 1], sidecar.as_ref(), false))
+        .collect();
+    Ok((columns, infos))
+}
+
+/// The 1-based indices of the selected columns (all without a selection).
+fn selected_columns(
+    path: &Path,
+    layout: &BinaryLayout,
+    selection: &[ColumnSelector],
+) -> Result<Vec<usize>, ReadError> {
+    if selection.is_empty() {
+        return Ok((1..=layout.ncols).collect());
+    }
+    selection
+        .iter()
+        .map(|c| {
+            let index = match c {
+                ColumnSelector::Index(i) => *i,
+                ColumnSelector::Name(name) => layout
+                    .names
+                    .iter()
+                    .position(|m| m == name)
+                    .map(|k| k + 1)
+                    .or_else(|| name.strip_prefix("col").and_then(|k| k.parse().ok()))
+                    .ok_or_else(|| ReadError::UnknownColumn {
+                        path: path.to_path_buf(),
+                        name: name.clone(),
+                        available: layout.names.clone(),
+                    })?,
+            };
+            if (1..=layout.ncols).contains(&index) {
+                Ok(index)
+            } else {
+                Err(ReadError::ColumnOutOfRange {
+                    path: path.to_path_buf(),
+                    index,
+                    ncols: layout.ncols,
+                })
+            }
+        })
+        .collect()
+}
+
+/// One pass over the file: the classical WV of each column (its own error, e.g. a constant
+/// column, per column).
+fn classical_pass(
+    path: &Path,
+    layout: &BinaryLayout,
+    columns: &[usize],
+    levels: usize,
+    freq_hz: f64,
+    alpha: f64,
+) -> Result<Vec<Result<WaveletVariance, crate::InputError>>, Error> {
+    let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, CHUNK_ROWS)?;
+    let mut accumulators = columns
+        .iter()
+        .map(|_| HaarWvAccumulator::new(levels))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut buffers = vec![Vec::with_capacity(CHUNK_ROWS); columns.len()];
+    while chunks.next_chunk_of(columns, &mut buffers)?.is_some() {
+        accumulators
+            .par_iter_mut()
+            .zip(&buffers)
+            .try_for_each(|(acc, values)| acc.push(values))?;
+    }
+    Ok(accumulators
+        .into_iter()
+        .map(|acc| acc.finish(freq_hz, alpha))
+        .collect())
+}
+
+/// The blocks' robust WV of each column (module docs); `classical` gives the intervals'
+/// classical side. A level whose root a block lacks is undefined.
+fn robust_pass(
+    path: &Path,
+    layout: &BinaryLayout,
+    columns: &[usize],
+    classical: &[Result<WaveletVariance, crate::InputError>],
+    opts: &WvOptions,
+) -> Result<Vec<Result<Box<WaveletVariance>, String>>, Error> {
+    let levels = opts.levels.unwrap_or(ROBUST_LEVELS);
+    let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, ROBUST_BLOCK)?;
+    // per column and level: sum of count x estimate, sum of counts; None once undefined
+    let mut pooled: Vec<Vec<Option<(f64, usize)>>> =
+        vec![vec![Some((0.0, 0)); levels]; columns.len()];
+    let mut buffers = vec![Vec::with_capacity(ROBUST_BLOCK); columns.len()];
+    let mut blocks = 0usize;
+    while let Some(rows) = chunks.next_chunk_of(columns, &mut buffers)? {
+        // a short last block holding fewer than 64 windows of the coarsest level is left out
+        if rows < 64 << levels && blocks > 0 {
+            break;
+        }
+        blocks += 1;
+        let block_levels = levels.min(default_levels(rows, Transform::Modwt, WaveletFilter::Haar));
+        let results: Vec<Option<WaveletVariance>> = buffers
+            .par_iter()
+            .map(|x| {
+                wavelet_variance(
+                    x,
+                    1.0,
+                    &WvOptions {
+                        levels: Some(block_levels),
+                        ..*opts
+                    },
+                )
+                .ok()
+            })
+            .collect();
+        for (pool, r) in pooled.iter_mut().zip(results) {
+            for (j, slot) in pool.iter_mut().enumerate() {
+                let estimate = r
+                    .as_ref()
+                    .and_then(|w| Some((*w.wv.get(j)?, *w.n_coefficients.get(j)?)));
+                *slot = match (*slot, estimate) {
+                    (Some((s, m)), Some((v, k))) if v.is_finite() && v > 0.0 => {
+                        Some((s + v * k as f64, m + k))
+                    }
+                    _ => None,
+                };
+            }
+        }
+    }
+    Ok(pooled
+        .into_iter()
+        .zip(classical)
+        .map(|(pool, c)| {
+            let c = c.as_ref().map_err(|e| e.to_string())?;
+            let robust: Vec<f64> = pool
+                .iter()
+                .map(|p| p.map_or(f64::NAN, |(s, m)| s / m as f64))
+                .collect();
+            let counts: Vec<usize> = pool.iter().map(|p| p.map_or(0, |(_, m)| m)).collect();
+            let eta: Vec<f64> = counts
+                .iter()
+                .enumerate()
+                .map(|(j, &m)| eta3(m.max(1), j + 1))
+                .collect();
+            Ok(Box::new(WaveletVariance::assemble(
+                c.n,
+                c.freq_hz,
+                opts,
+                &c.wv[..levels.min(c.wv.len())],
+                Some(&robust[..levels.min(c.wv.len())]),
+                counts[..levels.min(c.wv.len())].to_vec(),
+                eta[..levels.min(c.wv.len())].to_vec(),
+            )))
+        })
+        .collect())
+}

@@ -1,0 +1,153 @@
+//! The streamed calibration of a raw binary recording (`gmwm::calib::streamed`) against the
+//! in-memory one, and its block-wise robust WV against the robust WV of the whole series.
+
+use gmwm::calib::{Calibration, CalibrationOptions, ROBUST_LEVELS};
+use gmwm::imu::{read_table, Imu, ReadOptions};
+use gmwm::inference::NoProgress;
+use gmwm::model::Model;
+use gmwm::sim::simulate_model;
+use gmwm::{wavelet_variance, RobustOptions, WvOptions};
+use std::path::Path;
+
+fn write_f64(path: &Path, columns: &[Vec<f64>]) {
+    let n = columns[0].len();
+    let mut bytes = Vec::with_capacity(8 * n * columns.len());
+    for t in 0..n {
+        for c in columns {
+            bytes.extend_from_slice(&c[t].to_le_bytes());
+        }
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Two gyroscope axes in deg/s and a temperature column, 2^20 samples at 100 Hz: streamed and
+/// in memory give the same WV (1e-12: the accumulator sums per block, the kernel per tile),
+/// the same Allan variance (METHODS §3.4, exact up to rounding; the in-memory one may have one
+/// more cluster length, of one term), the same selected models, and
+/// the same noise density and random walk within 1e-4 (the two fits start from different
+/// values, the streamed one from the WV alone, and stop at the optimiser's tolerance).
+#[test]
+fn streamed_calibration_matches_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("imu.f64");
+    let n = 1 << 20;
+    let m1 =
+        Model::parse("WN(sigma2=1e-4)+RW(gamma2=1e-10)+GM(beta=0.05, sigma2_gm=1e-6)").unwrap();
+    let m2 = Model::parse("WN(sigma2=4e-4)+RW(gamma2=4e-10)").unwrap();
+    let x = simulate_model(&m1, n, 100.0, 1).unwrap();
+    let y = simulate_model(&m2, n, 100.0, 2).unwrap();
+    let temp: Vec<f64> = (0..n).map(|t| 25.0 + (t % 7) as f64 * 0.01).collect();
+    write_f64(&path, &[x, y, temp]);
+    std::fs::write(
+        dir.path().join("imu.f64.json"),
+        r#"{"sampling_frequency_hz": 100, "format": "f64", "n_columns": 3, "units": {"gyro": "deg/s"},
+            "columns": [{"name": "gyro_x"}, {"name": "gyro_y"}, {"name": "temperature"}]}"#,
+    )
+    .unwrap();
+    let read = ReadOptions::default();
+    let streaming = Calibration::new(CalibrationOptions {
+        stream_from: 1,
+        ..CalibrationOptions::default()
+    });
+    assert!(streaming.streams(&path, &read).unwrap());
+    let streamed = streaming.run_file(&path, &read, &NoProgress).unwrap();
+    let imu = Imu::from_table(read_table(&path, &read).unwrap()).unwrap();
+    let in_memory = Calibration::new(CalibrationOptions::default())
+        .run(&imu)
+        .unwrap();
+    assert!(!Calibration::new(CalibrationOptions::default())
+        .streams(&path, &read)
+        .unwrap());
+    assert_eq!(streamed.axes.len(), 2);
+    assert!(streamed.checks.iter().any(|c| c.starts_with("streamed")));
+    for (s, m) in streamed.axes.iter().zip(&in_memory.axes) {
+        assert_eq!(s.column, m.column);
+        assert_eq!(s.samples, n);
+        assert_eq!(s.unit, "rad/s");
+        for j in 0..m.wv.wv().len() {
+            assert!(
+                rel(s.wv.wv()[j], m.wv.wv()[j]) < 1e-12,
+                "{} WV level {}",
+                s.column,
+                j + 1
+            );
+            assert!(rel(s.wv.ci_high()[j], m.wv.ci_high()[j]) < 1e-12);
+        }
+        // the in-memory AV also has the one-term cluster m = N/2 beyond the WV's last level
+        assert!(m.allan.avar().len() - s.allan.avar().len() <= 1);
+        for (a, b) in s.allan.avar().iter().zip(m.allan.avar()) {
+            assert!(rel(*a, *b) < 1e-12, "{} AV {a} vs {b}", s.column);
+        }
+        assert_eq!(s.model, m.model, "{}", s.column);
+        let pairs = [
+            (&s.noise_density, &m.noise_density),
+            (&s.random_walk, &m.random_walk),
+        ];
+        for (es, em) in pairs {
+            let (vs, vm) = (es.as_ref().unwrap().value, em.as_ref().unwrap().value);
+            assert!(rel(vs, vm) < 1e-4, "{}: {vs} vs {vm}", s.column);
+        }
+        let c = s.contamination.as_ref().expect("a robust check");
+        assert_eq!(c.levels, ROBUST_LEVELS.min(m.wv.wv().len()));
+        assert!(!c.matters, "{}: {}", s.column, c.summary);
+    }
+}
+
+/// The robust WV of blocks of 2^21 samples, averaged, against the robust WV of the whole
+/// series (2^23 samples, so 4 blocks), on white noise with 0.1% spikes: within a quarter of the
+/// whole-series robust interval's half-width at every level up to 2^15 samples, and so far
+/// from the classical WV the spikes inflate. Measured (this seed): at most 3.9% of the
+/// half-width.
+#[test]
+fn streamed_robust_matches_whole_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("spiky.f64");
+    let n = 1 << 23;
+    let mut x = simulate_model(&Model::parse("WN(sigma2=1)").unwrap(), n, 1.0, 5).unwrap();
+    for t in (0..n).step_by(997) {
+        x[t] += 50.0;
+    }
+    write_f64(&path, &[x.clone()]);
+    std::fs::write(
+        dir.path().join("spiky.f64.json"),
+        r#"{"sampling_frequency_hz": 1, "format": "f64", "units": {"gyro": "rad/s"},
+            "columns": [{"name": "gyro_x"}]}"#,
+    )
+    .unwrap();
+    let streamed = Calibration::new(CalibrationOptions {
+        stream_from: 1,
+        ..CalibrationOptions::default()
+    })
+    .run_file(&path, &ReadOptions::default(), &NoProgress)
+    .unwrap();
+    let c = streamed.axes[0].contamination.as_ref().unwrap();
+    assert!(c.matters, "{}", c.summary);
+    let whole = wavelet_variance(
+        &x,
+        1.0,
+        &WvOptions {
+            levels: Some(ROBUST_LEVELS),
+            robust: Some(RobustOptions::default()),
+            ..WvOptions::default()
+        },
+    )
+    .unwrap();
+    let mut worst: f64 = 0.0;
+    for j in 0..ROBUST_LEVELS {
+        let half = 0.5 * (whole.ci_high()[j] - whole.ci_low()[j]);
+        let off = (c.robust.wv()[j] - whole.wv()[j]).abs() / half;
+        worst = worst.max(off);
+        assert!(
+            off < 0.25,
+            "level {}: {} vs {} (half-width {half})",
+            j + 1,
+            c.robust.wv()[j],
+            whole.wv()[j]
+        );
+    }
+    eprintln!("streamed robust: worst difference {worst:.3} of the half-width");
+}
