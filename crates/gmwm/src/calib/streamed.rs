@@ -21,8 +21,10 @@
 //!   tests (`streamed_robust_matches_whole_series`); contamination (spikes, steps) shows at
 //!   the fine scales, which the check covers.
 //!
-//! Memory: a chunk of rows, the accumulators (`8 · 2^J` bytes per axis for their rings) and
-//! one block per axis for the robust check.
+//! Memory: a chunk of rows, the accumulators' rings up to level 18 (2 MiB an axis), the lagged
+//! blocks of the coarser levels (`2^18` samples each, `J - 16` of them an axis,
+//! [`coarse_square_sums`]) and one block per axis for the robust check: about 30 MB an axis
+//! whatever the length.
 
 use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
 use crate::error::{Error, ParamError};
@@ -33,6 +35,7 @@ use crate::imu::{
 use crate::inference::Progress;
 use crate::variance::ci::eta3;
 use crate::variance::default_levels;
+use crate::variance::haar_coarse::coarse_square_sums;
 use crate::variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};
 use crate::wavelet::{Transform, WaveletFilter};
 use rayon::prelude::*;
@@ -137,32 +140,38 @@ impl Calibration {
             .wv
             .levels
             .unwrap_or_else(|| default_levels(n, Transform::Modwt, WaveletFilter::Haar));
-        let classical = if streamed.is_empty() {
-            Vec::new()
+        let robust_opts = self.options().robust_check.map(|r| WvOptions {
+            levels: Some(levels.min(ROBUST_LEVELS)),
+            robust: Some(r),
+            ..self.options().wv
+        });
+        // the two passes at once: the robust one only needs the classical WV at the end
+        let (classical, pooled) = if streamed.is_empty() {
+            (Vec::new(), None)
         } else {
-            classical_pass(
-                path,
-                &layout,
-                &streamed,
-                levels,
-                freq_hz,
-                self.options().wv.alpha,
-            )?
-        };
-        let robust = match (self.options().robust_check, streamed.is_empty()) {
-            (Some(r), false) => Some(robust_pass(
-                path,
-                &layout,
-                &streamed,
-                &classical,
-                &WvOptions {
-                    levels: Some(levels.min(ROBUST_LEVELS)),
-                    robust: Some(r),
-                    ..self.options().wv
+            let (c, r) = rayon::join(
+                || {
+                    classical_pass(
+                        path,
+                        &layout,
+                        &streamed,
+                        levels,
+                        freq_hz,
+                        self.options().wv.alpha,
+                    )
                 },
-            )?),
-            _ => None,
+                || {
+                    robust_opts
+                        .as_ref()
+                        .map(|o| robust_pass(path, &layout, &streamed, o))
+                        .transpose()
+                },
+            );
+            (c?, r?)
         };
+        let robust = pooled
+            .zip(robust_opts)
+            .map(|(p, o)| robust_wvs(p, &classical, &o));
         // an axis whose WV fails (a constant column, say) is left out with a check line, as
         // the in-memory pipeline does; only when every axis fails is that an error
         let mut checks = Vec::new();
@@ -296,8 +305,13 @@ fn selected_columns(
         .collect()
 }
 
-/// One pass over the file: the classical WV of each column (its own error, e.g. a constant
-/// column, per column).
+/// Levels up to which the classical pass keeps the accumulator's rings (`8 · 2^18` bytes, 2
+/// MiB an axis); coarser levels read their lagged samples again ([`coarse_square_sums`]).
+const RING_LEVELS: usize = 18;
+
+/// The classical WV of each column (its own error, e.g. a constant column, per column): the
+/// levels up to [`RING_LEVELS`] in one pass through [`HaarWvAccumulator`]s, the coarser ones
+/// from lagged blocks of the file ([`coarse_square_sums`]), the two at once.
 fn classical_pass(
     path: &Path,
     layout: &BinaryLayout,
@@ -306,38 +320,157 @@ fn classical_pass(
     freq_hz: f64,
     alpha: f64,
 ) -> Result<Vec<Result<WaveletVariance, crate::InputError>>, Error> {
-    let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, CHUNK_ROWS)?;
-    let mut accumulators = columns
-        .iter()
-        .map(|_| HaarWvAccumulator::new(levels))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut buffers = vec![Vec::with_capacity(CHUNK_ROWS); columns.len()];
-    while chunks.next_chunk_of(columns, &mut buffers)?.is_some() {
-        accumulators
-            .par_iter_mut()
-            .zip(&buffers)
-            .try_for_each(|(acc, values)| acc.push(values))?;
+    let fine_levels = levels.min(RING_LEVELS);
+    let fine = || -> Result<Vec<Result<WaveletVariance, crate::InputError>>, Error> {
+        let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, CHUNK_ROWS)?;
+        let mut accumulators = columns
+            .iter()
+            .map(|_| HaarWvAccumulator::new(fine_levels))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut buffers = vec![Vec::with_capacity(CHUNK_ROWS); columns.len()];
+        while chunks.next_chunk_of(columns, &mut buffers)?.is_some() {
+            accumulators
+                .par_iter_mut()
+                .zip(&buffers)
+                .try_for_each(|(acc, values)| acc.push(values))?;
+        }
+        Ok(accumulators
+            .into_iter()
+            .map(|acc| acc.finish(freq_hz, alpha))
+            .collect())
+    };
+    if levels <= RING_LEVELS {
+        return fine();
     }
-    Ok(accumulators
+    let coarse = || -> Result<Vec<Vec<(f64, usize)>>, Error> {
+        let mut reader = RowReader::open(path, layout, columns)?;
+        let n = reader.rows;
+        // the accumulator's offset: the mean of the first 2048 samples (any offset would do)
+        let mut head = vec![Vec::new(); columns.len()];
+        reader.read(0, n.min(2048), &mut head)?;
+        let offsets: Vec<f64> = head
+            .iter()
+            .map(|h| h.iter().sum::<f64>() / h.len().max(1) as f64)
+            .collect();
+        coarse_square_sums(n, RING_LEVELS, levels, &offsets, |k, out| {
+            let from = k << RING_LEVELS;
+            let to = (from + (1 << RING_LEVELS)).min(n);
+            reader.read(from, to - from, out)
+        })
+    };
+    let (fine, coarse) = rayon::join(fine, coarse);
+    let (fine, coarse) = (fine?, coarse?);
+    Ok(fine
         .into_iter()
-        .map(|acc| acc.finish(freq_hz, alpha))
+        .zip(coarse)
+        .map(|(wv, sums)| {
+            let wv = wv?;
+            let mut values = wv.wv.clone();
+            let mut counts = wv.n_coefficients.clone();
+            for (&(sum, kept), j) in sums.iter().zip(RING_LEVELS + 1..) {
+                if kept == 0 {
+                    break;
+                }
+                values.push(sum / kept as f64);
+                counts.push(kept);
+                debug_assert_eq!(kept, wv.n + 1 - (1usize << j));
+            }
+            let eta = counts
+                .iter()
+                .enumerate()
+                .map(|(i, &m)| eta3(m, i + 1))
+                .collect();
+            Ok(WaveletVariance::assemble(
+                wv.n,
+                freq_hz,
+                &WvOptions {
+                    levels: Some(values.len()),
+                    alpha,
+                    ..WvOptions::default()
+                },
+                &values,
+                None,
+                counts,
+                eta,
+            ))
+        })
         .collect())
 }
 
-/// The blocks' robust WV of each column (module docs); `classical` gives the intervals'
-/// classical side. A level whose root a block lacks is undefined.
+/// Positioned reads of rows of a raw binary file (the coarse levels read lagged blocks).
+struct RowReader {
+    file: std::fs::File,
+    path: std::path::PathBuf,
+    width: usize,
+    ncols: usize,
+    columns: Vec<usize>,
+    rows: usize,
+    bytes: Vec<u8>,
+}
+
+impl RowReader {
+    fn open(path: &Path, layout: &BinaryLayout, columns: &[usize]) -> Result<Self, Error> {
+        let width = layout.format.value_width().ok_or_else(|| {
+            ParamError::new("format", format!("{:?}", layout.format), "f64 or f32")
+        })?;
+        let io = |source| ReadError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = std::fs::File::open(path).map_err(io)?;
+        let len = file.metadata().map_err(io)?.len();
+        let rows = usize::try_from(len / (width * layout.ncols) as u64).unwrap_or(usize::MAX);
+        Ok(Self {
+            file,
+            path: path.to_path_buf(),
+            width,
+            ncols: layout.ncols,
+            columns: columns.to_vec(),
+            rows,
+            bytes: Vec::new(),
+        })
+    }
+
+    /// Rows `from .. from + count` of the selected columns, appended to `out[column]`.
+    fn read(&mut self, from: usize, count: usize, out: &mut [Vec<f64>]) -> Result<(), Error> {
+        use std::os::unix::fs::FileExt;
+        let row = self.width * self.ncols;
+        self.bytes.resize(count * row, 0);
+        self.file
+            .read_exact_at(&mut self.bytes, (from * row) as u64)
+            .map_err(|source| ReadError::Io {
+                path: self.path.clone(),
+                source,
+            })?;
+        for (o, &c) in out.iter_mut().zip(&self.columns) {
+            let at = (c - 1) * self.width;
+            o.extend(self.bytes.chunks_exact(row).map(|r| {
+                let v = &r[at..at + self.width];
+                match self.width {
+                    8 => f64::from_le_bytes(v.try_into().unwrap_or([0; 8])),
+                    _ => f64::from(f32::from_le_bytes(v.try_into().unwrap_or([0; 4]))),
+                }
+            }));
+        }
+        Ok(())
+    }
+}
+
+/// Per column and level, over the blocks: the sum of count x robust estimate and the sum of
+/// counts (`None` once a block has no root at that level).
+type Pooled = Vec<Vec<Option<(f64, usize)>>>;
+
+/// The blocks' robust WVs of each column, pooled (module docs).
 fn robust_pass(
     path: &Path,
     layout: &BinaryLayout,
     columns: &[usize],
-    classical: &[Result<WaveletVariance, crate::InputError>],
     opts: &WvOptions,
-) -> Result<Vec<Result<Box<WaveletVariance>, String>>, Error> {
+) -> Result<Pooled, Error> {
     let levels = opts.levels.unwrap_or(ROBUST_LEVELS);
     let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, ROBUST_BLOCK)?;
     // per column and level: sum of count x estimate, sum of counts; None once undefined
-    let mut pooled: Vec<Vec<Option<(f64, usize)>>> =
-        vec![vec![Some((0.0, 0)); levels]; columns.len()];
+    let mut pooled: Pooled = vec![vec![Some((0.0, 0)); levels]; columns.len()];
     let mut buffers = vec![Vec::with_capacity(ROBUST_BLOCK); columns.len()];
     let mut blocks = 0usize;
     while let Some(rows) = chunks.next_chunk_of(columns, &mut buffers)? {
@@ -375,7 +508,18 @@ fn robust_pass(
             }
         }
     }
-    Ok(pooled
+    Ok(pooled)
+}
+
+/// The pooled robust WV of each column (module docs); `classical` gives the intervals'
+/// classical side. A level whose root a block lacks is undefined.
+fn robust_wvs(
+    pooled: Pooled,
+    classical: &[Result<WaveletVariance, crate::InputError>],
+    opts: &WvOptions,
+) -> Vec<Result<Box<WaveletVariance>, String>> {
+    let levels = opts.levels.unwrap_or(ROBUST_LEVELS);
+    pooled
         .into_iter()
         .zip(classical)
         .map(|(pool, c)| {
@@ -390,15 +534,16 @@ fn robust_pass(
                 .enumerate()
                 .map(|(j, &m)| eta3(m.max(1), j + 1))
                 .collect();
+            let k = levels.min(c.wv.len());
             Ok(Box::new(WaveletVariance::assemble(
                 c.n,
                 c.freq_hz,
                 opts,
-                &c.wv[..levels.min(c.wv.len())],
-                Some(&robust[..levels.min(c.wv.len())]),
-                counts[..levels.min(c.wv.len())].to_vec(),
-                eta[..levels.min(c.wv.len())].to_vec(),
+                &c.wv[..k],
+                Some(&robust[..k]),
+                counts[..k].to_vec(),
+                eta[..k].to_vec(),
             )))
         })
-        .collect())
+        .collect()
 }
