@@ -46,6 +46,10 @@ Rows (ids for ``--only``):
                  (ONE axis, 31 candidates).                                 goal: <= 4 s
   select_boot    the same on --columns gyro_x with --optimism bootstrap; no R peer (no
                  reference timing of auto_imu(bootstrap = TRUE)).          goal: <= 15 s
+  calib1e8       (only when asked: --only calib1e8) writes a 10^8-sample raw f64 file (800
+                 MB: white noise sd 1e-3 plus a random walk of step sd 1e-6, numpy
+                 default_rng(8), sidecar gyro_x at 100 Hz) and times `gmwm calibrate FILE
+                 --format f64`; also its peak RSS (wait4).  goal: <= 10 s and <= 200 MB
 
 Peers. allantools runs in ``--peer-python`` (default: this interpreter); when it cannot import
 allantools the row is skipped with the install command (``--install-peers`` pip-installs it).
@@ -104,7 +108,9 @@ ROW_IDS = [
     "select6",
     "select_boot",
 ]
-OPTIONAL_ROW_IDS = ["stream1e6_kernel"]
+OPTIONAL_ROW_IDS = ["stream1e6_kernel", "calib1e8"]
+BIG_N = 100_000_000
+BIG_SEED = 8
 
 # the truth of shared/ref/timings_gmwm_3gm.json (paper Tab. II/III) in AR1 form at 1 Hz
 TRUTH_3AR1 = "AR1(phi=0.9, sigma2=1)+AR1(phi=0.99, sigma2=0.1)+AR1(phi=0.999, sigma2=0.01)"
@@ -174,6 +180,7 @@ class Timed:
         self.cwd = cwd
         self.runs: List[float] = []
         self.wall: List[float] = []
+        self.max_rss_mb: List[float] = []
         self.status = "pending"
         self.rc: Optional[int] = None
         self.error = ""
@@ -202,6 +209,7 @@ class Timed:
             "wall_s": self.wall,
             "median_s": self.median,
             "min_s": self.minimum,
+            "max_rss_mb": self.max_rss_mb,
             "error": self.error or None,
         }
 
@@ -224,7 +232,9 @@ def run_once(t: Timed, outdir: Path, timeout: float, verbose: bool) -> Optional[
         killer = threading.Timer(timeout, p.kill)
         killer.start()
         try:
-            p.wait()
+            # wait4: the child's peak resident set size comes with its exit status
+            _, status, usage = os.wait4(p.pid, 0)
+            p.returncode = os.waitstatus_to_exitcode(status)
         finally:
             killer.cancel()
         wall = time.perf_counter() - start
@@ -244,6 +254,7 @@ def run_once(t: Timed, outdir: Path, timeout: float, verbose: bool) -> Optional[
             return None
         value = float(hit.group(1))
     t.wall.append(wall)
+    t.max_rss_mb.append(usage.ru_maxrss / 1024.0)  # Linux: kilobytes
     if verbose:
         extra = f" (Rscript process {fmt_s(wall)})" if t.metric == "r_elapsed" else ""
         log(f"    {t.label}: {fmt_s(value)}{extra}")
@@ -484,6 +495,7 @@ class Row:
         self.ref_fallback: Optional[Tuple[float, float, str]] = None  # for a live R peer that fails
         self.criterion = False
         self.heavy = False                   # no warm-up runs (they would take as long as a timed run)
+        self.rss_max_mb: Optional[float] = None  # a peak-RSS goal beside the time goal
 
     def finish(self) -> None:
         if self.status == "skipped":
@@ -529,7 +541,17 @@ class Row:
             return None
         g = self.gmwm_value[0] if self.gmwm_value else None
         p = self.peer_value[0] if self.peer_value else None
-        return self.goal.met(g, p)
+        met = self.goal.met(g, p)
+        rss = self.peak_rss_mb
+        if met is not None and self.rss_max_mb is not None:
+            met = met and rss is not None and rss <= self.rss_max_mb
+        return met
+
+    @property
+    def peak_rss_mb(self) -> Optional[float]:
+        """The largest peak RSS over the gmwm runs."""
+        values = [v for t in self.gmwm for v in t.max_rss_mb]
+        return max(values) if values else None
 
     def cells(self) -> List[str]:
         if self.status == "skipped":
@@ -539,6 +561,8 @@ class Row:
         else:
             med, lo = self.gmwm_value or (None, None)
             gm = f"{fmt_s(med)} (min {fmt_s(lo)})"
+            if self.rss_max_mb is not None and self.peak_rss_mb is not None:
+                gm += f", peak RSS {self.peak_rss_mb:.0f} MB"
         if self.peer_value and self.peer_value[0] is not None:
             med, lo = self.peer_value
             pc = f"{fmt_s(med)} {self.peer_label}"
@@ -563,7 +587,9 @@ class Row:
             "peer": {"label": self.peer_label, "source": self.peer_source, "median_s": p[0], "min_s": p[1],
                      "commands": [t.to_json() for t in self.peer]},
             "ratio_peer_over_gmwm": self.ratio,
-            "goal": {"kind": self.goal.kind, "value": self.goal.value, "text": self.goal.text()},
+            "goal": {"kind": self.goal.kind, "value": self.goal.value, "text": self.goal.text(),
+                     "max_rss_mb": self.rss_max_mb},
+            "peak_rss_mb": self.peak_rss_mb,
             "met": self.met,
             "notes": self.notes,
         }
@@ -763,7 +789,39 @@ def build_rows(args: argparse.Namespace, wanted: List[str], work: Path, gmwm: st
                        refs.auto_imu(), call)
                 row.peer_label += " — one axis, 31 candidates"
             rows.append(row)
+        elif rid == "calib1e8":
+            row = Row(rid, "`gmwm calibrate` of a 10^8-sample raw f64 file (800 MB; WN + RW, 100 Hz)",
+                      Goal("max_s", 10.0))
+            row.rss_max_mb = 200.0
+            path = work / "imu_1e8.f64"
+            if prepare:
+                log(f"writing 10^8 samples of WN(sd 1e-3) + RW(step 1e-6), numpy default_rng({BIG_SEED}) -> {path}")
+                write_big(path, BIG_N, BIG_SEED)
+            row.gmwm.append(Timed("calib1e8.gmwm", [gmwm, "calibrate", str(path), "--format", "f64"]))
+            row.heavy = True
+            row.peer_label = "— (target: <= 10 s and peak RSS <= 200 MB)"
+            row.peer_source = "none"
+            row.notes.append("peak RSS from wait4 (ru_maxrss) of the gmwm process")
+            rows.append(row)
     return rows
+
+
+def write_big(path: Path, n: int, seed: int) -> None:
+    """n samples of white noise (sd 1e-3) plus a random walk (step sd 1e-6), little-endian f64,
+    written in pieces (memory stays small), with a sidecar naming the column gyro_x at 100 Hz."""
+    import numpy as np
+    rng = np.random.default_rng(seed)
+    piece = 1 << 22
+    level = 0.0
+    with open(path, "wb") as f:
+        for start in range(0, n, piece):
+            m = min(piece, n - start)
+            steps = rng.standard_normal(m) * 1e-6
+            walk = level + np.cumsum(steps)
+            level = float(walk[-1])
+            (rng.standard_normal(m) * 1e-3 + walk).astype("<f8").tofile(f)
+    Path(str(path) + ".json").write_text(json.dumps(
+        {"sampling_frequency_hz": 100, "columns": [{"name": "gyro_x", "unit": "rad/s"}]}))
 
 
 def run_criterion(row: Row, timeout: float) -> None:
