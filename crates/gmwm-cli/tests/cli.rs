@@ -793,6 +793,89 @@ fn fit_accepts_a_wv_json_and_bootstrap_weights() {
     }
 }
 
+/// `--covariance`: the default (auto) takes the exact V for a covered model and says so
+/// (`v_method` "exact", `v_replicates` null); `bootstrap` simulates as the package; `exact` on
+/// a model it does not cover (a generic AR(2)) is one clear error, where auto simulates; the
+/// intervals of the two agree within the bootstrap's noise.
+#[test]
+fn fit_and_select_covariance_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(
+        dir.path(),
+        "sim.csv",
+        "AR1(phi=0.99, sigma2=0.01)+WN(sigma2=1)",
+        1 << 14,
+        1.0,
+        3,
+    );
+    let fit = |method: &str| {
+        run_json(
+            gmwm()
+                .arg("fit")
+                .arg(&csv)
+                .args([
+                    "--model",
+                    "AR1()+WN()",
+                    "--G",
+                    "2000",
+                    "--inference",
+                    "--json",
+                ])
+                .args(["--covariance", method]),
+        )
+    };
+    let exact = fit("auto");
+    let inference = &exact["fits"][0]["inference"];
+    assert_eq!(inference["v_method"], "exact", "{inference}");
+    assert!(inference["v_replicates"].is_null());
+    assert_eq!(fit("exact")["fits"][0]["inference"], *inference);
+    let boot = fit("bootstrap");
+    assert_eq!(boot["fits"][0]["inference"]["v_method"], "bootstrap");
+    assert_eq!(boot["fits"][0]["inference"]["v_replicates"], 100);
+    // 100 replicates: an SE within ~sqrt(1/200) ~ 7% of the exact one; 30% is about 4 SE
+    let se =
+        |doc: &serde_json::Value, k: usize| doc["fits"][0]["parameters"][k]["se"].as_f64().unwrap();
+    for k in 0..3 {
+        let r = se(&boot, k) / se(&exact, k);
+        assert!(
+            (r - 1.0).abs() < 0.3,
+            "parameter {k}: bootstrap/exact SE {r}"
+        );
+    }
+    let select = |method: &str| {
+        run_json(
+            gmwm()
+                .arg("select")
+                .arg(&csv)
+                .args(["--model", "AR1()+WN()+RW()", "--G", "2000", "--json"])
+                .args(["--covariance", method]),
+        )
+    };
+    let s = select("auto");
+    assert_eq!(s["selections"][0]["v_method"], "exact");
+    assert!(s["selections"][0]["v_replicates"].is_null());
+    let b = select("bootstrap");
+    assert_eq!(b["selections"][0]["v_method"], "bootstrap");
+    assert_eq!(b["selections"][0]["v_replicates"], 50);
+    common::assert_one_line_error(
+        gmwm()
+            .arg("fit")
+            .arg(&csv)
+            .args(["--model", "AR(2)+WN()", "--G", "2000", "--inference"])
+            .args(["--covariance", "exact"]),
+        &["ARMA(p, q)", "exact WV covariance", "--covariance auto"],
+    );
+    let auto = run_json(gmwm().arg("fit").arg(&csv).args([
+        "--model",
+        "AR(2)+WN()",
+        "--G",
+        "2000",
+        "--inference",
+        "--json",
+    ]));
+    assert_eq!(auto["fits"][0]["inference"]["v_method"], "bootstrap");
+}
+
 /// `gmwm fit --inference` adds `se`, `ci_low`, `ci_high` per parameter and
 /// `gof: {statistic, df, p_value}` per fit; `--bootstrap B` switches to bootstrap inference.
 #[test]

@@ -61,6 +61,21 @@ def test_select_to_dict_is_the_cli_json():
     assert py == cli
 
 
+def test_fit_inference_covariance_is_the_cli_json():
+    # the exact V by default, the package's bootstrap on request; each as the CLI gives it
+    model = "AR1()+WN()+RW()"
+    for method in ("auto", "bootstrap"):
+        py = gmwm.fit(
+            str(ADIS), columns=["gyro_x"], model=model, G=2000, inference=True, covariance=method
+        ).to_dict()
+        cli = cli_json(
+            "fit", str(ADIS), "--columns", "gyro_x", "--model", model, "--G", "2000", "--inference",
+            "--covariance", method,
+        )
+        assert py == cli
+        assert py["fits"][0]["inference"]["v_method"] == ("exact" if method == "auto" else "bootstrap")
+
+
 def test_calibrate_to_dict_is_the_cli_json():
     py = gmwm.calibrate(str(ADIS), model="2*AR1()+WN()+RW()", bootstrap=10, G=2000)
     # calibrate writes its JSON with --json FILE; "-" is standard output
@@ -203,6 +218,7 @@ def test_implied_and_read():
         (lambda: gmwm.fit(np.random.default_rng(1).normal(size=4096), freq=1, model="WN()", weights="nope"), "weights"),
         (lambda: gmwm.select(np.random.default_rng(1).normal(size=4096), freq=1, model="WN()+RW()", bootstrap=1), "bootstrap"),
         (lambda: gmwm.select(np.random.default_rng(1).normal(size=4096), freq=1), "model"),
+        (lambda: gmwm.select(np.random.default_rng(1).normal(size=4096), freq=1, model="WN()+RW()", covariance="nope"), "covariance"),
         (lambda: gmwm.calibrate(np.ones((6, 4096)), freq=100), ""),
         (lambda: gmwm.calibrate(str(ADIS), gyro_unit="furlong"), "gyro_unit"),
         (lambda: gmwm.calibrate(str(ADIS), inflate=2, conservative=True), "inflate"),

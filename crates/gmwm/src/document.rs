@@ -178,13 +178,16 @@ struct SelectionReport<'a> {
     canonical_notes: Vec<CanonicalNote<'a>>,
     reason: String,
     rule: SelectionRule,
+    v_method: &'static str,
+    v_replicates: Option<usize>,
     rows: &'a [SelectionRow],
     candidates: Vec<CandidateRow>,
 }
 
 /// `{"selections": [...]}`: the document of `gmwm select --json`. Per column: `column`,
-/// `selected`, `selected_canonical`, `canonical`, `canonical_notes`, `reason`, `rule`, `rows`
-/// (one per canonical model, by WIC) and `candidates` (every candidate, by WIC).
+/// `selected`, `selected_canonical`, `canonical`, `canonical_notes`, `reason`, `rule`,
+/// `v_method` (`exact` or `bootstrap`: how V was obtained), `v_replicates` (null when exact),
+/// `rows` (one per canonical model, by WIC) and `candidates` (every candidate, by WIC).
 pub fn selections(items: &[(String, ModelSelection)]) -> Value {
     #[derive(Serialize)]
     struct Doc<'a> {
@@ -200,6 +203,8 @@ pub fn selections(items: &[(String, ModelSelection)]) -> Value {
             canonical_notes: canonical_notes(&s.selected_canonical),
             reason: s.reason(),
             rule: s.rule,
+            v_method: s.v_method,
+            v_replicates: s.v_replicates,
             rows: &s.rows,
             candidates: s
                 .candidates

@@ -201,7 +201,7 @@ impl Parts {
             ParamError::new(
                 "phi",
                 phi,
-                "phi >= 0 for the exact WV covariance (a negative autoregression alternates in sign; its V is simulated)",
+                "phi >= 0 for the exact WV covariance (a negative autoregression alternates in sign; --covariance auto or bootstrap simulates V)",
             )
         };
         for p in processes {
@@ -247,8 +247,8 @@ impl Parts {
                 Process::Arma(_) => {
                     return Err(ParamError::new(
                         "model",
-                        "ARMA(p, q)",
-                        "WN, QN, RW, DR, AR1, GM, MA1 or ARMA11 for the exact WV covariance (a generic ARMA's V is simulated)",
+                        "a generic ARMA(p, q) term",
+                        "only WN, QN, RW, DR, AR1, GM, MA1 and ARMA11 terms for the exact WV covariance (--covariance auto or bootstrap simulates V)",
                     ))
                 }
             }
