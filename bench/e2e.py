@@ -35,9 +35,10 @@ Rows (ids for ``--only``):
   robust_exact   fit_exact with --robust --eff 0.6, vs R robust = TRUE.     goal: ratio >= 50x
   robust_g       fit_g with --robust --eff 0.6, vs R robust = TRUE.         goal: ratio >= 50x
   inference      asymptotic inference at N = 1e6: (gmwm fit ... --inference) - (gmwm fit ...)
-                 with the exact start (--inference is the sandwich with a 100-replicate
-                 parametric-bootstrap V; --bootstrap B would be bootstrap inference), vs R
-                 summary(m, inference = TRUE).                             goal: <= 1 s
+                 with the exact start (--inference is the sandwich with the exact V of the
+                 fitted model, --covariance bootstrap the package's 100-replicate V;
+                 --bootstrap B would be bootstrap inference), vs R summary(m, inference =
+                 TRUE).                                                     goal: <= 1 s
   fit_adis       gmwm fit adis_16405_imu1.csv.gz --columns gyro_x --model "2*GM()+WN()+RW()"
                  --inference, whole command, vs R gmwm_imu + summary(inference = TRUE) on
                  the same column.                                           goal: <= 1 s
