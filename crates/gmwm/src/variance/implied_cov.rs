@@ -377,25 +377,38 @@ fn graded_integral(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
         .sum()
 }
 
-/// `V_jk` for one pair of levels (module docs, step 3).
-fn pair_covariance(parts: &Parts, n: usize, j: usize, k: usize) -> f64 {
-    let (lj, lk) = (1_i64 << j, 1_i64 << k);
-    let n = n as i64;
-    let tap = |l: i64| [(0_i64, 1.0), (l / 2, -2.0), (l, 1.0)];
-    let mut taps = [(0_i64, 0.0); 9];
-    for (i, (a, ca)) in tap(lj).into_iter().enumerate() {
-        for (m, (b, cb)) in tap(lk).into_iter().enumerate() {
-            taps[3 * i + m] = (a - b, ca * cb);
+impl<'a> Pair<'a> {
+    /// Levels `j` and `k` of `n`-sample series.
+    fn new(parts: &'a Parts, n: usize, j: usize, k: usize) -> Self {
+        let (lj, lk) = (1_i64 << j, 1_i64 << k);
+        Pair {
+            parts,
+            scale: 1.0 / (lj as f64 * lk as f64),
+            mu2: parts.dr * parts.dr * (lj as f64) * (lk as f64) / 16.0,
+            n: n as i64,
+            lj,
+            lk,
         }
     }
-    let pair = Pair {
-        parts,
-        scale: 1.0 / (lj as f64 * lk as f64),
-        mu2: parts.dr * parts.dr * (lj as f64) * (lk as f64) / 16.0,
-        n,
-        lj,
-        lk,
-    };
+
+    /// `(a - b, c_a c_b)` for `a in A_j`, `b in A_k` (module docs, step 1).
+    fn taps(&self) -> [(i64, f64); 9] {
+        let tap = |l: i64| [(0_i64, 1.0), (l / 2, -2.0), (l, 1.0)];
+        let mut taps = [(0_i64, 0.0); 9];
+        for (i, (a, ca)) in tap(self.lj).into_iter().enumerate() {
+            for (m, (b, cb)) in tap(self.lk).into_iter().enumerate() {
+                taps[3 * i + m] = (a - b, ca * cb);
+            }
+        }
+        taps
+    }
+}
+
+/// `V_jk` for one pair of levels (module docs, step 3).
+fn pair_covariance(parts: &Parts, n: usize, j: usize, k: usize) -> f64 {
+    let pair = Pair::new(parts, n, j, k);
+    let (n, lj, lk) = (pair.n, pair.lj, pair.lk);
+    let taps = pair.taps();
     // pairs exist for h in [lk - n, n - lj]; only the exponentials reach beyond -lj < h <= lk
     let (mut lo, mut hi) = (lk - n, n - lj);
     if parts.autoregressive.is_empty() {
@@ -643,22 +656,8 @@ mod tests {
             let parts = Parts::of(&processes(text, 1.0)).unwrap();
             for (j, k) in [(1, 1), (1, 13), (5, 9), (12, 13), (13, 13)] {
                 let fast = pair_covariance(&parts, n, j, k);
-                let (lj, lk) = (1_i64 << j, 1_i64 << k);
-                let tap = |l: i64| [(0_i64, 1.0), (l / 2, -2.0), (l, 1.0)];
-                let mut taps = [(0_i64, 0.0); 9];
-                for (i, (a, ca)) in tap(lj).into_iter().enumerate() {
-                    for (m, (b, cb)) in tap(lk).into_iter().enumerate() {
-                        taps[3 * i + m] = (a - b, ca * cb);
-                    }
-                }
-                let pair = Pair {
-                    parts: &parts,
-                    scale: 1.0 / (lj * lk) as f64,
-                    mu2: parts.dr * parts.dr * (lj * lk) as f64 / 16.0,
-                    n: n as i64,
-                    lj,
-                    lk,
-                };
+                let pair = Pair::new(&parts, n, j, k);
+                let (lj, lk, taps) = (pair.lj, pair.lk, pair.taps());
                 let mut direct = 0.0;
                 for h in lk - n as i64..=n as i64 - lj {
                     let mut g = pair.gamma(h as f64);
