@@ -48,7 +48,9 @@ fn select_json_has_the_documented_shape() {
             "rows",
             "rule",
             "selected",
-            "selected_canonical"
+            "selected_canonical",
+            "v_method",
+            "v_replicates"
         ]
     );
     let cands = sel[0]["candidates"].as_array().unwrap();

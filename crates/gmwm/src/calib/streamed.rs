@@ -70,7 +70,8 @@ impl Calibration {
         read: &ReadOptions,
     ) -> Result<Option<(BinaryLayout, u64)>, Error> {
         let wv = &self.options().wv;
-        if read.time_column.is_some()
+        if crate::imu::ros::container_of(path).is_some()
+            || read.time_column.is_some()
             || wv.robust.is_some()
             || wv.transform != Transform::Modwt
             || wv.filter != WaveletFilter::Haar
