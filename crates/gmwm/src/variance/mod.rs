@@ -7,8 +7,11 @@ pub mod cov;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
 pub mod robust;
+pub(crate) mod simd;
+pub(crate) mod stream;
 pub mod wv;
 
+pub use stream::binary_wavelet_variance;
 pub use wv::{default_levels, kept_count};
 
 use rayon::prelude::*;
