@@ -25,8 +25,9 @@ use std::sync::Mutex;
 /// Samples per part of a split pass: `2^22`.
 pub(crate) const PART: usize = 1 << 22;
 
-/// Rows per read: 64 Ki (512 KiB a column of f64).
-const CHUNK: usize = 1 << 16;
+/// Rows per read: 16 Ki (128 KiB a column of f64): the chunk, its demeaned copy and the
+/// samples read back for the top levels stay in the L2 cache.
+const CHUNK: usize = 1 << 14;
 
 /// Levels run through the rings of the pyramid (at most `8 · 2^20` bytes a column); the levels
 /// above run the lag recurrence of [`TopLevel`].
@@ -70,7 +71,7 @@ impl Plan {
 /// to rounding (the same offset, the mean of the first 2048 samples, and the same coefficients,
 /// summed in another order; about 1e-15 relative), and are bit for bit the same whatever the
 /// number of threads. Memory: per column about `8 · 2^min(J, 20)` bytes (the rings of the
-/// pyramid) and, per thread, a few chunks of 64 Ki rows of the file; it does not grow with the
+/// pyramid) and, per thread, a few chunks of 16 Ki rows of the file; it does not grow with the
 /// file's length.
 ///
 /// ```no_run
@@ -217,6 +218,16 @@ pub(crate) trait Source: Sync {
         bytes: &mut Vec<u8>,
         out: &mut [Vec<f64>],
     ) -> Result<(), ReadError>;
+    /// [`read`](Self::read) of rows already read and checked.
+    fn read_again(
+        &self,
+        row: usize,
+        n: usize,
+        bytes: &mut Vec<u8>,
+        out: &mut [Vec<f64>],
+    ) -> Result<(), ReadError> {
+        self.read(row, n, bytes, out)
+    }
 }
 
 /// Columns of a raw binary file.
@@ -243,6 +254,17 @@ impl Source for FileSource<'_> {
         out: &mut [Vec<f64>],
     ) -> Result<(), ReadError> {
         self.raw.read(row as u64, n, &self.columns, bytes, out)
+    }
+
+    fn read_again(
+        &self,
+        row: usize,
+        n: usize,
+        bytes: &mut Vec<u8>,
+        out: &mut [Vec<f64>],
+    ) -> Result<(), ReadError> {
+        self.raw
+            .read_unchecked(row as u64, n, &self.columns, bytes, out)
     }
 }
 
@@ -283,7 +305,7 @@ struct Buffers {
     cur: Vec<Vec<f64>>,
     /// The chunk's demeaned samples, a vector a column.
     y: Vec<Vec<f64>>,
-    /// The demeaned samples `d` rows back, for each lag `d` in use.
+    /// The samples `d` rows back (as read), for each lag `d` in use.
     lags: Vec<(usize, Vec<Vec<f64>>)>,
 }
 
@@ -493,7 +515,7 @@ fn run_part<S: Source>(
             s.acc.push(&cur[c]).map_err(|e| SplitError::Series(c, e))?;
             for top in s.tops.iter_mut().filter(|t| t.start < c1) {
                 let m = 1usize << (top.j - 1);
-                top.push(c0, &y[c], back(m, c), back(2 * m, c));
+                top.push(c0, &y[c], back(m, c), back(2 * m, c), offsets[c]);
             }
             s.block_sums.extend(y[c].chunks(BLOCK).map(sum_plain));
             Ok(())
@@ -518,8 +540,8 @@ fn run_part<S: Source>(
     Ok(part)
 }
 
-/// The demeaned samples `d` rows before `[c0, c0 + len)` of every column into `out`: zeros
-/// before the series start.
+/// The samples `d` rows before `[c0, c0 + len)` of every column into `out`, as read (rows
+/// checked by their own part); before the series start, the column's offset (a demeaned 0).
 fn read_lag<S: Source>(
     src: &S,
     c0: usize,
@@ -529,15 +551,16 @@ fn read_lag<S: Source>(
     bytes: &mut Vec<u8>,
     out: &mut [Vec<f64>],
 ) -> Result<(), ReadError> {
-    let zeros = d.saturating_sub(c0).min(len);
-    if zeros < len {
-        src.read(c0 + zeros - d, len - zeros, bytes, out)?;
+    let before = d.saturating_sub(c0).min(len);
+    if before < len {
+        src.read_again(c0 + before - d, len - before, bytes, out)?;
     } else {
         out.iter_mut().for_each(Vec::clear);
     }
-    for (v, &offset) in out.iter_mut().zip(offsets) {
-        v.iter_mut().for_each(|x| *x -= offset);
-        v.splice(0..0, std::iter::repeat(0.0).take(zeros));
+    if before > 0 {
+        for (v, &offset) in out.iter_mut().zip(offsets) {
+            v.splice(0..0, std::iter::repeat(offset).take(before));
+        }
     }
     Ok(())
 }
@@ -590,9 +613,9 @@ impl TopLevel {
         }
     }
 
-    /// Runs the chunk starting at sample `c0` (a multiple of [`BLOCK`]): demeaned samples `y`
-    /// and those `m` and `2m` rows back.
-    fn push(&mut self, c0: usize, y: &[f64], back_m: &[f64], back_2m: &[f64]) {
+    /// Runs the chunk starting at sample `c0` (a multiple of [`BLOCK`]): demeaned samples `y`,
+    /// and the samples `m` and `2m` rows back as read (`offset` not yet subtracted).
+    fn push(&mut self, c0: usize, y: &[f64], back_m: &[f64], back_2m: &[f64], offset: f64) {
         let from = self.start.saturating_sub(c0).min(y.len());
         let first_kept = (1usize << self.j) - 1;
         for (b, ((y, ym), y2m)) in y[from..]
@@ -603,7 +626,8 @@ impl TopLevel {
         {
             let b0 = c0 + from + b * BLOCK;
             let skip = first_kept.saturating_sub(b0).min(y.len());
-            let (carry, s1, s2) = top_block(&mut self.scratch, self.carry, y, ym, y2m, skip);
+            let (carry, s1, s2) =
+                top_block(&mut self.scratch, self.carry, y, ym, y2m, offset, skip);
             self.carry = carry;
             if skip < y.len() {
                 self.count += (y.len() - skip) as u64;
@@ -637,13 +661,15 @@ impl TopLevel {
 
 crate::variance::simd::multiversion! {
     /// One block of [`TopLevel::push`]: `L` from `carry` on, into `scratch`; returns the
-    /// carry after the block, and `Σ L`, `Σ L²` from index `skip` on.
+    /// carry after the block, and `Σ L`, `Σ L²` from index `skip` on. `xm`, `x2m` are the
+    /// samples `m` and `2m` back, `offset` not yet subtracted.
     fn top_block(
         scratch: &mut Vec<f64>,
         carry: f64,
         y: &[f64],
-        ym: &[f64],
-        y2m: &[f64],
+        xm: &[f64],
+        x2m: &[f64],
+        offset: f64,
         skip: usize,
     ) -> (f64, f64, f64) => top_block_impl
 }
@@ -653,17 +679,18 @@ fn top_block_impl(
     scratch: &mut Vec<f64>,
     carry: f64,
     y: &[f64],
-    ym: &[f64],
-    y2m: &[f64],
+    xm: &[f64],
+    x2m: &[f64],
+    offset: f64,
     skip: usize,
 ) -> (f64, f64, f64) {
     let len = y.len();
     scratch.clear();
     scratch.extend(
         y.iter()
-            .zip(&ym[..len])
-            .zip(&y2m[..len])
-            .map(|((&v, &u), &w)| (v - 2.0 * u) + w),
+            .zip(&xm[..len])
+            .zip(&x2m[..len])
+            .map(|((&v, &u), &w)| (v - 2.0 * (u - offset)) + (w - offset)),
     );
     let carry = if len == BLOCK {
         // four chains, one a quarter, started from the carry plus the quarter totals

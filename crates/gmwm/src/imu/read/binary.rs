@@ -416,36 +416,7 @@ impl RawRows {
         bytes: &mut Vec<u8>,
         out: &mut [Vec<f64>],
     ) -> Result<(), ReadError> {
-        let record = self.width * self.ncols;
-        let at = row * record as u64;
-        if record == 8 && cfg!(target_endian = "little") && columns == [0] {
-            // one f64 column: straight into the values, whose bytes are the file's
-            let values = &mut out[0];
-            values.resize(n, 0.0);
-            read_exact_at(&self.file, as_bytes(values), at).map_err(|e| io_error(&self.path, e))?;
-            if all_finite(values) {
-                return Ok(());
-            }
-            let i = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
-            return Err(non_finite(&self.path, row as usize + i, 1, values[i]));
-        }
-        bytes.resize(n * record, 0);
-        read_exact_at(&self.file, bytes, at).map_err(|e| io_error(&self.path, e))?;
-        let width = self.width;
-        for (&column, values) in columns.iter().zip(out.iter_mut()) {
-            debug_assert!(column < self.ncols);
-            values.resize(n, 0.0);
-            let offset = column * width;
-            if record == 8 {
-                for (v, r) in values.iter_mut().zip(bytes.chunks_exact(8)) {
-                    *v = f64::from_le_bytes(r.try_into().expect("8 bytes"));
-                }
-            } else {
-                for (v, r) in values.iter_mut().zip(bytes.chunks_exact(record)) {
-                    *v = decode(&r[offset..], width);
-                }
-            }
-        }
+        self.read_unchecked(row, n, columns, bytes, out)?;
         if out.iter().all(|v| all_finite(v)) {
             return Ok(());
         }
@@ -484,6 +455,49 @@ fn all_finite(x: &[f64]) -> bool {
     }
     let tail: f64 = quads.remainder().iter().map(|v| 0.0 * v).sum();
     acc.iter().sum::<f64>() + tail == 0.0
+}
+
+impl RawRows {
+    /// [`read`](Self::read) without the check for non-finite values: for rows read again.
+    ///
+    /// # Errors
+    /// [`ReadError::Io`].
+    pub(crate) fn read_unchecked(
+        &self,
+        row: u64,
+        n: usize,
+        columns: &[usize],
+        bytes: &mut Vec<u8>,
+        out: &mut [Vec<f64>],
+    ) -> Result<(), ReadError> {
+        let record = self.width * self.ncols;
+        let at = row * record as u64;
+        if record == 8 && cfg!(target_endian = "little") && columns == [0] {
+            // one f64 column: straight into the values, whose bytes are the file's
+            let values = &mut out[0];
+            values.resize(n, 0.0);
+            return read_exact_at(&self.file, as_bytes(values), at)
+                .map_err(|e| io_error(&self.path, e));
+        }
+        bytes.resize(n * record, 0);
+        read_exact_at(&self.file, bytes, at).map_err(|e| io_error(&self.path, e))?;
+        let width = self.width;
+        for (&column, values) in columns.iter().zip(out.iter_mut()) {
+            debug_assert!(column < self.ncols);
+            values.resize(n, 0.0);
+            let offset = column * width;
+            if record == 8 {
+                for (v, r) in values.iter_mut().zip(bytes.chunks_exact(8)) {
+                    *v = f64::from_le_bytes(r.try_into().expect("8 bytes"));
+                }
+            } else {
+                for (v, r) in values.iter_mut().zip(bytes.chunks_exact(record)) {
+                    *v = decode(&r[offset..], width);
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// `pread` of the whole buffer at `offset`.
