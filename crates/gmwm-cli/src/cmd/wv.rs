@@ -1,24 +1,17 @@
 //! `gmwm wv`: wavelet variance of each selected column.
 
 use crate::config::{InputConfig, WvConfig};
-use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named, note};
+use crate::input::{analyse_columns, is_wv, load, load_wv, named, note};
 use crate::render;
 use anyhow::Result;
-use gmwm::imu::{binary_layout, BinaryChunks, BinaryLayout, ColumnSelector};
-use gmwm::variance::default_levels;
-use gmwm::{
-    wavelet_variance, HaarWvAccumulator, Transform, WaveletFilter, WaveletVariance, WvOptions,
-};
+use gmwm::imu::{binary_layout, BinaryLayout, ColumnSelector};
+use gmwm::variance::binary_wavelet_variance;
+use gmwm::{wavelet_variance, Transform, WaveletFilter, WaveletVariance, WvOptions};
 use std::io::Write;
 
-/// Rows per read of the streaming path: 64 Ki rows (512 KiB a column), small enough to stay
-/// in cache between the read and the pyramid.
-const STREAM_CHUNK: usize = 1 << 16;
-
 /// Raw binary input (from `--format`, the name or the sidecar) with the classical Haar MODWT
-/// estimator and no time column streams: each selected column is read in chunks through
-/// [`HaarWvAccumulator`], never materialised, so memory stays at the accumulator's `8 · 2^J`
-/// bytes plus one chunk whatever the file size.
+/// estimator and no time column streams ([`gmwm::variance::binary_wavelet_variance`]): the
+/// columns are never loaded, and memory does not grow with the file.
 fn streamable(input: &InputConfig, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
     if input.read.time_column.is_some()
         || gmwm::imu::ros::container_of(&input.file).is_some()
@@ -56,53 +49,12 @@ fn run_streaming(
         Some(f) => f,
         None => stream_freq(&input.file)?,
     };
-    let names: Vec<String> = columns
+    // the errors name the file (and the column, or the row of a bad value)
+    let wvs = binary_wavelet_variance(&input.file, layout, &columns, freq_hz, opts)?;
+    Ok(columns
         .iter()
         .map(|&c| layout.names[c - 1].clone())
-        .collect();
-    // a read error names the file (and the column of a bad value) itself
-    let wvs = stream_columns(&input.file, layout, &columns, opts, freq_hz)?;
-    names
-        .into_iter()
         .zip(wvs)
-        .map(|(name, wv)| Ok((name.clone(), column_context(wv, &input.file, &name)?)))
-        .collect()
-}
-
-/// The WV of each streamed column, or why it has none.
-type ColumnWvs = Vec<Result<WaveletVariance, gmwm::Error>>;
-
-/// One pass over the file for every selected column: each chunk of rows is read once and its
-/// columns are pushed into their own accumulators in parallel (memory: one chunk of rows and
-/// the accumulators' rings, whatever N). The outer error is the file's; each column's WV
-/// carries its own (a constant column, say).
-fn stream_columns(
-    path: &std::path::Path,
-    layout: &BinaryLayout,
-    columns: &[usize],
-    opts: &WvOptions,
-    freq_hz: f64,
-) -> Result<ColumnWvs, gmwm::Error> {
-    use rayon::prelude::*;
-    let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, STREAM_CHUNK)?;
-    let n = usize::try_from(chunks.rows()).unwrap_or(usize::MAX);
-    let levels = opts
-        .levels
-        .unwrap_or_else(|| default_levels(n, Transform::Modwt, WaveletFilter::Haar).max(1));
-    let mut accumulators = columns
-        .iter()
-        .map(|_| HaarWvAccumulator::new(levels))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut buffers = vec![Vec::with_capacity(STREAM_CHUNK); columns.len()];
-    while chunks.next_chunk_of(columns, &mut buffers)?.is_some() {
-        accumulators
-            .par_iter_mut()
-            .zip(&buffers)
-            .try_for_each(|(acc, values)| acc.push(values))?;
-    }
-    Ok(accumulators
-        .into_iter()
-        .map(|acc| Ok(acc.finish(freq_hz, opts.alpha)?))
         .collect())
 }
 

@@ -286,6 +286,17 @@ pub enum ReadError {
         /// What is wrong, e.g. `series[0] (gyro_x): tau[2] = 12, expected 8`.
         reason: String,
     },
+    /// A column read from the file cannot be analysed (constant, or too short for the levels
+    /// asked): the error of a computation that streams the file instead of loading it.
+    #[error("{}: column {}: {source}", .path.display(), quote(.column))]
+    Series {
+        /// File.
+        path: PathBuf,
+        /// Column name.
+        column: String,
+        /// Why.
+        source: crate::error::SeriesError,
+    },
     /// An option has an impossible value (e.g. `ncols = 0`, `freq_hz = -1`).
     #[error(transparent)]
     InvalidOption(#[from] ParamError),

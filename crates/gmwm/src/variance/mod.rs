@@ -9,8 +9,11 @@ pub(crate) mod haar_coarse;
 pub(crate) mod haar_robust;
 pub mod implied_cov;
 pub mod robust;
+pub(crate) mod simd;
+pub(crate) mod stream;
 pub mod wv;
 
+pub use stream::binary_wavelet_variance;
 pub use wv::{default_levels, kept_count};
 
 use rayon::prelude::*;

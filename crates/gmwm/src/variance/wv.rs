@@ -404,7 +404,7 @@ fn level_fits(
 }
 
 /// Validates a requested level count against the series length.
-fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<(), InputError> {
+pub(crate) fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<(), InputError> {
     if levels == 0 || levels > MAX_LEVELS {
         return Err(
             ParamError::new("levels", levels, format!("must be in 1..={MAX_LEVELS}")).into(),
@@ -607,19 +607,10 @@ pub(crate) fn check_finite_result(values: &[f64], what: &str) -> Result<(), Seri
     }
 }
 
-/// Compensated mean.
-fn mean(x: &[f64]) -> f64 {
-    let mut s = NeumaierSum::default();
-    for block in x.chunks(BLOCK) {
-        s.add(sum_plain(block));
-    }
-    s.total() / x.len() as f64
-}
-
 /// Sum with four independent accumulators (vectorisable; blocks are then combined with a
 /// compensated sum by the caller).
-#[inline]
-fn sum_plain(x: &[f64]) -> f64 {
+#[inline(always)]
+pub(crate) fn sum_plain(x: &[f64]) -> f64 {
     let mut acc = [0.0f64; 4];
     let mut quads = x.chunks_exact(4);
     for q in &mut quads {
@@ -642,12 +633,12 @@ fn mean_square(x: &[f64]) -> f64 {
 
 /// Block length of the streaming pass: 4096 doubles (32 KiB) per buffer keeps the working set
 /// of one level in L1/L2 while amortising the per-block bookkeeping.
-const BLOCK: usize = 4096;
+pub(crate) const BLOCK: usize = 4096;
 
 /// Sum of squares with four independent accumulators (lets the compiler vectorise; the partial
 /// sums of one block are then combined with a compensated sum by the caller).
-#[inline]
-fn sum_squares(x: &[f64]) -> f64 {
+#[inline(always)]
+pub(crate) fn sum_squares(x: &[f64]) -> f64 {
     let mut acc = [0.0f64; 4];
     let mut quads = x.chunks_exact(4);
     for q in &mut quads {
@@ -679,10 +670,16 @@ fn sum_squares(x: &[f64]) -> f64 {
 #[derive(Debug, Clone)]
 pub struct HaarWvAccumulator {
     levels: usize,
+    /// Levels run through the pyramid: all of them, except in a part of a split pass
+    /// ([`for_part`](Self::for_part)) whose end comes before the first kept coefficient of the
+    /// levels above (their sums stay zero there).
+    active: usize,
     offset: Option<f64>,
     n: u64,
     first: Option<f64>,
-    rings: Vec<Vec<f64>>,
+    /// The lag rings one after the other: level j's `2^{j-1}` values start at `2^{j-1} - 1`
+    /// ([`ring_span`]).
+    rings: Vec<f64>,
     pos: Vec<usize>,
     sums: Vec<NeumaierSum>,
     scratch_in: Vec<f64>,
@@ -690,7 +687,25 @@ pub struct HaarWvAccumulator {
     /// Samples pushed but not yet run through the pyramid: blocks start at multiples of
     /// [`BLOCK`] in the series, whatever the chunks, so the roundings do not depend on them.
     pending: Vec<f64>,
+    /// Running sums of [`prime`](Self::prime), one a level (empty once the part runs).
+    priming: Vec<f64>,
 }
+
+/// Where level j's lag ring (`2^{j-1}` values) lies in [`HaarWvAccumulator`]'s ring storage.
+#[inline]
+fn ring_span(j: usize) -> std::ops::Range<usize> {
+    (1usize << (j - 1)) - 1..(1usize << j) - 1
+}
+
+/// Samples per lane block of [`HaarWvAccumulator::prime`]: the running sums of the levels whose
+/// ring holds at least this many values run four interleaved chains over blocks of this length,
+/// aligned on the level's span (which history reads must respect, see
+/// [`PRIME_ALIGN`](crate::variance::wv::PRIME_ALIGN)).
+pub(crate) const PRIME_BLOCK: usize = 2048;
+
+/// History reads of [`HaarWvAccumulator::prime`] end at `t0 - k · PRIME_ALIGN`: a multiple of
+/// [`PRIME_BLOCK`], so that no lane block straddles two of them.
+pub(crate) const PRIME_ALIGN: usize = 1 << 16;
 
 impl HaarWvAccumulator {
     /// A new accumulator for `levels` levels; the offset is the mean of the first block of
@@ -708,15 +723,17 @@ impl HaarWvAccumulator {
         }
         Ok(Self {
             levels,
+            active: levels,
             offset: None,
             n: 0,
             first: None,
-            rings: (1..=levels).map(|j| vec![0.0; 1usize << (j - 1)]).collect(),
+            rings: vec![0.0; (1usize << levels) - 1],
             pos: vec![0; levels],
             sums: vec![NeumaierSum::default(); levels],
             scratch_in: Vec::with_capacity(BLOCK),
             scratch_out: Vec::with_capacity(BLOCK),
             pending: Vec::with_capacity(BLOCK),
+            priming: Vec::new(),
         })
     }
 
@@ -733,42 +750,144 @@ impl HaarWvAccumulator {
         Ok(acc)
     }
 
-    /// An accumulator positioned after `history` (the samples before its first push), with
-    /// every ring primed directly: the Haar `V_{j-1,t}` is the moving average of the last
-    /// `2^{j-1}` samples (zero before the start), so level j's ring is filled by one sliding
-    /// window in O(2^j) instead of running the pyramid over the history.
-    fn primed(levels: usize, offset: f64, history: &[f64]) -> Result<Self, ParamError> {
-        let mut acc = Self::with_offset(levels, offset)?;
-        let t0 = history.len();
-        let Some(&head) = history.first() else {
-            return Ok(acc);
-        };
-        acc.n = t0 as u64;
-        acc.first = Some(head);
-        // Prefix sums of the demeaned history over the last 2^J samples (all any ring needs):
-        // prefix[k] = sum of the first k of them; samples before the series start count as 0.
-        let span = t0.min(1usize << levels);
-        let base = t0 - span;
-        let mut prefix = Vec::with_capacity(span + 1);
-        let mut running = 0.0;
-        prefix.push(0.0);
-        for &v in &history[base..] {
-            running += v - offset;
-            prefix.push(running);
+    /// An accumulator for the part `[t0, end)` of a series split in time (a split pass adds
+    /// the parts' sums in order with [`append`](Self::append)): it subtracts `offset` (the
+    /// series', the mean of its first 2048 samples), numbers its samples from `t0`, runs only
+    /// the levels with a kept coefficient before `end` and keeps its rings in `storage` (a
+    /// buffer of an earlier part, reused: its length does not matter). Unless `t0 = 0`, the
+    /// rings must then be filled by [`prime`](Self::prime) with the samples before `t0`.
+    ///
+    /// `t0` must be a multiple of 4096 (the blocks of the sums start at multiples of 4096 in
+    /// the series).
+    pub(crate) fn for_part(
+        levels: usize,
+        offset: f64,
+        t0: usize,
+        end: usize,
+        storage: Vec<f64>,
+    ) -> Result<Self, ParamError> {
+        Self::for_part_capped(levels, offset, t0, end, storage, levels)
+    }
+
+    /// [`for_part`](Self::for_part) running at most `ring_levels` levels through the pyramid:
+    /// the levels above are left to the caller, who adds their sums with
+    /// [`add_level_sum`](Self::add_level_sum).
+    pub(crate) fn for_part_capped(
+        levels: usize,
+        offset: f64,
+        t0: usize,
+        end: usize,
+        mut storage: Vec<f64>,
+        ring_levels: usize,
+    ) -> Result<Self, ParamError> {
+        debug_assert!(t0 % BLOCK == 0 && t0 < end);
+        if levels == 0 || levels > MAX_LEVELS {
+            return Err(ParamError::new(
+                "levels",
+                levels,
+                format!("must be in 1..={MAX_LEVELS}"),
+            ));
         }
-        for (ring, j) in acc.rings.iter_mut().zip(1..) {
-            let m = 1usize << (j - 1);
-            // ring[k] = V_{j-1, t} for t = t0 - m + k: mean of samples t - m + 1 ..= t
-            for (k, slot) in ring.iter_mut().enumerate() {
-                let Some(t) = (t0 + k).checked_sub(m) else {
-                    continue; // before the series start: the pyramid's zero ring
-                };
-                let end = t + 1 - base;
-                let start = (t + 1).saturating_sub(m).max(base) - base;
-                *slot = (prefix[end] - prefix[start]) / m as f64;
-            }
+        // level j's first kept coefficient is at t = 2^j - 1
+        let active = (1..=levels.min(ring_levels))
+            .take_while(|&j| (1usize << j) <= end)
+            .count();
+        let len = (1usize << active) - 1;
+        if t0 == 0 {
+            // the pyramid's values before the start are zero
+            storage.clear();
         }
-        Ok(acc)
+        // otherwise prime writes every value: the old ones may stay
+        storage.resize(len, 0.0);
+        for j in 1..=active {
+            // ring values whose windows lie wholly before the series start are zero, and
+            // prime only sees samples from 0 on
+            let before_start = (1usize << j).saturating_sub(t0).min(1 << (j - 1));
+            let span = ring_span(j);
+            storage[span.start..span.start + before_start].fill(0.0);
+        }
+        Ok(Self {
+            levels,
+            active,
+            offset: Some(offset),
+            n: t0 as u64,
+            first: None,
+            rings: storage,
+            pos: vec![0; levels],
+            sums: vec![NeumaierSum::default(); levels],
+            scratch_in: Vec::with_capacity(BLOCK),
+            scratch_out: Vec::with_capacity(BLOCK),
+            pending: Vec::with_capacity(BLOCK),
+            priming: if t0 == 0 {
+                Vec::new()
+            } else {
+                vec![0.0; active]
+            },
+        })
+    }
+
+    /// Fills the rings of a [`for_part`](Self::for_part) accumulator from the samples before
+    /// its start `t0`: `values` are the samples from `start` on. Calls come in time order and
+    /// cover `[t0 - 2^L, t0)` (from 0 when `t0 < 2^L`), `L` the levels run; every call but the
+    /// first starts, and every call ends, at `t0` minus a multiple of [`PRIME_ALIGN`], so the
+    /// result depends on the samples alone, not on how they are read.
+    ///
+    /// Level j's ring holds `V_{j-1,t}` for `t` in `[t0 - m, t0)`, `m = 2^{j-1}`: the mean of
+    /// the `m` samples up to `t` (zero before the series start), which a running sum over the
+    /// last `2^j` samples gives directly, O(2^j) instead of running the pyramid over them. The
+    /// running sum of each level starts at its own span, so it stays of the size of the
+    /// level's windows. Levels with at least [`PRIME_BLOCK`] values run it in blocks of that
+    /// length, each as four interleaved chains started from the block's quarter totals.
+    pub(crate) fn prime(&mut self, start: usize, values: &[f64]) {
+        let t0 = self.n as usize;
+        // in pieces ending at t0 - k PRIME_ALIGN (the scratch stays small)
+        let end = start + values.len();
+        let mut from = start;
+        while from < end {
+            let to = (t0 - (t0 - from - 1) / PRIME_ALIGN * PRIME_ALIGN).min(end);
+            self.prime_piece(from, &values[from - start..to - start]);
+            from = to;
+        }
+    }
+
+    fn prime_piece(&mut self, start: usize, values: &[f64]) {
+        let t0 = self.n as usize;
+        let offset = self.offset.unwrap_or(0.0);
+        debug_assert!(start + values.len() <= t0);
+        let mut y = std::mem::take(&mut self.scratch_in);
+        y.clear();
+        y.extend(values.iter().map(|&v| v - offset));
+        prime_levels(&mut self.rings, &mut self.priming, t0, start, &y);
+        self.scratch_in = y;
+    }
+
+    /// Appends the sums of the accumulator of the next part of a split pass (flushed), whose
+    /// rings are no longer needed.
+    pub(crate) fn append(&mut self, later: &Self) {
+        debug_assert!(later.pending.is_empty() && self.pending.is_empty());
+        for (a, b) in self.sums.iter_mut().zip(&later.sums) {
+            a.add(b.total());
+        }
+        self.n = later.n;
+    }
+
+    /// Adds `sum` (of squared wavelet coefficients) to level `j` (1-based): the levels a split
+    /// pass computes without the pyramid.
+    pub(crate) fn add_level_sum(&mut self, j: usize, sum: f64) {
+        self.sums[j - 1].add(sum);
+    }
+
+    /// Levels run through the pyramid.
+    pub(crate) fn active_levels(&self) -> usize {
+        self.active
+    }
+
+    /// Runs the pending samples of a part through the pyramid (the part's last block may be
+    /// partial only at the series end) and hands back the ring storage for the next part.
+    pub(crate) fn close_part(&mut self) -> Result<Vec<f64>, SeriesError> {
+        self.flush()?;
+        self.priming = Vec::new();
+        Ok(std::mem::take(&mut self.rings))
     }
 
     /// Number of samples pushed so far.
@@ -844,16 +963,14 @@ impl HaarWvAccumulator {
         input.clear();
         input.extend(block.iter().map(|&v| v - offset));
         output.resize(input.len(), 0.0);
-        let t0 = self.n;
-        for j in 1..=self.levels {
-            // First boundary-free coefficient of level j is at t = 2^j - 1.
-            let first_valid = (1u64 << j) - 1;
-            let skip = first_valid.saturating_sub(t0).min(input.len() as u64) as usize;
-            let ring = &mut self.rings[j - 1];
-            let s = haar_level(&input, &mut output, ring, &mut self.pos[j - 1], skip);
-            self.sums[j - 1].add(s);
-            std::mem::swap(&mut input, &mut output);
-        }
+        pyramid_block(
+            &mut input,
+            &mut output,
+            &mut self.rings,
+            &mut self.pos[..self.active],
+            &mut self.sums[..self.active],
+            self.n,
+        );
         self.n += block.len() as u64;
         self.scratch_in = input;
         self.scratch_out = output;
@@ -899,6 +1016,138 @@ impl HaarWvAccumulator {
             n, freq_hz, &opts, &wv, None, counts, eta,
         ))
     }
+}
+
+/// The pyramid over one block of demeaned samples (`input`, which it overwrites, as it does
+/// `output`) starting at sample `t0`: level j (1-based, one per `pos` entry) reads `V_{j-1}` and
+/// its ring and adds its squared boundary-free coefficients to `sums[j - 1]`.
+fn pyramid_block(
+    input: &mut Vec<f64>,
+    output: &mut Vec<f64>,
+    rings: &mut [f64],
+    pos: &mut [usize],
+    sums: &mut [NeumaierSum],
+    t0: u64,
+) {
+    for (j, (pos, sum)) in (1..).zip(pos.iter_mut().zip(sums.iter_mut())) {
+        // First boundary-free coefficient of level j is at t = 2^j - 1.
+        let first_valid = (1u64 << j) - 1;
+        let skip = first_valid.saturating_sub(t0).min(input.len() as u64) as usize;
+        let ring = &mut rings[ring_span(j)];
+        let s = haar_level(input, output, ring, pos, skip);
+        sum.add(s);
+        std::mem::swap(input, output);
+    }
+}
+
+crate::variance::simd::multiversion! {
+    /// The priming of every level's ring ([`HaarWvAccumulator::prime`]) by demeaned samples `y`
+    /// from sample `start` on, for a part starting at `t0`; `running` holds each level's
+    /// running sum.
+    fn prime_levels(rings: &mut [f64], running: &mut [f64], t0: usize, start: usize, y: &[f64])
+        => prime_levels_impl
+}
+
+#[inline(always)]
+fn prime_levels_impl(rings: &mut [f64], running: &mut [f64], t0: usize, start: usize, y: &[f64]) {
+    let end = start + y.len();
+    for (j, run) in (1..).zip(running.iter_mut()) {
+        let m = 1usize << (j - 1);
+        // the level's span [t0 - 2m, t0): o = s - (t0 - 2m) numbers its samples
+        let base = t0 as isize - 2 * m as isize;
+        let lo = (start as isize).max(base).max(0);
+        let hi = end as isize;
+        if lo >= hi {
+            continue;
+        }
+        let ring = &mut rings[ring_span(j)];
+        let inv = 1.0 / m as f64;
+        let ys = &y[(lo - start as isize) as usize..(hi - start as isize) as usize];
+        let o0 = (lo - base) as usize;
+        if m < PRIME_BLOCK {
+            for (o, &v) in (o0..).zip(ys) {
+                *run += v;
+                prime_slot(ring, o, m, *run, inv);
+            }
+            continue;
+        }
+        debug_assert!(o0 % PRIME_BLOCK == 0 && ys.len() % PRIME_BLOCK == 0);
+        for (b, block) in ys.chunks(PRIME_BLOCK).enumerate() {
+            let o = o0 + b * PRIME_BLOCK;
+            if block.len() < PRIME_BLOCK {
+                // only for reads that break the alignment contract
+                for (o, &v) in (o..).zip(block) {
+                    *run += v;
+                    prime_slot(ring, o, m, *run, inv);
+                }
+                continue;
+            }
+            *run = prime_block(ring, o, m, *run, inv, block);
+        }
+    }
+}
+
+/// One step of [`HaarWvAccumulator::prime`] for level j (`m = 2^{j-1}`): `run` is the running
+/// sum up to sample `o` of the level's span (numbered from `t0 - 2m`). The first half stores
+/// it; the second half turns the stored sum `m` samples back into the window mean.
+#[inline(always)]
+fn prime_slot(ring: &mut [f64], o: usize, m: usize, run: f64, inv: f64) {
+    if o < m {
+        ring[o] = run;
+    } else {
+        ring[o - m] = (run - ring[o - m]) * inv;
+    }
+}
+
+/// [`prime_slot`] over a block of [`PRIME_BLOCK`] samples (starting at span index `o0`, wholly
+/// in one half of the span): four chains, one per quarter, started from the running sum plus
+/// the quarter totals. Returns the running sum after the block (the start plus the totals).
+#[inline(always)]
+fn prime_block(ring: &mut [f64], o0: usize, m: usize, run: f64, inv: f64, ys: &[f64]) -> f64 {
+    const Q: usize = PRIME_BLOCK / 4;
+    let q: [&[f64]; 4] = [
+        &ys[..Q],
+        &ys[Q..2 * Q],
+        &ys[2 * Q..3 * Q],
+        &ys[3 * Q..PRIME_BLOCK],
+    ];
+    let totals = q.map(sum_plain);
+    let mut s = [0.0; 4];
+    s[0] = run;
+    for l in 1..4 {
+        s[l] = s[l - 1] + totals[l - 1];
+    }
+    let after = s[3] + totals[3];
+    if o0 < m {
+        let (r0, rest) = ring[o0..o0 + PRIME_BLOCK].split_at_mut(Q);
+        let (r1, rest) = rest.split_at_mut(Q);
+        let (r2, r3) = rest.split_at_mut(Q);
+        for i in 0..Q {
+            s[0] += q[0][i];
+            s[1] += q[1][i];
+            s[2] += q[2][i];
+            s[3] += q[3][i];
+            r0[i] = s[0];
+            r1[i] = s[1];
+            r2[i] = s[2];
+            r3[i] = s[3];
+        }
+    } else {
+        let (r0, rest) = ring[o0 - m..o0 - m + PRIME_BLOCK].split_at_mut(Q);
+        let (r1, rest) = rest.split_at_mut(Q);
+        let (r2, r3) = rest.split_at_mut(Q);
+        for i in 0..Q {
+            s[0] += q[0][i];
+            s[1] += q[1][i];
+            s[2] += q[2][i];
+            s[3] += q[3][i];
+            r0[i] = (s[0] - r0[i]) * inv;
+            r1[i] = (s[1] - r1[i]) * inv;
+            r2[i] = (s[2] - r2[i]) * inv;
+            r3[i] = (s[3] - r3[i]) * inv;
+        }
+    }
+    after
 }
 
 /// Haar MODWT WV of an in-memory series ([`haar_square_sums`]: the pyramid of
@@ -951,44 +1200,64 @@ fn haar_wv_in_memory(
     ))
 }
 
-/// Series shorter than this run on one thread: below it the split does not pay.
-const PARALLEL_MIN_LEN: usize = 1 << 18;
+/// Smallest part of a split Haar pass ([`part_len`]): `2^22` samples.
+pub(crate) const PART_MIN: usize = 1 << 22;
 
-/// Haar MODWT WV of an in-memory series, split in time across the rayon pool: each part's rings
-/// are primed from the samples before it ([`HaarWvAccumulator::primed`]), the per-level sums
-/// are then added in part order, so the result does not depend on scheduling. `x` has been
-/// checked (finite, not constant) by the caller.
+/// Samples per part of a split Haar pass: parts start at multiples of this length, a function
+/// of the level count (and of `min`, [`PART_MIN`] but in tests) alone, never of the thread
+/// count or of how the data are read, so the result is the same on any number of threads:
+/// `min`, or `2^{J-2}` when larger (more than 24 levels), since each part after the first
+/// primes its rings from the `2^J` samples before it, which this keeps to four parts' worth.
+/// `min` is a power of two of at least 4096 samples.
+pub(crate) fn part_len(levels: usize, min: usize) -> usize {
+    debug_assert!(min.is_power_of_two() && min >= BLOCK);
+    min.max(1usize << levels.saturating_sub(2).min(usize::BITS as usize - 2))
+}
+
+/// Haar MODWT WV of an in-memory series, split in time ([`part_len`]) across the rayon pool:
+/// each part's rings are primed from the samples before it ([`HaarWvAccumulator::prime`]),
+/// the per-level sums are then added in part order, so the result does not depend on the
+/// thread count. `x` has been checked (finite, not constant) by the caller.
 fn haar_wv_parallel(
     x: &[f64],
     levels: usize,
     freq_hz: f64,
     alpha: f64,
 ) -> Result<WaveletVariance, InputError> {
+    haar_wv_split(x, levels, freq_hz, alpha, PART_MIN)
+}
+
+/// [`haar_wv_parallel`] with parts of [`part_len`]`(levels, min_part)` samples.
+fn haar_wv_split(
+    x: &[f64],
+    levels: usize,
+    freq_hz: f64,
+    alpha: f64,
+    min_part: usize,
+) -> Result<WaveletVariance, InputError> {
     use rayon::prelude::*;
     let n = x.len();
-    let offset = mean(x);
-    let parts = if n >= PARALLEL_MIN_LEN {
-        rayon::current_num_threads().clamp(1, n / (PARALLEL_MIN_LEN / 4))
-    } else {
-        1
-    };
-    let bounds: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
-    let partial: Vec<HaarWvAccumulator> = (0..parts)
+    let head = &x[..n.min(crate::variance::haar::BLOCK)];
+    let offset = head.iter().sum::<f64>() / head.len() as f64;
+    let part = part_len(levels, min_part);
+    let partial: Vec<HaarWvAccumulator> = (0..n.div_ceil(part))
         .into_par_iter()
         .map(|p| {
-            let mut acc = HaarWvAccumulator::primed(levels, offset, &x[..bounds[p]])?;
-            acc.push(&x[bounds[p]..bounds[p + 1]])?;
-            acc.flush()?;
+            let (t0, t1) = (p * part, ((p + 1) * part).min(n));
+            let mut acc = HaarWvAccumulator::for_part(levels, offset, t0, t1, Vec::new())?;
+            if t0 > 0 {
+                let history = t0.saturating_sub(1usize << acc.active);
+                acc.prime(history, &x[history..t0]);
+            }
+            acc.push(&x[t0..t1])?;
+            acc.close_part()?;
             Ok(acc)
         })
         .collect::<Result<_, InputError>>()?;
     let mut parts = partial.into_iter();
     let mut total = parts.next().expect("at least one part");
     for part in parts {
-        for (a, b) in total.sums.iter_mut().zip(&part.sums) {
-            a.add(b.total());
-        }
-        total.n = part.n;
+        total.append(&part);
     }
     total.finish(freq_hz, alpha)
 }
@@ -996,7 +1265,7 @@ fn haar_wv_parallel(
 /// One Haar pyramid level over a block: reads `V_{j-1}` from `input`, writes `V_j` to `output`,
 /// updates the lag ring (length `m = 2^{j-1}`, oldest value at `*pos`), and returns the sum of
 /// squared wavelet coefficients from index `skip` on.
-#[inline]
+#[inline(always)]
 fn haar_level(
     input: &[f64],
     output: &mut [f64],
@@ -1025,18 +1294,17 @@ fn haar_level(
         ring.copy_from_slice(&input[b - m..]);
         *pos = 0;
     } else {
-        // The ring holds every lag: at most two contiguous segments since b < m.
+        // The ring holds every lag: at most two contiguous segments since b < m. Each value
+        // read from the ring is replaced by the new one in the same pass.
         let mut i = 0;
         while i < b {
             let run = (m - *pos).min(b - i);
-            let seg = &mut ring[*pos..*pos + run];
-            ss += level_span(
+            ss += level_span_ring(
                 &input[i..i + run],
-                seg,
+                &mut ring[*pos..*pos + run],
                 &mut output[i..i + run],
                 skip.saturating_sub(i),
             );
-            seg.copy_from_slice(&input[i..i + run]);
             i += run;
             *pos = (*pos + run) % m;
         }
@@ -1044,9 +1312,15 @@ fn haar_level(
     ss
 }
 
-/// `output = (new + old) / 2`; returns the sum of `((new - old) / 2)^2` over indices `>= skip`.
-#[inline]
-fn level_span(new: &[f64], old: &[f64], output: &mut [f64], skip: usize) -> f64 {
+crate::variance::simd::multiversion! {
+    /// `output = (new + old) / 2`; returns the sum of `((new - old) / 2)^2` over indices
+    /// `>= skip`.
+    fn level_span(new: &[f64], old: &[f64], output: &mut [f64], skip: usize) -> f64
+        => level_span_impl
+}
+
+#[inline(always)]
+fn level_span_impl(new: &[f64], old: &[f64], output: &mut [f64], skip: usize) -> f64 {
     let skip = skip.min(new.len());
     let (new_skip, new_kept) = new.split_at(skip);
     let (old_skip, old_kept) = old.split_at(skip);
@@ -1074,6 +1348,51 @@ fn level_span(new: &[f64], old: &[f64], output: &mut [f64], skip: usize) -> f64 
     {
         *o = 0.5 * (v + u);
         tail += (v - u) * (v - u);
+    }
+    0.25 * ((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail)
+}
+
+crate::variance::simd::multiversion! {
+    /// [`level_span`] with the old values taken from a ring segment, each replaced by the new
+    /// value (the same roundings, one pass over the segment instead of a read and a copy).
+    fn level_span_ring(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64
+        => level_span_ring_impl
+}
+
+#[inline(always)]
+fn level_span_ring_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64 {
+    let skip = skip.min(new.len());
+    let (new_skip, new_kept) = new.split_at(skip);
+    let (ring_skip, ring_kept) = ring.split_at_mut(skip);
+    let (out_skip, out_kept) = output.split_at_mut(skip);
+    for ((o, &v), r) in out_skip.iter_mut().zip(new_skip).zip(ring_skip) {
+        *o = 0.5 * (v + *r);
+        *r = v;
+    }
+    let mut acc = [0.0f64; 4];
+    let mut outs = out_kept.chunks_exact_mut(4);
+    let mut news = new_kept.chunks_exact(4);
+    let mut rings = ring_kept.chunks_exact_mut(4);
+    for ((o, v), r) in (&mut outs).zip(&mut news).zip(&mut rings) {
+        for k in 0..4 {
+            let u = r[k];
+            o[k] = 0.5 * (v[k] + u);
+            let w = v[k] - u;
+            acc[k] += w * w;
+            r[k] = v[k];
+        }
+    }
+    let mut tail = 0.0;
+    for ((o, &v), r) in outs
+        .into_remainder()
+        .iter_mut()
+        .zip(news.remainder())
+        .zip(rings.into_remainder())
+    {
+        let u = *r;
+        *o = 0.5 * (v + u);
+        tail += (v - u) * (v - u);
+        *r = v;
     }
     0.25 * ((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail)
 }
@@ -1219,36 +1538,96 @@ mod tests {
         }
     }
 
-    #[test]
-    fn parallel_split_matches_one_stream() {
-        let n = PARALLEL_MIN_LEN + 12_345;
-        let mut state = 99u64;
-        let x: Vec<f64> = (0..n)
-            .map(|i| {
+    /// A biased random walk plus noise: every level carries signal, the offset matters.
+    fn walk(n: usize, seed: u64) -> Vec<f64> {
+        let mut state = seed;
+        let mut level = 0.0;
+        (0..n)
+            .map(|_| {
                 state = state
                     .wrapping_mul(6364136223846793005)
                     .wrapping_add(1442695040888963407);
-                -9.81 + (state >> 11) as f64 / (1u64 << 53) as f64 + 1e-6 * (i % 977) as f64
+                let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                level += 0.01 * u;
+                -9.81 + level + u
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn split_pass_is_the_same_on_any_thread_count_and_matches_one_stream() {
+        // parts of 2^14 samples: 2^16 + 12345 samples make five parts, the last partial, and
+        // the 16 levels reach back over several parts
+        let n = (1 << 16) + 12_345;
+        let x = walk(n, 99);
         let levels = default_levels(n, Transform::Modwt, WaveletFilter::Haar);
-        let mut acc = HaarWvAccumulator::with_offset(levels, mean(&x)).unwrap();
+        let mut acc = HaarWvAccumulator::new(levels).unwrap();
         acc.push(&x).unwrap();
         let one = acc.finish(1.0, 0.05).unwrap();
-        for threads in [2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
+        let split = |threads: usize, min_part: usize| {
+            rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
-                .unwrap();
-            let split = pool.install(|| wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap());
-            for j in 0..levels {
-                // priming by sliding sums vs the pyramid differ by rounding only
-                assert!(
-                    rel(split.wv[j], one.wv[j]) < 1e-12,
-                    "{threads} threads, level {}",
-                    j + 1
-                );
-            }
+                .unwrap()
+                .install(|| haar_wv_split(&x, levels, 1.0, 0.05, min_part).unwrap())
+        };
+        let base = split(1, 1 << 14);
+        for threads in [2, 3] {
+            assert_eq!(split(threads, 1 << 14), base, "{threads} threads");
+        }
+        for j in 0..levels {
+            // priming by running sums vs the pyramid differ by rounding only
+            assert!(
+                rel(base.wv[j], one.wv[j]) < 1e-12,
+                "level {}: {} vs {}",
+                j + 1,
+                base.wv[j],
+                one.wv[j]
+            );
+        }
+        // one part: the single stream itself, bit for bit
+        assert_eq!(split(2, 1 << 20).wv, one.wv);
+        // the in-memory path agrees too
+        let memory = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
+        for j in 0..levels {
+            assert!(rel(base.wv[j], memory.wv[j]) < 1e-12, "level {}", j + 1);
+        }
+    }
+
+    #[test]
+    fn priming_gives_the_rings_of_a_single_pass() {
+        // integer data: the running sums and the pyramid's means are exact, so a primed part
+        // continues exactly as one pass over the whole series does, whatever the reads
+        let n = 3 * (1 << 14) + 777;
+        let mut state = 7u64;
+        let x: Vec<f64> = (0..n)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 40) % 1001) as f64 - 500.0
+            })
+            .collect();
+        let levels = 15;
+        let offset = x[..2048].iter().sum::<f64>() / 2048.0;
+        let t0 = 2 * (1 << 14);
+        let mut whole = HaarWvAccumulator::with_offset(levels, offset).unwrap();
+        whole.push(&x[..t0]).unwrap();
+        let mut part = HaarWvAccumulator::for_part(levels, offset, t0, n, vec![1.5; 7]).unwrap();
+        let history = t0 - (1 << levels);
+        // reads ending at t0 - k PRIME_ALIGN, the first one partial
+        let mut start = history;
+        while start < t0 {
+            let end = (t0 - (t0 - start - 1) / PRIME_ALIGN * PRIME_ALIGN).min(t0);
+            part.prime(start, &x[start..end]);
+            start = end;
+        }
+        for j in 1..=levels {
+            let span = ring_span(j);
+            let pos = whole.pos[j - 1];
+            let ring = &whole.rings[span.clone()];
+            let oldest_first: Vec<f64> = ring[pos..].iter().chain(&ring[..pos]).copied().collect();
+            assert_eq!(&part.rings[span], &oldest_first[..], "level {j}");
         }
     }
 

@@ -361,6 +361,169 @@ impl BinaryChunks {
     }
 }
 
+/// A raw binary file read by rows at any position (`pread`): several threads read it at once,
+/// each into its own buffers, and no read depends on another, so the file is not memory-mapped
+/// and no reader position is shared.
+#[derive(Debug)]
+pub(crate) struct RawRows {
+    path: PathBuf,
+    file: File,
+    width: usize,
+    ncols: usize,
+    rows: u64,
+}
+
+impl RawRows {
+    /// Opens `path` holding `ncols` interleaved little-endian columns of `format` (F64 or F32).
+    ///
+    /// # Errors
+    /// As [`BinaryChunks::open`].
+    pub(crate) fn open(path: &Path, format: InputFormat, ncols: usize) -> Result<Self, ReadError> {
+        let width = width_of(format)?;
+        check_ncols(ncols)?;
+        let (file, rows) = open_records(path, width * ncols)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+            width,
+            ncols,
+            rows,
+        })
+    }
+
+    /// Number of rows (samples per column).
+    pub(crate) fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Number of interleaved columns.
+    pub(crate) fn ncols(&self) -> usize {
+        self.ncols
+    }
+
+    /// Reads rows `[row, row + n)` (within the file) and decodes the 0-based `columns` into
+    /// `out[k]` (replaced), through `bytes` (a buffer reused between calls).
+    ///
+    /// # Errors
+    /// [`ReadError::Io`] (a file truncated since it was opened included) and
+    /// [`ReadError::BinaryNonFinite`] for the first NaN or infinity in file order (row first,
+    /// then column).
+    pub(crate) fn read(
+        &self,
+        row: u64,
+        n: usize,
+        columns: &[usize],
+        bytes: &mut Vec<u8>,
+        out: &mut [Vec<f64>],
+    ) -> Result<(), ReadError> {
+        self.read_unchecked(row, n, columns, bytes, out)?;
+        if out.iter().all(|v| all_finite(v)) {
+            return Ok(());
+        }
+        // the first one in file order: row first, then column
+        let (i, k) = (0..n)
+            .flat_map(|i| (0..columns.len()).map(move |k| (i, k)))
+            .find(|&(i, k)| !out[k][i].is_finite())
+            .expect("a non-finite value exists");
+        Err(non_finite(
+            &self.path,
+            row as usize + i,
+            columns[k] + 1,
+            out[k][i],
+        ))
+    }
+}
+
+/// The bytes of `values`, to read a little-endian f64 file into.
+fn as_bytes(values: &mut [f64]) -> &mut [u8] {
+    let len = std::mem::size_of_val(values);
+    // SAFETY: the slice's `len` bytes are initialised f64 values without padding, borrowed
+    // exclusively for the lifetime of the result; `u8` has alignment 1, and any bytes written
+    // through the result form a valid f64 (every bit pattern is one).
+    unsafe { std::slice::from_raw_parts_mut(values.as_mut_ptr().cast::<u8>(), len) }
+}
+
+/// Whether every value is finite: `0 · x` is 0 for a finite `x` and NaN otherwise, summed in
+/// four lanes (a loop the compiler vectorises, unlike a search that stops early).
+fn all_finite(x: &[f64]) -> bool {
+    let mut acc = [0.0f64; 4];
+    let mut quads = x.chunks_exact(4);
+    for q in &mut quads {
+        for k in 0..4 {
+            acc[k] += 0.0 * q[k];
+        }
+    }
+    let tail: f64 = quads.remainder().iter().map(|v| 0.0 * v).sum();
+    acc.iter().sum::<f64>() + tail == 0.0
+}
+
+impl RawRows {
+    /// [`read`](Self::read) without the check for non-finite values: for rows read again.
+    ///
+    /// # Errors
+    /// [`ReadError::Io`].
+    pub(crate) fn read_unchecked(
+        &self,
+        row: u64,
+        n: usize,
+        columns: &[usize],
+        bytes: &mut Vec<u8>,
+        out: &mut [Vec<f64>],
+    ) -> Result<(), ReadError> {
+        let record = self.width * self.ncols;
+        let at = row * record as u64;
+        if record == 8 && cfg!(target_endian = "little") && columns == [0] {
+            // one f64 column: straight into the values, whose bytes are the file's
+            let values = &mut out[0];
+            values.resize(n, 0.0);
+            return read_exact_at(&self.file, as_bytes(values), at)
+                .map_err(|e| io_error(&self.path, e));
+        }
+        bytes.resize(n * record, 0);
+        read_exact_at(&self.file, bytes, at).map_err(|e| io_error(&self.path, e))?;
+        let width = self.width;
+        for (&column, values) in columns.iter().zip(out.iter_mut()) {
+            debug_assert!(column < self.ncols);
+            values.resize(n, 0.0);
+            let offset = column * width;
+            if record == 8 {
+                for (v, r) in values.iter_mut().zip(bytes.chunks_exact(8)) {
+                    *v = f64::from_le_bytes(r.try_into().expect("8 bytes"));
+                }
+            } else {
+                for (v, r) in values.iter_mut().zip(bytes.chunks_exact(record)) {
+                    *v = decode(&r[offset..], width);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `pread` of the whole buffer at `offset`.
+#[cfg(unix)]
+fn read_exact_at(file: &File, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(file, buf, offset)
+}
+
+/// `pread` of the whole buffer at `offset`.
+#[cfg(windows)]
+fn read_exact_at(file: &File, mut buf: &mut [u8], mut offset: u64) -> std::io::Result<()> {
+    use std::os::windows::fs::FileExt;
+    while !buf.is_empty() {
+        match file.seek_read(buf, offset) {
+            Ok(0) => return Err(std::io::ErrorKind::UnexpectedEof.into()),
+            Ok(k) => {
+                buf = &mut buf[k..];
+                offset += k as u64;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
+}
+
 /// Calls `f` on consecutive chunks of one column of a raw binary file (see [`BinaryChunks`]);
 /// stops at the first error, from the file or from `f`.
 ///
