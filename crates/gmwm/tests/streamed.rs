@@ -151,3 +151,41 @@ fn streamed_robust_matches_whole_series() {
     }
     eprintln!("streamed robust: worst difference {worst:.3} of the half-width");
 }
+
+/// A constant (dead) gyroscope column among live ones: the streamed calibration leaves it out
+/// with a check line naming it and calibrates the others, as the in-memory one does.
+#[test]
+fn streamed_calibration_names_a_dead_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dead.f64");
+    let n = 1 << 16;
+    let x = simulate_model(
+        &Model::parse("WN(sigma2=1e-4)+RW(gamma2=1e-10)").unwrap(),
+        n,
+        100.0,
+        3,
+    )
+    .unwrap();
+    write_f64(&path, &[x, vec![0.25; n]]);
+    std::fs::write(
+        dir.path().join("dead.f64.json"),
+        r#"{"sampling_frequency_hz": 100, "format": "f64", "n_columns": 2, "units": {"gyro": "rad/s"},
+            "columns": [{"name": "gyro_x"}, {"name": "gyro_z"}]}"#,
+    )
+    .unwrap();
+    let report = Calibration::new(CalibrationOptions {
+        stream_from: 1,
+        ..CalibrationOptions::default()
+    })
+    .run_file(&path, &ReadOptions::default(), &NoProgress)
+    .unwrap();
+    assert_eq!(report.axes.len(), 1);
+    assert_eq!(report.axes[0].column, "gyro_x");
+    assert!(
+        report.checks.iter().any(|c| c.contains("not calibrated")
+            && c.contains("gyro_z")
+            && c.contains("constant")),
+        "{:?}",
+        report.checks
+    );
+}

@@ -3,8 +3,8 @@
 //!
 //! The pipeline of [`Calibration::run`] needs the samples only for four things, and each has a
 //! streamed form:
-//! - **the classical Haar WV**: accumulated chunk by chunk ([`crate::HaarWvAccumulator`]), one
-//!   pass over the file for every axis; identical to the in-memory estimate within 1e-12;
+//! - **the classical Haar WV**: streamed from the file for every axis at once
+//!   ([`binary_wavelet_variance`]); identical to the in-memory estimate within 1e-12;
 //! - **the Allan variance**: `AV(m) = 2 nu2(2m)`, exact from that WV (METHODS §3.4,
 //!   [`allan_from_wv`](crate::imu::allan_from_wv));
 //! - **the model selection and the fit**: they use the WV only ([`crate::Wic::select_wv`]);
@@ -21,10 +21,9 @@
 //!   tests (`streamed_robust_matches_whole_series`); contamination (spikes, steps) shows at
 //!   the fine scales, which the check covers.
 //!
-//! Memory: a chunk of rows, the accumulators' rings up to level 18 (2 MiB an axis), the lagged
-//! blocks of the coarser levels (`2^18` samples each, `J - 16` of them an axis,
-//! [`coarse_square_sums`]) and one block per axis for the robust check: about 30 MB an axis
-//! whatever the length.
+//! Memory: that of [`binary_wavelet_variance`] (the rings up to level 20, 8 MiB an axis, and a
+//! few chunks of rows per thread) and one block per axis for the robust check: tens of MB an
+//! axis whatever the length.
 
 use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
 use crate::error::{Error, ParamError};
@@ -33,10 +32,10 @@ use crate::imu::{
     ReadOptions, SensorInfo,
 };
 use crate::inference::Progress;
+use crate::variance::binary_wavelet_variance;
 use crate::variance::ci::eta3;
 use crate::variance::default_levels;
-use crate::variance::haar_coarse::coarse_square_sums;
-use crate::variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};
+use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use crate::wavelet::{Transform, WaveletFilter};
 use rayon::prelude::*;
 use std::path::Path;
@@ -50,8 +49,6 @@ pub const ROBUST_BLOCK: usize = 1 << 21;
 /// Levels of the streamed robust check: scales up to `2^15` samples, at least 64 windows a
 /// block.
 pub const ROBUST_LEVELS: usize = 15;
-/// Rows per read of the classical pass.
-const CHUNK_ROWS: usize = 1 << 16;
 
 impl Calibration {
     /// Whether [`Calibration::run_file`] streams `path`: a raw binary f64/f32 file (by
@@ -306,13 +303,9 @@ fn selected_columns(
         .collect()
 }
 
-/// Levels up to which the classical pass keeps the accumulator's rings (`8 · 2^18` bytes, 2
-/// MiB an axis); coarser levels read their lagged samples again ([`coarse_square_sums`]).
-const RING_LEVELS: usize = 18;
-
-/// The classical WV of each column (its own error, e.g. a constant column, per column): the
-/// levels up to [`RING_LEVELS`] in one pass through [`HaarWvAccumulator`]s, the coarser ones
-/// from lagged blocks of the file ([`coarse_square_sums`]), the two at once.
+/// The classical WV of each column ([`binary_wavelet_variance`]: parallel, bounded memory,
+/// the same bits on any number of threads); a column that cannot be analysed (a constant one,
+/// say) gets its error and the others are computed without it.
 fn classical_pass(
     path: &Path,
     layout: &BinaryLayout,
@@ -321,140 +314,56 @@ fn classical_pass(
     freq_hz: f64,
     alpha: f64,
 ) -> Result<Vec<Result<WaveletVariance, crate::InputError>>, Error> {
-    let fine_levels = levels.min(RING_LEVELS);
-    let fine = || -> Result<Vec<Result<WaveletVariance, crate::InputError>>, Error> {
-        let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, CHUNK_ROWS)?;
-        let mut accumulators = columns
-            .iter()
-            .map(|_| HaarWvAccumulator::new(fine_levels))
-            .collect::<Result<Vec<_>, _>>()?;
-        let mut buffers = vec![Vec::with_capacity(CHUNK_ROWS); columns.len()];
-        while chunks.next_chunk_of(columns, &mut buffers)?.is_some() {
-            accumulators
-                .par_iter_mut()
-                .zip(&buffers)
-                .try_for_each(|(acc, values)| acc.push(values))?;
-        }
-        Ok(accumulators
-            .into_iter()
-            .map(|acc| acc.finish(freq_hz, alpha))
-            .collect())
+    let opts = WvOptions {
+        levels: Some(levels),
+        alpha,
+        ..WvOptions::default()
     };
-    if levels <= RING_LEVELS {
-        return fine();
-    }
-    let coarse = || -> Result<Vec<Vec<(f64, usize)>>, Error> {
-        let mut reader = RowReader::open(path, layout, columns)?;
-        let n = reader.rows;
-        // the accumulator's offset: the mean of the first 2048 samples (any offset would do)
-        let mut head = vec![Vec::new(); columns.len()];
-        reader.read(0, n.min(2048), &mut head)?;
-        let offsets: Vec<f64> = head
+    let mut failed: Vec<(usize, crate::InputError)> = Vec::new();
+    loop {
+        let kept: Vec<usize> = columns
             .iter()
-            .map(|h| h.iter().sum::<f64>() / h.len().max(1) as f64)
+            .copied()
+            .filter(|c| !failed.iter().any(|(f, _)| f == c))
             .collect();
-        coarse_square_sums(n, RING_LEVELS, levels, &offsets, |k, out| {
-            let from = k << RING_LEVELS;
-            let to = (from + (1 << RING_LEVELS)).min(n);
-            reader.read(from, to - from, out)
-        })
-    };
-    let (fine, coarse) = rayon::join(fine, coarse);
-    let (fine, coarse) = (fine?, coarse?);
-    Ok(fine
-        .into_iter()
-        .zip(coarse)
-        .map(|(wv, sums)| {
-            let wv = wv?;
-            let mut values = wv.wv.clone();
-            let mut counts = wv.n_coefficients.clone();
-            for (&(sum, kept), j) in sums.iter().zip(RING_LEVELS + 1..) {
-                if kept == 0 {
-                    break;
-                }
-                values.push(sum / kept as f64);
-                counts.push(kept);
-                debug_assert_eq!(kept, wv.n + 1 - (1usize << j));
+        if kept.is_empty() {
+            break;
+        }
+        match binary_wavelet_variance(path, layout, &kept, freq_hz, &opts) {
+            Ok(wvs) => {
+                let mut wvs = kept.iter().copied().zip(wvs);
+                return Ok(columns
+                    .iter()
+                    .map(|c| match failed.iter().position(|(f, _)| f == c) {
+                        Some(k) => Err(failed[k].1.clone()),
+                        None => Ok(wvs
+                            .find(|(k, _)| k == c)
+                            .map(|(_, w)| w)
+                            .expect("every kept column has its WV")),
+                    })
+                    .collect());
             }
-            let eta = counts
-                .iter()
-                .enumerate()
-                .map(|(i, &m)| eta3(m, i + 1))
-                .collect();
-            Ok(WaveletVariance::assemble(
-                wv.n,
-                freq_hz,
-                &WvOptions {
-                    levels: Some(values.len()),
-                    alpha,
-                    ..WvOptions::default()
-                },
-                &values,
-                None,
-                counts,
-                eta,
-            ))
+            Err(ReadError::Series { column, source, .. }) => {
+                let Some(&c) = kept.iter().find(|&&c| layout.names[c - 1] == column) else {
+                    return Err(ReadError::Series {
+                        path: path.to_path_buf(),
+                        column,
+                        source,
+                    }
+                    .into());
+                };
+                failed.push((c, source.into()));
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    Ok(columns
+        .iter()
+        .map(|c| {
+            let k = failed.iter().position(|(f, _)| f == c).unwrap_or(0);
+            Err(failed[k].1.clone())
         })
         .collect())
-}
-
-/// Positioned reads of rows of a raw binary file (the coarse levels read lagged blocks).
-struct RowReader {
-    file: std::fs::File,
-    path: std::path::PathBuf,
-    width: usize,
-    ncols: usize,
-    columns: Vec<usize>,
-    rows: usize,
-    bytes: Vec<u8>,
-}
-
-impl RowReader {
-    fn open(path: &Path, layout: &BinaryLayout, columns: &[usize]) -> Result<Self, Error> {
-        let width = layout.format.value_width().ok_or_else(|| {
-            ParamError::new("format", format!("{:?}", layout.format), "f64 or f32")
-        })?;
-        let io = |source| ReadError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let file = std::fs::File::open(path).map_err(io)?;
-        let len = file.metadata().map_err(io)?.len();
-        let rows = usize::try_from(len / (width * layout.ncols) as u64).unwrap_or(usize::MAX);
-        Ok(Self {
-            file,
-            path: path.to_path_buf(),
-            width,
-            ncols: layout.ncols,
-            columns: columns.to_vec(),
-            rows,
-            bytes: Vec::new(),
-        })
-    }
-
-    /// Rows `from .. from + count` of the selected columns, appended to `out[column]`.
-    fn read(&mut self, from: usize, count: usize, out: &mut [Vec<f64>]) -> Result<(), Error> {
-        use std::os::unix::fs::FileExt;
-        let row = self.width * self.ncols;
-        self.bytes.resize(count * row, 0);
-        self.file
-            .read_exact_at(&mut self.bytes, (from * row) as u64)
-            .map_err(|source| ReadError::Io {
-                path: self.path.clone(),
-                source,
-            })?;
-        for (o, &c) in out.iter_mut().zip(&self.columns) {
-            let at = (c - 1) * self.width;
-            o.extend(self.bytes.chunks_exact(row).map(|r| {
-                let v = &r[at..at + self.width];
-                match self.width {
-                    8 => f64::from_le_bytes(v.try_into().unwrap_or([0; 8])),
-                    _ => f64::from(f32::from_le_bytes(v.try_into().unwrap_or([0; 4]))),
-                }
-            }));
-        }
-        Ok(())
-    }
 }
 
 /// Per column and level, over the blocks: the sum of count x robust estimate and the sum of

@@ -5,7 +5,6 @@ pub mod allan;
 pub mod ci;
 pub mod cov;
 pub(crate) mod haar;
-pub(crate) mod haar_coarse;
 pub(crate) mod haar_robust;
 pub mod implied_cov;
 pub mod robust;
