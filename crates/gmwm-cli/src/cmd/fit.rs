@@ -1,5 +1,6 @@
 //! `gmwm fit`: GMWM estimation of a latent error model on each selected column (METHODS §5).
 
+use crate::cmd::wv::{stream_columns, streamable};
 use crate::config::FitConfig;
 use crate::input::{analyse_columns, column_context, is_wv, load, load_wv};
 use crate::progress::bar;
@@ -7,7 +8,7 @@ use crate::render::Style;
 use anyhow::Result;
 use gmwm::fit::{CanonicalModel, StartInputs};
 use gmwm::inference::{infer_with_progress, Inference, InferenceOptions};
-use gmwm::{GmwmFit, WaveletVariance};
+use gmwm::{GmwmFit, WaveletVariance, Weighting};
 use rayon::prelude::*;
 use std::io::Write;
 
@@ -32,6 +33,46 @@ fn fit_wv_file(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
             ))
         })
         .collect()
+}
+
+/// Fits the columns of a raw binary file that `gmwm wv` would stream, when the weighting needs
+/// only the WV: each column's WV and range (all the fit takes from the series: N and
+/// `R = (max - min) / N`, as [`StartInputs::from_series`] gives them) come from one streamed
+/// pass instead of loading the file. Only for the columns the loader would take too: the
+/// file's single column, or `--columns`. `None` when the file is not such a case.
+fn fit_streamed(config: &FitConfig) -> Result<Option<Vec<(String, GmwmFit)>>> {
+    let input = &config.input;
+    if config.gmwm.weighting() == Weighting::Diag {
+        return Ok(None);
+    }
+    let Some(layout) = streamable(input, &config.wv)? else {
+        return Ok(None);
+    };
+    if layout.ncols > 1 && input.read.columns.is_empty() {
+        return Ok(None);
+    }
+    let columns = stream_columns(input, &layout, &config.wv)?;
+    let fits: Vec<_> = columns
+        .par_iter()
+        .map(|(_, c)| {
+            let n = c.wv.n();
+            let range = if n == 0 || c.max < c.min {
+                0.0
+            } else {
+                (c.max - c.min) / n as f64
+            };
+            config
+                .gmwm
+                .fit_from_wv(&c.wv, StartInputs { n, range })
+                .map_err(gmwm::Error::from)
+        })
+        .collect();
+    columns
+        .iter()
+        .zip(fits)
+        .map(|((name, _), r)| Ok((name.clone(), column_context(r, &input.file, name)?)))
+        .collect::<Result<_>>()
+        .map(Some)
 }
 
 /// METHODS §7 on one column's fit, at the series length and WV settings the fit carries, with
@@ -69,6 +110,8 @@ pub fn compute(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
     let file = &config.input.file;
     let fits = if is_wv(&config.input) {
         fit_wv_file(config)?
+    } else if let Some(fits) = fit_streamed(config)? {
+        fits
     } else {
         let loaded = load(&config.input)?;
         analyse_columns(&loaded, file, |x| {

@@ -5,14 +5,14 @@ use crate::input::{analyse_columns, is_wv, load, load_wv, named, note};
 use crate::render;
 use anyhow::Result;
 use gmwm::imu::{binary_layout, BinaryLayout, ColumnSelector};
-use gmwm::variance::binary_wavelet_variance;
+use gmwm::variance::{binary_columns_wv, StreamedColumn};
 use gmwm::{wavelet_variance, Transform, WaveletFilter, WaveletVariance, WvOptions};
 use std::io::Write;
 
 /// Raw binary input (from `--format`, the name or the sidecar) with the classical Haar MODWT
 /// estimator and no time column streams ([`gmwm::variance::binary_wavelet_variance`]): the
 /// columns are never loaded, and memory does not grow with the file.
-fn streamable(input: &InputConfig, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
+pub(crate) fn streamable(input: &InputConfig, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
     if input.read.time_column.is_some()
         || gmwm::imu::ros::container_of(&input.file).is_some()
         || opts.robust.is_some()
@@ -35,6 +35,17 @@ fn run_streaming(
     layout: &BinaryLayout,
     opts: &WvOptions,
 ) -> Result<Vec<(String, WaveletVariance)>> {
+    let columns = stream_columns(input, layout, opts)?;
+    Ok(columns.into_iter().map(|(name, c)| (name, c.wv)).collect())
+}
+
+/// The selected columns of a raw binary file (`--columns`, else all), streamed in one pass:
+/// each one's name, WV and range.
+pub(crate) fn stream_columns(
+    input: &InputConfig,
+    layout: &BinaryLayout,
+    opts: &WvOptions,
+) -> Result<Vec<(String, StreamedColumn)>> {
     let columns: Vec<usize> = if input.read.columns.is_empty() {
         (1..=layout.ncols).collect()
     } else {
@@ -50,11 +61,11 @@ fn run_streaming(
         None => stream_freq(&input.file)?,
     };
     // the errors name the file (and the column, or the row of a bad value)
-    let wvs = binary_wavelet_variance(&input.file, layout, &columns, freq_hz, opts)?;
+    let streamed = binary_columns_wv(&input.file, layout, &columns, freq_hz, opts)?;
     Ok(columns
         .iter()
         .map(|&c| layout.names[c - 1].clone())
-        .zip(wvs)
+        .zip(streamed)
         .collect())
 }
 

@@ -12,7 +12,7 @@ pub(crate) mod simd;
 pub(crate) mod stream;
 pub mod wv;
 
-pub use stream::binary_wavelet_variance;
+pub use stream::{binary_columns_wv, binary_wavelet_variance, StreamedColumn};
 pub use wv::{default_levels, kept_count};
 
 use rayon::prelude::*;

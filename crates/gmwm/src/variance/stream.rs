@@ -7,6 +7,11 @@
 //! for bit on any number of threads. Levels up to [`RING_LEVELS`] run through the accumulator's
 //! pyramid; the levels above, whose rings would be megabytes of memory touched once per sample,
 //! run a lag recurrence on samples read back from the file ([`TopLevel`]).
+//!
+//! Only the schedule depends on the threads: one column's parts run in parallel; several
+//! columns run in parallel part after part; a series of one part has its pyramid split in two
+//! halves, the levels above a split level running each chunk while the levels below run the
+//! next ([`HaarWvAccumulator::upper_part`]), which computes exactly what one pass would.
 
 use crate::error::{check_freq, InputError, ParamError, SeriesError};
 use crate::imu::read::binary::RawRows;
@@ -108,10 +113,38 @@ pub fn binary_wavelet_variance(
     freq_hz: f64,
     opts: &WvOptions,
 ) -> Result<Vec<WaveletVariance>, ReadError> {
+    let columns = binary_columns_wv(path, layout, columns, freq_hz, opts)?;
+    Ok(columns.into_iter().map(|c| c.wv).collect())
+}
+
+/// A column of a raw binary file streamed by [`binary_columns_wv`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamedColumn {
+    /// Its wavelet variance, as [`binary_wavelet_variance`] gives it.
+    pub wv: WaveletVariance,
+    /// Its smallest sample.
+    pub min: f64,
+    /// Its largest sample.
+    pub max: f64,
+}
+
+/// [`binary_wavelet_variance`] with each column's smallest and largest sample, found in the
+/// same pass: what a GMWM fit needs besides the WV (the range `R = (max - min) / N` of the
+/// start search, METHODS §6.1), so a fit of a raw binary file need not load it either.
+///
+/// # Errors
+/// As [`binary_wavelet_variance`].
+pub fn binary_columns_wv(
+    path: &Path,
+    layout: &BinaryLayout,
+    columns: &[usize],
+    freq_hz: f64,
+    opts: &WvOptions,
+) -> Result<Vec<StreamedColumn>, ReadError> {
     binary_wv_with(path, layout, columns, freq_hz, opts, &Plan::DEFAULT)
 }
 
-/// [`binary_wavelet_variance`] with another [`Plan`].
+/// [`binary_columns_wv`] with another [`Plan`].
 pub(crate) fn binary_wv_with(
     path: &Path,
     layout: &BinaryLayout,
@@ -119,7 +152,7 @@ pub(crate) fn binary_wv_with(
     freq_hz: f64,
     opts: &WvOptions,
     plan: &Plan,
-) -> Result<Vec<WaveletVariance>, ReadError> {
+) -> Result<Vec<StreamedColumn>, ReadError> {
     check_options(opts, freq_hz)?;
     if columns.is_empty() {
         return Err(ParamError::new("columns", "none", "at least one column").into());
@@ -174,9 +207,15 @@ pub(crate) fn binary_wv_with(
     })?;
     sums.into_iter()
         .zip(columns)
-        .map(|(acc, &c)| {
-            acc.finish(freq_hz, opts.alpha)
-                .map_err(|e| column_error(c, e))
+        .map(|(sums, &c)| {
+            Ok(StreamedColumn {
+                wv: sums
+                    .acc
+                    .finish(freq_hz, opts.alpha)
+                    .map_err(|e| column_error(c, e))?,
+                min: sums.min,
+                max: sums.max,
+            })
         })
         .collect()
 }
@@ -276,6 +315,8 @@ struct PartSums {
     tops: Vec<Vec<TopLevel>>,
     /// Sums of the demeaned samples of each block of [`BLOCK`] of the part, a vector a column.
     block_sums: Vec<Vec<f64>>,
+    /// Smallest and largest sample of each column in the part.
+    extremes: Vec<(f64, f64)>,
 }
 
 /// Why a split pass failed.
@@ -316,7 +357,7 @@ pub(crate) fn split_sums<S: Source>(
     src: &S,
     levels: usize,
     plan: &Plan,
-) -> Result<Vec<HaarWvAccumulator>, SplitError> {
+) -> Result<Vec<ColumnSums>, SplitError> {
     debug_assert!(plan.part.is_power_of_two() && plan.part >= BLOCK);
     debug_assert!(plan.chunk % BLOCK == 0 && plan.chunk > 0);
     debug_assert!(plan.ring_levels >= 12, "lags of at least BLOCK samples");
@@ -337,20 +378,35 @@ pub(crate) fn split_sums<S: Source>(
         .collect();
     let parts = n.div_ceil(plan.part);
     let pool = Mutex::new(Vec::new());
-    let run = |p: usize, parallel_columns: bool| {
+    let threads = rayon::current_num_threads();
+    let run = |p: usize, spread: Spread| {
         let t0 = p * plan.part;
         let t1 = (t0 + plan.part).min(n);
-        run_part(src, t0, t1, &offsets, levels, plan, parallel_columns, &pool)
+        run_part(src, t0, t1, &offsets, levels, plan, spread, &pool)
     };
     // one column: parts in parallel; several: parts in turn, columns in parallel (each part
-    // in flight holds every column's rings); the same sums either way
-    let results: Vec<Result<PartSums, SplitError>> =
-        if parts > 1 && k < rayon::current_num_threads() {
-            (0..parts).into_par_iter().map(|p| run(p, false)).collect()
+    // in flight holds every column's rings); one part of one column: its pyramid split in
+    // two halves run side by side. The same sums whichever.
+    let results: Vec<Result<PartSums, SplitError>> = if parts > 1 && k < threads {
+        (0..parts)
+            .into_par_iter()
+            .map(|p| run(p, Spread::Serial))
+            .collect()
+    } else {
+        let spread = if k > 1 {
+            Spread::Columns
         } else {
+            let rings = levels.min(plan.ring_levels).min(n.ilog2() as usize);
+            match split_level(rings, levels - levels.min(plan.ring_levels)) {
+                Some(split) if threads > 1 => Spread::Levels(split),
+                _ => Spread::Serial,
+            }
+        };
+        // on a thread of the pool, so that the parallel steps of a part join there
+        rayon::scope(|_| {
             let mut out = Vec::with_capacity(parts);
             for p in 0..parts {
-                let r = run(p, k > 1);
+                let r = run(p, spread);
                 let failed = r.is_err();
                 out.push(r);
                 if failed {
@@ -358,7 +414,8 @@ pub(crate) fn split_sums<S: Source>(
                 }
             }
             out
-        };
+        })
+    };
     // the first error in part order is the first in the file
     let mut done = Vec::with_capacity(parts);
     for r in results {
@@ -367,14 +424,26 @@ pub(crate) fn split_sums<S: Source>(
     Ok(combine(done, levels))
 }
 
+/// The sums of one column of a split pass, in an accumulator to
+/// [`finish`](HaarWvAccumulator::finish), with the column's smallest and largest sample.
+pub(crate) struct ColumnSums {
+    pub(crate) acc: HaarWvAccumulator,
+    pub(crate) min: f64,
+    pub(crate) max: f64,
+}
+
 /// Adds the parts' sums in part order, the lag-recurrence levels with the value they start
 /// from, known now that every block sum is.
-fn combine(parts: Vec<PartSums>, levels: usize) -> Vec<HaarWvAccumulator> {
+fn combine(parts: Vec<PartSums>, levels: usize) -> Vec<ColumnSums> {
     let k = parts[0].accs.len();
     let mut block_sums: Vec<Vec<f64>> = vec![Vec::new(); k];
+    let mut extremes = vec![(f64::INFINITY, f64::NEG_INFINITY); k];
     for part in &parts {
         for (all, own) in block_sums.iter_mut().zip(&part.block_sums) {
             all.extend_from_slice(own);
+        }
+        for (all, own) in extremes.iter_mut().zip(&part.extremes) {
+            *all = (all.0.min(own.0), all.1.max(own.1));
         }
     }
     let mut parts = parts.into_iter();
@@ -398,6 +467,10 @@ fn combine(parts: Vec<PartSums>, levels: usize) -> Vec<HaarWvAccumulator> {
         }
     }
     totals
+        .into_iter()
+        .zip(extremes)
+        .map(|(acc, (min, max))| ColumnSums { acc, min, max })
+        .collect()
 }
 
 /// Applies `f` to every column's state, in parallel or in turn.
@@ -421,6 +494,122 @@ struct ColumnPart {
     acc: HaarWvAccumulator,
     tops: Vec<TopLevel>,
     block_sums: Vec<f64>,
+    /// Smallest and largest sample of the part so far.
+    extremes: (f64, f64),
+}
+
+/// How the work of one part is spread over the threads (never a change to the result).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Spread {
+    /// One thread.
+    Serial,
+    /// The columns in parallel.
+    Columns,
+    /// One column, its pyramid split after this level ([`HaarWvAccumulator::split_at`]): the
+    /// levels below on one chunk while the levels above run the chunk before.
+    Levels(usize),
+}
+
+/// The level after which to split the pyramid of a part run alone, `levels` levels run
+/// through rings and `tops` levels by the lag recurrence, or `None` when there is too little
+/// to split: the point that balances a rough cost of the two halves (the lower half also
+/// reads the file and runs the lag recurrence). Only the schedule depends on it.
+fn split_level(levels: usize, tops: usize) -> Option<usize> {
+    // relative costs a sample: a level whose ring is past L1/L2 costs more
+    let cost = |j: usize| if j <= 12 { 1.0 } else { 1.6 };
+    let fixed = 3.0 + 2.5 * tops as f64;
+    let total: f64 = (1..=levels).map(cost).sum::<f64>() + fixed;
+    let mut lower = fixed;
+    for k in 1..levels {
+        lower += cost(k);
+        if lower >= total / 2.0 {
+            let other = total - lower;
+            // the split is worth it only with work on both sides
+            return (other >= total / 4.0).then_some(k);
+        }
+    }
+    None
+}
+
+/// The chunk `[c0, c1)` of a part starting at `t0` of a pass of `levels` levels, `ring_levels`
+/// of them through rings: read, then each column's pyramid (the lower half only, under a level
+/// split), lag-recurrence levels `top_levels`, block sums and extremes.
+#[allow(clippy::too_many_arguments)]
+fn run_chunk<S: Source>(
+    src: &S,
+    t0: usize,
+    c0: usize,
+    c1: usize,
+    offsets: &[f64],
+    (levels, ring_levels): (usize, usize),
+    top_levels: &[usize],
+    parallel_columns: bool,
+    buf: &mut Buffers,
+    states: &mut [ColumnPart],
+) -> Result<(), SplitError> {
+    let len = c1 - c0;
+    src.read(c0, len, &mut buf.bytes, &mut buf.cur)?;
+    // the demeaned samples feed the lag recurrence and the block sums its start values come
+    // from: with no level above the rings in the series, neither is needed
+    let tops = levels > ring_levels;
+    if tops {
+        for (y, (cur, &offset)) in buf.y.iter_mut().zip(buf.cur.iter().zip(offsets)) {
+            y.clear();
+            y.extend(cur.iter().map(|&v| v - offset));
+        }
+    }
+    // samples read back, for the levels that have started by the chunk's end
+    for (d, lag) in buf.lags.iter_mut() {
+        let needed = top_levels
+            .iter()
+            .any(|&j| TopLevel::start_of(j, t0) < c1 && lags_of(j).contains(d));
+        if needed {
+            read_lag(src, c0, len, *d, offsets, &mut buf.bytes, lag)?;
+        }
+    }
+    let (cur, y, lags) = (&buf.cur, &buf.y, &buf.lags);
+    let back = |d: usize, c: usize| -> &[f64] {
+        lags.iter()
+            .find(|(e, _)| *e == d)
+            .map_or(&[][..], |(_, v)| &v[c][..])
+    };
+    each_column(parallel_columns, states, |c, s| {
+        s.acc.push(&cur[c]).map_err(|e| SplitError::Series(c, e))?;
+        for top in s.tops.iter_mut().filter(|t| t.start < c1) {
+            let m = 1usize << (top.j - 1);
+            top.push(c0, &y[c], back(m, c), back(2 * m, c), offsets[c]);
+        }
+        if tops {
+            s.block_sums.extend(y[c].chunks(BLOCK).map(sum_plain));
+        }
+        let (lo, hi) = extremes(&cur[c]);
+        s.extremes = (s.extremes.0.min(lo), s.extremes.1.max(hi));
+        Ok(())
+    })
+}
+
+/// The lags the lag recurrence of level `j` reads back.
+fn lags_of(j: usize) -> [usize; 2] {
+    [1usize << (j - 1), 1usize << j]
+}
+
+/// Smallest and largest of finite values, in eight lanes (a loop the compiler vectorises).
+fn extremes(x: &[f64]) -> (f64, f64) {
+    let (mut lo, mut hi) = ([f64::INFINITY; 8], [f64::NEG_INFINITY; 8]);
+    let mut chunks = x.chunks_exact(8);
+    for c in &mut chunks {
+        for i in 0..8 {
+            lo[i] = if c[i] < lo[i] { c[i] } else { lo[i] };
+            hi[i] = if c[i] > hi[i] { c[i] } else { hi[i] };
+        }
+    }
+    let rest = chunks.remainder();
+    (
+        rest.iter().chain(&lo).fold(f64::INFINITY, |a, &v| a.min(v)),
+        rest.iter()
+            .chain(&hi)
+            .fold(f64::NEG_INFINITY, |a, &v| a.max(v)),
+    )
 }
 
 /// Runs the part `[t0, t1)` of every column.
@@ -432,10 +621,11 @@ fn run_part<S: Source>(
     offsets: &[f64],
     levels: usize,
     plan: &Plan,
-    parallel_columns: bool,
+    spread: Spread,
     pool: &Mutex<Vec<Buffers>>,
 ) -> Result<PartSums, SplitError> {
     let k = offsets.len();
+    let parallel_columns = spread == Spread::Columns;
     let mut buf = pool
         .lock()
         .ok()
@@ -449,14 +639,29 @@ fn run_part<S: Source>(
         .filter(|&j| (1usize << j) <= t1)
         .collect();
     let mut states = Vec::with_capacity(k);
+    // a level split (one column, a part needing no priming): the lower half's rings stop at
+    // the split
+    let split = match spread {
+        Spread::Levels(split) if k == 1 && t0 == 0 => Some(split),
+        _ => None,
+    };
     for (&offset, storage) in offsets.iter().zip(buf.rings.drain(..)) {
-        let acc =
-            HaarWvAccumulator::for_part_capped(levels, offset, t0, t1, storage, plan.ring_levels)
-                .map_err(SplitError::Param)?;
+        let mut acc = HaarWvAccumulator::for_part_capped(
+            levels,
+            offset,
+            t0,
+            t1,
+            storage,
+            split.unwrap_or(plan.ring_levels),
+        )
+        .map_err(SplitError::Param)?;
+        // the source checks every sample it reads
+        acc.trust_finite();
         states.push(ColumnPart {
             acc,
             tops: top_levels.iter().map(|&j| TopLevel::new(j, t0)).collect(),
             block_sums: Vec::with_capacity((t1 - t0).div_ceil(BLOCK)),
+            extremes: (f64::INFINITY, f64::NEG_INFINITY),
         });
     }
     // prime the rings from the samples before the part, in reads ending at t0 - i PRIME_ALIGN
@@ -474,8 +679,6 @@ fn run_part<S: Source>(
             from = to;
         }
     }
-    // the lags the top levels read back
-    let lags_of = |j: usize| [1usize << (j - 1), 1usize << j];
     let mut lags: Vec<usize> = top_levels.iter().flat_map(|&j| lags_of(j)).collect();
     lags.sort_unstable();
     lags.dedup();
@@ -485,54 +688,69 @@ fn run_part<S: Source>(
             buf.lags.push((d, vec![Vec::new(); k]));
         }
     }
+    // the upper half of a level split runs each chunk's scaling coefficients while the lower
+    // half runs the next chunk
+    let mut upper = match split {
+        Some(split) if split == active => {
+            states[0].acc.emit();
+            let mut upper = HaarWvAccumulator::upper_part(levels, t1, split + 1, plan.ring_levels)
+                .map_err(SplitError::Param)?;
+            upper.trust_finite();
+            Some(upper)
+        }
+        _ => None,
+    };
+    let mut handoff: Vec<f64> = Vec::new();
     let mut c0 = t0;
     while c0 < t1 {
         let c1 = (c0 + plan.chunk).min(t1);
-        let len = c1 - c0;
-        src.read(c0, len, &mut buf.bytes, &mut buf.cur)?;
-        for (y, (cur, &offset)) in buf.y.iter_mut().zip(buf.cur.iter().zip(offsets)) {
-            y.clear();
-            y.extend(cur.iter().map(|&v| v - offset));
-        }
-        // samples read back, for the levels that have started by the chunk's end
-        let started: Vec<usize> = top_levels
-            .iter()
-            .copied()
-            .filter(|&j| TopLevel::start_of(j, t0) < c1)
-            .collect();
-        for (d, lag) in buf.lags.iter_mut() {
-            if started.iter().any(|&j| lags_of(j).contains(d)) {
-                read_lag(src, c0, len, *d, offsets, &mut buf.bytes, lag)?;
-            }
-        }
-        let (cur, y, lags) = (&buf.cur, &buf.y, &buf.lags);
-        let back = |d: usize, c: usize| -> &[f64] {
-            lags.iter()
-                .find(|(e, _)| *e == d)
-                .map_or(&[][..], |(_, v)| &v[c][..])
+        let mut chunk = || {
+            run_chunk(
+                src,
+                t0,
+                c0,
+                c1,
+                offsets,
+                (levels, plan.ring_levels),
+                &top_levels,
+                parallel_columns,
+                &mut buf,
+                &mut states,
+            )
         };
-        each_column(parallel_columns, &mut states, |c, s| {
-            s.acc.push(&cur[c]).map_err(|e| SplitError::Series(c, e))?;
-            for top in s.tops.iter_mut().filter(|t| t.start < c1) {
-                let m = 1usize << (top.j - 1);
-                top.push(c0, &y[c], back(m, c), back(2 * m, c), offsets[c]);
+        match &mut upper {
+            Some(up) => {
+                let (lower, higher) = rayon::join(chunk, || up.push(&handoff));
+                lower?;
+                higher.map_err(|e| SplitError::Series(0, e))?;
+                handoff = states[0].acc.take_emitted(handoff);
             }
-            s.block_sums.extend(y[c].chunks(BLOCK).map(sum_plain));
-            Ok(())
-        })?;
+            None => chunk()?,
+        }
         c0 = c1;
     }
     let mut part = PartSums {
         accs: Vec::with_capacity(k),
         tops: Vec::with_capacity(k),
         block_sums: Vec::with_capacity(k),
+        extremes: Vec::with_capacity(k),
     };
     for (c, mut s) in states.into_iter().enumerate() {
         buf.rings
             .push(s.acc.close_part().map_err(|e| SplitError::Series(c, e))?);
+        if let Some(up) = upper.as_mut().filter(|_| c == 0) {
+            // the last chunk's coefficients, then the partial block the close ran
+            let last = s.acc.take_emitted(Vec::new());
+            for v in [&handoff, &last] {
+                up.push(v).map_err(|e| SplitError::Series(0, e))?;
+            }
+            up.close_part().map_err(|e| SplitError::Series(0, e))?;
+            s.acc.append_upper(up);
+        }
         part.accs.push(s.acc);
         part.tops.push(s.tops);
         part.block_sums.push(s.block_sums);
+        part.extremes.push(s.extremes);
     }
     if let Ok(mut p) = pool.lock() {
         p.push(buf);
@@ -839,6 +1057,9 @@ mod tests {
                         &small(chunk),
                     )
                     .unwrap()
+                    .into_iter()
+                    .map(|c| c.wv)
+                    .collect::<Vec<_>>()
                 })
         };
         let base = run(1, BLOCK, &[1, 2]);
@@ -860,7 +1081,13 @@ mod tests {
             let levels = memory.levels();
             let src = MemorySource(vec![&x]);
             let split = split_sums(&src, levels, &small(1 << 15)).unwrap();
-            let split = split.into_iter().next().unwrap().finish(1.0, 0.05).unwrap();
+            let column = split.into_iter().next().unwrap();
+            assert_eq!(column.min, x.iter().copied().fold(f64::INFINITY, f64::min));
+            assert_eq!(
+                column.max,
+                x.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            );
+            let split = column.acc.finish(1.0, 0.05).unwrap();
             assert_eq!(split.n_coefficients(), memory.n_coefficients());
             for j in 0..levels {
                 let r = rel(split.wv()[j], memory.wv()[j]);
@@ -870,8 +1097,9 @@ mod tests {
     }
 
     #[test]
-    fn one_part_is_the_single_stream() {
-        // below a part and the ring levels: the accumulator of the whole series, bit for bit
+    fn one_part_is_the_single_stream_on_any_thread_count() {
+        // below a part and the ring levels: the accumulator of the whole series, bit for bit,
+        // whether the pyramid runs on one thread or split in two halves side by side
         let x = series(70_000, 5, true);
         let mut acc = HaarWvAccumulator::new(16).unwrap();
         acc.push(&x).unwrap();
@@ -882,8 +1110,64 @@ mod tests {
             levels: Some(16),
             ..WvOptions::default()
         };
-        let streamed = binary_wavelet_variance(&path, &layout(1), &[1], 1.0, &opts).unwrap();
-        assert_eq!(streamed[0], one);
+        for threads in [1, 2, 3] {
+            let streamed = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| binary_wavelet_variance(&path, &layout(1), &[1], 1.0, &opts))
+                .unwrap();
+            assert_eq!(streamed[0], one, "{threads} threads");
+        }
+    }
+
+    #[test]
+    fn one_part_split_in_levels_is_the_same_on_any_thread_count_and_read_size() {
+        // one part of 2^17 samples with rings up to level 12 and four levels by the lag
+        // recurrence: one thread, or the pyramid in two halves (one column), or the columns in
+        // parallel (two)
+        let n = 100_000;
+        let (a, b) = (series(n, 8, true), series(n, 9, false));
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_f64(dir.path(), &[&a, &b]);
+        let plan = |chunk| Plan {
+            part: 1 << 17,
+            chunk,
+            ring_levels: 12,
+        };
+        let run = |threads: usize, chunk: usize, columns: &[usize]| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    binary_wv_with(
+                        &path,
+                        &layout(2),
+                        columns,
+                        1.0,
+                        &WvOptions::default(),
+                        &plan(chunk),
+                    )
+                    .unwrap()
+                })
+        };
+        let base = run(1, BLOCK, &[1, 2]);
+        assert_eq!(base[0].wv.levels(), 16);
+        for threads in [1, 2, 3] {
+            for chunk in [BLOCK, 5 * BLOCK, 1 << 16] {
+                assert_eq!(run(threads, chunk, &[1, 2]), base, "{threads} {chunk}");
+                assert_eq!(run(threads, chunk, &[1])[0], base[0], "{threads} {chunk}");
+            }
+        }
+        let memory = crate::wavelet_variance(&a, 1.0, &WvOptions::default()).unwrap();
+        for j in 0..16 {
+            assert!(
+                rel(base[0].wv.wv()[j], memory.wv()[j]) < 1e-12,
+                "level {}",
+                j + 1
+            );
+        }
     }
 
     #[test]

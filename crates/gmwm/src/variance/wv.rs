@@ -670,7 +670,10 @@ pub(crate) fn sum_squares(x: &[f64]) -> f64 {
 #[derive(Debug, Clone)]
 pub struct HaarWvAccumulator {
     levels: usize,
-    /// Levels run through the pyramid: all of them, except in a part of a split pass
+    /// First level run through the pyramid: 1, except for the upper half of a level split
+    /// ([`split_at`](Self::split_at)), fed with the scaling coefficients of the level below.
+    low: usize,
+    /// Last level run through the pyramid: `levels`, except in a part of a split pass
     /// ([`for_part`](Self::for_part)) whose end comes before the first kept coefficient of the
     /// levels above (their sums stay zero there).
     active: usize,
@@ -678,7 +681,7 @@ pub struct HaarWvAccumulator {
     n: u64,
     first: Option<f64>,
     /// The lag rings one after the other: level j's `2^{j-1}` values start at `2^{j-1} - 1`
-    /// ([`ring_span`]).
+    /// ([`ring_span`]) less `2^{low-1} - 1`.
     rings: Vec<f64>,
     pos: Vec<usize>,
     sums: Vec<NeumaierSum>,
@@ -689,6 +692,11 @@ pub struct HaarWvAccumulator {
     pending: Vec<f64>,
     /// Running sums of [`prime`](Self::prime), one a level (empty once the part runs).
     priming: Vec<f64>,
+    /// With `Some`, the scaling coefficients of the last level run, block after block, for the
+    /// upper half of a level split.
+    emitted: Option<Vec<f64>>,
+    /// The samples pushed are known to be finite (checked where they were read).
+    checked: bool,
 }
 
 /// Where level j's lag ring (`2^{j-1}` values) lies in [`HaarWvAccumulator`]'s ring storage.
@@ -723,6 +731,7 @@ impl HaarWvAccumulator {
         }
         Ok(Self {
             levels,
+            low: 1,
             active: levels,
             offset: None,
             n: 0,
@@ -734,6 +743,8 @@ impl HaarWvAccumulator {
             scratch_out: Vec::with_capacity(BLOCK),
             pending: Vec::with_capacity(BLOCK),
             priming: Vec::new(),
+            emitted: None,
+            checked: false,
         })
     }
 
@@ -808,6 +819,7 @@ impl HaarWvAccumulator {
         }
         Ok(Self {
             levels,
+            low: 1,
             active,
             offset: Some(offset),
             n: t0 as u64,
@@ -823,7 +835,67 @@ impl HaarWvAccumulator {
             } else {
                 vec![0.0; active]
             },
+            emitted: None,
+            checked: false,
         })
+    }
+
+    /// The upper half of a level split of the part `[0, end)` of a series (a part that needs no
+    /// priming): levels `low..` (up to `ring_levels`, and those with a kept coefficient before
+    /// `end`), run on the level-`(low - 1)` scaling coefficients that the lower half, made by
+    /// [`for_part_capped`](Self::for_part_capped) with `ring_levels = low - 1` and told to
+    /// [`emit`](Self::emit) them, hands out block by block
+    /// ([`take_emitted`](Self::take_emitted)), pushed in order. The two halves run in parallel
+    /// on consecutive chunks, and together ([`append_upper`](Self::append_upper) once both
+    /// are closed) compute exactly, bit for bit, what one accumulator would have.
+    pub(crate) fn upper_part(
+        levels: usize,
+        end: usize,
+        low: usize,
+        ring_levels: usize,
+    ) -> Result<Self, ParamError> {
+        let mut upper = Self::for_part_capped(levels, 0.0, 0, end, Vec::new(), low - 1)?;
+        let active = (1..=levels.min(ring_levels))
+            .take_while(|&j| (1usize << j) <= end)
+            .count();
+        debug_assert!(low >= 2 && low <= active);
+        // the rings of levels low..=active are zeroed by the first push, on the thread that
+        // runs the upper half (megabytes of fresh pages to fault in)
+        upper.rings = Vec::new();
+        upper.low = low;
+        upper.active = active;
+        Ok(upper)
+    }
+
+    /// Skips the check for non-finite samples: the caller checked them when it read them.
+    pub(crate) fn trust_finite(&mut self) {
+        self.checked = true;
+    }
+
+    /// Makes the lower half of a level split hand out the scaling coefficients of its last level
+    /// ([`upper_part`](Self::upper_part)).
+    pub(crate) fn emit(&mut self) {
+        self.emitted = Some(Vec::new());
+    }
+
+    /// The scaling coefficients run so far by the lower half of a level split, replacing them
+    /// by `reuse` (emptied).
+    pub(crate) fn take_emitted(&mut self, mut reuse: Vec<f64>) -> Vec<f64> {
+        reuse.clear();
+        match &mut self.emitted {
+            Some(e) => std::mem::replace(e, reuse),
+            None => reuse,
+        }
+    }
+
+    /// Adds the sums of the upper half of a level split (closed) to the lower half's.
+    pub(crate) fn append_upper(&mut self, upper: &Self) {
+        for (a, b) in self.sums[upper.low - 1..]
+            .iter_mut()
+            .zip(&upper.sums[upper.low - 1..])
+        {
+            a.add(b.total());
+        }
     }
 
     /// Fills the rings of a [`for_part`](Self::for_part) accumulator from the samples before
@@ -857,6 +929,7 @@ impl HaarWvAccumulator {
         let mut y = std::mem::take(&mut self.scratch_in);
         y.clear();
         y.extend(values.iter().map(|&v| v - offset));
+        debug_assert!(self.low == 1, "prime before a level split");
         prime_levels(&mut self.rings, &mut self.priming, t0, start, &y);
         self.scratch_in = y;
     }
@@ -949,28 +1022,42 @@ impl HaarWvAccumulator {
         self.first.get_or_insert(head);
         let mut input = std::mem::take(&mut self.scratch_in);
         let mut output = std::mem::take(&mut self.scratch_out);
-        if let Err(e) = check_finite(block) {
-            self.scratch_in = input;
-            self.scratch_out = output;
-            return Err(match e {
-                SeriesError::NonFinite { index, value } => SeriesError::NonFinite {
-                    index: self.n as usize + index,
-                    value,
-                },
-                other => other,
-            });
+        if !self.checked {
+            if let Err(e) = check_finite(block) {
+                self.scratch_in = input;
+                self.scratch_out = output;
+                return Err(match e {
+                    SeriesError::NonFinite { index, value } => SeriesError::NonFinite {
+                        index: self.n as usize + index,
+                        value,
+                    },
+                    other => other,
+                });
+            }
         }
         input.clear();
         input.extend(block.iter().map(|&v| v - offset));
         output.resize(input.len(), 0.0);
+        if self.active >= self.low {
+            // the rings of an upper half come zeroed here (see upper_part)
+            let len = ring_span(self.active).end - ring_span(self.low).start;
+            if self.rings.len() < len {
+                self.rings.resize(len, 0.0);
+            }
+        }
+        let levels = self.low - 1..self.active;
         pyramid_block(
             &mut input,
             &mut output,
             &mut self.rings,
-            &mut self.pos[..self.active],
-            &mut self.sums[..self.active],
+            self.low,
+            &mut self.pos[levels.clone()],
+            &mut self.sums[levels],
             self.n,
         );
+        if let Some(e) = &mut self.emitted {
+            e.extend_from_slice(&input);
+        }
         self.n += block.len() as u64;
         self.scratch_in = input;
         self.scratch_out = output;
@@ -1018,22 +1105,26 @@ impl HaarWvAccumulator {
     }
 }
 
-/// The pyramid over one block of demeaned samples (`input`, which it overwrites, as it does
-/// `output`) starting at sample `t0`: level j (1-based, one per `pos` entry) reads `V_{j-1}` and
-/// its ring and adds its squared boundary-free coefficients to `sums[j - 1]`.
+/// The pyramid over one block starting at sample `t0`: `input` holds `V_{low-1}` (the demeaned
+/// samples for `low = 1`) and ends holding the last level's `V`; `output` is scratch. Level j
+/// (one per `pos` entry from `low` on) reads `V_{j-1}` and its ring (in `rings`, which starts
+/// with level `low`'s) and adds its squared boundary-free coefficients to its entry of `sums`.
 fn pyramid_block(
     input: &mut Vec<f64>,
     output: &mut Vec<f64>,
     rings: &mut [f64],
+    low: usize,
     pos: &mut [usize],
     sums: &mut [NeumaierSum],
     t0: u64,
 ) {
-    for (j, (pos, sum)) in (1..).zip(pos.iter_mut().zip(sums.iter_mut())) {
+    let base = ring_span(low).start;
+    for (j, (pos, sum)) in (low..).zip(pos.iter_mut().zip(sums.iter_mut())) {
         // First boundary-free coefficient of level j is at t = 2^j - 1.
         let first_valid = (1u64 << j) - 1;
         let skip = first_valid.saturating_sub(t0).min(input.len() as u64) as usize;
-        let ring = &mut rings[ring_span(j)];
+        let span = ring_span(j);
+        let ring = &mut rings[span.start - base..span.end - base];
         let s = haar_level(input, output, ring, pos, skip);
         sum.add(s);
         std::mem::swap(input, output);
