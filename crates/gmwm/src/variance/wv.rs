@@ -659,7 +659,7 @@ pub(crate) fn sum_squares(x: &[f64]) -> f64 {
 pub struct HaarWvAccumulator {
     levels: usize,
     /// First level run through the pyramid: 1, except for the upper half of a level split
-    /// ([`split_at`](Self::split_at)), fed with the scaling coefficients of the level below.
+    /// ([`upper_part`](Self::upper_part)), fed with the scaling coefficients of the level below.
     low: usize,
     /// Last level run through the pyramid: `levels`, except in a part of a split pass
     /// ([`for_part`](Self::for_part)) whose end comes before the first kept coefficient of the
@@ -715,7 +715,7 @@ fn ring_span(j: usize) -> std::ops::Range<usize> {
 /// Samples per lane block of [`HaarWvAccumulator::prime`]: the running sums of the levels whose
 /// ring holds at least this many values run four interleaved chains over blocks of this length,
 /// aligned on the level's span (which history reads must respect, see
-/// [`PRIME_ALIGN`](crate::variance::wv::PRIME_ALIGN)).
+/// [`PRIME_ALIGN`]).
 pub(crate) const PRIME_BLOCK: usize = 2048;
 
 /// History reads of [`HaarWvAccumulator::prime`] end at `t0 - k · PRIME_ALIGN`: a multiple of
