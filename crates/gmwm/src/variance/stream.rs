@@ -42,7 +42,7 @@ pub(crate) const RING_LEVELS: usize = 20;
 /// the result, the chunk length never does.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Plan {
-    /// Samples per part: a power of two of at least [`PRIME_ALIGN`].
+    /// Samples per part: a power of two, at least [`BLOCK`].
     pub(crate) part: usize,
     /// Rows per read: a multiple of [`BLOCK`].
     pub(crate) chunk: usize,
@@ -75,9 +75,9 @@ impl Plan {
 /// The values equal those of [`wavelet_variance`](crate::wavelet_variance) of the loaded column
 /// to rounding (the same offset, the mean of the first 2048 samples, and the same coefficients,
 /// summed in another order; about 1e-15 relative), and are bit for bit the same whatever the
-/// number of threads. Memory: per column about `8 · 2^min(J, 20)` bytes (the rings of the
-/// pyramid) and, per thread, a few chunks of 16 Ki rows of the file; it does not grow with the
-/// file's length.
+/// number of threads. Memory: per column and per part in flight (at most one a thread) about
+/// `8 · 2^min(J, 20)` bytes (the rings of the pyramid), and per thread a few chunks of 16 Ki
+/// rows of the file; it does not grow with the file's length.
 ///
 /// ```no_run
 /// use gmwm::imu::{BinaryLayout, InputFormat};
@@ -505,7 +505,7 @@ enum Spread {
     Serial,
     /// The columns in parallel.
     Columns,
-    /// One column, its pyramid split after this level ([`HaarWvAccumulator::split_at`]): the
+    /// One column, its pyramid split after this level ([`HaarWvAccumulator::upper_part`]): the
     /// levels below on one chunk while the levels above run the chunk before.
     Levels(usize),
 }

@@ -671,7 +671,7 @@ pub(crate) fn sum_squares(x: &[f64]) -> f64 {
 pub struct HaarWvAccumulator {
     levels: usize,
     /// First level run through the pyramid: 1, except for the upper half of a level split
-    /// ([`split_at`](Self::split_at)), fed with the scaling coefficients of the level below.
+    /// ([`upper_part`](Self::upper_part)), fed with the scaling coefficients of the level below.
     low: usize,
     /// Last level run through the pyramid: `levels`, except in a part of a split pass
     /// ([`for_part`](Self::for_part)) whose end comes before the first kept coefficient of the
@@ -697,6 +697,25 @@ pub struct HaarWvAccumulator {
     emitted: Option<Vec<f64>>,
     /// The samples pushed are known to be finite (checked where they were read).
     checked: bool,
+    /// The series starts with this accumulator (no priming): until a level's ring has wrapped
+    /// once, its lags lie before the start and are the pyramid's zeros, so the large rings
+    /// ([`haar_level`]'s second case) are written before they are ever read, and need no
+    /// zeroing (fresh pages are then faulted in once, as they are first written).
+    fresh: bool,
+}
+
+/// Levels whose ring is read within a block ([`haar_level`]'s first case, `2^{j-1} <= BLOCK`):
+/// the only rings a fresh accumulator must zero.
+const SMALL_RING_LEVELS: usize = 13;
+
+/// Zeroes the rings of levels `low..=active.min(SMALL_RING_LEVELS)` in `rings` (which starts with
+/// level `low`'s).
+fn zero_small_rings(rings: &mut [f64], low: usize, active: usize) {
+    let top = active.min(SMALL_RING_LEVELS);
+    if top >= low {
+        let base = ring_span(low).start;
+        rings[..ring_span(top).end - base].fill(0.0);
+    }
 }
 
 /// Where level j's lag ring (`2^{j-1}` values) lies in [`HaarWvAccumulator`]'s ring storage.
@@ -708,7 +727,7 @@ fn ring_span(j: usize) -> std::ops::Range<usize> {
 /// Samples per lane block of [`HaarWvAccumulator::prime`]: the running sums of the levels whose
 /// ring holds at least this many values run four interleaved chains over blocks of this length,
 /// aligned on the level's span (which history reads must respect, see
-/// [`PRIME_ALIGN`](crate::variance::wv::PRIME_ALIGN)).
+/// [`PRIME_ALIGN`]).
 pub(crate) const PRIME_BLOCK: usize = 2048;
 
 /// History reads of [`HaarWvAccumulator::prime`] end at `t0 - k · PRIME_ALIGN`: a multiple of
@@ -736,6 +755,8 @@ impl HaarWvAccumulator {
             offset: None,
             n: 0,
             first: None,
+            // zeros never read but for the small rings (see `fresh`): calloc'd pages that are
+            // faulted in as they are first written
             rings: vec![0.0; (1usize << levels) - 1],
             pos: vec![0; levels],
             sums: vec![NeumaierSum::default(); levels],
@@ -745,6 +766,7 @@ impl HaarWvAccumulator {
             priming: Vec::new(),
             emitted: None,
             checked: false,
+            fresh: true,
         })
     }
 
@@ -805,17 +827,23 @@ impl HaarWvAccumulator {
             .count();
         let len = (1usize << active) - 1;
         if t0 == 0 {
-            // the pyramid's values before the start are zero
-            storage.clear();
-        }
-        // otherwise prime writes every value: the old ones may stay
-        storage.resize(len, 0.0);
-        for j in 1..=active {
-            // ring values whose windows lie wholly before the series start are zero, and
-            // prime only sees samples from 0 on
-            let before_start = (1usize << j).saturating_sub(t0).min(1 << (j - 1));
-            let span = ring_span(j);
-            storage[span.start..span.start + before_start].fill(0.0);
+            // only the small rings are read before they are written (see `fresh`): the old
+            // values may stay, and new storage is calloc'd, untouched
+            if storage.capacity() < len {
+                storage = vec![0.0; len];
+            } else {
+                storage.resize(len, 0.0);
+            }
+            zero_small_rings(&mut storage, 1, active);
+        } else {
+            // prime writes every value but those whose windows lie wholly before the series
+            // start, which are zero (prime only sees samples from 0 on)
+            storage.resize(len, 0.0);
+            for j in 1..=active {
+                let before_start = (1usize << j).saturating_sub(t0).min(1 << (j - 1));
+                let span = ring_span(j);
+                storage[span.start..span.start + before_start].fill(0.0);
+            }
         }
         Ok(Self {
             levels,
@@ -837,6 +865,7 @@ impl HaarWvAccumulator {
             },
             emitted: None,
             checked: false,
+            fresh: t0 == 0,
         })
     }
 
@@ -859,9 +888,10 @@ impl HaarWvAccumulator {
             .take_while(|&j| (1usize << j) <= end)
             .count();
         debug_assert!(low >= 2 && low <= active);
-        // the rings of levels low..=active are zeroed by the first push, on the thread that
-        // runs the upper half (megabytes of fresh pages to fault in)
-        upper.rings = Vec::new();
+        // the rings of levels low..=active: calloc'd, the small ones zeroed (see `fresh`)
+        let mut rings = vec![0.0; ring_span(active).end - ring_span(low).start];
+        zero_small_rings(&mut rings, low, active);
+        upper.rings = rings;
         upper.low = low;
         upper.active = active;
         Ok(upper)
@@ -1038,23 +1068,7 @@ impl HaarWvAccumulator {
         input.clear();
         input.extend(block.iter().map(|&v| v - offset));
         output.resize(input.len(), 0.0);
-        if self.active >= self.low {
-            // the rings of an upper half come zeroed here (see upper_part)
-            let len = ring_span(self.active).end - ring_span(self.low).start;
-            if self.rings.len() < len {
-                self.rings.resize(len, 0.0);
-            }
-        }
-        let levels = self.low - 1..self.active;
-        pyramid_block(
-            &mut input,
-            &mut output,
-            &mut self.rings,
-            self.low,
-            &mut self.pos[levels.clone()],
-            &mut self.sums[levels],
-            self.n,
-        );
+        self.pyramid_block(&mut input, &mut output);
         if let Some(e) = &mut self.emitted {
             e.extend_from_slice(&input);
         }
@@ -1105,29 +1119,30 @@ impl HaarWvAccumulator {
     }
 }
 
-/// The pyramid over one block starting at sample `t0`: `input` holds `V_{low-1}` (the demeaned
-/// samples for `low = 1`) and ends holding the last level's `V`; `output` is scratch. Level j
-/// (one per `pos` entry from `low` on) reads `V_{j-1}` and its ring (in `rings`, which starts
-/// with level `low`'s) and adds its squared boundary-free coefficients to its entry of `sums`.
-fn pyramid_block(
-    input: &mut Vec<f64>,
-    output: &mut Vec<f64>,
-    rings: &mut [f64],
-    low: usize,
-    pos: &mut [usize],
-    sums: &mut [NeumaierSum],
-    t0: u64,
-) {
-    let base = ring_span(low).start;
-    for (j, (pos, sum)) in (low..).zip(pos.iter_mut().zip(sums.iter_mut())) {
-        // First boundary-free coefficient of level j is at t = 2^j - 1.
-        let first_valid = (1u64 << j) - 1;
-        let skip = first_valid.saturating_sub(t0).min(input.len() as u64) as usize;
-        let span = ring_span(j);
-        let ring = &mut rings[span.start - base..span.end - base];
-        let s = haar_level(input, output, ring, pos, skip);
-        sum.add(s);
-        std::mem::swap(input, output);
+impl HaarWvAccumulator {
+    /// The pyramid over the next block: `input` holds `V_{low-1}` (the demeaned samples for
+    /// `low = 1`) and ends holding the last level's `V`; `output` is scratch. Level j
+    /// (`low..=active`) reads `V_{j-1}` and its ring and adds its squared boundary-free
+    /// coefficients to its sum.
+    fn pyramid_block(&mut self, input: &mut Vec<f64>, output: &mut Vec<f64>) {
+        let t0 = self.n;
+        let base = ring_span(self.low).start;
+        let levels = self.low - 1..self.active;
+        let pos = &mut self.pos[levels.clone()];
+        let sums = &mut self.sums[levels];
+        for (j, (pos, sum)) in (self.low..).zip(pos.iter_mut().zip(sums.iter_mut())) {
+            // First boundary-free coefficient of level j is at t = 2^j - 1.
+            let first_valid = (1u64 << j) - 1;
+            let skip = first_valid.saturating_sub(t0).min(input.len() as u64) as usize;
+            let span = ring_span(j);
+            let ring = &mut self.rings[span.start - base..span.end - base];
+            // a block wholly in the ring's first wrap (its end is a multiple of BLOCK, as is
+            // 2^{j-1} in haar_level's second case, so a block is wholly in it or wholly out)
+            let first_wrap = self.fresh && t0 + input.len() as u64 <= 1u64 << (j - 1);
+            let s = haar_level(input, output, ring, pos, skip, first_wrap);
+            sum.add(s);
+            std::mem::swap(input, output);
+        }
     }
 }
 
@@ -1355,7 +1370,9 @@ fn haar_wv_split(
 
 /// One Haar pyramid level over a block: reads `V_{j-1}` from `input`, writes `V_j` to `output`,
 /// updates the lag ring (length `m = 2^{j-1}`, oldest value at `*pos`), and returns the sum of
-/// squared wavelet coefficients from index `skip` on.
+/// squared wavelet coefficients from index `skip` on. With `first_wrap` (only for `m > b`), the
+/// block's lags all lie before the series start: zeros, not read from the ring (which is
+/// written all the same), with the same roundings.
 #[inline(always)]
 fn haar_level(
     input: &[f64],
@@ -1363,6 +1380,7 @@ fn haar_level(
     ring: &mut [f64],
     pos: &mut usize,
     skip: usize,
+    first_wrap: bool,
 ) -> f64 {
     let m = ring.len();
     let b = input.len();
@@ -1390,7 +1408,12 @@ fn haar_level(
         let mut i = 0;
         while i < b {
             let run = (m - *pos).min(b - i);
-            ss += level_span_ring(
+            let span = if first_wrap {
+                level_span_fresh
+            } else {
+                level_span_ring
+            };
+            ss += span(
                 &input[i..i + run],
                 &mut ring[*pos..*pos + run],
                 &mut output[i..i + run],
@@ -1481,6 +1504,51 @@ fn level_span_ring_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip:
         .zip(rings.into_remainder())
     {
         let u = *r;
+        *o = 0.5 * (v + u);
+        tail += (v - u) * (v - u);
+        *r = v;
+    }
+    0.25 * ((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail)
+}
+
+crate::variance::simd::multiversion! {
+    /// [`level_span_ring`] where every old value is a zero before the series start: the ring is
+    /// written, not read (the same roundings as reading zeros from it).
+    fn level_span_fresh(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64
+        => level_span_fresh_impl
+}
+
+#[inline(always)]
+fn level_span_fresh_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64 {
+    let skip = skip.min(new.len());
+    let (new_skip, new_kept) = new.split_at(skip);
+    let (ring_skip, ring_kept) = ring.split_at_mut(skip);
+    let (out_skip, out_kept) = output.split_at_mut(skip);
+    for ((o, &v), r) in out_skip.iter_mut().zip(new_skip).zip(ring_skip) {
+        *o = 0.5 * (v + 0.0);
+        *r = v;
+    }
+    let mut acc = [0.0f64; 4];
+    let mut outs = out_kept.chunks_exact_mut(4);
+    let mut news = new_kept.chunks_exact(4);
+    let mut rings = ring_kept.chunks_exact_mut(4);
+    for ((o, v), r) in (&mut outs).zip(&mut news).zip(&mut rings) {
+        for k in 0..4 {
+            let u = 0.0;
+            o[k] = 0.5 * (v[k] + u);
+            let w = v[k] - u;
+            acc[k] += w * w;
+            r[k] = v[k];
+        }
+    }
+    let mut tail = 0.0;
+    for ((o, &v), r) in outs
+        .into_remainder()
+        .iter_mut()
+        .zip(news.remainder())
+        .zip(rings.into_remainder())
+    {
+        let u = 0.0;
         *o = 0.5 * (v + u);
         tail += (v - u) * (v - u);
         *r = v;
