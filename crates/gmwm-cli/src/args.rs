@@ -721,7 +721,8 @@ pub struct WvEstimatorArgs {
     /// Number of levels J [default: floor(log2 N), one fewer if the last would keep < 2 coefficients].
     #[arg(long, value_name = "J", value_parser = at_least_1)]
     pub levels: Option<usize>,
-    /// Confidence level of the intervals (0.05 gives 95% intervals).
+    /// Significance level A: the intervals cover 1 - A (0.05 gives 95% intervals; a value
+    /// above 0.5, such as 0.95, is refused as a likely confidence level).
     #[arg(long, value_name = "A", default_value_t = 0.05, value_parser = alpha)]
     pub alpha: f64,
 }
@@ -769,7 +770,8 @@ pub struct AvarArgs {
     /// Textbook estimators, or the R package's (with its off-by-one terms, METHODS §13.8–13.10).
     #[arg(long, value_enum, default_value_t = ConventionArg::Textbook)]
     pub convention: ConventionArg,
-    /// Confidence level of the intervals (0.05 gives 95% intervals).
+    /// Significance level A: the intervals cover 1 - A (0.05 gives 95% intervals; a value
+    /// above 0.5, such as 0.95, is refused as a likely confidence level).
     #[arg(long, value_name = "A", default_value_t = 0.05, value_parser = alpha)]
     pub alpha: f64,
     /// Output format.
@@ -873,11 +875,16 @@ pub fn efficiency(s: &str) -> Result<f64, String> {
     }
 }
 
-/// `--alpha`: a level in (0, 1).
+/// `--alpha`: a significance level in (0, 0.5]
+/// ([`gmwm::variance::ci::significance_level_problem`]).
 pub fn alpha(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
-        _ => Err("must be in (0, 1): 0.05 gives 95% intervals".into()),
+    let v = s
+        .trim()
+        .parse::<f64>()
+        .map_err(|_| "must be a significance level in (0, 0.5]: 0.05 gives 95% intervals")?;
+    match gmwm::variance::ci::significance_level_problem(v) {
+        None => Ok(v),
+        Some(why) => Err(why),
     }
 }
 

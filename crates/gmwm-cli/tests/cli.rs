@@ -266,7 +266,17 @@ fn impossible_parameters_are_errors() {
         &["--eff", "(0, 0.99]"],
     );
     assert_one_line_error(&["wv", "--filter", "db99", p], &["db99"]);
-    assert_usage_error(&["wv", "--alpha", "2", p], &["--alpha", "(0, 1)"]);
+    assert_usage_error(&["wv", "--alpha", "2", p], &["--alpha", "(0, 0.5]"]);
+    // a confidence level given as alpha is refused with what to give instead
+    assert_usage_error(
+        &["wv", "--alpha", "0.95", p],
+        &[
+            "--alpha",
+            "significance level",
+            "5% intervals",
+            "for 95% intervals give 0.05",
+        ],
+    );
     assert_one_line_error(&["wv", "--levels", "9", p], &["level"]);
     assert_usage_error(&["wv", "--levels", "0", p], &["--levels", ">= 1"]);
     assert_usage_error(&["wv", "--freq=-3", p], &["--freq", "positive"]);
@@ -309,7 +319,7 @@ fn issue_10_numeric_flags_outside_their_domain_are_one_line_usage_errors() {
         ("--seed", "-1", "whole number"),
         ("--levels", "-2", ">= 1"),
         ("--eff", "-0.5", "(0, 0.99]"),
-        ("--alpha", "-0.05", "(0, 1)"),
+        ("--alpha", "-0.05", "(0, 0.5]"),
     ] {
         assert_usage_error(&["fit", "--model", "WN()", flag, value, p], &[flag, domain]);
     }

@@ -136,10 +136,8 @@ fn wv_options(
     } else {
         None
     };
-    if !(alpha > 0.0 && alpha < 1.0) {
-        return Err(err(format!(
-            "invalid alpha {alpha}: must be in (0, 1); 0.05 gives 95% intervals"
-        )));
+    if let Some(why) = gmwm::variance::ci::significance_level_problem(alpha) {
+        return Err(err(format!("invalid alpha {alpha}: {why}")));
     }
     if levels == Some(0) {
         return Err(err("invalid levels 0: at least one level"));
@@ -215,6 +213,9 @@ fn avar(
 ) -> PyResult<String> {
     check_columns(&arrays, &names)?;
     check_freq(freq)?;
+    if let Some(why) = gmwm::variance::ci::significance_level_problem(alpha) {
+        return Err(err(format!("invalid alpha {alpha}: {why}")));
+    }
     let opts = AllanOptions {
         kind: match kind {
             "overlapping" => AllanKind::Overlapping,

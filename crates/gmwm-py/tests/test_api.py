@@ -211,6 +211,7 @@ def test_implied_and_read():
         (lambda: gmwm.wv("/nonexistent/imu.csv", freq=1), "/nonexistent/imu.csv"),
         (lambda: gmwm.wv(str(ADIS), format="nope"), "format"),
         (lambda: gmwm.avar(np.ones(256), freq=1, kind="nope"), "kind"),
+        (lambda: gmwm.wv(np.random.default_rng(1).normal(size=256), freq=1, alpha=0.95), "for 95% intervals give 0.05"),
         (lambda: gmwm.implied("WN(sigma2=-1)", levels=4), ""),
         (lambda: gmwm.implied("XYZ()", levels=4), "XYZ"),
         (lambda: gmwm.simulate("WN(sigma2=1)", n=0), "n"),

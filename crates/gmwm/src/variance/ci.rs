@@ -26,6 +26,34 @@ pub fn eta3(kept: usize, j: usize) -> f64 {
     (kept as f64 / (j as f64).exp2()).max(1.0)
 }
 
+/// Why `alpha` is not a significance level the front ends accept, or `None` when it is one:
+/// `(0, 0.5]`. A value above 0.5 is most likely a confidence level (`0.95` for 95% intervals,
+/// which as alpha would give 5% ones), so the command line and the Python calls refuse it
+/// rather than obey it; the engine itself takes any level in `(0, 1)`.
+///
+/// ```
+/// use gmwm::variance::ci::significance_level_problem;
+/// assert!(significance_level_problem(0.05).is_none());
+/// assert!(significance_level_problem(0.95).unwrap().contains("for 95% intervals give 0.05"));
+/// ```
+pub fn significance_level_problem(alpha: f64) -> Option<String> {
+    // six decimals: 1 - 0.95 prints as 0.05, not 0.050000000000000044
+    let short = |v: f64| format!("{}", (v * 1e6).round() / 1e6);
+    if alpha > 0.0 && alpha <= 0.5 {
+        None
+    } else if alpha > 0.5 && alpha < 1.0 {
+        Some(format!(
+            "alpha is the significance level, in (0, 0.5]: the intervals cover 1 - alpha, so {} would give {}% intervals; for {}% intervals give {}",
+            short(alpha),
+            short(100.0 * (1.0 - alpha)),
+            short(100.0 * alpha),
+            short(1.0 - alpha),
+        ))
+    } else {
+        Some("must be a significance level in (0, 0.5]: 0.05 gives 95% intervals".to_string())
+    }
+}
+
 /// Checks chi-square degrees of freedom: finite and positive (they may be fractional).
 fn check_df(name: &'static str, df: f64) -> Result<(), ParamError> {
     if df.is_finite() && df > 0.0 {
