@@ -741,6 +741,12 @@ fn review_findings_are_errors_not_panics_or_silent_numbers() {
         &["--ncols", ">= 1"],
     );
     let ok = temp_file(".csv", b"x\n1\n3\n2\n5\n4\n6\n8\n7\n");
+    // a column count on a text file was ignored; it is refused, naming the file
+    let okp = ok.path().to_str().unwrap();
+    assert_one_line_error(
+        &["wv", "--freq", "1", "--ncols", "3", okp],
+        &["ncols", okp, "raw binary", "text"],
+    );
     gmwm()
         .args(["wv", "--freq", "1", "--alpha", "1e-300"])
         .arg(ok.path())

@@ -521,6 +521,22 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
     }
     let sidecar = find_sidecar(path)?;
     let format = resolve_format(path, opts.format, sidecar.as_ref())?;
+    // a column count only describes raw interleaved values; elsewhere it would be ignored
+    if let (Some(k), None) = (opts.ncols, format.value_width()) {
+        return Err(ParamError::new(
+            "ncols",
+            k,
+            format!(
+                "only for raw binary f64/f32 files; {} is read as {}, whose columns it states itself",
+                path.display(),
+                match format {
+                    InputFormat::ImuRecord(t) => format!("{} records", t.name()),
+                    _ => "text".to_string(),
+                }
+            ),
+        )
+        .into());
+    }
     let raw = match format {
         InputFormat::F64 | InputFormat::F32 => {
             binary::read_binary_table(path, format, opts, sidecar.as_ref())?
