@@ -822,7 +822,7 @@ def write_big(path: Path, n: int, seed: int) -> None:
             level = float(walk[-1])
             (rng.standard_normal(m) * 1e-3 + walk).astype("<f8").tofile(f)
     Path(str(path) + ".json").write_text(json.dumps(
-        {"sampling_frequency_hz": 100, "columns": [{"name": "gyro_x", "unit": "rad/s"}]}))
+        {"sampling_frequency_hz": 100, "units": {"gyro": "rad/s"}, "columns": [{"name": "gyro_x"}]}))
 
 
 def run_criterion(row: Row, timeout: float) -> None:

@@ -6,7 +6,7 @@ use crate::calib::{CalibrationReport, NavSet};
 use crate::fit::{
     Ar1GmForms, CanonicalModel, CanonicalTerm, NavParameter, ParameterEstimate, Reading,
 };
-use crate::inference::{Inference, JTest};
+use crate::inference::{Inference, JTest, VSource};
 use crate::selection::{SelectionRow, SelectionRule};
 use crate::{GmwmFit, ModelSelection};
 use serde::Serialize;
@@ -178,8 +178,8 @@ struct SelectionReport<'a> {
     canonical_notes: Vec<CanonicalNote<'a>>,
     reason: String,
     rule: SelectionRule,
-    v_method: &'static str,
-    v_replicates: Option<usize>,
+    #[serde(flatten)]
+    v_source: VSource,
     rows: &'a [SelectionRow],
     candidates: Vec<CandidateRow>,
 }
@@ -203,8 +203,7 @@ pub fn selections(items: &[(String, ModelSelection)]) -> Value {
             canonical_notes: canonical_notes(&s.selected_canonical),
             reason: s.reason(),
             rule: s.rule,
-            v_method: s.v_method,
-            v_replicates: s.v_replicates,
+            v_source: s.v_source,
             rows: &s.rows,
             candidates: s
                 .candidates

@@ -618,7 +618,7 @@ impl Calibration {
             &gmwm,
             &fit,
             &selection.wv_covariance,
-            selection.v_replicates,
+            selection.v_replicates(),
             &self.options.wv,
             &InferenceOptions {
                 alpha: self.options.wv.alpha,

@@ -117,7 +117,7 @@ impl Calibration {
             .into());
         };
         let sidecar = find_sidecar(path)?;
-        let (columns, infos) = selected(path, &layout, read)?;
+        let (columns, infos) = selected(path, &layout, read, sidecar.as_ref())?;
         let freq_hz = read
             .freq_hz
             .or_else(|| sidecar.as_ref().and_then(|s| s.sampling_frequency_hz))
@@ -241,7 +241,7 @@ pub fn columns(path: &Path, read: &ReadOptions) -> Result<Vec<(String, SensorInf
             "a raw binary f64/f32 recording (by --format, its name or its sidecar)",
         )
     })?;
-    let (columns, infos) = selected(path, &layout, read)?;
+    let (columns, infos) = selected(path, &layout, read, find_sidecar(path)?.as_ref())?;
     Ok(columns
         .into_iter()
         .zip(infos)
@@ -254,12 +254,12 @@ fn selected(
     path: &Path,
     layout: &BinaryLayout,
     read: &ReadOptions,
+    sidecar: Option<&crate::imu::Sidecar>,
 ) -> Result<(Vec<usize>, Vec<SensorInfo>), Error> {
-    let sidecar = find_sidecar(path)?;
     let columns = selected_columns(path, layout, &read.columns)?;
     let infos = columns
         .iter()
-        .map(|&c| SensorInfo::of_column(&layout.names[c - 1], sidecar.as_ref(), false))
+        .map(|&c| SensorInfo::of_column(&layout.names[c - 1], sidecar, false))
         .collect();
     Ok((columns, infos))
 }
@@ -320,50 +320,38 @@ fn classical_pass(
         ..WvOptions::default()
     };
     let mut failed: Vec<(usize, crate::InputError)> = Vec::new();
-    loop {
+    let (kept, wvs) = loop {
         let kept: Vec<usize> = columns
             .iter()
             .copied()
             .filter(|c| !failed.iter().any(|(f, _)| f == c))
             .collect();
         if kept.is_empty() {
-            break;
+            break (kept, Vec::new());
         }
         match binary_wavelet_variance(path, layout, &kept, freq_hz, &opts) {
-            Ok(wvs) => {
-                let mut wvs = kept.iter().copied().zip(wvs);
-                return Ok(columns
+            Ok(wvs) => break (kept, wvs),
+            // a column that cannot be analysed: again without it
+            Err(ReadError::Series { column, source, .. })
+                if kept.iter().any(|&c| layout.names[c - 1] == column) =>
+            {
+                let c = kept[kept
                     .iter()
-                    .map(|c| match failed.iter().position(|(f, _)| f == c) {
-                        Some(k) => Err(failed[k].1.clone()),
-                        None => Ok(wvs
-                            .find(|(k, _)| k == c)
-                            .map(|(_, w)| w)
-                            .expect("every kept column has its WV")),
-                    })
-                    .collect());
-            }
-            Err(ReadError::Series { column, source, .. }) => {
-                let Some(&c) = kept.iter().find(|&&c| layout.names[c - 1] == column) else {
-                    return Err(ReadError::Series {
-                        path: path.to_path_buf(),
-                        column,
-                        source,
-                    }
-                    .into());
-                };
+                    .position(|&c| layout.names[c - 1] == column)
+                    .unwrap_or(0)];
                 failed.push((c, source.into()));
             }
             Err(e) => return Err(e.into()),
         }
-    }
-    Ok(columns
-        .iter()
-        .map(|c| {
-            let k = failed.iter().position(|(f, _)| f == c).unwrap_or(0);
-            Err(failed[k].1.clone())
-        })
-        .collect())
+    };
+    // in the order of `columns`
+    let mut out: Vec<(usize, Result<WaveletVariance, crate::InputError>)> = kept
+        .into_iter()
+        .zip(wvs.into_iter().map(Ok))
+        .chain(failed.into_iter().map(|(c, e)| (c, Err(e))))
+        .collect();
+    out.sort_by_key(|(c, _)| columns.iter().position(|x| x == c));
+    Ok(out.into_iter().map(|(_, r)| r).collect())
 }
 
 /// Per column and level, over the blocks: the sum of count x robust estimate and the sum of

@@ -56,12 +56,41 @@ pub struct WvCovariance {
 }
 
 impl WvCovariance {
+    /// How it was obtained.
+    pub fn source(&self) -> VSource {
+        VSource(self.replicates)
+    }
+}
+
+/// How a V was obtained: the bootstrap's replicates, or `None` for the exact V.
+///
+/// Wire format (flattened into the result that carries it): `v_method` (`"exact"` or
+/// `"bootstrap"`) and `v_replicates` (null when exact).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VSource(pub(crate) Option<usize>);
+
+impl VSource {
     /// `"exact"` or `"bootstrap"`.
-    pub fn method_name(&self) -> &'static str {
-        match self.replicates {
+    pub fn method(&self) -> &'static str {
+        match self.0 {
             None => "exact",
             Some(_) => "bootstrap",
         }
+    }
+
+    /// Replicates behind a bootstrap V; `None` when exact.
+    pub fn replicates(&self) -> Option<usize> {
+        self.0
+    }
+}
+
+impl Serialize for VSource {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = s.serialize_struct("VSource", 2)?;
+        st.serialize_field("v_method", self.method())?;
+        st.serialize_field("v_replicates", &self.0)?;
+        st.end()
     }
 }
 

@@ -16,7 +16,7 @@ pub use asymptotic::{sandwich, wald_interval, z_value, IntervalScale, Sandwich, 
 pub use bootstrap::{
     fit_bootstrap, map_replicates, wv_bootstrap, FitBootstrap, FitBootstrapOptions, WvBootstrap,
 };
-pub use covariance::{wv_covariance, CovarianceMethod, WvCovariance};
+pub use covariance::{wv_covariance, CovarianceMethod, VSource, WvCovariance};
 pub use gof::{j_test, JTest};
 pub use progress::{NoProgress, Progress};
 pub use summary::{

@@ -26,7 +26,7 @@
 
 use super::asymptotic::{sandwich, scales, z_value, IntervalScale, ZConvention};
 use super::bootstrap::{fit_bootstrap, FitBootstrapOptions};
-use super::covariance::{wv_covariance, CovarianceMethod};
+use super::covariance::{wv_covariance, CovarianceMethod, VSource};
 use super::gof::{hartlap_factor, j_test, JTest};
 use super::progress::{NoProgress, Progress};
 use crate::error::ParamError;
@@ -251,10 +251,9 @@ pub struct Inference {
     pub(crate) z_convention: ZConvention,
     /// Interval scale.
     pub(crate) scale: IntervalScale,
-    /// How V was obtained: `"exact"` or `"bootstrap"`.
-    pub(crate) v_method: &'static str,
-    /// Replicates behind the WV covariance V (H, or B in bootstrap mode); `None` when exact.
-    pub(crate) v_replicates: Option<usize>,
+    /// How V was obtained: exact, or the replicates behind it (H, or B in bootstrap mode).
+    #[serde(flatten)]
+    pub(crate) v_source: VSource,
     /// B in bootstrap mode.
     pub(crate) bootstrap_replicates: Option<usize>,
     /// Per parameter, model order.
@@ -301,12 +300,12 @@ impl Inference {
 
     /// How V was obtained: `"exact"` or `"bootstrap"`.
     pub fn v_method(&self) -> &'static str {
-        self.v_method
+        self.v_source.method()
     }
 
     /// Replicates behind the WV covariance V (H, or B in bootstrap mode); `None` when exact.
     pub fn v_replicates(&self) -> Option<usize> {
-        self.v_replicates
+        self.v_source.replicates()
     }
 
     /// B in bootstrap mode.
@@ -607,12 +606,7 @@ fn infer_impl(
         z,
         z_convention: opts.z,
         scale: opts.scale,
-        v_method: if v_replicates.is_some() {
-            "bootstrap"
-        } else {
-            "exact"
-        },
-        v_replicates,
+        v_source: VSource(v_replicates),
         bootstrap_replicates: opts.bootstrap,
         parameters,
         covariance,
@@ -686,7 +680,7 @@ impl fmt::Display for Inference {
             ZConvention::TwoSided => 1.0 - self.alpha,
             ZConvention::Package => 1.0 - 2.0 * self.alpha,
         };
-        let how = match (self.method, self.v_replicates) {
+        let how = match (self.method, self.v_replicates()) {
             (InferenceMethod::Asymptotic, Some(h)) => {
                 format!("asymptotic (sandwich, V from {h} bootstrap replicates)")
             }
@@ -695,7 +689,9 @@ impl fmt::Display for Inference {
             }
             (InferenceMethod::Bootstrap, _) => format!(
                 "parametric bootstrap, {} replicates",
-                self.bootstrap_replicates.or(self.v_replicates).unwrap_or(0)
+                self.bootstrap_replicates
+                    .or(self.v_replicates())
+                    .unwrap_or(0)
             ),
         };
         writeln!(

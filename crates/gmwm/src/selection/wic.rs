@@ -9,7 +9,7 @@ use super::SelectionError;
 use crate::error::check_freq;
 use crate::fit::canonical::wv_separation;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
-use crate::inference::covariance::{wv_covariance, CovarianceMethod};
+use crate::inference::covariance::{wv_covariance, CovarianceMethod, VSource};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{NoProgress, Progress};
 use crate::model::{Model, ProcessKind};
@@ -609,12 +609,7 @@ impl Wic {
             selected_canonical: chosen.canonical.clone(),
             fit: chosen.fit.clone(),
             candidate_fits,
-            v_method: if v_replicates.is_some() {
-                "bootstrap"
-            } else {
-                "exact"
-            },
-            v_replicates,
+            v_source: VSource(v_replicates),
             wv_covariance: v.clone(),
         }
     }
@@ -938,10 +933,9 @@ pub struct ModelSelection {
     pub(crate) convention: OptimismConvention,
     /// Bootstrap replicates B.
     pub(crate) bootstrap: usize,
-    /// How V was obtained: `"exact"` or `"bootstrap"`.
-    pub(crate) v_method: &'static str,
-    /// Replicates behind V; `None` when exact.
-    pub(crate) v_replicates: Option<usize>,
+    /// How V was obtained: exact, or the replicates behind it.
+    #[serde(flatten)]
+    pub(crate) v_source: VSource,
     /// How the selected row was chosen.
     pub(crate) rule: SelectionRule,
     /// Separation below which a fit and its canonical reduction are not told apart.
@@ -1039,12 +1033,12 @@ impl ModelSelection {
 
     /// How V was obtained: `"exact"` or `"bootstrap"`.
     pub fn v_method(&self) -> &'static str {
-        self.v_method
+        self.v_source.method()
     }
 
     /// Replicates behind V; `None` when exact.
     pub fn v_replicates(&self) -> Option<usize> {
-        self.v_replicates
+        self.v_source.replicates()
     }
 }
 
