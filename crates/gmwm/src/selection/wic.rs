@@ -290,7 +290,13 @@ impl Wic {
     ///    series simulated from it ([`Wic::with_covariance`]);
     /// 3. every candidate (in parallel; each search seeded with `seed`) fitted in guess mode
     ///    against the same WV and weights; objective, optimism, WIC, GoF p-value (the J-test of
-    ///    §7.3 with `V`, or with the bootstrap optimism the bootstrap p-value of §7.4);
+    ///    §7.3 with `V`, or with the bootstrap optimism the bootstrap p-value of §7.4).
+    ///    Candidates with one canonical model and one objective (within [`WIC_TIE_REL`]) are
+    ///    one fit up to terms fitted to nothing: they share the GoF p-value of their smallest
+    ///    member, and with the bootstrap optimism its optimism too, bootstrapped once for the
+    ///    group (the asymptotic optimisms of such members agree, their terms fitted to nothing
+    ///    being inactive; a member bootstrapped apart would refit those terms on the
+    ///    replicates, where they are not);
     /// 4. each candidate's fit read as its canonical model
     ///    ([`GmwmFit::canonical`](crate::fit::GmwmFit::canonical)); candidates with the same
     ///    canonical model are one row, scored by its smallest member (fewest parameters, then
@@ -308,7 +314,7 @@ impl Wic {
     /// Cost: one WV of `x`, V (exact: O(J^2); bootstrap: B simulations and WVs of length N),
     /// one fit per candidate plus the
     /// refits of its canonical reading (with the bootstrap optimism, B simulations, WVs and two
-    /// fits per candidate on top).
+    /// fits per tie group on top).
     ///
     /// # Errors
     /// [`SelectionError::Setting`] for B < 2 or G = 0; [`SelectionError::Input`] for an
@@ -318,8 +324,9 @@ impl Wic {
         self.select_with_progress(x, freq_hz, &NoProgress)
     }
 
-    /// [`Wic::select`] reporting each scored candidate to `progress` (`start` with the number
-    /// of candidates, then one `advance` per finished candidate, in completion order).
+    /// [`Wic::select`] reporting the scored candidates to `progress` (`start` with the number
+    /// of candidates, then an `advance` as candidates are scored, a tie group's members at
+    /// once, in completion order).
     ///
     /// # Errors
     /// As [`Wic::select`].
@@ -416,8 +423,8 @@ impl Wic {
             v_replicates: covariance.replicates,
             replicate_opts: &replicate_opts,
         };
-        let done = AtomicUsize::new(0);
-        let scored: Vec<Scored> = self
+        // step 3, first half: every candidate's fit and its canonical reading
+        let fitted: Vec<(GmwmFit, CanonicalModel)> = self
             .candidates
             .par_iter()
             .map(|c| {
@@ -427,18 +434,65 @@ impl Wic {
                     self.estimator(c).fit_from_wv(wv, inputs)?
                 };
                 let canonical = fit.canonical_with(self.separation_limit)?;
-                let score = context.score(c, &canonical.model, &fit)?;
-                progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
-                Ok(Scored {
+                Ok((fit, canonical))
+            })
+            .zip(self.candidates.par_iter())
+            .map(|(r, c): (Result<_, FitError>, _)| r.map_err(fit_error(c)))
+            .collect::<Result<_, _>>()?;
+        // second half: the scores. A tie group (one canonical model, one objective) is one fit
+        // up to terms fitted to nothing; the bootstrap optimism simulates from that one fit,
+        // so it runs once per group, on its smallest member, whose optimism and p-value every
+        // member takes (as the p-value already was for the asymptotic optimism, step 4)
+        let ties: Vec<(&Model, f64, usize)> = fitted
+            .iter()
+            .zip(&self.candidates)
+            .map(|((fit, canonical), c)| (&canonical.model, fit.objective, c.n_params()))
+            .collect();
+        let representative: Vec<usize> = match self.method {
+            OptimismMethod::Asymptotic => (0..ties.len()).collect(),
+            OptimismMethod::Bootstrap => (0..ties.len())
+                .map(|i| tie_representative(i, &ties))
+                .collect(),
+        };
+        let mut groups: Vec<usize> = representative.clone();
+        groups.sort_unstable();
+        groups.dedup();
+        let done = AtomicUsize::new(0);
+        let group_scores: Vec<CandidateScore> = groups
+            .par_iter()
+            .map(|&g| {
+                let (fit, canonical) = &fitted[g];
+                let c = &self.candidates[g];
+                let score = context
+                    .score(c, &canonical.model, fit)
+                    .map_err(fit_error(c))?;
+                let members = representative.iter().filter(|&&r| r == g).count();
+                progress.advance(done.fetch_add(members, Ordering::Relaxed) + members);
+                Ok::<_, SelectionError>(score)
+            })
+            .collect::<Result<_, _>>()?;
+        let scored: Vec<Scored> = fitted
+            .into_iter()
+            .zip(&self.candidates)
+            .zip(&representative)
+            .map(|(((fit, canonical), c), r)| {
+                // `groups` is sorted and holds every representative
+                let group = &group_scores[groups.partition_point(|g| g < r)];
+                let score = CandidateScore {
+                    model: c.clone(),
+                    canonical_model: canonical.model.clone(),
+                    objective: fit.objective,
+                    wic: fit.objective + group.optimism,
+                    converged: fit.convergence.converged,
+                    ..group.clone()
+                };
+                Scored {
                     score,
                     fit,
                     canonical,
-                })
+                }
             })
-            .map(|r: Result<_, FitError>| r)
-            .zip(self.candidates.par_iter())
-            .map(|(r, c)| r.map_err(fit_error(c)))
-            .collect::<Result<_, _>>()?;
+            .collect();
         Ok(self.assemble(
             scored,
             &full_fit.weights.omega,
@@ -458,18 +512,19 @@ impl Wic {
     ) -> ModelSelection {
         // candidates with one canonical model and one objective (within WIC_TIE_REL) are one
         // fit up to terms fitted to nothing: one goodness-of-fit p-value, the smallest one's
+        let ties: Vec<(&Model, f64, usize)> = scored
+            .iter()
+            .map(|s| {
+                (
+                    &s.score.canonical_model,
+                    s.score.objective,
+                    s.score.model.n_params(),
+                )
+            })
+            .collect();
         let shared: Vec<(Option<f64>, bool)> = (0..scored.len())
             .map(|i| {
-                let same = |j: &usize| {
-                    let (a, b) = (&scored[i].score, &scored[*j].score);
-                    a.canonical_model == b.canonical_model
-                        && (a.objective - b.objective).abs() <= WIC_TIE_REL * a.objective.abs()
-                };
-                let first = (0..scored.len())
-                    .filter(same)
-                    .min_by_key(|&j| (scored[j].score.model.n_params(), j))
-                    .unwrap_or(i);
-                let s = &scored[first].score;
+                let s = &scored[tie_representative(i, &ties)].score;
                 (s.gof_p_value, s.gof_p_value_upper_bound)
             })
             .collect();
@@ -613,6 +668,19 @@ impl Wic {
             wv_covariance: v.clone(),
         }
     }
+}
+
+/// The candidate that stands for candidate `i`'s tie group: among the candidates with `i`'s
+/// canonical model and its objective within [`WIC_TIE_REL`] (`ties[j]` = canonical model,
+/// objective, parameter count), the one with the fewest parameters, then the first.
+fn tie_representative(i: usize, ties: &[(&Model, f64, usize)]) -> usize {
+    let (model, objective, _) = ties[i];
+    (0..ties.len())
+        .filter(|&j| {
+            ties[j].0 == model && (objective - ties[j].1).abs() <= WIC_TIE_REL * objective.abs()
+        })
+        .min_by_key(|&j| (ties[j].2, j))
+        .unwrap_or(i)
 }
 
 /// How many of the two terms every navigation filter carries (white noise, random walk) a
