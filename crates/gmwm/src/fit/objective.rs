@@ -195,23 +195,17 @@ impl Objective {
         a: Option<&mut [f64]>,
     ) -> Result<(), crate::InputError> {
         let levels = self.levels();
-        let processes = self.model.with_values(theta)?.processes(self.freq_hz)?;
+        let np = self.n_params();
         nu.fill(0.0);
-        for p in &processes {
+        let mut a = a;
+        self.model.for_each_process(theta, self.freq_hz, |p, col| {
             p.add_wv(nu);
-        }
-        if let Some(a) = a {
-            let np = self.n_params();
-            let mut col = 0;
-            for p in &processes {
-                let block = p.jacobian(levels);
-                for (j, row) in block.iter().enumerate() {
+            if let Some(a) = a.as_deref_mut() {
+                for (j, row) in p.jacobian(levels).iter().enumerate() {
                     a[j * np + col..j * np + col + row.len()].copy_from_slice(row);
                 }
-                col += block.first().map_or(0, Vec::len);
             }
-        }
-        Ok(())
+        })
     }
 
     /// A fresh evaluation buffer.
@@ -300,6 +294,16 @@ impl Objective {
     /// # Errors
     /// [`FitError::Length`]; [`FitError::Input`] when theta is not a valid model.
     pub fn value_at_theta(&self, theta: &[f64]) -> Result<f64, FitError> {
+        self.value_at_theta_in(theta, &mut Vec::new())
+    }
+
+    /// [`Objective::value_at_theta`] with the implied WV computed in `nu` (resized), so that
+    /// a loop over many theta (the starting-value draws) allocates nothing per evaluation.
+    pub(crate) fn value_at_theta_in(
+        &self,
+        theta: &[f64],
+        nu: &mut Vec<f64>,
+    ) -> Result<f64, FitError> {
         if theta.len() != self.n_params() {
             return Err(FitError::Length {
                 what: "theta",
@@ -307,10 +311,15 @@ impl Objective {
                 found: theta.len(),
             });
         }
-        let mut nu = vec![0.0; self.levels()];
-        self.implied(theta, &mut nu, None)?;
+        nu.resize(self.levels(), 0.0);
+        self.implied(theta, nu, None)?;
         if self.whitening.is_some() {
-            let e: Vec<f64> = self.nu_hat.iter().zip(&nu).map(|(h, n)| h - n).collect();
+            let e: Vec<f64> = self
+                .nu_hat
+                .iter()
+                .zip(nu.iter())
+                .map(|(h, n)| h - n)
+                .collect();
             let mut r = vec![0.0; self.levels()];
             self.whiten(&e, &mut r);
             return Ok(r.iter().map(|v| v * v).sum());

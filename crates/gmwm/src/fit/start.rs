@@ -220,6 +220,20 @@ fn one_draw(
     ctx: &DrawContext,
     rng: &mut ChaCha8Rng,
 ) -> Vec<f64> {
+    let mut theta = Vec::with_capacity(given.len());
+    draw_into(model, given, ctx, rng, &mut theta);
+    theta
+}
+
+/// [`one_draw`] into `theta` (cleared first), so that the search allocates nothing per draw.
+fn draw_into(
+    model: &Model,
+    given: &[Option<f64>],
+    ctx: &DrawContext,
+    rng: &mut ChaCha8Rng,
+    theta: &mut Vec<f64>,
+) {
+    theta.clear();
     let st = ctx.sigma2_t;
     let mut c: u32 = match ctx.dom {
         Dominance::Wn => 1,
@@ -227,7 +241,6 @@ fn one_draw(
         Dominance::Ar1 => 0,
     };
     let mut last_phi: f64 = 0.0;
-    let mut theta = Vec::with_capacity(given.len());
     let mut idx = 0;
     for comp in model.components() {
         let g = &given[idx..idx + comp.kind.n_params()];
@@ -313,7 +326,6 @@ fn one_draw(
             }
         }
     }
-    theta
 }
 
 /// Settings of the search.
@@ -408,13 +420,17 @@ pub fn starting_values(
         let end = (done + BATCH_DRAWS).min(total);
         let batch_best = (done..end)
             .into_par_iter()
-            .filter_map(|g| {
-                let mut rng = ChaCha8Rng::seed_from_u64(replicate_seed(options.seed, g as u64));
-                let theta = one_draw(model, &given, &ctx, &mut rng);
-                match objective.value_at_theta(&theta) {
-                    Ok(f) if f.is_finite() => Some((f, g)),
-                    _ => None,
-                }
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(theta, nu), g| {
+                    let mut rng = ChaCha8Rng::seed_from_u64(replicate_seed(options.seed, g as u64));
+                    draw_into(model, &given, &ctx, &mut rng, theta);
+                    (g, objective.value_at_theta_in(theta, nu))
+                },
+            )
+            .filter_map(|(g, value)| match value {
+                Ok(f) if f.is_finite() => Some((f, g)),
+                _ => None,
             })
             .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let previous = best.map(|b| b.0);

@@ -349,7 +349,7 @@ impl Component {
 }
 
 /// Checks one value against its [`ParamDomain`].
-fn check_value(
+pub(crate) fn check_value(
     component: usize,
     kind: ProcessKind,
     index: usize,

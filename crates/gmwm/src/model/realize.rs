@@ -47,6 +47,40 @@ impl Model {
             .collect()
     }
 
+    /// Calls `f` with the latent process of each component at the values `theta` (model
+    /// order) and the index in `theta` of its first parameter: what
+    /// `self.with_values(theta)?.processes(freq_hz)?` gives, with the same checks and errors,
+    /// without building a model or a vector (the objective evaluates it at every draw and
+    /// every step of a fit).
+    ///
+    /// # Errors
+    /// As [`Model::with_values`] and [`Model::processes`].
+    pub(crate) fn for_each_process(
+        &self,
+        theta: &[f64],
+        freq_hz: f64,
+        mut f: impl FnMut(&Process, usize),
+    ) -> Result<(), InputError> {
+        check_freq(freq_hz)?;
+        if theta.len() != self.n_params() {
+            return Err(super::ModelError::ThetaLength {
+                expected: self.n_params(),
+                found: theta.len(),
+            }
+            .into());
+        }
+        let mut at = 0;
+        for (i, c) in self.components().iter().enumerate() {
+            let mine = &theta[at..at + c.kind.n_params()];
+            for (index, &v) in mine.iter().enumerate() {
+                super::check_value(i, c.kind, index, v)?;
+            }
+            f(&(spec(c.kind).build)(c.kind, mine, freq_hz)?, at);
+            at += mine.len();
+        }
+        Ok(())
+    }
+
     /// Implied Haar WV of the model and of each component at `tau_j = 2^j`, `j = 1..=levels`
     /// (METHODS §4.1–§4.4; a sum of independent processes has the sum of their WVs).
     ///
