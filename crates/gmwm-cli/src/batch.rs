@@ -18,7 +18,7 @@ use gmwm::imu::InputFormat;
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::SystemTime;
 
@@ -299,32 +299,6 @@ fn read_json(path: &Path) -> Option<serde_json::Value> {
     serde_json::from_slice(&std::fs::read(path).ok()?).ok()
 }
 
-/// Writes `bytes` to `path` atomically: to a hidden temporary file in the same folder, then
-/// renamed over `path`; the temporary file is removed on failure.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::other("not a file name"))?;
-    let tmp = path.with_file_name(format!(
-        ".{}.{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let written = std::fs::File::create(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.flush()
-    });
-    match written.and_then(|()| std::fs::rename(&tmp, path)) {
-        Ok(()) => Ok(()),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
-}
-
 /// How a recording ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Status {
@@ -450,7 +424,7 @@ fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<Pa
     let items = crate::cmd::wv::compute(&one)?;
     let mut doc = Vec::new();
     crate::render::series(&mut doc, &crate::input::named(&items), Style::Json)?;
-    write_atomic(&out, &doc).with_context(|| format!("cannot write {}", out.display()))?;
+    crate::output::write(&out, &doc)?;
     let detail = Detail {
         count: Some(items.len()),
         second: items.iter().map(|(_, wv)| wv.wv().len()).max(),
@@ -576,7 +550,7 @@ pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
             table(&outcomes, &w, out)?;
             let mut text = serde_json::to_vec_pretty(&summary_json(&outcomes, &w))?;
             text.push(b'\n');
-            std::fs::write(p, text).with_context(|| format!("cannot write {}", p.display()))?;
+            crate::output::write(p, &text)?;
             writeln!(out, "wrote {} (JSON summary)", p.display())?;
         }
         None => table(&outcomes, &w, out)?,
@@ -767,16 +741,5 @@ mod tests {
         assert!(!is_recording(&bag, InputFormat::Auto));
         std::fs::write(bag.join("metadata.yaml"), b"").unwrap();
         assert!(is_recording(&bag, InputFormat::Auto));
-    }
-
-    #[test]
-    fn atomic_writes_replace_and_leave_no_temporary() {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("out.json");
-        write_atomic(&p, b"one").unwrap();
-        write_atomic(&p, b"two").unwrap();
-        assert_eq!(std::fs::read(&p).unwrap(), b"two");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
-        assert!(write_atomic(&dir.path().join("no/such/dir/x"), b"x").is_err());
     }
 }

@@ -9,6 +9,7 @@ mod batch;
 mod cmd;
 mod config;
 mod input;
+mod output;
 mod progress;
 mod render;
 

@@ -128,9 +128,16 @@ impl Figure {
             ImageFormat::Svg => self.svg()?.into_bytes(),
             ImageFormat::Png => self.png()?,
         };
-        std::fs::write(path, bytes).map_err(|source| PlotError::Io {
-            path: path.display().to_string(),
-            source,
+        // atomically: an interrupted run leaves the previous figure or none
+        gmwm::imu::write::write_atomic(path, &bytes).map_err(|e| match e {
+            gmwm::imu::ReadError::Io { source, .. } => PlotError::Io {
+                path: path.display().to_string(),
+                source,
+            },
+            other => PlotError::Io {
+                path: path.display().to_string(),
+                source: std::io::Error::other(other.to_string()),
+            },
         })
     }
 

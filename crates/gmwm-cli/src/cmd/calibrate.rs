@@ -55,13 +55,23 @@ pub struct Calibrated {
     pub written: Vec<PathBuf>,
 }
 
-/// Writes `bytes` to `path`: atomically in batch mode, else as it always has.
-fn write_file(path: &Path, bytes: &[u8], mode: Mode) -> std::io::Result<()> {
-    if mode.batch {
-        crate::batch::write_atomic(path, bytes)
-    } else {
-        std::fs::write(path, bytes)
+/// Refuses, before any work, an output file that is the recording or its sidecar.
+fn check_outputs(config: &CalibrateConfig, report_path: Option<&Path>) -> Result<()> {
+    let file = config.input.file.as_path();
+    let sidecars = gmwm::imu::sidecar::sidecar_candidates(file);
+    let inputs: Vec<&Path> = std::iter::once(file)
+        .chain(sidecars.iter().map(PathBuf::as_path))
+        .collect();
+    for (format, path) in &config.exports {
+        crate::output::check_not_input(&format!("--export {format}"), path, &inputs)?;
     }
+    if let Some(json) = config.json.as_deref().filter(|p| *p != Path::new("-")) {
+        crate::output::check_not_input("--json", json, &inputs)?;
+    }
+    if let Some(report) = report_path {
+        crate::output::check_not_input("--report", report, &inputs)?;
+    }
+    Ok(())
 }
 
 /// [`execute`] with its mode; returns what was calibrated and written.
@@ -73,6 +83,7 @@ pub fn execute_in(
 ) -> Result<Calibrated> {
     let print_summary = mode.print_summary;
     let exports = &config.exports;
+    check_outputs(config, report_path)?;
     let calibration = Calibration::new(config.options.clone());
     // a long raw binary recording is calibrated while streamed from the file (bounded memory)
     let streamed = config.input.topic.is_none()
@@ -113,9 +124,7 @@ pub fn execute_in(
             let target = per_axis_path(path, &set.label);
             let result = render(*format, &set.noise)
                 .map_err(anyhow::Error::from)
-                .and_then(|text| {
-                    write_file(&target, text.as_bytes(), mode).map_err(anyhow::Error::from)
-                });
+                .and_then(|text| crate::output::write(&target, text.as_bytes()));
             match result {
                 Ok(()) => {
                     written.push(format!("{} ({format})", target.display()));
@@ -128,7 +137,7 @@ pub fn execute_in(
     let json_to_stdout = config.json.as_deref() == Some(Path::new("-"));
     let doc = gmwm::document::calibration(&recording.path, &recording.notes, &report, &sets);
     if let Some(path) = report_path {
-        match write_report(config, path, &recording, &report, &sets, &doc, mode) {
+        match write_report(config, path, &recording, &report, &sets, &doc) {
             Ok(figures) => {
                 written.push(format!(
                     "{} (HTML report, {figures} figures)",
@@ -143,18 +152,8 @@ pub fn execute_in(
         if json_to_stdout {
             serde_json::to_writer_pretty(&mut *out, &doc)?;
             writeln!(out)?;
-        } else if mode.batch {
-            let bytes = serde_json::to_vec_pretty(&doc)?;
-            crate::batch::write_atomic(path, &bytes)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            written.push(format!("{} (JSON)", path.display()));
-            paths.push(path.clone());
         } else {
-            let file = std::fs::File::create(path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            let mut w = std::io::BufWriter::new(file);
-            serde_json::to_writer_pretty(&mut w, &doc)?;
-            w.flush()?;
+            crate::output::write_json(path, &doc)?;
             written.push(format!("{} (JSON)", path.display()));
             paths.push(path.clone());
         }
@@ -188,7 +187,6 @@ fn write_report(
     report: &CalibrationReport,
     sets: &[NavSet],
     doc: &serde_json::Value,
-    mode: Mode,
 ) -> Result<usize> {
     let mut formats: Vec<(ExportFormat, Option<&Path>)> = config
         .exports
@@ -232,8 +230,7 @@ fn write_report(
     };
     let html = gmwm_plot::report::render(report, &ctx)?;
     let figures = html.matches("<figure>").count();
-    write_file(path, html.as_bytes(), mode)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    crate::output::write(path, html.as_bytes())?;
     Ok(figures)
 }
 

@@ -1,6 +1,10 @@
 //! Writing series: a [`SeriesWriter`] whose format follows the file's extension (CSV, gzip CSV,
 //! TSV, raw little-endian f64/f32), streamed row by row, and the JSON sidecar that tells
 //! readers the sampling rate and, for raw binary, the layout.
+//!
+//! Every file is written atomically ([`AtomicFile`]): under a temporary name beside it, then
+//! renamed over it once complete, so an interrupted run leaves the previous file or none,
+//! never a partial one.
 
 use super::{InputFormat, ReadError, Sidecar};
 use crate::error::ParamError;
@@ -9,6 +13,7 @@ use flate2::Compression;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Write buffer: large enough that system calls are rare.
 const BUF_CAPACITY: usize = 1 << 20;
@@ -84,9 +89,130 @@ impl OutputFormat {
     }
 }
 
+/// A file written under a temporary name in its destination's folder
+/// (`.NAME.PID.K.tmp`) and renamed over the destination by [`AtomicFile::commit`]. A rename
+/// within one folder is atomic, so readers of the destination, and whatever is left after the
+/// process is interrupted or killed, see the previous file (or none), never a partial one.
+/// Dropped without a commit (an error on the way), the temporary file is removed; a process
+/// killed outright leaves it behind, under its hidden name.
+///
+/// # Examples
+/// ```
+/// use gmwm::imu::write::AtomicFile;
+/// use std::io::Write;
+/// let dir = std::env::temp_dir().join(format!("gmwm-doc-atomic-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir).unwrap();
+/// let path = dir.join("calib.json");
+/// let mut f = AtomicFile::create(&path).unwrap();
+/// f.write_all(b"{}\n").unwrap();
+/// assert!(!path.exists()); // not there until committed
+/// f.commit().unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), b"{}\n");
+/// # std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub struct AtomicFile {
+    path: PathBuf,
+    tmp: PathBuf,
+    file: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file for `path`.
+    ///
+    /// # Errors
+    /// [`ReadError::Io`] naming `path` when its folder cannot be written (or `path` has no
+    /// file name).
+    pub fn create(path: &Path) -> Result<Self, ReadError> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let name = path.file_name().ok_or_else(|| {
+            io_error(
+                path,
+                io::Error::new(io::ErrorKind::InvalidInput, "not a file name"),
+            )
+        })?;
+        let tmp = path.with_file_name(format!(
+            ".{}.{}.{}.tmp",
+            name.to_string_lossy(),
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
+        let file = File::create(&tmp).map_err(|e| io_error(path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            tmp,
+            file: Some(BufWriter::with_capacity(BUF_CAPACITY, file)),
+        })
+    }
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes the file and renames it over the destination.
+    ///
+    /// # Errors
+    /// [`ReadError::Io`] naming the destination when the last writes or the rename fail (the
+    /// temporary file is then removed).
+    pub fn commit(mut self) -> Result<(), ReadError> {
+        let result = match self.file.take() {
+            Some(w) => w
+                .into_inner()
+                .map_err(io::IntoInnerError::into_error)
+                .and_then(|f| {
+                    drop(f);
+                    std::fs::rename(&self.tmp, &self.path)
+                }),
+            None => Ok(()),
+        };
+        result.map_err(|e| {
+            let _ = std::fs::remove_file(&self.tmp);
+            io_error(&self.path, e)
+        })
+    }
+
+    fn writer(&mut self) -> io::Result<&mut BufWriter<File>> {
+        self.file
+            .as_mut()
+            .ok_or_else(|| io::Error::other("the file was committed"))
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.writer()?.write(buf)
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
+        self.writer()?.write_all(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.writer()?.flush()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.file.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Writes `bytes` to `path` atomically ([`AtomicFile`]).
+///
+/// # Errors
+/// [`ReadError::Io`] naming `path` when it cannot be written.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReadError> {
+    let mut f = AtomicFile::create(path)?;
+    f.write_all(bytes).map_err(|e| io_error(path, e))?;
+    f.commit()
+}
+
 enum Sink {
-    Plain(BufWriter<File>),
-    Gzip(GzEncoder<BufWriter<File>>),
+    Plain(AtomicFile),
+    Gzip(GzEncoder<AtomicFile>),
 }
 
 impl Sink {
@@ -122,8 +248,7 @@ impl SeriesWriter {
         if names.is_empty() {
             return Err(ParamError::new("columns", 0, "at least one column to write").into());
         }
-        let file = File::create(path).map_err(|e| io_error(path, e))?;
-        let buffered = BufWriter::with_capacity(BUF_CAPACITY, file);
+        let buffered = AtomicFile::create(path)?;
         let sink = match format {
             OutputFormat::Text { gzip: true, .. } => {
                 Sink::Gzip(GzEncoder::new(buffered, Compression::default()))
@@ -210,17 +335,16 @@ impl SeriesWriter {
         Ok(())
     }
 
-    /// Flushes the file (and ends the gzip stream).
+    /// Ends the gzip stream and puts the complete file in place ([`AtomicFile::commit`]): a
+    /// writer dropped without `finish` leaves no file.
     ///
     /// # Errors
     /// [`ReadError::Io`] when the final writes fail.
     pub fn finish(self) -> Result<(), ReadError> {
-        let path = self.path;
         match self.sink {
-            Sink::Plain(mut w) => w.flush(),
-            Sink::Gzip(w) => w.finish().and_then(|mut w| w.flush()),
+            Sink::Plain(w) => w.commit(),
+            Sink::Gzip(w) => w.finish().map_err(|e| io_error(&self.path, e))?.commit(),
         }
-        .map_err(|e| io_error(&path, e))
     }
 }
 
@@ -238,24 +362,6 @@ fn io_error(path: &Path, source: io::Error) -> ReadError {
         path: path.to_path_buf(),
         source,
     }
-}
-
-/// Opens `path` for writing, gzip-compressed when it ends in `.gz` (the gzip stream is ended
-/// when the writer is dropped; prefer [`SeriesWriter`], which reports that last write).
-///
-/// # Errors
-/// [`ReadError::Io`] naming the path when it cannot be created.
-pub fn create(path: &Path) -> Result<Box<dyn Write>, ReadError> {
-    let file = File::create(path).map_err(|e| io_error(path, e))?;
-    let buffered = BufWriter::with_capacity(BUF_CAPACITY, file);
-    let gz = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gz"));
-    Ok(if gz {
-        Box::new(GzEncoder::new(buffered, Compression::default()))
-    } else {
-        Box::new(buffered)
-    })
 }
 
 /// Writes rows of equal-length columns as CSV (shortest round-tripping floats, so reading the
@@ -312,7 +418,7 @@ pub fn sidecar_path(data: &Path) -> PathBuf {
 pub fn write_sidecar(data: &Path, sidecar: &Sidecar) -> Result<PathBuf, ReadError> {
     let path = sidecar_path(data);
     let text = serde_json::to_string_pretty(sidecar).expect("a sidecar serialises");
-    std::fs::write(&path, text + "\n").map_err(|e| io_error(&path, e))?;
+    write_atomic(&path, (text + "\n").as_bytes())?;
     Ok(path)
 }
 
