@@ -250,8 +250,8 @@ fn check_haar(a: &WvEstimatorArgs, opts: &WvOptions) -> Result<()> {
     if opts.filter != WaveletFilter::Haar {
         return Err(UsageError(format!(
             "invalid --filter {}: every model's implied wavelet variance is the Haar one \
-             (METHODS §1.8, §4), so fits and selections use --filter haar (the default); other \
-             filters are for gmwm wv",
+             (METHODS §1.8, §4), so fits and selections use --filter haar (the default); \
+             other filters are for gmwm wv",
             a.filter
         ))
         .into());
@@ -311,7 +311,8 @@ impl TryFrom<&DemoArgs> for DemoConfig {
         let wv = wv_options(&a.estimator)?;
         anyhow::ensure!(
             wv.filter == WaveletFilter::Haar && wv.transform == Transform::Modwt,
-            "gmwm demo compares with the implied WV of METHODS §4, which exists for the Haar MODWT only; drop --filter/--transform"
+            "gmwm demo compares with the implied WV of METHODS §4, which exists for the Haar \
+             MODWT only; drop --filter/--transform"
         );
         Ok(Self {
             n: a.n,

@@ -557,7 +557,8 @@ fn allan_variance_white_noise_is_sigma2_over_m() {
             let truth = if kind == AllanKind::Modified {
                 mvar_white_noise(m, sigma2)
             } else {
-                sigma2 / m as f64 // AV, HV of white noise (METHODS §3; no m dependence beyond 1/m)
+                // AV, HV of white noise (METHODS §3; no m dependence beyond 1/m)
+                sigma2 / m as f64
             };
             // five standard errors of a chi-square estimate with edf degrees of freedom
             let bound = 5.0 * (2.0 / a.edf()[k]).sqrt();

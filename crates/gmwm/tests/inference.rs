@@ -1,5 +1,5 @@
 //! Inference on a GMWM fit (METHODS §7): J-test, sandwich covariance, intervals, parametric
-//! bootstrap, with METHODS test values, closed forms and seeded Monte Carlo.
+//! bootstrap, with the test values of docs/methods.md, closed forms and seeded Monte Carlo.
 
 use gmwm::fit::weights::FullWeights;
 use gmwm::fit::{Gmwm, Objective, Parametrisation, PhiOrder, TransformPreset, Weights};

@@ -10,7 +10,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
-/// METHODS test values are printed with 7 significant digits: half a unit in the last place.
+/// The test values of docs/methods.md are printed with 7 significant digits: half a unit in the
+/// last place.
 const PRINTED_7: f64 = 5e-7;
 /// Correct tuning constants are printed to 6 decimals (METHODS §2.3 table).
 const C_TABLE_TOL: f64 = 1e-6;

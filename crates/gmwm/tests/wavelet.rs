@@ -1,5 +1,6 @@
 //! Wavelet transforms (METHODS §1.1–§1.4, §1.10): fast pyramids against the direct-convolution
-//! oracle for every filter, METHODS test values, closed forms, identities and bad input.
+//! oracle for every filter, the test values of docs/methods.md, closed forms, identities and
+//! bad input.
 
 use gmwm::wavelet::{Dwt, Modwt, WaveletCoefficients, WaveletFilter, WaveletScratch};
 use gmwm::{InputError, SeriesError};

@@ -31,8 +31,8 @@ fn run_saved(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
     }
     note(
         file,
-        "Allan variance from the saved Haar wavelet variance, AV(m) = 2 WV(2m) (METHODS §3.4), \
-         intervals the WV's times 2; not recomputed from a recording",
+        "Allan variance from the saved Haar wavelet variance, AV(m) = 2 WV(2m) \
+         (METHODS §3.4), intervals the WV's times 2; not recomputed from a recording",
     );
     Ok(items)
 }

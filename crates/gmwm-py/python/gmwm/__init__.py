@@ -148,8 +148,9 @@ def _split(options: Dict[str, Any]) -> Tuple[Dict[str, Any], Dict[str, Any]]:
 
 
 def wv(data: Data, *, freq: Optional[float] = None, names: Optional[Sequence[str]] = None, **options) -> SeriesResult:
-    """Wavelet variance of each column with confidence intervals (METHODS §1, §2): ``robust``,
-    ``eff``, ``robust_convention``, ``filter``, ``transform``, ``levels``, ``alpha``."""
+    """Wavelet variance of each column with confidence intervals (METHODS §1, §2):
+    ``robust``, ``eff``, ``robust_convention``, ``filter``, ``transform``, ``levels``,
+    ``alpha``."""
     read_options, options = _split(options)
     arrays, cols, rate = _columns(data, freq, names, read_options)
     return SeriesResult(json.loads(_native.wv(arrays, cols, rate, **options)))
@@ -189,7 +190,8 @@ def fit(
 ) -> FitResult:
     """GMWM estimate of ``model`` on each column (METHODS §5): ``weights`` (fast, diag,
     bootstrap), ``G`` (starting-value draws), ``seed``, ``inference``, ``bootstrap`` and
-    ``covariance`` (METHODS §7; "auto", "exact" or "bootstrap": how V is obtained), ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``."""
+    ``covariance`` (METHODS §7; "auto", "exact" or "bootstrap": how V is obtained),
+    ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``."""
     read_options, options = _split(options)
     arrays, cols, rate = _columns(data, freq, names, read_options)
     doc = _native.fit(arrays, cols, rate, model, draws=G, progress=progress, **options)

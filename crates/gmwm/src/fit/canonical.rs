@@ -139,7 +139,7 @@ fn contributing(implied: &ImpliedWv, log_variance: &[f64]) -> Vec<bool> {
         .collect()
 }
 
-/// METHODS-style separation of two implied WVs (module doc): `sqrt(sum_j ln(a_j / b_j)^2 /
+/// The separation of two implied WVs (module doc): `sqrt(sum_j ln(a_j / b_j)^2 /
 /// log_variance_j)`. Levels where either value is not a positive finite number are skipped.
 ///
 /// ```

@@ -127,8 +127,8 @@ pub enum FitError {
     /// silently be wrong.
     #[error(
         "the wavelet variance uses the {filter} filter, but every model's implied wavelet \
-         variance is the Haar one (METHODS §1.8, §4): fit, select and infer on a Haar wavelet \
-         variance (other filters are for display only)"
+         variance is the Haar one (METHODS §1.8, §4): fit, select and infer on a Haar \
+         wavelet variance (other filters are for display only)"
     )]
     NotHaar {
         /// The filter of the WV.

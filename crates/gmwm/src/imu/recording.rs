@@ -84,7 +84,8 @@ impl Recording {
         let mut notes = Vec::new();
         if let Some(t) = table.record_type {
             notes.push(format!(
-                "{t} records: rates are the increments x the rate from the time stamps x the type's scale factors (METHODS §9.3), in rad/s and m/s^2"
+                "{t} records: rates are the increments x the rate from the time stamps x the \
+                 type's scale factors (METHODS §9.3), in rad/s and m/s^2"
             ));
         }
         if let Some(timing) = &table.timing {

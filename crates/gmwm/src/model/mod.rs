@@ -24,7 +24,7 @@
 //! - `WN`, `QN`, `RW`, `DR` appear at most once each (identifiability);
 //! - **at most one ARMA-family term** (`MA1`, `ARMA11`, `AR(p)`, `MA(q)`, `ARMA(p,q)`): two such
 //!   terms are not identifiable from one another by the wavelet variance (a sum of ARMAs is an
-//!   ARMA). METHODS does not state this rule; it is ours;
+//!   ARMA). The R package has no such rule; it is gmwm's own;
 //! - orders: `AR(p)`, `MA(q)` need an order from 1 to [`MAX_ORDER`]; `ARMA(p,q)` needs
 //!   `p + q >= 1`, each at most [`MAX_ORDER`];
 //! - every given value is finite and in its basic domain ([`ParamDomain`]).

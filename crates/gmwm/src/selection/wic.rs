@@ -1196,7 +1196,7 @@ fn check_haar(filter: crate::WaveletFilter) -> Result<(), SelectionError> {
     crate::fit::check_haar(filter).map_err(|_| SelectionError::Setting {
         name: "filter",
         value: filter.to_string(),
-        expected: "haar: every model's implied wavelet variance is the Haar one (METHODS §1.8, \
-                   §4); other filters are for display only",
+        expected: "haar: every model's implied wavelet variance is the Haar one \
+                   (METHODS §1.8, §4); other filters are for display only",
     })
 }

@@ -174,8 +174,8 @@ fn quantile_from_tail(tail: f64, upper: bool, df: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// statrs inverts the regularised gamma by bisection/Newton to ~1e-9 relative; the METHODS
-    /// values carry 7 significant digits.
+    /// statrs inverts the regularised gamma by bisection/Newton to ~1e-9 relative; the test
+    /// values of docs/methods.md carry 7 significant digits.
     const TOL: f64 = 5e-7;
 
     fn close(a: f64, b: f64) -> bool {

@@ -73,7 +73,7 @@ pub fn wv_diag_covariance(
 mod tests {
     use super::*;
 
-    /// METHODS values carry 7 significant digits.
+    /// The test values of docs/methods.md carry 7 significant digits.
     const TOL: f64 = 5e-7;
 
     #[test]
