@@ -311,8 +311,8 @@ impl TryFrom<&DemoArgs> for DemoConfig {
         let wv = wv_options(&a.estimator)?;
         anyhow::ensure!(
             wv.filter == WaveletFilter::Haar && wv.transform == Transform::Modwt,
-            "gmwm demo compares with the implied WV of METHODS §4, which exists for the Haar \
-             MODWT only; drop --filter/--transform"
+            "gmwm demo compares with the implied WV of METHODS §4, which exists for the \
+             Haar MODWT only; drop --filter/--transform"
         );
         Ok(Self {
             n: a.n,

@@ -13,7 +13,7 @@
 //!
 //! ```
 //! use gmwm::{wavelet_variance, WvOptions};
-//! // ramp x_t = t + 1: the Haar MODWT WV is 0.25 at tau = 2, 1.0 at tau = 4 (METHODS §1.10)
+//! // ramp x_t = t + 1: Haar MODWT WV 0.25 at tau = 2, 1.0 at tau = 4 (METHODS §1.10)
 //! let x: Vec<f64> = (1..=8).map(f64::from).collect();
 //! let wv = wavelet_variance(&x, 1.0, &WvOptions { levels: Some(2), ..WvOptions::default() }).unwrap();
 //! assert!((wv.wv()[0] - 0.25).abs() < 1e-12 && (wv.wv()[1] - 1.0).abs() < 1e-12);
