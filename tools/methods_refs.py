@@ -47,6 +47,7 @@ CITATION = re.compile(r"\bMETHODS(?=" + COMMENT_BREAK + "§)")
 RUST_COMMENT = re.compile(r"^(?P<lead>[ \t]*)(?P<mark>//[/!]?)(?P<gap> ?)(?P<text>.*)$")
 HASH_COMMENT = re.compile(r"^(?P<lead>[ \t]*)(?P<mark>#)(?P<gap> ?)(?P<text>.*)$")
 SYNTAX = {"rust": True}  # comment syntax of the file being rewritten
+BLOCK_START = re.compile(r"^([-+*>|=#]|\d+[.)]$|```)")
 LIST_ITEM = re.compile(r"^(?P<indent> *)(?P<bullet>[-*+] |\d+\. )")
 
 
@@ -155,6 +156,9 @@ def rewrap(lines, i, fenced, limit=MAX_LINE):
         words = text[lead:].split(" ")
         keep = len(words)
         while keep > 1 and len(prefix) + lead + len(" ".join(words[:keep])) > limit:
+            keep -= 1
+        # a moved word must not open a Markdown block on its new line (a list, a heading...)
+        while keep > 1 and BLOCK_START.match(words[keep]):
             keep -= 1
         if keep == len(words) or keep < 1:
             return False
