@@ -42,7 +42,10 @@ fn sources(root: &Path) -> Vec<PathBuf> {
                 }
             } else {
                 let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-                let ci = path.parent().is_some_and(|p| p.ends_with(".ci"));
+                let ci = path
+                    .parent()
+                    .and_then(Path::file_name)
+                    .is_some_and(|d| d == ".ci");
                 if ci || matches!(ext, "rs" | "py" | "pyi" | "md" | "toml" | "txt" | "sh") {
                     out.push(path);
                 }
