@@ -14,8 +14,9 @@ Usage (from anywhere; the repository is the parent of this script's folder):
 
 It is idempotent: a second run changes nothing. Re-run it after merging a branch that still
 writes `METHODS §`. Lines it cannot bring under the limit (a long string literal, a line in a
-code block) are listed for a hand fix; the test `methods_reference` in
-`crates/gmwm/tests/methods_reference.rs` fails while any old citation is left.
+code block) are listed for a hand fix. The tests in `crates/gmwm/tests/methods_reference.rs`
+(`cargo test --release -p gmwm --test integration methods_reference`) fail while any old
+citation is left or a cited section has no heading in docs/methods.md.
 """
 
 from __future__ import annotations
