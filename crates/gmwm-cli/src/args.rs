@@ -59,14 +59,15 @@ pub enum Command {
         after_long_help = "Examples:\n  gmwm implied --model \"3*AR1(phi=0.9, sigma2=1)+WN(sigma2=2)\" --levels 10\n  gmwm implied --model \"GM(beta=0.25, sigma2_gm=7.08e-9)+RW(gamma2=3.9e-14)\" --levels 20 --freq 250 --json"
     )]
     Implied(ImpliedArgs),
-    /// Estimate a latent error model by GMWM on each selected column (METHODS §5), from a
+    /// Estimate a latent error model by GMWM on each selected column (docs/methods.md §5), from a
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
         allow_negative_numbers = true,
         after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200"
     )]
     Fit(FitArgs),
-    /// Select a model by the Wavelet Information Criterion on each selected column (METHODS §8).
+    /// Select a model by the Wavelet Information Criterion on each selected column (docs/methods.md
+    /// §8).
     #[command(allow_negative_numbers = true, after_long_help = SELECT_EXAMPLES)]
     Select(SelectArgs),
     /// Calibrate an IMU recording: per axis the WV, the model selected by WIC, its fit with
@@ -414,12 +415,12 @@ pub struct SelectArgs {
     /// Input.
     #[command(flatten)]
     pub input: InputArgs,
-    /// Full model: every non-empty sub-model of it is a candidate (METHODS §8.4); values in it
-    /// are ignored. With --candidates it is one more candidate of the list.
+    /// Full model: every non-empty sub-model of it is a candidate (docs/methods.md §8.4); values in
+    /// it are ignored. With --candidates it is one more candidate of the list.
     #[arg(long, value_name = "MODEL", required_unless_present = "candidates")]
     pub model: Option<String>,
     /// Candidate models separated by ';' instead of the sub-models of --model; their common
-    /// denominator is added if absent and plays the full model (METHODS §8.5).
+    /// denominator is added if absent and plays the full model (docs/methods.md §8.5).
     #[arg(long, value_name = "M1;M2;...")]
     pub candidates: Option<String>,
     /// Bootstrap replicates B: of the covariance V of the WV when it is simulated from the
@@ -431,11 +432,11 @@ pub struct SelectArgs {
     /// MA1 or ARMA11 terms, else simulated (auto); always exact; or simulated as the R package.
     #[arg(long, value_enum, default_value_t = CovarianceArg::Auto)]
     pub covariance: CovarianceArg,
-    /// Optimism estimator (METHODS §8.2, §8.3).
+    /// Optimism estimator (docs/methods.md §8.2, §8.3).
     #[arg(long, value_enum, default_value_t = OptimismArg::Asymptotic)]
     pub optimism: OptimismArg,
     /// Asymptotic optimism formula: the corrected derivative and trace order, or the R
-    /// package's (METHODS §13.15).
+    /// package's (docs/methods.md §13.15).
     #[arg(long, value_enum, default_value_t = OptimismConventionArg::Corrected)]
     pub convention: OptimismConventionArg,
     /// How the selected model is chosen among the canonical models whose WIC is within one
@@ -504,7 +505,7 @@ pub struct FitArgs {
     /// Wavelet-variance settings of the estimate.
     #[command(flatten)]
     pub estimator: WvEstimatorArgs,
-    /// Weighting matrix Omega (METHODS §5.2): CI-width ("fast", the IMU default), the
+    /// Weighting matrix Omega (docs/methods.md §5.2): CI-width ("fast", the IMU default), the
     /// Percival asymptotic diagonal, or a parametric bootstrap of the WV variances at the
     /// first fit (100 replicates of the series length, then a refit).
     #[arg(long, value_enum, default_value_t = WeightsArg::Fast)]
@@ -515,7 +516,7 @@ pub struct FitArgs {
     /// Seed of the starting-value search.
     #[arg(long, value_name = "S", default_value_t = 1337, value_parser = seed)]
     pub seed: u64,
-    /// Add inference (METHODS §7): standard errors, 1 - alpha intervals and the J-test
+    /// Add inference (docs/methods.md §7): standard errors, 1 - alpha intervals and the J-test
     /// goodness of fit, from the sandwich with the WV covariance V (see --covariance).
     #[arg(long)]
     pub inference: bool,
@@ -559,7 +560,7 @@ impl From<CovarianceArg> for gmwm::inference::CovarianceMethod {
 pub enum WeightsArg {
     /// Inverse squared CI widths (package "fast").
     Fast,
-    /// Inverse of the Percival asymptotic diagonal covariance (METHODS §1.10).
+    /// Inverse of the Percival asymptotic diagonal covariance (docs/methods.md §1.10).
     Diag,
     /// Inverse of the parametric-bootstrap WV variances at the fast fit, then refit (§5.2).
     Bootstrap,
@@ -711,8 +712,8 @@ pub struct WvEstimatorArgs {
     /// Robust tuning constant and solver: the correct formula, or the R package's.
     #[arg(long, value_enum, default_value_t = RobustConventionArg::Exact)]
     pub robust_convention: RobustConventionArg,
-    /// Wavelet filter (METHODS §1.8): haar, d4, d6, d8, d16, fk4, fk8, fk14, fk22, bl14, bl20,
-    /// la8, la16, la20, mb4, mb8, mb16, mb24.
+    /// Wavelet filter (docs/methods.md §1.8): haar, d4, d6, d8, d16, fk4, fk8, fk14, fk22, bl14,
+    /// bl20, la8, la16, la20, mb4, mb8, mb16, mb24.
     #[arg(long, value_name = "NAME", default_value = "haar")]
     pub filter: String,
     /// Wavelet transform.
@@ -767,7 +768,8 @@ pub struct AvarArgs {
     /// Which variance.
     #[arg(long, value_enum, default_value_t = KindArg::Overlapping)]
     pub kind: KindArg,
-    /// Textbook estimators, or the R package's (with its off-by-one terms, METHODS §13.8–13.10).
+    /// Textbook estimators, or the R package's (with its off-by-one terms, docs/methods.md
+    /// §13.8–13.10).
     #[arg(long, value_enum, default_value_t = ConventionArg::Textbook)]
     pub convention: ConventionArg,
     /// Significance level A: the intervals cover 1 - A (0.05 gives 95% intervals; a value
@@ -788,7 +790,7 @@ pub enum FormatArg {
     Csv,
     /// Tab-separated text.
     Tsv,
-    /// iMAR binary IMU records (METHODS §9.2-9.3: f64 time + 6 int32 increments).
+    /// iMAR binary IMU records (docs/methods.md §9.2-9.3: f64 time + 6 int32 increments).
     Imar,
     /// Northrop Grumman LN-200 records (int32 increments, gyro 2^-21 rad).
     Ln200,

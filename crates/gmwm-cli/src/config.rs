@@ -245,13 +245,13 @@ fn robust_at_eff(a: &WvEstimatorArgs) -> Result<RobustOptions> {
 }
 
 /// Refuses a non-Haar `--filter` for the estimation commands (fit, select, calibrate): every
-/// model's implied WV is the Haar one (METHODS §1.8, §4); the engine refuses it too.
+/// model's implied WV is the Haar one (docs/methods.md §1.8, §4); the engine refuses it too.
 fn check_haar(a: &WvEstimatorArgs, opts: &WvOptions) -> Result<()> {
     if opts.filter != WaveletFilter::Haar {
         return Err(UsageError(format!(
             "invalid --filter {}: every model's implied wavelet variance is the Haar one \
-             (METHODS §1.8, §4), so fits and selections use --filter haar (the default); other \
-             filters are for gmwm wv",
+             (docs/methods.md §1.8, §4), so fits and selections use --filter haar (the default); \
+             other filters are for gmwm wv",
             a.filter
         ))
         .into());
@@ -311,7 +311,8 @@ impl TryFrom<&DemoArgs> for DemoConfig {
         let wv = wv_options(&a.estimator)?;
         anyhow::ensure!(
             wv.filter == WaveletFilter::Haar && wv.transform == Transform::Modwt,
-            "gmwm demo compares with the implied WV of METHODS §4, which exists for the Haar MODWT only; drop --filter/--transform"
+            "gmwm demo compares with the implied WV of docs/methods.md §4, which exists for the \
+             Haar MODWT only; drop --filter/--transform"
         );
         Ok(Self {
             n: a.n,
@@ -382,14 +383,14 @@ impl TryFrom<&AvarArgs> for AvarConfig {
                 ConventionArg::Package => AvConvention::Package,
             },
         };
-        // METHODS §3.4, AV(m) = 2 WV(2m), holds for the overlapping textbook estimator only
+        // docs/methods.md §3.4, AV(m) = 2 WV(2m), holds for the overlapping textbook estimator only
         let saved_wv = SavedWvCheck::default().or_else(|| {
             (allan.kind != AllanKind::Overlapping || allan.convention != AvConvention::Textbook)
                 .then(|| {
                     format!(
                         "--kind {} --convention {} needs the raw recording; a saved wavelet \
                          variance gives only the overlapping textbook Allan variance \
-                         (AV(m) = 2 WV(2m), METHODS §3.4)",
+                         (AV(m) = 2 WV(2m), docs/methods.md §3.4)",
                         allan.kind,
                         allan.convention.name()
                     )
@@ -479,7 +480,7 @@ pub struct FitConfig {
     pub gmwm: Gmwm,
     /// The wavelet variance it fits (Haar).
     pub wv: WvOptions,
-    /// `--inference` (and `--bootstrap B`): METHODS §7 on each fit; `None` without.
+    /// `--inference` (and `--bootstrap B`): docs/methods.md §7 on each fit; `None` without.
     pub inference: Option<InferenceOptions>,
     /// Flags a saved wavelet variance cannot honour (`--robust`, `--filter`/`--transform`,
     /// `--weights diag`).
@@ -1102,7 +1103,7 @@ mod tests {
     }
 
     const HAAR_ONLY: &str = "invalid --filter la8: every model's implied wavelet variance is \
-        the Haar one (METHODS §1.8, §4), so fits and selections use --filter haar (the \
+        the Haar one (docs/methods.md §1.8, §4), so fits and selections use --filter haar (the \
         default); other filters are for gmwm wv";
 
     #[test]
@@ -1279,7 +1280,7 @@ mod tests {
             refused(&["avar", "x", "--kind", "modified"]),
             "wv.json: --kind modified --convention textbook needs the raw recording; a saved \
              wavelet variance gives only the overlapping textbook Allan variance \
-             (AV(m) = 2 WV(2m), METHODS §3.4)"
+             (AV(m) = 2 WV(2m), docs/methods.md §3.4)"
         );
         assert!(refused(&["avar", "x", "--convention", "package"]).contains("--kind overlapping"));
         for ok in [

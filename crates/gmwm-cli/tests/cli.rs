@@ -590,7 +590,7 @@ fn implied_json_has_model_and_process_wv() {
         .iter()
         .map(|v| v.as_f64().unwrap())
         .collect();
-    // METHODS §4 test values: AR1(0.5, 1) 1/3, 0.3125, 0.2705078125; WN(1) 0.5, 0.25, 0.125
+    // docs/methods.md §4 test values: AR1(0.5, 1) 1/3, 0.3125, 0.2705078125; WN(1) 0.5, 0.25, 0.125
     for (got, want) in wv
         .iter()
         .zip([1.0 / 3.0 + 0.5, 0.3125 + 0.25, 0.2705078125 + 0.125])

@@ -212,7 +212,7 @@ fn issue_saved_wv_json_in_every_command() {
     let renamed = write(dir.path(), "wv.out", &out.stdout);
     let (doc, _) = json_and_stderr(gmwm().arg("wv").arg(&renamed).arg("--json"));
     assert_eq!(doc["series"][0]["wv"], original["series"][0]["wv"]);
-    // avar: METHODS §3.4 from the Haar WV, equal to the avar of the recording
+    // avar: docs/methods.md §3.4 from the Haar WV, equal to the avar of the recording
     let (from_wv, stderr) = json_and_stderr(gmwm().arg("avar").arg(&saved).arg("--json"));
     assert!(stderr.contains("AV(m) = 2 WV(2m)"), "{stderr}");
     let (from_csv, _) = json_and_stderr(gmwm().arg("avar").arg(&csv).arg("--json"));
@@ -225,7 +225,7 @@ fn issue_saved_wv_json_in_every_command() {
     }
     one_line_error(
         gmwm().arg("avar").arg(&saved).args(["--kind", "modified"]),
-        &["needs the raw recording", "METHODS §3.4"],
+        &["needs the raw recording", "docs/methods.md §3.4"],
     );
     // select, by index
     let (doc, _) = json_and_stderr(

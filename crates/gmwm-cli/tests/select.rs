@@ -1,5 +1,5 @@
-//! End-to-end tests of `gmwm select` (METHODS §8): the JSON shape, the table, determinism and
-//! one test per bad-input class.
+//! End-to-end tests of `gmwm select` (docs/methods.md §8): the JSON shape, the table, determinism
+//! and one test per bad-input class.
 
 mod common;
 

@@ -1,5 +1,5 @@
-//! The figures of METHODS §11 (paper Figs. 1–4) and the IEEE Std 952 read-off, built from the
-//! engine's results. Each builder only arranges numbers the engine computed.
+//! The figures of docs/methods.md §11 (paper Figs. 1–4) and the IEEE Std 952 read-off, built from
+//! the engine's results. Each builder only arranges numbers the engine computed.
 
 use crate::chart::{BarRow, Bars, Mark, Panel, PanelKind, Series};
 use crate::style::number;
@@ -62,9 +62,9 @@ pub enum Layout {
     Overlay,
 }
 
-/// Horizontal axis of a WV figure: the Haar WV scale (METHODS §14.1).
+/// Horizontal axis of a WV figure: the Haar WV scale (docs/methods.md §14.1).
 pub const WV_SCALE: &str = "scale τ = 2^j/f (s)";
-/// Horizontal axis of an Allan-type figure: the cluster time (METHODS §14.1).
+/// Horizontal axis of an Allan-type figure: the cluster time (docs/methods.md §14.1).
 pub const AV_SCALE: &str = "cluster time τ = m/f (s)";
 
 /// A unit as set in figures: `m/s^2` as `m/s²`.
@@ -74,7 +74,7 @@ fn pretty(unit: &str) -> String {
 
 /// The unit of a noise term for a series in `unit`: SI names when the data are in SI
 /// (`rad/s`, `m/s^2`), else in terms of the data unit; the engine's one formula
-/// ([`gmwm::units::si_unit`], METHODS §14.2), so figures and report agree.
+/// ([`gmwm::units::si_unit`], docs/methods.md §14.2), so figures and report agree.
 fn term_unit(term: NoiseTerm, unit: &str) -> String {
     match unit.parse::<SignalUnit>() {
         Ok(u) if u.to_si() == 1.0 => si_unit(term, Some(u.kind()), unit),
@@ -311,7 +311,7 @@ pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]
 }
 
 /// The legend entry of one fitted component: its process and the values a filter uses, in the
-/// data unit (continuous time; METHODS §14.2, through the engine's read-off).
+/// data unit (continuous time; docs/methods.md §14.2, through the engine's read-off).
 fn component_label(fit: &GmwmFit, index: usize, unit: &str) -> String {
     let component = &fit.model().components()[index];
     let kind = component.kind.name();
@@ -474,7 +474,7 @@ pub fn selection_figure(columns: &[Column<'_, ModelSelection>], rows: usize) -> 
 }
 
 /// One IEEE 952 term on the Allan deviation: its line `sigma(value, tau)` and where it is
-/// read (METHODS §14.3).
+/// read (docs/methods.md §14.3).
 struct SlopeLine {
     symbol: &'static str,
     value: Option<f64>,
@@ -484,7 +484,7 @@ struct SlopeLine {
     legend: String,
 }
 
-/// The IEEE Std 952 read-off (METHODS §14.3) on the Allan deviation: the −1/2 slope line
+/// The IEEE Std 952 read-off (docs/methods.md §14.3) on the Allan deviation: the −1/2 slope line
 /// through N at 1 s, the flat line at the minimum (B × 0.664) and the +1/2 slope line through
 /// K at 3 s, each with its read-off point; a term without a value is left out and named in
 /// the title.

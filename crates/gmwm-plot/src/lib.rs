@@ -1,8 +1,8 @@
 //! Figures and the HTML calibration report of the gmwm platform.
 //!
-//! Every figure of METHODS §11 (paper Figs. 1–4) and the IEEE Std 952 read-off, as SVG or PNG,
-//! drawn with plotters on pure-Rust backends with an embedded DejaVu Sans, so that nothing here
-//! needs a system font or a C library; and [`report::render`], one self-contained HTML page of
+//! Every figure of docs/methods.md §11 (paper Figs. 1–4) and the IEEE Std 952 read-off, as SVG or
+//! PNG, drawn with plotters on pure-Rust backends with an embedded DejaVu Sans, so that nothing
+//! here needs a system font or a C library; and [`report::render`], one self-contained HTML page of
 //! a calibration. This crate renders the engine's results and computes no statistic of its own:
 //! what it shows is what `gmwm --json` gives.
 //!

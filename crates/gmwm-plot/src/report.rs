@@ -438,7 +438,11 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
     let pair = (a.allan.clone(), a.ieee.clone());
     out.push_str(&figure_html(
         &ieee_figure(&one(a, &pair)),
-        &format!("{}: Allan deviation with the IEEE 952 slope lines (cluster time m/f, half the WV scale of the same information, METHODS §14.1).", a.column),
+        &format!(
+            "{}: Allan deviation with the IEEE 952 slope lines (cluster time m/f, half the WV \
+             scale of the same information, docs/methods.md §14.1).",
+            a.column
+        ),
     )?);
 
     // contamination

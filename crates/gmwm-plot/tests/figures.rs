@@ -149,7 +149,7 @@ fn figures_wv_grid_and_overlay_of_the_adis_imu() {
     assert_eq!(svg.polygons, 6);
     assert!(
         svg.texts.iter().any(|t| t == gmwm_plot::WV_SCALE),
-        "the WV scale is named (METHODS §14.1)"
+        "the WV scale is named (docs/methods.md §14.1)"
     );
 }
 
@@ -171,7 +171,7 @@ fn figures_allan_deviation_of_a_precomputed_wv_and_the_recording() {
     assert!(svg.texts.iter().any(|t| t.contains("Allan deviation")));
     assert!(
         svg.texts.iter().any(|t| t.contains("cluster time")),
-        "the AV scale is named (METHODS §14.1)"
+        "the AV scale is named (docs/methods.md §14.1)"
     );
 }
 
@@ -402,7 +402,7 @@ fn figures_refuse_a_bad_name_or_size_in_one_line() {
 #[test]
 fn figures_ieee_lines_of_white_noise_and_random_walk_go_through_their_read_offs() {
     // N = 1e-3 rad/s/√Hz and K = 1e-4 rad/s²/√Hz at 100 Hz (sigma2 = N² f, gamma2 = K² / f):
-    // both regions are read, and each point lies on its line (METHODS §14.3). Seed 1: a
+    // both regions are read, and each point lies on its line (docs/methods.md §14.3). Seed 1: a
     // series whose RW region is read (in 2 of 20 seeds the top octaves go to the rate ramp and
     // the read-off gives no K; the engine's ieee tests cover that case)
     let model: gmwm::model::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();

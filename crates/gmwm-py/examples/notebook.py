@@ -7,7 +7,7 @@ import numpy as np
 import gmwm
 
 # %% A 100 Hz gyroscope: white noise N = 1e-3 rad/s/√Hz, random walk K = 1e-4 rad/s²/√Hz,
-# and a Gauss-Markov bias with a 20 s correlation time (METHODS §14.2: sigma2 = N² f,
+# and a Gauss-Markov bias with a 20 s correlation time (docs/methods.md §14.2: sigma2 = N² f,
 # gamma2 = K² / f).
 f = 100.0
 truth = "GM(beta=0.05, sigma2_gm=1e-8)+WN(sigma2=1e-4)+RW(gamma2=1e-10)"

@@ -163,7 +163,7 @@ fn json(value: &serde_json::Value) -> String {
     value.to_string()
 }
 
-/// Wavelet variance of each column (METHODS §1, §2): the `gmwm wv --json` document.
+/// Wavelet variance of each column (docs/methods.md §1, §2): the `gmwm wv --json` document.
 #[pyfunction]
 #[pyo3(signature = (arrays, names, freq, robust=false, eff=0.6, robust_convention="exact", filter="haar", transform="modwt", levels=None, alpha=0.05))]
 #[allow(clippy::too_many_arguments)]
@@ -198,7 +198,7 @@ fn wv(
     Ok(json(&gmwm::document::series(&items)))
 }
 
-/// Allan, modified Allan or Hadamard variance of each column (METHODS §3): the
+/// Allan, modified Allan or Hadamard variance of each column (docs/methods.md §3): the
 /// `gmwm avar --json` document.
 #[pyfunction]
 #[pyo3(signature = (arrays, names, freq, kind="overlapping", convention="textbook", alpha=0.05))]
@@ -239,7 +239,7 @@ fn avar(
     Ok(json(&gmwm::document::series(&items)))
 }
 
-/// The implied WV of a fully specified model and of each process (METHODS §4): the
+/// The implied WV of a fully specified model and of each process (docs/methods.md §4): the
 /// `gmwm implied --json` document.
 #[pyfunction]
 #[pyo3(signature = (model, levels, freq=1.0))]
@@ -256,7 +256,7 @@ type Simulated<'py> = (
     Vec<(String, Bound<'py, PyArray1<f64>>)>,
 );
 
-/// A seeded simulation of a fully specified model (METHODS §10): the sum and, with
+/// A seeded simulation of a fully specified model (docs/methods.md §10): the sum and, with
 /// `components`, each process.
 #[pyfunction]
 #[pyo3(signature = (model, n, freq=1.0, seed=0, components=false))]
@@ -333,7 +333,7 @@ impl Progress for PyProgress {
     }
 }
 
-/// GMWM fit of a model on each column (METHODS §5, §7 with `inference`): the
+/// GMWM fit of a model on each column (docs/methods.md §5, §7 with `inference`): the
 /// `gmwm fit --json` document.
 #[pyfunction]
 #[pyo3(signature = (arrays, names, freq, model, weights="fast", draws=None, seed=1337, inference=false, bootstrap=None, covariance="auto", robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
@@ -442,7 +442,7 @@ fn fit(
     out.map_err(err)
 }
 
-/// WIC model selection on each column (METHODS §8): the `gmwm select --json` document.
+/// WIC model selection on each column (docs/methods.md §8): the `gmwm select --json` document.
 #[pyfunction]
 #[pyo3(signature = (arrays, names, freq, model=None, candidates=None, bootstrap=50, covariance="auto", optimism="asymptotic", convention="corrected", rule="navigation", draws=None, seed=1337, robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
 #[allow(clippy::too_many_arguments)]

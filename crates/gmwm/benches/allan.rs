@@ -1,4 +1,4 @@
-//! Criterion benches of the Allan variance (METHODS §3.2): the O(N)-per-octave overlapping
+//! Criterion benches of the Allan variance (docs/methods.md §3.2): the O(N)-per-octave overlapping
 //! estimator on seeded white noise, all octave cluster lengths (`2m <= N`).
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use gmwm::{allan_variance, AllanOptions};

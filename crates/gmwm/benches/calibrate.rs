@@ -2,8 +2,8 @@
 //! as `gmwm calibrate` runs it (open the recording, then per axis WV, 63-candidate WIC
 //! selection, identified fit, inference, canonical and IEEE read-off, all axes in parallel).
 //!
-//! `raw` reads IXSEA binary records (METHODS §9.2: f64 time + six f64 increments, 56 bytes per
-//! epoch); `ros` reads an MCAP file of `sensor_msgs/Imu` messages (CDR). N defaults to 10^6
+//! `raw` reads IXSEA binary records (docs/methods.md §9.2: f64 time + six f64 increments, 56 bytes
+//! per epoch); `ros` reads an MCAP file of `sensor_msgs/Imu` messages (CDR). N defaults to 10^6
 //! per axis; `GMWM_BENCH_CALIBRATE_N=10000000` runs the size (one iteration takes
 //! minutes: run it with `--sample-size 10` and expect a long wait).
 

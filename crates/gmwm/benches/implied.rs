@@ -1,5 +1,5 @@
-//! Criterion benches of the implied Haar WV and its Jacobian (METHODS §4.2, §4.5) for the model
-//! 3*AR1 + WN + QN + RW at J = 20 levels (a navigation-grade gyro fit), summing per-process
+//! Criterion benches of the implied Haar WV and its Jacobian (docs/methods.md §4.2, §4.5) for the
+//! model 3*AR1 + WN + QN + RW at J = 20 levels (a navigation-grade gyro fit), summing per-process
 //! results as the GMWM objective does.
 use criterion::{criterion_group, criterion_main, Criterion};
 use gmwm::process::{Ar1, LatentProcess, Process, Qn, Rw, Wn};

@@ -1,4 +1,4 @@
-//! Criterion benches of inference on a GMWM fit (METHODS §7) for the 3*GM truth of
+//! Criterion benches of inference on a GMWM fit (docs/methods.md §7) for the 3*GM truth of
 //! `shared/ref/timings_gmwm_3gm.json` (AR1 (0.9, 1), (0.99, 0.1), (0.999, 0.01) at 1 Hz):
 //! parametric-bootstrap inference with B = 100 at N = 1e5 (with and without the bootstrap GoF
 //! refits, G = 10000) and asymptotic inference (sandwich, V from H = 100 replicates) at N = 1e6.

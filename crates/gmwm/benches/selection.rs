@@ -1,5 +1,5 @@
-//! Criterion bench of WIC model selection (METHODS §8.6): the asymptotic optimism over the 63
-//! nested candidates of `3*AR1()+WN()+RW()+QN()+DR()` on N = 1e6 samples of AR1 + WN + RW at
+//! Criterion bench of WIC model selection (docs/methods.md §8.6): the asymptotic optimism over the
+//! 63 nested candidates of `3*AR1()+WN()+RW()+QN()+DR()` on N = 1e6 samples of AR1 + WN + RW at
 //! 100 Hz, with the defaults (B = 50 bootstrap replicates of V, G = 1e5 draws with early stop,
 //! seed 1337). The R package's `auto_imu` with 31 candidates (3*AR1()+WN()+RW()+QN()) took
 //! 106 s on gyro_x of adis_16405_imu1 (N = 1e6) on the reference machine

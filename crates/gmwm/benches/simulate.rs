@@ -1,5 +1,5 @@
-//! Criterion bench of the streaming simulator (STYLE §7, METHODS §10): 10^7 samples of the
-//! NavChip-like truth 3*AR1 + WN + QN + RW (per-sample parameters, METHODS §5.10, as
+//! Criterion bench of the streaming simulator (STYLE §7, docs/methods.md §10): 10^7 samples of the
+//! NavChip-like truth 3*AR1 + WN + QN + RW (per-sample parameters, docs/methods.md §5.10, as
 //! processes), simulator
 //! built outside the timed loop, output buffer reused.
 

@@ -16,16 +16,16 @@ pub enum Error {
     /// A parameter or option has an impossible value.
     #[error(transparent)]
     Param(#[from] ParamError),
-    /// A model text could not be parsed or breaks a model rule (METHODS §0.2).
+    /// A model text could not be parsed or breaks a model rule (docs/methods.md §0.2).
     #[error(transparent)]
     ModelParse(#[from] crate::model::ModelParseError),
-    /// A model breaks a rule of METHODS §0.2 or has an invalid value.
+    /// A model breaks a rule of docs/methods.md §0.2 or has an invalid value.
     #[error(transparent)]
     Model(#[from] crate::model::ModelError),
-    /// A GMWM fit could not be set up or evaluated (METHODS §5).
+    /// A GMWM fit could not be set up or evaluated (docs/methods.md §5).
     #[error(transparent)]
     Fit(#[from] crate::fit::FitError),
-    /// A WIC model selection could not be set up or run (METHODS §8).
+    /// A WIC model selection could not be set up or run (docs/methods.md §8).
     #[error(transparent)]
     Selection(#[from] crate::selection::SelectionError),
     /// Calibrating a recording failed.
@@ -53,7 +53,7 @@ pub enum InputError {
     /// A parameter or option has an impossible value.
     #[error(transparent)]
     Param(#[from] ParamError),
-    /// The model breaks a rule of METHODS §0.2 or has an invalid value.
+    /// The model breaks a rule of docs/methods.md §0.2 or has an invalid value.
     #[error(transparent)]
     Model(#[from] crate::model::ModelError),
 }
@@ -168,7 +168,7 @@ impl ParamError {
     }
 }
 
-/// Checks that a series is non-empty, finite and not constant (METHODS §0.1 preconditions).
+/// Checks that a series is non-empty, finite and not constant (docs/methods.md §0.1 preconditions).
 ///
 /// One vectorisable pass (min, max and a NaN-propagating probe); the offending index is looked
 /// up only on failure.

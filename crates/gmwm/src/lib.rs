@@ -6,13 +6,15 @@
 //!
 //! Conventions, stated once:
 //! - scales are labelled `tau_j = 2^j` samples (`2^j / freq_hz` seconds), the package label of
-//!   METHODS §0.1; Allan cluster lengths `m` are in samples, and `AV(m) = 2 WV(tau = 2m)` (§3.4);
+//!   docs/methods.md §0.1; Allan cluster lengths `m` are in samples, and `AV(m) = 2 WV(tau = 2m)`
+//!   (§3.4);
 //! - every variance is a variance, never a standard deviation, in the squared unit of the data;
-//! - section numbers such as "METHODS §1.7" refer to `shared/spec/METHODS.md`.
+//! - section numbers such as "§1.7" refer to the methods reference of this repository,
+//!   `docs/methods.md`: the formulas, defaults and test values, section by section.
 //!
 //! ```
 //! use gmwm::{wavelet_variance, WvOptions};
-//! // a ramp x_t = t + 1: the Haar MODWT WV is 0.25 at tau = 2 and 1.0 at tau = 4 (METHODS §1.10)
+//! // ramp x_t = t + 1: Haar MODWT WV 0.25 at tau = 2, 1.0 at tau = 4 (docs/methods.md §1.10)
 //! let x: Vec<f64> = (1..=8).map(f64::from).collect();
 //! let wv = wavelet_variance(&x, 1.0, &WvOptions { levels: Some(2), ..WvOptions::default() }).unwrap();
 //! assert!((wv.wv()[0] - 0.25).abs() < 1e-12 && (wv.wv()[1] - 1.0).abs() < 1e-12);

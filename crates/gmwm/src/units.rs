@@ -1,11 +1,11 @@
-//! Units of inertial signals and of their noise terms (METHODS §14.1, §14.2).
+//! Units of inertial signals and of their noise terms (docs/methods.md §14.1, §14.2).
 //!
 //! This module owns unit parsing ([`SignalUnit`]), the SI factors, the datasheet units and
 //! the continuous-to-discrete forms of each noise term ([`forms`]). The discrete-to-continuous
 //! formulas of a fitted model (`N = sqrt(sigma2 / f)`, ...) live in one place,
 //! [`crate::fit::GmwmFit::navigation`]; this module takes their results.
 //!
-//! # Continuous SI units (METHODS §14.2), `u` the signal unit
+//! # Continuous SI units (docs/methods.md §14.2), `u` the signal unit
 //!
 //! | term | gyroscope | accelerometer | data unit `u` |
 //! |---|---|---|---|
@@ -136,7 +136,7 @@ impl SignalUnit {
         }
     }
 
-    /// METHODS §14.2: the factor to SI, `value_si = value * to_si()` (π/180 for deg/s,
+    /// docs/methods.md §14.2: the factor to SI, `value_si = value * to_si()` (π/180 for deg/s,
     /// π/180/3600 for deg/h, [`STANDARD_GRAVITY`] for g, 1e-3 of it for mg).
     pub fn to_si(self) -> f64 {
         match self {
@@ -241,7 +241,7 @@ impl FromStr for SignalUnit {
     }
 }
 
-/// A noise term of METHODS §14.2 in its continuous-time form.
+/// A noise term of docs/methods.md §14.2 in its continuous-time form.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum NoiseTerm {
@@ -297,7 +297,7 @@ impl fmt::Display for Quantity {
 pub struct UnitForms {
     /// Continuous-time form, in SI (known sensor kind) or in the data unit.
     pub si: Quantity,
-    /// Discrete form at the sampling rate, where one exists (METHODS §14.2).
+    /// Discrete form at the sampling rate, where one exists (docs/methods.md §14.2).
     pub discrete: Option<Quantity>,
     /// Datasheet form, where the sensor kind is known and one exists (module doc).
     pub datasheet: Option<Quantity>,
@@ -305,7 +305,7 @@ pub struct UnitForms {
     pub conversion: String,
 }
 
-/// METHODS §14.2: the continuous-time unit of a noise term: SI for a known sensor kind, in
+/// docs/methods.md §14.2: the continuous-time unit of a noise term: SI for a known sensor kind, in
 /// terms of `data_unit` otherwise (module table; e.g. `"V/√Hz"`, `"V/s/√Hz"`).
 pub fn si_unit(term: NoiseTerm, kind: Option<SignalKind>, data_unit: &str) -> String {
     let (u, per_s) = match kind {
@@ -338,7 +338,7 @@ struct Datasheet {
     formula: &'static str,
 }
 
-/// METHODS §14.2 datasheet units (module table).
+/// docs/methods.md §14.2 datasheet units (module table).
 fn datasheet(term: NoiseTerm, kind: SignalKind) -> Option<Datasheet> {
     let d = |factor, unit, formula| {
         Some(Datasheet {
@@ -382,7 +382,7 @@ fn datasheet(term: NoiseTerm, kind: SignalKind) -> Option<Datasheet> {
     }
 }
 
-/// METHODS §14.2: the datasheet form of a continuous SI value (units of the module doc);
+/// docs/methods.md §14.2: the datasheet form of a continuous SI value (units of the module doc);
 /// `None` where the term has no datasheet unit (Q; the accelerometer R).
 pub fn to_datasheet(term: NoiseTerm, kind: SignalKind, si_value: f64) -> Option<Quantity> {
     datasheet(term, kind).map(|d| Quantity {
@@ -391,13 +391,13 @@ pub fn to_datasheet(term: NoiseTerm, kind: SignalKind, si_value: f64) -> Option<
     })
 }
 
-/// METHODS §14.2: the continuous SI value of a datasheet figure (the inverse of
+/// docs/methods.md §14.2: the continuous SI value of a datasheet figure (the inverse of
 /// [`to_datasheet`]); `None` where the term has no datasheet unit.
 pub fn from_datasheet(term: NoiseTerm, kind: SignalKind, value: f64) -> Option<f64> {
     datasheet(term, kind).map(|d| value / d.factor)
 }
 
-/// METHODS §14.2: a continuous-time value (SI for a known `kind`, else in terms of
+/// docs/methods.md §14.2: a continuous-time value (SI for a known `kind`, else in terms of
 /// `data_unit`) with its discrete form at `freq_hz` and its datasheet form.
 ///
 /// Discrete forms (what a discrete filter's Q matrix takes): white-noise sd per sample

@@ -1,5 +1,5 @@
-//! Allan, modified Allan and Hadamard variances (METHODS §3): hand values, slow oracles, the
-//! AV = 2 WV identity (§3.4), R package and allantools references, white-noise closed forms.
+//! Allan, modified Allan and Hadamard variances (docs/methods.md §3): hand values, slow oracles,
+//! the AV = 2 WV identity (§3.4), R package and allantools references, white-noise closed forms.
 
 use crate::common::{data_dir, f64s, read_ref, rel_diff};
 use gmwm::variance::allan::package_error;
@@ -12,7 +12,7 @@ use rand_distr::{Distribution, Normal};
 use std::io::Read;
 use std::sync::OnceLock;
 
-/// METHODS §3 test values carry 7 significant digits.
+/// docs/methods.md §3 test values carry 7 significant digits.
 const TOL_METHODS: f64 = 5e-7;
 /// Fast (prefix sums) versus slow (compensated direct sums) on the same data: both are accurate
 /// to a few ulps per term, so 1e-12 leaves a wide margin while catching any off-by-one term.
@@ -134,7 +134,7 @@ fn slow(x: &[f64], m: usize, kind: AllanKind, convention: AvConvention) -> f64 {
     }
 }
 
-/// Haar MODWT WV at level j (m = 2^{j-1}) by its direct formula (METHODS §3.4):
+/// Haar MODWT WV at level j (m = 2^{j-1}) by its direct formula (docs/methods.md §3.4):
 /// `W_t = (mean(x_{t-m+1..t}) - mean(x_{t-2m+1..t-m})) / 2`, `t = 2m-1..N-1`, mean of squares.
 fn haar_wv_direct(x: &[f64], m: usize) -> f64 {
     let coefs: Vec<f64> = (2 * m - 1..x.len())
@@ -153,7 +153,7 @@ fn oracles_match_methods_3_hand_values() {
 }
 
 // ------------------------------------------------------------------------------------------
-// METHODS §3 test values
+// docs/methods.md §3 test values
 
 #[test]
 fn allan_variance_matches_methods_3_test_values() {
@@ -527,7 +527,7 @@ fn allan_variance_package_differs_from_textbook_as_documented() {
 // ------------------------------------------------------------------------------------------
 // White noise: closed forms and the degrees of freedom
 
-/// E[MVAR(m)] for white noise of variance sigma2 (METHODS §3.6): the inner sum is
+/// E[MVAR(m)] for white noise of variance sigma2 (docs/methods.md §3.6): the inner sum is
 /// `(1/m) sum_t w_t x_t` with `w` the difference of two triangular weight vectors offset by m.
 fn mvar_white_noise(m: usize, sigma2: f64) -> f64 {
     let mut w = vec![0.0_f64; 3 * m];
@@ -557,7 +557,8 @@ fn allan_variance_white_noise_is_sigma2_over_m() {
             let truth = if kind == AllanKind::Modified {
                 mvar_white_noise(m, sigma2)
             } else {
-                sigma2 / m as f64 // AV, HV of white noise (METHODS §3; no m dependence beyond 1/m)
+                // AV, HV of white noise (docs/methods.md §3; no m dependence beyond 1/m)
+                sigma2 / m as f64
             };
             // five standard errors of a chi-square estimate with edf degrees of freedom
             let bound = 5.0 * (2.0 / a.edf()[k]).sqrt();

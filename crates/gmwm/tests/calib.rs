@@ -106,7 +106,7 @@ fn calibration_reads_off_known_noise() {
         assert!(lo < t && t < hi, "{lo} < {t} < {hi}");
     }
     let sheet = n.forms.as_ref().unwrap().datasheet.as_ref().unwrap();
-    // METHODS §14.2: °/√h = rad/s/√Hz × 180/π × 60
+    // docs/methods.md §14.2: °/√h = rad/s/√Hz × 180/π × 60
     let expected = n.value * 180.0 / std::f64::consts::PI * 60.0;
     assert!(
         (sheet.value / expected - 1.0).abs() < 1e-12,
@@ -262,7 +262,8 @@ fn calibration_skips_a_dead_channel() {
 }
 
 /// A recording without a random walk gets an upper bound on it, said to be one (from the
-/// Allan variance's band, METHODS §14.2 AV of a random walk `K^2 tau / 3`), never an estimate.
+/// Allan variance's band, docs/methods.md §14.2 AV of a random walk `K^2 tau / 3`), never an
+/// estimate.
 #[test]
 fn calibration_bounds_an_undetected_random_walk() {
     let x = simulate_model(&"WN(sigma2=1e-4)".parse().unwrap(), N, FREQ, 21).unwrap();

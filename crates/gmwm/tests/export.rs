@@ -1,5 +1,5 @@
-//! Navigation-stack noise files (METHODS §14.4): each format renders, parses by hand, and holds
-//! the right numbers under the right keys; missing values are typed errors naming the key.
+//! Navigation-stack noise files (docs/methods.md §14.4): each format renders, parses by hand, and
+//! holds the right numbers under the right keys; missing values are typed errors naming the key.
 
 use crate::common::rel_diff;
 use gmwm::calib::export::{render, ExportError, ExportFormat, NavNoise, SensorNoise};

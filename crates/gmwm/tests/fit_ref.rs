@@ -212,7 +212,7 @@ fn wv_json_round_trip_and_refusals() {
     let _ = data_dir();
 }
 
-/// METHODS §5.7 refusals, each a clear error; a power-of-two length works (its last,
+/// docs/methods.md §5.7 refusals, each a clear error; a power-of-two length works (its last,
 /// coefficient-less level is not produced by the default J, §1.6).
 #[test]
 fn section_5_7_refusals_and_power_of_two() {

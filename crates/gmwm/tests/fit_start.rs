@@ -1,5 +1,5 @@
-//! Starting values (METHODS §6) and the two-stage fit (§5.4–§5.5): hand values, reproducible
-//! draws, recovery from guess mode, and the objective against the R package.
+//! Starting values (docs/methods.md §6) and the two-stage fit (§5.4–§5.5): hand values,
+//! reproducible draws, recovery from guess mode, and the objective against the R package.
 
 use crate::common::{f64s, read_column, read_ref};
 use gmwm::fit::{

@@ -1,5 +1,5 @@
-//! IEEE Std 952 read-offs (METHODS §14.3): closed-form Allan variances (§14.2 derivation check),
-//! a simulated WN + RW series, and the ADIS16405 recording.
+//! IEEE Std 952 read-offs (docs/methods.md §14.3): closed-form Allan variances (§14.2 derivation
+//! check), a simulated WN + RW series, and the ADIS16405 recording.
 
 use crate::common::{read_column, rel_diff};
 use gmwm::calib::ieee::{ieee_readoff, IeeeReadoff, DOMINANCE};
@@ -33,7 +33,7 @@ fn closed_form(avar: impl Fn(f64) -> f64) -> AllanVariance {
 
 /// As [`closed_form`], built the public way: a wavelet variance file (`null` for an undefined
 /// value) read by the engine and turned into its Allan variance, `AV(m) = 2 nu2(tau = 2m)`
-/// (METHODS §3.4); `avar(k, tau_s)` gives the AV at octave `k` (`None`: undefined).
+/// (docs/methods.md §3.4); `avar(k, tau_s)` gives the AV at octave `k` (`None`: undefined).
 fn closed_form_with(avar: impl Fn(usize, f64) -> Option<f64>) -> AllanVariance {
     let n = 1_000_000_000usize;
     let m: Vec<f64> = (0..20).map(|k| f64::from(1u32 << k)).collect();
@@ -72,7 +72,7 @@ fn closed_form_with(avar: impl Fn(usize, f64) -> Option<f64>) -> AllanVariance {
 
 static CLOSED_FORMS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
-/// METHODS §14.2 derivation check: the AV of each term at cluster time `t` seconds.
+/// docs/methods.md §14.2 derivation check: the AV of each term at cluster time `t` seconds.
 fn wn(n: f64) -> impl Fn(f64) -> f64 {
     move |t| n * n / t
 }
@@ -169,7 +169,7 @@ fn ieee_sums_of_terms_come_back_within_the_contamination_bound() {
 
 #[test]
 fn ieee_bias_instability_is_the_minimum_over_0_664() {
-    // METHODS §14.5: min Allan deviation 1e-4 -> B = 1.506024e-4 (7 digits: 5e-7)
+    // docs/methods.md §14.5: min Allan deviation 1e-4 -> B = 1.506024e-4 (7 digits: 5e-7)
     let t0 = 2f64.powi(10) / FREQ_HZ;
     let av = closed_form(|t| 1e-8 * (1.0 + (t / t0).ln().powi(2)));
     let ro = ieee_readoff(&av).unwrap();
@@ -225,8 +225,8 @@ fn ieee_refuses_other_variances_and_survives_bad_values() {
     );
 }
 
-/// METHODS §14.3 on a simulated WN + RW series (seeded, 1e6 samples at 100 Hz): N within 5%,
-/// K within 30% (its region is the last few octaves, each with a handful of edf).
+/// docs/methods.md §14.3 on a simulated WN + RW series (seeded, 1e6 samples at 100 Hz): N within
+/// 5%, K within 30% (its region is the last few octaves, each with a handful of edf).
 #[test]
 fn ieee_simulated_white_noise_and_random_walk() {
     // five seeded series: N within 5% and inside its interval in every one; K within 30% and
@@ -278,9 +278,9 @@ fn adis(column: &str, unit: SignalUnit) -> IeeeReadoff {
     ieee_readoff(&av).unwrap()
 }
 
-/// The ADIS16405 recording against its datasheet (METHODS §14.5: ARW 2.0 °/√h, VRW 0.2 m/s/√h).
-/// Numbers are printed for the report; only a factor-2 sanity bound is asserted, the datasheet
-/// being "typical" and the recording one unit.
+/// The ADIS16405 recording against its datasheet (docs/methods.md §14.5: ARW 2.0 °/√h, VRW 0.2
+/// m/s/√h). Numbers are printed for the report; only a factor-2 sanity bound is asserted, the
+/// datasheet being "typical" and the recording one unit.
 #[test]
 fn ieee_adis16405_against_the_datasheet() {
     for (column, unit, kind, sheet) in [

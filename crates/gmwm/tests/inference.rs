@@ -1,5 +1,5 @@
-//! Inference on a GMWM fit (METHODS §7): J-test, sandwich covariance, intervals, parametric
-//! bootstrap, with METHODS test values, closed forms and seeded Monte Carlo.
+//! Inference on a GMWM fit (docs/methods.md §7): J-test, sandwich covariance, intervals, parametric
+//! bootstrap, with the test values of docs/methods.md, closed forms and seeded Monte Carlo.
 
 use gmwm::fit::weights::FullWeights;
 use gmwm::fit::{Gmwm, Objective, Parametrisation, PhiOrder, TransformPreset, Weights};
@@ -168,7 +168,7 @@ fn j_test_rejects_bad_input() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Asymptotic inference (METHODS §7.1, §7.2)
+// Asymptotic inference (docs/methods.md §7.1, §7.2)
 
 use gmwm::inference::{
     infer, sandwich, wald_interval, z_value, Inference, InferenceMethod, InferenceOptions,
@@ -177,7 +177,7 @@ use gmwm::inference::{
 use gmwm::sim::replicate_seed;
 use rayon::prelude::*;
 
-/// METHODS §7 test values carry 7 significant digits.
+/// docs/methods.md §7 test values carry 7 significant digits.
 const METHODS_TOL: f64 = 5e-7;
 
 #[test]
@@ -345,7 +345,7 @@ fn asymptotic_intervals_cover_wn_rw() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Parametric bootstrap (METHODS §7.4)
+// Parametric bootstrap (docs/methods.md §7.4)
 
 fn bootstrap_case(
     b: usize,

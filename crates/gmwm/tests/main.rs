@@ -14,6 +14,7 @@ mod fit_ref;
 mod fit_start;
 mod ieee;
 mod inference;
+mod methods_reference;
 mod model;
 mod process;
 mod read;

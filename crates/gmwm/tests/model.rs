@@ -1,4 +1,4 @@
-//! Models (METHODS §0.2–§0.3): the text language, canonical display, rules, operators.
+//! Models (docs/methods.md §0.2–§0.3): the text language, canonical display, rules, operators.
 
 use gmwm::model::{
     ar, ar1, ar1_with, arma, arma11_with, arma_with, dr, dr_with, gm, gm_with, ma, ma1, qn, rw, wn,

@@ -1,6 +1,6 @@
-//! Latent processes (METHODS §4): test values of §4, closed forms against the §1.9 quadrature
-//! oracle, §4.1 against the closed forms, derivatives against finite differences, GM <-> AR1,
-//! constructor accept/reject tables.
+//! Latent processes (docs/methods.md §4): test values of §4, closed forms against the §1.9
+//! quadrature oracle, §4.1 against the closed forms, derivatives against finite differences, GM <->
+//! AR1, constructor accept/reject tables.
 
 use crate::common::rel_diff;
 use gmwm::process::spectral::{spectral_wv, spectral_wv_level};
@@ -9,7 +9,7 @@ use gmwm::process::{
 };
 use proptest::prelude::*;
 
-/// METHODS §4 test values are printed with 7 significant digits.
+/// docs/methods.md §4 test values are printed with 7 significant digits.
 const PRINTED: f64 = 5e-7;
 /// Values marked "(hand)" or exact in binary.
 const EXACT: f64 = 1e-13;
@@ -170,7 +170,7 @@ fn dr_derivatives_closed_form() {
 
 #[test]
 fn arma_numeric_jacobian_matches_arma11_analytic() {
-    // METHODS §4.7 property: numeric ARMA(1,1) Jacobian = ARMA11 analytic one to ~1e-7.
+    // docs/methods.md §4.7 property: numeric ARMA(1,1) Jacobian = ARMA11 analytic one to ~1e-7.
     let (phi, theta, s2) = (0.5, 0.3, 1.0);
     let num = Arma::new(vec![phi], vec![theta], s2).unwrap().jacobian(8);
     let ana = Arma11::new(phi, theta, s2).unwrap().jacobian(8);
@@ -271,7 +271,8 @@ fn process_closed_forms_match_spectral_oracle() {
 
 #[test]
 fn dr_matches_empirical_wv_of_a_ramp() {
-    // METHODS §1.10 / §4.2: the Haar WV of x_t = omega (t + 1) is omega^2 tau^2 / 16 exactly.
+    // docs/methods.md §1.10 / §4.2: the Haar WV of x_t = omega (t + 1) is omega^2 tau^2 / 16
+    // exactly.
     let omega = -0.37;
     let x: Vec<f64> = (0..4096).map(|t| omega * (t + 1) as f64).collect();
     let opts = gmwm::WvOptions {

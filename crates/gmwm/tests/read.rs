@@ -1,5 +1,6 @@
-//! Readers (METHODS §9): every malformed-input class with its exact message, text/gzip/binary
-//! round trips, the chunked reader, IMU binary records (§9.2–9.3) and the shared recordings.
+//! Readers (docs/methods.md §9): every malformed-input class with its exact message,
+//! text/gzip/binary round trips, the chunked reader, IMU binary records (§9.2–9.3) and the shared
+//! recordings.
 
 use crate::common::data_dir;
 use flate2::write::GzEncoder;
@@ -613,7 +614,8 @@ fn binary_chunks_errors() {
     assert_eq!(calls, 1);
 }
 
-// ---------------------------------------------------------------- IMU records, METHODS §9.2-9.3
+// ---------------------------------------------------------------- IMU records, docs/methods.md
+// §9.2-9.3
 
 fn int_record(t: f64, v: [i32; 6]) -> Vec<u8> {
     let mut b = t.to_le_bytes().to_vec();
@@ -631,7 +633,8 @@ fn double_record(t: f64, v: [f64; 6]) -> Vec<u8> {
     b
 }
 
-/// METHODS §9.2 test value: 2 LN200 epochs 5 ms apart, gyro X 2^21 counts → 200 Hz, 200 rad/s.
+/// docs/methods.md §9.2 test value: 2 LN200 epochs 5 ms apart, gyro X 2^21 counts → 200 Hz, 200
+/// rad/s.
 #[test]
 fn imu_record_ln200_test_value() {
     let d = tempfile::tempdir().unwrap();
@@ -652,7 +655,7 @@ fn imu_record_ln200_test_value() {
     );
 }
 
-/// METHODS §9.2 test value: a 33-byte LN200 file is refused.
+/// docs/methods.md §9.2 test value: a 33-byte LN200 file is refused.
 #[test]
 fn imu_record_33_bytes_refused() {
     let d = tempfile::tempdir().unwrap();
@@ -668,7 +671,7 @@ fn imu_record_33_bytes_refused() {
     );
 }
 
-/// METHODS §9.3 test value: IXSEA, 1 count of gyro at 100 Hz = 4.8481368e-4 rad/s.
+/// docs/methods.md §9.3 test value: IXSEA, 1 count of gyro at 100 Hz = 4.8481368e-4 rad/s.
 #[test]
 fn imu_record_ixsea_test_value() {
     let d = tempfile::tempdir().unwrap();
@@ -1238,7 +1241,7 @@ fn issue_series_files_follow_their_extension_and_sidecars_do_not_collide() {
 
 // ---------------------------------------------------------------- IMU records, every type
 
-/// Hand scale factors of METHODS §9.3 (rad or m/s per count), independent of the library's.
+/// Hand scale factors of docs/methods.md §9.3 (rad or m/s per count), independent of the library's.
 fn scales(t: ImuRecordType) -> (f64, f64) {
     let arcsec = std::f64::consts::PI / (180.0 * 3600.0);
     match t {

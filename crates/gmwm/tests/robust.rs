@@ -1,5 +1,5 @@
-//! Robust wavelet variance (METHODS §2): reference values, Monte Carlo checks and bad input.
-//! (Brent's methods, METHODS §12, are crate-internal and tested in `math::brent`.)
+//! Robust wavelet variance (docs/methods.md §2): reference values, Monte Carlo checks and bad
+//! input. (Brent's methods, docs/methods.md §12, are crate-internal and tested in `math::brent`.)
 
 use gmwm::error::{InputError, SeriesError};
 use gmwm::variance::robust::{
@@ -10,30 +10,31 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
-/// METHODS test values are printed with 7 significant digits: half a unit in the last place.
+/// The test values of docs/methods.md are printed with 7 significant digits: half a unit in the
+/// last place.
 const PRINTED_7: f64 = 5e-7;
-/// Correct tuning constants are printed to 6 decimals (METHODS §2.3 table).
+/// Correct tuning constants are printed to 6 decimals (docs/methods.md §2.3 table).
 const C_TABLE_TOL: f64 = 1e-6;
 /// The package constant is only as good as R's `optimize` tolerance eps^0.25 ~ 1.22e-4
-/// (METHODS §2.3, §2.5 "c = 4.9734 (+-2e-4)").
+/// (docs/methods.md §2.3, §2.5 "c = 4.9734 (+-2e-4)").
 const PACKAGE_C_TOL: f64 = 2e-4;
 /// Our Brent minimiser takes R's steps, so its iterate matches R's printed 6 decimals.
 const PACKAGE_PATH_TOL: f64 = 1e-6;
 /// Efficiencies in the §2.3 table are printed to 5 decimals.
 const EFF_TABLE_TOL: f64 = 5e-6;
-/// Monte Carlo bound of METHODS §2.5: "within 0.05 of 1".
+/// Monte Carlo bound of docs/methods.md §2.5: "within 0.05 of 1".
 const CONTAMINATED_TOL: f64 = 0.05;
 /// Clean Gaussian n = 1e5: the robust variance has sd ~ sqrt(2 / (eff n)) ~ 0.006 at eff 0.6;
 /// 3% is five standard deviations.
 const CLEAN_TOL: f64 = 0.03;
 
-/// METHODS §2.5 test coefficients.
+/// docs/methods.md §2.5 test coefficients.
 const Y10: [f64; 10] = [-1.2, 0.3, 0.8, -0.4, 1.1, -0.9, 0.2, -0.1, 0.6, -0.7];
-/// METHODS §2.5 pathological coefficients.
+/// docs/methods.md §2.5 pathological coefficients.
 const Y_PATH: [f64; 10] = [-2.0, -1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 30.0];
-/// Correct constant for eff 0.6 as printed in METHODS §2.3/§2.5.
+/// Correct constant for eff 0.6 as printed in docs/methods.md §2.3/§2.5.
 const C_EXACT_06: f64 = 4.400278;
-/// Package constant for eff 0.6 as printed in METHODS §2.5.
+/// Package constant for eff 0.6 as printed in docs/methods.md §2.5.
 const C_PACKAGE_06: f64 = 4.973361;
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -44,14 +45,14 @@ fn rel(a: f64, b: f64) -> f64 {
 
 #[test]
 fn a_of_c_matches_methods_2_5() {
-    // METHODS §2.5: a(4.400278) = 0.5691689, a(4.973361) = 0.6367236
+    // docs/methods.md §2.5: a(4.400278) = 0.5691689, a(4.973361) = 0.6367236
     assert!((a_of_c(4.400278) - 0.5691689).abs() < PRINTED_7);
     assert!((a_of_c(4.973361) - 0.6367236).abs() < PRINTED_7);
 }
 
 #[test]
 fn a_of_c_equals_expected_psi_squared_by_quadrature() {
-    // a(c) = E[psi_c(Z)^2] (METHODS §2.1): Simpson's rule on [-c, c]
+    // a(c) = E[psi_c(Z)^2] (docs/methods.md §2.1): Simpson's rule on [-c, c]
     let c = 4.5;
     let n = 20_000;
     let h = 2.0 * c / n as f64;
@@ -69,7 +70,7 @@ fn a_of_c_equals_expected_psi_squared_by_quadrature() {
 
 #[test]
 fn truncated_normal_moments_match_closed_forms() {
-    // METHODS §2.2: mu_0 = 2 Phi(c) - 1, mu_2 = mu_0 - 2 c phi(c); at c = 1.96, mu_0 ~ 0.95
+    // docs/methods.md §2.2: mu_0 = 2 Phi(c) - 1, mu_2 = mu_0 - 2 c phi(c); at c = 1.96, mu_0 ~ 0.95
     let mu = truncated_normal_moments(1.959963984540054);
     assert!((mu[0] - 0.95).abs() < 1e-15, "{}", mu[0] - 0.95);
     let phi = (-0.5f64 * 1.959963984540054 * 1.959963984540054).exp()
@@ -79,7 +80,7 @@ fn truncated_normal_moments_match_closed_forms() {
 
 #[test]
 fn tuning_constant_exact_matches_methods_2_3_table() {
-    // METHODS §2.3 table: correct c and a(correct c)
+    // docs/methods.md §2.3 table: correct c and a(correct c)
     let table = [
         (0.5, 4.060125, 0.522277),
         (0.6, 4.400278, 0.569169),
@@ -100,7 +101,7 @@ fn tuning_constant_exact_matches_methods_2_3_table() {
 
 #[test]
 fn tuning_constant_package_matches_methods_2_3_table() {
-    // METHODS §2.3 table: package c and the true efficiency at the package c
+    // docs/methods.md §2.3 table: package c and the true efficiency at the package c
     let table = [
         (0.5, 4.777414, 0.68898),
         (0.6, 4.973361, 0.72700),
@@ -120,14 +121,14 @@ fn tuning_constant_package_matches_methods_2_3_table() {
         // the package's own (slipped) formula is met at its constant
         assert!((package_efficiency(c) - eff).abs() < 1e-3, "eff {eff}");
     }
-    // METHODS §2.5: "Package constant for eff 0.6: c = 4.9734 (+-2e-4)"
+    // docs/methods.md §2.5: "Package constant for eff 0.6: c = 4.9734 (+-2e-4)"
     let c = tuning_constant(0.6, RobustConvention::Package).unwrap();
     assert!((c - 4.9734).abs() < PACKAGE_C_TOL);
 }
 
 #[test]
 fn efficiency_is_increasing_past_the_zero_of_m() {
-    // METHODS §2.3: the root finder relies on eff increasing in c
+    // docs/methods.md §2.3: the root finder relies on eff increasing in c
     let mut prev = 0.0;
     let mut c = 2.4;
     while c < 100.0 {
@@ -167,7 +168,7 @@ fn robust_options_new_rejects_eff_0_1_nan() {
 
 #[test]
 fn robust_scale_package_route_matches_methods_2_5() {
-    // METHODS §2.5: package robust (eff 0.6) 0.6481826; robust (eff 0.8) 0.616337
+    // docs/methods.md §2.5: package robust (eff 0.6) 0.6481826; robust (eff 0.8) 0.616337
     let c = tuning_constant(0.6, RobustConvention::Package).unwrap();
     let s2 = robust_scale(&Y10, c, RobustConvention::Package).unwrap();
     assert!((s2 - 0.6481826).abs() < PRINTED_7, "{s2}");
@@ -178,7 +179,7 @@ fn robust_scale_package_route_matches_methods_2_5() {
 
 #[test]
 fn robust_scale_package_route_reproduces_local_minimum() {
-    // METHODS §2.5 pathology: package robust (eff 0.6) 176.0876, larger than classical 91.5
+    // docs/methods.md §2.5 pathology: package robust (eff 0.6) 176.0876, larger than classical 91.5
     let c = tuning_constant(0.6, RobustConvention::Package).unwrap();
     let s2 = robust_scale(&Y_PATH, c, RobustConvention::Package).unwrap();
     assert!(rel(s2, 176.0876) < 1e-6, "{s2}");
@@ -186,7 +187,7 @@ fn robust_scale_package_route_reproduces_local_minimum() {
 
 #[test]
 fn robust_scale_exact_matches_methods_2_5() {
-    // METHODS §2.5 "Port default mode": 0.6909524 / 1.902038 (c = 4.400278),
+    // docs/methods.md §2.5 "Port default mode": 0.6909524 / 1.902038 (c = 4.400278),
     // 0.6481894 / 1.800190 (c = 4.973361)
     let cases = [
         (&Y10, C_EXACT_06, 0.6909524),
@@ -205,7 +206,7 @@ fn robust_scale_exact_matches_methods_2_5() {
 
 #[test]
 fn robust_scale_solves_the_scale_equation() {
-    // METHODS §2.1: (1/n) sum psi_c(y_i / s)^2 = a(c) at the returned s^2
+    // docs/methods.md §2.1: (1/n) sum psi_c(y_i / s)^2 = a(c) at the returned s^2
     for y in [&Y10, &Y_PATH] {
         let s2 = robust_scale(y, C_EXACT_06, RobustConvention::Exact).unwrap();
         let s = s2.sqrt();
@@ -234,7 +235,7 @@ fn robust_scale_is_scale_equivariant() {
 
 #[test]
 fn robust_ci_matches_methods_2_5() {
-    // METHODS §2.5: classical 0.525 CI [0.2045587, 3.158041]; robust 0.6481826 CI
+    // docs/methods.md §2.5: classical 0.525 CI [0.2045587, 3.158041]; robust 0.6481826 CI
     // [0.1374296, 4.844999]
     let (lo, hi) = robust_ci(0.6481826, 0.525, 0.2045587, 3.158041, 0.6, None);
     assert!((lo - 0.1374296).abs() < PRINTED_7, "{lo}");
@@ -248,7 +249,8 @@ fn robust_ci_matches_methods_2_5() {
 
 #[test]
 fn robust_ci_substitutes_non_positive_lower_bound() {
-    // METHODS §2.5: lo_r <= 0 -> min(nu_r / 2, smallest earlier lower bound); level 1 -> nu_r / 2
+    // docs/methods.md §2.5: lo_r <= 0 -> min(nu_r / 2, smallest earlier lower bound); level 1 ->
+    // nu_r / 2
     let (lo, hi) = robust_ci(1.0, 1.0, 0.05, 2.0, 0.5, None);
     assert_eq!(lo, 0.5);
     assert!((hi - (1.0 + 2f64.sqrt())).abs() < 1e-15);
@@ -263,7 +265,7 @@ fn gaussian(n: usize, seed: u64) -> Vec<f64> {
 
 #[test]
 fn robust_scale_resists_one_percent_gross_outliers() {
-    // METHODS §2.5: 1e5 N(0,1), 1% replaced by 100: classical ~101, robust within 0.05 of 1
+    // docs/methods.md §2.5: 1e5 N(0,1), 1% replaced by 100: classical ~101, robust within 0.05 of 1
     let mut y = gaussian(100_000, 20_251_122);
     for v in y.iter_mut().step_by(100) {
         *v = 100.0;
@@ -277,7 +279,7 @@ fn robust_scale_resists_one_percent_gross_outliers() {
 
 #[test]
 fn robust_scale_is_consistent_at_the_gaussian() {
-    // METHODS §2.1: s^2 is Fisher-consistent for the variance at the Gaussian
+    // docs/methods.md §2.1: s^2 is Fisher-consistent for the variance at the Gaussian
     let y: Vec<f64> = gaussian(100_000, 7).iter().map(|v| 3.0 * v).collect();
     for conv in [RobustConvention::Exact, RobustConvention::Package] {
         let c = tuning_constant(0.6, conv).unwrap();
@@ -286,8 +288,8 @@ fn robust_scale_is_consistent_at_the_gaussian() {
     }
 }
 
-/// Slow, obviously right twin of the port route (METHODS §2.4 "Port"): MAD start and the plain
-/// fixed point `s^2 <- s^2 mean(psi_c(y/s)^2) / a(c)` to a relative change of 1e-14.
+/// Slow, obviously right twin of the port route (docs/methods.md §2.4 "Port"): MAD start and the
+/// plain fixed point `s^2 <- s^2 mean(psi_c(y/s)^2) / a(c)` to a relative change of 1e-14.
 fn fixed_point_oracle(y: &[f64], c: f64) -> f64 {
     let mut abs: Vec<f64> = y.iter().map(|v| v.abs()).collect();
     abs.sort_by(f64::total_cmp);
@@ -403,7 +405,8 @@ fn robust_scale_rejects_empty_and_zero_input() {
 #[test]
 fn robust_scale_reports_missing_root() {
     // values spread over many orders of magnitude: at any s at most ~one residual sits near the
-    // peak of psi_c^2, so mean psi_c^2 < a(c) everywhere (METHODS §2.4 non-monotone equation)
+    // peak of psi_c^2, so mean psi_c^2 < a(c) everywhere (docs/methods.md §2.4 non-monotone
+    // equation)
     let y: Vec<f64> = (0..12).map(|k| 10f64.powi(3 * k)).collect();
     let err = robust_scale(&y, C_EXACT_06, RobustConvention::Exact).unwrap_err();
     assert!(

@@ -3,7 +3,7 @@
 //! ([`wavelet_variance`]) and streamed ([`HaarWvAccumulator`]).
 //!
 //! The reference: with prefix sums `S`, the level-j Haar MODWT coefficient at `t` is
-//! `W = (S[t+1] - 2 S[t+1-m] + S[t+1-2m]) / 2^j`, `m = 2^(j-1)` (METHODS §1.2), so
+//! `W = (S[t+1] - 2 S[t+1-m] + S[t+1-2m]) / 2^j`, `m = 2^(j-1)` (docs/methods.md §1.2), so
 //! `nu2_j = sum D^2 / (M_j 4^j)` with integer `D`; the sum of squares is exact in `i128`, and
 //! the only rounding is its final conversion to `f64` (half an ulp). The engine computes the
 //! same numbers through its f64 pyramid (averages of averages, each exact for integers until

@@ -1,4 +1,4 @@
-//! Model selection by WIC (METHODS §8): the model Hessian (§4.6), the §8 test values,
+//! Model selection by WIC (docs/methods.md §8): the model Hessian (§4.6), the §8 test values,
 //! candidate enumeration, seeded Monte Carlo and the R package's auto_imu on real data.
 
 use crate::common::{data_dir, f64s, read_column, read_ref};
@@ -17,7 +17,7 @@ fn model(text: &str) -> Model {
     Model::parse(text).unwrap_or_else(|e| panic!("{text}: {e}"))
 }
 
-/// The METHODS §8 test values are printed with 7 significant digits.
+/// The docs/methods.md §8 test values are printed with 7 significant digits.
 const METHODS_TOL: f64 = 5e-7;
 
 fn close(a: f64, b: f64, rel: f64) -> bool {
@@ -93,7 +93,8 @@ fn model_hessian_matches_central_differences_of_the_jacobian() {
         assert_eq!(h[j][1][2], 0.0);
         assert_eq!(h[j][1][1], 0.0, "(sigma2, sigma2) = 0");
     }
-    // METHODS §4.6: AR1(0.5, 1) (phi, phi) at tau = 2, 4, 8, 16; DR (omega, omega) = tau^2/8
+    // docs/methods.md §4.6: AR1(0.5, 1) (phi, phi) at tau = 2, 4, 8, 16; DR (omega, omega) =
+    // tau^2/8
     let h = model("AR1(phi=0.5, sigma2=1)+DR(omega=0.2)")
         .hessian(4, 1.0)
         .unwrap();
@@ -188,9 +189,9 @@ fn d_matrix_matches_methods_8_test_value() {
 
 #[test]
 fn optimism_derivative_uses_b_plus_d() {
-    // dTheta = d theta_hat / d nu_hat' (METHODS §8.2, §13.15): refit AR1(phi, sigma2) exactly
-    // (Newton on Q to convergence) to a WV it cannot match, perturb nu_hat level by level, and
-    // compare the finite differences with (B + D)^{-1} A' Omega; (B - D)^{-1} must miss.
+    // dTheta = d theta_hat / d nu_hat' (docs/methods.md §8.2, §13.15): refit AR1(phi, sigma2)
+    // exactly (Newton on Q to convergence) to a WV it cannot match, perturb nu_hat level by level,
+    // and compare the finite differences with (B + D)^{-1} A' Omega; (B - D)^{-1} must miss.
     let levels = 6;
     let freq = 1.0;
     let omega_w: Vec<f64> = (1..=levels).map(|j| 1.0 + j as f64).collect();
@@ -285,7 +286,7 @@ fn arb_model() -> impl Strategy<Value = Model> {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// METHODS §8.2 sanity identity: D = 0 and V = Omega^{-1} give 2p, for any positive
+    /// docs/methods.md §8.2 sanity identity: D = 0 and V = Omega^{-1} give 2p, for any positive
     /// diagonal Omega, in both conventions.
     #[test]
     fn optimism_is_twice_the_parameter_count_when_v_is_omega_inverse(
@@ -479,7 +480,7 @@ fn selection_is_deterministic_and_consistent() {
 
 #[test]
 fn bootstrap_optimism_agrees_with_the_asymptotic_one() {
-    // METHODS §8.3 vs §8.2 on the true model: both estimate the same expected excess loss.
+    // docs/methods.md §8.3 vs §8.2 on the true model: both estimate the same expected excess loss.
     let truth = model("AR1(phi=0.9, sigma2=1)+WN(sigma2=2)");
     let x = simulate_model(&truth, 4000, 1.0, 5).unwrap();
     let base = Wic::parse_list(&["AR1()+WN()"]).unwrap().with_draws(300);
@@ -640,7 +641,7 @@ fn excess_loss(truth: &Model, candidate: &str, n: usize, reps: usize) -> (f64, f
 
 #[test]
 fn asymptotic_optimism_estimates_the_out_of_sample_excess_loss() {
-    // METHODS §8.1: optimism = E[loss on new data] - E[apparent loss], checked against its
+    // docs/methods.md §8.1: optimism = E[loss on new data] - E[apparent loss], checked against its
     // definition by Monte Carlo for the true model and two over-fitted ones (a superfluous QN
     // and DR; a second AR1, whose phi is not identified at the truth).
     let truth = model("AR1(phi=0.95, sigma2=0.1)+WN(sigma2=1)+RW(gamma2=1e-2)");
@@ -659,7 +660,7 @@ fn asymptotic_optimism_estimates_the_out_of_sample_excess_loss() {
     }
 }
 
-/// Seeded Monte Carlo of METHODS §8.6 selection: `reps` series of length `n` at 100 Hz from
+/// Seeded Monte Carlo of docs/methods.md §8.6 selection: `reps` series of length `n` at 100 Hz from
 /// the truth, the nested candidates of `full`, G = `draws`, B = `replicates` for V; returns
 /// (true model selected, a strict sub-model of the truth selected) counts.
 fn selection_mc(

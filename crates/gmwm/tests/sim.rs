@@ -1,4 +1,4 @@
-//! Simulation (METHODS §10): hand values, determinism and chunking invariance, Monte Carlo
+//! Simulation (docs/methods.md §10): hand values, determinism and chunking invariance, Monte Carlo
 //! moments and wavelet variances against closed forms (§4.2), and rejected parameters.
 
 use gmwm::process::{Ar1, Arma, Arma11, Dr, Ma1, Process, Qn, Rw, Wn};
@@ -14,7 +14,7 @@ const SEED: u64 = 42;
 /// bias of a few SE) is caught.
 const MC_SE: f64 = 4.0;
 
-/// Hand values of METHODS §10.3 are compared to the 8 digits they are quoted with.
+/// Hand values of docs/methods.md §10.3 are compared to the 8 digits they are quoted with.
 const HAND_TOL: f64 = 5e-8;
 
 /// Every kind of process but GM (an AR1 at a rate), with parameters far from degenerate.
@@ -68,7 +68,7 @@ fn assert_mc(values: &[f64], truth: f64, what: &str) {
 }
 
 /// Exact autocovariances `gamma_0..gamma_h_max` of an ARMA(p, q) from its MA(inf) weights
-/// `psi_i = ma_i + sum_l ar_l psi_{i-l}` (METHODS §4.4), `gamma_h = sigma2 sum_k psi_k
+/// `psi_i = ma_i + sum_l ar_l psi_{i-l}` (docs/methods.md §4.4), `gamma_h = sigma2 sum_k psi_k
 /// psi_{k+h}`, truncated where the weights are below 1e-300 relative.
 fn arma_autocov(ar: &[f64], ma: &[f64], sigma2: f64, h_max: usize) -> Vec<f64> {
     let k_max = 20_000;
@@ -91,7 +91,7 @@ fn bits(x: &[f64]) -> Vec<u64> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Hand values (METHODS §10.3)
+// Hand values (docs/methods.md §10.3)
 
 #[test]
 fn simulate_drift_matches_hand_values() {
@@ -259,7 +259,7 @@ fn simulator_clone_continues_the_same_streams() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Monte Carlo moments (METHODS §10.1)
+// Monte Carlo moments (docs/methods.md §10.1)
 
 /// Replicates of length `n`: per replicate the known-mean (zero) estimators mean x_t^2 and
 /// mean x_t x_{t+1}, unbiased for gamma_0 and gamma_1 of a stationary zero-mean series.
@@ -284,7 +284,7 @@ fn check_moments(g: &Process, mode: StartMode, gamma0: f64, gamma1: f64) {
 fn simulate_moments_match_autocovariances() {
     let st = StartMode::Stationary;
     check_moments(&Process::Wn(Wn { sigma2: 2.0 }), st, 2.0, 0.0);
-    // QN: Var = 2 q2, lag-1 covariance -q2 (METHODS §10.1).
+    // QN: Var = 2 q2, lag-1 covariance -q2 (docs/methods.md §10.1).
     check_moments(&Process::Qn(Qn { q2: 0.5 }), st, 1.0, -0.5);
     let (phi, s2) = (0.95, 0.3);
     let g0 = s2 / (1.0 - phi * phi);
@@ -297,7 +297,7 @@ fn simulate_moments_match_autocovariances() {
         s2 * theta,
     );
     for mode in [StartMode::Stationary, StartMode::Zero] {
-        // MA1 is stationary in both modes (one extra innovation, METHODS §10.1).
+        // MA1 is stationary in both modes (one extra innovation, docs/methods.md §10.1).
         check_moments(
             &Process::Ma1(Ma1 { theta, sigma2: s2 }),
             mode,
@@ -358,7 +358,7 @@ fn simulate_random_walk_increments_have_variance_gamma2() {
     }
     assert_mc(&d0, gamma2, "RW increment variance");
     assert_mc(&d1, 0.0, "RW increment lag-1 covariance");
-    // The first value is w_0, not 0 (METHODS §10.1).
+    // The first value is w_0, not 0 (docs/methods.md §10.1).
     assert_mc(&first, gamma2, "RW first value");
 }
 
@@ -387,7 +387,8 @@ fn simulate_stationary_start_has_stationary_variance() {
         g0,
         "AR1 x_0^2, stationary start",
     );
-    // Package start (METHODS §10.1, §13.21): x = 0, so the first kept value is one innovation.
+    // Package start (docs/methods.md §10.1, §13.21): x = 0, so the first kept value is one
+    // innovation.
     let zero = first_sample_second_moment(&ar1, StartMode::Zero, reps);
     assert_mc(&zero, s2, "AR1 x_0^2, zero start");
     assert!(mean_se(&zero).0 < g0 / 10.0);
@@ -423,14 +424,14 @@ fn simulate_stationary_start_has_stationary_variance() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Empirical Haar WV against the closed forms of METHODS §4.2
+// Empirical Haar WV against the closed forms of docs/methods.md §4.2
 
-/// `K(phi, tau) = 3 - 4 phi^{tau/2} + phi^tau` (METHODS §4.2).
+/// `K(phi, tau) = 3 - 4 phi^{tau/2} + phi^tau` (docs/methods.md §4.2).
 fn k_term(phi: f64, tau: f64) -> f64 {
     3.0 - 4.0 * phi.powf(tau / 2.0) + phi.powf(tau)
 }
 
-/// The closed forms of METHODS §4.2, typed here as the independent truth.
+/// The closed forms of docs/methods.md §4.2, typed here as the independent truth.
 fn closed_form_wv(g: &Process, tau: f64) -> f64 {
     match *g {
         Process::Wn(Wn { sigma2 }) => sigma2 / tau,
@@ -498,7 +499,7 @@ fn simulate_wv_matches_closed_forms() {
             );
         }
     }
-    // A sum: WV of independent components add (METHODS §4.1), DR included.
+    // A sum: WV of independent components add (docs/methods.md §4.1), DR included.
     let mut sum = gens[..4].to_vec();
     sum.push(Process::Dr(Dr { omega: 0.01 }));
     let mut per_level = vec![Vec::new(); levels];
@@ -518,7 +519,7 @@ fn simulate_wv_matches_closed_forms() {
 
 #[test]
 fn simulate_drift_wv_is_exact() {
-    // DR is deterministic: its empirical Haar WV equals omega^2 tau^2 / 16 (METHODS §4.2,
+    // DR is deterministic: its empirical Haar WV equals omega^2 tau^2 / 16 (docs/methods.md §4.2,
     // §10.3) in every replicate.
     let g = Process::Dr(Dr { omega: 0.01 });
     let x = simulate(std::slice::from_ref(&g), 4096, SEED).unwrap();
@@ -678,7 +679,7 @@ fn simulator_rejects_bad_parameters() {
 
 /// Issue 3 Monte Carlo: for every process and for the 3*GM+WN+QN+RW demo truth, the mean
 /// empirical Haar WV over R seeded replicates matches the model's implied WV (the library's
-/// closed forms, METHODS §4) within 4 standard errors estimated from the replicates (about
+/// closed forms, docs/methods.md §4) within 4 standard errors estimated from the replicates (about
 /// 1% family-wise false-alarm rate over the ~150 level comparisons), at every level that keeps
 /// at least 64 coefficients.
 #[test]

@@ -26,8 +26,8 @@ fn rel(a: f64, b: f64) -> f64 {
 
 /// Two gyroscope axes in deg/s and a temperature column, 2^20 samples at 100 Hz: streamed and
 /// in memory give the same WV (1e-12: the accumulator sums per block, the kernel per tile),
-/// the same Allan variance (METHODS §3.4, exact up to rounding; the in-memory one may have one
-/// more cluster length, of one term), the same selected models, and
+/// the same Allan variance (docs/methods.md §3.4, exact up to rounding; the in-memory one may have
+/// one more cluster length, of one term), the same selected models, and
 /// the same noise density and random walk within 1e-4 (the two fits start from different
 /// values, the streamed one from the WV alone, and stop at the optimiser's tolerance).
 #[test]

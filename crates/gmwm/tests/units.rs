@@ -1,4 +1,4 @@
-//! Units, datasheet forms and discrete forms (METHODS §14.2) against the §14.5 hand values.
+//! Units, datasheet forms and discrete forms (docs/methods.md §14.2) against the §14.5 hand values.
 
 use crate::common::rel_diff;
 use gmwm::fit::{Gmwm, NavParameter, Weights};
@@ -10,7 +10,7 @@ use gmwm::units::{
 };
 use proptest::prelude::*;
 
-/// METHODS §14.5 values are printed with 7 significant digits (ADIS figures with 4).
+/// docs/methods.md §14.5 values are printed with 7 significant digits (ADIS figures with 4).
 const TOL_7: f64 = 5e-7;
 /// The ARW of §14.5's first line, 0.343775 °/√h, is printed with 6 significant digits.
 const TOL_6: f64 = 5e-6;
@@ -27,7 +27,7 @@ const GYRO: SignalKind = SignalKind::Gyroscope;
 const ACCEL: SignalKind = SignalKind::Accelerometer;
 
 /// The physical parameters of a model at its true values, through the fit's own formulas
-/// (`GmwmFit::navigation`, METHODS §14.2): the fit starts at the truth, where the objective
+/// (`GmwmFit::navigation`, docs/methods.md §14.2): the fit starts at the truth, where the objective
 /// against the implied WV is zero.
 fn navigation(model: &str, freq_hz: f64) -> Vec<NavParameter> {
     let m = Model::parse(model).unwrap();
@@ -49,7 +49,7 @@ fn nav_value(nav: &[NavParameter], name: &str) -> f64 {
 
 #[test]
 fn units_white_noise_hand_values() {
-    // METHODS §14.5: WN sigma2 = 1e-6 (rad/s)^2 at 100 Hz
+    // docs/methods.md §14.5: WN sigma2 = 1e-6 (rad/s)^2 at 100 Hz
     let n = nav_value(&navigation("WN(sigma2=1e-6)", 100.0), "white_noise_density");
     assert!(rel_diff(n, 1e-4) < TOL_FIT, "{n}");
     let f = forms(NoiseTerm::NoiseDensity, Some(GYRO), "deg/s", 1e-4, 100.0);
@@ -73,7 +73,7 @@ fn units_white_noise_hand_values() {
 
 #[test]
 fn units_random_walk_hand_values() {
-    // METHODS §14.5: RW gamma2 = 1e-12 at 200 Hz
+    // docs/methods.md §14.5: RW gamma2 = 1e-12 at 200 Hz
     let k = nav_value(
         &navigation("RW(gamma2=1e-12)", 200.0),
         "rate_random_walk_density",
@@ -91,7 +91,7 @@ fn units_random_walk_hand_values() {
 
 #[test]
 fn units_accelerometer_hand_values() {
-    // METHODS §14.5: accelerometer WN sd 0.02 m/s^2 at 100 Hz
+    // docs/methods.md §14.5: accelerometer WN sd 0.02 m/s^2 at 100 Hz
     let n = nav_value(&navigation("WN(sigma2=4e-4)", 100.0), "white_noise_density");
     assert!(rel_diff(n, 2e-3) < TOL_FIT, "{n}");
     let f = forms(NoiseTerm::NoiseDensity, Some(ACCEL), "g", n, 100.0);
@@ -109,7 +109,7 @@ fn units_accelerometer_hand_values() {
         f.conversion
     );
     assert!(rel_diff(n / (STANDARD_GRAVITY * 1e-6), 203.9432) < TOL_7);
-    // bias in mg (METHODS §14.2)
+    // bias in mg (docs/methods.md §14.2)
     let b = to_datasheet(NoiseTerm::BiasInstability, ACCEL, 9.80665e-3).unwrap();
     assert!(
         rel_diff(b.value, 1.0) < TOL_EXACT && b.unit == "mg",
@@ -122,7 +122,7 @@ fn units_accelerometer_hand_values() {
 
 #[test]
 fn units_gauss_markov_hand_values() {
-    // METHODS §14.5: AR1 phi = 0.999, sigma2 = 1e-8 at 100 Hz
+    // docs/methods.md §14.5: AR1 phi = 0.999, sigma2 = 1e-8 at 100 Hz
     let gm = Ar1::new(0.999, 1e-8).unwrap().to_gm(100.0).unwrap();
     assert!(rel_diff(gm.beta, 0.1000500) < TOL_7, "{}", gm.beta);
     assert!(rel_diff(1.0 / gm.beta, 9.994999) < TOL_7);
@@ -156,7 +156,8 @@ fn units_gauss_markov_hand_values() {
 
 #[test]
 fn units_quantization_and_drift_hand_values() {
-    // METHODS §14.5: QN q2 = 1e-10 at 100 Hz: Q = 1e-7 u s; DR omega = 1e-7 at 100 Hz: R = 1e-5
+    // docs/methods.md §14.5: QN q2 = 1e-10 at 100 Hz: Q = 1e-7 u s; DR omega = 1e-7 at 100 Hz: R =
+    // 1e-5
     let q = nav_value(
         &navigation("QN(q2=1e-10)", 100.0),
         "quantization_coefficient",
@@ -179,7 +180,7 @@ fn units_quantization_and_drift_hand_values() {
 
 #[test]
 fn units_adis_datasheet_figures() {
-    // METHODS §14.5: ADIS16405 gyro ARW 2.0 °/√h, accel VRW 0.2 m/s/√h
+    // docs/methods.md §14.5: ADIS16405 gyro ARW 2.0 °/√h, accel VRW 0.2 m/s/√h
     let n = from_datasheet(NoiseTerm::NoiseDensity, GYRO, 2.0).unwrap();
     assert!(rel_diff(n, 5.818e-4) < TOL_4, "{n}");
     let n = from_datasheet(NoiseTerm::NoiseDensity, ACCEL, 0.2).unwrap();

@@ -1,5 +1,6 @@
-//! Wavelet transforms (METHODS §1.1–§1.4, §1.10): fast pyramids against the direct-convolution
-//! oracle for every filter, METHODS test values, closed forms, identities and bad input.
+//! Wavelet transforms (docs/methods.md §1.1–§1.4, §1.10): fast pyramids against the
+//! direct-convolution oracle for every filter, the test values of docs/methods.md, closed forms,
+//! identities and bad input.
 
 use gmwm::wavelet::{Dwt, Modwt, WaveletCoefficients, WaveletFilter, WaveletScratch};
 use gmwm::{InputError, SeriesError};
@@ -47,7 +48,7 @@ fn sum_sq(x: &[f64]) -> f64 {
     x.iter().map(|v| v * v).sum()
 }
 
-/// Periodic MODWT and DWT preserve energy (METHODS §1.2, §1.4):
+/// Periodic MODWT and DWT preserve energy (docs/methods.md §1.2, §1.4):
 /// `sum_j ||W_j||^2 + ||V_J||^2 = ||x||^2`, to the precision of the filter's table.
 #[test]
 fn wavelet_transforms_preserve_energy() {
@@ -84,7 +85,7 @@ fn wavelet_transforms_preserve_energy() {
     }
 }
 
-/// METHODS §1.10 test values: x = 1..8, Haar, J = 3. Level 3 keeps its single boundary-free
+/// docs/methods.md §1.10 test values: x = 1..8, Haar, J = 3. Level 3 keeps its single boundary-free
 /// coefficient W_{3,7} = (mean(5..8) - mean(1..4)) / 2 = 2 (the package keeps none, §1.3/§13.1).
 #[test]
 fn modwt_haar_ramp_methods_1_10() {
@@ -100,10 +101,10 @@ fn modwt_haar_ramp_methods_1_10() {
     let wv: Vec<f64> = (1..=2)
         .map(|j| sum_sq(w.kept(j)) / w.kept(j).len() as f64)
         .collect();
-    assert_close(&wv, &[0.25, 1.0], 1.0, "WV (METHODS §1.10)");
+    assert_close(&wv, &[0.25, 1.0], 1.0, "WV (docs/methods.md §1.10)");
 }
 
-/// METHODS §1.10 test values: x = (1,3,2,5,4,6,8,7), Haar, J = 2.
+/// docs/methods.md §1.10 test values: x = (1,3,2,5,4,6,8,7), Haar, J = 2.
 #[test]
 fn modwt_haar_second_series_methods_1_10() {
     let x = [1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0];
@@ -122,7 +123,7 @@ fn modwt_haar_second_series_methods_1_10() {
     assert!((sum_sq(w.kept(2)) / 5.0 - 1.05).abs() < 1e-15);
 }
 
-/// METHODS §1.2 Haar closed form, m = 2^{j-1}, periodic indices:
+/// docs/methods.md §1.2 Haar closed form, m = 2^{j-1}, periodic indices:
 /// `W_{j,t} = (1/2) [mean(x_{t-m+1..t}) - mean(x_{t-2m+1..t-m})]`.
 #[test]
 fn modwt_haar_closed_form() {
@@ -147,7 +148,7 @@ fn modwt_haar_closed_form() {
     }
 }
 
-/// METHODS §1.3 counts for a longer filter: `n_j = (2^j - 1)(L - 1)`, `M_j = N - L_j + 1`.
+/// docs/methods.md §1.3 counts for a longer filter: `n_j = (2^j - 1)(L - 1)`, `M_j = N - L_j + 1`.
 #[test]
 fn modwt_boundary_counts_la8() {
     let x = series(64, 12);
@@ -160,7 +161,7 @@ fn modwt_boundary_counts_la8() {
     assert_eq!(kept, vec![57, 43, 15]);
 }
 
-/// METHODS §1.4 Haar: `W_{1,t} = (x_{2t+1} - x_{2t}) / sqrt2`, no boundary coefficients.
+/// docs/methods.md §1.4 Haar: `W_{1,t} = (x_{2t+1} - x_{2t}) / sqrt2`, no boundary coefficients.
 #[test]
 fn dwt_haar_closed_form() {
     let x = series(64, 13);
@@ -177,7 +178,7 @@ fn dwt_haar_closed_form() {
     assert_eq!(w.kept(3).len(), 8);
 }
 
-/// METHODS §1.10 test values: package DWT "WV" (mean of squared coefficients).
+/// docs/methods.md §1.10 test values: package DWT "WV" (mean of squared coefficients).
 #[test]
 fn dwt_haar_wv_methods_1_10() {
     let cases: [(&[f64], [f64; 2]); 2] = [
@@ -209,7 +210,7 @@ fn wavelet_empty_series_rejected() {
     }
 }
 
-/// METHODS §1.2: `2^J > N` is an error.
+/// docs/methods.md §1.2: `2^J > N` is an error.
 #[test]
 fn modwt_too_short_rejected() {
     let x = [1.0, 2.0, 3.0, 5.0, 4.0, 6.0, 8.0];
@@ -227,7 +228,7 @@ fn modwt_too_short_rejected() {
         .is_ok());
 }
 
-/// METHODS §1.3: every level must keep at least one coefficient, `N >= L_j`.
+/// docs/methods.md §1.3: every level must keep at least one coefficient, `N >= L_j`.
 #[test]
 fn modwt_level_without_kept_coefficient_rejected() {
     let x = series(21, 14);
@@ -246,8 +247,8 @@ fn modwt_level_without_kept_coefficient_rejected() {
     assert_eq!(w.kept(2).len(), 1);
 }
 
-/// METHODS §1.4: N must be divisible by 2^J; the error names the largest valid J and the nearest
-/// valid lengths.
+/// docs/methods.md §1.4: N must be divisible by 2^J; the error names the largest valid J and the
+/// nearest valid lengths.
 #[test]
 fn dwt_not_divisible_rejected() {
     let x = series(100, 15);
@@ -269,7 +270,7 @@ fn dwt_not_divisible_rejected() {
         .is_ok());
 }
 
-/// METHODS §1.4: too few samples for 2^J, or no boundary-free coefficient at some level.
+/// docs/methods.md §1.4: too few samples for 2^J, or no boundary-free coefficient at some level.
 #[test]
 fn dwt_too_short_rejected() {
     let e = Dwt::new(WaveletFilter::Haar, 3)
@@ -321,7 +322,7 @@ fn wavelet_plans_are_send_sync_clone() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// MODWT is linear and commutes with circular shifts (METHODS §1.2, periodic boundary).
+    /// MODWT is linear and commutes with circular shifts (docs/methods.md §1.2, periodic boundary).
     #[test]
     fn modwt_is_linear_and_shift_equivariant(
         fi in 0usize..18,

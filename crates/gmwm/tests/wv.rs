@@ -371,7 +371,7 @@ fn streaming_wv_is_exact_to_1e_9_at_a_billion_samples() {
     check_streaming_exact(1_000_000_001);
 }
 
-/// The in-memory robust route (one pyramid pass, windowed power sums, METHODS §2.4 "Port")
+/// The in-memory robust route (one pyramid pass, windowed power sums, docs/methods.md §2.4 "Port")
 /// against the direct route: [`robust_scale`] (exact MAD start, fixed point, Brent polish) on
 /// the MODWT coefficients of every level. Both solve to ~1e-14 in `s`; the coefficients differ
 /// by the offset removed before the pyramid (rounding only), so 1e-10 relative is the bound.

@@ -8,7 +8,7 @@ use gmwm::imu::allan_from_wv;
 use gmwm::{allan_variance, AllanVariance};
 use std::io::Write;
 
-/// A saved wavelet variance: the overlapping Allan variance by METHODS §3.4,
+/// A saved wavelet variance: the overlapping Allan variance by docs/methods.md §3.4,
 /// `AV(m) = 2 WV(2m)`, exact for the classical Haar MODWT WV and the textbook estimator; other
 /// kinds and conventions need the recording.
 fn run_saved(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
@@ -31,8 +31,8 @@ fn run_saved(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
     }
     note(
         file,
-        "Allan variance from the saved Haar wavelet variance, AV(m) = 2 WV(2m) (METHODS §3.4), \
-         intervals the WV's times 2; not recomputed from a recording",
+        "Allan variance from the saved Haar wavelet variance, AV(m) = 2 WV(2m) \
+         (docs/methods.md §3.4), intervals the WV's times 2; not recomputed from a recording",
     );
     Ok(items)
 }

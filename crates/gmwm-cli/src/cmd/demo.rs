@@ -1,5 +1,5 @@
 //! `gmwm demo`: the main job on a built-in default — simulate a sensor with known truth
-//! (METHODS §5.10), compute its wavelet variance, fit the truth's model structure
+//! (docs/methods.md §5.10), compute its wavelet variance, fit the truth's model structure
 //! `3*GM()+WN()+QN()+RW()` by GMWM in guess mode, and show truth against estimate.
 
 use crate::config::DemoConfig;
@@ -44,7 +44,7 @@ pub fn run(config: &DemoConfig, out: &mut impl Write) -> Result<()> {
     let fit = Gmwm::new(sensor.model.without_values())
         .fit_from_wv(&wv, gmwm::fit::StartInputs::from_series(&x))?;
     let fit_time = started.elapsed();
-    // the fit lists AR1/GM blocks by phi descending (METHODS §5.6): order the truth alike
+    // the fit lists AR1/GM blocks by phi descending (docs/methods.md §5.6): order the truth alike
     let truth: Vec<f64> = sensor.model.values().into_iter().flatten().collect();
     let truth = gmwm::fit::Parametrisation::canonical_order(&sensor.model, &truth)?;
     let parameters = fit

@@ -1,4 +1,5 @@
-//! `gmwm fit`: GMWM estimation of a latent error model on each selected column (METHODS §5).
+//! `gmwm fit`: GMWM estimation of a latent error model on each selected column (docs/methods.md
+//! §5).
 
 use crate::cmd::wv::{stream_columns, streamable};
 use crate::config::FitConfig;
@@ -75,8 +76,8 @@ fn fit_streamed(config: &FitConfig) -> Result<Option<Vec<(String, GmwmFit)>>> {
         .map(Some)
 }
 
-/// METHODS §7 on one column's fit, at the series length and WV settings the fit carries, with
-/// a progress bar on a terminal.
+/// docs/methods.md §7 on one column's fit, at the series length and WV settings the fit carries,
+/// with a progress bar on a terminal.
 fn inference(
     config: &FitConfig,
     opts: &InferenceOptions,

@@ -1,5 +1,5 @@
 //! `gmwm select`: model selection by the Wavelet Information Criterion on each selected column
-//! (METHODS §8), the candidates folded by canonical model.
+//! (docs/methods.md §8), the candidates folded by canonical model.
 
 use crate::config::SelectConfig;
 use crate::input::{analyse_columns, column_context, is_wv, load, load_wv};

@@ -4,7 +4,7 @@ Wavelet Moments, on a Rust engine.
 The verbs are the CLI's, with keyword options named as its flags::
 
     import gmwm
-    wv = gmwm.wv("imu.csv.gz")                       # METHODS §1: every sensor column
+    wv = gmwm.wv("imu.csv.gz")                       # docs/methods.md §1: every sensor column
     fit = gmwm.fit(x, freq=100, model="2*AR1()+WN()+RW()")
     cal = gmwm.calibrate("run.bag", gyro_unit=None)  # the pipeline of `gmwm calibrate`
     cal.to_dataframe()                               # N, B, K per axis with intervals
@@ -148,15 +148,16 @@ def _split(options: Dict[str, Any]) -> Tuple[Dict[str, Any], Dict[str, Any]]:
 
 
 def wv(data: Data, *, freq: Optional[float] = None, names: Optional[Sequence[str]] = None, **options) -> SeriesResult:
-    """Wavelet variance of each column with confidence intervals (METHODS §1, §2): ``robust``,
-    ``eff``, ``robust_convention``, ``filter``, ``transform``, ``levels``, ``alpha``."""
+    """Wavelet variance of each column with confidence intervals (docs/methods.md §1, §2):
+    ``robust``, ``eff``, ``robust_convention``, ``filter``, ``transform``, ``levels``,
+    ``alpha``."""
     read_options, options = _split(options)
     arrays, cols, rate = _columns(data, freq, names, read_options)
     return SeriesResult(json.loads(_native.wv(arrays, cols, rate, **options)))
 
 
 def avar(data: Data, *, freq: Optional[float] = None, names: Optional[Sequence[str]] = None, **options) -> SeriesResult:
-    """Allan, modified Allan or Hadamard variance of each column (METHODS §3): ``kind``
+    """Allan, modified Allan or Hadamard variance of each column (docs/methods.md §3): ``kind``
     (overlapping, non-overlapping, modified, hadamard, hadamard-non-overlapping),
     ``convention`` (textbook, package), ``alpha``."""
     read_options, options = _split(options)
@@ -166,12 +167,12 @@ def avar(data: Data, *, freq: Optional[float] = None, names: Optional[Sequence[s
 
 def implied(model: str, *, levels: int, freq: float = 1.0) -> Implied:
     """Implied (theoretical) wavelet variance of a fully specified model and of each process
-    (METHODS §4)."""
+    (docs/methods.md §4)."""
     return Implied(json.loads(_native.implied(model, levels, freq)))
 
 
 def simulate(model: str, *, n: int, freq: float = 1.0, seed: int = 0, components: bool = False):
-    """A seeded simulation of a fully specified model (METHODS §10): the series, or with
+    """A seeded simulation of a fully specified model (docs/methods.md §10): the series, or with
     ``components=True`` a pair ``(series, {process: series})``."""
     x, parts = _native.simulate(model, n, freq, seed, components)
     return (x, dict(parts)) if components else x
@@ -187,9 +188,10 @@ def fit(
     progress: Progress = None,
     **options,
 ) -> FitResult:
-    """GMWM estimate of ``model`` on each column (METHODS §5): ``weights`` (fast, diag,
+    """GMWM estimate of ``model`` on each column (docs/methods.md §5): ``weights`` (fast, diag,
     bootstrap), ``G`` (starting-value draws), ``seed``, ``inference``, ``bootstrap`` and
-    ``covariance`` (METHODS §7; "auto", "exact" or "bootstrap": how V is obtained), ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``."""
+    ``covariance`` (docs/methods.md §7; "auto", "exact" or "bootstrap": how V is obtained),
+    ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``."""
     read_options, options = _split(options)
     arrays, cols, rate = _columns(data, freq, names, read_options)
     doc = _native.fit(arrays, cols, rate, model, draws=G, progress=progress, **options)
@@ -207,7 +209,7 @@ def select(
     progress: Progress = None,
     **options,
 ) -> SelectionResult:
-    """Model selection by the Wavelet Information Criterion on each column (METHODS §8):
+    """Model selection by the Wavelet Information Criterion on each column (docs/methods.md §8):
     ``model`` (every sub-model is a candidate) or ``candidates`` (a list, or text separated by
     ``;``), ``bootstrap``, ``covariance``, ``optimism``, ``convention``, ``rule``, ``G``, ``seed``, and the WV
     settings."""

@@ -15,23 +15,23 @@ class GmwmError(ValueError):
 def wv(arrays: Sequence[F64], names: Sequence[str], freq: float, robust: bool = ..., eff: float = ...,
        robust_convention: str = ..., filter: str = ..., transform: str = ..., levels: Optional[int] = ...,
        alpha: float = ...) -> str:
-    """Wavelet variance of each column (METHODS §1, §2)."""
+    """Wavelet variance of each column (docs/methods.md §1, §2)."""
 
 def avar(arrays: Sequence[F64], names: Sequence[str], freq: float, kind: str = ..., convention: str = ...,
          alpha: float = ...) -> str:
-    """Allan, modified Allan or Hadamard variance of each column (METHODS §3)."""
+    """Allan, modified Allan or Hadamard variance of each column (docs/methods.md §3)."""
 
 def implied(model: str, levels: int, freq: float = ...) -> str:
-    """Implied WV of a fully specified model and of each process (METHODS §4)."""
+    """Implied WV of a fully specified model and of each process (docs/methods.md §4)."""
 
 def simulate(model: str, n: int, freq: float = ..., seed: int = ..., components: bool = ...) -> Tuple[F64, List[Tuple[str, F64]]]:
-    """Seeded simulation (METHODS §10): the series and, with components, each process."""
+    """Seeded simulation (docs/methods.md §10): the series and, with components, each process."""
 
 def fit(arrays: Sequence[F64], names: Sequence[str], freq: float, model: str, weights: str = ...,
         draws: Optional[int] = ..., seed: int = ..., inference: bool = ..., bootstrap: Optional[int] = ...,
         covariance: str = ..., robust: bool = ..., eff: float = ..., robust_convention: str = ..., levels: Optional[int] = ...,
         alpha: float = ..., progress: Progress = ...) -> str:
-    """GMWM fit of `model` on each column (METHODS §5, §7)."""
+    """GMWM fit of `model` on each column (docs/methods.md §5, §7)."""
 
 def select(arrays: Sequence[F64], names: Sequence[str], freq: float, model: Optional[str] = ...,
            candidates: Optional[Sequence[str]] = ..., bootstrap: int = ..., covariance: str = ...,
@@ -39,7 +39,7 @@ def select(arrays: Sequence[F64], names: Sequence[str], freq: float, model: Opti
            convention: str = ..., rule: str = ..., draws: Optional[int] = ..., seed: int = ...,
            robust: bool = ..., eff: float = ..., robust_convention: str = ..., levels: Optional[int] = ...,
            alpha: float = ..., progress: Progress = ...) -> str:
-    """WIC model selection on each column (METHODS §8)."""
+    """WIC model selection on each column (docs/methods.md §8)."""
 
 def read(path: str, columns: Optional[Sequence[str]] = ..., freq: Optional[float] = ..., format: str = ...,
          ncols: Optional[int] = ..., header: str = ..., time_column: Optional[str] = ...,

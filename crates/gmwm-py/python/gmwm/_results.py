@@ -46,7 +46,7 @@ class _Document:
 
 
 class Series(_Document):
-    """One column's wavelet or Allan-type variance (METHODS §1–§3).
+    """One column's wavelet or Allan-type variance (docs/methods.md §1–§3).
 
     Attributes: ``name``, ``n``, ``freq_hz``, ``alpha``, ``tau`` (samples), ``tau_s``
     (seconds), ``value`` (the variance: ``wv`` or ``avar``), ``ci_low``, ``ci_high``, and for
@@ -122,7 +122,7 @@ class SeriesResult(_Document):
 
 
 class Implied(_Document):
-    """The implied WV of a model and of each process (METHODS §4)."""
+    """The implied WV of a model and of each process (docs/methods.md §4)."""
 
     def __init__(self, doc: Dict[str, Any]):
         super().__init__(doc)
@@ -136,7 +136,7 @@ class Implied(_Document):
 
 
 class FitResult(_Document):
-    """GMWM fits, one per column (METHODS §5; §7 with ``inference=True``)."""
+    """GMWM fits, one per column (docs/methods.md §5; §7 with ``inference=True``)."""
 
     def __init__(self, doc: Dict[str, Any]):
         super().__init__(doc)
@@ -174,7 +174,7 @@ class FitResult(_Document):
 
 
 class SelectionResult(_Document):
-    """WIC selections, one per column (METHODS §8)."""
+    """WIC selections, one per column (docs/methods.md §8)."""
 
     def __init__(self, doc: Dict[str, Any]):
         super().__init__(doc)

@@ -1,5 +1,5 @@
 //! Does contamination matter? The classical wavelet variance of an axis against its robust
-//! one (paper Fig. 2, METHODS §2): on clean Gaussian data both estimate the same WV and the
+//! one (paper Fig. 2, docs/methods.md §2): on clean Gaussian data both estimate the same WV and the
 //! classical estimate lies inside the robust interval at all but about `alpha` of the scales;
 //! outliers inflate the classical estimate above the robust interval at the scales they reach.
 
@@ -53,7 +53,7 @@ pub enum FitUses {
     Robust,
 }
 
-/// Compares `classical` with `robust` (METHODS §2, paper Fig. 2) at confidence level
+/// Compares `classical` with `robust` (docs/methods.md §2, paper Fig. 2) at confidence level
 /// `1 - alpha`: a level counts as outside when the classical estimate is beyond the robust
 /// interval; the verdict is the fit verdict's rule (more than `ceil(alpha J)` levels outside, or
 /// one outside by more than [`CHANCE_MISS_REL`] relative).

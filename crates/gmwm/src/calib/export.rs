@@ -1,4 +1,4 @@
-//! Navigation-stack noise files (METHODS §14.4).
+//! Navigation-stack noise files (docs/methods.md §14.4).
 //!
 //! [`render`] writes the IMU noise block of five navigation stacks from one [`NavNoise`]
 //! (continuous-time SI values). Every key's unit is stated in a comment beside it, and the
@@ -20,8 +20,8 @@
 //! white noise of density `*RandomWalk` with correlation time `*BiasCorrelationTime` (its
 //! stationary sd is `RandomWalk × sqrt(T / 2)`), plus a constant turn-on bias of sd
 //! `*TurnOnBiasSigma` drawn once per run. So for PX4 the random walk should be the GM driving
-//! density (METHODS §14.2) when a GM bias is exported; [`SensorNoise::bias_sigma`] is written
-//! as the turn-on sigma, and the stationary sd implied by the other two keys is stated in a
+//! density (docs/methods.md §14.2) when a GM bias is exported; [`SensorNoise::bias_sigma`] is
+//! written as the turn-on sigma, and the stationary sd implied by the other two keys is stated in a
 //! comment so the two can be compared.
 
 use crate::error::ParamError;
@@ -32,7 +32,7 @@ use std::fmt::Write as _;
 use std::str::FromStr;
 use thiserror::Error;
 
-/// Continuous-time SI noise of one sensor triad (METHODS §14.2, §14.4).
+/// Continuous-time SI noise of one sensor triad (docs/methods.md §14.2, §14.4).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct SensorNoise {
     /// White-noise density N: rad/s/√Hz or m/s²/√Hz.
@@ -48,7 +48,7 @@ pub struct SensorNoise {
     pub bias_driving_density: Option<f64>,
 }
 
-/// What a navigation filter needs, with provenance (METHODS §14.4).
+/// What a navigation filter needs, with provenance (docs/methods.md §14.4).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NavNoise {
     /// IMU rate, Hz.
@@ -64,7 +64,7 @@ pub struct NavNoise {
     pub comments: Vec<String>,
 }
 
-/// A navigation stack's noise file (METHODS §14.4).
+/// A navigation stack's noise file (docs/methods.md §14.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ExportFormat {
@@ -680,8 +680,8 @@ fn px4(noise: &NavNoise) -> Result<String, ExportError> {
     Ok(out)
 }
 
-/// METHODS §14.4: renders the noise file of a navigation stack (keys, units and layout in the
-/// module doc).
+/// docs/methods.md §14.4: renders the noise file of a navigation stack (keys, units and layout in
+/// the module doc).
 ///
 /// # Errors
 /// [`ExportError::Missing`] naming the key of a value the format needs (all formats need both

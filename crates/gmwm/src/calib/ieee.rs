@@ -1,9 +1,9 @@
-//! IEEE Std 952 read-offs from the Allan deviation (METHODS §14.3).
+//! IEEE Std 952 read-offs from the Allan deviation (docs/methods.md §14.3).
 //!
 //! # The region rule
 //! Each coefficient is read off the part of the Allan deviation curve where its own noise term
 //! dominates. Which scales those are is decided on a smooth model, not on noisy local slopes:
-//! the five IEEE terms (METHODS §14.2 derivation check) are fitted to the Allan variance by
+//! the five IEEE terms (docs/methods.md §14.2 derivation check) are fitted to the Allan variance by
 //! non-negative least squares,
 //!
 //! `AV(tau) ~ c_Q 3/tau^2 + c_N / tau + c_B + c_K tau/3 + c_R tau^2/2`, every `c >= 0`,
@@ -43,8 +43,8 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::fmt;
 
-/// METHODS §14.3: the flicker-floor factor `sqrt(2 ln 2 / π) = 0.6643`, rounded to 0.664 as in
-/// IEEE Std 952 and METHODS §14.5 (min ADEV 1e-4 gives B = 1.506024e-4 only with 0.664).
+/// docs/methods.md §14.3: the flicker-floor factor `sqrt(2 ln 2 / π) = 0.6643`, rounded to 0.664 as
+/// in IEEE Std 952 and docs/methods.md §14.5 (min ADEV 1e-4 gives B = 1.506024e-4 only with 0.664).
 pub const FLICKER_FACTOR: f64 = 0.664;
 
 /// Share of the fitted AV a term must carry at a scale for the scale to join its region.
@@ -62,7 +62,7 @@ const EDF_CAP: f64 = 100.0;
 /// solution instead of noise.
 const SVD_EPS: f64 = 1e-13;
 
-/// One IEEE Std 952 coefficient read off the Allan deviation (METHODS §14.3).
+/// One IEEE Std 952 coefficient read off the Allan deviation (docs/methods.md §14.3).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Readoff {
     /// The coefficient (data unit), or `None` where its region holds fewer than two scales.
@@ -79,7 +79,7 @@ pub struct Readoff {
     pub note: Option<String>,
 }
 
-/// The five IEEE Std 952 coefficients (METHODS §14.3), in the data unit `u`.
+/// The five IEEE Std 952 coefficients (docs/methods.md §14.3), in the data unit `u`.
 ///
 /// Wire format: `N`, `B`, `K`, `Q`, `R`, each a [`Readoff`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -107,13 +107,14 @@ struct Term {
     region: &'static str,
     /// Slope of its line in the Allan deviation.
     slope: &'static str,
-    /// AV per unit squared coefficient at cluster time `tau` (METHODS §14.2 derivation check).
+    /// AV per unit squared coefficient at cluster time `tau` (docs/methods.md §14.2 derivation
+    /// check).
     basis: fn(f64) -> f64,
-    /// Read-off time, seconds (METHODS §14.3); `basis(at) = 1` there.
+    /// Read-off time, seconds (docs/methods.md §14.3); `basis(at) = 1` there.
     at_tau_s: f64,
 }
 
-/// METHODS §14.2, §14.3: the five terms in model-column order Q, N, B, K, R.
+/// docs/methods.md §14.2, §14.3: the five terms in model-column order Q, N, B, K, R.
 const TERMS: [Term; 5] = [
     Term {
         region: "quantization",
@@ -193,8 +194,8 @@ impl Scales {
     }
 }
 
-/// METHODS §14.3 (module doc): the non-negative least-squares fit of the five-term model, in
-/// relative terms; returns the AV coefficients `c_Q, c_N, c_B, c_K, c_R` (all `>= 0`).
+/// docs/methods.md §14.3 (module doc): the non-negative least-squares fit of the five-term model,
+/// in relative terms; returns the AV coefficients `c_Q, c_N, c_B, c_K, c_R` (all `>= 0`).
 fn fit_terms(s: &Scales) -> [f64; 5] {
     let n = s.len();
     let w: Vec<f64> = s.edf.iter().map(|e| e.min(EDF_CAP).sqrt()).collect();
@@ -274,7 +275,7 @@ fn region(s: &Scales, c: &[f64; 5], j: usize) -> Vec<usize> {
     best
 }
 
-/// METHODS §14.3: the fixed-slope line of term `j` through the data on `idx`, read at its
+/// docs/methods.md §14.3: the fixed-slope line of term `j` through the data on `idx`, read at its
 /// read-off time (module doc); `None` when a value is not finite.
 fn line(s: &Scales, j: usize, idx: &[usize], values: &[f64]) -> Option<f64> {
     let basis = TERMS[j].basis;
@@ -324,7 +325,7 @@ fn seconds(t: f64) -> String {
     }
 }
 
-/// METHODS §14.3: the read-off of a line term (N, K, Q or R).
+/// docs/methods.md §14.3: the read-off of a line term (N, K, Q or R).
 fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
     let term = &TERMS[j];
     let idx = near_read_off(s, region(s, c, j), term.at_tau_s);
@@ -381,7 +382,7 @@ fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
     }
 }
 
-/// METHODS §14.3: bias instability, minimum deviation / [`FLICKER_FACTOR`] (module doc).
+/// docs/methods.md §14.3: bias instability, minimum deviation / [`FLICKER_FACTOR`] (module doc).
 fn bias_readoff(s: &Scales) -> Readoff {
     // the minimum; an interior scale attaining it is preferred, so a flat floor counts
     let min = s.avar.iter().copied().fold(f64::INFINITY, f64::min);
@@ -441,8 +442,8 @@ fn bias_readoff(s: &Scales) -> Readoff {
     }
 }
 
-/// METHODS §14.3: the IEEE Std 952 read-offs N, B, K, Q, R of an Allan variance (region rule
-/// and constants in the module doc), in the unit of the data the AV was computed from.
+/// docs/methods.md §14.3: the IEEE Std 952 read-offs N, B, K, Q, R of an Allan variance (region
+/// rule and constants in the module doc), in the unit of the data the AV was computed from.
 ///
 /// # Errors
 /// [`ParamError`] named `kind` unless `av` is an Allan variance (overlapping or not): the

@@ -1,4 +1,4 @@
-//! From the per-axis read-off to the one set of values a navigation filter takes (METHODS
+//! From the per-axis read-off to the one set of values a navigation filter takes (docs/methods.md
 //! §14.4): which axis speaks for a sensor triad, and how conservative the values are.
 
 use super::export::{NavNoise, SensorNoise};
@@ -92,8 +92,8 @@ pub struct NavSet {
 }
 
 impl CalibrationReport {
-    /// The navigation-filter values under `policy` and `adjustment` (METHODS §14.4): the noise
-    /// density from each axis's white-noise read-off, the random walk from its random-walk
+    /// The navigation-filter values under `policy` and `adjustment` (docs/methods.md §14.4): the
+    /// noise density from each axis's white-noise read-off, the random walk from its random-walk
     /// read-off, the Gauss–Markov keys from its dominant correlated term. One set, or one per
     /// axis letter with [`AxisPolicy::PerAxis`].
     pub fn nav_sets(

@@ -161,7 +161,7 @@ pub enum EstimateStatus {
 ///
 /// Wire format: `value`, `ci_low`, `ci_high` (null where no interval exists), `unit`,
 /// `status` (`estimated`, `undetermined`, `upper-bound`), `source` (which term or rule gave
-/// it), `forms` (continuous SI, discrete and datasheet forms, METHODS §14.2; null for
+/// it), `forms` (continuous SI, discrete and datasheet forms, docs/methods.md §14.2; null for
 /// quantities in the data unit).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Estimate {
@@ -200,7 +200,7 @@ pub struct GaussMarkovBias {
 /// interval), `max_relative_deviation`, `explains_wv`, `summary` (one line).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitVerdict {
-    /// p-value of the J-test (METHODS §7.3).
+    /// p-value of the J-test (docs/methods.md §7.3).
     pub j_test_p_value: Option<f64>,
     /// Number of scales.
     pub levels: usize,
@@ -640,7 +640,7 @@ impl Calibration {
                 },
             )
             .map_err(engine)?,
-            // METHODS §3.4: the overlapping AV is twice the classical Haar WV, exactly
+            // docs/methods.md §3.4: the overlapping AV is twice the classical Haar WV, exactly
             AxisData::Streamed { wv, .. } => allan_from_wv(wv).map_err(|e| engine(e.into()))?,
         };
         let ieee = ieee_readoff(&allan).map_err(|e| engine(e.into()))?;
@@ -1048,7 +1048,7 @@ impl Readoff<'_> {
     }
 
     /// K from the canonical random-walk term; without one, the slowest Gauss–Markov term's
-    /// driving-noise density (METHODS §14.4, saying so).
+    /// driving-noise density (docs/methods.md §14.4, saying so).
     fn random_walk(&self, notes: &mut Vec<String>) -> Option<Estimate> {
         let f = self.freq_hz;
         if let Some(t) = self.canonical.term(ProcessKind::Rw) {
@@ -1145,9 +1145,9 @@ impl Readoff<'_> {
 }
 
 /// An upper bound on the random-walk density K of a recording whose model has no random walk:
-/// a random walk adds `K^2 tau / 3` to the Allan variance (METHODS §14.2), so at every cluster
-/// time `K <= sqrt(3 AV_high(tau) / tau)` with `AV_high` the upper end of the AV's band; the
-/// tightest of these, with its cluster time. `None` without a finite positive bound.
+/// a random walk adds `K^2 tau / 3` to the Allan variance (docs/methods.md §14.2), so at every
+/// cluster time `K <= sqrt(3 AV_high(tau) / tau)` with `AV_high` the upper end of the AV's band;
+/// the tightest of these, with its cluster time. `None` without a finite positive bound.
 fn random_walk_upper_bound(av: &AllanVariance) -> Option<(f64, f64)> {
     av.ci_high
         .iter()

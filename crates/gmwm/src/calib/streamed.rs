@@ -5,7 +5,7 @@
 //! streamed form:
 //! - **the classical Haar WV**: streamed from the file for every axis at once
 //!   ([`binary_wavelet_variance`]); identical to the in-memory estimate within 1e-12;
-//! - **the Allan variance**: `AV(m) = 2 nu2(2m)`, exact from that WV (METHODS §3.4,
+//! - **the Allan variance**: `AV(m) = 2 nu2(2m)`, exact from that WV (docs/methods.md §3.4,
 //!   [`allan_from_wv`](crate::imu::allan_from_wv));
 //! - **the model selection and the fit**: they use the WV only ([`crate::Wic::select_wv`]);
 //!   the starting values then come from the WV alone (no series range for drift draws), and
@@ -16,8 +16,8 @@
 //!   [`ROBUST_BLOCK`] samples, in memory one block at a time: per level, the blocks' robust
 //!   estimates averaged with weights their coefficient counts, at the levels up to
 //!   [`ROBUST_LEVELS`] (scales of at most `2^15` samples, where a block holds at least 64
-//!   windows). The interval is the robust one (METHODS §2.5) for the pooled count. The error
-//!   of this approximation against the robust WV of the whole series is measured in the
+//!   windows). The interval is the robust one (docs/methods.md §2.5) for the pooled count. The
+//!   error of this approximation against the robust WV of the whole series is measured in the
 //!   tests (`streamed_robust_matches_whole_series`); contamination (spikes, steps) shows at
 //!   the fine scales, which the check covers.
 //!

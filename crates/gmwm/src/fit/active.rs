@@ -4,10 +4,10 @@
 //! Such a component contributes nothing to the implied WV and stays there under small changes
 //! of `nu2_hat`: its derivative `d theta_hat / d nu2_hat'` is zero, its Jacobian column (and,
 //! for an AR1 whose variance vanished, its phi's column) is zero, and its value may lie outside
-//! the domain of its transform (a drift of exactly 0). Standard errors, the sandwich (METHODS
-//! §7.1), the J-test (§7.3), the bootstrap refits (§7.4) and the optimism (§8.2–§8.3) are
-//! therefore computed on the active sub-model, which has the same implied WV and objective;
-//! the boundary parameters are reported without a standard error.
+//! the domain of its transform (a drift of exactly 0). Standard errors, the sandwich
+//! (docs/methods.md §7.1), the J-test (§7.3), the bootstrap refits (§7.4) and the optimism
+//! (§8.2–§8.3) are therefore computed on the active sub-model, which has the same implied WV and
+//! objective; the boundary parameters are reported without a standard error.
 
 use super::{FitError, GmwmFit};
 use crate::model::{Component, ImpliedWv, Model};

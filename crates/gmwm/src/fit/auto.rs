@@ -1,4 +1,4 @@
-//! The full GMWM pipeline with generated starting values (METHODS §5.4–§5.5, §6).
+//! The full GMWM pipeline with generated starting values (docs/methods.md §5.4–§5.5, §6).
 //!
 //! A fully specified model starts from its values and only stage 2 (minimise `Q`) runs.
 //! Otherwise the §6 search gives the best draw, stage 1 minimises the flattening objective
@@ -13,8 +13,8 @@ use crate::model::{Component, Model};
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 
 impl Gmwm {
-    /// Computes the WV of `x` (with `wv_opts`) and fits the model (METHODS §5.5), generating
-    /// starting values unless the model is fully specified. Works with every weighting.
+    /// Computes the WV of `x` (with `wv_opts`) and fits the model (docs/methods.md §5.5),
+    /// generating starting values unless the model is fully specified. Works with every weighting.
     ///
     /// # Errors
     /// As [`wavelet_variance`] (in [`FitError::Input`]), [`Weights::new`],

@@ -24,8 +24,8 @@
 //! ```
 //!
 //! ([`WaveletVariance::log_variance`](crate::WaveletVariance::log_variance): `eta_j` are the
-//! equivalent degrees of freedom of METHODS §1.7, `psi'` the trigamma function). At one level
-//! `delta` is the number of standard errors of `ln nu2_hat_j` between the two curves; over
+//! equivalent degrees of freedom of docs/methods.md §1.7, `psi'` the trigamma function). At one
+//! level `delta` is the number of standard errors of `ln nu2_hat_j` between the two curves; over
 //! the levels it adds them in quadrature, treating the levels as independent (adjacent Haar
 //! levels are positively correlated, so it leans towards "separable"). Two fits whose
 //! separation is at most 2 ([`SEPARATION_LIMIT`], a heuristic limit: two standard errors in
@@ -139,7 +139,7 @@ fn contributing(implied: &ImpliedWv, log_variance: &[f64]) -> Vec<bool> {
         .collect()
 }
 
-/// METHODS-style separation of two implied WVs (module doc): `sqrt(sum_j ln(a_j / b_j)^2 /
+/// The separation of two implied WVs (module doc): `sqrt(sum_j ln(a_j / b_j)^2 /
 /// log_variance_j)`. Levels where either value is not a positive finite number are skipped.
 ///
 /// ```
@@ -158,7 +158,7 @@ pub fn wv_separation(a: &[f64], b: &[f64], log_variance: &[f64]) -> f64 {
         .sqrt()
 }
 
-/// One parameter of a canonical term (METHODS §0.2 name, per-sample value).
+/// One parameter of a canonical term (docs/methods.md §0.2 name, per-sample value).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TermParameter {
     /// Name (`sigma2`, `phi`, `beta`, `gamma2`, ...).
@@ -179,7 +179,7 @@ pub struct CanonicalTerm {
     /// The kind.
     #[serde(skip)]
     pub kind: ProcessKind,
-    /// Values in METHODS §0.2 order.
+    /// Values in docs/methods.md §0.2 order.
     pub parameters: Vec<TermParameter>,
     /// Physical read-off (data unit `u`).
     pub physical: Vec<NavParameter>,
@@ -515,7 +515,7 @@ impl Part {
             .collect()
     }
 
-    /// The per-sample AR1 form of an AR1/GM part (METHODS §4.3).
+    /// The per-sample AR1 form of an AR1/GM part (docs/methods.md §4.3).
     fn ar1(&self, freq_hz: f64) -> Option<Ar1> {
         let v = self.values();
         match self.kind() {
@@ -559,7 +559,7 @@ impl Part {
     }
 }
 
-/// An AR1/GM part of `kind` with the AR1 form `ar1` (GM through METHODS §4.3).
+/// An AR1/GM part of `kind` with the AR1 form `ar1` (GM through docs/methods.md §4.3).
 fn part_from_ar1(kind: ProcessKind, ar1: Ar1, freq_hz: f64, from: Vec<usize>) -> Option<Part> {
     let values = match kind {
         ProcessKind::Gm => {

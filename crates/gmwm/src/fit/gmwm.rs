@@ -1,4 +1,4 @@
-//! The GMWM estimator settings and the fit from caller-given starting values (METHODS §5.5
+//! The GMWM estimator settings and the fit from caller-given starting values (docs/methods.md §5.5
 //! steps 3, 4, 6, 8, 10–12), the bootstrap weighting (§5.2) and the refit of another model on
 //! a fit's WV (`update`, §5.9); the fit with generated starting values (§6) is in
 //! [`super::auto`].
@@ -14,10 +14,10 @@ use crate::sim::bootstrap::wv_bootstrap;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use serde::Serialize;
 
-/// Default number of bootstrap replicates H behind [`Weighting::Bootstrap`] (METHODS §5.7).
+/// Default number of bootstrap replicates H behind [`Weighting::Bootstrap`] (docs/methods.md §5.7).
 pub const DEFAULT_BOOTSTRAP_REPLICATES: usize = 100;
 
-/// GMWM estimator settings (METHODS §5): the model and how to fit it. Build with
+/// GMWM estimator settings (docs/methods.md §5): the model and how to fit it. Build with
 /// [`Gmwm::new`] and the `with_*` setters, then call [`Gmwm::fit_wv`] or [`Gmwm::fit_series`].
 ///
 /// ```
@@ -42,9 +42,9 @@ pub struct Gmwm {
     options: LmOptions,
     /// The values the user gave (kept in the §6 draws; all `Some`: the fit's start).
     pub(crate) given: Vec<Option<f64>>,
-    /// Starting-value search settings (METHODS §6).
+    /// Starting-value search settings (docs/methods.md §6).
     pub(crate) start_options: StartOptions,
-    /// Bootstrap weighting: replicates H and rounds K (METHODS §5.2, §5.5 step 8).
+    /// Bootstrap weighting: replicates H and rounds K (docs/methods.md §5.2, §5.5 step 8).
     bootstrap_replicates: usize,
     bootstrap_rounds: usize,
 }
@@ -53,7 +53,7 @@ impl Gmwm {
     /// An estimator of `model` with the IMU defaults: fast weights, IMU transforms, ordered
     /// AR1/GM components. Its values are ignored by the explicit-start fits
     /// ([`Gmwm::fit_wv`], ...) and used by [`Gmwm::fit`] / [`Gmwm::fit_from_wv`]: all given
-    /// means the start, some given means kept in the starting-value draws (METHODS §6).
+    /// means the start, some given means kept in the starting-value draws (docs/methods.md §6).
     pub fn new(model: Model) -> Self {
         Self {
             given: model.values(),
@@ -76,8 +76,8 @@ impl Gmwm {
         Ok(Self::new(Model::parse(text)?))
     }
 
-    /// Sets the replicates H and rounds K of [`Weighting::Bootstrap`] (METHODS §5.2; defaults
-    /// 100 and 1).
+    /// Sets the replicates H and rounds K of [`Weighting::Bootstrap`] (docs/methods.md §5.2;
+    /// defaults 100 and 1).
     ///
     /// # Errors
     /// [`ParamError`] for `replicates < 2` (no covariance) or `rounds == 0`.
@@ -101,13 +101,13 @@ impl Gmwm {
         Ok(self)
     }
 
-    /// Sets the weighting (METHODS §5.2); default [`Weighting::Fast`].
+    /// Sets the weighting (docs/methods.md §5.2); default [`Weighting::Fast`].
     pub fn with_weighting(mut self, weighting: Weighting) -> Self {
         self.weighting = weighting;
         self
     }
 
-    /// Sets the transform preset (METHODS §5.3); default [`TransformPreset::Imu`].
+    /// Sets the transform preset (docs/methods.md §5.3); default [`TransformPreset::Imu`].
     pub fn with_preset(mut self, preset: TransformPreset) -> Self {
         self.preset = preset;
         self
@@ -125,7 +125,7 @@ impl Gmwm {
         self
     }
 
-    /// Sets the seed of the starting-value search (METHODS §5.7; default 1337).
+    /// Sets the seed of the starting-value search (docs/methods.md §5.7; default 1337).
     pub fn with_seed(mut self, seed: u64) -> Self {
         self.start_options.seed = seed;
         self
@@ -137,7 +137,7 @@ impl Gmwm {
         self
     }
 
-    /// The weighting (METHODS §5.2).
+    /// The weighting (docs/methods.md §5.2).
     pub fn weighting(&self) -> Weighting {
         self.weighting
     }
@@ -156,7 +156,7 @@ impl Gmwm {
         g
     }
 
-    /// Fits the model to an empirical WV (METHODS §5.5) from `start` (theta in model order,
+    /// Fits the model to an empirical WV (docs/methods.md §5.5) from `start` (theta in model order,
     /// original parametrisation). Works with the fast and bootstrap weightings; the diag weights
     /// need the series ([`Gmwm::fit_series`]).
     ///
@@ -179,7 +179,7 @@ impl Gmwm {
         self.finish(fit, wv, StartInputs::from_wv(wv))
     }
 
-    /// METHODS §5.7: a robust fit needs parameters + 1 <= J.
+    /// docs/methods.md §5.7: a robust fit needs parameters + 1 <= J.
     fn check_robust_levels(&self, wv: &WaveletVariance) -> Result<(), FitError> {
         let params = self.model.n_params();
         if wv.robust.is_some() && params + 1 > wv.levels() {
@@ -191,8 +191,8 @@ impl Gmwm {
         Ok(())
     }
 
-    /// Computes the WV of `x` (METHODS §5.5 step 3, with `wv_options`) and the weights, then
-    /// fits as [`Gmwm::fit_wv`]; works with every [`Weighting`].
+    /// Computes the WV of `x` (docs/methods.md §5.5 step 3, with `wv_options`) and the weights,
+    /// then fits as [`Gmwm::fit_wv`]; works with every [`Weighting`].
     ///
     /// # Errors
     /// As [`wavelet_variance`] (wrapped in [`FitError::Input`]) and [`Gmwm::fit_wv`].
@@ -211,7 +211,7 @@ impl Gmwm {
         self.finish(fit, &wv, StartInputs::from_series(x))
     }
 
-    /// METHODS §5.5 step 8 and §5.9: the bootstrap rounds when asked, then the empirical WV
+    /// docs/methods.md §5.5 step 8 and §5.9: the bootstrap rounds when asked, then the empirical WV
     /// and the search inputs are attached to the fit (for `update` and reporting).
     pub(crate) fn finish(
         &self,
@@ -252,8 +252,8 @@ impl Gmwm {
         Ok(fit)
     }
 
-    /// The package's `update` (METHODS §5.9): fits this estimator's model to the WV stored in
-    /// `fit` with `fit`'s original (fast or diag) weights, without recomputing the WV. Values
+    /// The package's `update` (docs/methods.md §5.9): fits this estimator's model to the WV stored
+    /// in `fit` with `fit`'s original (fast or diag) weights, without recomputing the WV. Values
     /// in this model are starting values as in [`Gmwm::fit`]; the starting-value search uses
     /// this estimator's seed and G and the stored N and range.
     ///
@@ -306,8 +306,8 @@ impl Gmwm {
         let param_names = param.names().to_vec();
         let objective = Objective::new(&self.model, param.clone(), nu_hat, &weights, freq_hz)?;
         let mut min = minimize(&objective, &u0, &self.options)?;
-        // METHODS §5.6 (port): stable sort of the AR1/GM blocks, phi decreasing (a no-op for
-        // the ordered chain); then leave a false boundary point (components fitted to nothing
+        // docs/methods.md §5.6 (port): stable sort of the AR1/GM blocks, phi decreasing (a no-op
+        // for the ordered chain); then leave a false boundary point (components fitted to nothing
         // that the data want back, fit::revive), at most MAX_REVIVALS times
         let mut revivals = 0;
         let (theta, fitted, implied_wv) = loop {
@@ -376,7 +376,7 @@ impl Gmwm {
     }
 }
 
-/// The result of a GMWM fit (METHODS §5.9).
+/// The result of a GMWM fit (docs/methods.md §5.9).
 ///
 /// Wire format: `model` (text with the estimates), `theta` and `param_names` (model order,
 /// original parametrisation, GM as `beta`, `sigma2_gm`), `start`, `objective` (`Q`, §5.1),
@@ -396,7 +396,7 @@ pub struct GmwmFit {
     pub(crate) param_names: Vec<String>,
     /// The starting values used (after the §5.6 ordering).
     pub(crate) start: Vec<f64>,
-    /// `Q(theta_hat)` (METHODS §5.1).
+    /// `Q(theta_hat)` (docs/methods.md §5.1).
     pub(crate) objective: f64,
     /// How the optimiser ended.
     pub(crate) convergence: Convergence,
@@ -412,7 +412,7 @@ pub struct GmwmFit {
     pub(crate) preset: TransformPreset,
     /// AR1/GM parametrisation used.
     pub(crate) phi_order: PhiOrder,
-    /// Which weighting produced `weights` (METHODS §5.2).
+    /// Which weighting produced `weights` (docs/methods.md §5.2).
     pub(crate) weighting: Weighting,
     /// The fast V of the first fit when the bootstrap weighting replaced it (the package's
     /// `orgV`); `None` otherwise (then `weights.v` is `orgV`).
@@ -421,7 +421,8 @@ pub struct GmwmFit {
     pub(crate) bootstrap_replicates: Option<usize>,
     /// The empirical WV fitted, with its CI (`None` only for a bare [`Gmwm::fit_weighted`]).
     pub(crate) empirical: Option<WaveletVariance>,
-    /// Series length and range behind the starting values (METHODS §6.1), kept for `update`.
+    /// Series length and range behind the starting values (docs/methods.md §6.1), kept for
+    /// `update`.
     pub(crate) inputs: Option<StartInputs>,
     /// Labels of the parameters of the components fitted to nothing (implied WV below
     /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level,
@@ -452,7 +453,7 @@ impl GmwmFit {
         &self.start
     }
 
-    /// `Q(theta_hat)` (METHODS §5.1).
+    /// `Q(theta_hat)` (docs/methods.md §5.1).
     pub fn objective(&self) -> f64 {
         self.objective
     }
@@ -492,7 +493,7 @@ impl GmwmFit {
         self.phi_order
     }
 
-    /// Which weighting produced `weights` (METHODS §5.2).
+    /// Which weighting produced `weights` (docs/methods.md §5.2).
     pub fn weighting(&self) -> Weighting {
         self.weighting
     }
@@ -513,7 +514,8 @@ impl GmwmFit {
         self.empirical.as_ref()
     }
 
-    /// Series length and range behind the starting values (METHODS §6.1), kept for `update`.
+    /// Series length and range behind the starting values (docs/methods.md §6.1), kept for
+    /// `update`.
     pub fn inputs(&self) -> Option<StartInputs> {
         self.inputs
     }

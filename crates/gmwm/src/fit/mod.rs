@@ -1,5 +1,5 @@
-//! GMWM estimation (METHODS §5): parameter transforms (§5.3), weighting matrices (§5.2), the
-//! objective with its analytic gradient (§5.1, §5.4) and a Levenberg–Marquardt optimiser.
+//! GMWM estimation (docs/methods.md §5): parameter transforms (§5.3), weighting matrices (§5.2),
+//! the objective with its analytic gradient (§5.1, §5.4) and a Levenberg–Marquardt optimiser.
 //!
 //! The optimiser works on unconstrained parameters `u`; [`Parametrisation`] maps them to the
 //! model's `theta` (original parametrisation, GM in `(beta, sigma2_gm)`), [`Weights`] holds the
@@ -43,7 +43,7 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum FitError {
-    /// A parameter value lies outside the domain of its transform (METHODS §5.3).
+    /// A parameter value lies outside the domain of its transform (docs/methods.md §5.3).
     #[error("parameter {index} ({name}) = {value} is outside the domain of its transform: expected {expected}")]
     OutOfDomain {
         /// 0-based index in theta.
@@ -103,7 +103,7 @@ pub enum FitError {
         /// The value.
         value: f64,
     },
-    /// More parameters than levels: the model is not identified (METHODS §5.7).
+    /// More parameters than levels: the model is not identified (docs/methods.md §5.7).
     #[error("the model has {params} parameters but only {levels} levels are fitted; use a smaller model or more levels")]
     TooFewLevels {
         /// Number of parameters.
@@ -123,12 +123,12 @@ pub enum FitError {
         value: f64,
     },
     /// The wavelet variance was computed with another filter than Haar: every implied WV of
-    /// METHODS §4 is the Haar WV (§1.8), so a fit, a selection or an inference on it would
+    /// docs/methods.md §4 is the Haar WV (§1.8), so a fit, a selection or an inference on it would
     /// silently be wrong.
     #[error(
         "the wavelet variance uses the {filter} filter, but every model's implied wavelet \
-         variance is the Haar one (METHODS §1.8, §4): fit, select and infer on a Haar wavelet \
-         variance (other filters are for display only)"
+         variance is the Haar one (docs/methods.md §1.8, §4): fit, select and infer on a Haar \
+         wavelet variance (other filters are for display only)"
     )]
     NotHaar {
         /// The filter of the WV.

@@ -1,4 +1,4 @@
-//! The GMWM objective on the unconstrained parameters (METHODS §5.1, §5.4).
+//! The GMWM objective on the unconstrained parameters (docs/methods.md §5.1, §5.4).
 //!
 //! `Q(u) = sum_j omega_j (nu2_hat_j - nu2_j(theta(u)))^2 = sum_j r_j^2` with whitened residuals
 //! `r_j = sqrt(omega_j) (nu2_hat_j - nu2_j)`. Wavelet variances span many decades (1e-6 to 1e-14
@@ -45,7 +45,7 @@ pub(crate) struct Eval {
 
 impl Objective {
     /// The objective of `model` (values ignored) against `nu2_hat` with weights `weights` at
-    /// `freq_hz` (used by GM terms, METHODS §4.3).
+    /// `freq_hz` (used by GM terms, docs/methods.md §4.3).
     ///
     /// # Errors
     /// [`FitError::Length`] when the weights, WV or parametrisation disagree in size;
@@ -62,9 +62,9 @@ impl Objective {
         Self::build(model, param, nu_hat, sqrt_omega, None, freq_hz)
     }
 
-    /// The objective with a full weighting `Omega = V^{-1}` (METHODS §5.1 with a non-diagonal
-    /// Omega, e.g. the efficient weights of §7.3): `Q = (nu2_hat - nu2)' Omega (nu2_hat - nu2)`,
-    /// minimised through the whitened residuals `W (nu2_hat - nu2)`.
+    /// The objective with a full weighting `Omega = V^{-1}` (docs/methods.md §5.1 with a
+    /// non-diagonal Omega, e.g. the efficient weights of §7.3): `Q = (nu2_hat - nu2)' Omega
+    /// (nu2_hat - nu2)`, minimised through the whitened residuals `W (nu2_hat - nu2)`.
     ///
     /// # Errors
     /// As [`Objective::new`].
@@ -186,8 +186,8 @@ impl Objective {
         self.freq_hz
     }
 
-    /// Implied WV `nu2(theta)` and, if asked, its Jacobian `A` (row-major J x p, METHODS §4.5,
-    /// original parametrisation) into the given buffers.
+    /// Implied WV `nu2(theta)` and, if asked, its Jacobian `A` (row-major J x p, docs/methods.md
+    /// §4.5, original parametrisation) into the given buffers.
     fn implied(
         &self,
         theta: &[f64],
@@ -223,7 +223,7 @@ impl Objective {
     /// Whitened residuals at `u` (and their Jacobian when `with_jacobian`) into `ev`.
     /// `u` has length p (caller's invariant).
     ///
-    /// `d r_j / d u_k = -sqrt(omega_j) sum_i A_ji d theta_i / d u_k` (METHODS §5.4).
+    /// `d r_j / d u_k = -sqrt(omega_j) sum_i A_ji d theta_i / d u_k` (docs/methods.md §5.4).
     pub(crate) fn evaluate(
         &self,
         u: &[f64],
@@ -287,8 +287,8 @@ impl Objective {
         }
     }
 
-    /// METHODS §5.1, paper eq. (3): `Q = sum_j omega_j (nu2_hat_j - nu2_j(theta))^2` (with a full
-    /// weighting `(nu2_hat - nu2)' Omega (nu2_hat - nu2)`) at theta
+    /// docs/methods.md §5.1, paper eq. (3): `Q = sum_j omega_j (nu2_hat_j - nu2_j(theta))^2` (with
+    /// a full weighting `(nu2_hat - nu2)' Omega (nu2_hat - nu2)`) at theta
     /// (original parametrisation). No factor N.
     ///
     /// # Errors
@@ -332,7 +332,7 @@ impl Objective {
             .sum())
     }
 
-    /// METHODS §5.1: `Q(theta(u))`.
+    /// docs/methods.md §5.1: `Q(theta(u))`.
     ///
     /// # Errors
     /// [`FitError::Length`]; [`FitError::Input`] when theta(u) is not a valid model (e.g. a
@@ -344,7 +344,7 @@ impl Objective {
         Ok(ev.r.iter().map(|r| r * r).sum())
     }
 
-    /// METHODS §5.4: `grad_u Q = -2 sum_j omega_j r_j (A(theta) d theta / d u)_j` with the
+    /// docs/methods.md §5.4: `grad_u Q = -2 sum_j omega_j r_j (A(theta) d theta / d u)_j` with the
     /// analytic A of §4.5 (GM with respect to `beta`, `sigma2_gm` at the rate).
     ///
     /// # Errors

@@ -1,5 +1,6 @@
-//! Minimising the GMWM objective over `u` (METHODS §5.4): Levenberg–Marquardt on the whitened
-//! residuals `r_j = sqrt(omega_j) (nu2_hat_j - nu2_j(theta(u)))` with the analytic Jacobian.
+//! Minimising the GMWM objective over `u` (docs/methods.md §5.4): Levenberg–Marquardt on the
+//! whitened residuals `r_j = sqrt(omega_j) (nu2_hat_j - nu2_j(theta(u)))` with the analytic
+//! Jacobian.
 //!
 //! The package minimises `Q` with R's conjugate gradients (100 iterations, numerical gradient),
 //! which often stops short; §5.4 allows any method reaching a lower objective. `Q` is a sum of
@@ -193,7 +194,7 @@ pub(crate) struct Minimum {
     pub(crate) u: Vec<f64>,
     /// Model parameters `theta(u)` (original parametrisation).
     pub(crate) theta: Vec<f64>,
-    /// `Q` at the end (METHODS §5.1).
+    /// `Q` at the end (docs/methods.md §5.1).
     pub(crate) objective: f64,
     /// Implied WV at the end.
     pub(crate) implied_wv: Vec<f64>,
@@ -235,7 +236,7 @@ fn sum_sq(r: &[f64]) -> f64 {
     r.iter().map(|v| v * v).sum()
 }
 
-/// METHODS §5.4: minimises `Q(u)` of `objective` from `u0` by Levenberg–Marquardt.
+/// docs/methods.md §5.4: minimises `Q(u)` of `objective` from `u0` by Levenberg–Marquardt.
 ///
 /// Each iteration forms `J'J` and `J'r` (O(J p^2)), solves the damped normal equations
 /// `(J'J + mu D) h = -J'r` by Cholesky and evaluates the implied WV and its Jacobian once per

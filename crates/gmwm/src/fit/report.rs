@@ -1,10 +1,10 @@
 //! Views of a [`GmwmFit`] for people and navigation filters: the estimates in model order,
-//! every AR1/GM component in both forms (METHODS §4.3, rate-aware), and the parameters in the
-//! physical units a Kalman filter or an Allan-variance chart uses.
+//! every AR1/GM component in both forms (docs/methods.md §4.3, rate-aware), and the parameters in
+//! the physical units a Kalman filter or an Allan-variance chart uses.
 //!
 //! Physical forms, with `f` the sampling rate in Hz and `u` the unit of the data (e.g. rad/s
 //! for a gyroscope, m/s^2 for an accelerometer); each is fixed by the Allan variance it implies
-//! (`AV(T) = 2 WV(2T)`, METHODS §3.4, with the §4.2 closed forms):
+//! (`AV(T) = 2 WV(2T)`, docs/methods.md §3.4, with the §4.2 closed forms):
 //!
 //! | process | quantity | value | unit | AV at cluster time T |
 //! |---|---|---|---|---|
@@ -23,7 +23,7 @@ use crate::model::ProcessKind;
 use serde::Serialize;
 use std::fmt;
 
-/// One estimate, in model order (original parametrisation, METHODS §0.2 names).
+/// One estimate, in model order (original parametrisation, docs/methods.md §0.2 names).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ParameterEstimate {
     /// Process of the component (`GM`, `WN`, ...).
@@ -38,7 +38,7 @@ pub struct ParameterEstimate {
     pub start: f64,
 }
 
-/// An AR1 or GM component in both forms (METHODS §4.3, `dt = 1 / freq_hz`).
+/// An AR1 or GM component in both forms (docs/methods.md §4.3, `dt = 1 / freq_hz`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Ar1GmForms {
     /// Process as written in the model (`AR1` or `GM`).
@@ -134,7 +134,7 @@ impl GmwmFit {
 
 impl Ar1GmForms {
     /// Both forms of an AR1 (`theta = [phi, sigma2]`) or GM (`[beta, sigma2_gm]`) component
-    /// at `freq_hz` (METHODS §4.3); `None` for other kinds.
+    /// at `freq_hz` (docs/methods.md §4.3); `None` for other kinds.
     pub(crate) fn of(
         kind: ProcessKind,
         index: usize,
@@ -160,7 +160,7 @@ impl Ar1GmForms {
     }
 }
 
-/// The physical parameters of one component (module table) with parameters `theta` (METHODS
+/// The physical parameters of one component (module table) with parameters `theta` (docs/methods.md
 /// §0.2 order) at `freq_hz`; `unit` names the data unit (`"u"` when `None`); empty for the MA
 /// and ARMA kinds. `index` is the component's position, copied into each entry.
 pub(crate) fn physical_parameters(
@@ -341,7 +341,7 @@ mod tests {
             .unwrap();
         let forms = fit.ar1_gm_forms();
         assert_eq!(forms.len(), 3);
-        // METHODS §5.10 AR1 forms, printed to 7 digits: relative 5e-7
+        // docs/methods.md §5.10 AR1 forms, printed to 7 digits: relative 5e-7
         let published = [
             (0.9990005, 1.414585e-11),
             (0.9999749, 6.430559e-13),

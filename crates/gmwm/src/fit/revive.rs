@@ -1,6 +1,6 @@
 //! Leaving a false boundary point: an active-set step for components fitted to nothing.
 //!
-//! The optimiser works on log-scaled variances (METHODS §5.3). A variance that a poor start
+//! The optimiser works on log-scaled variances (docs/methods.md §5.3). A variance that a poor start
 //! drives towards zero reaches values like 1e-30 within a few steps; its component then has no
 //! measurable influence ([`COLLAPSE_INFLUENCE`](super::optimize::COLLAPSE_INFLUENCE)) and,
 //! in log coordinates, no usable gradient either, even when the data need it back: the fit

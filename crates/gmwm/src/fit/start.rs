@@ -1,4 +1,4 @@
-//! Starting values by random search (METHODS §6, the IMU algorithm of paper Appendix C).
+//! Starting values by random search (docs/methods.md §6, the IMU algorithm of paper Appendix C).
 //!
 //! [`starting_values`] draws G candidate parameter vectors following the §6.3 table, scores
 //! each by the flattening objective `F` (§5.4) at the untransformed draw and keeps the draw
@@ -33,7 +33,7 @@ pub const MIN_DRAWS: usize = 5000;
 /// A batch that improves the best `F` by at most this fraction counts as no improvement
 /// (F is a sum of squared relative errors; 1e-6 of it is far below what stage 1 resolves).
 pub(crate) const EARLY_STOP_REL: f64 = 1e-6;
-/// Upper end of the AR1 phi draws (METHODS §6.3).
+/// Upper end of the AR1 phi draws (docs/methods.md §6.3).
 pub(crate) const PHI_MAX: f64 = 0.999995;
 /// AR coefficient bounds of the §6.5 ARMA draws (the package's constants).
 const ARMA_LO: f64 = -0.99999999;
@@ -44,7 +44,7 @@ const ARMA_TRIES: usize = 1000;
 /// Number of psi weights in the §6.5 ARMA variance scaling.
 const PSI_TERMS: usize = 1000;
 
-/// The non-WV inputs of the search (METHODS §6.1).
+/// The non-WV inputs of the search (docs/methods.md §6.1).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StartInputs {
     /// Series length N (RW draws scale with `1 / N`).
@@ -100,7 +100,7 @@ impl StartInputs {
     }
 }
 
-/// Which process dominates the first scales (METHODS §6.2).
+/// Which process dominates the first scales (docs/methods.md §6.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum Dominance {
     /// Quantisation noise (slope below -1/2 for both CI bounds).
@@ -111,7 +111,7 @@ pub enum Dominance {
     Ar1,
 }
 
-/// METHODS §6.2: slopes `ln(b / nu2_hat_1) / ln 4` for `b` in the level-2 CI bounds
+/// docs/methods.md §6.2: slopes `ln(b / nu2_hat_1) / ln 4` for `b` in the level-2 CI bounds
 /// `(lo2, hi2)`: both below -1/2 gives [`Dominance::Qn`], both above [`Dominance::Ar1`],
 /// otherwise [`Dominance::Wn`] (also for non-finite inputs).
 pub(crate) fn dominance(nu1: f64, lo2: f64, hi2: f64) -> Dominance {
@@ -129,13 +129,13 @@ pub(crate) fn dominance(nu1: f64, lo2: f64, hi2: f64) -> Dominance {
     }
 }
 
-/// METHODS §6.3 condition 1: `phi = (1 - sqrt(1 - 3U)) / 5` for `U` in `[0, 1/3]`
+/// docs/methods.md §6.3 condition 1: `phi = (1 - sqrt(1 - 3U)) / 5` for `U` in `[0, 1/3]`
 /// (0 at `U = 0`, 0.2 at `U = 1/3`).
 pub(crate) fn condition1_phi(u: f64) -> f64 {
     (1.0 - (1.0 - 3.0 * u).max(0.0).sqrt()) / 5.0
 }
 
-/// METHODS §6.3 condition 3: `phi = last_phi + (0.999995 - last_phi) sqrt(1 - 3U)` for `U`
+/// docs/methods.md §6.3 condition 3: `phi = last_phi + (0.999995 - last_phi) sqrt(1 - 3U)` for `U`
 /// in `[0, 1/3]`.
 pub(crate) fn condition3_phi(u: f64, last_phi: f64) -> f64 {
     last_phi + (PHI_MAX - last_phi) * (1.0 - 3.0 * u).max(0.0).sqrt()
@@ -212,7 +212,7 @@ struct DrawContext {
     only_qn: bool,
 }
 
-/// One draw (METHODS §6.3) in model order, original parametrisation (GM converted from the
+/// One draw (docs/methods.md §6.3) in model order, original parametrisation (GM converted from the
 /// AR1 draw with the rate); given values are kept.
 fn one_draw(
     model: &Model,
@@ -368,7 +368,7 @@ pub struct StartValues {
     pub dominance: Dominance,
 }
 
-/// METHODS §6: the best of up to G random draws for `model` (values it carries are kept)
+/// docs/methods.md §6: the best of up to G random draws for `model` (values it carries are kept)
 /// given the empirical WV `wv` (estimate and CI) and `inputs`.
 ///
 /// # Errors

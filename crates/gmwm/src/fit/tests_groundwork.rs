@@ -1,4 +1,4 @@
-//! GMWM estimation groundwork (METHODS §5): objective values, analytic gradient, optimiser
+//! GMWM estimation groundwork (docs/methods.md §5): objective values, analytic gradient, optimiser
 //! recovery on exact and simulated wavelet variances.
 
 use gmwm::fit::{
@@ -9,7 +9,7 @@ use gmwm::model::Model;
 use gmwm::sim::simulate_model;
 use gmwm::{wavelet_variance, WvOptions};
 
-/// METHODS §5.9 test values carry 7 significant digits.
+/// docs/methods.md §5.9 test values carry 7 significant digits.
 const METHODS_TOL: f64 = 5e-7;
 /// Required recovery of theta0 from its exact implied WV (brief: 1e-6 relative); LM converges
 /// quadratically, so the reached accuracy is far below this.
@@ -23,7 +23,7 @@ fn rel(a: f64, b: f64) -> f64 {
     (a / b - 1.0).abs()
 }
 
-/// Fast weights (METHODS §5.2) from the CI of a simulated realisation of `truth`, with the
+/// Fast weights (docs/methods.md §5.2) from the CI of a simulated realisation of `truth`, with the
 /// exact implied WV of `truth` at the same levels.
 fn exact_problem(truth: &Model, n: usize, freq: f64, seed: u64) -> (Vec<f64>, Weights) {
     let x = simulate_model(truth, n, freq, seed).unwrap();
@@ -59,7 +59,7 @@ fn objective_matches_methods_5_9() {
     assert!(rel(q, 0.01167277) < METHODS_TOL, "Q = {q}");
     let u = obj.parametrisation().to_u(&theta).unwrap();
     assert!(rel(obj.value(&u).unwrap(), q) < 1e-14);
-    // flattening objective F = 3 (1 - 1/1.1)^2 = 0.02479339 (METHODS §5.9)
+    // flattening objective F = 3 (1 - 1/1.1)^2 = 0.02479339 (docs/methods.md §5.9)
     let flat = Weights::flattening(&nu_hat).unwrap();
     let obj = objective(&truth, &nu_hat, &flat, 1.0, PhiOrder::Ordered);
     let f = obj.value_at_theta(&theta).unwrap();
@@ -134,7 +134,7 @@ fn check_gradient(obj: &Objective, u: &[f64]) {
 
 #[test]
 fn gradient_matches_finite_differences() {
-    // IMU-scale values (METHODS §5.10 GM): WV from 1e-6 down to 1e-10
+    // IMU-scale values (docs/methods.md §5.10 GM): WV from 1e-6 down to 1e-10
     let truth = model(
         "GM(beta=0.25, sigma2_gm=7.08e-9)+WN(sigma2=6.94e-7)+QN(q2=2.29e-6)+RW(gamma2=3.9e-14)",
     );
@@ -308,7 +308,7 @@ fn gmwm_fits_simulated_data_with_both_weightings() {
     assert!(matches!(e, FitError::Length { what: "theta", .. }), "{e}");
     let e = est.fit_wv(&wv, 1.0, &[1.5, 0.1, 0.5]).unwrap_err();
     assert!(matches!(e, FitError::OutOfDomain { index: 0, .. }), "{e}");
-    // robust: parameters + 1 <= J (METHODS §5.7)
+    // robust: parameters + 1 <= J (docs/methods.md §5.7)
     let robust3 = WvOptions {
         levels: Some(3),
         robust: Some(gmwm::RobustOptions::default()),
@@ -352,9 +352,9 @@ fn gmwm_orders_ar1_components_by_phi() {
 
 #[test]
 fn minimize_recovers_the_methods_5_10_navchip_model() {
-    // METHODS §5.10: 3*GM()+WN()+QN()+RW() at 250 Hz, ~3.1e6 samples, 21 levels. Weights: the
-    // chi-square proxy V_j = nu2_j^2 * 2 / eta_j with eta_j = M_j / 2^j (METHODS §1.7), so no
-    // simulation is needed.
+    // docs/methods.md §5.10: 3*GM()+WN()+QN()+RW() at 250 Hz, ~3.1e6 samples, 21 levels. Weights:
+    // the chi-square proxy V_j = nu2_j^2 * 2 / eta_j with eta_j = M_j / 2^j (docs/methods.md §1.7),
+    // so no simulation is needed.
     let text = "GM(beta=6.28e-3, sigma2_gm=1.28e-8)+GM(beta=0.25, sigma2_gm=7.08e-9)\
                 +GM(beta=8.48, sigma2_gm=6.48e-9)+WN(sigma2=6.94e-7)+QN(q2=2.29e-6)\
                 +RW(gamma2=3.9e-14)";

@@ -1,5 +1,5 @@
 //! Parameter transforms: the optimiser works on unconstrained `u`, the model on `theta`
-//! (METHODS §5.3).
+//! (docs/methods.md §5.3).
 //!
 //! # Ordered AR1/GM components (deviation from the package, documented)
 //! With [`PhiOrder::Ordered`] and two or more AR1 (or GM) components, their `phi`s are
@@ -25,7 +25,7 @@ pub fn logistic(u: f64) -> f64 {
     }
 }
 
-/// One scalar transform `theta = g(u)` (METHODS §5.3).
+/// One scalar transform `theta = g(u)` (docs/methods.md §5.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ParamTransform {
@@ -57,7 +57,7 @@ impl ParamTransform {
         }
     }
 
-    /// METHODS §5.3: `u = g^{-1}(theta)`; `None` when theta is outside the open domain.
+    /// docs/methods.md §5.3: `u = g^{-1}(theta)`; `None` when theta is outside the open domain.
     pub fn to_u(self, theta: f64) -> Option<f64> {
         if !theta.is_finite() {
             return None;
@@ -89,7 +89,7 @@ impl ParamTransform {
         }
     }
 
-    /// METHODS §5.3: `theta = g(u)`.
+    /// docs/methods.md §5.3: `theta = g(u)`.
     pub fn from_u(self, u: f64) -> f64 {
         match self {
             ParamTransform::Identity => u,
@@ -118,7 +118,7 @@ impl ParamTransform {
 /// ([`Parametrisation::to_u_restart`]): a phi of 0 restarts at 1e-9, of 1 at 1 - 1e-9.
 pub const RESTART_EDGE: f64 = 1e-9;
 
-/// Which table of METHODS §5.3 to use.
+/// Which table of docs/methods.md §5.3 to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TransformPreset {
@@ -150,7 +150,7 @@ enum Slot {
     Beta(f64),
 }
 
-/// The map `u -> theta` of a whole model (METHODS §5.3).
+/// The map `u -> theta` of a whole model (docs/methods.md §5.3).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parametrisation {
     /// Per parameter: its scalar transform, `None` for the ordered slots.
@@ -164,7 +164,7 @@ pub struct Parametrisation {
 }
 
 impl Parametrisation {
-    /// The transforms of METHODS §5.3 for `model` (values are ignored): with
+    /// The transforms of docs/methods.md §5.3 for `model` (values are ignored): with
     /// [`TransformPreset::Imu`] AR1/GM `phi` logit (0, 1), GM `beta` log, MA1 `theta` logit,
     /// ARMA11 and ARMA coefficients pseudo-logit; with [`TransformPreset::Ssm`] AR1 `phi` and MA1
     /// `theta` pseudo-logit, ARMA coefficients of polynomial order 1 pseudo-logit and of
@@ -294,7 +294,7 @@ impl Parametrisation {
         }
     }
 
-    /// METHODS §5.3 (and the ordered chain of the module doc): `u` from `theta`.
+    /// docs/methods.md §5.3 (and the ordered chain of the module doc): `u` from `theta`.
     ///
     /// # Errors
     /// [`FitError::Length`]; [`FitError::OutOfDomain`] naming the parameter; with the ordered
@@ -371,7 +371,7 @@ impl Parametrisation {
         }
     }
 
-    /// METHODS §5.3: `theta` from `u`.
+    /// docs/methods.md §5.3: `theta` from `u`.
     ///
     /// # Errors
     /// [`FitError::Length`].
@@ -430,9 +430,9 @@ impl Parametrisation {
         }
     }
 
-    /// METHODS §5.6 (port): theta with the AR1/GM blocks `(phi, sigma2)` / `(beta, sigma2_gm)`
-    /// stably sorted by `phi` decreasing (GM: `beta` increasing), wherever they appear; other
-    /// parameters stay in place. Use it on a start before [`Parametrisation::to_u`] with the
+    /// docs/methods.md §5.6 (port): theta with the AR1/GM blocks `(phi, sigma2)` / `(beta,
+    /// sigma2_gm)` stably sorted by `phi` decreasing (GM: `beta` increasing), wherever they appear;
+    /// other parameters stay in place. Use it on a start before [`Parametrisation::to_u`] with the
     /// ordered chain, and on a [`PhiOrder::Free`] result.
     ///
     /// # Errors
@@ -470,11 +470,11 @@ impl Parametrisation {
 mod tests {
     use super::*;
 
-    /// METHODS §5.9 test values carry 7 significant digits.
+    /// docs/methods.md §5.9 test values carry 7 significant digits.
     const METHODS_TOL: f64 = 5e-7;
 
     #[test]
-    #[allow(clippy::approx_constant)] // the METHODS §5.9 value, as printed
+    #[allow(clippy::approx_constant)] // the docs/methods.md §5.9 value, as printed
     fn to_u_matches_methods_5_9() {
         let close = |a: f64, b: f64| (a / b - 1.0).abs() < METHODS_TOL;
         assert!(close(ParamTransform::Logit.to_u(0.9).unwrap(), 2.1972246));
@@ -569,7 +569,7 @@ mod tests {
         let p = Parametrisation::new(&m, TransformPreset::Imu, PhiOrder::Ordered, 250.0).unwrap();
         assert!(p.is_ordered());
         assert_eq!(p.names()[0], "GM[0].beta");
-        // METHODS §5.10 truth, betas increasing = phis decreasing
+        // docs/methods.md §5.10 truth, betas increasing = phis decreasing
         let theta = [
             6.28e-3, 1.28e-8, 0.25, 7.08e-9, 8.48, 6.48e-9, 6.94e-7, 2.29e-6, 3.9e-14, 1e-6,
         ];

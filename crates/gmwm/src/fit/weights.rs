@@ -1,5 +1,5 @@
-//! The weighting matrix Omega of the GMWM objective (METHODS §5.2), diagonal in every supported
-//! option.
+//! The weighting matrix Omega of the GMWM objective (docs/methods.md §5.2), diagonal in every
+//! supported option.
 //!
 //! Levels whose weight cannot be formed (a zero or non-finite CI width or variance, e.g. a robust
 //! level without a scale or the coefficient-less last level of a power-of-two series, §5.9) are
@@ -12,7 +12,7 @@ use crate::variance::wv::WaveletVariance;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-/// Which V (and Omega = V^{-1}) to use (METHODS §5.2).
+/// Which V (and Omega = V^{-1}) to use (docs/methods.md §5.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Weighting {
@@ -20,17 +20,17 @@ pub enum Weighting {
     /// package default (`compute.v = "fast"`, used by `gmwm.imu`).
     #[default]
     Fast,
-    /// Percival's asymptotic diagonal (METHODS §1.10) with the per-level divisor, `/ eff` if
-    /// robust; needs the series.
+    /// Percival's asymptotic diagonal (docs/methods.md §1.10) with the per-level divisor, `/ eff`
+    /// if robust; needs the series.
     Diag,
-    /// METHODS §5.2 `bootstrap`: fit with the fast weights, then (K rounds, default 1) take
+    /// docs/methods.md §5.2 `bootstrap`: fit with the fast weights, then (K rounds, default 1) take
     /// `V_jj` from a parametric bootstrap of the WV at the current estimate (H replicates of the
     /// observed length, default 100, §7.4) and refit stage 2 from the estimate with
     /// `Omega = diag(V)^{-1}` (the package ignores the off-diagonals; so do we).
     Bootstrap,
 }
 
-/// Diagonal weights `omega_j = 1 / V_jj` (METHODS §5.2).
+/// Diagonal weights `omega_j = 1 / V_jj` (docs/methods.md §5.2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Weights {
     /// `V_jj`, the (proxy) variance of `nu2_hat_j` (the package's `orgV` diagonal).
@@ -56,7 +56,7 @@ impl Weights {
         Ok(Self { v, omega })
     }
 
-    /// METHODS §5.2 "fast": `V_jj = (ci_high_j - ci_low_j)^2`, Omega = V^{-1}.
+    /// docs/methods.md §5.2 "fast": `V_jj = (ci_high_j - ci_low_j)^2`, Omega = V^{-1}.
     ///
     /// # Errors
     /// [`FitError::BadWeight`] for a level whose CI width is zero or not finite.
@@ -76,8 +76,8 @@ impl Weights {
         Self::from_v(v, "squared CI width")
     }
 
-    /// METHODS §5.2 "diag": `V_jj` from [`wv_diag_covariance`] of the series `x` at the levels
-    /// and filter of `wv` (per-level divisor), divided by `eff` when `wv` is robust.
+    /// docs/methods.md §5.2 "diag": `V_jj` from [`wv_diag_covariance`] of the series `x` at the
+    /// levels and filter of `wv` (per-level divisor), divided by `eff` when `wv` is robust.
     ///
     /// Cost: one MODWT of `x` and one FFT per level.
     ///
@@ -91,8 +91,8 @@ impl Weights {
         Self::from_v(v, "diag variance")
     }
 
-    /// METHODS §5.4 stage 1: the flattening objective `F = sum_j (1 - nu2_j / nu2_hat_j)^2` is
-    /// `Q` with `omega_j = 1 / nu2_hat_j^2` (`V_jj = nu2_hat_j^2`).
+    /// docs/methods.md §5.4 stage 1: the flattening objective `F = sum_j (1 - nu2_j / nu2_hat_j)^2`
+    /// is `Q` with `omega_j = 1 / nu2_hat_j^2` (`V_jj = nu2_hat_j^2`).
     ///
     /// # Errors
     /// [`FitError::BadWeight`] for a zero or non-finite `nu2_hat_j`.
@@ -148,8 +148,8 @@ impl Weights {
 }
 
 /// A full (non-diagonal) weighting `Omega = V^{-1}` given by a covariance `V` of the WV vector
-/// (METHODS §5.2 "full", §7.3 efficient weights), applied through a whitening matrix `W` with
-/// `W' W = V^{-1}`: the objective's residuals become `W (nu2_hat - nu2(theta))`
+/// (docs/methods.md §5.2 "full", §7.3 efficient weights), applied through a whitening matrix `W`
+/// with `W' W = V^{-1}`: the objective's residuals become `W (nu2_hat - nu2(theta))`
 /// ([`super::Objective::with_full_weights`]).
 ///
 /// `W = L^{-1}` for the Cholesky factor `V = L L'`. WV levels span many decades, so the
@@ -278,7 +278,7 @@ mod tests {
 
     #[test]
     fn fast_v_matches_methods_5_9() {
-        // CI bounds (2.19972535, 2.6215535): V = 0.42182815^2 = 0.1779390 (METHODS §5.9)
+        // CI bounds (2.19972535, 2.6215535): V = 0.42182815^2 = 0.1779390 (docs/methods.md §5.9)
         let x: Vec<f64> = (0..64).map(|i| ((i * 37) % 11) as f64).collect();
         let mut wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
         wv.ci_low[0] = 2.19972535;

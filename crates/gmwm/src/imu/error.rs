@@ -204,7 +204,8 @@ pub enum ReadError {
         /// File.
         path: PathBuf,
     },
-    /// The epochs of a binary IMU record file (METHODS §9.2) are not in increasing time order.
+    /// The epochs of a binary IMU record file (docs/methods.md §9.2) are not in increasing time
+    /// order.
     #[error(
         "{}: record {index} (0-based): time {value} is not greater than the previous time \
          {previous}; the epochs must be in strictly increasing time order",

@@ -1,4 +1,4 @@
-//! IMU data and readers (METHODS §9).
+//! IMU data and readers (docs/methods.md §9).
 //!
 //! - [`read_table`]: CSV/TSV text (plain or gzip), raw little-endian f64/f32 binary and binary
 //!   IMU records into a [`Table`] of named columns, with the JSON [`Sidecar`], the time column
@@ -6,10 +6,10 @@
 //! - [`check_times`]: rate, gaps, duplicates and reordering of any time stamps (module
 //!   [`timing`]);
 //! - [`BinaryChunks`] / [`for_each_chunk`]: one column of a huge binary file in bounded memory;
-//! - [`read_imu_record_file`]: the binary IMU epoch records of METHODS §9.2–9.3;
+//! - [`read_imu_record_file`]: the binary IMU epoch records of docs/methods.md §9.2–9.3;
 //! - [`read_wv_json`]: a wavelet variance computed elsewhere (`gmwm wv --json`), to fit again;
 //! - [`write::SeriesWriter`]: series to CSV, TSV, gzip or raw binary by file name;
-//! - [`Imu`]: gyroscope/accelerometer axes with a common rate (METHODS §9.1).
+//! - [`Imu`]: gyroscope/accelerometer axes with a common rate (docs/methods.md §9.1).
 //!
 //! This module knows no statistics; every error is a [`ReadError`] (or a
 //! [`ParamError`](crate::error::ParamError) for impossible options) naming the file, line and

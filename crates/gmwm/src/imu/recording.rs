@@ -27,7 +27,7 @@ pub struct RecordingOptions {
 pub enum RecordingSource {
     /// Delimited text or raw binary columns.
     Table,
-    /// Binary IMU records (METHODS §9.2).
+    /// Binary IMU records (docs/methods.md §9.2).
     Records {
         /// The record type.
         record_type: String,
@@ -84,7 +84,8 @@ impl Recording {
         let mut notes = Vec::new();
         if let Some(t) = table.record_type {
             notes.push(format!(
-                "{t} records: rates are the increments x the rate from the time stamps x the type's scale factors (METHODS §9.3), in rad/s and m/s^2"
+                "{t} records: rates are the increments x the rate from the time stamps x the \
+                 type's scale factors (docs/methods.md §9.3), in rad/s and m/s^2"
             ));
         }
         if let Some(timing) = &table.timing {

@@ -1,5 +1,5 @@
-//! The [`Imu`] object of METHODS §9.1: sensor columns with their sensor type, axis, unit and a
-//! common sampling rate.
+//! The [`Imu`] object of docs/methods.md §9.1: sensor columns with their sensor type, axis, unit
+//! and a common sampling rate.
 
 use super::read::{Column, ColumnSelector, ImuRecordType, ReadWarning, Table};
 use super::sidecar::Sidecar;
@@ -106,7 +106,8 @@ impl SensorInfo {
 
     /// Sensor, axis and unit of every column of `table`, as [`Imu::from_table`] reads them:
     /// sensor and axis from the column name, else the sidecar's meaning; the unit the name
-    /// states, else the sidecar's, else rad/s and m/s^2 for binary IMU records (METHODS §9.3).
+    /// states, else the sidecar's, else rad/s and m/s^2 for binary IMU records (docs/methods.md
+    /// §9.3).
     pub fn of_table(table: &Table) -> Vec<SensorInfo> {
         let sidecar = table.sidecar.as_ref();
         let record = table.record_type.is_some();
@@ -131,7 +132,7 @@ impl SensorInfo {
     }
 
     /// The unit of a column, as text: the one its name states, else the sidecar's for its
-    /// sensor, else rad/s and m/s^2 for binary IMU records (`record`, METHODS §9.3).
+    /// sensor, else rad/s and m/s^2 for binary IMU records (`record`, docs/methods.md §9.3).
     pub fn column_unit(
         name: &str,
         sensor: Sensor,
@@ -225,7 +226,7 @@ impl Axis {
     }
 }
 
-/// An inertial measurement unit recording (METHODS §9.1): gyroscope columns first, then
+/// An inertial measurement unit recording (docs/methods.md §9.1): gyroscope columns first, then
 /// accelerometers, then other columns, all of the same length, sampled at `freq_hz`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Imu {
@@ -240,13 +241,13 @@ pub struct Imu {
 impl Imu {
     /// Builds an IMU from columns and what each measures.
     ///
-    /// Columns are reordered stably: gyroscopes, accelerometers, others (METHODS §9.1).
+    /// Columns are reordered stably: gyroscopes, accelerometers, others (docs/methods.md §9.1).
     ///
     /// # Errors
     /// [`ParamError`] if there are no columns, `info` and `columns` differ in length, columns
     /// differ in length or are empty, an axis label is empty, an axis repeats within one sensor
-    /// (METHODS §9.1 "duplicates within one sensor are refused"), or `freq_hz` is not positive
-    /// and finite.
+    /// (docs/methods.md §9.1 "duplicates within one sensor are refused"), or `freq_hz` is not
+    /// positive and finite.
     pub fn new(
         columns: Vec<Column>,
         info: Vec<SensorInfo>,
@@ -313,8 +314,8 @@ impl Imu {
     /// from the sidecar's meaning ([`SensorInfo::infer`]); columns that match neither become
     /// [`Sensor::Other`] with the column name as label. Units: the one the column name states
     /// ([`SensorInfo::unit_from_name`]), else the sidecar's, else rad/s and m/s^2 for binary
-    /// IMU records (METHODS §9.3), as text. The name comes from the sidecar, else the file name.
-    /// The table's timing report and warnings are kept ([`Imu::timing`], [`Imu::warnings`]).
+    /// IMU records (docs/methods.md §9.3), as text. The name comes from the sidecar, else the file
+    /// name. The table's timing report and warnings are kept ([`Imu::timing`], [`Imu::warnings`]).
     ///
     /// # Errors
     /// [`ReadError::FreqNotDerivable`] if `table.freq_hz` is `None`; [`ParamError`] as
@@ -349,7 +350,7 @@ impl Imu {
         self
     }
 
-    /// Records the binary record type the data came from (METHODS §9.1 `stype`).
+    /// Records the binary record type the data came from (docs/methods.md §9.1 `stype`).
     pub fn with_record_type(mut self, record_type: ImuRecordType) -> Self {
         self.record_type = Some(record_type);
         self
@@ -389,7 +390,7 @@ impl Imu {
         self.axes.iter().find(|a| a.tag().eq_ignore_ascii_case(tag))
     }
 
-    /// `(number of gyroscopes, number of accelerometers)` (METHODS §9.1 `num.sensor`).
+    /// `(number of gyroscopes, number of accelerometers)` (docs/methods.md §9.1 `num.sensor`).
     pub fn num_sensor(&self) -> (usize, usize) {
         (self.gyroscopes().count(), self.accelerometers().count())
     }
@@ -404,7 +405,7 @@ impl Imu {
         self.name.as_deref()
     }
 
-    /// Binary record type, if read from one (METHODS §9.1 `stype`).
+    /// Binary record type, if read from one (docs/methods.md §9.1 `stype`).
     pub fn record_type(&self) -> Option<ImuRecordType> {
         self.record_type
     }

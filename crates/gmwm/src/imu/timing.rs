@@ -132,7 +132,7 @@ pub enum UnitSource {
     /// Stated by the column name (`[ns]`, `_ms`, `(s)`, ...) or by the convention of the tool
     /// that names columns so (`%time` and `field.header.stamp` of `rostopic echo -p` are ns).
     Stated,
-    /// Fixed by the file format (the seconds of binary IMU records, METHODS §9.2).
+    /// Fixed by the file format (the seconds of binary IMU records, docs/methods.md §9.2).
     Format,
     /// Inferred from the values ([`infer_time_unit`]).
     Inferred,

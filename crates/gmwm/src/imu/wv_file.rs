@@ -98,7 +98,7 @@ pub fn select_series(
         .collect()
 }
 
-/// METHODS §3.4, the overlapping Allan variance from the classical Haar MODWT WV:
+/// docs/methods.md §3.4, the overlapping Allan variance from the classical Haar MODWT WV:
 /// `AV(m) = 2 nu2(tau = 2m)` at cluster lengths `m = tau / 2`, exact for the estimators over
 /// the same index set (the textbook overlapping AV of
 /// [`allan_variance`](crate::allan_variance) with every `N - 2m + 1` term); the interval is the
@@ -123,7 +123,7 @@ pub fn allan_from_wv(wv: &WaveletVariance) -> Result<AllanVariance, ParamError> 
             "wavelet variance",
             what,
             "the classical Haar MODWT one, which gives the Allan variance by AV(m) = 2 WV(2m) \
-             (METHODS §3.4)",
+             (docs/methods.md §3.4)",
         ));
     }
     let tau: Vec<f64> = wv.tau.iter().map(|t| t / 2.0).collect();

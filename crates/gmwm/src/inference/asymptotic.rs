@@ -1,13 +1,13 @@
-//! Asymptotic inference on a GMWM fit (METHODS §7.1, §7.2, §7.6): the sandwich covariance and
-//! confidence intervals.
+//! Asymptotic inference on a GMWM fit (docs/methods.md §7.1, §7.2, §7.6): the sandwich covariance
+//! and confidence intervals.
 //!
 //! # Intervals (port choices, documented deviations from the package)
 //! - `z = Phi^{-1}(1 - alpha/2)` by default ([`ZConvention::TwoSided`]); the package's
 //!   `Phi^{-1}(1 - alpha)` (a 90% interval labelled 95%, §13.13) is [`ZConvention::Package`].
 //! - GM parameters: the Jacobian `A` is taken in the GM parametrisation `(beta, sigma2_gm)`
-//!   (METHODS §4.5), so the sandwich is directly the covariance of `(beta_hat, sigma2_gm_hat)`:
-//!   this *is* the delta method, exact in the Jacobian, and the SE column is in GM units (the
-//!   package leaves it in AR1 units and maps the endpoints one by one, §13.19).
+//!   (docs/methods.md §4.5), so the sandwich is directly the covariance of `(beta_hat,
+//!   sigma2_gm_hat)`: this *is* the delta method, exact in the Jacobian, and the SE column is in GM
+//!   units (the package leaves it in AR1 units and maps the endpoints one by one, §13.19).
 //! - [`IntervalScale::Transformed`] (default): a Wald interval on `g(theta)` mapped back, with
 //!   `g = ln` for the parameters living on `(0, inf)` (every variance, the GM `beta`), `g = atanh`
 //!   for the coefficients living on `(-1, 1)` (AR1 `phi`, MA1 `theta`, ARMA11 `phi`, `theta`)
@@ -26,7 +26,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, Normal};
 
-/// Which normal quantile multiplies the SE (METHODS §7.2).
+/// Which normal quantile multiplies the SE (docs/methods.md §7.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ZConvention {
@@ -50,7 +50,7 @@ pub enum IntervalScale {
     Natural,
 }
 
-/// METHODS §7.2: the normal quantile `z` for `alpha` under `convention`
+/// docs/methods.md §7.2: the normal quantile `z` for `alpha` under `convention`
 /// (`alpha = 0.05`: 1.959964 two-sided, 1.644854 package).
 ///
 /// # Errors
@@ -66,7 +66,7 @@ pub fn z_value(alpha: f64, convention: ZConvention) -> Result<f64, ParamError> {
     Ok(-normal.inverse_cdf(tail))
 }
 
-/// The sandwich covariance of METHODS §7.1 and the rank of `A' Omega A`.
+/// The sandwich covariance of docs/methods.md §7.1 and the rank of `A' Omega A`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sandwich {
     /// `Psi = H V H'` (p x p).
@@ -82,7 +82,7 @@ pub struct Sandwich {
 /// times the rounding level of its entries).
 pub const PINV_RCOND: f64 = 1e-12;
 
-/// METHODS §7.1: `H = (A' Omega A)^+ A' Omega`, `Psi = H V H'` with `A` (J x p), `Omega`
+/// docs/methods.md §7.1: `H = (A' Omega A)^+ A' Omega`, `Psi = H V H'` with `A` (J x p), `Omega`
 /// (J x J) and `V` (J x J).
 ///
 /// The columns of `A` are first scaled to unit `Omega`-norm (parameters differ by many decades,
@@ -205,13 +205,13 @@ pub(crate) fn scales(model: &Model, scale: IntervalScale) -> Vec<Scale> {
         .collect()
 }
 
-/// METHODS §7.2 with the scale of the module doc: the interval of `estimate` with standard error
-/// `se` (natural units) for a parameter of `domain`, `z` from [`z_value`].
+/// docs/methods.md §7.2 with the scale of the module doc: the interval of `estimate` with standard
+/// error `se` (natural units) for a parameter of `domain`, `z` from [`z_value`].
 ///
 /// # Examples
 /// ```
 /// use gmwm::inference::asymptotic::{wald_interval, IntervalScale};
-/// // METHODS §7 test value: theta 1, SE 1.745743, package z 1.644854
+/// // docs/methods.md §7 test value: theta 1, SE 1.745743, package z 1.644854
 /// let (lo, hi) = wald_interval(1.0, 1.745743, 1.644854, None, IntervalScale::Natural);
 /// assert!((lo + 1.871492).abs() < 1e-6 && (hi - 3.871492).abs() < 1e-6);
 /// ```

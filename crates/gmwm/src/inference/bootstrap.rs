@@ -1,6 +1,6 @@
-//! Parametric bootstrap of a fit (METHODS §7.4): each replicate simulates a new series of the
-//! observed length from the fitted model, computes its WV with the observed settings and refits.
-//! The WV part ([`map_replicates`], [`wv_bootstrap`], [`WvBootstrap`]) lives in
+//! Parametric bootstrap of a fit (docs/methods.md §7.4): each replicate simulates a new series of
+//! the observed length from the fitted model, computes its WV with the observed settings and
+//! refits. The WV part ([`map_replicates`], [`wv_bootstrap`], [`WvBootstrap`]) lives in
 //! [`crate::sim::bootstrap`], which the fit's bootstrap weights use too, and is re-exported here.
 //!
 //! Replicate `r` uses the seed [`replicate_seed`]`(seed, r)`, so results do not depend on the
@@ -17,7 +17,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// The parametric bootstrap of a fit (the package's `all_bootstrapper`, METHODS §7.4): per
+/// The parametric bootstrap of a fit (the package's `all_bootstrapper`, docs/methods.md §7.4): per
 /// replicate the refit from `theta_hat` and, optionally, the objective of a fresh two-stage fit.
 ///
 /// Wire format: `replicates`, `theta_hat`, `estimates` (B x p, replicate order), `mean`, `sd`,
@@ -38,7 +38,7 @@ pub struct FitBootstrap {
     pub v: DMatrix<f64>,
     /// `C = Cov(nu2_hat*, nu2(theta*))` (J x J, divisor B - 1; row index the empirical WV
     /// level, column the implied one), the input of the WIC bootstrap optimism `2 tr(C Omega)`
-    /// (METHODS §8.3).
+    /// (docs/methods.md §8.3).
     pub cross_cov: DMatrix<f64>,
     /// Final objective of a fresh two-stage fit per replicate (the bootstrap GoF input), when
     /// asked.
@@ -57,8 +57,8 @@ struct ReplicateFit {
 }
 
 /// The weighting the replicates use: the fit's when it can be formed from one replicate
-/// (`Diag`), else the fast weights (METHODS §7.4: "its (classical or robust) WV, CI and fast
-/// Omega"; a bootstrap weighting would nest a bootstrap in every replicate).
+/// (`Diag`), else the fast weights (docs/methods.md §7.4: "its (classical or robust) WV, CI and
+/// fast Omega"; a bootstrap weighting would nest a bootstrap in every replicate).
 pub(crate) fn replicate_weighting(gmwm: &Gmwm) -> Weighting {
     if gmwm.weighting() == Weighting::Diag {
         Weighting::Diag
@@ -78,12 +78,12 @@ pub struct FitBootstrapOptions {
     pub gof_draws: Option<usize>,
 }
 
-/// METHODS §7.4 `all_bootstrapper(B)`: simulates `replicates` series of length `n` from the
+/// docs/methods.md §7.4 `all_bootstrapper(B)`: simulates `replicates` series of length `n` from the
 /// fitted model (rate `fit.freq_hz`), computes each one's WV with `wv_opts` (its `levels` is
 /// set to the fit's J) and weights, and refits from `fit.theta` (stage 2 only). Components the
 /// fit drove to the boundary are left out of the simulation and held there: the active
 /// sub-model is refitted ([`GmwmFit::active_sub_model`]). With `gof_draws = Some(G)` each
-/// replicate is also fitted from a fresh starting-value search with G draws (METHODS §6,
+/// replicate is also fitted from a fresh starting-value search with G draws (docs/methods.md §6,
 /// seeded per replicate) and its final objective kept.
 ///
 /// Replicate `r` simulates with [`replicate_seed`]`(seed, r)` and searches starting values with

@@ -1,6 +1,7 @@
 //! `V`, the covariance of the wavelet-variance vector at a model's estimate, behind the
 //! sandwich intervals, the J-test and the WIC optimism: computed exactly
-//! ([`crate::variance::implied_cov`]) or estimated by the parametric bootstrap of METHODS §7.4.
+//! ([`crate::variance::implied_cov`]) or estimated by the parametric bootstrap of docs/methods.md
+//! §7.4.
 //!
 //! The bootstrap estimates the same matrix with Monte Carlo noise of about `sqrt(2/H)` per
 //! entry (14% at the package's H = 100, 20% at the selection's 50), and costs `H` simulations
@@ -31,7 +32,7 @@ pub enum CovarianceMethod {
     Auto,
     /// Exact, or an error naming what is not covered.
     Exact,
-    /// Parametric bootstrap (METHODS §7.4), as the package.
+    /// Parametric bootstrap (docs/methods.md §7.4), as the package.
     Bootstrap,
 }
 
@@ -97,7 +98,7 @@ impl Serialize for VSource {
 /// `V` of the WV (estimator `wv_opts`, whose `levels` must be set) of `n`-sample series drawn
 /// from `model` (all values set) at `freq_hz`, by `method`; a bootstrap uses `replicates`
 /// series seeded with `seed` and reports each to `progress`. The exact `V` of a robust WV is
-/// the classical one over the efficiency (METHODS §1.10).
+/// the classical one over the efficiency (docs/methods.md §1.10).
 ///
 /// # Errors
 /// [`InputError`] for a model without values, a bad rate or levels; with

@@ -1,4 +1,5 @@
-//! Goodness of fit: the J-test of over-identifying restrictions (METHODS §7.3, paper eq. 4).
+//! Goodness of fit: the J-test of over-identifying restrictions (docs/methods.md §7.3, paper eq.
+//! 4).
 //!
 //! The package re-estimates with `V` itself as the weight (§13.11); here the statistic is the
 //! efficient-weight one: re-minimise `Q` from `theta_hat` (stage 2 only) with `Omega = V^{-1}`,
@@ -14,7 +15,7 @@ use serde::Serialize;
 use statrs::function::gamma::gamma_ur;
 use std::fmt;
 
-/// The J-test result (METHODS §7.3).
+/// The J-test result (docs/methods.md §7.3).
 ///
 /// Wire format: `statistic` (T), `df` (J - p), `p_value` (`1 - F_chi2(T; df)`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -37,8 +38,8 @@ impl fmt::Display for JTest {
     }
 }
 
-/// Upper tail `1 - F_chi2(t; df)` of the chi-square distribution (METHODS §7.3), accurate far
-/// into the tail (regularised upper incomplete gamma `Q(df/2, t/2)`); 1 for `t <= 0`, NaN for a
+/// Upper tail `1 - F_chi2(t; df)` of the chi-square distribution (docs/methods.md §7.3), accurate
+/// far into the tail (regularised upper incomplete gamma `Q(df/2, t/2)`); 1 for `t <= 0`, NaN for a
 /// NaN `t`. With `df = 0` the distribution is the point mass at 0, whose upper tail at `t > 0`
 /// is 0.
 pub fn chi_square_upper_tail(t: f64, df: usize) -> f64 {
@@ -59,9 +60,9 @@ pub fn hartlap_factor(replicates: usize, levels: usize) -> Option<f64> {
     (replicates > levels + 2).then(|| (replicates - levels - 2) as f64 / (replicates - 1) as f64)
 }
 
-/// METHODS §7.3, paper eq. (4): the J-test of `fit` (a fit by `gmwm`) with `v`, a covariance of
-/// the WV vector (J x J, full or diagonal; e.g. a parametric-bootstrap covariance, which the
-/// caller should debias with [`hartlap_factor`] since the statistic uses its inverse).
+/// docs/methods.md §7.3, paper eq. (4): the J-test of `fit` (a fit by `gmwm`) with `v`, a
+/// covariance of the WV vector (J x J, full or diagonal; e.g. a parametric-bootstrap covariance,
+/// which the caller should debias with [`hartlap_factor`] since the statistic uses its inverse).
 ///
 /// Re-minimises the objective from `fit.theta` (stage 2 only, default [`LmOptions`]) with
 /// `Omega = V^{-1}`, `T = Q` at that minimum, `df = J - p`, `p = 1 - F_chi2(T; df)`. Components

@@ -1,4 +1,4 @@
-//! One entry point for inference on a GMWM fit (METHODS §7.5, the package's
+//! One entry point for inference on a GMWM fit (docs/methods.md §7.5, the package's
 //! `summary(fit, inference = TRUE, ...)`): standard errors, confidence intervals and goodness
 //! of fit, asymptotic or by parametric bootstrap.
 //!
@@ -49,7 +49,7 @@ pub enum VShape {
     Diagonal,
 }
 
-/// Options of [`infer`] (METHODS §7.5).
+/// Options of [`infer`] (docs/methods.md §7.5).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct InferenceOptions {
     /// Intervals are `1 - alpha` (default 0.05).
@@ -96,9 +96,9 @@ impl Default for InferenceOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum InferenceMethod {
-    /// Sandwich covariance (METHODS §7.1).
+    /// Sandwich covariance (docs/methods.md §7.1).
     Asymptotic,
-    /// Parametric bootstrap (METHODS §7.4).
+    /// Parametric bootstrap (docs/methods.md §7.4).
     Bootstrap,
 }
 
@@ -118,7 +118,7 @@ pub struct ParameterInference {
     pub ci_high: Option<f64>,
 }
 
-/// The bootstrap goodness-of-fit test (METHODS §7.4).
+/// The bootstrap goodness-of-fit test (docs/methods.md §7.4).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BootstrapGof {
     /// The observed objective `Q(theta_hat)`.
@@ -230,7 +230,7 @@ impl fmt::Display for InferenceWarning {
     }
 }
 
-/// Inference on a GMWM fit (METHODS §7).
+/// Inference on a GMWM fit (docs/methods.md §7).
 ///
 /// Wire format: `method` ("asymptotic" | "bootstrap"), `alpha`, `z`, `z_convention`, `scale`,
 /// `v_method` ("exact" | "bootstrap"), `v_replicates` (replicates behind V, null when exact),
@@ -263,9 +263,9 @@ pub struct Inference {
     pub(crate) covariance: Vec<Vec<Option<f64>>>,
     /// `Q(theta_hat)` of the fit.
     pub(crate) objective: f64,
-    /// The J-test (METHODS §7.3).
+    /// The J-test (docs/methods.md §7.3).
     pub(crate) gof: Option<JTest>,
-    /// The bootstrap GoF test (METHODS §7.4), when run.
+    /// The bootstrap GoF test (docs/methods.md §7.4), when run.
     pub(crate) bootstrap_gof: Option<BootstrapGof>,
     /// Soft problems.
     pub(crate) warnings: Vec<InferenceWarning>,
@@ -329,12 +329,12 @@ impl Inference {
         self.objective
     }
 
-    /// The J-test (METHODS §7.3).
+    /// The J-test (docs/methods.md §7.3).
     pub fn gof(&self) -> Option<&JTest> {
         self.gof.as_ref()
     }
 
-    /// The bootstrap GoF test (METHODS §7.4), when run.
+    /// The bootstrap GoF test (docs/methods.md §7.4), when run.
     pub fn bootstrap_gof(&self) -> Option<&BootstrapGof> {
         self.bootstrap_gof.as_ref()
     }
@@ -345,7 +345,7 @@ impl Inference {
     }
 }
 
-/// METHODS §7.5: inference on `fit` (a fit by `gmwm` of a series of length `n`, WV computed
+/// docs/methods.md §7.5: inference on `fit` (a fit by `gmwm` of a series of length `n`, WV computed
 /// with `wv_opts`, whose `levels` is replaced by the fit's J) with `opts`.
 ///
 /// Asymptotic mode: V from `opts.v_replicates` series simulated from the fitted model, the
@@ -383,7 +383,7 @@ pub fn infer_with_progress(
     infer_impl(gmwm, fit, n, wv_opts, opts, progress, None)
 }
 
-/// Asymptotic inference on `fit` (METHODS §7.1–§7.3) with a WV covariance `v` the caller
+/// Asymptotic inference on `fit` (docs/methods.md §7.1–§7.3) with a WV covariance `v` the caller
 /// already has (e.g. the V of a model selection, at the full model's estimate, which nests
 /// `fit`'s model), exact or from `v_replicates` bootstrap replicates: the sandwich and the
 /// J-test without computing V again. `opts.bootstrap`, `opts.v_method` and
@@ -647,11 +647,11 @@ fn sd(x: &[f64]) -> f64 {
     (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
 }
 
-/// Resamples of the bootstrap GoF p-value (METHODS §7.4, as the package).
+/// Resamples of the bootstrap GoF p-value (docs/methods.md §7.4, as the package).
 pub const GOF_RESAMPLES: usize = 1000;
 
-/// METHODS §7.4: bootstrap GoF p-value (share of `objectives` strictly above `observed`) and
-/// its interval: [`GOF_RESAMPLES`] resamples with replacement of the objectives, each giving a
+/// docs/methods.md §7.4: bootstrap GoF p-value (share of `objectives` strictly above `observed`)
+/// and its interval: [`GOF_RESAMPLES`] resamples with replacement of the objectives, each giving a
 /// p-value, and their `alpha/2`, `1 - alpha/2` empirical quantiles (lower order statistic
 /// `sorted[floor(q (R - 1))]`, no interpolation). Seeded by `seed`.
 pub fn bootstrap_gof(observed: f64, objectives: &[f64], alpha: f64, seed: u64) -> BootstrapGof {

@@ -1,4 +1,4 @@
-//! Brent's one-dimensional minimiser and bracketing root finder (METHODS §12).
+//! Brent's one-dimensional minimiser and bracketing root finder (docs/methods.md §12).
 //!
 //! Both follow R. P. Brent, *Algorithms for Minimization without Derivatives*, Prentice-Hall
 //! 1973: chapter 5 (`localmin`: golden section + successive parabolic interpolation, the method
@@ -8,8 +8,8 @@
 
 use crate::error::ParamError;
 
-/// R's `optimize` default tolerance `.Machine$double.eps^0.25` (METHODS §2.3): `2^-52` to the
-/// quarter power is exactly `2^-13`.
+/// R's `optimize` default tolerance `.Machine$double.eps^0.25` (docs/methods.md §2.3): `2^-52` to
+/// the quarter power is exactly `2^-13`.
 pub(crate) const OPTIMIZE_TOL: f64 = 1.220_703_125e-4;
 
 /// Square of the golden-section ratio, `(3 - sqrt 5) / 2` (Brent 1973, ch. 5).
@@ -56,8 +56,8 @@ fn check_interval(lower: f64, upper: f64, tol: f64) -> Result<(), ParamError> {
     Ok(())
 }
 
-/// Local minimum of `f` on `(lower, upper)` by Brent's method, as R's `optimize` (METHODS §12,
-/// §2.3, §2.4).
+/// Local minimum of `f` on `(lower, upper)` by Brent's method, as R's `optimize` (docs/methods.md
+/// §12, §2.3, §2.4).
 ///
 /// # Formula
 /// Brent (1973), ch. 5, `localmin`. The first point is `lower + 0.381966 (upper - lower)`; each
@@ -68,8 +68,8 @@ fn check_interval(lower: f64, upper: f64, tol: f64) -> Result<(), ParamError> {
 /// evaluated. Non-finite function values are replaced by `f64::MAX` (R does the same, with a
 /// warning).
 ///
-/// Only a *local* minimum is guaranteed: that is precisely the package behaviour METHODS §2.4
-/// documents (test value 176.0876).
+/// Only a *local* minimum is guaranteed: that is precisely the package behaviour docs/methods.md
+/// §2.4 documents (test value 176.0876).
 ///
 /// # Errors
 /// [`ParamError`] if the interval is not finite with `lower < upper`, or `tol` is not positive.
@@ -184,8 +184,8 @@ pub(crate) fn minimize<F: FnMut(f64) -> f64>(
     Ok(Minimum { x, fx, evaluations })
 }
 
-/// Root of `f` in the bracket `[lower, upper]` by the Brent–Dekker method (METHODS §12, §2.3,
-/// §2.4).
+/// Root of `f` in the bracket `[lower, upper]` by the Brent–Dekker method (docs/methods.md §12,
+/// §2.3, §2.4).
 ///
 /// # Formula
 /// Brent (1973), ch. 4, `zero`: keeps a sign-changing bracket `[b, c]` and steps by inverse

@@ -1,5 +1,5 @@
-//! Numerical building blocks (METHODS §12): compensated sums, 1-D minimisation and root finding,
-//! special functions.
+//! Numerical building blocks (docs/methods.md §12): compensated sums, 1-D minimisation and root
+//! finding, special functions.
 
 pub(crate) mod brent;
 pub(crate) mod special;

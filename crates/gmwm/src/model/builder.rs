@@ -1,4 +1,4 @@
-//! Free functions and operators that build models in Rust code (METHODS §0.2–§0.3).
+//! Free functions and operators that build models in Rust code (docs/methods.md §0.2–§0.3).
 //!
 //! `wn()`, `gm()`, `ar(2)`, ... return a [`Component`] in guess mode; the `*_with` functions
 //! return a validated component with every value given. `+` and `k *` cannot return a
@@ -120,7 +120,7 @@ pub fn ar1_with(phi: f64, sigma2: f64) -> Result<Component, ModelError> {
     given(ProcessKind::Ar1, [phi, sigma2])
 }
 
-/// `GM(beta, sigma2_gm)` (METHODS §4.3).
+/// `GM(beta, sigma2_gm)` (docs/methods.md §4.3).
 ///
 /// # Errors
 /// [`ModelError::BadParameter`] unless `beta` > 0 and `sigma2_gm` > 0 are finite.
@@ -167,7 +167,7 @@ pub fn ma_with(ma: &[f64], sigma2: f64) -> Result<Component, ModelError> {
     )
 }
 
-/// `ARMA(p,q)` with coefficients `ar`, `ma` (R sign convention, METHODS §0.2) and `sigma2`.
+/// `ARMA(p,q)` with coefficients `ar`, `ma` (R sign convention, docs/methods.md §0.2) and `sigma2`.
 ///
 /// # Errors
 /// As [`ar_with`]; `ARMA(0,0)` is rejected.
@@ -179,7 +179,7 @@ pub fn arma_with(ar: &[f64], ma: &[f64], sigma2: f64) -> Result<Component, Model
 }
 
 /// An unvalidated sum of terms `k * component`, built by `+` and `k *`; [`ModelSpec::build`]
-/// (or `Model::try_from`) applies the rules of METHODS §0.2.
+/// (or `Model::try_from`) applies the rules of docs/methods.md §0.2.
 ///
 /// Validation is deferred because operators cannot return a `Result`.
 #[derive(Debug, Clone, PartialEq, Default)]

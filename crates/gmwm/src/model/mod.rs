@@ -1,9 +1,9 @@
-//! Latent error models: an ordered sum of stochastic process components (METHODS §0.2).
+//! Latent error models: an ordered sum of stochastic process components (docs/methods.md §0.2).
 //!
 //! A [`Model`] is what the GMWM estimator fits: for example `3*GM()+WN()+QN()+RW()`, three
 //! Gauss–Markov processes plus white noise, quantisation noise and a random walk. Its parameter
 //! vector `theta` is the concatenation of the components' parameters in model order, with the
-//! names and order of METHODS §0.2 ([`ProcessKind::param_names`]).
+//! names and order of docs/methods.md §0.2 ([`ProcessKind::param_names`]).
 //!
 //! Three ways to build one, all validated by the same rules ([`Model::new`]):
 //! - text, as users of the R package write it: [`Model::parse`] / [`str::parse`], grammar in
@@ -11,20 +11,20 @@
 //! - free functions and operators: `(3 * gm() + wn() + qn() + rw()).build()` (see [`ModelSpec`]);
 //! - components directly: `Model::new(vec![Component::guess(ProcessKind::Wn)])`.
 //!
-//! # Guess mode and user values (METHODS §0.3)
+//! # Guess mode and user values (docs/methods.md §0.3)
 //! Every parameter value is optional ([`Component::values`] holds `Option<f64>`). A component
-//! without values is in *guess mode*: the estimator computes its starting values (METHODS §6).
-//! **Deviation from the package (METHODS §13.20):** in a partly specified model such as
-//! `AR1(phi=0.9, sigma2=0.1)+WN()` the missing values stay `None` here, and the estimator fills
+//! without values is in *guess mode*: the estimator computes its starting values (docs/methods.md
+//! §6). **Deviation from the package (docs/methods.md §13.20):** in a partly specified model such
+//! as `AR1(phi=0.9, sigma2=0.1)+WN()` the missing values stay `None` here, and the estimator fills
 //! them from its own starting values; the package instead starts them at fixed placeholders
 //! (WN at 3, ...), which is rarely what the user meant.
 //!
-//! # Rules (METHODS §0.2, plus one of ours)
+//! # Rules (docs/methods.md §0.2, plus one of ours)
 //! - `GM` and `AR1` may repeat (`k*GM()`), but may not be mixed in one model;
 //! - `WN`, `QN`, `RW`, `DR` appear at most once each (identifiability);
 //! - **at most one ARMA-family term** (`MA1`, `ARMA11`, `AR(p)`, `MA(q)`, `ARMA(p,q)`): two such
 //!   terms are not identifiable from one another by the wavelet variance (a sum of ARMAs is an
-//!   ARMA). METHODS does not state this rule; it is ours;
+//!   ARMA). The R package has no such rule; it is gmwm's own;
 //! - orders: `AR(p)`, `MA(q)` need an order from 1 to [`MAX_ORDER`]; `ARMA(p,q)` needs
 //!   `p + q >= 1`, each at most [`MAX_ORDER`];
 //! - every given value is finite and in its basic domain ([`ParamDomain`]).
@@ -57,17 +57,17 @@ use thiserror::Error;
 /// Largest order accepted for `AR(p)`, `MA(q)` and each order of `ARMA(p,q)`.
 ///
 /// A guard against absurd allocations from typos such as `AR(20000000)`; IMU error models use
-/// orders of 1 to 3, and the implied WV of METHODS §4.4 becomes numerically meaningless long
-/// before 100 lags.
+/// orders of 1 to 3, and the implied WV of docs/methods.md §4.4 becomes numerically meaningless
+/// long before 100 lags.
 pub const MAX_ORDER: usize = 100;
 
 /// Largest multiplier `k` accepted in `k*GM()` / `k*AR1()` (and by `k * gm()`).
 ///
 /// A guard against absurd allocations from typos; the package's largest automatic search
-/// (METHODS §8.4) uses 3 GMs, and more than a handful is never identifiable.
+/// (docs/methods.md §8.4) uses 3 GMs, and more than a handful is never identifiable.
 pub const MAX_MULTIPLIER: usize = 100;
 
-/// The kind of one latent process (METHODS §0.2).
+/// The kind of one latent process (docs/methods.md §0.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum ProcessKind {
     /// White noise, parameter `sigma2`.
@@ -80,7 +80,7 @@ pub enum ProcessKind {
     Dr,
     /// First-order autoregression, parameters `phi`, `sigma2`.
     Ar1,
-    /// Gauss–Markov process (AR1 reparametrised with the sampling rate, METHODS §4.3),
+    /// Gauss–Markov process (AR1 reparametrised with the sampling rate, docs/methods.md §4.3),
     /// parameters `beta`, `sigma2_gm`.
     Gm,
     /// First-order moving average, parameters `theta`, `sigma2`.
@@ -92,24 +92,26 @@ pub enum ProcessKind {
     /// Moving average of order q, parameters `ma1..maq`, `sigma2`.
     Ma(usize),
     /// ARMA(p, q) (package name `SARIMA` without seasonal part), parameters `ar1..arp`,
-    /// `ma1..maq`, `sigma2`; R sign convention (METHODS §0.2).
+    /// `ma1..maq`, `sigma2`; R sign convention (docs/methods.md §0.2).
     Arma(usize, usize),
 }
 
-/// The basic domain of one parameter value, checked whenever a value is given (METHODS §5.3
+/// The basic domain of one parameter value, checked whenever a value is given (docs/methods.md §5.3
 /// lists the transforms the optimiser applies on these domains).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum ParamDomain {
     /// A variance (`sigma2`, `sigma2_gm`, `q2`, `gamma2`): finite and > 0 (log transform).
     Variance,
-    /// The GM `beta`: finite and > 0 (`phi = exp(-beta / freq)` lies in (0, 1), METHODS §4.3).
+    /// The GM `beta`: finite and > 0 (`phi = exp(-beta / freq)` lies in (0, 1), docs/methods.md
+    /// §4.3).
     Rate,
     /// The AR1/MA1/ARMA11 coefficients `phi`, `theta`: in the open interval (-1, 1)
-    /// (the pseudo-logit domain of METHODS §5.3).
+    /// (the pseudo-logit domain of docs/methods.md §5.3).
     UnitInterval,
-    /// Any finite number: DR `omega` and the `AR(p)`/`MA(q)`/`ARMA(p,q)` coefficients (METHODS
-    /// §5.3 imposes no joint stationarity; the package's placeholders are -1 and -2).
+    /// Any finite number: DR `omega` and the `AR(p)`/`MA(q)`/`ARMA(p,q)` coefficients
+    /// (docs/methods.md §5.3 imposes no joint stationarity; the package's placeholders are -1
+    /// and -2).
     Finite,
 }
 
@@ -135,7 +137,7 @@ impl ParamDomain {
 }
 
 impl ProcessKind {
-    /// The canonical name: `"WN"`, `"AR1"`, `"AR(2)"`, `"ARMA(2,1)"` (METHODS §0.2).
+    /// The canonical name: `"WN"`, `"AR1"`, `"AR(2)"`, `"ARMA(2,1)"` (docs/methods.md §0.2).
     pub fn name(&self) -> String {
         let spec = spec(*self);
         match &spec.orders {
@@ -152,7 +154,7 @@ impl ProcessKind {
         spec(*self).name
     }
 
-    /// Parameter names in `theta` order (METHODS §0.2): WN `sigma2`; QN `q2`; RW `gamma2`;
+    /// Parameter names in `theta` order (docs/methods.md §0.2): WN `sigma2`; QN `q2`; RW `gamma2`;
     /// DR `omega`; AR1 `phi, sigma2`; GM `beta, sigma2_gm`; MA1 `theta, sigma2`; ARMA11
     /// `phi, theta, sigma2`; AR(p) `ar1..arp, sigma2`; MA(q) `ma1..maq, sigma2`; ARMA(p,q)
     /// `ar1..arp, ma1..maq, sigma2`.
@@ -215,7 +217,7 @@ impl ProcessKind {
         }
     }
 
-    /// Whether the kind may repeat in a model (`k*GM()`, `k*AR1()`; METHODS §0.2).
+    /// Whether the kind may repeat in a model (`k*GM()`, `k*AR1()`; docs/methods.md §0.2).
     pub fn may_repeat(&self) -> bool {
         spec(*self).occurs == Occurs::Repeats
     }
@@ -258,7 +260,8 @@ impl fmt::Display for ProcessKind {
     }
 }
 
-/// One term of a model: a process kind and its (optional) parameter values (METHODS §0.2–§0.3).
+/// One term of a model: a process kind and its (optional) parameter values (docs/methods.md
+/// §0.2–§0.3).
 ///
 /// `values` has one entry per parameter of `kind`, in [`ProcessKind::param_names`] order; `None`
 /// means "not given" (the estimator chooses the starting value). The fields are public for
@@ -273,7 +276,7 @@ pub struct Component {
 }
 
 impl Component {
-    /// A component in guess mode: no value given (METHODS §0.3).
+    /// A component in guess mode: no value given (docs/methods.md §0.3).
     ///
     /// The kind's orders are not checked here (see [`ProcessKind::check_orders`]); a bad order
     /// is reported when the component enters a [`Model`].
@@ -296,8 +299,8 @@ impl Component {
         Ok(c)
     }
 
-    /// Sets the parameter called `name` (ASCII case-insensitive, METHODS §0.2 names) to `value`,
-    /// e.g. `ar1().with("phi", 0.9)?`.
+    /// Sets the parameter called `name` (ASCII case-insensitive, docs/methods.md §0.2 names) to
+    /// `value`, e.g. `ar1().with("phi", 0.9)?`.
     ///
     /// # Errors
     /// [`ModelError::UnknownParameter`] (with the valid names) or [`ModelError::BadParameter`]
@@ -318,7 +321,7 @@ impl Component {
         Ok(self)
     }
 
-    /// Whether no value is given (guess mode, METHODS §0.3).
+    /// Whether no value is given (guess mode, docs/methods.md §0.3).
     pub fn is_guess(&self) -> bool {
         self.values.iter().all(Option::is_none)
     }
@@ -415,7 +418,7 @@ pub fn format_value(v: f64) -> String {
     }
 }
 
-/// A model-rule violation (METHODS §0.2) or an invalid component.
+/// A model-rule violation (docs/methods.md §0.2) or an invalid component.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum ModelError {
@@ -425,7 +428,7 @@ pub enum ModelError {
     /// WN, QN, RW or DR (or an ARMA kind) appears more than once.
     #[error(
         "{kind} appears {count} times but may appear at most once; only GM and AR1 may repeat \
-         (METHODS §0.2)"
+         (docs/methods.md §0.2)"
     )]
     Repeated {
         /// The repeated kind.
@@ -436,7 +439,7 @@ pub enum ModelError {
     /// GM and AR1 in the same model.
     #[error(
         "GM and AR1 may not be mixed in one model (found {gm} GM and {ar1} AR1); use one of \
-         them (METHODS §0.2)"
+         them (docs/methods.md §0.2)"
     )]
     GmAr1Mixed {
         /// Number of GM components.
@@ -480,7 +483,7 @@ pub enum ModelError {
         component: usize,
         /// Its kind.
         kind: ProcessKind,
-        /// The parameter name (METHODS §0.2).
+        /// The parameter name (docs/methods.md §0.2).
         name: String,
         /// The value given.
         value: f64,
@@ -523,7 +526,7 @@ pub enum ModelError {
 }
 
 /// A validated latent error model: an ordered, non-empty sum of components obeying the rules of
-/// METHODS §0.2 (see the [module docs](self)).
+/// docs/methods.md §0.2 (see the [module docs](self)).
 ///
 /// Its `Display` is the canonical text, which [`Model::parse`] reads back to an equal model
 /// (bitwise-equal values); serde (de)serialises a model as that string.
@@ -599,7 +602,7 @@ pub(crate) fn validate(components: &[Component]) -> Result<(), (usize, ModelErro
 }
 
 impl Model {
-    /// A model from its components, in order, validated against the rules of METHODS §0.2
+    /// A model from its components, in order, validated against the rules of docs/methods.md §0.2
     /// (module docs).
     ///
     /// # Errors
@@ -631,12 +634,13 @@ impl Model {
         self.components.len()
     }
 
-    /// Number of parameters, the length of `theta` (METHODS §0.2).
+    /// Number of parameters, the length of `theta` (docs/methods.md §0.2).
     pub fn n_params(&self) -> usize {
         self.components.iter().map(|c| c.kind.n_params()).sum()
     }
 
-    /// `(component index, parameter name)` for each entry of `theta`, in order (METHODS §0.2).
+    /// `(component index, parameter name)` for each entry of `theta`, in order (docs/methods.md
+    /// §0.2).
     pub fn param_names(&self) -> Vec<(usize, String)> {
         self.components
             .iter()
@@ -646,7 +650,7 @@ impl Model {
     }
 
     /// Whether no value is given anywhere: the estimator computes all starting values
-    /// (METHODS §0.3).
+    /// (docs/methods.md §0.3).
     pub fn is_guess_mode(&self) -> bool {
         self.components.iter().all(Component::is_guess)
     }
@@ -664,7 +668,7 @@ impl Model {
             .collect()
     }
 
-    /// The same structure with every value set from `theta` (model order, METHODS §0.2).
+    /// The same structure with every value set from `theta` (model order, docs/methods.md §0.2).
     ///
     /// # Errors
     /// [`ModelError::ThetaLength`] or [`ModelError::BadParameter`].
@@ -707,7 +711,7 @@ impl Model {
         self.components.iter().filter(|c| c.kind == kind).count()
     }
 
-    /// Whether the model has a GM component (GM parametrisation, METHODS §4.3).
+    /// Whether the model has a GM component (GM parametrisation, docs/methods.md §4.3).
     pub fn uses_gm(&self) -> bool {
         self.count(ProcessKind::Gm) > 0
     }

@@ -1,4 +1,4 @@
-//! The model text language, as users of the R package write it (METHODS §0.2–§0.3).
+//! The model text language, as users of the R package write it (docs/methods.md §0.2–§0.3).
 //!
 //! # Grammar
 //! ```text
@@ -8,7 +8,7 @@
 //!          | ("AR" | "MA") "(" INT ")" [ args ]     AR(2), MA(3)(0.5, 1)
 //!          | "ARMA" "(" INT "," INT ")" [ args ]    ARMA(2,1)(ar1=0.5, ma1=0.3, sigma2=1)
 //! args    := "(" [ arg ( "," arg )* ] ")"
-//! arg     := NUMBER                                  positional, in METHODS §0.2 order
+//! arg     := NUMBER                                  positional, in docs/methods.md §0.2 order
 //!          | PNAME "=" NUMBER                        named; positional ones come first
 //! NUMBER  := [+-] digits [ "." digits ] [ (e|E) [+-] digits ]   (".5" and "5." too)
 //! ```
@@ -59,7 +59,7 @@ pub enum ParseErrorKind {
     UnknownParameter {
         /// The name as written.
         name: String,
-        /// The process's valid parameter names (METHODS §0.2).
+        /// The process's valid parameter names (docs/methods.md §0.2).
         valid: Vec<String>,
     },
     /// A parameter given twice (by name, or by position and name).
@@ -76,8 +76,8 @@ pub enum ParseErrorKind {
     BadNumber,
     /// A multiplier `k` outside 1..=[`MAX_MULTIPLIER`].
     BadMultiplier,
-    /// A model rule (METHODS §0.2) or a value domain is violated; the position points at the
-    /// offending term or value.
+    /// A model rule (docs/methods.md §0.2) or a value domain is violated; the position points at
+    /// the offending term or value.
     Rule(ModelError),
 }
 
@@ -255,11 +255,11 @@ pub(crate) fn parse_model(text: &str) -> Res<Model> {
 fn rule_texts(e: &ModelError) -> (String, String) {
     match e {
         ModelError::Repeated { kind, count } => (
-            format!("{kind} at most once (METHODS §0.2: only GM and AR1 may repeat)"),
+            format!("{kind} at most once (docs/methods.md §0.2: only GM and AR1 may repeat)"),
             format!("{kind} {count} times"),
         ),
         ModelError::GmAr1Mixed { gm, ar1 } => (
-            "GM or AR1 terms, not both (METHODS §0.2)".to_string(),
+            "GM or AR1 terms, not both (docs/methods.md §0.2)".to_string(),
             format!("{gm} GM and {ar1} AR1"),
         ),
         ModelError::ArmaFamily { first, second } => (

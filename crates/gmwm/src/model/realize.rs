@@ -1,4 +1,4 @@
-//! From a fully specified model to numbers: its latent processes (METHODS §0.2, §4.3), its
+//! From a fully specified model to numbers: its latent processes (docs/methods.md §0.2, §4.3), its
 //! implied Haar wavelet variance and the derivatives with respect to theta (§4.1–§4.6).
 
 use super::{Component, Model};
@@ -9,7 +9,7 @@ use std::fmt;
 
 impl Component {
     /// The latent process of a fully specified component; `freq_hz` converts GM to its AR1
-    /// (METHODS §4.3) and is otherwise unused.
+    /// (docs/methods.md §4.3) and is otherwise unused.
     ///
     /// # Errors
     /// [`ParamError`] naming the first missing value, or the process constructor's error for an
@@ -82,7 +82,7 @@ impl Model {
     }
 
     /// Implied Haar WV of the model and of each component at `tau_j = 2^j`, `j = 1..=levels`
-    /// (METHODS §4.1–§4.4; a sum of independent processes has the sum of their WVs).
+    /// (docs/methods.md §4.1–§4.4; a sum of independent processes has the sum of their WVs).
     ///
     /// # Errors
     /// As [`Model::processes`]; `levels` must be in 1..=60.
@@ -113,7 +113,7 @@ impl Model {
     }
 
     /// Jacobian of the implied WV with respect to theta (model order, original
-    /// parametrisation: GM in (beta, sigma2_gm)), `[level][param]` (METHODS §4.5).
+    /// parametrisation: GM in (beta, sigma2_gm)), `[level][param]` (docs/methods.md §4.5).
     ///
     /// # Errors
     /// As [`Model::implied_wv`].
@@ -129,8 +129,8 @@ impl Model {
             .collect())
     }
 
-    /// METHODS §4.6: second derivatives of the implied WV with respect to theta (model order,
-    /// original parametrisation as [`Model::jacobian`]), `[level][param][param]`, symmetric.
+    /// docs/methods.md §4.6: second derivatives of the implied WV with respect to theta (model
+    /// order, original parametrisation as [`Model::jacobian`]), `[level][param][param]`, symmetric.
     ///
     /// Block diagonal: the WV of a sum is the sum of the components' WVs, so a cross-component
     /// second derivative is zero. Each block is its process's [`LatentProcess::hessian`]; GM

@@ -1,4 +1,4 @@
-//! AR1 and Gauss–Markov processes (METHODS §0.2, §4.2, §4.3, §4.5, §4.6).
+//! AR1 and Gauss–Markov processes (docs/methods.md §0.2, §4.2, §4.3, §4.5, §4.6).
 //!
 //! # Numerically stable evaluation
 //! The closed form of §4.2, written with `m = tau/2`, is
@@ -74,7 +74,7 @@ pub struct Ar1 {
 }
 
 /// Gauss–Markov process: an AR1 parametrised by its inverse correlation time `beta` (1/s) and
-/// stationary variance `sigma2_gm` at sampling rate `freq_hz` (METHODS §4.3).
+/// stationary variance `sigma2_gm` at sampling rate `freq_hz` (docs/methods.md §4.3).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Gm {
     /// Inverse correlation time in 1/s, `> 0`.
@@ -97,7 +97,7 @@ impl Ar1 {
         Ok(Self { phi, sigma2 })
     }
 
-    /// METHODS §4.3: the Gauss–Markov parametrisation at `freq_hz`:
+    /// docs/methods.md §4.3: the Gauss–Markov parametrisation at `freq_hz`:
     /// `beta = -ln(phi) freq`, `sigma2_gm = sigma2 / (1 - phi^2)`.
     ///
     /// # Errors
@@ -134,7 +134,7 @@ impl Gm {
         })
     }
 
-    /// METHODS §4.3: the equivalent per-sample AR1: `phi = exp(-beta dt)`,
+    /// docs/methods.md §4.3: the equivalent per-sample AR1: `phi = exp(-beta dt)`,
     /// `sigma2 = sigma2_gm (1 - exp(-2 beta dt))`, `dt = 1/freq_hz`.
     pub fn to_ar1(&self) -> Ar1 {
         let l = self.beta / self.freq_hz;
@@ -145,7 +145,7 @@ impl Gm {
     }
 }
 
-/// METHODS §4.2 (AR1 row), stable form of the module doc, at half-width `m`.
+/// docs/methods.md §4.2 (AR1 row), stable form of the module doc, at half-width `m`.
 ///
 /// `lag` is `L = -ln(phi)` when known exactly (GM); otherwise it is computed from `phi` when
 /// `phi > 0`. For `phi <= 0` the closed form has no cancellation and is used as written.
@@ -293,8 +293,8 @@ fn series_g_f64(l: f64, m: f64) -> f64 {
     acc
 }
 
-/// AR1 spectral density `sigma2 / ((1-phi)^2 + 4 phi sin^2(pi f))` (METHODS §1.9), the same as
-/// `sigma2 / (1 - 2 phi cos 2 pi f + phi^2)` without its cancellation at `f = 0`.
+/// AR1 spectral density `sigma2 / ((1-phi)^2 + 4 phi sin^2(pi f))` (docs/methods.md §1.9), the same
+/// as `sigma2 / (1 - 2 phi cos 2 pi f + phi^2)` without its cancellation at `f = 0`.
 pub(crate) fn ar1_spectrum(one_m_phi: f64, phi: f64, sigma2: f64, f: f64) -> f64 {
     let s = (std::f64::consts::PI * f).sin();
     sigma2 / (one_m_phi * one_m_phi + 4.0 * phi * s * s)
@@ -392,8 +392,8 @@ impl LatentProcess for Gm {
     }
 }
 
-/// METHODS §10.1: `x_t = phi x_{t-1} + w_t`, `w ~ N(0, sigma2)`, evaluated four samples at a
-/// time so that the recursion's latency is paid once per four: within the block of samples
+/// docs/methods.md §10.1: `x_t = phi x_{t-1} + w_t`, `w ~ N(0, sigma2)`, evaluated four samples at
+/// a time so that the recursion's latency is paid once per four: within the block of samples
 /// `4k .. 4k + 3`, `x_{4k+i} = phi^(i+1) x_{4k-1} + a_i` with `a_0 = w_{4k}` and
 /// `a_i = phi a_{i-1} + w_{4k+i}`, the partial sums `a` not depending on the block's start.
 /// Blocks are fixed by the sample index, not by the chunks asked for, so any chunking gives the
@@ -510,7 +510,7 @@ impl Simulate for Gm {
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.beta, self.sigma2_gm, self.freq_hz).map(drop)
     }
-    /// Simulated as its exact per-sample AR1 ([`Gm::to_ar1`], METHODS §4.3).
+    /// Simulated as its exact per-sample AR1 ([`Gm::to_ar1`], docs/methods.md §4.3).
     fn sampler(&self, rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         self.to_ar1().sampler(rng, start)
     }

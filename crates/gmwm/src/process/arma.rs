@@ -1,5 +1,5 @@
-//! General ARMA(p, q) (METHODS §0.2, §4.4, §4.7), with AR(p) (`ma` empty) and MA(q) (`ar` empty)
-//! as special cases. R sign convention: AR polynomial `1 - sum ar_i B^i`, MA polynomial
+//! General ARMA(p, q) (docs/methods.md §0.2, §4.4, §4.7), with AR(p) (`ma` empty) and MA(q) (`ar`
+//! empty) as special cases. R sign convention: AR polynomial `1 - sum ar_i B^i`, MA polynomial
 //! `1 + sum ma_i B^i`.
 
 use crate::sim::sampler::SimRng;
@@ -126,12 +126,12 @@ impl Arma {
         m > 1.0
     }
 
-    /// MA(inf) weights `psi_0 = 1, psi_1, ...` (METHODS §4.4).
+    /// MA(inf) weights `psi_0 = 1, psi_1, ...` (docs/methods.md §4.4).
     pub fn psi_weights(&self, n: usize) -> Vec<f64> {
         psi(&self.ar, &self.ma, n)
     }
 
-    /// METHODS §4.4: autocovariances `gamma_0..gamma_{max_lag}` from the exact
+    /// docs/methods.md §4.4: autocovariances `gamma_0..gamma_{max_lag}` from the exact
     /// `(r+1) x (r+1)` linear system (`r = max(p, q+1)`), then the AR recursion; `gamma_0` is
     /// exact, not the package's 1000-term MA(inf) truncation (§13.12). Values are NaN only if
     /// the system were singular, which stationarity (checked by [`Arma::new`]) excludes.
@@ -232,7 +232,8 @@ fn monic_roots(a: &[f64]) -> Vec<C64> {
     z
 }
 
-/// METHODS §4.4: `psi_i = ma_i (0 if i > q) + sum_{l=1}^{min(i,p)} ar_l psi_{i-l}`, `psi_0 = 1`.
+/// docs/methods.md §4.4: `psi_i = ma_i (0 if i > q) + sum_{l=1}^{min(i,p)} ar_l psi_{i-l}`,
+/// `psi_0 = 1`.
 fn psi(ar: &[f64], ma: &[f64], n: usize) -> Vec<f64> {
     let mut out = vec![0.0; n.max(1)];
     out[0] = 1.0;
@@ -247,7 +248,7 @@ fn psi(ar: &[f64], ma: &[f64], n: usize) -> Vec<f64> {
     out
 }
 
-/// METHODS §4.4 linear system plus recursion; see [`Arma::autocovariance`].
+/// docs/methods.md §4.4 linear system plus recursion; see [`Arma::autocovariance`].
 fn autocovariance(ar: &[f64], ma: &[f64], sigma2: f64, max_lag: usize) -> Vec<f64> {
     let (p, q) = (ar.len(), ma.len());
     let r = p.max(q + 1);
@@ -309,7 +310,7 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     Some(x)
 }
 
-/// METHODS §4.4: WV through §4.1 from the exact autocovariances (no validation).
+/// docs/methods.md §4.4: WV through §4.1 from the exact autocovariances (no validation).
 fn arma_wv(ar: &[f64], ma: &[f64], sigma2: f64, levels: usize) -> Vec<f64> {
     if levels == 0 {
         return Vec::new();
@@ -323,7 +324,7 @@ fn max_half_width(levels: usize) -> f64 {
     2f64.powi(levels.clamp(1, 1000) as i32 - 1)
 }
 
-/// Richardson rounds of METHODS §4.7.
+/// Richardson rounds of docs/methods.md §4.7.
 const RICHARDSON_ROUNDS: usize = 4;
 
 impl Arma {
@@ -337,7 +338,7 @@ impl Arma {
         arma_wv(&c[..p], &c[p..], self.sigma2, levels)
     }
 
-    /// METHODS §4.7: Richardson-extrapolated central differences with respect to the
+    /// docs/methods.md §4.7: Richardson-extrapolated central differences with respect to the
     /// coefficient `k` of `c`, four rounds halving the step. The initial step is
     /// `1e-3 max(|c_k|, 0.1)`, at most `0.05 / m_max` (the WV varies through `phi^m`), instead of
     /// numDeriv's `|1e-4 c_k| + 1e-4 [|c_k| < zero_tol]`, whose step for a small non-zero
@@ -419,7 +420,7 @@ impl LatentProcess for Arma {
     fn wv(&self, levels: usize) -> Vec<f64> {
         arma_wv(&self.ar, &self.ma, self.sigma2, levels)
     }
-    /// METHODS §4.7 for the coefficients; `nu2 / sigma2` (§4.5) for `sigma2`.
+    /// docs/methods.md §4.7 for the coefficients; `nu2 / sigma2` (§4.5) for `sigma2`.
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         self.jacobian_at(&self.coefs(), levels)
     }
@@ -487,15 +488,15 @@ impl LatentProcess for Arma {
 }
 
 // ------------------------------------------------------------------------------------------
-// Simulation (METHODS §10.1)
+// Simulation (docs/methods.md §10.1)
 
 /// Relative size of the AR transient left after the burn-in of a stationary-mode ARMA(p, q):
 /// below the 53-bit resolution of most downstream sums, so the start is stationary for every
-/// practical purpose (METHODS §10.1 port).
+/// practical purpose (docs/methods.md §10.1 port).
 const STATIONARY_BURN_IN_TOL: f64 = 1e-12;
 
 /// R's `arima.sim` burn-in constant: `n0 = p + q + ceil(6 / ln(min root modulus))`, a transient
-/// of `e^-6 ≈ 2.5e-3` relative (METHODS §10.1).
+/// of `e^-6 ≈ 2.5e-3` relative (docs/methods.md §10.1).
 const R_BURN_IN_LOG: f64 = 6.0;
 
 /// Longest burn-in a generic ARMA may need (AR root moduli down to about `1 + 2.8e-7`);
@@ -504,7 +505,7 @@ const MAX_BURN_IN: usize = 100_000_000;
 
 /// Whether the AR polynomial `1 - sum ar_i B^i` has every root outside the unit circle,
 /// by the Schur–Cohn (step-down Levinson) test: every reflection coefficient `|k| < 1`
-/// (METHODS §10.1, §12). Exact up to rounding; an empty `ar` is stationary.
+/// (docs/methods.md §10.1, §12). Exact up to rounding; an empty `ar` is stationary.
 ///
 /// # Formula
 /// `k_p = ar_p`; `ar'_i = (ar_i + k_p ar_{p-i}) / (1 - k_p^2)`, i = 1..p-1; repeat on `ar'`.
@@ -561,7 +562,7 @@ fn inverse_root_radius(ar: &[f64]) -> f64 {
     hi
 }
 
-/// Burn-in length of a generic ARMA in each start mode (METHODS §10.1).
+/// Burn-in length of a generic ARMA in each start mode (docs/methods.md §10.1).
 fn arma_burn_in(ar: &[f64], q: usize, mode: StartMode) -> Result<usize, ParamError> {
     let p = ar.len();
     let rho = inverse_root_radius(ar);
@@ -602,7 +603,7 @@ struct ArmaState {
 }
 
 impl Step for ArmaState {
-    /// METHODS §10.1 (ARMA(p, q), R's `arima.sim`): `y_t = e_t + sum_k ma_k e_{t-k}` (0 for
+    /// docs/methods.md §10.1 (ARMA(p, q), R's `arima.sim`): `y_t = e_t + sum_k ma_k e_{t-k}` (0 for
     /// the first q), `x_t = y_t + sum_i ar_i x_{t-i}`.
     #[inline]
     fn step(&mut self) -> f64 {

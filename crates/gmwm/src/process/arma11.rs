@@ -1,4 +1,4 @@
-//! ARMA(1,1) (METHODS §0.2, §4.2, §4.5, §4.6).
+//! ARMA(1,1) (docs/methods.md §0.2, §4.2, §4.5, §4.6).
 //!
 //! Near `phi = 1` the closed form cancels like the AR1 one. Its autocovariance is
 //! `gamma_0 = sigma2 (1 + 2 theta phi + theta^2)/(1 - phi^2)`,
@@ -73,7 +73,7 @@ impl Arma11 {
     }
 }
 
-/// METHODS §4.2 (ARMA11 row):
+/// docs/methods.md §4.2 (ARMA11 row):
 /// `nu2 = sigma2 [(1+theta)^2 (1-phi^2) tau - 2 (theta+phi)(1+theta phi) K] / [tau^2 (1-phi)^3 (1+phi)]`,
 /// `K = 3 - 4 phi^{tau/2} + phi^tau`; for `phi > 1/2` through the decomposition of the module doc.
 pub(crate) fn arma11_wv_jet<const N: usize>(
@@ -126,7 +126,7 @@ impl LatentProcess for Arma11 {
     }
 }
 
-/// METHODS §10.1: `x_t = phi x_{t-1} + w_t + theta w_{t-1}`; `(x, w)` are the last values.
+/// docs/methods.md §10.1: `x_t = phi x_{t-1} + w_t + theta w_{t-1}`; `(x, w)` are the last values.
 #[derive(Debug, Clone)]
 struct Arma11Sampler {
     rng: SimRng,

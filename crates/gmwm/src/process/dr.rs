@@ -1,4 +1,4 @@
-//! Deterministic drift (METHODS §0.2, §4.2, §10.1).
+//! Deterministic drift (docs/methods.md §0.2, §4.2, §10.1).
 
 use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
@@ -39,7 +39,7 @@ impl Dr {
     }
 }
 
-/// METHODS §4.2: `nu2 = omega^2 tau^2 / 16`, `tau = 2m`.
+/// docs/methods.md §4.2: `nu2 = omega^2 tau^2 / 16`, `tau = 2m`.
 fn unit_wv(m: f64) -> f64 {
     let tau = 2.0 * m;
     tau * tau / 16.0
@@ -79,7 +79,7 @@ impl LatentProcess for Dr {
     }
 }
 
-/// METHODS §10.1: `x_t = omega (t + 1)`, t = 0, 1, ... across chunks (no randomness).
+/// docs/methods.md §10.1: `x_t = omega (t + 1)`, t = 0, 1, ... across chunks (no randomness).
 #[derive(Debug, Clone)]
 struct DrSampler {
     omega: f64,

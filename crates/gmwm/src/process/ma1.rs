@@ -1,4 +1,4 @@
-//! First-order moving average (METHODS §0.2, §4.2, §4.5, §4.6, §10.1).
+//! First-order moving average (docs/methods.md §0.2, §4.2, §4.5, §4.6, §10.1).
 
 use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
@@ -56,7 +56,8 @@ impl Ma1 {
     }
 }
 
-/// METHODS §4.2 (MA1 row): `nu2 = sigma2 [(1 + theta)^2 tau - 6 theta] / tau^2`, `tau = 2m`.
+/// docs/methods.md §4.2 (MA1 row): `nu2 = sigma2 [(1 + theta)^2 tau - 6 theta] / tau^2`, `tau =
+/// 2m`.
 pub(crate) fn ma1_wv_jet<const N: usize>(theta: Jet<N>, sigma2: Jet<N>, m: f64) -> Jet<N> {
     let tau = 2.0 * m;
     sigma2 * ((theta + 1.0).powi(2) * tau - theta * 6.0) / (tau * tau)
@@ -88,7 +89,7 @@ impl LatentProcess for Ma1 {
     }
 }
 
-/// METHODS §10.1: `x_t = w_t + theta w_{t-1}`, stationary in both start modes (one extra
+/// docs/methods.md §10.1: `x_t = w_t + theta w_{t-1}`, stationary in both start modes (one extra
 /// innovation `w` drawn first).
 #[derive(Debug, Clone)]
 struct Ma1Sampler {

@@ -1,13 +1,13 @@
 //! Latent processes of an IMU error model and their implied (theoretical) Haar wavelet variance,
-//! with first and second derivatives (METHODS §4).
+//! with first and second derivatives (docs/methods.md §4).
 //!
 //! Every process implements [`LatentProcess`]; [`Process`] is the closed set of them. Levels are
-//! `j = 1..=levels` at scales `tau_j = 2^j` samples, parameters are per sample (METHODS §0.1);
-//! only [`Gm`] carries a sampling rate (§4.3).
+//! `j = 1..=levels` at scales `tau_j = 2^j` samples, parameters are per sample (docs/methods.md
+//! §0.1); only [`Gm`] carries a sampling rate (§4.3).
 //!
 //! Each process's module holds all of its facts: its name and parameters in the model language
 //! (with their domains), its validating constructor, its implied WV and derivatives, its
-//! spectral density, and how it is simulated (METHODS §10.1). One table maps a
+//! spectral density, and how it is simulated (docs/methods.md §10.1). One table maps a
 //! [`ProcessKind`](crate::model::ProcessKind) to those facts; the model language, the model's
 //! validation and the simulator ([`crate::sim`]) read it.
 //!
@@ -45,16 +45,16 @@ use crate::sim::sampler::Sampler;
 use crate::sim::sampler::SimRng;
 use crate::sim::StartMode;
 
-/// A latent process with an implied Haar wavelet variance (METHODS §4). Object safe.
+/// A latent process with an implied Haar wavelet variance (docs/methods.md §4). Object safe.
 pub trait LatentProcess {
-    /// Component name as in METHODS §0.2: "WN", "QN", "RW", "DR", "AR1", "GM", "MA1", "ARMA11",
-    /// "ARMA".
+    /// Component name as in docs/methods.md §0.2: "WN", "QN", "RW", "DR", "AR1", "GM", "MA1",
+    /// "ARMA11", "ARMA".
     fn name(&self) -> &'static str;
-    /// Parameter names in METHODS §0.2 order.
+    /// Parameter names in docs/methods.md §0.2 order.
     fn param_names(&self) -> Vec<&'static str>;
     /// Parameter values in the order of [`LatentProcess::param_names`].
     fn params(&self) -> Vec<f64>;
-    /// METHODS §4.2: implied Haar WV at `tau_j = 2^j` samples, `j = 1..=levels`.
+    /// docs/methods.md §4.2: implied Haar WV at `tau_j = 2^j` samples, `j = 1..=levels`.
     fn wv(&self, levels: usize) -> Vec<f64>;
     /// Adds the implied WV at levels `1..=out.len()` to `out` (the objective's and the
     /// starting-value search's hot path: no allocation where a process overrides it).
@@ -64,17 +64,17 @@ pub trait LatentProcess {
             *o += w;
         }
     }
-    /// METHODS §4.5: Jacobian `d nu2_j / d theta_k`, indexed `[level][param]`.
+    /// docs/methods.md §4.5: Jacobian `d nu2_j / d theta_k`, indexed `[level][param]`.
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>>;
-    /// METHODS §4.6: second derivatives, indexed `[level][param][param]` (symmetric).
+    /// docs/methods.md §4.6: second derivatives, indexed `[level][param][param]` (symmetric).
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>>;
-    /// METHODS §1.9: spectral density `S(f)` on `|f| <= 1/2` (cycles per sample); the RW
+    /// docs/methods.md §1.9: spectral density `S(f)` on `|f| <= 1/2` (cycles per sample); the RW
     /// pseudo-spectrum for RW; `None` for the deterministic drift.
     fn spectral_density(&self, f: f64) -> Option<f64>;
 }
 
 /// What the engine needs of a process beyond [`LatentProcess`]: its validation, again, and its
-/// simulation (METHODS §10.1). Implemented by every process next to its implied WV.
+/// simulation (docs/methods.md §10.1). Implemented by every process next to its implied WV.
 pub(crate) trait Simulate: LatentProcess {
     /// Checks the values through the process's own constructor (the fields are public, so a
     /// value may have been built without it).
@@ -91,7 +91,7 @@ pub(crate) trait Simulate: LatentProcess {
 /// `From` conversions.
 macro_rules! processes {
     ($($(#[doc = $doc:literal])* $v:ident,)*) => {
-        /// One latent process of a model (METHODS §0.2).
+        /// One latent process of a model (docs/methods.md §0.2).
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
         pub enum Process {
             $($(#[doc = $doc])* $v($v),)*
@@ -177,7 +177,7 @@ impl LatentProcess for Process {
     }
 }
 
-/// METHODS §4.1: Haar WV at `tau_j = 2^j`, `j = 1..=levels`, from autocovariances
+/// docs/methods.md §4.1: Haar WV at `tau_j = 2^j`, `j = 1..=levels`, from autocovariances
 /// `gamma_0, gamma_1, ...`:
 /// `nu2(tau) = [m (gamma_0 - gamma_m) + sum_{i=1}^{m-1} i (2 gamma_{m-i} - gamma_i - gamma_{2m-i})] / (2 m^2)`
 /// with `m = tau / 2`. Level `j` needs `gamma_0 .. gamma_{2^j - 1}`; levels whose lags are not
@@ -201,7 +201,7 @@ pub fn autocovariance_wv(gamma: &[f64], levels: usize) -> Vec<f64> {
     out
 }
 
-/// Half-widths `m_j = 2^{j-1}` for `j = 1..=levels` (METHODS §0.1), as `f64`.
+/// Half-widths `m_j = 2^{j-1}` for `j = 1..=levels` (docs/methods.md §0.1), as `f64`.
 /// Adds `scale * unit(m)` at half-widths `m = 1, 2, 4, ...` to `out` (the implied WV of a
 /// process that is one parameter times a fixed shape: WN, QN, RW, DR).
 pub(crate) fn add_scaled(out: &mut [f64], scale: f64, unit: impl Fn(f64) -> f64) {

@@ -1,4 +1,4 @@
-//! Quantisation noise (METHODS §0.2, §4.2, §10.1).
+//! Quantisation noise (docs/methods.md §0.2, §4.2, §10.1).
 
 use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
@@ -21,7 +21,7 @@ pub(crate) const SPEC: Spec = Spec {
     build: |_, v, _| Ok(Qn::new(v[0])?.into()),
 };
 
-/// `sqrt(12)`: scales `U(0, 1)` to variance 1 for quantisation noise (METHODS §10.1).
+/// `sqrt(12)`: scales `U(0, 1)` to variance 1 for quantisation noise (docs/methods.md §10.1).
 const SQRT_12: f64 = 3.464_101_615_137_754_6;
 
 /// Quantisation noise: first difference of white noise of variance `q2`.
@@ -42,7 +42,7 @@ impl Qn {
     }
 }
 
-/// METHODS §4.2: `nu2 = 6 q2 / tau^2`, `tau = 2m`.
+/// docs/methods.md §4.2: `nu2 = 6 q2 / tau^2`, `tau = 2m`.
 fn unit_wv(m: f64) -> f64 {
     let tau = 2.0 * m;
     6.0 / (tau * tau)
@@ -76,13 +76,13 @@ impl LatentProcess for Qn {
     }
 }
 
-/// One QN value from consecutive uniforms (METHODS §10.1): `sqrt(q2) (u_{t+1} - u_t)`.
+/// One QN value from consecutive uniforms (docs/methods.md §10.1): `sqrt(q2) (u_{t+1} - u_t)`.
 #[inline]
 pub(crate) fn qn_value(sqrt_q2: f64, u_t: f64, u_next: f64) -> f64 {
     sqrt_q2 * (u_next - u_t)
 }
 
-/// METHODS §10.1: `x_t = sqrt(q2) (u_{t+1} - u_t)`, `u ~ sqrt(12) U(0, 1)`; `u` is the last
+/// docs/methods.md §10.1: `x_t = sqrt(q2) (u_{t+1} - u_t)`, `u ~ sqrt(12) U(0, 1)`; `u` is the last
 /// uniform drawn.
 #[derive(Debug, Clone)]
 struct QnSampler {

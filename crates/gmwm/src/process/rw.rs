@@ -1,4 +1,4 @@
-//! Random walk (METHODS §0.2, §4.2, §10.1).
+//! Random walk (docs/methods.md §0.2, §4.2, §10.1).
 
 use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
@@ -40,7 +40,7 @@ impl Rw {
     }
 }
 
-/// METHODS §4.2: `nu2 = gamma2 (tau^2 + 2) / (12 tau)`, `tau = 2m`.
+/// docs/methods.md §4.2: `nu2 = gamma2 (tau^2 + 2) / (12 tau)`, `tau = 2m`.
 fn unit_wv(m: f64) -> f64 {
     let tau = 2.0 * m;
     (tau * tau + 2.0) / (12.0 * tau)
@@ -81,7 +81,7 @@ impl Simulate for Rw {
         Self::new(self.gamma2).map(drop)
     }
     fn sampler(&self, rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
-        // METHODS §10.1: `x_t = sum_{i=0}^{t} w_i`, `w ~ N(0, gamma2)` (the first value is
+        // docs/methods.md §10.1: `x_t = sum_{i=0}^{t} w_i`, `w ~ N(0, gamma2)` (the first value is
         // `w_0`, not 0): the AR1 recursion with phi = 1 from x = 0, whose products by 1 are
         // exact, so the blocks of four are the running sum's
         Ok(Box::new(Ar1Sampler::new(rng, 1.0, self.gamma2.sqrt(), 0.0)))

@@ -1,4 +1,4 @@
-//! Slow quadrature oracle of the spectral definition of the Haar WV (METHODS §1.9, paper
+//! Slow quadrature oracle of the spectral definition of the Haar WV (docs/methods.md §1.9, paper
 //! eq. 2), for tests and validation only.
 //!
 //! `nu2_j = int_{-1/2}^{1/2} |H_j(f)|^2 S(f) df`, `|H_j(f)|^2 = sin^4(pi f m) / (m^2 sin^2(pi f))`,
@@ -92,8 +92,8 @@ impl Rule {
     }
 }
 
-/// METHODS §1.9: `nu2_j` of a spectral density `density(f)` on `[-1/2, 1/2]` (even in `f`) by
-/// quadrature; slow oracle (see the module doc). `j >= 1`; `j = 0` gives NaN.
+/// docs/methods.md §1.9: `nu2_j` of a spectral density `density(f)` on `[-1/2, 1/2]` (even in `f`)
+/// by quadrature; slow oracle (see the module doc). `j >= 1`; `j = 0` gives NaN.
 pub fn spectral_wv_level(density: &dyn Fn(f64) -> f64, j: usize) -> f64 {
     if j == 0 || j > 40 {
         return f64::NAN;
@@ -141,7 +141,7 @@ pub fn spectral_wv_level(density: &dyn Fn(f64) -> f64, j: usize) -> f64 {
     2.0 * total
 }
 
-/// METHODS §1.9: the implied WV of a process at levels `1..=levels` by quadrature of its
+/// docs/methods.md §1.9: the implied WV of a process at levels `1..=levels` by quadrature of its
 /// spectral density; `None` for a process without one (DR). Slow oracle.
 pub fn spectral_wv(process: &dyn LatentProcess, levels: usize) -> Option<Vec<f64>> {
     process.spectral_density(0.25)?;

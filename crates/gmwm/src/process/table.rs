@@ -2,8 +2,8 @@
 //! simulator know of each [`ProcessKind`].
 //!
 //! Each kind's facts are declared once, in its own module next to its struct, as a [`Spec`]:
-//! its name in the model language, its parameters with their domains (METHODS §0.2), how often
-//! it may appear in a model, and its constructor (which validates). The implied WV and its
+//! its name in the model language, its parameters with their domains (docs/methods.md §0.2), how
+//! often it may appear in a model, and its constructor (which validates). The implied WV and its
 //! derivatives are the struct's [`LatentProcess`](super::LatentProcess) impl, its simulation
 //! its [`Simulate`](super::Simulate) impl. [`spec`] is the only map from a kind to its facts:
 //! the parser, the metadata methods of [`ProcessKind`], [`Component::process`] and the
@@ -25,14 +25,14 @@ pub(crate) struct Spec {
     pub(crate) name: &'static str,
     /// How the kind is written in lists and suggestions: `"WN()"`, `"AR(p)"`.
     pub(crate) syntax: &'static str,
-    /// The parameters, in `theta` order (METHODS §0.2).
+    /// The parameters, in `theta` order (docs/methods.md §0.2).
     pub(crate) params: Params,
     /// The orders written after the name (`AR(p)`, `ARMA(p,q)`); `None` for the other kinds.
     pub(crate) orders: Option<Orders>,
-    /// How often the kind may appear in one model (METHODS §0.2).
+    /// How often the kind may appear in one model (docs/methods.md §0.2).
     pub(crate) occurs: Occurs,
     /// The validated process from every value, in parameter order; `freq_hz` converts GM
-    /// (METHODS §4.3) and is unused otherwise. The kind gives the orders of an order kind.
+    /// (docs/methods.md §4.3) and is unused otherwise. The kind gives the orders of an order kind.
     pub(crate) build: fn(ProcessKind, &[f64], f64) -> Result<Process, ParamError>,
 }
 
@@ -73,7 +73,7 @@ impl Orders {
     }
 }
 
-/// How often a kind may appear in one model (METHODS §0.2).
+/// How often a kind may appear in one model (docs/methods.md §0.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Occurs {
     /// At most once (identifiability): WN, QN, RW, DR.

@@ -1,4 +1,4 @@
-//! White noise (METHODS §0.2, §4.2, §10.1).
+//! White noise (docs/methods.md §0.2, §4.2, §10.1).
 
 use crate::sim::sampler::SimRng;
 use serde::{Deserialize, Serialize};
@@ -39,7 +39,7 @@ impl Wn {
     }
 }
 
-/// METHODS §4.2: `nu2 = sigma2 / tau`, `tau = 2m`.
+/// docs/methods.md §4.2: `nu2 = sigma2 / tau`, `tau = 2m`.
 fn unit_wv(m: f64) -> f64 {
     let tau = 2.0 * m;
     1.0 / tau
@@ -75,7 +75,7 @@ impl LatentProcess for Wn {
     }
 }
 
-/// METHODS §10.1: `x_t ~ N(0, sigma2)` i.i.d.
+/// docs/methods.md §10.1: `x_t ~ N(0, sigma2)` i.i.d.
 #[derive(Debug, Clone)]
 struct WnSampler {
     rng: SimRng,

@@ -1,5 +1,5 @@
-//! Candidate models of a selection: the nested sub-models of a full model (METHODS §8.4) and
-//! the common denominator of a user's list (§8.5).
+//! Candidate models of a selection: the nested sub-models of a full model (docs/methods.md §8.4)
+//! and the common denominator of a user's list (§8.5).
 //!
 //! A candidate is a term list (`["AR1", "AR1", "WN"]`); the package keeps candidates in a
 //! lexicographically ordered set of such lists (byte order of the names: "AR1" < "DR" < "GM" <
@@ -25,8 +25,8 @@ pub fn terms(model: &Model) -> String {
         .join(" ")
 }
 
-/// METHODS §8.5: refuses ARMA-family terms (the package's check is inert, §13.17) and repeated
-/// WN/QN/RW/DR (a validated [`Model`] cannot hold them; checked again for clarity).
+/// docs/methods.md §8.5: refuses ARMA-family terms (the package's check is inert, §13.17) and
+/// repeated WN/QN/RW/DR (a validated [`Model`] cannot hold them; checked again for clarity).
 pub(crate) fn check_candidate(model: &Model) -> Result<(), SelectionError> {
     let candidate = model.without_values().to_string();
     if let Some(kind) = model.kinds().into_iter().find(|k| k.is_arma_family()) {
@@ -56,9 +56,9 @@ fn model_of(kinds: &[ProcessKind]) -> Model {
         .expect("a non-empty subset of a valid model's terms is a valid model")
 }
 
-/// METHODS §8.4: every non-empty subset of the full model's terms, terms kept in their original
-/// order, identical term lists merged (which of several AR1s is dropped does not matter), in the
-/// package's set order (byte order of the term lists), guess mode.
+/// docs/methods.md §8.4: every non-empty subset of the full model's terms, terms kept in their
+/// original order, identical term lists merged (which of several AR1s is dropped does not matter),
+/// in the package's set order (byte order of the term lists), guess mode.
 ///
 /// For `3*AR1()+WN()+RW()+QN()+DR()`: 63 candidates, from `AR1()` to `WN()+RW()+QN()+DR()`.
 ///
@@ -93,8 +93,8 @@ pub fn nested_candidates(full: &Model) -> Result<Vec<Model>, SelectionError> {
     Ok(set.iter().map(|names| model_of(&lists[names])).collect())
 }
 
-/// METHODS §8.5: the common denominator of a list of candidates: as many AR1 (or GM) terms as
-/// the candidate with most of them, then WN, QN, RW, DR when any candidate has them, in that
+/// docs/methods.md §8.5: the common denominator of a list of candidates: as many AR1 (or GM) terms
+/// as the candidate with most of them, then WN, QN, RW, DR when any candidate has them, in that
 /// order; guess mode. E.g. {AR1 WN}, {AR1 AR1 RW}, {QN DR} give `2*AR1()+WN()+QN()+RW()+DR()`.
 ///
 /// # Errors
@@ -189,7 +189,7 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "candidate GM()+WN() uses GM but candidate AR1() uses AR1; all candidates must use \
-             the same one (METHODS §8.5)"
+             the same one (docs/methods.md §8.5)"
         );
         assert!(matches!(
             common_denominator(&[]),

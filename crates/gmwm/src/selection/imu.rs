@@ -1,4 +1,4 @@
-//! WIC selection on every axis of an IMU recording (METHODS §8.6 `auto.imu`).
+//! WIC selection on every axis of an IMU recording (docs/methods.md §8.6 `auto.imu`).
 
 use super::{ModelSelection, SelectionError, Wic};
 use crate::imu::{Imu, Sensor};
@@ -46,7 +46,7 @@ impl fmt::Display for ImuSelection {
     }
 }
 
-/// METHODS §8.6 `auto.imu`: runs `wic` on every axis of `imu` in parallel (each axis is
+/// docs/methods.md §8.6 `auto.imu`: runs `wic` on every axis of `imu` in parallel (each axis is
 /// deterministic given the seed, so the result does not depend on the thread count) and tags
 /// each result by sensor and axis.
 ///

@@ -1,4 +1,4 @@
-//! Model selection by the Wavelet Information Criterion (METHODS §8, paper eq. 5).
+//! Model selection by the Wavelet Information Criterion (docs/methods.md §8, paper eq. 5).
 //!
 //! `WIC = Q(theta_hat) + optimism`: the apparent loss of a candidate (its GMWM objective against
 //! the data's WV, §5.1) plus an estimate of how much that loss flatters it ([`optimism`]).
@@ -102,15 +102,15 @@ use crate::fit::FitError;
 use crate::model::ProcessKind;
 use thiserror::Error;
 
-/// Why a model selection could not be set up or run (METHODS §8).
+/// Why a model selection could not be set up or run (docs/methods.md §8).
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum SelectionError {
     /// An ARMA-family term in a candidate: selection supports WN, QN, RW, DR, AR1 and GM only
-    /// (METHODS §8.5; the package's guard is inert, §13.17).
+    /// (docs/methods.md §8.5; the package's guard is inert, §13.17).
     #[error(
         "candidate {candidate}: {kind} is not supported in model selection; use only WN, QN, RW, \
-         DR and AR1 or GM terms (METHODS §8.5)"
+         DR and AR1 or GM terms (docs/methods.md §8.5)"
     )]
     ArmaNotSupported {
         /// Canonical text of the candidate.
@@ -129,7 +129,7 @@ pub enum SelectionError {
     /// GM in one candidate and AR1 in another (or both in one).
     #[error(
         "candidate {gm} uses GM but candidate {ar1} uses AR1; all candidates must use the same \
-         one (METHODS §8.5)"
+         one (docs/methods.md §8.5)"
     )]
     GmAr1Mixed {
         /// A candidate with GM terms.

@@ -1,4 +1,4 @@
-//! The optimism of a candidate's apparent loss (METHODS §8.1–§8.3): how much lower its GMWM
+//! The optimism of a candidate's apparent loss (docs/methods.md §8.1–§8.3): how much lower its GMWM
 //! objective is on the data it was fitted to than it would be on new data.
 //!
 //! # Asymptotic optimism (§8.2)
@@ -35,7 +35,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::fmt;
 
-/// How the optimism is estimated (METHODS §8.2, §8.3).
+/// How the optimism is estimated (docs/methods.md §8.2, §8.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum OptimismMethod {
@@ -56,7 +56,7 @@ impl fmt::Display for OptimismMethod {
     }
 }
 
-/// Which asymptotic formula (METHODS §8.2, §13.15).
+/// Which asymptotic formula (docs/methods.md §8.2, §13.15).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum OptimismConvention {
@@ -68,7 +68,7 @@ pub enum OptimismConvention {
     Package,
 }
 
-/// METHODS §8.2, §4.6: `D_kl = sum_j H_jkl [Omega (nu2(theta_hat) - nu2_hat)]_j`, from the
+/// docs/methods.md §8.2, §4.6: `D_kl = sum_j H_jkl [Omega (nu2(theta_hat) - nu2_hat)]_j`, from the
 /// model Hessian `hessian[level][k][l]` ([`Model::hessian`](crate::model::Model::hessian)), the
 /// weighting matrix, the implied and the empirical WV.
 ///
@@ -101,7 +101,7 @@ pub fn d_matrix(
     Ok(d)
 }
 
-/// METHODS §8.2: the asymptotic optimism from the Jacobian `a` (J x p), `d` ([`d_matrix`],
+/// docs/methods.md §8.2: the asymptotic optimism from the Jacobian `a` (J x p), `d` ([`d_matrix`],
 /// p x p), the weighting matrix `omega` and the covariance `v` of the WV (both J x J).
 ///
 /// # Errors
@@ -111,7 +111,7 @@ pub fn d_matrix(
 /// ```
 /// use gmwm::selection::{asymptotic_optimism, OptimismConvention};
 /// use nalgebra::DMatrix;
-/// // METHODS §8 test values: WN + RW at tau = 2, 4, 8, Omega = diag(1, 2, 3), D = 0, V = I
+/// // docs/methods.md §8 test values: WN + RW at tau = 2, 4, 8, Omega = diag(1, 2, 3), D = 0, V = I
 /// let a = DMatrix::from_column_slice(3, 2, &[0.5, 0.25, 0.125, 0.25, 0.375, 0.6875]);
 /// let omega = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 2.0, 3.0]));
 /// let o = asymptotic_optimism(&a, &DMatrix::zeros(2, 2), &omega, &DMatrix::identity(3, 3),
@@ -182,7 +182,7 @@ pub fn asymptotic_optimism(
     Ok(opt)
 }
 
-/// METHODS §8.3: `2 tr(C Omega)` with `C` the cross-covariance (divisor H - 1) of the
+/// docs/methods.md §8.3: `2 tr(C Omega)` with `C` the cross-covariance (divisor H - 1) of the
 /// replicate WVs `nu_hat_star[r]` and the implied WVs of the refitted estimates
 /// `nu_theta_star[r]`.
 ///

@@ -1,5 +1,5 @@
-//! The selection procedure (METHODS §8.6): fit the full model, bootstrap V from it, fit every
-//! candidate against the same empirical WV and weights, score it, rank by WIC.
+//! The selection procedure (docs/methods.md §8.6): fit the full model, bootstrap V from it, fit
+//! every candidate against the same empirical WV and weights, score it, rank by WIC.
 
 use super::candidates::{check_candidate, common_denominator, nested_candidates, same_terms};
 use super::optimism::{
@@ -26,15 +26,15 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 pub const DEFAULT_BOOTSTRAP: usize = 50;
 /// Default seed (the package's 1337).
 pub const DEFAULT_SEED: u64 = 1337;
-/// Starting-value draws of the fresh fits behind the bootstrap GoF p-value (METHODS §7.4:
+/// Starting-value draws of the fresh fits behind the bootstrap GoF p-value (docs/methods.md §7.4:
 /// "a fresh guess with G = 10000 draws").
 pub const DEFAULT_BOOTSTRAP_DRAWS: usize = 10_000;
 /// The bootstrap replicates are seeded from `seed + 5`, as the package's `summary` (§7.5), so
 /// that their random streams differ from those of the starting-value search seeded by `seed`.
 const BOOTSTRAP_SEED_OFFSET: u64 = 5;
 
-/// A WIC model selection (METHODS §8): the full model, the candidates and the settings. Build
-/// with [`Wic::nested`] or [`Wic::list`], adjust with the `with_*` setters, run with
+/// A WIC model selection (docs/methods.md §8): the full model, the candidates and the settings.
+/// Build with [`Wic::nested`] or [`Wic::list`], adjust with the `with_*` setters, run with
 /// [`Wic::select`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Wic {
@@ -104,7 +104,7 @@ impl Wic {
         }
     }
 
-    /// Nested selection (METHODS §8.4, `auto.imu`, `rank.models(nested = TRUE)`): every
+    /// Nested selection (docs/methods.md §8.4, `auto.imu`, `rank.models(nested = TRUE)`): every
     /// sub-model of `full` ([`nested_candidates`]); values in `full` are ignored.
     ///
     /// # Errors
@@ -114,7 +114,7 @@ impl Wic {
         Ok(Self::with_candidates(full.without_values(), candidates))
     }
 
-    /// Selection among a user's list (METHODS §8.5, `rank.models(nested = FALSE)`): the
+    /// Selection among a user's list (docs/methods.md §8.5, `rank.models(nested = FALSE)`): the
     /// candidates in the order given (identical term lists merged, values ignored); the common
     /// denominator ([`common_denominator`]) plays the full model and is appended as a candidate
     /// unless a given one has the same terms (which then plays the full model).
@@ -208,7 +208,7 @@ impl Wic {
         self
     }
 
-    /// Sets the WV estimator (classical or robust, METHODS §8.6 `robust`, `eff`, `alpha`);
+    /// Sets the WV estimator (classical or robust, docs/methods.md §8.6 `robust`, `eff`, `alpha`);
     /// default [`WvOptions::default`]. `levels` applies to the data and every replicate.
     pub fn with_wv_options(mut self, options: WvOptions) -> Self {
         self.wv_options = options;
@@ -282,7 +282,7 @@ impl Wic {
         Ok(())
     }
 
-    /// Runs the selection on the series `x` sampled at `freq_hz` (METHODS §8.6):
+    /// Runs the selection on the series `x` sampled at `freq_hz` (docs/methods.md §8.6):
     ///
     /// 1. the WV of `x`, its fast weights, and the full model fitted in guess mode;
     /// 2. asymptotic optimism: `V` = full covariance of the WV at the full model's estimate
@@ -385,8 +385,8 @@ impl Wic {
             move |source| SelectionError::Fit { candidate, source }
         };
         progress.start(self.candidates.len());
-        // every candidate with the package's fast weights (METHODS §5.2, §8.6), for which the
-        // asymptotic optimism is calibrated (selection module docs)
+        // every candidate with the package's fast weights (docs/methods.md §5.2, §8.6), for which
+        // the asymptotic optimism is calibrated (selection module docs)
         let full_fit = self
             .estimator(&self.full)
             .fit_from_wv(wv, inputs)
@@ -807,7 +807,7 @@ impl Context<'_> {
         })
     }
 
-    /// METHODS §8.2 at the candidate's estimate, over the parameters of its active
+    /// docs/methods.md §8.2 at the candidate's estimate, over the parameters of its active
     /// components ([`GmwmFit::active_parameters`], `crate::fit::active`).
     fn asymptotic(&self, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<f64, FitError> {
         let levels = fit.nu_hat.len();
@@ -820,8 +820,8 @@ impl Context<'_> {
         asymptotic_optimism(&a, &d, self.omega, v, self.wic.convention)
     }
 
-    /// METHODS §7.3 with the full model's V, a bootstrap one debiased for its inversion by the
-    /// Hartlap factor ([`hartlap_factor`]); `None` when `J <= p` (no degrees of freedom), when
+    /// docs/methods.md §7.3 with the full model's V, a bootstrap one debiased for its inversion by
+    /// the Hartlap factor ([`hartlap_factor`]); `None` when `J <= p` (no degrees of freedom), when
     /// B is too small for an invertible estimate (`B <= J + 2`), V is not positive definite or
     /// the estimate lies on the boundary of its transform domain.
     fn j_test_p_value(
@@ -855,7 +855,7 @@ impl Context<'_> {
         }
     }
 
-    /// METHODS §8.3 and the bootstrap GoF p-value of §7.4: B series simulated from the
+    /// docs/methods.md §8.3 and the bootstrap GoF p-value of §7.4: B series simulated from the
     /// candidate's estimate; each is refitted from theta_hat (stage 2, its own fast weights)
     /// for `C = Cov(nu2_hat*, nu2(theta*))`, and fitted afresh (guess mode, G =
     /// `bootstrap_draws`) for an objective value; the p-value is the share of those strictly
@@ -914,7 +914,7 @@ impl Context<'_> {
     }
 }
 
-/// One candidate of the selection (METHODS §8.6).
+/// One candidate of the selection (docs/methods.md §8.6).
 ///
 /// Wire format: `model` (canonical text, guess mode), `canonical_model` (its fit read as a
 /// canonical model, [`crate::fit::canonical`]), `objective` (`Q(theta_hat)`, §5.1),
@@ -981,7 +981,7 @@ pub struct SelectionRow {
     pub status: RowStatus,
 }
 
-/// The result of a WIC selection (METHODS §8.6).
+/// The result of a WIC selection (docs/methods.md §8.6).
 ///
 /// Wire format: `full_model`, `method` (`asymptotic`/`bootstrap`), `convention`
 /// (`corrected`/`package`, used by the asymptotic optimism), `bootstrap` (B), `v_method`
@@ -1259,12 +1259,12 @@ impl fmt::Display for ModelSelection {
 }
 
 /// Refuses a wavelet variance with another filter than Haar: every implied WV is the Haar one
-/// (METHODS §1.8, §4), as [`crate::fit::FitError::NotHaar`] says for a single fit.
+/// (docs/methods.md §1.8, §4), as [`crate::fit::FitError::NotHaar`] says for a single fit.
 fn check_haar(filter: crate::WaveletFilter) -> Result<(), SelectionError> {
     crate::fit::check_haar(filter).map_err(|_| SelectionError::Setting {
         name: "filter",
         value: filter.to_string(),
-        expected: "haar: every model's implied wavelet variance is the Haar one (METHODS §1.8, \
-                   §4); other filters are for display only",
+        expected: "haar: every model's implied wavelet variance is the Haar one \
+                   (docs/methods.md §1.8, §4); other filters are for display only",
     })
 }

@@ -1,10 +1,10 @@
-//! Parametric bootstrap of the wavelet variance (METHODS §7.4): nothing is resampled from the
-//! data; each replicate simulates a new series of the observed length from a (fitted) model and
+//! Parametric bootstrap of the wavelet variance (docs/methods.md §7.4): nothing is resampled from
+//! the data; each replicate simulates a new series of the observed length from a (fitted) model and
 //! computes its WV with the observed settings.
 //!
 //! This is the part of the bootstrap that needs only a model, the simulator and the wavelet
-//! variance, so that the fit (bootstrap weights, METHODS §5.2) and inference (§7.4) both build
-//! on it without depending on each other; `gmwm::inference` re-exports it.
+//! variance, so that the fit (bootstrap weights, docs/methods.md §5.2) and inference (§7.4) both
+//! build on it without depending on each other; `gmwm::inference` re-exports it.
 //!
 //! Replicate `r` uses the seed [`replicate_seed`]`(seed, r)`, so results do not depend on the
 //! thread count or on the order in which rayon runs the replicates. Each worker thread reuses
@@ -131,7 +131,7 @@ impl WvBootstrap {
     }
 }
 
-/// METHODS §7.4 `cov_bootstrapper(H)`: the covariance of the WV vector over `replicates`
+/// docs/methods.md §7.4 `cov_bootstrapper(H)`: the covariance of the WV vector over `replicates`
 /// series of length `n` simulated from `model` (all values set), each analysed with `wv_opts`
 /// (set `levels` to the observed J so that every replicate has the same levels).
 ///

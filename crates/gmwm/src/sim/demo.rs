@@ -1,12 +1,12 @@
 //! The built-in demo sensor behind `gmwm demo`: a known truth to simulate, analyse and (once
-//! estimation lands) recover (METHODS §5.10, §10).
+//! estimation lands) recover (docs/methods.md §5.10, §10).
 
 use crate::error::InputError;
 use crate::model::Model;
 use serde::Serialize;
 
-/// The NavChip Y-axis gyroscope of paper Table I (METHODS §5.10), classical column, at 250 Hz:
-/// `3*GM() + WN() + QN() + RW()` with beta = (0.250, 6.28e-3, 8.48) 1/s,
+/// The NavChip Y-axis gyroscope of paper Table I (docs/methods.md §5.10), classical column, at 250
+/// Hz: `3*GM() + WN() + QN() + RW()` with beta = (0.250, 6.28e-3, 8.48) 1/s,
 /// sigma2_gm = (7.08e-9, 1.28e-8, 6.48e-9), WN 6.94e-7, QN 2.29e-6, RW 3.90e-14.
 pub const DEMO_MODEL: &str = "GM(beta=0.25, sigma2_gm=7.08e-9)+GM(beta=6.28e-3, sigma2_gm=1.28e-8)\
 +GM(beta=8.48, sigma2_gm=6.48e-9)+WN(sigma2=6.94e-7)+QN(q2=2.29e-6)+RW(gamma2=3.9e-14)";
@@ -24,7 +24,7 @@ pub struct DemoSensor {
 }
 
 impl Default for DemoSensor {
-    /// The NavChip truth of METHODS §5.10 ([`DEMO_MODEL`] at [`DEMO_FREQ_HZ`]).
+    /// The NavChip truth of docs/methods.md §5.10 ([`DEMO_MODEL`] at [`DEMO_FREQ_HZ`]).
     fn default() -> Self {
         Self {
             model: DEMO_MODEL
@@ -36,7 +36,7 @@ impl Default for DemoSensor {
 }
 
 impl DemoSensor {
-    /// Simulates `n` samples with `seed` (METHODS §10.2, stationary starts).
+    /// Simulates `n` samples with `seed` (docs/methods.md §10.2, stationary starts).
     ///
     /// # Errors
     /// `n == 0`.
@@ -51,7 +51,8 @@ mod tests {
 
     #[test]
     fn demo_sensor_reproduces_methods_5_10() {
-        // METHODS §5.10: implied WV at tau = 2, 2^10, 2^21 (package and hand agree, 7 digits)
+        // docs/methods.md §5.10: implied WV at tau = 2, 2^10, 2^21 (package and hand agree, 7
+        // digits)
         let s = DemoSensor::default();
         let wv = s.model.implied_wv(21, s.freq_hz).unwrap();
         for (j, want) in [(1, 3.782112e-6), (10, 1.927074e-9), (21, 7.281275e-9)] {

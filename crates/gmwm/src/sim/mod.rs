@@ -1,10 +1,11 @@
-//! Seeded simulation (METHODS §10).
+//! Seeded simulation (docs/methods.md §10).
 //!
 //! [`Simulator`] streams any sum of the latent [`Process`](crate::process::Process)es of
-//! METHODS §10.1 (each process simulates itself, next to its implied WV);
+//! docs/methods.md §10.1 (each process simulates itself, next to its implied WV);
 //! [`simulate_model`] and [`Simulator::for_model`] simulate a [`Model`](crate::model::Model);
 //! [`DemoSensor`] is the known truth behind `gmwm demo`.
-//! [`bootstrap`] simulates parametric-bootstrap replicates and their wavelet variances (METHODS §7.4).
+//! [`bootstrap`] simulates parametric-bootstrap replicates and their wavelet variances
+//! (docs/methods.md §7.4).
 
 pub mod bootstrap;
 pub mod demo;

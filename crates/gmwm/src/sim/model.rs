@@ -1,4 +1,4 @@
-//! Simulating a model (METHODS §10.2): the latent processes of a fully specified [`Model`]
+//! Simulating a model (docs/methods.md §10.2): the latent processes of a fully specified [`Model`]
 //! (validated by their constructors, GM at the model's sampling rate, §4.3) summed by one
 //! [`Simulator`].
 
@@ -17,7 +17,7 @@ impl Simulator {
     }
 }
 
-/// Simulates `n` samples of a fully specified model at `freq_hz` (METHODS §10.2).
+/// Simulates `n` samples of a fully specified model at `freq_hz` (docs/methods.md §10.2).
 ///
 /// # Errors
 /// As [`Simulator::for_model`]; `n` must be at least 1.

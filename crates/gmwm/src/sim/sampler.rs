@@ -1,4 +1,4 @@
-//! The simulation state of one process (METHODS §10.1), as the simulator drives it.
+//! The simulation state of one process (docs/methods.md §10.1), as the simulator drives it.
 //!
 //! A process says how it is simulated in its own module (`crate::process::*`): it implements
 //! [`Step`] on a small state (its xoshiro256++ stream, its last values) and builds that state,

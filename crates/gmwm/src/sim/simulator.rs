@@ -1,4 +1,4 @@
-//! Streaming, seeded simulation of a sum of independent processes (METHODS §10.1–§10.2).
+//! Streaming, seeded simulation of a sum of independent processes (docs/methods.md §10.1–§10.2).
 //!
 //! A [`Simulator`] holds one small state per component (the last `p` values and `q`
 //! innovations of an ARMA, the last uniform of QN, the level of RW, the time of DR), built by
@@ -10,8 +10,8 @@
 //! model order.
 //!
 //! The processes are those of [`crate::process`], validated by their constructors; GM is
-//! simulated as its exact AR1 at its sampling rate (METHODS §4.3). Random streams cannot match
-//! R's Mersenne Twister, so only the laws match the package (METHODS §12).
+//! simulated as its exact AR1 at its sampling rate (docs/methods.md §4.3). Random streams cannot
+//! match R's Mersenne Twister, so only the laws match the package (docs/methods.md §12).
 
 use super::sampler::{stream, Sampler};
 use crate::error::ParamError;
@@ -22,13 +22,13 @@ use serde::{Deserialize, Serialize};
 /// How the autoregressive components (AR1, GM, ARMA11, ARMA) start.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum StartMode {
-    /// Default of the port (METHODS §10.1): every sample follows the stationary law. AR1 and
-    /// ARMA11 draw their initial state exactly from it; a generic ARMA(p, q) runs a burn-in of
+    /// Default of the port (docs/methods.md §10.1): every sample follows the stationary law. AR1
+    /// and ARMA11 draw their initial state exactly from it; a generic ARMA(p, q) runs a burn-in of
     /// `p + q + ceil(ln(1e-12) / ln(rho))` samples, `rho` the largest modulus of the inverse
     /// AR roots, so the leftover transient is below `1e-12` relative.
     #[default]
     Stationary,
-    /// The package (METHODS §10.1, §13.21): AR1 and ARMA11 start at `x = 0` (the first kept
+    /// The package (docs/methods.md §10.1, §13.21): AR1 and ARMA11 start at `x = 0` (the first kept
     /// value is `w_1`, resp. `w_1 + theta w_0`); a generic ARMA follows R's `arima.sim`
     /// (first `q` MA outputs set to 0, AR recursion from zeros, burn-in
     /// `p + q + ceil(6 / ln(min root modulus))`). The burn-in innovations come first in the
@@ -36,7 +36,8 @@ pub enum StartMode {
     Zero,
 }
 
-/// A streaming simulator of a sum of independent [`Process`]es (METHODS §10.2, `gen_model`).
+/// A streaming simulator of a sum of independent [`Process`]es (docs/methods.md §10.2,
+/// `gen_model`).
 ///
 /// Same seed, same bits, whatever the chunking of [`fill`](Self::fill) calls. `Send + Sync +
 /// Clone`; a clone continues the same streams.
@@ -86,8 +87,8 @@ impl Simulator {
         })
     }
 
-    /// Chooses how AR parts start (METHODS §10.1, §13.21) and restarts the simulation from its
-    /// first sample (same seed). Cost: the burn-ins of generic ARMA components again.
+    /// Chooses how AR parts start (docs/methods.md §10.1, §13.21) and restarts the simulation from
+    /// its first sample (same seed). Cost: the burn-ins of generic ARMA components again.
     pub fn with_start(mut self, mode: StartMode) -> Self {
         self.start = mode;
         // Validation and burn-in lengths do not depend on the mode beyond what `new` checked:
@@ -123,7 +124,7 @@ impl Simulator {
         }
     }
 
-    /// Writes the next samples of each component separately (METHODS §10.2, `gen_lts`):
+    /// Writes the next samples of each component separately (docs/methods.md §10.2, `gen_lts`):
     /// `out[k]` receives the next `out[k].len()` values of component `k`. Adding the columns
     /// in model order reproduces [`fill`](Self::fill) bit for bit.
     ///
@@ -153,7 +154,8 @@ impl Simulator {
     }
 }
 
-/// Simulates `n` samples of the sum of `processes` from the stationary start (METHODS §10.2).
+/// Simulates `n` samples of the sum of `processes` from the stationary start (docs/methods.md
+/// §10.2).
 ///
 /// # Errors
 /// As [`Simulator::new`], and for `n == 0`.
@@ -163,7 +165,7 @@ impl Simulator {
 /// use gmwm::process::Dr;
 /// use gmwm::sim::simulate;
 /// let x = simulate(&[Dr::new(2.0).unwrap().into()], 4, 1).unwrap();
-/// assert_eq!(x, vec![2.0, 4.0, 6.0, 8.0]); // METHODS §10.3 test value
+/// assert_eq!(x, vec![2.0, 4.0, 6.0, 8.0]); // docs/methods.md §10.3 test value
 /// ```
 pub fn simulate(processes: &[Process], n: usize, seed: u64) -> Result<Vec<f64>, ParamError> {
     if n == 0 {
@@ -185,9 +187,9 @@ pub fn replicate_seed(seed: u64, replicate: u64) -> u64 {
     splitmix64(splitmix64(seed) ^ replicate.wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
 
-/// METHODS §10.1 (QN): `x_t = sqrt(q2) (u_{t+1} - u_t)` for given `u_0..u_N` (`N + 1`
+/// docs/methods.md §10.1 (QN): `x_t = sqrt(q2) (u_{t+1} - u_t)` for given `u_0..u_N` (`N + 1`
 /// values give `N` samples; fewer than two give none). The deterministic path of the QN
-/// simulator, exposed for the hand test values of METHODS §10.3.
+/// simulator, exposed for the hand test values of docs/methods.md §10.3.
 ///
 /// # Examples
 /// ```

@@ -1,4 +1,4 @@
-//! Allan, modified Allan and Hadamard variances (METHODS §3).
+//! Allan, modified Allan and Hadamard variances (docs/methods.md §3).
 //!
 //! One entry point, [`allan_variance`], computes any of five estimators at a standard set of
 //! cluster lengths `m` (in samples), with a chi-square confidence interval on the variance scale.
@@ -7,9 +7,10 @@
 //! - [`AvConvention::Textbook`] (default): the textbook estimators, every available term summed,
 //!   cluster lengths starting at `m = 1` (octaves `1, 2, 4, ...` for the Allan kinds, powers of
 //!   three `1, 3, 9, ...` for the Hadamard kinds). The overlapping Allan variance then satisfies
-//!   `AV(m) = 2 WV(tau = 2m)` exactly (METHODS §3.4).
-//! - [`AvConvention::Package`]: the R package's estimators, defects included (METHODS §13.8–§13.10),
-//!   at the package's cluster lengths, so that results compare with `gmwm::avar`/`gmwm::hadam`.
+//!   `AV(m) = 2 WV(tau = 2m)` exactly (docs/methods.md §3.4).
+//! - [`AvConvention::Package`]: the R package's estimators, defects included (docs/methods.md
+//!   §13.8–§13.10), at the package's cluster lengths, so that results compare with
+//!   `gmwm::avar`/`gmwm::hadam`.
 //!
 //! How far apart the two conventions are on real data (adis_16405_imu1 gyro_x and accel_x, first
 //! 1e5 samples; bounds checked in `tests/allan.rs`):
@@ -35,26 +36,26 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
-/// Which variance of METHODS §3 to compute.
+/// Which variance of docs/methods.md §3 to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum AllanKind {
-    /// Maximal-overlap Allan variance, METHODS §3.2 (package type "mo"). Default: the most
+    /// Maximal-overlap Allan variance, docs/methods.md §3.2 (package type "mo"). Default: the most
     /// efficient Allan estimator, and the one equal to twice the Haar WV (§3.4).
     #[default]
     Overlapping,
-    /// Non-overlapping Allan variance, METHODS §3.1 (package type "to").
+    /// Non-overlapping Allan variance, docs/methods.md §3.1 (package type "to").
     NonOverlapping,
-    /// Modified Allan variance, METHODS §3.6 (Riley; not in the package).
+    /// Modified Allan variance, docs/methods.md §3.6 (Riley; not in the package).
     Modified,
-    /// Maximal-overlap Hadamard variance, METHODS §3.5 (package `hadam` type "mo").
+    /// Maximal-overlap Hadamard variance, docs/methods.md §3.5 (package `hadam` type "mo").
     Hadamard,
-    /// Non-overlapping Hadamard variance, METHODS §3.5 (package `hadam` type "to").
+    /// Non-overlapping Hadamard variance, docs/methods.md §3.5 (package `hadam` type "to").
     HadamardNonOverlapping,
 }
 
 impl AllanKind {
-    /// Every kind, in declaration order (METHODS §3).
+    /// Every kind, in declaration order (docs/methods.md §3).
     pub const ALL: [AllanKind; 5] = [
         AllanKind::Overlapping,
         AllanKind::NonOverlapping,
@@ -63,7 +64,7 @@ impl AllanKind {
         AllanKind::HadamardNonOverlapping,
     ];
 
-    /// The CLI / serde name of the kind (METHODS §3), e.g. `"non-overlapping"`.
+    /// The CLI / serde name of the kind (docs/methods.md §3), e.g. `"non-overlapping"`.
     pub fn name(self) -> &'static str {
         match self {
             AllanKind::Overlapping => "overlapping",
@@ -74,7 +75,7 @@ impl AllanKind {
         }
     }
 
-    /// Whether the kind is a Hadamard variance (cluster lengths `3^i`, METHODS §3.5).
+    /// Whether the kind is a Hadamard variance (cluster lengths `3^i`, docs/methods.md §3.5).
     pub fn is_hadamard(self) -> bool {
         matches!(
             self,
@@ -92,7 +93,7 @@ impl fmt::Display for AllanKind {
 impl FromStr for AllanKind {
     type Err = ParamError;
 
-    /// Parses a CLI name (METHODS §3), case-insensitively.
+    /// Parses a CLI name (docs/methods.md §3), case-insensitively.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         AllanKind::ALL
             .into_iter()
@@ -104,24 +105,24 @@ impl FromStr for AllanKind {
     }
 }
 
-/// Textbook estimators (default) or the package's, defects included (METHODS §13.8–§13.10).
+/// Textbook estimators (default) or the package's, defects included (docs/methods.md §13.8–§13.10).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum AvConvention {
-    /// Textbook estimators over all available terms, cluster lengths from `m = 1` (METHODS §3.1,
-    /// §3.2, §3.5, §3.6). Default: correct, and consistent with the Haar WV (§3.4).
+    /// Textbook estimators over all available terms, cluster lengths from `m = 1` (docs/methods.md
+    /// §3.1, §3.2, §3.5, §3.6). Default: correct, and consistent with the Haar WV (§3.4).
     #[default]
     Textbook,
-    /// The R package gmwm's `avar`/`hadam` (METHODS §3.1, §3.2, §3.5, §13.8–§13.10): disjoint
-    /// pairs/triples for "to", one term short for "mo", divisor `6(M-2)` for the Hadamard "to",
-    /// and its cluster sets (`2^i`, `i = 1..floor(log2 N) - 1`; `3^i`, `i = 1..floor(log3 N) - 1`
-    /// ("mo") or `- 2` ("to")). The package has no modified AV; [`AllanKind::Modified`] is
+    /// The R package gmwm's `avar`/`hadam` (docs/methods.md §3.1, §3.2, §3.5, §13.8–§13.10):
+    /// disjoint pairs/triples for "to", one term short for "mo", divisor `6(M-2)` for the Hadamard
+    /// "to", and its cluster sets (`2^i`, `i = 1..floor(log2 N) - 1`; `3^i`, `i = 1..floor(log3
+    /// N) - 1` ("mo") or `- 2` ("to")). The package has no modified AV; [`AllanKind::Modified`] is
     /// computed as in the textbook convention.
     Package,
 }
 
 impl AvConvention {
-    /// The CLI / serde name (METHODS §13.8): `"textbook"` or `"package"`.
+    /// The CLI / serde name (docs/methods.md §13.8): `"textbook"` or `"package"`.
     pub fn name(self) -> &'static str {
         match self {
             AvConvention::Textbook => "textbook",
@@ -139,7 +140,7 @@ impl fmt::Display for AvConvention {
 impl FromStr for AvConvention {
     type Err = ParamError;
 
-    /// Parses `"textbook"` or `"package"` (METHODS §13.8), case-insensitively.
+    /// Parses `"textbook"` or `"package"` (docs/methods.md §13.8), case-insensitively.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         [AvConvention::Textbook, AvConvention::Package]
             .into_iter()
@@ -148,15 +149,15 @@ impl FromStr for AvConvention {
     }
 }
 
-/// Options of [`allan_variance`] (METHODS §3).
+/// Options of [`allan_variance`] (docs/methods.md §3).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AllanOptions {
-    /// Which variance (default [`AllanKind::Overlapping`], METHODS §3.2).
+    /// Which variance (default [`AllanKind::Overlapping`], docs/methods.md §3.2).
     pub kind: AllanKind,
     /// Confidence level of the chi-square interval, in (0, 1) (default 0.05 for 95% intervals,
-    /// as the WV's, METHODS §1.7).
+    /// as the WV's, docs/methods.md §1.7).
     pub alpha: f64,
-    /// Estimator convention (default [`AvConvention::Textbook`], METHODS §13.8–§13.10).
+    /// Estimator convention (default [`AvConvention::Textbook`], docs/methods.md §13.8–§13.10).
     pub convention: AvConvention,
 }
 
@@ -170,14 +171,14 @@ impl Default for AllanOptions {
     }
 }
 
-/// Allan-type variances of one series across cluster lengths (METHODS §3).
+/// Allan-type variances of one series across cluster lengths (docs/methods.md §3).
 ///
 /// All vectors have one entry per cluster length, in increasing order.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AllanVariance {
-    /// Which variance (METHODS §3).
+    /// Which variance (docs/methods.md §3).
     pub(crate) kind: AllanKind,
-    /// Estimator convention used (METHODS §13.8–§13.10).
+    /// Estimator convention used (docs/methods.md §13.8–§13.10).
     pub(crate) convention: AvConvention,
     /// Number of samples of the series.
     pub(crate) n: usize,
@@ -185,23 +186,24 @@ pub struct AllanVariance {
     pub(crate) freq_hz: f64,
     /// Confidence level of the intervals.
     pub(crate) alpha: f64,
-    /// Cluster lengths `m` in samples (METHODS §3.1: `tau` samples).
+    /// Cluster lengths `m` in samples (docs/methods.md §3.1: `tau` samples).
     pub(crate) tau: Vec<f64>,
     /// Cluster lengths in seconds, `m / freq_hz`.
     pub(crate) tau_s: Vec<f64>,
-    /// The variance estimate (Allan, modified Allan or Hadamard variance; METHODS §3.1–§3.6).
+    /// The variance estimate (Allan, modified Allan or Hadamard variance; docs/methods.md
+    /// §3.1–§3.6).
     pub(crate) avar: Vec<f64>,
-    /// Its square root (Allan / Hadamard deviation, METHODS §3.3).
+    /// Its square root (Allan / Hadamard deviation, docs/methods.md §3.3).
     pub(crate) adev: Vec<f64>,
-    /// Lower chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
+    /// Lower chi-square confidence bound, variance scale (docs/methods.md §1.7 through §3.3/§3.4).
     pub(crate) ci_low: Vec<f64>,
-    /// Upper chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
+    /// Upper chi-square confidence bound, variance scale (docs/methods.md §1.7 through §3.3/§3.4).
     pub(crate) ci_high: Vec<f64>,
     /// Equivalent degrees of freedom of the chi-square interval (see [`allan_variance`]).
     pub(crate) edf: Vec<f64>,
     /// Number of terms (squared differences) summed by the estimator.
     pub(crate) terms: Vec<usize>,
-    /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))` (METHODS §3.3), in both
+    /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))` (docs/methods.md §3.3), in both
     /// conventions; its deviation band is [`AllanVariance::package_band`]. The package itself
     /// calls this band "known to be incorrect"; prefer `ci_low`/`ci_high`.
     pub(crate) error: Vec<f64>,
@@ -209,12 +211,12 @@ pub struct AllanVariance {
 
 /// Read access to the results; the fields are the engine's own.
 impl AllanVariance {
-    /// Which variance (METHODS §3).
+    /// Which variance (docs/methods.md §3).
     pub fn kind(&self) -> AllanKind {
         self.kind
     }
 
-    /// Estimator convention used (METHODS §13.8–§13.10).
+    /// Estimator convention used (docs/methods.md §13.8–§13.10).
     pub fn convention(&self) -> AvConvention {
         self.convention
     }
@@ -234,7 +236,7 @@ impl AllanVariance {
         self.alpha
     }
 
-    /// Cluster lengths `m` in samples (METHODS §3.1: `tau` samples).
+    /// Cluster lengths `m` in samples (docs/methods.md §3.1: `tau` samples).
     pub fn tau(&self) -> &[f64] {
         &self.tau
     }
@@ -244,22 +246,23 @@ impl AllanVariance {
         &self.tau_s
     }
 
-    /// The variance estimate (Allan, modified Allan or Hadamard variance; METHODS §3.1–§3.6).
+    /// The variance estimate (Allan, modified Allan or Hadamard variance; docs/methods.md
+    /// §3.1–§3.6).
     pub fn avar(&self) -> &[f64] {
         &self.avar
     }
 
-    /// Its square root (Allan / Hadamard deviation, METHODS §3.3).
+    /// Its square root (Allan / Hadamard deviation, docs/methods.md §3.3).
     pub fn adev(&self) -> &[f64] {
         &self.adev
     }
 
-    /// Lower chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
+    /// Lower chi-square confidence bound, variance scale (docs/methods.md §1.7 through §3.3/§3.4).
     pub fn ci_low(&self) -> &[f64] {
         &self.ci_low
     }
 
-    /// Upper chi-square confidence bound, variance scale (METHODS §1.7 through §3.3/§3.4).
+    /// Upper chi-square confidence bound, variance scale (docs/methods.md §1.7 through §3.3/§3.4).
     pub fn ci_high(&self) -> &[f64] {
         &self.ci_high
     }
@@ -274,7 +277,7 @@ impl AllanVariance {
         &self.terms
     }
 
-    /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))` (METHODS §3.3), in both
+    /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))` (docs/methods.md §3.3), in both
     /// conventions; its deviation band is [`AllanVariance::package_band`]. The package itself
     /// calls this band "known to be incorrect"; prefer `ci_low`/`ci_high`.
     pub fn error(&self) -> &[f64] {
@@ -284,7 +287,7 @@ impl AllanVariance {
 
 impl AllanVariance {
     /// The package's deviation-scale band `(adev (1 - e), adev (1 + e))` per cluster length
-    /// (METHODS §3.3; the `lci`/`uci` columns of `gmwm::avar`).
+    /// (docs/methods.md §3.3; the `lci`/`uci` columns of `gmwm::avar`).
     pub fn package_band(&self) -> (Vec<f64>, Vec<f64>) {
         let lo = self
             .adev
@@ -339,7 +342,7 @@ impl fmt::Display for AllanVariance {
     }
 }
 
-/// Computes an Allan-type variance at all standard cluster lengths (METHODS §3).
+/// Computes an Allan-type variance at all standard cluster lengths (docs/methods.md §3).
 ///
 /// # Formula
 /// With moving means `ybar_k(m) = mean(x_k .. x_{k+m-1})` and block means
@@ -355,19 +358,19 @@ impl fmt::Display for AllanVariance {
 ///
 /// Cluster lengths start at `m = 1` and continue while at least one term exists, so the
 /// overlapping AV is defined at the same cluster lengths as the Haar MODWT WV with
-/// `J = floor(log2 N)` levels and `AV(2^{j-1}) = 2 nu2_j` (METHODS §3.4, §13.23); these are also
-/// allantools' octave taus.
+/// `J = floor(log2 N)` levels and `AV(2^{j-1}) = 2 nu2_j` (docs/methods.md §3.4, §13.23); these are
+/// also allantools' octave taus.
 ///
-/// Equivalent degrees of freedom: the overlapping kinds use the eta3 rule of METHODS §1.7,
+/// Equivalent degrees of freedom: the overlapping kinds use the eta3 rule of docs/methods.md §1.7,
 /// "terms / filter width" (for the overlapping AV exactly eta3 of the Haar WV at `tau = 2m`, via
 /// §3.4); the non-overlapping kinds use the exact edf of a sum of squared Gaussian white-noise
 /// differences (lag correlations -1/2 for first differences; -2/3 and 1/6 for second differences).
 /// The package convention's disjoint pairs/triples are independent under white noise, so their
 /// edf is the number `M` of pairs/triples; its "mo" estimators use the textbook overlapping
-/// rule (with the full count `N - 2m + 1` or `N - 3m + 1`). The interval is the chi-square interval of METHODS
-/// §1.7 on the variance scale.
+/// rule (with the full count `N - 2m + 1` or `N - 3m + 1`). The interval is the chi-square interval
+/// of docs/methods.md §1.7 on the variance scale.
 ///
-/// Package convention: see [`AvConvention::Package`] and METHODS §3.1, §3.2, §3.5. A
+/// Package convention: see [`AvConvention::Package`] and docs/methods.md §3.1, §3.2, §3.5. A
 /// Hadamard "mo" level with `N = 3m` has no term; the package crashes there (§13.10), this port
 /// returns 0 (like the package's AV "mo" at `N = 2m`).
 ///
@@ -386,7 +389,7 @@ impl fmt::Display for AllanVariance {
 /// # Examples
 /// ```
 /// use gmwm::{allan_variance, AllanOptions};
-/// // METHODS §3.4 test values: x = (1,3,2,5,4,6,8,7), textbook overlapping AV(2) = 2.1
+/// // docs/methods.md §3.4 test values: x = (1,3,2,5,4,6,8,7), textbook overlapping AV(2) = 2.1
 /// let x = [1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0];
 /// let av = allan_variance(&x, 1.0, &AllanOptions::default()).unwrap();
 /// assert_eq!(av.tau(), [1.0, 2.0, 4.0]);
@@ -455,7 +458,7 @@ pub fn allan_variance(
     Ok(out)
 }
 
-/// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))`, METHODS §3.3.
+/// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))`, docs/methods.md §3.3.
 pub fn package_error(n: usize, m: usize) -> f64 {
     1.0 / (2.0 * (n as f64 / m as f64 - 1.0)).sqrt()
 }
@@ -506,7 +509,7 @@ impl Method {
         }
     }
 
-    /// Cluster lengths (METHODS §3.1, §3.5; textbook rule in [`allan_variance`]).
+    /// Cluster lengths (docs/methods.md §3.1, §3.5; textbook rule in [`allan_variance`]).
     fn clusters(self, n: usize) -> Vec<usize> {
         match self {
             // at least one term: N - 2m + 1 >= 1 (and K = floor(N/m) >= 2, the same condition)
@@ -655,8 +658,8 @@ fn powers(base: usize, first: u32, keep: impl Fn(usize) -> bool) -> Vec<usize> {
 }
 
 /// The package's cluster set `base^i`, `i = 1..floor(log10(N)/log10(base)) - drop`, with the
-/// level count evaluated in floating point exactly as `avar_*_cpp`/`hadam_*_cpp` do (METHODS §3.1,
-/// §3.5).
+/// level count evaluated in floating point exactly as `avar_*_cpp`/`hadam_*_cpp` do
+/// (docs/methods.md §3.1, §3.5).
 fn package_levels(
     n: usize,
     base: f64,
@@ -672,7 +675,7 @@ fn package_levels(
 }
 
 /// Prefix sums `S_0 = 0`, `S_{i+1} = sum_{t<=i} (x_t - mean)` of the centred series, each computed
-/// with Neumaier-compensated summation and rounded once (METHODS §3 numerics).
+/// with Neumaier-compensated summation and rounded once (docs/methods.md §3 numerics).
 fn centred_prefix_sums(x: &[f64]) -> Vec<f64> {
     let n = x.len() as f64;
     let mean = NeumaierSum::of(x.iter().copied()) / n;
@@ -717,7 +720,7 @@ fn blocked_sum(len: usize, f: impl Fn(usize) -> f64) -> f64 {
 }
 
 /// `sum_{k < terms} (S_{k+2m} - 2 S_{k+m} + S_k)^2` = `m^2 sum (ybar_{k+m} - ybar_k)^2`
-/// (METHODS §3.2).
+/// (docs/methods.md §3.2).
 fn sum_sq_second_diff(s: &[f64], m: usize, terms: usize) -> f64 {
     let a = &s[2 * m..2 * m + terms];
     let b = &s[m..m + terms];
@@ -749,7 +752,7 @@ fn sum_sq_second_diff(s: &[f64], m: usize, terms: usize) -> f64 {
 }
 
 /// `sum_{k < terms} (S_{k+3m} - 3 S_{k+2m} + 3 S_{k+m} - S_k)^2`
-/// = `m^2 sum (ybar_{k+2m} - 2 ybar_{k+m} + ybar_k)^2` (METHODS §3.5).
+/// = `m^2 sum (ybar_{k+2m} - 2 ybar_{k+m} + ybar_k)^2` (docs/methods.md §3.5).
 fn sum_sq_third_diff(s: &[f64], m: usize, terms: usize) -> f64 {
     let a = &s[3 * m..3 * m + terms];
     let b = &s[2 * m..2 * m + terms];
@@ -761,7 +764,7 @@ fn sum_sq_third_diff(s: &[f64], m: usize, terms: usize) -> f64 {
     })
 }
 
-/// Block means `Y_k = (S_{(k+1)m} - S_{km}) / m`, `k < floor(N/m)` (METHODS §3.1).
+/// Block means `Y_k = (S_{(k+1)m} - S_{km}) / m`, `k < floor(N/m)` (docs/methods.md §3.1).
 fn block_means(s: &[f64], m: usize) -> Vec<f64> {
     let k = (s.len() - 1) / m;
     let mf = m as f64;
@@ -769,8 +772,9 @@ fn block_means(s: &[f64], m: usize) -> Vec<f64> {
 }
 
 /// `sum_{j < terms} [sum_{i=j}^{j+m-1} (S_{i+2m} - 2 S_{i+m} + S_i)]^2`, i.e.
-/// `m^4 * 2 (N - 3m + 2) MVAR(m)` (METHODS §3.6), in O(N): the inner window sums are differences
-/// of a compensated running sum `Q` of the second differences `D_i = S_{i+2m} - 2S_{i+m} + S_i`.
+/// `m^4 * 2 (N - 3m + 2) MVAR(m)` (docs/methods.md §3.6), in O(N): the inner window sums are
+/// differences of a compensated running sum `Q` of the second differences `D_i = S_{i+2m} -
+/// 2S_{i+m} + S_i`.
 fn modified_sum(s: &[f64], m: usize, terms: usize) -> f64 {
     // D_i for i = 0..terms + m - 1 (= N - 2m + 1 values), Q_0 = 0, Q_{i+1} = Q_i + D_i
     let nd = terms + m - 1;
@@ -814,7 +818,7 @@ mod tests {
 
     #[test]
     fn package_levels_match_the_cpp_counts() {
-        // METHODS §3.1, §3.5: N = 1e5 gives 15 AV, 9 HV "mo" and 8 HV "to" levels
+        // docs/methods.md §3.1, §3.5: N = 1e5 gives 15 AV, 9 HV "mo" and 8 HV "to" levels
         assert_eq!(package_levels(100_000, 2.0, 1, 2, |_| true).len(), 15);
         assert_eq!(package_levels(100_000, 3.0, 1, 3, |_| true).len(), 9);
         assert_eq!(package_levels(100_000, 3.0, 2, 3, |_| true).len(), 8);

@@ -1,4 +1,4 @@
-//! Chi-square ("eta3") confidence intervals of a variance estimate (METHODS §1.7).
+//! Chi-square ("eta3") confidence intervals of a variance estimate (docs/methods.md §1.7).
 
 use crate::error::ParamError;
 use statrs::distribution::{ChiSquared, Continuous, ContinuousCDF, Normal};
@@ -20,7 +20,7 @@ pub fn check_alpha(alpha: f64) -> Result<(), ParamError> {
     }
 }
 
-/// Equivalent degrees of freedom of the level-j WV, METHODS §1.7, paper eq. (1) CI:
+/// Equivalent degrees of freedom of the level-j WV, docs/methods.md §1.7, paper eq. (1) CI:
 /// `eta_j = max(M_j / 2^j, 1)` with `M_j` the number of kept coefficients.
 pub fn eta3(kept: usize, j: usize) -> f64 {
     (kept as f64 / (j as f64).exp2()).max(1.0)
@@ -68,7 +68,7 @@ fn check_df(name: &'static str, df: f64) -> Result<(), ParamError> {
 }
 
 /// Chi-square interval of a variance estimate with `eta` equivalent degrees of freedom,
-/// METHODS §1.7: `[eta v / q(1 - alpha/2; eta), eta v / q(alpha/2; eta)]`.
+/// docs/methods.md §1.7: `[eta v / q(1 - alpha/2; eta), eta v / q(alpha/2; eta)]`.
 ///
 /// # Errors
 /// [`ParamError`] naming `alpha` when it is outside (0, 1) ([`check_alpha`]), `eta` when it is
@@ -96,7 +96,7 @@ pub(crate) fn interval_unchecked(estimate: f64, eta: f64, alpha: f64) -> (f64, f
 }
 
 /// Quantile of the chi-square distribution with real `df > 0` at probability `p` in (0, 1)
-/// (METHODS §12).
+/// (docs/methods.md §12).
 ///
 /// statrs' own `inverse_cdf` returns NaN at df = 1, p = 0.025 and is off by 4e-3 in probability
 /// at df = 5e5 (the level-1 eta of a 1e6-sample series), so this solves `P(df/2, x/2) = p`
@@ -174,8 +174,8 @@ fn quantile_from_tail(tail: f64, upper: bool, df: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// statrs inverts the regularised gamma by bisection/Newton to ~1e-9 relative; the METHODS
-    /// values carry 7 significant digits.
+    /// statrs inverts the regularised gamma by bisection/Newton to ~1e-9 relative; the test
+    /// values of docs/methods.md carry 7 significant digits.
     const TOL: f64 = 5e-7;
 
     fn close(a: f64, b: f64) -> bool {
@@ -184,7 +184,7 @@ mod tests {
 
     #[test]
     fn chi_square_interval_matches_methods_1_7() {
-        // METHODS §1.10 test values: nu = 1, M = 100, alpha = 0.05
+        // docs/methods.md §1.10 test values: nu = 1, M = 100, alpha = 0.05
         for (j, lo, hi) in [
             (1, 0.7000821, 1.545243),
             (2, 0.6150596, 1.905528),

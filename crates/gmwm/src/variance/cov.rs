@@ -1,11 +1,12 @@
-//! Asymptotic diagonal covariance of the wavelet variance ("diag", Percival 1995; METHODS §1.10).
+//! Asymptotic diagonal covariance of the wavelet variance ("diag", Percival 1995; docs/methods.md
+//! §1.10).
 
 use crate::error::{check_series, InputError};
 use crate::wavelet::{Modwt, WaveletFilter};
 use rustfft::{num_complex::Complex, FftPlanner};
 use serde::{Deserialize, Serialize};
 
-/// Which count divides `A_j` (METHODS §1.10, §13.4).
+/// Which count divides `A_j` (docs/methods.md §1.10, §13.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum DiagDivisor {
@@ -17,7 +18,7 @@ pub enum DiagDivisor {
 }
 
 /// `A = s_0^2 / 2 + sum_{k >= 1} s_k^2` for the biased, non-centred sample autocovariance
-/// `s_k = (1/n) sum_t w_t w_{t+k}` of `w` (METHODS §1.10).
+/// `s_k = (1/n) sum_t w_t w_{t+k}` of `w` (docs/methods.md §1.10).
 ///
 /// Computed with one zero-padded FFT and Parseval: with padding `L >= 2n - 1` the circular
 /// autocovariance equals the linear one, so `sum_{|k| < n} s_k^2 = (1/L) sum_f |X_f|^4 / n^2`
@@ -42,8 +43,8 @@ pub fn half_sum_squared_autocovariance(w: &[f64]) -> f64 {
 }
 
 /// Diagonal of the asymptotic covariance matrix V of the MODWT wavelet variance at levels
-/// `1..=levels`, METHODS §1.10: `V_jj = 2 A_j / n_j` (or `/ n_1` with [`DiagDivisor::Package`]).
-/// Multiply by `1 / eff` for the robust estimator.
+/// `1..=levels`, docs/methods.md §1.10: `V_jj = 2 A_j / n_j` (or `/ n_1` with
+/// [`DiagDivisor::Package`]). Multiply by `1 / eff` for the robust estimator.
 ///
 /// # Errors
 /// Bad series or levels, as [`Modwt::transform`].
@@ -73,7 +74,7 @@ pub fn wv_diag_covariance(
 mod tests {
     use super::*;
 
-    /// METHODS values carry 7 significant digits.
+    /// The test values of docs/methods.md carry 7 significant digits.
     const TOL: f64 = 5e-7;
 
     #[test]

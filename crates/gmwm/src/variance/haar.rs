@@ -1,6 +1,6 @@
 //! In-memory Haar MODWT kernel behind [`wavelet_variance`](crate::wavelet_variance)
-//! (METHODS §1.2, §1.3, §1.5): the classical Haar wavelet variance by a cache-blocked pyramid
-//! split in time (low levels) and in phase (high levels).
+//! (docs/methods.md §1.2, §1.3, §1.5): the classical Haar wavelet variance by a cache-blocked
+//! pyramid split in time (low levels) and in phase (high levels).
 //!
 //! The pyramid is the one of [`HaarWvAccumulator`](crate::HaarWvAccumulator) with two changes
 //! that do not change a single rounding: the scaling coefficients are kept as window *sums*
@@ -87,7 +87,7 @@ impl LevelSink for SquareSums {
 }
 
 /// Per-level sums of squared Haar MODWT wavelet coefficients `sum_t W_{j,t}^2` over the
-/// boundary-free `t >= 2^j - 1` (METHODS §1.3, §1.5), `j = 1..=levels`, of `x - offset`, by
+/// boundary-free `t >= 2^j - 1` (docs/methods.md §1.3, §1.5), `j = 1..=levels`, of `x - offset`, by
 /// [`haar_pass`].
 ///
 /// Non-finite sums (window sums or squares overflowing for data near `f64::MAX`, or a
@@ -104,8 +104,8 @@ pub(crate) fn haar_square_sums(x: &[f64], levels: usize, offset: f64) -> Vec<f64
         .collect()
 }
 
-/// The Haar MODWT pyramid of `x - offset` (METHODS §1.2), levels `1..=levels`, feeding every
-/// level's boundary-free coefficients (METHODS §1.3) to sinks made by `make`.
+/// The Haar MODWT pyramid of `x - offset` (docs/methods.md §1.2), levels `1..=levels`, feeding
+/// every level's boundary-free coefficients (docs/methods.md §1.3) to sinks made by `make`.
 ///
 /// Stage A runs levels `1..=L` ([`low_levels`]) as a pyramid over blocks of [`BLOCK`] samples,
 /// in parts of [`PART`] samples; each part first runs the pyramid, without counting, over the
@@ -203,7 +203,8 @@ fn stage_a<S: LevelSink>(
             *c = v - offset;
         }
         for j in 1..=levels {
-            // the first boundary-free coefficient of level j is at t = 2^j - 1 (METHODS §1.3)
+            // the first boundary-free coefficient of level j is at t = 2^j - 1 (docs/methods.md
+            // §1.3)
             let skip = if t < t0 {
                 b
             } else {
@@ -282,8 +283,8 @@ fn stage_b<S: LevelSink>(
     let mut diff = Vec::new();
     for j in low + 1..=levels {
         let lag = 1usize << (j - 1 - low);
-        // rows before first_row hold boundary coefficients (METHODS §1.3): t = r + k 2^low is
-        // kept iff k >= 2^{j-low}, or k = 2^{j-low} - 1 for the last phase r = 2^low - 1
+        // rows before first_row hold boundary coefficients (docs/methods.md §1.3): t = r + k 2^low
+        // is kept iff k >= 2^{j-low}, or k = 2^{j-low} - 1 for the last phase r = 2^low - 1
         let first_row = 1usize << (j - low);
         let mut tail = 0.0;
         diff.clear();
@@ -576,7 +577,7 @@ mod tests {
             .collect()
     }
 
-    /// Direct `sum_t W_{j,t}^2` from the closed form of METHODS §1.2 (window means).
+    /// Direct `sum_t W_{j,t}^2` from the closed form of docs/methods.md §1.2 (window means).
     fn naive_sums(x: &[f64], levels: usize) -> Vec<f64> {
         (1..=levels)
             .map(|j| {

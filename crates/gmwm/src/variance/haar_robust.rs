@@ -1,5 +1,5 @@
-//! Robust Haar MODWT wavelet variance of an in-memory series, Exact convention (METHODS §2.1,
-//! §2.4 "Port"): the windowed solver of
+//! Robust Haar MODWT wavelet variance of an in-memory series, Exact convention (docs/methods.md
+//! §2.1, §2.4 "Port"): the windowed solver of
 //! [`robust_scale_long`](crate::variance::robust::robust_scale_long) with every level's pass
 //! folded into one pyramid over the data ([`haar_pass`]).
 //!
@@ -64,9 +64,9 @@ impl LevelSink for RobustSink {
     }
 }
 
-/// Per level `j = 1..=levels` of `x - offset`: the classical WV (mean of `W_{j,t}^2`, METHODS
-/// §1.5), the robust variance `s^2` (METHODS §2.1, Exact convention; `Err` as
-/// [`robust_scale`]) and the number of kept coefficients.
+/// Per level `j = 1..=levels` of `x - offset`: the classical WV (mean of `W_{j,t}^2`,
+/// docs/methods.md §1.5), the robust variance `s^2` (docs/methods.md §2.1, Exact convention; `Err`
+/// as [`robust_scale`]) and the number of kept coefficients.
 pub(crate) fn haar_robust_levels(
     x: &[f64],
     levels: usize,

@@ -2,15 +2,15 @@
 //! computed exactly instead of by simulation.
 //!
 //! `V_jk = Cov(nu2_hat_j, nu2_hat_k)` over series of length `N` drawn from the model is what the
-//! parametric bootstrap of METHODS §7.4 (`cov_bootstrapper`) estimates with `H` replicates; this
-//! module gives its value as `H -> infinity`, with no Monte Carlo error, in `O(J^2)` work
+//! parametric bootstrap of docs/methods.md §7.4 (`cov_bootstrapper`) estimates with `H` replicates;
+//! this module gives its value as `H -> infinity`, with no Monte Carlo error, in `O(J^2)` work
 //! independent of `N` (about 0.1 s at `N = 10^8`, `J = 26`, where 50 replicates take minutes).
 //!
 //! # Formulas
 //! Let `S_t = x_0 + ... + x_t` and, at level `j` (`L_j = 2^j`, `H_j = L_j / 2`), the Haar MODWT
 //! coefficient `W_{j,t} = (S_t - 2 S_{t-H_j} + S_{t-L_j}) / L_j` (the recent half-window's sum
 //! minus the older one's, over `L_j`; kept for `t = L_j - 1 .. N - 1`, so `M_j = N - L_j + 1`
-//! coefficients, METHODS §1.3). The estimator is `nu2_hat_j = (1/M_j) sum_t W_{j,t}^2`.
+//! coefficients, docs/methods.md §1.3). The estimator is `nu2_hat_j = (1/M_j) sum_t W_{j,t}^2`.
 //!
 //! 1. **Covariance of the coefficients.** Write `Cov(S_x, S_y) = K(y - x) + f(x) + g(y)`: the
 //!    weights `(1, -2, 1)` sum to zero, so `f` and `g` drop out and, with `A_j = {0, H_j, L_j}`,
@@ -34,7 +34,7 @@
 //!    - DR(`omega`) is deterministic: it adds no covariance but a mean `mu_j = omega L_j / 4`
 //!      to every coefficient.
 //!
-//!    Checks: `gamma_jj(0)` is the implied WV of METHODS §4.2 for each process (tested).
+//!    Checks: `gamma_jj(0)` is the implied WV of docs/methods.md §4.2 for each process (tested).
 //! 2. **Covariance of the squares.** For `W = mu + Z` with `Z` a linear process in independent
 //!    innovations `xi_u` (fourth cumulant `kappa_u`, zero third cumulant),
 //!    `Cov(W_a^2, W_b^2) = 2 Cov(Z_a, Z_b)^2 + 4 mu_a mu_b Cov(Z_a, Z_b) + sum_u alpha_a(u)^2 alpha_b(u)^2 kappa_u`.
@@ -55,9 +55,9 @@
 //!
 //! Assumptions, as in the bootstrap it replaces: the series is the model (Gaussian innovations,
 //! QN's uniform ones, AR processes from their stationary law); a robust WV's covariance is taken
-//! as the classical one over the efficiency (METHODS §1.10). Generic ARMA(p, q) and negative
-//! autoregressive coefficients are not covered: [`exact_wv_covariance`] says so and the callers
-//! simulate instead.
+//! as the classical one over the efficiency (docs/methods.md §1.10). Generic ARMA(p, q) and
+//! negative autoregressive coefficients are not covered: [`exact_wv_covariance`] says so and the
+//! callers simulate instead.
 
 use crate::error::{InputError, ParamError};
 use crate::model::Model;
@@ -486,8 +486,8 @@ pub(crate) fn exact_covariance_of(
 
 /// The exact covariance matrix `V` (`levels x levels`) of the classical Haar MODWT wavelet
 /// variance of `n`-sample series drawn from `model` (all values set) at `freq_hz`: the limit of
-/// the parametric bootstrap of METHODS §7.4 as its replicates grow, without simulating (module
-/// docs give the formulas). Divide by the efficiency for a robust WV.
+/// the parametric bootstrap of docs/methods.md §7.4 as its replicates grow, without simulating
+/// (module docs give the formulas). Divide by the efficiency for a robust WV.
 ///
 /// ```
 /// use gmwm::model::Model;
@@ -752,7 +752,7 @@ mod tests {
 
     #[test]
     fn diagonal_lag_zero_is_the_implied_wv() {
-        // gamma_jj(0) is the process's WV at tau = 2^j (METHODS §4.2)
+        // gamma_jj(0) is the process's WV at tau = 2^j (docs/methods.md §4.2)
         for text in [
             "WN(sigma2=2)",
             "RW(gamma2=0.5)",

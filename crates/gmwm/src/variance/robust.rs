@@ -1,4 +1,4 @@
-//! Robust wavelet variance: Tukey-biweight M-estimator of scale (METHODS §2).
+//! Robust wavelet variance: Tukey-biweight M-estimator of scale (docs/methods.md §2).
 //!
 //! Per level, the robust WV is the `s^2` solving the "Huber Proposal 2" scale equation
 //! `(1/n) sum_i psi_c(y_i / s)^2 = a(c)` built on Tukey's biweight `psi_c` (§2.1), with the
@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
-/// Which tuning constant and solver to use (METHODS §2.3–§2.4).
+/// Which tuning constant and solver to use (docs/methods.md §2.3–§2.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RobustConvention {
@@ -34,7 +34,7 @@ pub enum RobustConvention {
 }
 
 impl fmt::Display for RobustConvention {
-    /// `exact` or `package` (METHODS §2.3–§2.4), the spelling [`FromStr`] accepts.
+    /// `exact` or `package` (docs/methods.md §2.3–§2.4), the spelling [`FromStr`] accepts.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             RobustConvention::Exact => "exact",
@@ -46,7 +46,7 @@ impl fmt::Display for RobustConvention {
 impl FromStr for RobustConvention {
     type Err = ParamError;
 
-    /// Parses `exact` or `package`, case-insensitively (METHODS §2.3–§2.4).
+    /// Parses `exact` or `package`, case-insensitively (docs/methods.md §2.3–§2.4).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         if s.eq_ignore_ascii_case("exact") {
             Ok(RobustConvention::Exact)
@@ -62,27 +62,27 @@ impl FromStr for RobustConvention {
     }
 }
 
-/// Default requested Gaussian efficiency, the package's `eff = 0.6` (METHODS §2.3; paper
+/// Default requested Gaussian efficiency, the package's `eff = 0.6` (docs/methods.md §2.3; paper
 /// Sec. III: near 0.5 is highly robust).
 pub const DEFAULT_EFF: f64 = 0.6;
 
 /// Largest efficiency accepted; the package refuses `eff > 0.99` for robust estimation
-/// (METHODS §2.5 R-level guard): the tuning constant grows without bound as eff -> 1 and the
-/// estimator stops being robust.
+/// (docs/methods.md §2.5 R-level guard): the tuning constant grows without bound as eff -> 1 and
+/// the estimator stops being robust.
 pub const MAX_EFF: f64 = 0.99;
 
-/// Options of the robust estimator (METHODS §2).
+/// Options of the robust estimator (docs/methods.md §2).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RobustOptions {
-    /// Requested Gaussian efficiency in (0, 0.99] (METHODS §2.3).
+    /// Requested Gaussian efficiency in (0, 0.99] (docs/methods.md §2.3).
     pub eff: f64,
-    /// Convention (METHODS §2.3–§2.4).
+    /// Convention (docs/methods.md §2.3–§2.4).
     pub convention: RobustConvention,
 }
 
 impl Default for RobustOptions {
-    /// `eff = 0.6` (the package default, METHODS §2.3) with the [`RobustConvention::Exact`]
-    /// convention (correct formulas, METHODS §2.4 "Port").
+    /// `eff = 0.6` (the package default, docs/methods.md §2.3) with the [`RobustConvention::Exact`]
+    /// convention (correct formulas, docs/methods.md §2.4 "Port").
     fn default() -> Self {
         Self {
             eff: DEFAULT_EFF,
@@ -92,7 +92,7 @@ impl Default for RobustOptions {
 }
 
 impl RobustOptions {
-    /// Validated constructor (METHODS §2.3, §2.5).
+    /// Validated constructor (docs/methods.md §2.3, §2.5).
     ///
     /// # Errors
     /// [`ParamError`] (name `eff`) unless `eff` is finite and in `(0, 0.99]`; values above 0.99
@@ -102,7 +102,7 @@ impl RobustOptions {
         Ok(Self { eff, convention })
     }
 
-    /// The tuning constant `c` of these options (METHODS §2.3); see [`tuning_constant`].
+    /// The tuning constant `c` of these options (docs/methods.md §2.3); see [`tuning_constant`].
     ///
     /// # Errors
     /// As [`tuning_constant`].
@@ -152,7 +152,7 @@ fn check_c(c: f64) -> Result<(), ParamError> {
 /// `1 / sqrt(2 pi)`, the standard normal density at 0.
 const INV_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
 
-/// Truncated standard normal moments `mu_0, mu_2, ..., mu_20` at `c` (METHODS §2.2).
+/// Truncated standard normal moments `mu_0, mu_2, ..., mu_20` at `c` (docs/methods.md §2.2).
 ///
 /// # Formula
 /// `mu_{2k}(c) = E[Z^{2k} 1{|Z| <= c}]`, `Z ~ N(0, 1)`, by the recursion
@@ -174,10 +174,10 @@ pub fn truncated_normal_moments(c: f64) -> [f64; 11] {
     mu
 }
 
-/// Beyond this `c`, `P(|Z| > c) < 2e-17` is below half an ulp of 1 (METHODS §2.2).
+/// Beyond this `c`, `P(|Z| > c) < 2e-17` is below half an ulp of 1 (docs/methods.md §2.2).
 const CENTRAL_MASS_ONE: f64 = 8.5;
 
-/// `P(|Z| <= c) = 2 Phi(c) - 1` for `c >= 0`, given `two_phi = 2 phi(c)` (METHODS §2.2).
+/// `P(|Z| <= c) = 2 Phi(c) - 1` for `c >= 0`, given `two_phi = 2 phi(c)` (docs/methods.md §2.2).
 ///
 /// Series `2 phi(c) sum_{n >= 0} c^{2n+1} / (2n+1)!!` (all terms positive, so no
 /// cancellation; relative error a few ulps). Used instead of `statrs`' erf, whose error near
@@ -202,7 +202,8 @@ fn central_normal_mass(c: f64, two_phi: f64) -> f64 {
     (two_phi * total).min(1.0)
 }
 
-/// `sum_i coef[i] mu[first + i] / c^{2i}`: a binomial expansion in `z^2 / c^2` (METHODS §2.2–2.3).
+/// `sum_i coef[i] mu[first + i] / c^{2i}`: a binomial expansion in `z^2 / c^2` (docs/methods.md
+/// §2.2–2.3).
 fn expand(mu: &[f64; 11], first: usize, coef: &[f64], c: f64) -> f64 {
     let inv_c2 = 1.0 / (c * c);
     let mut scale = 1.0;
@@ -214,15 +215,15 @@ fn expand(mu: &[f64; 11], first: usize, coef: &[f64], c: f64) -> f64 {
     total
 }
 
-/// Binomial coefficients of `(1 - x)^4` (METHODS §2.2).
+/// Binomial coefficients of `(1 - x)^4` (docs/methods.md §2.2).
 const BINOM4: [f64; 5] = [1.0, -4.0, 6.0, -4.0, 1.0];
-/// Binomial coefficients of `(1 - x)^8` (METHODS §2.3).
+/// Binomial coefficients of `(1 - x)^8` (docs/methods.md §2.3).
 const BINOM8: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, -8.0, 1.0];
-/// The package's `(1 - x)^8` with the sign slip on the `mu_18` term (METHODS §2.3, §13.5).
+/// The package's `(1 - x)^8` with the sign slip on the `mu_18` term (docs/methods.md §2.3, §13.5).
 const BINOM8_PACKAGE: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, 8.0, 1.0];
 
 /// `a(c) = E[psi_c(Z)^2]`, the Gaussian consistency constant of the biweight scale equation
-/// (METHODS §2.2).
+/// (docs/methods.md §2.2).
 ///
 /// # Formula
 /// `a(c) = mu_2 - 4 mu_4 / c^2 + 6 mu_6 / c^4 - 4 mu_8 / c^6 + mu_10 / c^8`
@@ -230,7 +231,7 @@ const BINOM8_PACKAGE: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, 8.0
 ///
 /// # Examples
 /// ```
-/// // METHODS §2.5 test value: a(4.400278) = 0.5691689
+/// // docs/methods.md §2.5 test value: a(4.400278) = 0.5691689
 /// assert!((gmwm::variance::robust::a_of_c(4.400278) - 0.5691689).abs() < 1e-7);
 /// ```
 pub fn a_of_c(c: f64) -> f64 {
@@ -238,7 +239,7 @@ pub fn a_of_c(c: f64) -> f64 {
     expand(&mu, 1, &BINOM4, c)
 }
 
-/// `M(c)` and `Q(c)` of METHODS §2.3, with the given `(1 - x)^8` coefficients.
+/// `M(c)` and `Q(c)` of docs/methods.md §2.3, with the given `(1 - x)^8` coefficients.
 fn m_and_q(c: f64, binom8: &[f64; 9]) -> (f64, f64) {
     let mu = truncated_normal_moments(c);
     let a = expand(&mu, 1, &BINOM4, c);
@@ -248,7 +249,7 @@ fn m_and_q(c: f64, binom8: &[f64; 9]) -> (f64, f64) {
 }
 
 /// Gaussian efficiency of the biweight scale estimate with tuning constant `c`, relative to the
-/// MLE of the variance (METHODS §2.3, correct formula).
+/// MLE of the variance (docs/methods.md §2.3, correct formula).
 ///
 /// # Formula
 /// `M(c) = mu_4 - 4 mu_6/c^2 + 6 mu_8/c^4 - 4 mu_10/c^6 + mu_12/c^8 - a(c)`,
@@ -263,7 +264,7 @@ pub fn efficiency(c: f64) -> f64 {
 }
 
 /// The package's efficiency formula: [`efficiency`] with the `mu_18` term of `Q` carrying
-/// `+8/c^14` instead of `-8/c^14` (METHODS §2.3, §13.5).
+/// `+8/c^14` instead of `-8/c^14` (docs/methods.md §2.3, §13.5).
 ///
 /// # Formula
 /// As [`efficiency`] with `Q` coefficients `1, -8, 28, -56, 70, -56, 28, +8, 1`.
@@ -273,15 +274,16 @@ pub fn package_efficiency(c: f64) -> f64 {
 }
 
 /// Absolute tolerance on the correct tuning constant: ~10 ulps at c ~ 5, far below the 1e-6
-/// of the METHODS §2.3 table.
+/// of the docs/methods.md §2.3 table.
 const C_ROOT_TOL: f64 = 1e-14;
-/// Bracket for the zero of `M(c)` (METHODS §2.3), which lies at c ~ 2.39498: `M(2) < 0 < M(3)`.
+/// Bracket for the zero of `M(c)` (docs/methods.md §2.3), which lies at c ~ 2.39498: `M(2) < 0 <
+/// M(3)`.
 const M_ZERO_BRACKET: (f64, f64) = (2.0, 3.0);
-/// Upper end of the tuning-constant search, as the package's `[0, 100]` (METHODS §2.3):
+/// Upper end of the tuning-constant search, as the package's `[0, 100]` (docs/methods.md §2.3):
 /// `eff(100) = 0.999998 > 0.99`.
 const C_MAX: f64 = 100.0;
 
-/// Tuning constant `c` for the requested Gaussian efficiency (METHODS §2.3).
+/// Tuning constant `c` for the requested Gaussian efficiency (docs/methods.md §2.3).
 ///
 /// - [`RobustConvention::Exact`]: solves `efficiency(c) = eff` by Brent–Dekker root finding
 ///   (to about 1e-14) on `[c_0, 100]`, where `c_0 ~ 2.39498` is the zero of `M(c)`; efficiency
@@ -319,7 +321,8 @@ pub fn tuning_constant(eff: f64, convention: RobustConvention) -> Result<f64, Pa
     }
 }
 
-/// Tukey's biweight `psi_c(r) = r (1 - r^2/c^2)^2` for `|r| <= c`, 0 otherwise (METHODS §2.1).
+/// Tukey's biweight `psi_c(r) = r (1 - r^2/c^2)^2` for `|r| <= c`, 0 otherwise (docs/methods.md
+/// §2.1).
 pub fn psi_biweight(r: f64, c: f64) -> f64 {
     if r.abs() <= c {
         let t = 1.0 - (r / c) * (r / c);
@@ -333,7 +336,7 @@ pub fn psi_biweight(r: f64, c: f64) -> f64 {
 /// error of a 1e7-term mean near 1e-15 relative at a fraction of Neumaier's cost per term.
 const BLOCK: usize = 256;
 
-/// `(1/n) sum_i psi_c(y_i * inv_s)^2` (METHODS §2.1), one O(n) pass, no allocation.
+/// `(1/n) sum_i psi_c(y_i * inv_s)^2` (docs/methods.md §2.1), one O(n) pass, no allocation.
 fn mean_psi2(y: &[f64], inv_s: f64, c: f64) -> f64 {
     let inv_c2 = 1.0 / (c * c);
     let c2 = c * c;
@@ -355,18 +358,18 @@ fn mean_psi2(y: &[f64], inv_s: f64, c: f64) -> f64 {
 }
 
 /// Standard normal quantile at 0.75, `Phi^{-1}(3/4)`: MAD / this is consistent for the
-/// standard deviation at the Gaussian (METHODS §2.4 "Port").
+/// standard deviation at the Gaussian (docs/methods.md §2.4 "Port").
 pub(crate) const MAD_CONSISTENCY: f64 = 0.674_489_750_196_081_7;
 
-/// Relative change of `s^2` between fixed-point iterates at which the port stops (METHODS §2.4:
-/// the test values were produced at 1e-12).
+/// Relative change of `s^2` between fixed-point iterates at which the port stops (docs/methods.md
+/// §2.4: the test values were produced at 1e-12).
 pub(crate) const FIXED_POINT_TOL: f64 = 1e-12;
 
 /// Iteration cap of the fixed point; Gaussian-like levels converge in a few dozen steps, and
-/// beyond the cap the bracketing fallback takes over (METHODS §2.4).
+/// beyond the cap the bracketing fallback takes over (docs/methods.md §2.4).
 pub(crate) const FIXED_POINT_MAX_ITER: usize = 500;
 
-/// Robust variance `s^2` of zero-mean coefficients `y` (METHODS §2.1, §2.4), for a tuning
+/// Robust variance `s^2` of zero-mean coefficients `y` (docs/methods.md §2.1, §2.4), for a tuning
 /// constant `c` from [`tuning_constant`].
 ///
 /// # Formula
@@ -398,7 +401,7 @@ pub(crate) const FIXED_POINT_MAX_ITER: usize = 500;
 /// ```
 /// use gmwm::variance::robust::{robust_scale, RobustConvention};
 /// let y = [-1.2, 0.3, 0.8, -0.4, 1.1, -0.9, 0.2, -0.1, 0.6, -0.7];
-/// // METHODS §2.5 test value (port default with c = 4.400278)
+/// // docs/methods.md §2.5 test value (port default with c = 4.400278)
 /// let s2 = robust_scale(&y, 4.400278, RobustConvention::Exact).unwrap();
 /// assert!((s2 - 0.6909524).abs() < 1e-6);
 /// ```
@@ -495,7 +498,7 @@ pub(crate) const WINDOW_SLIDES: usize = 3;
 /// is at most 20, so `mean psi_c^2` keeps ~14 digits.
 const U_POWER_MAX: f64 = 0.36;
 
-/// Robust variance of a long coefficient series, [`RobustConvention::Exact`] (METHODS §2.4
+/// Robust variance of a long coefficient series, [`RobustConvention::Exact`] (docs/methods.md §2.4
 /// "Port"): the same root as [`robust_scale`] — the down-crossing of
 /// `h(s) = mean(psi_c(y/s)^2) - a(c)` that the fixed point from the MAD start reaches — found in
 /// about one pass over the data instead of dozens.
@@ -564,7 +567,7 @@ pub(crate) enum WindowOutcome {
 }
 
 /// `mean(psi_c(y/s)^2)` for every `s` in a window `[s_lo, s_hi]`, from one pass over `y`
-/// (METHODS §2.1; see [`robust_scale_long`]).
+/// (docs/methods.md §2.1; see [`robust_scale_long`]).
 ///
 /// With `u = y^2 k2`, `k2 = 1 / (c s)^2`: `psi_c(y/s)^2 = c^2 P(u) 1{u <= 1}`,
 /// `P(u) = u (1 - u)^4 = u - 4u^2 + 6u^3 - 4u^4 + u^5`. Values with `y^2 < L`,
@@ -581,7 +584,7 @@ pub(crate) struct PowerWindow {
 }
 
 /// The pass behind [`PowerWindow`], fed in pieces (e.g. by the blocks of a pyramid) and merged
-/// in a fixed order (METHODS §2.1; see [`robust_scale_long`]).
+/// in a fixed order (docs/methods.md §2.1; see [`robust_scale_long`]).
 #[derive(Debug, Clone)]
 pub(crate) struct PowerAccumulator {
     c: f64,
@@ -766,7 +769,7 @@ impl PowerWindow {
         acc.finish()
     }
 
-    /// `mean(psi_c(y/s)^2)` at `s` in the window (METHODS §2.1).
+    /// `mean(psi_c(y/s)^2)` at `s` in the window (docs/methods.md §2.1).
     pub(crate) fn mean_psi2(&self, s: f64) -> f64 {
         let k2 = 1.0 / ((self.c * s) * (self.c * s));
         let kappa = self.below * k2;
@@ -799,8 +802,8 @@ impl PowerWindow {
     }
 
     /// The down-crossing of `h(s) = mean(psi_c(y/s)^2) - a` on the window `[lo, hi]` by
-    /// Brent–Dekker to 1e-14 relative in `s` (METHODS §2.4), or, when `h` does not go from `+`
-    /// to `-` across it, the next window towards the root in the direction the fixed point
+    /// Brent–Dekker to 1e-14 relative in `s` (docs/methods.md §2.4), or, when `h` does not go from
+    /// `+` to `-` across it, the next window towards the root in the direction the fixed point
     /// moves (down where `h(lo) <= 0`, up otherwise), twice as wide.
     pub(crate) fn solve(&self, a: f64, lo: f64, hi: f64) -> Result<WindowOutcome, InputError> {
         let h = |s: f64| self.mean_psi2(s) - a;
@@ -816,14 +819,14 @@ impl PowerWindow {
         })
     }
 
-    /// Mean of `y^2` over the whole pass (the classical WV of the level, METHODS §1.5).
+    /// Mean of `y^2` over the whole pass (the classical WV of the level, docs/methods.md §1.5).
     pub(crate) fn mean_square(&self) -> f64 {
         self.sum_squares / self.n
     }
 }
 
-/// Relative change of the fixed point below which a local bracket is tried (METHODS §2.4): the
-/// iteration contracts linearly (rate ~0.5 at the Gaussian, closer to 1 with outliers), a
+/// Relative change of the fixed point below which a local bracket is tried (docs/methods.md §2.4):
+/// the iteration contracts linearly (rate ~0.5 at the Gaussian, closer to 1 with outliers), a
 /// Brent–Dekker polish from here costs ~8 passes instead of ~25–400.
 const POLISH_FROM: f64 = 1e-4;
 /// Bracket widenings tried by [`polish`], each by a factor 4 (covers contraction rates up to
@@ -831,7 +834,7 @@ const POLISH_FROM: f64 = 1e-4;
 const POLISH_WIDENINGS: usize = 4;
 
 /// Root of `h(s) = mean(psi_c(y/s)^2) - a(c)` on a small bracket around the fixed-point iterate
-/// `s` (METHODS §2.4): the stable root the iteration converges to is a down-crossing of `h`
+/// `s` (docs/methods.md §2.4): the stable root the iteration converges to is a down-crossing of `h`
 /// (`h > 0` below, `h <= 0` above). `None` if no such bracket within the widenings, in which case
 /// the caller keeps iterating.
 fn polish(y: &[f64], c: f64, a: f64, s: f64, change: f64) -> Option<f64> {
@@ -849,15 +852,15 @@ fn polish(y: &[f64], c: f64, a: f64, s: f64, change: f64) -> Option<f64> {
     None
 }
 
-/// Grid ratio of the bracket search in `s` (METHODS §2.4 fallback): `2^(1/4)`, fine enough not
-/// to step over the stable root of a Gaussian-like level.
+/// Grid ratio of the bracket search in `s` (docs/methods.md §2.4 fallback): `2^(1/4)`, fine enough
+/// not to step over the stable root of a Gaussian-like level.
 const GRID_RATIO: f64 = 1.189_207_115_002_721;
 /// Grid points searched on each side of `s0`: `2^(±60)` covers any sensible scale.
 const GRID_STEPS: i32 = 240;
 /// Relative tolerance on `s` for the fallback root finder (squared: ~2e-14 on `s^2`).
 const S_ROOT_RTOL: f64 = 1e-14;
 
-/// Fallback of METHODS §2.4: Brent–Dekker on `h(s) = mean(psi_c(y/s)^2) - a(c)`, on the
+/// Fallback of docs/methods.md §2.4: Brent–Dekker on `h(s) = mean(psi_c(y/s)^2) - a(c)`, on the
 /// down-crossing (`h > 0` below, `h <= 0` above; the root the fixed point is attracted to)
 /// nearest `s0`. `h < 0` both for `s -> 0` and `s -> inf`.
 #[cold]
@@ -896,7 +899,8 @@ fn scale_exact_bracketed(y: &[f64], c: f64, a: f64, s0: f64) -> Result<f64, Inpu
     Ok(root.x * root.x)
 }
 
-/// Upper end of the package's search interval for `s2 = s^2 / var(y)` (METHODS §2.4 step 2).
+/// Upper end of the package's search interval for `s2 = s^2 / var(y)` (docs/methods.md §2.4 step
+/// 2).
 const PACKAGE_S2_MAX: f64 = 2.0;
 
 fn scale_package(y: &[f64], c: f64, a: f64) -> Result<f64, InputError> {
@@ -932,7 +936,7 @@ fn scale_package(y: &[f64], c: f64, a: f64) -> Result<f64, InputError> {
     Ok(m.x * var)
 }
 
-/// `mean(psi_c((y_i / sd) / s)^2)` in the package's order of operations (METHODS §2.4).
+/// `mean(psi_c((y_i / sd) / s)^2)` in the package's order of operations (docs/methods.md §2.4).
 fn mean_psi2_scaled(y: &[f64], sd: f64, s: f64, c: f64) -> f64 {
     let inv_c2 = 1.0 / (c * c);
     let mut total = NeumaierSum::default();
@@ -951,7 +955,7 @@ fn mean_psi2_scaled(y: &[f64], sd: f64, s: f64, c: f64) -> f64 {
     total.total() / y.len() as f64
 }
 
-/// Robust confidence interval of one level (METHODS §2.5).
+/// Robust confidence interval of one level (docs/methods.md §2.5).
 ///
 /// # Formula
 /// With `k = sqrt(1 / eff)`, classical WV `nu_c` and its eta3 CI `(lo_c, hi_c)` on the same
@@ -966,7 +970,7 @@ fn mean_psi2_scaled(y: &[f64], sd: f64, s: f64, c: f64) -> f64 {
 ///
 /// # Examples
 /// ```
-/// // METHODS §2.5 test value
+/// // docs/methods.md §2.5 test value
 /// let (lo, hi) = gmwm::variance::robust::robust_ci(0.6481826, 0.525, 0.2045587, 3.158041, 0.6, None);
 /// assert!((lo - 0.1374296).abs() < 1e-6 && (hi - 4.844999).abs() < 1e-5);
 /// ```
@@ -1032,7 +1036,7 @@ mod tests {
 
     #[test]
     fn truncated_normal_moments_tend_to_double_factorials() {
-        // METHODS §2.2: mu_{2k}(inf) = (2k - 1)!!
+        // docs/methods.md §2.2: mu_{2k}(inf) = (2k - 1)!!
         let mu = truncated_normal_moments(40.0);
         let mut df = 1.0;
         for (k, &m) in mu.iter().enumerate() {
@@ -1063,7 +1067,7 @@ mod tests {
 
     #[test]
     fn scale_exact_bracketed_agrees_with_iteration() {
-        // METHODS §2.4: the fallback finds the same root as the fixed point + polish
+        // docs/methods.md §2.4: the fallback finds the same root as the fixed point + polish
         let c = 4.400278;
         let a = a_of_c(c);
         for y in [
@@ -1107,9 +1111,9 @@ mod tests {
 
     #[test]
     fn robust_scale_long_finds_the_direct_root() {
-        // METHODS §2.4: the windowed route (subsample root, one power-sum pass, Brent on the
-        // window) and the direct fixed point from the exact MAD start solve the same equation to
-        // ~1e-14 in s; 1e-11 on s^2 leaves room for the different summation orders. Cases: clean
+        // docs/methods.md §2.4: the windowed route (subsample root, one power-sum pass, Brent on
+        // the window) and the direct fixed point from the exact MAD start solve the same equation
+        // to ~1e-14 in s; 1e-11 on s^2 leaves room for the different summation orders. Cases: clean
         // Gaussian, 2% gross outliers, a heavy-tailed mixture (MAD start far from the root), and a
         // window that must slide (a subsample that misses the contaminated stretch).
         let c = tuning_constant(0.6, RobustConvention::Exact).unwrap();

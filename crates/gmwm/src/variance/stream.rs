@@ -59,8 +59,8 @@ impl Plan {
     };
 }
 
-/// The classical Haar MODWT wavelet variance (METHODS §1.5, with the chi-square intervals of
-/// §1.7) of columns of a raw little-endian binary file, streamed: the columns are never loaded,
+/// The classical Haar MODWT wavelet variance (docs/methods.md §1.5, with the chi-square intervals
+/// of §1.7) of columns of a raw little-endian binary file, streamed: the columns are never loaded,
 /// and the file is read once (plus, for the highest levels and for the start of each part of
 /// 2^22 rows, samples read back from it) by positioned reads spread over the rayon pool.
 ///
@@ -130,7 +130,7 @@ pub struct StreamedColumn {
 
 /// [`binary_wavelet_variance`] with each column's smallest and largest sample, found in the
 /// same pass: what a GMWM fit needs besides the WV (the range `R = (max - min) / N` of the
-/// start search, METHODS §6.1), so a fit of a raw binary file need not load it either.
+/// start search, docs/methods.md §6.1), so a fit of a raw binary file need not load it either.
 ///
 /// # Errors
 /// As [`binary_wavelet_variance`].

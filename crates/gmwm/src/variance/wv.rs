@@ -1,4 +1,4 @@
-//! Wavelet variance: classical (METHODS §1.5, paper eq. 1) and robust (§2), with chi-square
+//! Wavelet variance: classical (docs/methods.md §1.5, paper eq. 1) and robust (§2), with chi-square
 //! confidence intervals (§1.7), for the MODWT (default) and the DWT with any filter of §1.8.
 //!
 //! The Haar MODWT classical WV — the one every later step of the platform uses — is computed by
@@ -25,13 +25,14 @@ use std::fmt;
 pub struct WvOptions {
     /// Transform; default MODWT, the package default and the only one with exact implied WV.
     pub transform: Transform,
-    /// Wavelet filter; default Haar, the filter every implied-WV formula of METHODS §4 assumes.
+    /// Wavelet filter; default Haar, the filter every implied-WV formula of docs/methods.md §4
+    /// assumes.
     pub filter: WaveletFilter,
     /// Number of levels J; `None` chooses [`default_levels`].
     pub levels: Option<usize>,
     /// Confidence level of the intervals; default 0.05 (95% intervals), as the package.
     pub alpha: f64,
-    /// Robust (Tukey biweight M-) estimation when `Some` (METHODS §2).
+    /// Robust (Tukey biweight M-) estimation when `Some` (docs/methods.md §2).
     pub robust: Option<RobustOptions>,
 }
 
@@ -66,7 +67,7 @@ pub struct WaveletVariance {
     pub(crate) alpha: f64,
     /// Robust options, `None` for the classical estimator.
     pub(crate) robust: Option<RobustOptions>,
-    /// Scale `tau_j = 2^j` in samples (METHODS §0.1).
+    /// Scale `tau_j = 2^j` in samples (docs/methods.md §0.1).
     pub(crate) tau: Vec<f64>,
     /// Scale in seconds, `2^j / freq_hz`.
     pub(crate) tau_s: Vec<f64>,
@@ -116,7 +117,7 @@ impl WaveletVariance {
         self.robust
     }
 
-    /// Scale `tau_j = 2^j` in samples (METHODS §0.1).
+    /// Scale `tau_j = 2^j` in samples (docs/methods.md §0.1).
     pub fn tau(&self) -> &[f64] {
         &self.tau
     }
@@ -231,11 +232,11 @@ impl WaveletVariance {
     ///
     /// # Formula
     /// For the classical estimator `eta_j nu2_hat_j / nu2_j` is approximately chi-square with
-    /// `eta_j` degrees of freedom (the approximation behind the intervals, METHODS §1.7), and
-    /// the log of a chi-square variable with `eta` degrees of freedom has variance
+    /// `eta_j` degrees of freedom (the approximation behind the intervals, docs/methods.md §1.7),
+    /// and the log of a chi-square variable with `eta` degrees of freedom has variance
     /// `psi'(eta / 2)` (the trigamma function): `2 / eta` for large `eta`, 1.64 at
     /// `eta = 2`, 4.93 at `eta = 1`. The robust estimator's is `1 / eff` times larger (the
-    /// factor by which its intervals widen, METHODS §2.5).
+    /// factor by which its intervals widen, docs/methods.md §2.5).
     ///
     /// ```
     /// use gmwm::{wavelet_variance, WvOptions};
@@ -266,7 +267,7 @@ impl WaveletVariance {
     }
 
     /// Assembles the result from per-level estimates and counts: scales, chi-square intervals
-    /// (METHODS §1.7) and, for robust estimates, the robust intervals of §2.5.
+    /// (docs/methods.md §1.7) and, for robust estimates, the robust intervals of §2.5.
     pub(crate) fn assemble(
         n: usize,
         freq_hz: f64,
@@ -357,7 +358,7 @@ impl fmt::Display for WaveletVariance {
     }
 }
 
-/// Default number of levels (METHODS §1.6, port recommendation): the largest J with
+/// Default number of levels (docs/methods.md §1.6, port recommendation): the largest J with
 /// `2^J <= N` whose last level keeps at least two boundary-free coefficients. For the Haar MODWT
 /// this is `floor(log2 N)` (the package's default), minus one when N is a power of two — where
 /// the package's last level is NaN (§13.1). For the DWT, J is also limited by the number of
@@ -370,8 +371,8 @@ pub fn default_levels(n: usize, transform: Transform, filter: WaveletFilter) -> 
     j
 }
 
-/// Kept (boundary-free) coefficient count of level `j` (METHODS §1.3, §1.4), `None` when the
-/// level does not exist for this length.
+/// Kept (boundary-free) coefficient count of level `j` (docs/methods.md §1.3, §1.4), `None` when
+/// the level does not exist for this length.
 pub fn kept_count(
     n: usize,
     j: usize,
@@ -436,8 +437,8 @@ pub(crate) fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<
     Ok(())
 }
 
-/// Wavelet variance of `x` sampled at `freq_hz`, METHODS §1.5 (classical) or §2 (robust), with
-/// chi-square intervals (§1.7; robust intervals §2.5).
+/// Wavelet variance of `x` sampled at `freq_hz`, docs/methods.md §1.5 (classical) or §2 (robust),
+/// with chi-square intervals (§1.7; robust intervals §2.5).
 ///
 /// The classical Haar MODWT path is a streaming O(N·J) pass ([`HaarWvAccumulator`]); other
 /// filters and the DWT go through the transform ([`Modwt`], [`Dwt`]) and keep O(N·J) memory.
@@ -569,7 +570,7 @@ fn from_levels(
     Ok(result)
 }
 
-/// Robust (Exact convention) Haar MODWT WV of an in-memory series (METHODS §2, §2.5): the
+/// Robust (Exact convention) Haar MODWT WV of an in-memory series (docs/methods.md §2, §2.5): the
 /// coefficients level by level ([`for_each_haar_level`], the pyramid of the classical pass with
 /// the mean of the first block removed) and the robust scale of each by [`robust_scale_long`],
 /// the next level's transform overlapping the current level's solve. `x` has been checked.
@@ -651,7 +652,7 @@ pub(crate) fn sum_squares(x: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
-/// Streaming Haar MODWT classical wavelet variance (METHODS §1.2 pyramid, §1.3, §1.5).
+/// Streaming Haar MODWT classical wavelet variance (docs/methods.md §1.2 pyramid, §1.3, §1.5).
 ///
 /// Feed the series in chunks of any size with [`push`](Self::push), then [`finish`](Self::finish).
 /// Level j keeps a ring of the last `2^{j-1}` values of the level-(j-1) scaling coefficients,
@@ -1078,7 +1079,7 @@ impl HaarWvAccumulator {
         Ok(())
     }
 
-    /// Finishes the pass: wavelet variance with chi-square intervals (METHODS §1.5, §1.7).
+    /// Finishes the pass: wavelet variance with chi-square intervals (docs/methods.md §1.5, §1.7).
     ///
     /// # Errors
     /// [`SeriesError`] when nothing was pushed, the series is constant, or it is too short for
@@ -1262,7 +1263,7 @@ fn prime_block(ring: &mut [f64], o0: usize, m: usize, run: f64, inv: f64, ys: &[
 ///
 /// The data checks of [`check_series`] are folded in: a constant series is found by a scan that
 /// stops at the first differing sample, a non-finite sample turns the sums into NaN and
-/// [`check_series`] then names it. The offset removed before the pyramid (METHODS §1.5 is
+/// [`check_series`] then names it. The offset removed before the pyramid (docs/methods.md §1.5 is
 /// unchanged by any constant offset) is the mean of the first [`BLOCK`](crate::variance::haar::BLOCK)
 /// samples, the series' level where it starts, so no extra pass over the data is needed. Falls
 /// back to the streaming pass when the kernel's window sums or squares overflow (data near
@@ -1561,7 +1562,7 @@ fn level_span_fresh_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip
 mod tests {
     use super::*;
 
-    /// Values of METHODS §1.10 are given to 7 significant digits.
+    /// Values of docs/methods.md §1.10 are given to 7 significant digits.
     const METHODS_TOL: f64 = 5e-7;
 
     fn rel(a: f64, b: f64) -> f64 {
@@ -1622,8 +1623,8 @@ mod tests {
 
     #[test]
     fn dwt_wv_is_normalised_to_the_modwt_scale() {
-        // METHODS §1.10 DWT values: the package's raw means (0.5, 4.0) and (2.25, 4.25) are 2^j
-        // times the MODWT-scale WV (§13.3); we divide by 2^j.
+        // docs/methods.md §1.10 DWT values: the package's raw means (0.5, 4.0) and (2.25, 4.25) are
+        // 2^j times the MODWT-scale WV (§13.3); we divide by 2^j.
         for (x, raw) in [
             ((1..=8).map(f64::from).collect::<Vec<_>>(), [0.5, 4.0]),
             (vec![1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0], [2.25, 4.25]),
@@ -1641,7 +1642,7 @@ mod tests {
 
     #[test]
     fn overlapping_allan_variance_is_twice_the_wv() {
-        // METHODS §3.4: AV(m = 2^{j-1}) = 2 WV_j over the same index set, exactly
+        // docs/methods.md §3.4: AV(m = 2^{j-1}) = 2 WV_j over the same index set, exactly
         let x: Vec<f64> = (0..3000)
             .map(|i| ((i * 7919) % 1013) as f64 * 0.01 - 9.81)
             .collect();

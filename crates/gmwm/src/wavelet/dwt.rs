@@ -1,4 +1,4 @@
-//! Decimated DWT by the pyramid algorithm, periodic boundary (METHODS §1.4).
+//! Decimated DWT by the pyramid algorithm, periodic boundary (docs/methods.md §1.4).
 
 use crate::error::{InputError, ParamError, SeriesError};
 
@@ -8,14 +8,14 @@ use super::{
     WaveletScratch,
 };
 
-/// A validated DWT plan: filter and number of levels `J` (METHODS §1.4).
+/// A validated DWT plan: filter and number of levels `J` (docs/methods.md §1.4).
 ///
 /// Plan once, run on every series; the plan is a plain comparable value, `Send + Sync`.
 ///
 /// # Examples
 /// ```
 /// use gmwm::wavelet::{Dwt, WaveletFilter};
-/// // METHODS §1.4: Haar W_{1,t} = (x_{2t+1} - x_{2t}) / sqrt2
+/// // docs/methods.md §1.4: Haar W_{1,t} = (x_{2t+1} - x_{2t}) / sqrt2
 /// let w = Dwt::new(WaveletFilter::Haar, 1).unwrap().transform(&[1.0, 3.0, 2.0, 5.0]).unwrap();
 /// assert!((w.kept(1)[0] - 2.0 / 2f64.sqrt()).abs() < 1e-15);
 /// assert!((w.kept(1)[1] - 3.0 / 2f64.sqrt()).abs() < 1e-15);
@@ -27,7 +27,7 @@ pub struct Dwt {
 }
 
 impl Dwt {
-    /// Plans a `levels`-level DWT with `filter` (METHODS §1.4).
+    /// Plans a `levels`-level DWT with `filter` (docs/methods.md §1.4).
     ///
     /// # Errors
     /// [`ParamError`] named `levels` unless `1 <= levels <= 60`.
@@ -47,7 +47,7 @@ impl Dwt {
     }
 
     /// Largest `J <= 60` a DWT of `n` samples with `filter` accepts: `2^J` divides `n` and every
-    /// level keeps at least one boundary-free coefficient (METHODS §1.4). 0 if none fits.
+    /// level keeps at least one boundary-free coefficient (docs/methods.md §1.4). 0 if none fits.
     pub fn max_levels(filter: WaveletFilter, n: usize) -> usize {
         (1..=super::MAX_LEVELS)
             .take_while(|&j| {
@@ -58,7 +58,7 @@ impl Dwt {
             .unwrap_or(0)
     }
 
-    /// Checks that `n` samples suit this plan (METHODS §1.4).
+    /// Checks that `n` samples suit this plan (docs/methods.md §1.4).
     ///
     /// # Errors
     /// [`SeriesError::Empty`] for `n = 0`; [`SeriesError::TooShort`] if `2^J > n`;
@@ -90,7 +90,7 @@ impl Dwt {
         }
     }
 
-    /// Runs the DWT of `x` (METHODS §1.4): `w[j-1]` has `N / 2^j` coefficients.
+    /// Runs the DWT of `x` (docs/methods.md §1.4): `w[j-1]` has `N / 2^j` coefficients.
     ///
     /// Non-finite values are not checked here (the caller validates the series once). Cost
     /// `O(N L)` time; memory: the output (`< N` values) plus two length-`N/2` buffers.
@@ -104,7 +104,7 @@ impl Dwt {
     }
 
     /// Runs the DWT of `x` into `out`, reusing the allocations of `out` and `scratch`
-    /// (METHODS §1.4); afterwards `scratch.scaling()` holds `V_J` (`N / 2^J` values).
+    /// (docs/methods.md §1.4); afterwards `scratch.scaling()` holds `V_J` (`N / 2^J` values).
     ///
     /// # Formula
     /// `V_0 = x`; for `j = 1..J`, `N_{j-1} = N / 2^{j-1}`, `t = 0..N_{j-1}/2 - 1`:
@@ -143,8 +143,8 @@ impl Dwt {
     }
 }
 
-/// One decimating pyramid step (METHODS §1.4): `w_t = sum_l h_l v_{(2t + 1 - l) mod M}`, same with
-/// `g` into `next`, `M = v.len()` even, `t = 0..M/2 - 1`.
+/// One decimating pyramid step (docs/methods.md §1.4): `w_t = sum_l h_l v_{(2t + 1 - l) mod M}`,
+/// same with `g` into `next`, `M = v.len()` even, `t = 0..M/2 - 1`.
 ///
 /// Only the first `floor((L - 1) / 2)` outputs reach back past `v_0`; they alone use modular
 /// indexing (possibly wrapping several times when `M < L`).

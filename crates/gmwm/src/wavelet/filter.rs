@@ -1,5 +1,5 @@
 //! Published orthonormal scaling filters and their quadrature-mirror wavelet filters
-//! (METHODS §1.1, §1.8).
+//! (docs/methods.md §1.1, §1.8).
 //!
 //! The coefficients are the published values (Daubechies 1992; Percival & Walden 2000, *Wavelet
 //! Methods for Time Series Analysis*, ch. 4; Fejer–Korovkin: Nielsen 2001; minimum bandwidth:
@@ -13,54 +13,55 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::ParamError;
 
-/// A published wavelet filter, selected by its lower-case name (METHODS §1.8).
+/// A published wavelet filter, selected by its lower-case name (docs/methods.md §1.8).
 ///
 /// Serialised, displayed and parsed by [`WaveletFilter::name`] (`"haar"`, `"d4"`, …, `"mb24"`);
 /// parsing ignores ASCII case.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum WaveletFilter {
-    /// Haar, L = 2 (METHODS §1.1); the default, and the only filter with implied-WV formulas (§4).
+    /// Haar, L = 2 (docs/methods.md §1.1); the default, and the only filter with implied-WV
+    /// formulas (§4).
     #[default]
     Haar,
-    /// Daubechies extremal phase, L = 4 (METHODS §1.8).
+    /// Daubechies extremal phase, L = 4 (docs/methods.md §1.8).
     D4,
-    /// Daubechies extremal phase, L = 6 (METHODS §1.8).
+    /// Daubechies extremal phase, L = 6 (docs/methods.md §1.8).
     D6,
-    /// Daubechies extremal phase, L = 8 (METHODS §1.8).
+    /// Daubechies extremal phase, L = 8 (docs/methods.md §1.8).
     D8,
-    /// Daubechies extremal phase, L = 16 (METHODS §1.8).
+    /// Daubechies extremal phase, L = 16 (docs/methods.md §1.8).
     D16,
-    /// Fejer–Korovkin, L = 4 (METHODS §1.8).
+    /// Fejer–Korovkin, L = 4 (docs/methods.md §1.8).
     Fk4,
-    /// Fejer–Korovkin, L = 8 (METHODS §1.8).
+    /// Fejer–Korovkin, L = 8 (docs/methods.md §1.8).
     Fk8,
-    /// Fejer–Korovkin, L = 14 (METHODS §1.8).
+    /// Fejer–Korovkin, L = 14 (docs/methods.md §1.8).
     Fk14,
-    /// Fejer–Korovkin, L = 22 (METHODS §1.8).
+    /// Fejer–Korovkin, L = 22 (docs/methods.md §1.8).
     Fk22,
-    /// Battle–Lemarie (truncated), L = 14 (METHODS §1.8).
+    /// Battle–Lemarie (truncated), L = 14 (docs/methods.md §1.8).
     Bl14,
-    /// Battle–Lemarie (truncated), L = 20 (METHODS §1.8).
+    /// Battle–Lemarie (truncated), L = 20 (docs/methods.md §1.8).
     Bl20,
-    /// Least asymmetric (symmlet), L = 8 (METHODS §1.8).
+    /// Least asymmetric (symmlet), L = 8 (docs/methods.md §1.8).
     La8,
-    /// Least asymmetric (symmlet), L = 16 (METHODS §1.8).
+    /// Least asymmetric (symmlet), L = 16 (docs/methods.md §1.8).
     La16,
-    /// Least asymmetric (symmlet), L = 20 (METHODS §1.8).
+    /// Least asymmetric (symmlet), L = 20 (docs/methods.md §1.8).
     La20,
-    /// Minimum bandwidth, L = 4 (METHODS §1.8); published with 7 significant digits only.
+    /// Minimum bandwidth, L = 4 (docs/methods.md §1.8); published with 7 significant digits only.
     Mb4,
-    /// Minimum bandwidth, L = 8 (METHODS §1.8).
+    /// Minimum bandwidth, L = 8 (docs/methods.md §1.8).
     Mb8,
-    /// Minimum bandwidth, L = 16 (METHODS §1.8).
+    /// Minimum bandwidth, L = 16 (docs/methods.md §1.8).
     Mb16,
-    /// Minimum bandwidth, L = 24 (METHODS §1.8).
+    /// Minimum bandwidth, L = 24 (docs/methods.md §1.8).
     Mb24,
 }
 
 impl WaveletFilter {
-    /// Every filter, in the order of the METHODS §1.8 table.
+    /// Every filter, in the order of the docs/methods.md §1.8 table.
     pub const ALL: [WaveletFilter; 18] = [
         WaveletFilter::Haar,
         WaveletFilter::D4,
@@ -82,7 +83,7 @@ impl WaveletFilter {
         WaveletFilter::Mb24,
     ];
 
-    /// Lower-case name as used by the package and on the command line (METHODS §1.8).
+    /// Lower-case name as used by the package and on the command line (docs/methods.md §1.8).
     pub fn name(&self) -> &'static str {
         match self {
             WaveletFilter::Haar => "haar",
@@ -106,13 +107,13 @@ impl WaveletFilter {
         }
     }
 
-    /// Filter length `L` (METHODS §1.8), the number of scaling coefficients.
+    /// Filter length `L` (docs/methods.md §1.8), the number of scaling coefficients.
     #[allow(clippy::len_without_is_empty)] // a filter is never empty
     pub fn len(&self) -> usize {
         self.scaling().len()
     }
 
-    /// Published scaling (low-pass) filter `g_0 .. g_{L-1}` (METHODS §1.1, §1.8).
+    /// Published scaling (low-pass) filter `g_0 .. g_{L-1}` (docs/methods.md §1.1, §1.8).
     ///
     /// Unscaled (DWT) normalisation: `sum g = sqrt2`, `sum g^2 = 1`, up to
     /// [`orthonormality_tolerance`](Self::orthonormality_tolerance).
@@ -140,7 +141,7 @@ impl WaveletFilter {
     }
 
     /// Wavelet (high-pass) filter by the quadrature mirror rule `h_l = (-1)^l g_{L-1-l}`
-    /// (METHODS §1.1).
+    /// (docs/methods.md §1.1).
     ///
     /// # Examples
     /// ```
@@ -153,7 +154,7 @@ impl WaveletFilter {
     }
 
     /// Precision the published table carries: the largest acceptable deviation in
-    /// `sum g = sqrt2`, `sum g^2 = 1` and `sum_l g_l g_{l+2k} = 0` (METHODS §1.8).
+    /// `sum g = sqrt2`, `sum g^2 = 1` and `sum_l g_l g_{l+2k} = 0` (docs/methods.md §1.8).
     ///
     /// Per family: worst deviation observed in the table, then the tolerance (about 2–3 times it).
     /// - `haar`, `d4`, `d6`, `fk4`: full double precision; worst `9e-16`, tolerance `1e-14`.
@@ -188,7 +189,7 @@ impl WaveletFilter {
         }
     }
 
-    /// MODWT scaling filter `g~ = g / sqrt2` (METHODS §1.1, §1.2).
+    /// MODWT scaling filter `g~ = g / sqrt2` (docs/methods.md §1.1, §1.2).
     pub fn modwt_scaling(&self) -> Vec<f64> {
         self.scaling()
             .iter()
@@ -196,7 +197,7 @@ impl WaveletFilter {
             .collect()
     }
 
-    /// MODWT wavelet filter `h~ = h / sqrt2` (METHODS §1.1, §1.2).
+    /// MODWT wavelet filter `h~ = h / sqrt2` (docs/methods.md §1.1, §1.2).
     pub fn modwt_wavelet(&self) -> Vec<f64> {
         self.wavelet()
             .iter()
@@ -226,7 +227,8 @@ pub(crate) struct Taps {
 }
 
 impl Taps {
-    /// Taps of `filter` times `scale` (1 for the DWT, `1/sqrt2` for the MODWT, METHODS §1.1).
+    /// Taps of `filter` times `scale` (1 for the DWT, `1/sqrt2` for the MODWT, docs/methods.md
+    /// §1.1).
     pub fn new(filter: WaveletFilter, scale: f64) -> Self {
         let g = filter.scaling();
         let mut taps = Taps {
@@ -253,7 +255,7 @@ impl Taps {
     }
 }
 
-/// Quadrature mirror of a scaling filter, `h_l = (-1)^l g_{L-1-l}` (METHODS §1.1).
+/// Quadrature mirror of a scaling filter, `h_l = (-1)^l g_{L-1-l}` (docs/methods.md §1.1).
 pub fn quadrature_mirror(g: &[f64]) -> Vec<f64> {
     g.iter()
         .rev()
@@ -271,7 +273,7 @@ impl fmt::Display for WaveletFilter {
 impl FromStr for WaveletFilter {
     type Err = ParamError;
 
-    /// Parses a filter name, ignoring ASCII case and surrounding whitespace (METHODS §1.8).
+    /// Parses a filter name, ignoring ASCII case and surrounding whitespace (docs/methods.md §1.8).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let t = s.trim();
         Self::ALL
@@ -548,8 +550,8 @@ mod tests {
     use super::*;
     use std::f64::consts::SQRT_2;
 
-    /// METHODS §1.8: `sum g = sqrt2`, `sum g^2 = 1`, `sum_l g_l g_{l+2k} = 0` (k >= 1), each to
-    /// the precision of the published table.
+    /// docs/methods.md §1.8: `sum g = sqrt2`, `sum g^2 = 1`, `sum_l g_l g_{l+2k} = 0` (k >= 1),
+    /// each to the precision of the published table.
     #[test]
     fn filter_scaling_is_orthonormal() {
         for f in WaveletFilter::ALL {
@@ -576,8 +578,8 @@ mod tests {
         assert!((energy - 1.0).abs() > WaveletFilter::D4.orthonormality_tolerance());
     }
 
-    /// METHODS §1.1: `h_l = (-1)^l g_{L-1-l}`; `h` sums to 0, has unit energy and is orthogonal
-    /// to every even shift of `g`.
+    /// docs/methods.md §1.1: `h_l = (-1)^l g_{L-1-l}`; `h` sums to 0, has unit energy and is
+    /// orthogonal to every even shift of `g`.
     #[test]
     fn filter_wavelet_is_quadrature_mirror() {
         for f in WaveletFilter::ALL {
@@ -608,7 +610,7 @@ mod tests {
         assert_eq!(h, vec![g[3], -g[2], g[1], -g[0]]);
     }
 
-    /// METHODS §1.1: MODWT filters are the DWT filters over sqrt2.
+    /// docs/methods.md §1.1: MODWT filters are the DWT filters over sqrt2.
     #[test]
     fn filter_modwt_filters_are_rescaled() {
         assert_eq!(WaveletFilter::Haar.modwt_scaling().len(), 2);

@@ -1,5 +1,5 @@
 //! Wavelet filters and transforms: the MODWT and DWT pyramids with periodic boundary
-//! (METHODS §1.1–§1.4, §1.8).
+//! (docs/methods.md §1.1–§1.4, §1.8).
 //!
 //! - [`WaveletFilter`]: the published scaling filters and their quadrature mirrors (§1.1, §1.8).
 //! - [`Modwt`] and [`Dwt`]: plans (filter + number of levels, validated once) that run the
@@ -9,7 +9,7 @@
 //! - `naive` (crate-internal, test builds only): slow direct-convolution twins of both
 //!   transforms, the test oracle.
 //!
-//! Deviation from the R package (METHODS §1.3, §13.1): when exactly one boundary-free
+//! Deviation from the R package (docs/methods.md §1.3, §13.1): when exactly one boundary-free
 //! coefficient remains at a level, it is **kept** (the package keeps none and returns a NaN
 //! variance); a level with no boundary-free coefficient at all is refused with
 //! [`SeriesError::TooShort`](crate::error::SeriesError::TooShort).
@@ -37,21 +37,21 @@ pub use modwt::Modwt;
 /// needed; the bound keeps every `2^j` representable in a 64-bit `usize`).
 pub const MAX_LEVELS: usize = 60;
 
-/// Decimated or maximal-overlap wavelet transform (METHODS §1.2, §1.4).
+/// Decimated or maximal-overlap wavelet transform (docs/methods.md §1.2, §1.4).
 ///
 /// Serialised, displayed and parsed as `"modwt"` / `"dwt"`; parsing ignores ASCII case.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Transform {
-    /// Maximal-overlap DWT (METHODS §1.2), the default.
+    /// Maximal-overlap DWT (docs/methods.md §1.2), the default.
     #[default]
     Modwt,
-    /// Decimated DWT (METHODS §1.4).
+    /// Decimated DWT (docs/methods.md §1.4).
     Dwt,
 }
 
 impl Transform {
-    /// Lower-case name, `"modwt"` or `"dwt"` (METHODS §1.2, §1.4).
+    /// Lower-case name, `"modwt"` or `"dwt"` (docs/methods.md §1.2, §1.4).
     pub fn name(&self) -> &'static str {
         match self {
             Transform::Modwt => "modwt",
@@ -88,7 +88,7 @@ pub(crate) fn pow2(j: usize) -> usize {
 }
 
 /// Number of leading level-`j` MODWT coefficients touched by the periodic wrap-around,
-/// `n_j = (2^j - 1)(L - 1)` (METHODS §1.3).
+/// `n_j = (2^j - 1)(L - 1)` (docs/methods.md §1.3).
 ///
 /// The level-j equivalent filter has width `L_j = n_j + 1`; coefficient `t` is boundary-free iff
 /// `t >= n_j`. Saturates at `usize::MAX` instead of overflowing.
@@ -104,7 +104,7 @@ pub fn modwt_boundary(filter_len: usize, j: usize) -> usize {
 }
 
 /// Number of leading level-`j` DWT coefficients touched by the periodic wrap-around,
-/// `ceil((L - 2)(1 - 2^-j))` (METHODS §1.4); 0 for Haar.
+/// `ceil((L - 2)(1 - 2^-j))` (docs/methods.md §1.4); 0 for Haar.
 ///
 /// Computed exactly in integers as `(L - 2) - floor((L - 2) / 2^j)`.
 ///
@@ -121,20 +121,20 @@ pub fn dwt_boundary(filter_len: usize, j: usize) -> usize {
 }
 
 /// Wavelet coefficients of every level of a MODWT or DWT, boundary coefficients included
-/// (METHODS §1.2–§1.4).
+/// (docs/methods.md §1.2–§1.4).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct WaveletCoefficients {
     /// `w[j-1]` = all coefficients `W_{j,0..}` of level `j` (N of them for the MODWT,
     /// `N / 2^j` for the DWT), boundary ones included.
     pub w: Vec<Vec<f64>>,
     /// `boundary[j-1]` = number of leading level-`j` coefficients touched by the periodic
-    /// boundary, to drop before estimation (METHODS §1.3, §1.4).
+    /// boundary, to drop before estimation (docs/methods.md §1.3, §1.4).
     pub boundary: Vec<usize>,
 }
 
 impl WaveletCoefficients {
-    /// Kept (boundary-free) coefficients of level `j`, 1-based (METHODS §1.3, §1.4); never empty
-    /// for a transform output.
+    /// Kept (boundary-free) coefficients of level `j`, 1-based (docs/methods.md §1.3, §1.4); never
+    /// empty for a transform output.
     ///
     /// # Panics
     /// If `j == 0` or `j > self.levels()` (a caller bug, not a data problem).
@@ -156,7 +156,7 @@ impl WaveletCoefficients {
 
 /// Reusable work buffers of [`Modwt::transform_with_scratch`] and
 /// [`Dwt::transform_with_scratch`]; after a run it holds the final scaling coefficients `V_J`
-/// (METHODS §1.2, §1.4).
+/// (docs/methods.md §1.2, §1.4).
 #[derive(Debug, Clone, Default)]
 pub struct WaveletScratch {
     /// Current scaling coefficients `V_j`.
@@ -172,8 +172,8 @@ impl WaveletScratch {
     }
 
     /// Scaling coefficients `V_J` of the last level of the last successful transform
-    /// (METHODS §1.2, §1.4): length N for the MODWT, `N / 2^J` for the DWT; empty before the
-    /// first run.
+    /// (docs/methods.md §1.2, §1.4): length N for the MODWT, `N / 2^J` for the DWT; empty before
+    /// the first run.
     pub fn scaling(&self) -> &[f64] {
         &self.v
     }
@@ -226,7 +226,7 @@ mod tests {
         assert_eq!((e.name, e.value.as_str()), ("transform", "fft"));
     }
 
-    /// METHODS §1.3: `n_j = (2^j - 1)(L - 1)`.
+    /// docs/methods.md §1.3: `n_j = (2^j - 1)(L - 1)`.
     #[test]
     fn modwt_boundary_formula() {
         assert_eq!(modwt_boundary(2, 1), 1);
@@ -235,7 +235,7 @@ mod tests {
         assert_eq!(modwt_boundary(24, 60), usize::MAX); // saturates
     }
 
-    /// METHODS §1.4: `ceil((L - 2)(1 - 2^-j))`, checked against the real-valued formula.
+    /// docs/methods.md §1.4: `ceil((L - 2)(1 - 2^-j))`, checked against the real-valued formula.
     #[test]
     fn dwt_boundary_formula() {
         for len in (2..=24).step_by(2) {

@@ -1,4 +1,4 @@
-//! Maximal-overlap DWT by the pyramid algorithm, periodic boundary (METHODS §1.2, §1.3).
+//! Maximal-overlap DWT by the pyramid algorithm, periodic boundary (docs/methods.md §1.2, §1.3).
 
 use crate::error::{InputError, ParamError, SeriesError};
 
@@ -8,14 +8,14 @@ use super::{
     WaveletScratch,
 };
 
-/// A validated MODWT plan: filter and number of levels `J` (METHODS §1.2).
+/// A validated MODWT plan: filter and number of levels `J` (docs/methods.md §1.2).
 ///
 /// Plan once, run on every series; the plan is a plain comparable value, `Send + Sync`.
 ///
 /// # Examples
 /// ```
 /// use gmwm::wavelet::{Modwt, WaveletFilter};
-/// // METHODS §1.10: x = 1..8, Haar, J = 3
+/// // docs/methods.md §1.10: x = 1..8, Haar, J = 3
 /// let x: Vec<f64> = (1..=8).map(f64::from).collect();
 /// let w = Modwt::new(WaveletFilter::Haar, 3).unwrap().transform(&x).unwrap();
 /// assert_eq!(w.kept(1), &[0.5; 7]);
@@ -29,7 +29,7 @@ pub struct Modwt {
 }
 
 impl Modwt {
-    /// Plans a `levels`-level MODWT with `filter` (METHODS §1.2).
+    /// Plans a `levels`-level MODWT with `filter` (docs/methods.md §1.2).
     ///
     /// # Errors
     /// [`ParamError`] named `levels` unless `1 <= levels <= 60`.
@@ -50,7 +50,7 @@ impl Modwt {
 
     /// Largest `J <= 60` a MODWT of `n` samples with `filter` accepts: `2^J <= n` and at least
     /// one boundary-free coefficient at every level, `n >= L_J = (2^J - 1)(L - 1) + 1`
-    /// (METHODS §1.2, §1.3). 0 if not even one level fits.
+    /// (docs/methods.md §1.2, §1.3). 0 if not even one level fits.
     pub fn max_levels(filter: WaveletFilter, n: usize) -> usize {
         (1..=super::MAX_LEVELS)
             .take_while(|&j| pow2(j) <= n && modwt_boundary(filter.len(), j) < n)
@@ -58,7 +58,7 @@ impl Modwt {
             .unwrap_or(0)
     }
 
-    /// Checks that `n` samples suffice (METHODS §1.2, §1.3).
+    /// Checks that `n` samples suffice (docs/methods.md §1.2, §1.3).
     ///
     /// # Errors
     /// [`SeriesError::Empty`] for `n = 0`; [`SeriesError::TooShort`] if `2^J > n`, or naming the
@@ -78,7 +78,7 @@ impl Modwt {
         }
     }
 
-    /// Runs the MODWT of `x` (METHODS §1.2); boundary counts `n_j` of §1.3.
+    /// Runs the MODWT of `x` (docs/methods.md §1.2); boundary counts `n_j` of §1.3.
     ///
     /// Non-finite values are not checked here (the caller validates the series once). Cost
     /// `O(N J L)` time; memory: the output (`J N` values) plus two length-N buffers.
@@ -92,7 +92,7 @@ impl Modwt {
     }
 
     /// Runs the MODWT of `x` into `out`, reusing the allocations of `out` and `scratch`
-    /// (METHODS §1.2); afterwards `scratch.scaling()` holds `V_J`.
+    /// (docs/methods.md §1.2); afterwards `scratch.scaling()` holds `V_J`.
     ///
     /// # Formula
     /// `V_0 = x`; for `j = 1..J`, `t = 0..N-1`, indices modulo N:
@@ -125,8 +125,8 @@ impl Modwt {
     }
 }
 
-/// One pyramid step (METHODS §1.2): `w_t = sum_l h_l v_{t - step l}`, same with `g` into `next`,
-/// indices modulo `N = v.len()`.
+/// One pyramid step (docs/methods.md §1.2): `w_t = sum_l h_l v_{t - step l}`, same with `g` into
+/// `next`, indices modulo `N = v.len()`.
 ///
 /// Accumulates filter tap by tap; each tap splits `t` into the wrap-around head `t < step l`
 /// (reading `v_{t + N - step l}`) and the plain tail (reading `v_{t - step l}`), so no `%` runs.

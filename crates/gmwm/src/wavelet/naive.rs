@@ -1,5 +1,5 @@
 //! Test oracle: slow, obviously correct MODWT and DWT by direct circular convolution with the
-//! level-j equivalent filters (METHODS §1.2, §1.4).
+//! level-j equivalent filters (docs/methods.md §1.2, §1.4).
 //!
 //! Public so the integration tests can drive it; not meant for production use (cost
 //! `O(N L_j)` per level instead of `O(N L)`). No validation: the only requirement is a non-empty
@@ -9,8 +9,8 @@ use std::f64::consts::FRAC_1_SQRT_2;
 
 use super::{quadrature_mirror, WaveletFilter};
 
-/// Level-j equivalent filters (METHODS §1.2, §1.3): a single convolution of the series with these
-/// gives `W_j` and `V_j` directly.
+/// Level-j equivalent filters (docs/methods.md §1.2, §1.3): a single convolution of the series with
+/// these gives `W_j` and `V_j` directly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EquivalentFilters {
     /// Equivalent wavelet filter, width `L_j = (2^j - 1)(L - 1) + 1`.
@@ -20,7 +20,7 @@ pub struct EquivalentFilters {
 }
 
 /// Output of the oracle transforms: every wavelet coefficient of every level and the final
-/// scaling coefficients `V_J` (METHODS §1.2, §1.4).
+/// scaling coefficients `V_J` (docs/methods.md §1.2, §1.4).
 #[derive(Debug, Clone, PartialEq)]
 pub struct NaiveTransform {
     /// `w[j-1]` = level-j wavelet coefficients (no boundary removal).
@@ -40,7 +40,7 @@ fn upsampled_convolution(f: &[f64], step: usize, prev: &[f64]) -> Vec<f64> {
     c
 }
 
-/// Level-`j` equivalent filters built from the taps `h`, `g` (METHODS §1.2): `g_1 = g`,
+/// Level-`j` equivalent filters built from the taps `h`, `g` (docs/methods.md §1.2): `g_1 = g`,
 /// `g_k = (g upsampled by 2^{k-1}) * g_{k-1}`, `h_j = (h upsampled by 2^{j-1}) * g_{j-1}`.
 ///
 /// Pass `h~`, `g~` for the MODWT and the unscaled `h`, `g` for the DWT.
@@ -55,7 +55,7 @@ pub fn equivalent_filters(h: &[f64], g: &[f64], j: usize) -> EquivalentFilters {
     EquivalentFilters { wavelet, scaling }
 }
 
-/// MODWT level-`j` equivalent filters `h~_j`, `g~_j` of `filter` (METHODS §1.2).
+/// MODWT level-`j` equivalent filters `h~_j`, `g~_j` of `filter` (docs/methods.md §1.2).
 pub fn modwt_equivalent_filters(filter: WaveletFilter, j: usize) -> EquivalentFilters {
     let g: Vec<f64> = filter.scaling().iter().map(|c| c * FRAC_1_SQRT_2).collect();
     let h = quadrature_mirror(&g);
@@ -76,8 +76,8 @@ fn circular_filter(f: &[f64], x: &[f64], count: usize, end: impl Fn(usize) -> us
         .collect()
 }
 
-/// Oracle MODWT (METHODS §1.2): `W_{j,t} = sum_l h~_{j,l} x_{(t - l) mod N}`, and `V_J` with
-/// `g~_J`, for `j = 1..levels`.
+/// Oracle MODWT (docs/methods.md §1.2): `W_{j,t} = sum_l h~_{j,l} x_{(t - l) mod N}`, and `V_J`
+/// with `g~_J`, for `j = 1..levels`.
 ///
 /// # Panics
 /// If `x` is empty.
@@ -96,7 +96,7 @@ pub fn modwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform 
     NaiveTransform { w, scaling }
 }
 
-/// Oracle DWT (METHODS §1.4) by decimated equivalent filters:
+/// Oracle DWT (docs/methods.md §1.4) by decimated equivalent filters:
 /// `W_{j,t} = sum_l h_{j,l} x_{(2^j (t + 1) - 1 - l) mod N}`, `t = 0..N/2^j - 1`, with the
 /// unscaled `h_j = 2^{j/2} h~_j`; likewise `V_J`.
 ///
@@ -126,7 +126,7 @@ pub fn dwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform {
 mod tests {
     use super::*;
 
-    /// METHODS §1.1: Haar MODWT filters (1/2, -1/2), (1/2, 1/2); level 2 has width 4.
+    /// docs/methods.md §1.1: Haar MODWT filters (1/2, -1/2), (1/2, 1/2); level 2 has width 4.
     #[test]
     fn naive_equivalent_filters_haar_by_hand() {
         let e1 = modwt_equivalent_filters(WaveletFilter::Haar, 1);
@@ -138,7 +138,7 @@ mod tests {
         assert_eq!(la8.wavelet.len(), 7 * 7 + 1); // L_3 = (2^3 - 1)(8 - 1) + 1
     }
 
-    /// METHODS §1.10 by hand: x = 1..8, Haar, periodic; W_{1,0} wraps (x_0 - x_7)/2 = -3.5.
+    /// docs/methods.md §1.10 by hand: x = 1..8, Haar, periodic; W_{1,0} wraps (x_0 - x_7)/2 = -3.5.
     #[test]
     fn naive_modwt_haar_ramp_by_hand() {
         let x: Vec<f64> = (1..=8).map(f64::from).collect();
@@ -150,7 +150,7 @@ mod tests {
         assert!(close(&r.scaling, &[5.5, 4.5, 3.5, 2.5, 3.5, 4.5, 5.5, 6.5]));
     }
 
-    /// METHODS §1.4 by hand: Haar W_{1,t} = (x_{2t+1} - x_{2t}) / sqrt2.
+    /// docs/methods.md §1.4 by hand: Haar W_{1,t} = (x_{2t+1} - x_{2t}) / sqrt2.
     #[test]
     fn naive_dwt_haar_by_hand() {
         let x = [1.0, 3.0, 2.0, 5.0, 4.0, 6.0, 8.0, 7.0];

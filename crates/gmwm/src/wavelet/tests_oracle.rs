@@ -1,5 +1,5 @@
 //! The fast pyramids against the direct-convolution oracle ([`super::naive`], crate-internal)
-//! for every filter (METHODS §1.2, §1.4); moved from the integration tests when the oracle
+//! for every filter (docs/methods.md §1.2, §1.4); moved from the integration tests when the oracle
 //! stopped being public.
 
 use gmwm::wavelet::naive;
@@ -101,7 +101,7 @@ fn check_transform(
     );
 }
 
-/// METHODS §1.2: the pyramid equals direct circular convolution with the level-j equivalent
+/// docs/methods.md §1.2: the pyramid equals direct circular convolution with the level-j equivalent
 /// filter, for every filter, several lengths (powers of two and not) and level counts, reusing
 /// dirty output and scratch buffers throughout.
 #[test]
@@ -131,8 +131,9 @@ fn modwt_matches_naive() {
     }
 }
 
-/// METHODS §1.4: the pyramid equals decimated direct convolution with the level-j equivalent
-/// filter, for every filter, including levels shorter than the filter (multiple wrap-around).
+/// docs/methods.md §1.4: the pyramid equals decimated direct convolution with the level-j
+/// equivalent filter, for every filter, including levels shorter than the filter (multiple
+/// wrap-around).
 #[test]
 fn dwt_matches_naive() {
     let mut out = WaveletCoefficients::default();

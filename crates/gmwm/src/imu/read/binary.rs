@@ -1,5 +1,5 @@
 //! Raw little-endian binary: interleaved f64/f32 columns, and the IMU epoch records of
-//! METHODS §9.2.
+//! docs/methods.md §9.2.
 //!
 //! Values are decoded with `from_le_bytes` (never text parsing). Whole-file reads memory-map the
 //! file; [`BinaryChunks`] reads fixed-size blocks so that series of 10^9 samples can be consumed
@@ -553,7 +553,7 @@ pub fn for_each_chunk(
     Ok(())
 }
 
-/// Binary IMU record types of METHODS §9.2–9.3.
+/// Binary IMU record types of docs/methods.md §9.2–9.3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ImuRecordType {
     /// iMAR: int32 counts, gyro 0.1 arcsec, accel 1.52588e-6 m/s.
@@ -570,11 +570,11 @@ pub enum ImuRecordType {
     NavchipInt,
 }
 
-/// One arcsecond in radians: pi / (180 · 3600) (METHODS §9.3).
+/// One arcsecond in radians: pi / (180 · 3600) (docs/methods.md §9.3).
 const ARCSEC_RAD: f64 = std::f64::consts::PI / (180.0 * 3600.0);
 
 impl ImuRecordType {
-    /// Every type, in the order of METHODS §9.3.
+    /// Every type, in the order of docs/methods.md §9.3.
     pub const ALL: [Self; 6] = [
         Self::Imar,
         Self::Ln200,
@@ -601,7 +601,7 @@ impl ImuRecordType {
         matches!(self, Self::Ixsea | Self::NavchipFlt)
     }
 
-    /// Bytes per epoch: 8 (time) + 6 · 4 = 32 or 8 + 6 · 8 = 56 (METHODS §9.2).
+    /// Bytes per epoch: 8 (time) + 6 · 4 = 32 or 8 + 6 · 8 = 56 (docs/methods.md §9.2).
     pub fn record_size(self) -> usize {
         if self.is_double() {
             56
@@ -610,7 +610,7 @@ impl ImuRecordType {
         }
     }
 
-    /// METHODS §9.3: gyroscope scale, rad per count.
+    /// docs/methods.md §9.3: gyroscope scale, rad per count.
     pub fn scale_gyro(self) -> f64 {
         match self {
             Self::Imar => 0.1 * ARCSEC_RAD,
@@ -622,7 +622,7 @@ impl ImuRecordType {
         }
     }
 
-    /// METHODS §9.3: accelerometer scale, m/s per count.
+    /// docs/methods.md §9.3: accelerometer scale, m/s per count.
     pub fn scale_accel(self) -> f64 {
         match self {
             Self::Imar => 0.001_525_88 / 1000.0,
@@ -642,7 +642,7 @@ impl fmt::Display for ImuRecordType {
 impl FromStr for ImuRecordType {
     type Err = ParamError;
 
-    /// Case-insensitive type name (METHODS §9.2).
+    /// Case-insensitive type name (docs/methods.md §9.2).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let t = s.trim();
         Self::ALL
@@ -658,7 +658,7 @@ impl FromStr for ImuRecordType {
     }
 }
 
-/// METHODS §9.2's `round(1 / mean(diff(time)))`, the mean taken over the regular steps
+/// docs/methods.md §9.2's `round(1 / mean(diff(time)))`, the mean taken over the regular steps
 /// ([`check_times`]: steps within 1.5 nominal steps), so that a gap in the epochs does not lower
 /// the rate that converts every increment; identical to the package's on a file without gaps.
 fn record_freq(path: &Path, t: &[f64]) -> Result<f64, ReadError> {
@@ -681,14 +681,14 @@ fn record_freq(path: &Path, t: &[f64]) -> Result<f64, ReadError> {
     }
 }
 
-/// Column names of the IMU records, in record order (METHODS §9.2).
+/// Column names of the IMU records, in record order (docs/methods.md §9.2).
 pub(crate) const RECORD_COLUMNS: [&str; 6] = [
     "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
 ];
 
-/// Reads the selected columns of a binary IMU record file (METHODS §9.2–9.3), memory-mapped:
-/// the times are decoded once (checked finite and strictly increasing), then each selected
-/// column is decoded and scaled in one pass straight from the map, so no raw copy is held.
+/// Reads the selected columns of a binary IMU record file (docs/methods.md §9.2–9.3),
+/// memory-mapped: the times are decoded once (checked finite and strictly increasing), then each
+/// selected column is decoded and scaled in one pass straight from the map, so no raw copy is held.
 pub(crate) fn read_record_table(
     path: &Path,
     record_type: ImuRecordType,
@@ -701,7 +701,7 @@ pub(crate) fn read_record_table(
         return Err(ParamError::new(
             "time column",
             t,
-            "no time column: IMU records carry their own time (METHODS §9.2)",
+            "no time column: IMU records carry their own time (docs/methods.md §9.2)",
         )
         .into());
     }
@@ -709,7 +709,7 @@ pub(crate) fn read_record_table(
         return Err(ParamError::new(
             "time unit",
             u,
-            "no unit: IMU record times are in seconds (METHODS §9.2)",
+            "no unit: IMU record times are in seconds (docs/methods.md §9.2)",
         )
         .into());
     }
@@ -791,13 +791,13 @@ pub(crate) fn read_record_table(
     })
 }
 
-/// Reads a binary IMU record file (METHODS §9.2): each epoch is a little-endian f64 time then
-/// gyro X, Y, Z and accel X, Y, Z increments (int32 or f64 by type). Returns an [`Imu`] with
+/// Reads a binary IMU record file (docs/methods.md §9.2): each epoch is a little-endian f64 time
+/// then gyro X, Y, Z and accel X, Y, Z increments (int32 or f64 by type). Returns an [`Imu`] with
 /// `freq = round(1 / mean time step)` (the mean over the regular steps, see `record_freq`:
-/// METHODS §9.2's rate on a file without gaps) and rates `raw · freq · scale` (METHODS §9.3),
-/// in rad/s and m/s^2, columns named `gyro_x` ... `accel_z`; its [`Imu::timing`] reports the
-/// epochs' gaps. The same columns are read by [`read_table`](super::read_table) with
-/// [`InputFormat::ImuRecord`].
+/// docs/methods.md §9.2's rate on a file without gaps) and rates `raw · freq · scale`
+/// (docs/methods.md §9.3), in rad/s and m/s^2, columns named `gyro_x` ... `accel_z`; its
+/// [`Imu::timing`] reports the epochs' gaps. The same columns are read by
+/// [`read_table`](super::read_table) with [`InputFormat::ImuRecord`].
 ///
 /// The file is memory-mapped and must not change while it is read.
 ///
@@ -838,7 +838,7 @@ mod tests {
         assert_eq!(ImuRecordType::Ixsea.record_size(), 56);
     }
 
-    /// METHODS §9.3 table values.
+    /// docs/methods.md §9.3 table values.
     #[test]
     fn imu_record_scales_match_methods_9_3() {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-7 * b.abs();

@@ -81,7 +81,7 @@ pub enum InputFormat {
     Csv,
     /// Tab separated (no sniffing).
     Tsv,
-    /// Binary IMU epoch records of METHODS §9.2 (time, then gyro X, Y, Z and accel X, Y, Z
+    /// Binary IMU epoch records of docs/methods.md §9.2 (time, then gyro X, Y, Z and accel X, Y, Z
     /// increments), read as columns `gyro_x` ... `accel_z` in rad/s and m/s^2 and the time.
     ImuRecord(ImuRecordType),
     /// Raw little-endian f64, `ncols` interleaved columns.
@@ -297,7 +297,8 @@ pub struct Table {
     /// Columns left out of the default selection: other time columns, and the columns that
     /// are neither a gyroscope nor an accelerometer axis when the file has such axes.
     pub skipped: Vec<String>,
-    /// The binary IMU record type the table was decoded from, if any (METHODS §9.1 `stype`).
+    /// The binary IMU record type the table was decoded from, if any (docs/methods.md §9.1
+    /// `stype`).
     pub record_type: Option<ImuRecordType>,
 }
 
@@ -504,7 +505,7 @@ pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<Strin
 /// Sampling frequency, first match wins: `opts.freq_hz`; the time column's rate,
 /// [`TimingReport::rate_hz`] (1 / the nominal step: the mean of the steps within 1.5 median
 /// steps, so gaps do not lower it; not rounded, so 62.5 Hz survives) — for IMU records
-/// METHODS §9.2's rounded rate; the sidecar's `sampling_frequency_hz`; otherwise `None` and
+/// docs/methods.md §9.2's rounded rate; the sidecar's `sampling_frequency_hz`; otherwise `None` and
 /// the caller decides. A given rate or a sidecar rate that differs from the time column's by
 /// more than [`RATE_TOLERANCE`] is a [`ReadWarning`].
 ///
@@ -642,7 +643,7 @@ pub(crate) struct RawTable {
     pub(crate) time_origin: f64,
     /// Unit stated by the time column's name or the format.
     pub(crate) time_unit: Option<TimeUnit>,
-    /// Rate fixed by the format (IMU records: METHODS §9.2).
+    /// Rate fixed by the format (IMU records: docs/methods.md §9.2).
     pub(crate) freq_hz: Option<f64>,
     /// Physical lines of the data rows (text files).
     pub(crate) lines: Option<LineMap>,
