@@ -477,7 +477,7 @@ pub enum RuleArg {
 /// `--optimism`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum OptimismArg {
-    /// Closed form with the full model's bootstrap V (the package default).
+    /// Closed form with the full model's V, exact or simulated as --covariance says (the package default).
     Asymptotic,
     /// Parametric bootstrap per candidate (about K times slower for K candidates).
     Bootstrap,

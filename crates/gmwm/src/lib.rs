@@ -1,8 +1,9 @@
 //! # gmwm — stochastic error calibration of inertial sensors
 //!
 //! The engine of the gmwm platform: wavelet transforms, the wavelet variance (classical and
-//! robust), Allan and Hadamard variances, IMU data readers, and (in later modules) latent error
-//! models estimated by the Generalized Method of Wavelet Moments.
+//! robust), Allan and Hadamard variances, IMU data readers, latent error models estimated by the
+//! Generalized Method of Wavelet Moments with their inference and selection, and the
+//! calibration pipeline that turns a recording into a navigation filter's parameters.
 //!
 //! Conventions, stated once:
 //! - scales are labelled `tau_j = 2^j` samples (`2^j / freq_hz` seconds), the package label of

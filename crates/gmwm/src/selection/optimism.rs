@@ -39,7 +39,7 @@ use std::fmt;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum OptimismMethod {
-    /// Closed form at theta_hat with the full model's bootstrap V (§8.2); the package default.
+    /// Closed form at theta_hat with the full model's V, exact or simulated (§8.2); the package default.
     #[default]
     Asymptotic,
     /// Per candidate, a parametric bootstrap from its estimate (§8.3); about K times slower

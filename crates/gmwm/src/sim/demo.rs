@@ -1,5 +1,5 @@
-//! The built-in demo sensor behind `gmwm demo`: a known truth to simulate, analyse and (once
-//! estimation lands) recover (docs/methods.md §5.10, §10).
+//! The built-in demo sensor behind `gmwm demo`: a known truth to simulate, analyse and recover
+//! (docs/methods.md §5.10, §10).
 
 use crate::error::InputError;
 use crate::model::Model;
