@@ -67,19 +67,43 @@ fn randomised_commands_give_the_same_bits_at_any_thread_count() {
     same_bits_at_1_2_3_threads(
         &[
             &fit[..],
-            &["--G", "500", "--inference", "--bootstrap", "20", "--seed", "3"],
+            &[
+                "--G",
+                "500",
+                "--inference",
+                "--bootstrap",
+                "20",
+                "--seed",
+                "3",
+            ],
         ]
         .concat(),
         d,
     );
     // selection: candidates in parallel, V simulated, and the bootstrap optimism
-    let select = ["select", file, "--model", "AR1()+WN()+RW()", "--json", "--G", "500"];
+    let select = [
+        "select",
+        file,
+        "--model",
+        "AR1()+WN()+RW()",
+        "--json",
+        "--G",
+        "500",
+    ];
     same_bits_at_1_2_3_threads(
-        &[&select[..], &["--covariance", "bootstrap", "--bootstrap", "20"]].concat(),
+        &[
+            &select[..],
+            &["--covariance", "bootstrap", "--bootstrap", "20"],
+        ]
+        .concat(),
         d,
     );
     same_bits_at_1_2_3_threads(
-        &[&select[..], &["--optimism", "bootstrap", "--bootstrap", "10"]].concat(),
+        &[
+            &select[..],
+            &["--optimism", "bootstrap", "--bootstrap", "10"],
+        ]
+        .concat(),
         d,
     );
 }

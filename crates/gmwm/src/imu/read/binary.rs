@@ -9,15 +9,11 @@ use super::{binary_names, resolve_selection, Column, InputFormat, RawTable, Read
 use crate::error::{Error, ParamError};
 use crate::imu::timing::{check_times, TimeUnit, UnitSource};
 use crate::imu::{Imu, ReadError, Sidecar};
-use memmap2::Mmap;
 use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
-
-/// Records decoded between two hand-backs of the mapped pages (64 Ki records, 2–3.5 MiB).
-const RELEASE_EVERY: usize = 1 << 16;
 
 /// Read buffer of [`BinaryChunks`].
 const BUF_CAPACITY: usize = 1 << 20;
@@ -86,15 +82,68 @@ fn open_records(path: &Path, record: usize) -> Result<(File, u64), ReadError> {
     Ok((file, size / record))
 }
 
-/// Memory-maps a whole file read-only.
-fn map(path: &Path, file: &File) -> Result<Mmap, ReadError> {
-    // SAFETY: the map is read-only and private to this call; as with any memory map, the file
-    // must not be truncated by another process while it is read (documented on the public
-    // readers).
-    unsafe { Mmap::map(file) }.map_err(|e| io_error(path, e))
+/// Records read at a time by the whole-file readers.
+const TABLE_CHUNK_ROWS: u64 = 1 << 16;
+
+/// Calls `f(first, bytes)` on consecutive runs of whole records (`first` is the index of the
+/// run's first record) of `rows` records of `record` bytes, read with positioned reads of
+/// [`TABLE_CHUNK_ROWS`] records into one buffer. The whole-file readers read so, not through a
+/// memory map: a file truncated or rewritten by another process while it is read gives an error
+/// (or the bytes read), never undefined behaviour, and the resident set is the output plus one
+/// buffer.
+fn for_each_record_run(
+    path: &Path,
+    file: &File,
+    (rows, record): (u64, usize),
+    mut f: impl FnMut(usize, &[u8]) -> Result<(), ReadError>,
+) -> Result<(), ReadError> {
+    let mut buf = vec![0u8; TABLE_CHUNK_ROWS.min(rows) as usize * record];
+    let mut row = 0u64;
+    while row < rows {
+        let n = (rows - row).min(TABLE_CHUNK_ROWS) as usize;
+        let bytes = &mut buf[..n * record];
+        read_exact_at(file, bytes, row * record as u64).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::UnexpectedEof {
+                io_error(
+                    path,
+                    std::io::Error::new(e.kind(), "the file shrank while it was read"),
+                )
+            } else {
+                io_error(path, e)
+            }
+        })?;
+        f(row as usize, bytes)?;
+        row += n as u64;
+    }
+    Ok(())
 }
 
-/// Width in bytes of a binary format, or an option error for text formats.
+/// The columns `wanted` (in that order) of a raw binary file of `rows` records of `record`
+/// bytes, `width` bytes a value ([`for_each_record_run`]).
+fn read_columns(
+    path: &Path,
+    file: &File,
+    (rows, record, width): (u64, usize, usize),
+    wanted: &[usize],
+) -> Result<Vec<Vec<f64>>, ReadError> {
+    let capacity = usize::try_from(rows).unwrap_or(usize::MAX);
+    let mut out: Vec<Vec<f64>> = wanted
+        .iter()
+        .map(|_| Vec::with_capacity(capacity))
+        .collect();
+    for_each_record_run(path, file, (rows, record), |_, bytes| {
+        for (values, &k) in out.iter_mut().zip(wanted) {
+            values.extend(
+                bytes
+                    .chunks_exact(record)
+                    .map(|r| decode(&r[k * width..], width)),
+            );
+        }
+        Ok(())
+    })?;
+    Ok(out)
+}
+
 fn width_of(format: InputFormat) -> Result<usize, ParamError> {
     format.value_width().ok_or_else(|| {
         ParamError::new(
@@ -113,8 +162,8 @@ fn check_ncols(ncols: usize) -> Result<(), ParamError> {
     }
 }
 
-/// Reads a raw binary table (memory-mapped). The file must not change while it is read.
-/// `ncols` and the column names come from the options, else the sidecar.
+/// Reads a raw binary table with positioned reads ([`read_columns`]). `ncols` and the column
+/// names come from the options, else the sidecar.
 pub(crate) fn read_binary_table(
     path: &Path,
     format: InputFormat,
@@ -129,14 +178,13 @@ pub(crate) fn read_binary_table(
     check_ncols(ncols)?;
     let names = binary_names(sidecar, ncols);
     let sel = resolve_selection(path, &names, opts, sidecar)?;
-    let (file, _rows) = open_records(path, width * ncols)?;
-    let bytes = map(path, &file)?;
     let record = width * ncols;
-    let column = |k: usize| -> Result<Vec<f64>, ReadError> {
-        let values: Vec<f64> = bytes
-            .chunks_exact(record)
-            .map(|r| decode(&r[k * width..], width))
-            .collect();
+    let (file, rows) = open_records(path, record)?;
+    // the time column (if any) first, then the selected ones, in one pass over the file
+    let wanted: Vec<usize> = sel.time.iter().chain(&sel.columns).copied().collect();
+    let mut read = read_columns(path, &file, (rows, record, width), &wanted)?.into_iter();
+    let mut column = |k: usize| -> Result<Vec<f64>, ReadError> {
+        let values = read.next().unwrap_or_default();
         match values.iter().position(|v| !v.is_finite()) {
             Some(i) => Err(non_finite(path, i, k + 1, values[i])),
             None => Ok(values),
@@ -719,47 +767,46 @@ pub(crate) fn read_record_table(
     };
     let sel = resolve_selection(path, &names, &select, None)?;
     let (file, rows) = open_records(path, record)?;
-    let bytes = map(path, &file)?;
-    // one pass over the records, handing decoded pages back to the kernel as it goes: the
-    // resident set is the output plus about one release step of the file
-    let mut release = crate::imu::ros::Release::new(&bytes);
-    let mut time: Vec<f64> = Vec::with_capacity(rows as usize);
+    let capacity = usize::try_from(rows).unwrap_or(usize::MAX);
+    let mut time: Vec<f64> = Vec::with_capacity(capacity);
     let mut counts: Vec<Vec<f64>> = sel
         .columns
         .iter()
-        .map(|_| Vec::with_capacity(rows as usize))
+        .map(|_| Vec::with_capacity(capacity))
         .collect();
-    for (i, r) in bytes.chunks_exact(record).enumerate() {
-        let t = decode(r, 8);
-        if !t.is_finite() {
-            return Err(non_finite(path, i, 1, t));
-        }
-        if let Some(&previous) = time.last() {
-            if t <= previous {
-                return Err(ReadError::RecordTimeNotIncreasing {
-                    path: path.to_path_buf(),
-                    index: i as u64,
-                    previous,
-                    value: t,
-                });
+    // one pass over the records
+    for_each_record_run(path, &file, (rows, record), |first, bytes| {
+        for (j, r) in bytes.chunks_exact(record).enumerate() {
+            let i = first + j;
+            let t = decode(r, 8);
+            if !t.is_finite() {
+                return Err(non_finite(path, i, 1, t));
+            }
+            if let Some(&previous) = time.last() {
+                if t <= previous {
+                    return Err(ReadError::RecordTimeNotIncreasing {
+                        path: path.to_path_buf(),
+                        index: i as u64,
+                        previous,
+                        value: t,
+                    });
+                }
+            }
+            time.push(t);
+            for (c, &k) in sel.columns.iter().enumerate() {
+                let raw = if record_type.is_double() {
+                    decode(&r[8 + 8 * k..], 8)
+                } else {
+                    decode_i32(&r[8 + 4 * k..])
+                };
+                if !raw.is_finite() {
+                    return Err(non_finite(path, i, k + 2, raw));
+                }
+                counts[c].push(raw);
             }
         }
-        time.push(t);
-        for (c, &k) in sel.columns.iter().enumerate() {
-            let raw = if record_type.is_double() {
-                decode(&r[8 + 8 * k..], 8)
-            } else {
-                decode_i32(&r[8 + 4 * k..])
-            };
-            if !raw.is_finite() {
-                return Err(non_finite(path, i, k + 2, raw));
-            }
-            counts[c].push(raw);
-        }
-        if i % RELEASE_EVERY == 0 {
-            release.upto(i * record);
-        }
-    }
+        Ok(())
+    })?;
     let freq = record_freq(path, &time)?;
     let mut columns = Vec::with_capacity(sel.columns.len());
     for (&k, mut values) in sel.columns.iter().zip(counts) {
@@ -822,6 +869,31 @@ pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<I
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_file_that_shrinks_while_it_is_read_is_an_error() {
+        let dir = std::env::temp_dir().join(format!("gmwm-shrink-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.f64");
+        let values: Vec<u8> = (0..200_000u32)
+            .flat_map(|i| f64::from(i).to_le_bytes())
+            .collect();
+        std::fs::write(&path, &values).unwrap();
+        let (file, rows) = open_records(&path, 8).unwrap();
+        let all = read_columns(&path, &file, (rows, 8, 8), &[0]).unwrap();
+        assert_eq!(all[0].len(), 200_000);
+        assert_eq!(all[0][199_999], 199_999.0);
+        // another process truncates it after its size was taken
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .unwrap()
+            .set_len(8 * 100_000)
+            .unwrap();
+        let e = read_columns(&path, &file, (rows, 8, 8), &[0]).unwrap_err();
+        assert!(e.to_string().contains("x.f64: the file shrank while it was read"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn imu_record_type_from_str_and_sizes() {
