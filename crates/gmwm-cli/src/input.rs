@@ -42,15 +42,10 @@ pub fn note(file: &Path, text: &str) {
     eprintln!("gmwm: note: {}: {text}", file.display());
 }
 
-/// Prints what the reader found: the time column and its rate, the columns left out, then
-/// every warning, each once.
-fn report(table: &Table) {
-    let file = &table.path;
-    if let Some(t) = &table.timing {
-        note(file, &t.to_string());
-    }
-    if !table.skipped.is_empty() {
-        let names: Vec<String> = table.skipped.iter().map(|n| quote(n)).collect();
+/// Prints the columns a reader left out (none: nothing).
+pub fn note_not_analysed(file: &Path, skipped: &[String]) {
+    if !skipped.is_empty() {
+        let names: Vec<String> = skipped.iter().map(|n| quote(n)).collect();
         note(
             file,
             &format!(
@@ -60,6 +55,16 @@ fn report(table: &Table) {
             ),
         );
     }
+}
+
+/// Prints what the reader found: the time column and its rate, the columns left out, then
+/// every warning, each once.
+fn report(table: &Table) {
+    let file = &table.path;
+    if let Some(t) = &table.timing {
+        note(file, &t.to_string());
+    }
+    note_not_analysed(file, &table.skipped);
     for w in &table.warnings {
         match w {
             ReadWarning::FreqDisagrees {
@@ -228,6 +233,16 @@ pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
 /// its columns and what each measures from the sidecar, no samples read.
 pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
     let columns = gmwm::calib::streamed::columns(&input.file, &input.read)?;
+    // the columns left out, as the in-memory reader notes them
+    let skipped = match gmwm::imu::binary_layout(&input.file, &input.read)? {
+        Some(layout) => {
+            let sidecar = gmwm::imu::find_sidecar(&input.file)?;
+            layout
+                .selection(&input.file, &input.read, sidecar.as_ref())?
+                .1
+        }
+        None => Vec::new(),
+    };
     Ok(LoadedRecording {
         path: input.file.clone(),
         columns,
@@ -235,7 +250,9 @@ pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
         topic: None,
         source: gmwm::imu::RecordingSource::Table,
         timing: None,
-        notes: Vec::new(),
+        notes: gmwm::imu::recording::left_out_note(&skipped)
+            .into_iter()
+            .collect(),
     })
 }
 

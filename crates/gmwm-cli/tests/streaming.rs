@@ -203,3 +203,47 @@ fn fit_of_a_raw_binary_file_streams_to_the_fit_of_the_loaded_values() {
         );
     }
 }
+
+#[test]
+fn streamed_columns_are_the_ones_the_loader_analyses() {
+    // a raw f64 file of three interleaved columns, a gyroscope axis among them: streamed, `gmwm
+    // wv` analyses the sensor axis and notes the others, as the loader does for a CSV
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("imu.f64");
+    let n = 4096;
+    let bytes: Vec<u8> = (0..n)
+        .flat_map(|i| {
+            let x = (i as f64 * 0.37).sin();
+            [20.0 + 0.001 * i as f64, x, (i % 7) as f64]
+        })
+        .flat_map(f64::to_le_bytes)
+        .collect();
+    std::fs::write(&path, bytes).unwrap();
+    std::fs::write(
+        dir.path().join("imu.f64.json"),
+        r#"{"sampling_frequency_hz": 100, "format": "f64", "n_columns": 3,
+            "columns": [{"name": "temp"}, {"name": "gyro_x"}, {"name": "counter"}]}"#,
+    )
+    .unwrap();
+    let out = gmwm().arg("wv").arg(&path).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let names: Vec<&str> = doc["series"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["gyro_x"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("not analysed: temp, counter"), "{stderr}");
+    // --columns still takes any column
+    let doc = run_json(
+        gmwm()
+            .arg("wv")
+            .arg(&path)
+            .args(["--json", "--columns", "counter,gyro_x"]),
+    );
+    assert_eq!(doc["series"][0]["name"], "counter");
+    assert_eq!(doc["series"][1]["name"], "gyro_x");
+}

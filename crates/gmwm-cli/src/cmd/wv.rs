@@ -4,7 +4,7 @@ use crate::config::{InputConfig, WvConfig};
 use crate::input::{analyse_columns, is_wv, load, load_wv, named, note};
 use crate::render;
 use anyhow::Result;
-use gmwm::imu::{binary_layout, BinaryLayout, ColumnSelector};
+use gmwm::imu::{binary_layout, BinaryLayout};
 use gmwm::variance::{binary_columns_wv, StreamedColumn};
 use gmwm::{wavelet_variance, Transform, WaveletFilter, WaveletVariance, WvOptions};
 use std::io::Write;
@@ -39,23 +39,16 @@ fn run_streaming(
     Ok(columns.into_iter().map(|(name, c)| (name, c.wv)).collect())
 }
 
-/// The selected columns of a raw binary file (`--columns`, else all), streamed in one pass:
-/// each one's name, WV and range.
+/// The selected columns of a raw binary file (`--columns`, else the sensor axes, else all, as
+/// the in-memory reader selects them), streamed in one pass: each one's name, WV and range.
 pub(crate) fn stream_columns(
     input: &InputConfig,
     layout: &BinaryLayout,
     opts: &WvOptions,
 ) -> Result<Vec<(String, StreamedColumn)>> {
-    let columns: Vec<usize> = if input.read.columns.is_empty() {
-        (1..=layout.ncols).collect()
-    } else {
-        input
-            .read
-            .columns
-            .iter()
-            .map(|c| binary_column_index(c, layout))
-            .collect::<Result<_>>()?
-    };
+    let sidecar = gmwm::imu::find_sidecar(&input.file)?;
+    let (columns, skipped) = layout.selection(&input.file, &input.read, sidecar.as_ref())?;
+    crate::input::note_not_analysed(&input.file, &skipped);
     let freq_hz = match input.read.freq_hz {
         Some(f) => f,
         None => stream_freq(&input.file)?,
@@ -67,33 +60,6 @@ pub(crate) fn stream_columns(
         .map(|&c| layout.names[c - 1].clone())
         .zip(streamed)
         .collect())
-}
-
-/// A `--columns` entry of a raw binary file: a 1-based index, a name of the sidecar, or
-/// `colK`.
-fn binary_column_index(column: &ColumnSelector, layout: &BinaryLayout) -> Result<usize> {
-    let t = column.to_string();
-    let ncols = layout.ncols;
-    let index = match column {
-        ColumnSelector::Index(i) => Some(*i),
-        ColumnSelector::Name(n) => layout
-            .names
-            .iter()
-            .position(|m| m == n)
-            .map(|k| k + 1)
-            .or_else(|| n.strip_prefix("col").and_then(|k| k.parse().ok())),
-    };
-    let index = index.ok_or_else(|| {
-        anyhow::anyhow!(
-            "invalid --columns {t:?}: binary columns are 1-based indices or the names {}",
-            layout.names.join(", ")
-        )
-    })?;
-    anyhow::ensure!(
-        (1..=ncols).contains(&index),
-        "invalid --columns {t}: the file has {ncols} interleaved column(s) (--ncols)"
-    );
-    Ok(index)
 }
 
 fn stream_freq(path: &std::path::Path) -> Result<f64> {

@@ -28,8 +28,7 @@
 use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
 use crate::error::{Error, ParamError};
 use crate::imu::{
-    binary_layout, find_sidecar, BinaryChunks, BinaryLayout, ColumnSelector, ReadError,
-    ReadOptions, SensorInfo,
+    binary_layout, find_sidecar, BinaryChunks, BinaryLayout, ReadError, ReadOptions, SensorInfo,
 };
 use crate::inference::Progress;
 use crate::variance::binary_wavelet_variance;
@@ -256,51 +255,12 @@ fn selected(
     read: &ReadOptions,
     sidecar: Option<&crate::imu::Sidecar>,
 ) -> Result<(Vec<usize>, Vec<SensorInfo>), Error> {
-    let columns = selected_columns(path, layout, &read.columns)?;
+    let (columns, _) = layout.selection(path, read, sidecar)?;
     let infos = columns
         .iter()
         .map(|&c| SensorInfo::of_column(&layout.names[c - 1], sidecar, false))
         .collect();
     Ok((columns, infos))
-}
-
-/// The 1-based indices of the selected columns (all without a selection).
-fn selected_columns(
-    path: &Path,
-    layout: &BinaryLayout,
-    selection: &[ColumnSelector],
-) -> Result<Vec<usize>, ReadError> {
-    if selection.is_empty() {
-        return Ok((1..=layout.ncols).collect());
-    }
-    selection
-        .iter()
-        .map(|c| {
-            let index = match c {
-                ColumnSelector::Index(i) => *i,
-                ColumnSelector::Name(name) => layout
-                    .names
-                    .iter()
-                    .position(|m| m == name)
-                    .map(|k| k + 1)
-                    .or_else(|| name.strip_prefix("col").and_then(|k| k.parse().ok()))
-                    .ok_or_else(|| ReadError::UnknownColumn {
-                        path: path.to_path_buf(),
-                        name: name.clone(),
-                        available: layout.names.clone(),
-                    })?,
-            };
-            if (1..=layout.ncols).contains(&index) {
-                Ok(index)
-            } else {
-                Err(ReadError::ColumnOutOfRange {
-                    path: path.to_path_buf(),
-                    index,
-                    ncols: layout.ncols,
-                })
-            }
-        })
-        .collect()
 }
 
 /// The classical WV of each column ([`binary_wavelet_variance`]: parallel, bounded memory,

@@ -91,9 +91,7 @@ impl Recording {
         if let Some(timing) = &table.timing {
             notes.push(timing.to_string());
         }
-        if !table.skipped.is_empty() {
-            notes.push(format!("columns left out: {}", table.skipped.join(", ")));
-        }
+        notes.extend(left_out_note(&table.skipped));
         notes.extend(table.warnings.iter().map(ToString::to_string));
         let source = match table.record_type {
             Some(t) => RecordingSource::Records {
@@ -221,4 +219,9 @@ fn imu_of_messages(msgs: ImuMessages, freq_hz: f64) -> Result<Imu, Error> {
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_default();
     Ok(Imu::new(columns, info, freq_hz)?.with_name(name))
+}
+
+/// The note on the columns a reader left out (`None` when it left out none).
+pub fn left_out_note(skipped: &[String]) -> Option<String> {
+    (!skipped.is_empty()).then(|| format!("columns left out: {}", skipped.join(", ")))
 }

@@ -891,7 +891,11 @@ mod tests {
             .set_len(8 * 100_000)
             .unwrap();
         let e = read_columns(&path, &file, (rows, 8, 8), &[0]).unwrap_err();
-        assert!(e.to_string().contains("x.f64: the file shrank while it was read"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("x.f64: the file shrank while it was read"),
+            "{e}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -452,6 +452,26 @@ pub struct BinaryLayout {
     pub names: Vec<String>,
 }
 
+impl BinaryLayout {
+    /// The columns [`read_table`] would analyse in this layout (1-based indices: `--columns`,
+    /// else the sensor axes, else every column but the time columns) and the names of those
+    /// it leaves out, by the one rule of the in-memory readers, so that a streamed file
+    /// analyses the same columns as a loaded one.
+    ///
+    /// # Errors
+    /// [`ReadError::UnknownColumn`] / [`ReadError::ColumnOutOfRange`] for a selector that
+    /// names no column.
+    pub fn selection(
+        &self,
+        path: &Path,
+        opts: &ReadOptions,
+        sidecar: Option<&Sidecar>,
+    ) -> Result<(Vec<usize>, Vec<String>), ReadError> {
+        let sel = resolve_selection(path, &self.names, opts, sidecar)?;
+        Ok((sel.columns.iter().map(|k| k + 1).collect(), sel.skipped))
+    }
+}
+
 /// The raw binary layout of `path` if [`read_table`] would read it as raw f64/f32 (from
 /// `opts.format`, the name or the sidecar), `None` otherwise; for readers that stream
 /// ([`BinaryChunks`]).
