@@ -589,6 +589,10 @@ pub struct SimulateArgs {
     /// Also write each component as its own column (x is their sum).
     #[arg(long)]
     pub components: bool,
+    /// Write an output of more than 10^9 samples, or larger than the free space of the output
+    /// file's file system (refused without it, stating the size).
+    #[arg(long)]
+    pub yes: bool,
 }
 
 /// `gmwm implied`.
@@ -888,10 +892,17 @@ pub fn alpha(s: &str) -> Result<f64, String> {
     }
 }
 
-/// A count of at least `min`.
+/// A count of at least `min`: digits, or a whole number in exponent notation (`1e6`).
 fn count_at_least(s: &str, min: usize) -> Result<usize, String> {
-    match s.trim().parse::<usize>() {
-        Ok(v) if v >= min => Ok(v),
+    let t = s.trim();
+    let v = t.parse::<usize>().ok().or_else(|| {
+        t.parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite() && *x >= 0.0 && x.fract() == 0.0 && *x < 9.0e15)
+            .map(|x| x as usize)
+    });
+    match v {
+        Some(v) if v >= min => Ok(v),
         _ => Err(format!("must be a whole number >= {min}")),
     }
 }

@@ -11,17 +11,19 @@ mod config;
 mod input;
 mod progress;
 mod render;
+mod spool;
 
 use args::Cli;
 use clap::Parser;
-use config::Config;
+use config::{Config, InputConfig, PlotKind};
 use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 
 /// Validates the flags into the subcommand's configuration, before any file is read, then
 /// runs it.
 fn run(cli: &Cli) -> anyhow::Result<()> {
-    let config = Config::try_from(&cli.command)?;
+    let mut config = Config::try_from(&cli.command)?;
+    let _spool = prepare_input(&mut config)?;
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
     match &config {
@@ -40,6 +42,82 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
     }
     out.flush()?;
     Ok(())
+}
+
+/// The recording of a one-recording command.
+fn input_mut(config: &mut Config) -> Option<&mut InputConfig> {
+    Some(match config {
+        Config::Wv(c) => &mut c.input,
+        Config::Avar(c) => &mut c.input,
+        Config::Fit(c) => &mut c.input,
+        Config::Select(c) => &mut c.input,
+        Config::Calibrate(c) => &mut c.input,
+        Config::Report(c) => &mut c.calibrate.input,
+        Config::Plot(c) => match &mut c.kind {
+            PlotKind::Wv(c) => &mut c.input,
+            PlotKind::Avar(c) | PlotKind::Ieee(c) => &mut c.input,
+            PlotKind::Compare(c) => &mut c.input,
+            PlotKind::Fit(c) => &mut c.input,
+            PlotKind::Select(c) => &mut c.input,
+        },
+        _ => return None,
+    })
+}
+
+/// Before anything is read: standard input (`-`) or a pipe as FILE is copied to a temporary
+/// file ([`spool`]; the guard removes it), and raw floats that are no sensor's samples (f64
+/// read as f32, ...) are warned about, naming the other format.
+fn prepare_input(config: &mut Config) -> anyhow::Result<Option<spool::Spool>> {
+    if let Config::Batch(b) = config {
+        if let Some(p) = b.inputs.iter().find(|p| spool::is_stream(p)) {
+            return Err(UsageError(format!(
+                "{}: batch mode (several FILEs, a folder, --out-dir, --force) reads files; \
+                 give standard input or a pipe alone, without --out-dir/--force",
+                if p.as_os_str() == "-" {
+                    spool::STDIN.to_string()
+                } else {
+                    p.display().to_string()
+                }
+            ))
+            .into());
+        }
+        return Ok(None);
+    }
+    let mut guard = None;
+    if let Config::Topics(t) = config {
+        if spool::is_stream(&t.file) {
+            let (copy, g) = spool::spool(&t.file)?;
+            t.file = copy;
+            guard = Some(g);
+        }
+        return Ok(guard);
+    }
+    let Some(input) = input_mut(config) else {
+        return Ok(None);
+    };
+    if spool::is_stream(&input.file) {
+        let (copy, g) = spool::spool(&input.file)?;
+        input.file = copy;
+        guard = Some(g);
+    }
+    warn_implausible(input);
+    Ok(guard)
+}
+
+/// A warning when FILE is raw f64/f32 whose first values no sensor gives
+/// ([`gmwm::imu::plausible::raw_floats`]); silent when it is not raw floats or cannot be read
+/// (the reader then says why).
+fn warn_implausible(input: &InputConfig) {
+    if input.read.format == gmwm::imu::InputFormat::Auto
+        && (gmwm::imu::ros::container_of(&input.file).is_some() || input::is_wv(input))
+    {
+        return;
+    }
+    if let Ok(Some(layout)) = gmwm::imu::binary_layout(&input.file, &input.read) {
+        if let Ok(Some(bad)) = gmwm::imu::plausible::raw_floats(&input.file, &layout) {
+            eprintln!("gmwm: warning: {}", spool::shown(&bad.to_string()));
+        }
+    }
 }
 
 /// A flag combination the command refuses (e.g. `gmwm fit --filter la8`): reported in one line
@@ -114,7 +192,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("gmwm: error: {}", one_line(&e));
+            eprintln!("gmwm: error: {}", spool::shown(&one_line(&e)));
             if e.downcast_ref::<UsageError>().is_some() {
                 ExitCode::from(2)
             } else {

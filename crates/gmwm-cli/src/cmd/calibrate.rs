@@ -213,7 +213,7 @@ fn write_report(
         }
     }
     let ctx = gmwm_plot::report::ReportContext {
-        file: config.input.file.display().to_string(),
+        file: crate::spool::shown(&config.input.file.display().to_string()),
         source: match &recording.source {
             gmwm::imu::RecordingSource::Records { record_type } => {
                 format!("binary IMU records ({record_type})")

@@ -4,9 +4,10 @@
 use crate::config::SimulateConfig;
 use anyhow::{Context, Result};
 use gmwm::imu::write::{write_csv_header, write_csv_rows, write_sidecar};
-use gmwm::imu::{SeriesWriter, Sidecar, SidecarColumn};
+use gmwm::imu::{OutputFormat, SeriesWriter, Sidecar, SidecarColumn};
 use gmwm::sim::Simulator;
 use std::io::Write;
+use std::path::Path;
 
 /// Samples simulated and written per step: bounded memory for any N.
 const CHUNK: usize = 1 << 16;
@@ -27,6 +28,106 @@ impl Sink<'_> {
     }
 }
 
+/// Samples above which `--yes` is needed.
+pub const CONFIRM_SAMPLES: usize = 1_000_000_000;
+
+/// Bytes per value written as text (`-0.7416573867739413,`: the shortest round-trip form of a
+/// double is up to about 20 characters).
+const TEXT_BYTES: u64 = 20;
+
+/// About how many bytes `n` rows of `ncols` values take in the output's format (text
+/// uncompressed).
+fn estimated_bytes(config: &SimulateConfig, ncols: usize) -> u64 {
+    let per_value = match config.output.as_deref().map(OutputFormat::from_path) {
+        Some(Ok(OutputFormat::F64)) => 8,
+        Some(Ok(OutputFormat::F32)) => 4,
+        _ => TEXT_BYTES,
+    };
+    (config.n as u64)
+        .saturating_mul(ncols as u64)
+        .saturating_mul(per_value)
+}
+
+/// A size with its unit (`1.2 GB`, decimal units).
+fn bytes(b: u64) -> String {
+    let units = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = b as f64;
+    let mut k = 0;
+    while v >= 1000.0 && k + 1 < units.len() {
+        v /= 1000.0;
+        k += 1;
+    }
+    if k == 0 {
+        format!("{b} bytes")
+    } else {
+        format!("{v:.1} {}", units[k])
+    }
+}
+
+/// Free bytes for an unprivileged writer on the file system that will hold `path`.
+#[cfg(unix)]
+fn free_space(path: &Path) -> Option<u64> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let s = rustix::fs::statvfs(dir).ok()?;
+    Some(s.f_bavail.saturating_mul(s.f_frsize))
+}
+
+#[cfg(not(unix))]
+fn free_space(_: &Path) -> Option<u64> {
+    None
+}
+
+/// Refuses, without `--yes`, more than [`CONFIRM_SAMPLES`] samples, or a file larger than the
+/// free space of its file system: one line with the size it would write and the flag.
+fn check_size(config: &SimulateConfig, ncols: usize) -> Result<()> {
+    if config.yes {
+        return Ok(());
+    }
+    let size = estimated_bytes(config, ncols);
+    let gz = config.output.as_deref().is_some_and(|p| {
+        matches!(
+            OutputFormat::from_path(p),
+            Ok(OutputFormat::Text { gzip: true, .. })
+        )
+    });
+    let target = match &config.output {
+        Some(p) => p.display().to_string(),
+        None => "standard output".to_string(),
+    };
+    let what = format!(
+        "about {}{} ({} samples x {ncols} column{})",
+        bytes(size),
+        if gz { " before compression" } else { "" },
+        config.n,
+        if ncols == 1 { "" } else { "s" }
+    );
+    if config.n > CONFIRM_SAMPLES {
+        return Err(crate::UsageError(format!(
+            "--n {}: gmwm simulate would write {what} to {target}, more than {CONFIRM_SAMPLES} \
+             samples; give --yes to write it",
+            config.n
+        ))
+        .into());
+    }
+    if let Some(p) = &config.output {
+        if let Some(free) = free_space(p) {
+            if size > free && !gz {
+                return Err(crate::UsageError(format!(
+                    "{}: gmwm simulate would write {what}, and its file system has {} free; \
+                     give --yes to write it anyway",
+                    p.display(),
+                    bytes(free)
+                ))
+                .into());
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Runs the subcommand.
 pub fn run(config: &SimulateConfig, stdout: &mut impl Write) -> Result<()> {
     let model = &config.model;
@@ -36,6 +137,7 @@ pub fn run(config: &SimulateConfig, stdout: &mut impl Write) -> Result<()> {
     if config.components {
         names.extend(model.components().iter().map(|c| c.to_string()));
     }
+    check_size(config, names.len())?;
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
     // Create the file first so a bad path or an unknown extension fails before any work.
     let mut sink = match &config.output {

@@ -1,0 +1,136 @@
+//! Whether raw little-endian floats look like sensor samples: a file of f64 values read as
+//! f32 (or the reverse, or integers read as floats) decodes to numbers no sensor gives
+//! (|x| near 1e38, subnormals, NaN), and its wavelet variance is then nonsense (2e45) without
+//! any error. [`raw_floats`] samples the start of the file and says so.
+
+use super::read::{BinaryLayout, InputFormat};
+use super::ReadError;
+use std::fmt;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// Values looked at: the first this many of the file.
+const SAMPLE: usize = 1 << 16;
+
+/// A magnitude no inertial sensor reports, in any unit.
+pub const HUGE: f64 = 1e20;
+
+/// A nonzero magnitude no inertial sensor reports (a subnormal f32 is below 1.2e-38).
+pub const TINY: f64 = 1e-30;
+
+/// Raw floats that do not look like sensor samples ([`raw_floats`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImplausibleFloats {
+    /// The file.
+    pub path: PathBuf,
+    /// The format it was read with: [`InputFormat::F64`] or [`InputFormat::F32`].
+    pub format: InputFormat,
+    /// Values looked at (the first of the file).
+    pub looked_at: usize,
+    /// Of those, finite with |x| > [`HUGE`].
+    pub huge: usize,
+    /// Of those, nonzero with |x| < [`TINY`] (subnormals among them).
+    pub tiny: usize,
+    /// Of those, NaN or infinite.
+    pub non_finite: usize,
+    /// The largest finite magnitude seen.
+    pub largest: f64,
+}
+
+impl ImplausibleFloats {
+    /// The other raw format, the likely right one.
+    pub fn other_format(&self) -> InputFormat {
+        match self.format {
+            InputFormat::F32 => InputFormat::F64,
+            _ => InputFormat::F32,
+        }
+    }
+}
+
+impl fmt::Display for ImplausibleFloats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut parts = Vec::new();
+        if self.huge > 0 {
+            parts.push(format!(
+                "{} beyond {HUGE:e} (largest {:.1e})",
+                self.huge, self.largest
+            ));
+        }
+        if self.tiny > 0 {
+            parts.push(format!("{} nonzero below {TINY:e}", self.tiny));
+        }
+        if self.non_finite > 0 {
+            parts.push(format!("{} NaN or infinite", self.non_finite));
+        }
+        write!(
+            f,
+            "{}: read as {}, the first {} values do not look like sensor samples ({}); is it \
+             --format {}?",
+            self.path.display(),
+            self.format,
+            self.looked_at,
+            parts.join(", "),
+            self.other_format()
+        )
+    }
+}
+
+/// Looks at the first values of a raw f64/f32 file (`layout`) and returns what is implausible
+/// when any value is beyond [`HUGE`], at least 1% are NaN or infinite, or at least 5% are
+/// nonzero below [`TINY`]; `None` when they look like samples (or the file is not raw floats).
+///
+/// # Errors
+/// [`ReadError::Io`] when the file cannot be opened or read.
+pub fn raw_floats(
+    path: &Path,
+    layout: &BinaryLayout,
+) -> Result<Option<ImplausibleFloats>, ReadError> {
+    let Some(width) = layout.format.value_width() else {
+        return Ok(None);
+    };
+    let io = |source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut bytes = Vec::with_capacity(SAMPLE * width);
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take((SAMPLE * width) as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    let mut out = ImplausibleFloats {
+        path: path.to_path_buf(),
+        format: layout.format,
+        looked_at: 0,
+        huge: 0,
+        tiny: 0,
+        non_finite: 0,
+        largest: 0.0,
+    };
+    for chunk in bytes.chunks_exact(width) {
+        let x = match chunk {
+            [a, b, c, d] => f64::from(f32::from_le_bytes([*a, *b, *c, *d])),
+            _ => {
+                let mut v = [0u8; 8];
+                v.copy_from_slice(chunk);
+                f64::from_le_bytes(v)
+            }
+        };
+        out.looked_at += 1;
+        let a = x.abs();
+        if !x.is_finite() {
+            out.non_finite += 1;
+            continue;
+        }
+        out.largest = out.largest.max(a);
+        if a > HUGE {
+            out.huge += 1;
+        } else if a != 0.0 && a < TINY {
+            out.tiny += 1;
+        }
+    }
+    let implausible = out.huge > 0
+        || (out.non_finite > 0 && out.non_finite * 100 >= out.looked_at)
+        || (out.tiny > 0 && out.tiny * 20 >= out.looked_at);
+    Ok(implausible.then_some(out))
+}
