@@ -137,6 +137,15 @@ pub enum SeriesError {
         /// Which quantity overflowed.
         what: String,
     },
+    /// Every computed variance is zero although the samples differ: their squares underflow.
+    #[error(
+        "the {what} is zero at every scale although the samples differ: squares of the data \
+         underflow double precision (|x| near 1e-154 or less); rescale the series"
+    )]
+    Underflow {
+        /// Which quantity underflowed.
+        what: String,
+    },
     /// Every sample has the same value: all variances are zero and nothing can be estimated.
     #[error("series is constant (every sample equals {value}); its variances are all zero")]
     Constant {

@@ -194,6 +194,39 @@ pub enum ReadError {
         /// File.
         path: PathBuf,
     },
+    /// A text file in another encoding than UTF-8 (UTF-16 by its byte-order mark, or 8-bit
+    /// text such as Latin-1): refused with what it is instead of as binary data.
+    #[error("{}: text is not UTF-8 ({detail}); save it as UTF-8", .path.display())]
+    NotUtf8 {
+        /// File.
+        path: PathBuf,
+        /// What it is, e.g. `UTF-16 little-endian, byte-order mark FF FE`.
+        detail: String,
+    },
+    /// A text file whose lines end in a carriage return alone (classic Mac OS): read as one
+    /// line, it would have a header and no data.
+    #[error(
+        "{}: lines end in a carriage return alone (CR, classic Mac OS); save it with LF or \
+         CRLF line ends",
+        .path.display()
+    )]
+    CrLineEnds {
+        /// File.
+        path: PathBuf,
+    },
+    /// Every column of the file is a time column: nothing is left to analyse.
+    #[error(
+        "{}: no column to analyse: every column is a time column (\"{}\" gives the time; \
+         --columns selects a column anyway)",
+        .path.display(),
+        quote(.column)
+    )]
+    OnlyTime {
+        /// File.
+        path: PathBuf,
+        /// The time column.
+        column: String,
+    },
     /// A JSON document was given where a table of samples is read.
     #[error(
         "{}: is JSON, not a table of samples (a wavelet variance saved by `gmwm wv --json` is \
