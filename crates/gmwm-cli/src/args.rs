@@ -626,6 +626,11 @@ rate, and for raw binary the format, --ncols and the column names; gzip is recog
 first bytes; binary data without --format is refused instead of being read as text; a JSON
 document is a wavelet variance saved by `gmwm wv --json`.
 
+FILE - reads standard input (text, gzip, a saved wavelet variance, or raw binary with --format
+f64|f32; messages call it <stdin>; no sidecar can come with it, so --freq is needed unless a
+time column gives the rate); a pipe such as <(zcat run.csv.gz) is read the same way. Raw floats
+that no sensor gives (f64 read as f32, ...) are warned about.
+
 Time column: --time-column, else the first column named time, timestamp, t, stamp, %time
 (rostopic echo -p, ns), #timestamp [ns] (EuRoC/TUM-VI), timestamp_ns, time_s, time [s],
 field.header.stamp (ns), ... (case-insensitive; a header stamp is preferred). It is not
@@ -645,8 +650,8 @@ linear_acceleration.x, ...), only those, and the others are listed in a note.";
 pub struct InputArgs {
     /// Data file: CSV/TSV (optionally .gz), raw little-endian binary (.f64, .f32 or
     /// --format f64|f32), binary IMU records (--format imar|ln200|...), a ROS recording (.bag,
-    /// .mcap, .db3, rosbag2 folder), or a wavelet variance saved by `gmwm wv --json` (see --help
-    /// for how FILE is read).
+    /// .mcap, .db3, rosbag2 folder), or a wavelet variance saved by `gmwm wv --json`; - for
+    /// standard input (see --help for how FILE is read).
     #[arg(value_name = "FILE", long_help = INPUT_HELP)]
     pub file: PathBuf,
     /// Columns to analyse, comma-separated names or 1-based indices (also the series of a

@@ -24,9 +24,76 @@ use std::process::ExitCode;
 fn run(cli: &Cli) -> anyhow::Result<()> {
     let mut config = Config::try_from(&cli.command)?;
     let _spool = prepare_input(&mut config)?;
+    let levels = levels_of(&config);
+    execute(&config).map_err(|e| match levels {
+        // a series too short for the levels asked: the flag is the thing to change
+        Some(j) if too_short(&e) => e.context(format!("--levels {j}")),
+        _ => e,
+    })
+}
+
+/// `--levels J` when the command was given one.
+fn levels_of(config: &Config) -> Option<usize> {
+    match config {
+        Config::Wv(c) => c.wv.levels,
+        Config::Fit(c) => c.wv.levels,
+        Config::Select(c) => c.wv.levels,
+        Config::Calibrate(c) => c.options.wv.levels,
+        Config::Report(c) => c.calibrate.options.wv.levels,
+        Config::Plot(c) => match &c.kind {
+            PlotKind::Wv(c) => c.wv.levels,
+            PlotKind::Fit(c) => c.wv.levels,
+            PlotKind::Select(c) => c.wv.levels,
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// Whether a series was too short for the computation (the engine's
+/// [`gmwm::SeriesError::TooShort`], however wrapped).
+fn too_short(e: &anyhow::Error) -> bool {
+    use gmwm::{Error, FitError, InputError, SelectionError, SeriesError};
+    let short = |s: &SeriesError| matches!(s, SeriesError::TooShort { .. });
+    let input = |i: &InputError| matches!(i, InputError::Series(s) if short(s));
+    e.chain().any(|c| {
+        c.downcast_ref::<SeriesError>().is_some_and(short)
+            || c.downcast_ref::<InputError>().is_some_and(input)
+            || c.downcast_ref::<FitError>()
+                .is_some_and(|f| matches!(f, FitError::Input(i) if input(i)))
+            || c.downcast_ref::<SelectionError>()
+                .is_some_and(|f| matches!(f, SelectionError::Input(i) if input(i)))
+            || c.downcast_ref::<Error>().is_some_and(|g| match g {
+                Error::Series(s) => short(s),
+                Error::Fit(FitError::Input(i)) | Error::Selection(SelectionError::Input(i)) => {
+                    input(i)
+                }
+                _ => false,
+            })
+    })
+}
+
+/// Standard output with its write errors naming it (`standard output: No space left on
+/// device`); the kind is kept (a closed pipe is still [`std::io::ErrorKind::BrokenPipe`]).
+struct Stdout<W>(W);
+
+impl<W: Write> Write for Stdout<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write(buf).map_err(named_stdout)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush().map_err(named_stdout)
+    }
+}
+
+fn named_stdout(e: std::io::Error) -> std::io::Error {
+    std::io::Error::new(e.kind(), format!("standard output: {e}"))
+}
+
+fn execute(config: &Config) -> anyhow::Result<()> {
     let stdout = std::io::stdout();
-    let mut out = BufWriter::new(stdout.lock());
-    match &config {
+    let mut out = BufWriter::new(Stdout(stdout.lock()));
+    match config {
         Config::Demo(c) => cmd::demo::run(c, &mut out)?,
         Config::Wv(c) => cmd::wv::run(c, &mut out)?,
         Config::Avar(c) => cmd::avar::run(c, &mut out)?,
@@ -95,6 +162,27 @@ fn prepare_input(config: &mut Config) -> anyhow::Result<Option<spool::Spool>> {
     let Some(input) = input_mut(config) else {
         return Ok(None);
     };
+    if let Some(topic) = &input.topic {
+        if !spool::is_stream(&input.file)
+            && gmwm::imu::ros::container_of(&input.file).is_none()
+            && input.read.format == gmwm::imu::InputFormat::Auto
+            && input.file.exists()
+        {
+            return Err(UsageError(format!(
+                "invalid --topic {topic}: {} is not a ROS recording (ROS1 bag, MCAP, rosbag2 \
+                 sqlite3)",
+                input.file.display()
+            ))
+            .into());
+        }
+    }
+    if input.file.is_dir() && !config::is_rosbag2_folder(&input.file) {
+        anyhow::bail!(
+            "{}: is a folder, not a recording (a rosbag2 folder holds metadata.yaml; gmwm wv \
+             and gmwm calibrate also take a folder of recordings)",
+            input.file.display()
+        );
+    }
     if spool::is_stream(&input.file) {
         let (copy, g) = spool::spool(&input.file)?;
         input.file = copy;

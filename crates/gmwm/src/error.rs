@@ -137,14 +137,15 @@ pub enum SeriesError {
         /// Which quantity overflowed.
         what: String,
     },
-    /// Every computed variance is zero although the samples differ: their squares underflow.
+    /// The samples differ so little that squared differences underflow double precision:
+    /// every variance would be zero or subnormal noise.
     #[error(
-        "the {what} is zero at every scale although the samples differ: squares of the data \
-         underflow double precision (|x| near 1e-154 or less); rescale the series"
+        "the samples differ by at most {range:e}: squared differences underflow double \
+         precision (below 1e-300); rescale the series"
     )]
     Underflow {
-        /// Which quantity underflowed.
-        what: String,
+        /// `max - min` of the samples.
+        range: f64,
     },
     /// Every sample has the same value: all variances are zero and nothing can be estimated.
     #[error("series is constant (every sample equals {value}); its variances are all zero")]
@@ -177,22 +178,39 @@ impl ParamError {
     }
 }
 
-/// Checks that a series is non-empty, finite and not constant (METHODS §0.1 preconditions).
+/// Samples whose range is below this have squared differences below 1e-300, near the end of
+/// double precision (normal numbers stop at 2.2e-308).
+pub const UNDERFLOW_RANGE: f64 = 1e-150;
+
+/// Checks that a series is non-empty, finite and not constant (METHODS §0.1 preconditions), nor
+/// so flat that its squared differences underflow ([`UNDERFLOW_RANGE`]).
 ///
 /// One vectorisable pass (min, max and a NaN-propagating probe); the offending index is looked
 /// up only on failure.
 ///
 /// # Errors
-/// [`SeriesError::Empty`], [`SeriesError::NonFinite`] (first offending index) or
-/// [`SeriesError::Constant`].
+/// [`SeriesError::Empty`], [`SeriesError::TooShort`] (one sample),
+/// [`SeriesError::NonFinite`] (first offending index), [`SeriesError::Constant`] or
+/// [`SeriesError::Underflow`].
 pub fn check_series(x: &[f64]) -> Result<(), SeriesError> {
     let first = *x.first().ok_or(SeriesError::Empty)?;
+    if x.len() == 1 {
+        // one sample is no series: say so rather than call it constant
+        return Err(SeriesError::TooShort {
+            n: 1,
+            needed: 2,
+            what: "a variance".into(),
+        });
+    }
     check_finite(x)?;
     let (lo, hi) = x
         .iter()
         .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     if lo == hi {
         return Err(SeriesError::Constant { value: first });
+    }
+    if hi - lo < UNDERFLOW_RANGE {
+        return Err(SeriesError::Underflow { range: hi - lo });
     }
     Ok(())
 }

@@ -232,8 +232,8 @@ fn write_report(
     };
     let html = gmwm_plot::report::render(report, &ctx)?;
     let figures = html.matches("<figure>").count();
-    write_file(path, html.as_bytes(), mode)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    // the caller names the file
+    write_file(path, html.as_bytes(), mode)?;
     Ok(figures)
 }
 

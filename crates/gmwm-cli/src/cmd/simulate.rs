@@ -83,6 +83,11 @@ fn free_space(_: &Path) -> Option<u64> {
 /// Refuses, without `--yes`, more than [`CONFIRM_SAMPLES`] samples, or a file larger than the
 /// free space of its file system: one line with the size it would write and the flag.
 fn check_size(config: &SimulateConfig, ncols: usize) -> Result<()> {
+    size_check(config, ncols, config.output.as_deref().and_then(free_space))
+}
+
+/// [`check_size`] with the free bytes of the output's file system given.
+fn size_check(config: &SimulateConfig, ncols: usize, free: Option<u64>) -> Result<()> {
     if config.yes {
         return Ok(());
     }
@@ -113,7 +118,7 @@ fn check_size(config: &SimulateConfig, ncols: usize) -> Result<()> {
         .into());
     }
     if let Some(p) = &config.output {
-        if let Some(free) = free_space(p) {
+        if let Some(free) = free {
             if size > free && !gz {
                 return Err(crate::UsageError(format!(
                     "{}: gmwm simulate would write {what}, and its file system has {} free; \
@@ -211,5 +216,52 @@ fn csv_quote(s: &str) -> String {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(n: usize, output: Option<&str>, yes: bool) -> SimulateConfig {
+        SimulateConfig {
+            model: "WN(sigma2=1)".parse().unwrap(),
+            n,
+            freq_hz: 1.0,
+            seed: 0,
+            output: output.map(Into::into),
+            components: false,
+            yes,
+        }
+    }
+
+    #[test]
+    fn a_file_larger_than_the_free_space_needs_yes() {
+        // 1e8 f64 samples: 800 MB, on a file system with 100 MB free
+        let c = config(100_000_000, Some("big.f64"), false);
+        let e = size_check(&c, 1, Some(100_000_000))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("big.f64") && e.contains("800.0 MB") && e.contains("100.0 MB free"),
+            "{e}"
+        );
+        assert!(e.contains("--yes"), "{e}");
+        assert!(size_check(&config(100_000_000, Some("big.f64"), true), 1, Some(1)).is_ok());
+        assert!(size_check(&c, 1, Some(1_000_000_000)).is_ok());
+        // text: about 20 bytes a value
+        let csv = config(1000, Some("x.csv"), false);
+        let e = size_check(&csv, 2, Some(10_000)).unwrap_err().to_string();
+        assert!(e.contains("40.0 kB") && e.contains("2 columns"), "{e}");
+    }
+
+    #[test]
+    fn more_than_a_billion_samples_need_yes_wherever_they_go() {
+        let e = size_check(&config(CONFIRM_SAMPLES + 1, None, false), 1, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("standard output") && e.contains("--yes"), "{e}");
+        assert!(size_check(&config(CONFIRM_SAMPLES, None, false), 1, None).is_ok());
+        assert!(size_check(&config(CONFIRM_SAMPLES + 1, None, true), 1, None).is_ok());
     }
 }

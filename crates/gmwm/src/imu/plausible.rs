@@ -35,6 +35,8 @@ pub struct ImplausibleFloats {
     pub non_finite: usize,
     /// The largest finite magnitude seen.
     pub largest: f64,
+    /// The bytes looked at are printable ASCII text: the file is text, not raw floats.
+    pub text: bool,
 }
 
 impl ImplausibleFloats {
@@ -62,15 +64,18 @@ impl fmt::Display for ImplausibleFloats {
         if self.non_finite > 0 {
             parts.push(format!("{} NaN or infinite", self.non_finite));
         }
+        let hint = if self.text {
+            "the file is text: drop --format".to_string()
+        } else {
+            format!("is it --format {}?", self.other_format())
+        };
         write!(
             f,
-            "{}: read as {}, the first {} values do not look like sensor samples ({}); is it \
-             --format {}?",
+            "{}: read as {}, the first {} values do not look like sensor samples ({}); {hint}",
             self.path.display(),
             self.format,
             self.looked_at,
             parts.join(", "),
-            self.other_format()
         )
     }
 }
@@ -106,6 +111,10 @@ pub fn raw_floats(
         tiny: 0,
         non_finite: 0,
         largest: 0.0,
+        text: !bytes.is_empty()
+            && bytes
+                .iter()
+                .all(|b| b.is_ascii_graphic() || matches!(b, b' ' | b'\t' | b'\r' | b'\n')),
     };
     for chunk in bytes.chunks_exact(width) {
         let x = match chunk {

@@ -598,16 +598,12 @@ fn haar_robust_in_memory(
     from_levels(n, freq_hz, opts, &per_level)
 }
 
-/// Refuses non-finite estimates from finite data (overflowing squares), and estimates that are
-/// zero at every scale (underflowing squares: the callers have refused a constant series, the
-/// only data whose variances are all zero): never silent numbers.
+/// Refuses non-finite estimates from finite data (overflowing squares): never silent numbers.
 pub(crate) fn check_finite_result(values: &[f64], what: &str) -> Result<(), SeriesError> {
-    if !values.iter().all(|v| v.is_finite()) {
-        Err(SeriesError::Overflow { what: what.into() })
-    } else if !values.is_empty() && values.iter().all(|&v| v == 0.0) {
-        Err(SeriesError::Underflow { what: what.into() })
-    } else {
+    if values.iter().all(|v| v.is_finite()) {
         Ok(())
+    } else {
+        Err(SeriesError::Overflow { what: what.into() })
     }
 }
 
@@ -1287,6 +1283,10 @@ fn haar_wv_in_memory(
     if !sums.iter().all(|s| s.is_finite()) {
         check_series(x)?;
         return haar_wv_parallel(x, levels, freq_hz, alpha);
+    }
+    if sums.iter().all(|&s| s < f64::MIN_POSITIVE) {
+        // zero or subnormal at every level from non-constant data: squares underflowed
+        check_series(x)?;
     }
     let n = x.len();
     let opts = WvOptions {
