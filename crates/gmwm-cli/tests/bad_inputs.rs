@@ -15,8 +15,22 @@ use std::time::Duration;
 /// Longest a run may take (the corpus files are small: a run takes milliseconds).
 const TIME_LIMIT: Duration = Duration::from_secs(60);
 
-/// The commands "all" stands for: every command that reads a recording.
-const ALL: [&str; 7] = ["wv", "avar", "fit", "select", "calibrate", "plot", "report"];
+/// The commands "all" stands for: every command that reads a recording (`plot` is `plot wv`,
+/// `plot-K` is `plot K`).
+const ALL: [&str; 12] = [
+    "wv",
+    "avar",
+    "fit",
+    "select",
+    "calibrate",
+    "plot",
+    "plot-avar",
+    "plot-compare",
+    "plot-fit",
+    "plot-select",
+    "plot-ieee",
+    "report",
+];
 
 fn corpus() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_inputs")
@@ -159,20 +173,24 @@ fn argv(case: &Case, command: &str, file: Option<&str>, work: &Path, run: usize)
     let has = |flag: &str| case.flags.iter().any(|f| f == flag || f.starts_with(flag));
     let mut a: Vec<String> = match command {
         "plot" => vec!["plot".into(), "wv".into()],
-        c => vec![c.into()],
+        c => match c.strip_prefix("plot-") {
+            Some(figure) => vec!["plot".into(), figure.into()],
+            None => vec![c.into()],
+        },
     };
     a.extend(file.map(String::from));
     let model = match command {
-        "fit" => Some("WN()"),
-        "select" => Some("AR1()+WN()"),
+        "fit" | "plot-fit" => Some("WN()"),
+        "select" | "plot-select" => Some("AR1()+WN()"),
         "calibrate" | "report" => Some("WN()+RW()"),
         _ => None,
     };
     if let Some(m) = model.filter(|_| !has("--model")) {
         a.extend(["--model".into(), m.into()]);
     }
-    if matches!(command, "plot" | "report") && !has("-o") && !has("{no-o}") {
-        let ext = if command == "plot" { "svg" } else { "html" };
+    let figure = command.starts_with("plot");
+    if (figure || command == "report") && !has("-o") && !has("{no-o}") {
+        let ext = if figure { "svg" } else { "html" };
         let out = work.join(format!("out{run}.{ext}"));
         a.extend(["-o".into(), out.display().to_string()]);
     }
@@ -297,7 +315,7 @@ fn check(case: &Case, command: &str, work: &Path, run: usize) -> Result<(), Stri
             return fail(&format!("{n:?} not on stderr"));
         }
         match command {
-            "plot" | "report" => {
+            c if c.starts_with("plot") || c == "report" => {
                 let written = std::fs::read_dir(work)
                     .unwrap()
                     .filter_map(|e| e.ok())
