@@ -194,14 +194,33 @@ pub enum ReadError {
         /// File.
         path: PathBuf,
     },
-    /// A text file in another encoding than UTF-8 (UTF-16 by its byte-order mark, or 8-bit
-    /// text such as Latin-1): refused with what it is instead of as binary data.
-    #[error("{}: text is not UTF-8 ({detail}); save it as UTF-8", .path.display())]
+    /// A text file in UTF-16 (by its byte-order mark): refused with what it is instead of as
+    /// binary data.
+    #[error(
+        "{}: text is UTF-16 {} (byte-order mark {}), not UTF-8; save it as UTF-8",
+        .path.display(),
+        if *.big_endian { "big-endian" } else { "little-endian" },
+        if *.big_endian { "FE FF" } else { "FF FE" }
+    )]
+    Utf16 {
+        /// File.
+        path: PathBuf,
+        /// Byte order: FE FF (big-endian) or FF FE.
+        big_endian: bool,
+    },
+    /// 8-bit text (Latin-1, Windows-1252, ...): printable but for bytes that are not UTF-8.
+    #[error(
+        "{}:{line}: byte 0x{byte:02x} is not UTF-8 (8-bit text such as Latin-1 or \
+         Windows-1252?); save the file as UTF-8",
+        .path.display()
+    )]
     NotUtf8 {
         /// File.
         path: PathBuf,
-        /// What it is, e.g. `UTF-16 little-endian, byte-order mark FF FE`.
-        detail: String,
+        /// 1-based line of the first such byte.
+        line: u64,
+        /// The byte.
+        byte: u8,
     },
     /// A text file whose lines end in a carriage return alone (classic Mac OS): read as one
     /// line, it would have a header and no data.

@@ -425,15 +425,9 @@ pub fn resolve_format(
     ) {
         match sniff(path)? {
             Content::Binary => {
-                return Err(match other_encoding(path) {
-                    Some(detail) => ReadError::NotUtf8 {
-                        path: path.to_path_buf(),
-                        detail,
-                    },
-                    None => ReadError::LooksBinary {
-                        path: path.to_path_buf(),
-                    },
-                })
+                return Err(other_encoding(path).unwrap_or(ReadError::LooksBinary {
+                    path: path.to_path_buf(),
+                }))
             }
             Content::Json => {
                 return Err(ReadError::NotATable {
@@ -457,15 +451,16 @@ fn head(path: &Path) -> Vec<u8> {
 }
 
 /// What a file that [`sniff`] finds binary is when it is text in another encoding: UTF-16 by
-/// its byte-order mark, or 8-bit text (no NUL, printable ASCII but for a few bytes above 0x7f,
-/// such as Latin-1's degree sign).
-fn other_encoding(path: &Path) -> Option<String> {
+/// its byte-order mark ([`ReadError::Utf16`]), or 8-bit text ([`ReadError::NotUtf8`]: no NUL,
+/// printable ASCII but for a few bytes above 0x7f, such as Latin-1's degree sign).
+fn other_encoding(path: &Path) -> Option<ReadError> {
     let head = head(path);
-    if head.starts_with(&[0xff, 0xfe]) {
-        return Some("UTF-16 little-endian, byte-order mark FF FE".into());
-    }
-    if head.starts_with(&[0xfe, 0xff]) {
-        return Some("UTF-16 big-endian, byte-order mark FE FF".into());
+    let path = path.to_path_buf();
+    if head.starts_with(&[0xff, 0xfe]) || head.starts_with(&[0xfe, 0xff]) {
+        return Some(ReadError::Utf16 {
+            path,
+            big_endian: head[0] == 0xfe,
+        });
     }
     let printable = |b: &u8| b.is_ascii_graphic() || matches!(b, b' ' | b'\t' | b'\r' | b'\n');
     let high = head.iter().filter(|b| **b >= 0x80).count();
@@ -474,11 +469,12 @@ fn other_encoding(path: &Path) -> Option<String> {
         return None;
     }
     let offset = std::str::from_utf8(&head).err()?.valid_up_to();
-    let line = 1 + head[..offset].iter().filter(|&&b| b == b'\n').count();
-    Some(format!(
-        "byte 0x{:02x} on line {line}, 8-bit text such as Latin-1 or Windows-1252",
-        head[offset]
-    ))
+    let line = 1 + head[..offset].iter().filter(|&&b| b == b'\n').count() as u64;
+    Some(ReadError::NotUtf8 {
+        path,
+        line,
+        byte: head[offset],
+    })
 }
 
 /// Whether the start of a plain file breaks lines with a carriage return alone.
