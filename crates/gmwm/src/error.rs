@@ -277,5 +277,24 @@ mod tests {
             Err(SeriesError::Constant { value }) if value == 2.0
         ));
         assert!(check_series(&[1.0, 2.0]).is_ok());
+        // one sample is too short, not "constant"
+        assert!(matches!(
+            check_series(&[0.5]),
+            Err(SeriesError::TooShort {
+                n: 1,
+                needed: 2,
+                ..
+            })
+        ));
+        // squared differences that underflow: refused, not variances of zero
+        assert!(matches!(
+            check_series(&[1e-300, -2e-300, 3e-300]),
+            Err(SeriesError::Underflow { range }) if (range - 5e-300).abs() < 1e-310
+        ));
+        assert!(matches!(
+            check_series(&[5e-324, 0.0]),
+            Err(SeriesError::Underflow { .. })
+        ));
+        assert!(check_series(&[1e-140, 2e-140]).is_ok());
     }
 }

@@ -143,3 +143,77 @@ pub fn raw_floats(
         || (out.tiny > 0 && out.tiny * 20 >= out.looked_at);
     Ok(implausible.then_some(out))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn layout(format: InputFormat) -> BinaryLayout {
+        BinaryLayout {
+            format,
+            ncols: 1,
+            names: vec!["col1".into()],
+        }
+    }
+
+    fn file(bytes: &[u8]) -> tempfile::NamedTempFile {
+        let mut f = tempfile::NamedTempFile::new().unwrap();
+        std::io::Write::write_all(&mut f, bytes).unwrap();
+        f
+    }
+
+    /// Gyro-like samples in rad/s.
+    fn samples() -> Vec<f64> {
+        (0..4096u64)
+            .map(|k| ((k * 7919 + 13) % 1009) as f64 * 1e-6 - 5e-4)
+            .collect()
+    }
+
+    #[test]
+    fn f64_read_as_f32_is_implausible_and_names_f64() {
+        let bytes: Vec<u8> = samples().iter().flat_map(|v| v.to_le_bytes()).collect();
+        let f = file(&bytes);
+        let bad = raw_floats(f.path(), &layout(InputFormat::F32))
+            .unwrap()
+            .expect("implausible");
+        assert_eq!(bad.looked_at, 8192);
+        assert!(!bad.text);
+        let text = bad.to_string();
+        assert!(
+            text.contains("read as f32") && text.ends_with("is it --format f64?"),
+            "{text}"
+        );
+        // read right: plausible
+        assert_eq!(
+            raw_floats(f.path(), &layout(InputFormat::F64)).unwrap(),
+            None
+        );
+    }
+
+    #[test]
+    fn f32_samples_are_plausible_and_text_is_named_text() {
+        let bytes: Vec<u8> = samples()
+            .iter()
+            .flat_map(|v| (*v as f32).to_le_bytes())
+            .collect();
+        let f = file(&bytes);
+        assert_eq!(
+            raw_floats(f.path(), &layout(InputFormat::F32)).unwrap(),
+            None
+        );
+        let t = file(b"gyro_x\n0.001\n-0.002\n0.003\n0.0015\n-0.0005\n0.0025\n0.001\n");
+        let bad = raw_floats(t.path(), &layout(InputFormat::F64))
+            .unwrap()
+            .expect("text read as f64");
+        assert!(bad.text && bad.to_string().ends_with("the file is text: drop --format"));
+    }
+
+    #[test]
+    fn text_formats_are_not_looked_at() {
+        let f = file(b"x\n1\n");
+        assert_eq!(
+            raw_floats(f.path(), &layout(InputFormat::Csv)).unwrap(),
+            None
+        );
+    }
+}
