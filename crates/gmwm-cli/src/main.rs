@@ -17,6 +17,7 @@ use args::Cli;
 use clap::Parser;
 use config::{Config, InputConfig, PlotKind};
 use std::io::{BufWriter, Write};
+use std::path::Path;
 use std::process::ExitCode;
 
 /// Validates the flags into the subcommand's configuration, before any file is read, then
@@ -24,12 +25,58 @@ use std::process::ExitCode;
 fn run(cli: &Cli) -> anyhow::Result<()> {
     let mut config = Config::try_from(&cli.command)?;
     let _spool = prepare_input(&mut config)?;
+    check_outputs(&config)?;
     let levels = levels_of(&config);
     execute(&config).map_err(|e| match levels {
         // a series too short for the levels asked: the flag is the thing to change
         Some(j) if too_short(&e) => e.context(format!("--levels {j}")),
         _ => e,
     })
+}
+
+/// The files a command will write (`-` for standard output left out).
+fn outputs(config: &Config) -> Vec<&Path> {
+    let mut out: Vec<&Path> = Vec::new();
+    match config {
+        Config::Calibrate(c) => {
+            out.extend(c.exports.iter().map(|(_, p)| p.as_path()));
+            out.extend(c.json.as_deref());
+            out.extend(c.report.as_deref());
+        }
+        Config::Report(r) => {
+            out.extend(r.calibrate.exports.iter().map(|(_, p)| p.as_path()));
+            out.extend(r.calibrate.json.as_deref());
+            out.push(&r.output);
+        }
+        Config::Plot(p) => out.push(&p.figure.output),
+        _ => {}
+    }
+    out.retain(|p| p.as_os_str() != "-");
+    out
+}
+
+/// Before any work: every file the command writes must have a folder to go in (STYLE §9: a bad
+/// path fails in milliseconds, not after the calibration).
+fn check_outputs(config: &Config) -> anyhow::Result<()> {
+    for path in outputs(config) {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        if !dir.is_dir() {
+            let why = if dir.exists() {
+                "is not a folder"
+            } else {
+                "does not exist"
+            };
+            anyhow::bail!(
+                "{}: cannot be written: {} {why}",
+                path.display(),
+                dir.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// `--levels J` when the command was given one.
