@@ -590,6 +590,10 @@ pub struct SimulateArgs {
     /// Also write each component as its own column (x is their sum).
     #[arg(long)]
     pub components: bool,
+    /// Write an output of more than 10^9 samples, or larger than the free space of the output
+    /// file's file system (refused without it, stating the size).
+    #[arg(long)]
+    pub yes: bool,
 }
 
 /// `gmwm implied`.
@@ -623,6 +627,11 @@ rate, and for raw binary the format, --ncols and the column names; gzip is recog
 first bytes; binary data without --format is refused instead of being read as text; a JSON
 document is a wavelet variance saved by `gmwm wv --json`.
 
+FILE - reads standard input (text, gzip, a saved wavelet variance, or raw binary with --format
+f64|f32; messages call it <stdin>; no sidecar can come with it, so --freq is needed unless a
+time column gives the rate); a pipe such as <(zcat run.csv.gz) is read the same way. Raw floats
+that no sensor gives (f64 read as f32, ...) are warned about.
+
 Time column: --time-column, else the first column named time, timestamp, t, stamp, %time
 (rostopic echo -p, ns), #timestamp [ns] (EuRoC/TUM-VI), timestamp_ns, time_s, time [s],
 field.header.stamp (ns), ... (case-insensitive; a header stamp is preferred). It is not
@@ -642,8 +651,8 @@ linear_acceleration.x, ...), only those, and the others are listed in a note.";
 pub struct InputArgs {
     /// Data file: CSV/TSV (optionally .gz), raw little-endian binary (.f64, .f32 or
     /// --format f64|f32), binary IMU records (--format imar|ln200|...), a ROS recording (.bag,
-    /// .mcap, .db3, rosbag2 folder), or a wavelet variance saved by `gmwm wv --json` (see --help
-    /// for how FILE is read).
+    /// .mcap, .db3, rosbag2 folder), or a wavelet variance saved by `gmwm wv --json`; - for
+    /// standard input (see --help for how FILE is read).
     #[arg(value_name = "FILE", long_help = INPUT_HELP)]
     pub file: PathBuf,
     /// Columns to analyse, comma-separated names or 1-based indices (also the series of a
@@ -890,10 +899,17 @@ pub fn alpha(s: &str) -> Result<f64, String> {
     }
 }
 
-/// A count of at least `min`.
+/// A count of at least `min`: digits, or a whole number in exponent notation (`1e6`).
 fn count_at_least(s: &str, min: usize) -> Result<usize, String> {
-    match s.trim().parse::<usize>() {
-        Ok(v) if v >= min => Ok(v),
+    let t = s.trim();
+    let v = t.parse::<usize>().ok().or_else(|| {
+        t.parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite() && *x >= 0.0 && x.fract() == 0.0 && *x < 9.0e15)
+            .map(|x| x as usize)
+    });
+    match v {
+        Some(v) if v >= min => Ok(v),
         _ => Err(format!("must be a whole number >= {min}")),
     }
 }

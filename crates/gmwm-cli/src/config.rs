@@ -420,6 +420,8 @@ pub struct SimulateConfig {
     pub output: Option<PathBuf>,
     /// `--components`: each component as its own column too.
     pub components: bool,
+    /// `--yes`: write an output above the size limits.
+    pub yes: bool,
 }
 
 impl TryFrom<&SimulateArgs> for SimulateConfig {
@@ -440,6 +442,7 @@ impl TryFrom<&SimulateArgs> for SimulateConfig {
             seed: a.seed,
             output: a.output.clone(),
             components: a.components,
+            yes: a.yes,
         })
     }
 }
@@ -880,11 +883,20 @@ impl TryFrom<&ReportArgs> for ReportConfig {
             ))
             .into());
         }
+        let file = &a.calibrate.input.file;
+        if a.output.is_none() && a.calibrate.report.is_none() && file.as_os_str() == "-" {
+            return Err(UsageError(format!(
+                "{}: the report is named after the recording, and standard input has no name; \
+                 give -o FILE",
+                crate::spool::STDIN
+            ))
+            .into());
+        }
         let output = a
             .output
             .clone()
             .or_else(|| a.calibrate.report.clone())
-            .unwrap_or_else(|| default_report(&a.calibrate.input.file));
+            .unwrap_or_else(|| default_report(file));
         Ok(Self {
             calibrate: (&a.calibrate).try_into()?,
             output,

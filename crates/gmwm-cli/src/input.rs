@@ -9,6 +9,11 @@ use gmwm::imu::{
 use gmwm::WaveletVariance;
 use std::path::Path;
 
+/// A path as the user named it (`<stdin>` for the copy of standard input, [`crate::spool`]).
+pub fn shown_path(path: &Path) -> std::path::PathBuf {
+    crate::spool::shown(&path.display().to_string()).into()
+}
+
 /// A loaded input: the table and the sampling rate to use.
 pub struct Loaded {
     /// Columns read.
@@ -39,7 +44,10 @@ fn hz(x: f64) -> String {
 
 /// Prints a note on stderr.
 pub fn note(file: &Path, text: &str) {
-    eprintln!("gmwm: note: {}: {text}", file.display());
+    eprintln!(
+        "gmwm: note: {}",
+        crate::spool::shown(&format!("{}: {text}", file.display()))
+    );
 }
 
 /// Prints the columns a reader left out (none: nothing).
@@ -75,13 +83,13 @@ fn report(table: &Table) {
             } => eprintln!(
                 "gmwm: warning: {}: --freq {} Hz differs by {:.0}% from time column \"{}\" \
                  ({} Hz); --freq is used",
-                file.display(),
+                crate::spool::shown(&file.display().to_string()),
                 hz(*given_hz),
                 100.0 * (given_hz - time_hz).abs() / time_hz,
                 quote(column),
                 hz(*time_hz),
             ),
-            w => eprintln!("gmwm: warning: {w}"),
+            w => eprintln!("gmwm: warning: {}", crate::spool::shown(&w.to_string())),
         }
     }
 }
@@ -105,10 +113,18 @@ pub fn load(input: &InputConfig) -> Result<Loaded> {
     report(&table);
     let freq_hz = match input.read.freq_hz.or(table.freq_hz) {
         Some(f) => f,
+        None if crate::spool::is_stdin(&input.file) => {
+            return Err(crate::UsageError(format!(
+                "{}: no sampling rate: standard input has no JSON sidecar and no time column \
+                 was found; give --freq",
+                crate::spool::STDIN
+            ))
+            .into())
+        }
         None => {
             eprintln!(
                 "gmwm: warning: {}: no sampling rate (no --freq, time column or JSON sidecar); using 1 Hz, so tau_s is in samples",
-                input.file.display()
+                crate::spool::shown(&input.file.display().to_string())
             );
             1.0
         }
@@ -214,7 +230,7 @@ pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
     };
     let rec = gmwm::imu::Recording::open(&input.file, &opts)?;
     Ok(LoadedRecording {
-        path: rec.path,
+        path: shown_path(&rec.path),
         columns: rec
             .imu
             .axes()
@@ -244,7 +260,7 @@ pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
         None => Vec::new(),
     };
     Ok(LoadedRecording {
-        path: input.file.clone(),
+        path: shown_path(&input.file),
         columns,
         imu: None,
         topic: None,

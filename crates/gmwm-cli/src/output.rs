@@ -12,6 +12,15 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
     write_atomic(path, bytes).map_err(|e| cannot_write(path, e))
 }
 
+/// Writes `bytes` to `path` atomically; the error is the operating system's cause alone, for
+/// callers that name the file themselves.
+pub fn write_io(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    write_atomic(path, bytes).map_err(|e| match e {
+        ReadError::Io { source, .. } => source,
+        other => std::io::Error::other(other.to_string()),
+    })
+}
+
 /// Writes `value` as pretty JSON (with a final newline) to `path` atomically.
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
     let mut file = AtomicFile::create(path).map_err(|e| cannot_write(path, e))?;

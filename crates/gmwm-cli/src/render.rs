@@ -29,13 +29,15 @@ pub struct Named<'a, T> {
 /// A result with a CSV form: one header, then one row per scale.
 pub trait CsvRows {
     /// Header line (without the newline), first column `series`.
-    const HEADER: &'static str;
+    fn header(&self) -> String;
     /// Writes the rows of the series `name`.
     fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()>;
 }
 
 impl CsvRows for WaveletVariance {
-    const HEADER: &'static str = "series,level,tau,tau_s,wv,ci_low,ci_high";
+    fn header(&self) -> String {
+        "series,level,tau,tau_s,wv,ci_low,ci_high".to_string()
+    }
     fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()> {
         for j in 0..self.wv().len() {
             writeln!(
@@ -55,7 +57,12 @@ impl CsvRows for WaveletVariance {
 }
 
 impl CsvRows for AllanVariance {
-    const HEADER: &'static str = "series,tau,tau_s,avar,adev,ci_low,ci_high";
+    /// The variance's own names: `avar,adev`, `mavar,mdev` or `hvar,hdev`
+    /// ([`gmwm::AllanKind::columns`]).
+    fn header(&self) -> String {
+        let (var, dev) = self.kind().columns();
+        format!("series,tau,tau_s,{var},{dev},ci_low,ci_high")
+    }
     fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()> {
         for k in 0..self.avar().len() {
             writeln!(
@@ -92,7 +99,10 @@ pub fn series<T: Serialize + std::fmt::Display + CsvRows>(
             }
         }
         Style::Csv => {
-            writeln!(out, "{}", T::HEADER)?;
+            // one kind per command: the first result's header is every result's
+            if let Some(first) = items.first() {
+                writeln!(out, "{}", first.result.header())?;
+            }
             for it in items {
                 it.result.write_rows(it.name, out)?;
             }

@@ -129,10 +129,12 @@ fn calibrate_killed_while_writing_leaves_the_old_outputs_or_complete_ones() {
     let input = recording(dir.path());
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
-    // the first change is the first write (nothing else is written in `out`); later ones are
-    // further into the write phase, up to the renames
+    // the first change is the first write (nothing else is written in `out`), so the runs
+    // killed at it are always killed while writing; later ones are further into the write
+    // phase, up to the renames (how many changes the watcher sees depends on the machine: a
+    // run whose write phase shows fewer simply completes)
     let mut killed = 0;
-    for after in [0, 0, 1, 1, 2, 3, 4, 6] {
+    for after in [0, 0, 0, 0, 1, 1, 2, 3] {
         killed += usize::from(run_and_kill(&input, &out, after));
         check_outputs(&out);
     }

@@ -86,7 +86,7 @@ fn avar_json_and_csv_have_the_documented_fields() {
         .assert()
         .success()
         .stdout(predicate::str::starts_with(
-            "series,tau,tau_s,avar,adev,ci_low,ci_high\ngyro_x,",
+            "series,tau,tau_s,mavar,mdev,ci_low,ci_high\ngyro_x,",
         ));
 }
 
@@ -1012,4 +1012,360 @@ fn issue_10_fit_reports_the_canonical_model() {
         text.contains("the data cannot tell this fit from one of GM()+QN()+RW()"),
         "{text}"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 15: the message defects of the bad-input review (the corpus is tests/bad_inputs.rs)
+
+/// 4096 samples of a fixed pattern as `gyro_x` CSV text.
+fn pattern_csv() -> tempfile::NamedTempFile {
+    let mut text = String::from("gyro_x\n");
+    for k in 0..4096u64 {
+        text.push_str(&format!(
+            "{:.4}\n",
+            ((k * 7919 + 13) % 1009) as f64 / 1000.0 - 0.5
+        ));
+    }
+    temp_file(".csv", text.as_bytes())
+}
+
+#[test]
+fn issue_15_a_model_rule_violation_is_stated_once() {
+    let f = pattern_csv();
+    for cmd in [
+        vec!["fit", "--model", "AR1(phi=2,sigma2=1)+WN()"],
+        vec!["simulate", "--model", "AR1(phi=2,sigma2=1)", "--n", "10"],
+    ] {
+        let mut c = gmwm();
+        c.args(&cmd);
+        if cmd[0] == "fit" {
+            c.arg(f.path()).args(["--freq", "100"]);
+        }
+        let out = c.output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert_eq!(
+            stderr.matches("open interval (-1, 1)").count(),
+            1,
+            "the cause once: {stderr}"
+        );
+        assert!(stderr.contains("found \"2\""), "{stderr}");
+    }
+}
+
+#[test]
+fn issue_15_a_json_that_is_no_wv_document_says_what_it_should_be() {
+    let f = temp_file(".json", b"[]");
+    for cmd in ["wv", "fit", "avar"] {
+        let out = gmwm()
+            .arg(cmd)
+            .arg(f.path())
+            .args(["--model", "WN()"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        if cmd != "fit" {
+            // --model belongs to fit only: a usage error before the file is read
+            continue;
+        }
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains("the document is an empty array")
+                && stderr.contains("gmwm wv --json")
+                && !stderr.contains("FileDoc")
+                && !stderr.contains("invalid length"),
+            "{stderr}"
+        );
+    }
+    common::assert_one_line_error(
+        gmwm().arg("wv").arg(f.path()),
+        &["an empty array", "\"series\" array"],
+    );
+}
+
+#[test]
+fn issue_15_f64_read_as_f32_is_warned() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("log.bin");
+    // gyro-like values in rad/s, written as f64
+    let bytes: Vec<u8> = (0..4096u64)
+        .flat_map(|k| (((k * 7919 + 13) % 1009) as f64 * 1e-6).to_le_bytes())
+        .collect();
+    std::fs::write(&f, bytes).unwrap();
+    let out = gmwm()
+        .args(["wv", "--format", "f32", "--freq", "100"])
+        .arg(&f)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warning = stderr
+        .lines()
+        .find(|l| l.starts_with("gmwm: warning: "))
+        .unwrap_or_else(|| panic!("no warning: {stderr}"));
+    assert!(
+        warning.contains("log.bin")
+            && warning.contains("read as f32")
+            && warning.contains("is it --format f64?"),
+        "{warning}"
+    );
+    // read right, no warning
+    let out = gmwm()
+        .args(["wv", "--format", "f64", "--freq", "100"])
+        .arg(&f)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+}
+
+#[test]
+fn issue_15_allan_kinds_name_their_columns_and_say_allan() {
+    let f = pattern_csv();
+    for (kind, header, title) in [
+        ("overlapping", "avar,adev", "overlapping Allan variance"),
+        (
+            "non-overlapping",
+            "avar,adev",
+            "non-overlapping Allan variance",
+        ),
+        ("modified", "mavar,mdev", "modified Allan variance"),
+        ("hadamard", "hvar,hdev", "overlapping Hadamard variance"),
+        (
+            "hadamard-non-overlapping",
+            "hvar,hdev",
+            "non-overlapping Hadamard variance",
+        ),
+    ] {
+        let csv = gmwm()
+            .args(["avar", "--freq", "100", "--csv", "--kind", kind])
+            .arg(f.path())
+            .output()
+            .unwrap();
+        let csv = String::from_utf8_lossy(&csv.stdout);
+        assert!(
+            csv.starts_with(&format!("series,tau,tau_s,{header},ci_low,ci_high\n")),
+            "{kind}: {csv}"
+        );
+        let table = gmwm()
+            .args(["avar", "--freq", "100", "--kind", kind])
+            .arg(f.path())
+            .output()
+            .unwrap();
+        let table = String::from_utf8_lossy(&table.stdout);
+        let (var, dev) = header.split_once(',').unwrap();
+        assert!(table.contains(title), "{kind}: {table}");
+        assert!(
+            table.contains(var) && table.contains(dev),
+            "{kind}: {table}"
+        );
+    }
+}
+
+#[test]
+fn issue_15_fit_csv_has_the_units_and_the_objective_of_the_json() {
+    let f = pattern_csv();
+    let args = ["fit", "--freq", "100", "--model", "GM()+WN()"];
+    let doc = run_json(gmwm().args(args).arg(f.path()).arg("--json"));
+    let fit = &doc["fits"][0];
+    let out = gmwm()
+        .args(args)
+        .arg(f.path())
+        .arg("--csv")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let csv = String::from_utf8_lossy(&out.stdout);
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("column,process,index,name,value,se,ci_low,ci_high,unit,objective")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let objective = fit["objective"].as_f64().unwrap();
+    for r in &rows {
+        assert_eq!(r.len(), 10, "{r:?}");
+        let o: f64 = r[9].parse().unwrap();
+        assert!((o - objective).abs() <= 1e-12 * objective.abs(), "{r:?}");
+    }
+    let row = |name: &str| {
+        rows.iter()
+            .find(|r| r[3] == name)
+            .unwrap_or_else(|| panic!("{name}"))
+    };
+    assert_eq!(row("beta")[8], "1/s");
+    assert_eq!(row("sigma2_gm")[8], "u^2");
+    // the physical quantities of --json's navigation, with their units
+    for q in fit["navigation"].as_array().unwrap() {
+        let r = row(q["name"].as_str().unwrap());
+        assert_eq!(r[8], q["unit"].as_str().unwrap());
+        let v: f64 = r[4].parse().unwrap();
+        let want = q["value"].as_f64().unwrap();
+        assert!((v - want).abs() <= 1e-12 * want.abs());
+    }
+}
+
+#[test]
+fn issue_15_standard_input_is_read_as_the_file() {
+    let f = pattern_csv();
+    let from_file = run_json(gmwm().args(["wv", "--freq", "100", "--json"]).arg(f.path()));
+    let from_stdin = run_json(
+        gmwm()
+            .args(["wv", "-", "--freq", "100", "--json"])
+            .pipe_stdin(f.path())
+            .unwrap(),
+    );
+    assert_eq!(from_file["series"][0]["wv"], from_stdin["series"][0]["wv"]);
+    // raw binary with --format
+    let dir = tempfile::tempdir().unwrap();
+    let raw = dir.path().join("x.f64");
+    let values: Vec<f64> = (0..4096u64)
+        .map(|k| ((k * 7919 + 13) % 1009) as f64 / 1000.0 - 0.5)
+        .collect();
+    std::fs::write(
+        &raw,
+        values
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect::<Vec<u8>>(),
+    )
+    .unwrap();
+    for cmd in ["wv", "avar", "fit", "select"] {
+        let mut c = gmwm();
+        c.args([cmd, "-", "--format", "f64", "--freq", "100", "--json"]);
+        if cmd == "fit" || cmd == "select" {
+            c.args(["--model", "AR1()+WN()"]);
+        }
+        let doc = run_json(c.pipe_stdin(&raw).unwrap());
+        assert!(doc.is_object(), "{cmd}");
+    }
+    let binary = run_json(
+        gmwm()
+            .args(["wv", "-", "--format", "f64", "--freq", "100", "--json"])
+            .pipe_stdin(&raw)
+            .unwrap(),
+    );
+    let a = from_file["series"][0]["wv"][0].as_f64().unwrap();
+    let b = binary["series"][0]["wv"][0].as_f64().unwrap();
+    assert!((a - b).abs() < 1e-12, "{a} {b}");
+    // calibrate names it <stdin>
+    let doc = run_json(
+        gmwm()
+            .args([
+                "calibrate",
+                "-",
+                "--freq",
+                "100",
+                "--model",
+                "WN()+RW()",
+                "--json",
+                "-",
+            ])
+            .pipe_stdin(f.path())
+            .unwrap(),
+    );
+    assert!(doc.to_string().contains("<stdin>"), "{doc}");
+    assert!(
+        !doc.to_string().contains("gmwm-input-"),
+        "no temporary path: {doc}"
+    );
+    // a wavelet variance piped from gmwm wv --json
+    let wv = gmwm()
+        .args(["wv", "--freq", "100", "--json"])
+        .arg(f.path())
+        .output()
+        .unwrap();
+    let fit = run_json(
+        gmwm()
+            .args(["fit", "-", "--model", "WN()", "--json"])
+            .write_stdin(wv.stdout),
+    );
+    assert!(fit["fits"][0]["objective"].is_number());
+}
+
+#[test]
+fn issue_15_standard_input_refusals() {
+    let f = pattern_csv();
+    // no rate: no sidecar can exist
+    common::assert_usage_error(
+        gmwm().args(["wv", "-"]).pipe_stdin(f.path()).unwrap(),
+        &["<stdin>", "give --freq"],
+    );
+    common::assert_usage_error(
+        gmwm()
+            .args(["wv", "-", "--format", "f64"])
+            .pipe_stdin(f.path())
+            .unwrap(),
+        &["<stdin>", "give --freq"],
+    );
+    // an output named after the input
+    common::assert_usage_error(
+        gmwm()
+            .args(["report", "-", "--freq", "100"])
+            .pipe_stdin(f.path())
+            .unwrap(),
+        &["<stdin>", "-o FILE"],
+    );
+    // batch mode reads files
+    common::assert_usage_error(
+        gmwm()
+            .args(["wv", "-", "--freq", "100"])
+            .arg(f.path())
+            .pipe_stdin(f.path())
+            .unwrap(),
+        &["<stdin>", "batch mode"],
+    );
+    // a bad line is named on standard input, not in a temporary copy
+    common::assert_one_line_error(
+        gmwm()
+            .args(["wv", "-", "--freq", "100"])
+            .write_stdin("gyro_x\n1\n2\nnan\n"),
+        &["<stdin>:4:", "\"nan\""],
+    );
+}
+
+#[test]
+fn issue_15_simulate_refuses_an_implausible_size_without_yes() {
+    for (extra, bytes) in [(vec![], "2.0 TB"), (vec!["-o", "sim.f64"], "800.0 GB")] {
+        let dir = tempfile::tempdir().unwrap();
+        common::assert_usage_error(
+            gmwm()
+                .current_dir(dir.path())
+                .args(["simulate", "--model", "WN(sigma2=1)", "--n", "1e11"])
+                .args(&extra),
+            &["--n 100000000000", bytes, "--yes"],
+        );
+        assert!(
+            std::fs::read_dir(dir.path()).unwrap().next().is_none(),
+            "nothing written"
+        );
+    }
+    // an ordinary size needs nothing, and --yes changes nothing else
+    let plain = gmwm()
+        .args([
+            "simulate",
+            "--model",
+            "WN(sigma2=1)",
+            "--n",
+            "1e3",
+            "--seed",
+            "3",
+        ])
+        .output()
+        .unwrap();
+    let yes = gmwm()
+        .args([
+            "simulate",
+            "--model",
+            "WN(sigma2=1)",
+            "--n",
+            "1000",
+            "--seed",
+            "3",
+            "--yes",
+        ])
+        .output()
+        .unwrap();
+    assert!(plain.status.success() && yes.status.success());
+    assert_eq!(plain.stdout, yes.stdout);
+    assert_eq!(String::from_utf8_lossy(&plain.stdout).lines().count(), 1001);
 }

@@ -137,6 +137,16 @@ pub enum SeriesError {
         /// Which quantity overflowed.
         what: String,
     },
+    /// The samples differ so little that squared differences underflow double precision:
+    /// every variance would be zero or subnormal noise.
+    #[error(
+        "the samples differ by at most {range:e}: squared differences underflow double \
+         precision (below 1e-300); rescale the series"
+    )]
+    Underflow {
+        /// `max - min` of the samples.
+        range: f64,
+    },
     /// Every sample has the same value: all variances are zero and nothing can be estimated.
     #[error("series is constant (every sample equals {value}); its variances are all zero")]
     Constant {
@@ -168,22 +178,39 @@ impl ParamError {
     }
 }
 
-/// Checks that a series is non-empty, finite and not constant (docs/methods.md §0.1 preconditions).
+/// Samples whose range is below this have squared differences below 1e-300, near the end of
+/// double precision (normal numbers stop at 2.2e-308).
+pub const UNDERFLOW_RANGE: f64 = 1e-150;
+
+/// Checks that a series is non-empty, finite and not constant (docs/methods.md §0.1 preconditions),
+/// nor so flat that its squared differences underflow ([`UNDERFLOW_RANGE`]).
 ///
 /// One vectorisable pass (min, max and a NaN-propagating probe); the offending index is looked
 /// up only on failure.
 ///
 /// # Errors
-/// [`SeriesError::Empty`], [`SeriesError::NonFinite`] (first offending index) or
-/// [`SeriesError::Constant`].
+/// [`SeriesError::Empty`], [`SeriesError::TooShort`] (one sample),
+/// [`SeriesError::NonFinite`] (first offending index), [`SeriesError::Constant`] or
+/// [`SeriesError::Underflow`].
 pub fn check_series(x: &[f64]) -> Result<(), SeriesError> {
     let first = *x.first().ok_or(SeriesError::Empty)?;
+    if x.len() == 1 {
+        // one sample is no series: say so rather than call it constant
+        return Err(SeriesError::TooShort {
+            n: 1,
+            needed: 2,
+            what: "a variance".into(),
+        });
+    }
     check_finite(x)?;
     let (lo, hi) = x
         .iter()
         .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     if lo == hi {
         return Err(SeriesError::Constant { value: first });
+    }
+    if hi - lo < UNDERFLOW_RANGE {
+        return Err(SeriesError::Underflow { range: hi - lo });
     }
     Ok(())
 }
@@ -250,5 +277,24 @@ mod tests {
             Err(SeriesError::Constant { value }) if value == 2.0
         ));
         assert!(check_series(&[1.0, 2.0]).is_ok());
+        // one sample is too short, not "constant"
+        assert!(matches!(
+            check_series(&[0.5]),
+            Err(SeriesError::TooShort {
+                n: 1,
+                needed: 2,
+                ..
+            })
+        ));
+        // squared differences that underflow: refused, not variances of zero
+        assert!(matches!(
+            check_series(&[1e-300, -2e-300, 3e-300]),
+            Err(SeriesError::Underflow { range }) if (range - 5e-300).abs() < 1e-310
+        ));
+        assert!(matches!(
+            check_series(&[5e-324, 0.0]),
+            Err(SeriesError::Underflow { .. })
+        ));
+        assert!(check_series(&[1e-140, 2e-140]).is_ok());
     }
 }

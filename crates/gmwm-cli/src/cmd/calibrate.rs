@@ -124,7 +124,8 @@ pub fn execute_in(
             let target = per_axis_path(path, &set.label);
             let result = render(*format, &set.noise)
                 .map_err(anyhow::Error::from)
-                .and_then(|text| crate::output::write(&target, text.as_bytes()));
+                // the file is named below
+                .and_then(|text| Ok(crate::output::write_io(&target, text.as_bytes())?));
             match result {
                 Ok(()) => {
                     written.push(format!("{} ({format})", target.display()));
@@ -211,7 +212,7 @@ fn write_report(
         }
     }
     let ctx = gmwm_plot::report::ReportContext {
-        file: config.input.file.display().to_string(),
+        file: crate::spool::shown(&config.input.file.display().to_string()),
         source: match &recording.source {
             gmwm::imu::RecordingSource::Records { record_type } => {
                 format!("binary IMU records ({record_type})")
@@ -230,7 +231,8 @@ fn write_report(
     };
     let html = gmwm_plot::report::render(report, &ctx)?;
     let figures = html.matches("<figure>").count();
-    crate::output::write(path, html.as_bytes())?;
+    // the caller names the file
+    crate::output::write_io(path, html.as_bytes())?;
     Ok(figures)
 }
 

@@ -171,8 +171,15 @@ fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Wr
             writeln!(out)?;
         }
         Style::Csv => {
-            writeln!(out, "column,process,index,name,value,se,ci_low,ci_high")?;
+            // as --json: the parameters (`parameters`), then the physical quantities
+            // (`navigation`), each with its unit in terms of u, the data unit, and the
+            // column's objective
+            writeln!(
+                out,
+                "column,process,index,name,value,se,ci_low,ci_high,unit,objective"
+            )?;
             for ((column, fit), inf) in fits.iter().zip(&inferences) {
+                let objective = fit.objective();
                 for (k, p) in fit.parameters().into_iter().enumerate() {
                     let (se, lo, hi) = match inf {
                         Some(i) => {
@@ -185,8 +192,19 @@ fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Wr
                     };
                     writeln!(
                         out,
-                        "{column},{},{},{},{:e},{se},{lo},{hi}",
-                        p.process, p.index, p.name, p.value
+                        "{column},{},{},{},{:e},{se},{lo},{hi},{},{objective:e}",
+                        p.process,
+                        p.index,
+                        p.name,
+                        p.value,
+                        parameter_unit(&p.name)
+                    )?;
+                }
+                for q in fit.navigation(None) {
+                    writeln!(
+                        out,
+                        "{column},{},{},{},{:e},,,,{},{objective:e}",
+                        q.process, q.index, q.name, q.value, q.unit
                     )?;
                 }
             }
@@ -216,4 +234,22 @@ fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Wr
         }
     }
     Ok(())
+}
+
+/// The unit of a model parameter in terms of u, the data unit (per-sample parameters, as the
+/// model is written): `beta` 1/s, the coefficients (`phi`, `theta`, `arK`, `maK`) none, the drift `omega` u per
+/// sample, every variance (`sigma2`, `sigma2_gm`, `gamma2`, `q2`) u^2.
+fn parameter_unit(name: &str) -> &'static str {
+    if name == "beta" {
+        "1/s"
+    } else if ["phi", "theta", "ar", "ma"]
+        .iter()
+        .any(|p| name.starts_with(p))
+    {
+        "1"
+    } else if name == "omega" {
+        "u/sample"
+    } else {
+        "u^2"
+    }
 }

@@ -4,9 +4,10 @@
 use crate::config::SimulateConfig;
 use anyhow::{Context, Result};
 use gmwm::imu::write::{write_csv_header, write_csv_rows, write_sidecar};
-use gmwm::imu::{SeriesWriter, Sidecar, SidecarColumn};
+use gmwm::imu::{OutputFormat, SeriesWriter, Sidecar, SidecarColumn};
 use gmwm::sim::Simulator;
 use std::io::Write;
+use std::path::Path;
 
 /// Samples simulated and written per step: bounded memory for any N.
 const CHUNK: usize = 1 << 16;
@@ -27,6 +28,111 @@ impl Sink<'_> {
     }
 }
 
+/// Samples above which `--yes` is needed.
+pub const CONFIRM_SAMPLES: usize = 1_000_000_000;
+
+/// Bytes per value written as text (`-0.7416573867739413,`: the shortest round-trip form of a
+/// double is up to about 20 characters).
+const TEXT_BYTES: u64 = 20;
+
+/// About how many bytes `n` rows of `ncols` values take in the output's format (text
+/// uncompressed).
+fn estimated_bytes(config: &SimulateConfig, ncols: usize) -> u64 {
+    let per_value = match config.output.as_deref().map(OutputFormat::from_path) {
+        Some(Ok(OutputFormat::F64)) => 8,
+        Some(Ok(OutputFormat::F32)) => 4,
+        _ => TEXT_BYTES,
+    };
+    (config.n as u64)
+        .saturating_mul(ncols as u64)
+        .saturating_mul(per_value)
+}
+
+/// A size with its unit (`1.2 GB`, decimal units).
+fn bytes(b: u64) -> String {
+    let units = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = b as f64;
+    let mut k = 0;
+    while v >= 1000.0 && k + 1 < units.len() {
+        v /= 1000.0;
+        k += 1;
+    }
+    if k == 0 {
+        format!("{b} bytes")
+    } else {
+        format!("{v:.1} {}", units[k])
+    }
+}
+
+/// Free bytes for an unprivileged writer on the file system that will hold `path`.
+#[cfg(unix)]
+fn free_space(path: &Path) -> Option<u64> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let s = rustix::fs::statvfs(dir).ok()?;
+    Some(s.f_bavail.saturating_mul(s.f_frsize))
+}
+
+#[cfg(not(unix))]
+fn free_space(_: &Path) -> Option<u64> {
+    None
+}
+
+/// Refuses, without `--yes`, more than [`CONFIRM_SAMPLES`] samples, or a file larger than the
+/// free space of its file system: one line with the size it would write and the flag.
+fn check_size(config: &SimulateConfig, ncols: usize) -> Result<()> {
+    size_check(config, ncols, config.output.as_deref().and_then(free_space))
+}
+
+/// [`check_size`] with the free bytes of the output's file system given.
+fn size_check(config: &SimulateConfig, ncols: usize, free: Option<u64>) -> Result<()> {
+    if config.yes {
+        return Ok(());
+    }
+    let size = estimated_bytes(config, ncols);
+    let gz = config.output.as_deref().is_some_and(|p| {
+        matches!(
+            OutputFormat::from_path(p),
+            Ok(OutputFormat::Text { gzip: true, .. })
+        )
+    });
+    let target = match &config.output {
+        Some(p) => p.display().to_string(),
+        None => "standard output".to_string(),
+    };
+    let what = format!(
+        "about {}{} ({} samples x {ncols} column{})",
+        bytes(size),
+        if gz { " before compression" } else { "" },
+        config.n,
+        if ncols == 1 { "" } else { "s" }
+    );
+    if config.n > CONFIRM_SAMPLES {
+        return Err(crate::UsageError(format!(
+            "--n {}: gmwm simulate would write {what} to {target}, more than {CONFIRM_SAMPLES} \
+             samples; give --yes to write it",
+            config.n
+        ))
+        .into());
+    }
+    if let Some(p) = &config.output {
+        if let Some(free) = free {
+            if size > free && !gz {
+                return Err(crate::UsageError(format!(
+                    "{}: gmwm simulate would write {what}, and its file system has {} free; \
+                     give --yes to write it anyway",
+                    p.display(),
+                    bytes(free)
+                ))
+                .into());
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Runs the subcommand.
 pub fn run(config: &SimulateConfig, stdout: &mut impl Write) -> Result<()> {
     let model = &config.model;
@@ -36,6 +142,7 @@ pub fn run(config: &SimulateConfig, stdout: &mut impl Write) -> Result<()> {
     if config.components {
         names.extend(model.components().iter().map(|c| c.to_string()));
     }
+    check_size(config, names.len())?;
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
     // Create the file first so a bad path or an unknown extension fails before any work.
     let mut sink = match &config.output {
@@ -109,5 +216,52 @@ fn csv_quote(s: &str) -> String {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(n: usize, output: Option<&str>, yes: bool) -> SimulateConfig {
+        SimulateConfig {
+            model: "WN(sigma2=1)".parse().unwrap(),
+            n,
+            freq_hz: 1.0,
+            seed: 0,
+            output: output.map(Into::into),
+            components: false,
+            yes,
+        }
+    }
+
+    #[test]
+    fn a_file_larger_than_the_free_space_needs_yes() {
+        // 1e8 f64 samples: 800 MB, on a file system with 100 MB free
+        let c = config(100_000_000, Some("big.f64"), false);
+        let e = size_check(&c, 1, Some(100_000_000))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("big.f64") && e.contains("800.0 MB") && e.contains("100.0 MB free"),
+            "{e}"
+        );
+        assert!(e.contains("--yes"), "{e}");
+        assert!(size_check(&config(100_000_000, Some("big.f64"), true), 1, Some(1)).is_ok());
+        assert!(size_check(&c, 1, Some(1_000_000_000)).is_ok());
+        // text: about 20 bytes a value
+        let csv = config(1000, Some("x.csv"), false);
+        let e = size_check(&csv, 2, Some(10_000)).unwrap_err().to_string();
+        assert!(e.contains("40.0 kB") && e.contains("2 columns"), "{e}");
+    }
+
+    #[test]
+    fn more_than_a_billion_samples_need_yes_wherever_they_go() {
+        let e = size_check(&config(CONFIRM_SAMPLES + 1, None, false), 1, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("standard output") && e.contains("--yes"), "{e}");
+        assert!(size_check(&config(CONFIRM_SAMPLES, None, false), 1, None).is_ok());
+        assert!(size_check(&config(CONFIRM_SAMPLES + 1, None, true), 1, None).is_ok());
     }
 }

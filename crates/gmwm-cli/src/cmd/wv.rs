@@ -66,6 +66,14 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
     let sidecar = gmwm::imu::find_sidecar(path)?;
     Ok(match sidecar.and_then(|s| s.sampling_frequency_hz) {
         Some(f) => f,
+        None if crate::spool::is_stdin(path) => {
+            return Err(crate::UsageError(format!(
+                "{}: no sampling rate: raw binary on standard input has no JSON sidecar; give \
+                 --freq",
+                crate::spool::STDIN
+            ))
+            .into())
+        }
         None => {
             eprintln!(
                 "gmwm: warning: {}: no sampling rate (no --freq or JSON sidecar); using 1 Hz, so tau_s is in samples",

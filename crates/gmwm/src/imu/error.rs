@@ -194,6 +194,58 @@ pub enum ReadError {
         /// File.
         path: PathBuf,
     },
+    /// A text file in UTF-16 (by its byte-order mark): refused with what it is instead of as
+    /// binary data.
+    #[error(
+        "{}: text is UTF-16 {} (byte-order mark {}), not UTF-8; save it as UTF-8",
+        .path.display(),
+        if *.big_endian { "big-endian" } else { "little-endian" },
+        if *.big_endian { "FE FF" } else { "FF FE" }
+    )]
+    Utf16 {
+        /// File.
+        path: PathBuf,
+        /// Byte order: FE FF (big-endian) or FF FE.
+        big_endian: bool,
+    },
+    /// 8-bit text (Latin-1, Windows-1252, ...): printable but for bytes that are not UTF-8.
+    #[error(
+        "{}:{line}: byte 0x{byte:02x} is not UTF-8 (8-bit text such as Latin-1 or \
+         Windows-1252?); save the file as UTF-8",
+        .path.display()
+    )]
+    NotUtf8 {
+        /// File.
+        path: PathBuf,
+        /// 1-based line of the first such byte.
+        line: u64,
+        /// The byte.
+        byte: u8,
+    },
+    /// A text file whose lines end in a carriage return alone (classic Mac OS): read as one
+    /// line, it would have a header and no data.
+    #[error(
+        "{}: lines end in a carriage return alone (CR, classic Mac OS); save it with LF or \
+         CRLF line ends",
+        .path.display()
+    )]
+    CrLineEnds {
+        /// File.
+        path: PathBuf,
+    },
+    /// Every column of the file is a time column: nothing is left to analyse.
+    #[error(
+        "{}: no column to analyse: every column is a time column (\"{}\" gives the time; \
+         --columns selects a column anyway)",
+        .path.display(),
+        quote(.column)
+    )]
+    OnlyTime {
+        /// File.
+        path: PathBuf,
+        /// The time column.
+        column: String,
+    },
     /// A JSON document was given where a table of samples is read.
     #[error(
         "{}: is JSON, not a table of samples (a wavelet variance saved by `gmwm wv --json` is \

@@ -9,6 +9,7 @@
 //! - [`read_imu_record_file`]: the binary IMU epoch records of docs/methods.md §9.2–9.3;
 //! - [`read_wv_json`]: a wavelet variance computed elsewhere (`gmwm wv --json`), to fit again;
 //! - [`write::SeriesWriter`]: series to CSV, TSV, gzip or raw binary by file name;
+//! - [`plausible::raw_floats`]: whether raw floats look like samples (f64 read as f32, ...);
 //! - [`Imu`]: gyroscope/accelerometer axes with a common rate (docs/methods.md §9.1).
 //!
 //! This module knows no statistics; every error is a [`ReadError`] (or a
@@ -27,6 +28,7 @@
 //! ```
 
 mod error;
+pub mod plausible;
 pub mod read;
 pub mod recording;
 pub mod ros;

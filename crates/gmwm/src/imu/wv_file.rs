@@ -169,7 +169,16 @@ pub fn read_wv_json(
         path: path.to_path_buf(),
         source,
     })?;
-    let doc: FileDoc = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| bad(format!("not valid JSON: {e}")))?;
+    if !value.is_object() {
+        return Err(bad(format!(
+            "the document is {}, not an object with a \"series\" array as `gmwm wv --json` \
+             writes (a recording is CSV/TSV text or raw binary, not JSON)",
+            json_kind(&value)
+        )));
+    }
+    let doc: FileDoc = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
     let series = doc
         .series
         .ok_or_else(|| bad("no \"series\" array at the top level".into()))?;
@@ -286,4 +295,17 @@ pub fn read_wv_json(
         ));
     }
     Ok(out)
+}
+
+/// What a JSON value is, for a message: `an array`, `a string`, ...
+fn json_kind(v: &serde_json::Value) -> &'static str {
+    match v {
+        serde_json::Value::Null => "null",
+        serde_json::Value::Bool(_) => "a boolean",
+        serde_json::Value::Number(_) => "a number",
+        serde_json::Value::String(_) => "a string",
+        serde_json::Value::Array(a) if a.is_empty() => "an empty array",
+        serde_json::Value::Array(_) => "an array",
+        serde_json::Value::Object(_) => "an object",
+    }
 }

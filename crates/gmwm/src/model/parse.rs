@@ -173,11 +173,9 @@ impl fmt::Display for ModelParseError {
     }
 }
 
-impl std::error::Error for ModelParseError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        self.rule().map(|e| e as _)
-    }
-}
+/// No source: a rule violation's expectation and value are already in the message (a chain
+/// printer would state them twice); [`ModelParseError::rule`] gives it typed.
+impl std::error::Error for ModelParseError {}
 
 const NUMBER: &str = "a number such as 0.5, -2 or 7.08e-9";
 

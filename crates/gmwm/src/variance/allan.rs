@@ -75,6 +75,28 @@ impl AllanKind {
         }
     }
 
+    /// What the kind computes, for titles: `"overlapping Allan variance"`, `"modified Allan
+    /// variance"`, `"overlapping Hadamard variance"`, ...
+    pub fn title(self) -> &'static str {
+        match self {
+            AllanKind::Overlapping => "overlapping Allan variance",
+            AllanKind::NonOverlapping => "non-overlapping Allan variance",
+            AllanKind::Modified => "modified Allan variance",
+            AllanKind::Hadamard => "overlapping Hadamard variance",
+            AllanKind::HadamardNonOverlapping => "non-overlapping Hadamard variance",
+        }
+    }
+
+    /// The names of the variance and of its square root in tables and CSV headers: `avar`
+    /// `adev` (Allan), `mavar` `mdev` (modified Allan), `hvar` `hdev` (Hadamard).
+    pub fn columns(self) -> (&'static str, &'static str) {
+        match self {
+            AllanKind::Overlapping | AllanKind::NonOverlapping => ("avar", "adev"),
+            AllanKind::Modified => ("mavar", "mdev"),
+            AllanKind::Hadamard | AllanKind::HadamardNonOverlapping => ("hvar", "hdev"),
+        }
+    }
+
     /// Whether the kind is a Hadamard variance (cluster lengths `3^i`, docs/methods.md §3.5).
     pub fn is_hadamard(self) -> bool {
         matches!(
@@ -307,15 +329,11 @@ impl AllanVariance {
 
 impl fmt::Display for AllanVariance {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (var, dev) = if self.kind.is_hadamard() {
-            ("hvar", "hdev")
-        } else {
-            ("avar", "adev")
-        };
+        let (var, dev) = self.kind.columns();
         writeln!(
             f,
-            "{} variance ({} convention), n = {}, freq = {} Hz, {}% CI",
-            self.kind,
+            "{} ({} convention), n = {}, freq = {} Hz, {}% CI",
+            self.kind.title(),
             self.convention,
             self.n,
             self.freq_hz,

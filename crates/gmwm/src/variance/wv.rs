@@ -1285,6 +1285,10 @@ fn haar_wv_in_memory(
         check_series(x)?;
         return haar_wv_parallel(x, levels, freq_hz, alpha);
     }
+    if sums.iter().all(|&s| s < f64::MIN_POSITIVE) {
+        // zero or subnormal at every level from non-constant data: squares underflowed
+        check_series(x)?;
+    }
     let n = x.len();
     let opts = WvOptions {
         levels: Some(levels),

@@ -426,9 +426,9 @@ pub fn resolve_format(
     ) {
         match sniff(path)? {
             Content::Binary => {
-                return Err(ReadError::LooksBinary {
+                return Err(other_encoding(path).unwrap_or(ReadError::LooksBinary {
                     path: path.to_path_buf(),
-                })
+                }))
             }
             Content::Json => {
                 return Err(ReadError::NotATable {
@@ -439,6 +439,49 @@ pub fn resolve_format(
         }
     }
     Ok(format)
+}
+
+/// The first bytes of a plain file (not gzip), empty if it cannot be read.
+fn head(path: &Path) -> Vec<u8> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(SNIFF_BYTES);
+    if let Ok(f) = std::fs::File::open(path) {
+        let _ = f.take(SNIFF_BYTES as u64).read_to_end(&mut head);
+    }
+    head
+}
+
+/// What a file that [`sniff`] finds binary is when it is text in another encoding: UTF-16 by
+/// its byte-order mark ([`ReadError::Utf16`]), or 8-bit text ([`ReadError::NotUtf8`]: no NUL,
+/// printable ASCII but for a few bytes above 0x7f, such as Latin-1's degree sign).
+fn other_encoding(path: &Path) -> Option<ReadError> {
+    let head = head(path);
+    let path = path.to_path_buf();
+    if head.starts_with(&[0xff, 0xfe]) || head.starts_with(&[0xfe, 0xff]) {
+        return Some(ReadError::Utf16 {
+            path,
+            big_endian: head[0] == 0xfe,
+        });
+    }
+    let printable = |b: &u8| b.is_ascii_graphic() || matches!(b, b' ' | b'\t' | b'\r' | b'\n');
+    let high = head.iter().filter(|b| **b >= 0x80).count();
+    let plain = head.iter().filter(|b| printable(b)).count();
+    if head.is_empty() || head.contains(&0) || plain + high < head.len() || high * 20 > head.len() {
+        return None;
+    }
+    let offset = std::str::from_utf8(&head).err()?.valid_up_to();
+    let line = 1 + head[..offset].iter().filter(|&&b| b == b'\n').count() as u64;
+    Some(ReadError::NotUtf8 {
+        path,
+        line,
+        byte: head[offset],
+    })
+}
+
+/// Whether the start of a plain file breaks lines with a carriage return alone.
+fn cr_line_ends(path: &Path) -> bool {
+    let head = head(path);
+    !head.contains(&b'\n') && head.iter().filter(|&&b| b == b'\r').count() > 1
 }
 
 /// Layout of a raw f64/f32 file: what [`read_table`] would use for it.
@@ -563,8 +606,23 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
             binary::read_binary_table(path, format, opts, sidecar.as_ref())?
         }
         InputFormat::ImuRecord(t) => binary::read_record_table(path, t, opts)?,
-        f => text::read_text_table(path, f, opts, sidecar.as_ref())?,
+        f => text::read_text_table(path, f, opts, sidecar.as_ref()).map_err(|e| match e {
+            ReadError::HeaderOnly { .. } | ReadError::Empty { .. } if cr_line_ends(path) => {
+                ReadError::CrLineEnds {
+                    path: path.to_path_buf(),
+                }
+            }
+            e => e,
+        })?,
     };
+    if raw.columns.is_empty() {
+        if let Some(t) = &raw.time {
+            return Err(ReadError::OnlyTime {
+                path: path.to_path_buf(),
+                column: t.name.clone(),
+            });
+        }
+    }
     let mut warnings = Vec::new();
     let (time, timing) = match raw.time {
         Some(mut col) => {

@@ -1,0 +1,102 @@
+//! Standard input (`-`) and pipes as FILE. The readers look at a file more than once (its
+//! first bytes, then the data; raw binary is memory-mapped), which a pipe cannot give: the
+//! stream is copied once to a private temporary folder, read from there, and removed at the
+//! end. Messages name it as the user did (`<stdin>`, or the FIFO's path), not the copy.
+
+use anyhow::{Context, Result};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// How standard input is named in messages.
+pub const STDIN: &str = "<stdin>";
+
+/// The copy and the name the user gave it, once per run.
+static SPOOLED: OnceLock<(PathBuf, String)> = OnceLock::new();
+
+/// The temporary folder of the copy, removed when dropped.
+pub struct Spool {
+    dir: PathBuf,
+}
+
+impl Drop for Spool {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// Whether `path` is a stream to copy first: `-` (standard input), or a FIFO, character device
+/// or socket (`<(zcat x.gz)`, a named pipe).
+pub fn is_stream(path: &Path) -> bool {
+    if path == Path::new("-") {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if let Ok(m) = std::fs::metadata(path) {
+            let t = m.file_type();
+            return t.is_fifo() || t.is_char_device() || t.is_socket();
+        }
+    }
+    false
+}
+
+/// Whether `path` is the copy of standard input (no sidecar, no name: `--freq` is needed unless
+/// a time column gives the rate).
+pub fn is_stdin(path: &Path) -> bool {
+    SPOOLED
+        .get()
+        .is_some_and(|(copy, shown)| copy == path && shown == STDIN)
+}
+
+/// `text` with the copy's path replaced by the name the user gave (`<stdin>`, the FIFO's path).
+pub fn shown(text: &str) -> String {
+    match SPOOLED.get() {
+        Some((copy, name)) => text.replace(&copy.display().to_string(), name),
+        None => text.to_string(),
+    }
+}
+
+/// Copies the stream `path` (`-` or a pipe) to a temporary file and returns its path with the
+/// guard that removes it. The copy keeps a pipe's file name (so `data.f64` is still raw f64)
+/// and its sidecar, when one is beside it.
+pub fn spool(path: &Path) -> Result<(PathBuf, Spool)> {
+    let stdin = path == Path::new("-");
+    let shown_name = if stdin {
+        STDIN.to_string()
+    } else {
+        path.display().to_string()
+    };
+    let dir = std::env::temp_dir().join(format!("gmwm-input-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("{shown_name}: cannot create a temporary folder to read it"))?;
+    let guard = Spool { dir: dir.clone() };
+    let name = match path.file_name() {
+        Some(n) if !stdin => n.to_os_string(),
+        _ => "stdin".into(),
+    };
+    let copy = dir.join(name);
+    let mut file = std::fs::File::create(&copy)
+        .with_context(|| format!("{shown_name}: cannot create its temporary copy"))?;
+    let copied = if stdin {
+        std::io::copy(&mut std::io::stdin().lock(), &mut file)
+    } else {
+        std::fs::File::open(path).and_then(|mut f| std::io::copy(&mut f, &mut file))
+    };
+    copied
+        .and_then(|_| file.flush())
+        .with_context(|| format!("{shown_name}: cannot read it"))?;
+    if !stdin {
+        for candidate in gmwm::imu::sidecar::sidecar_candidates(path) {
+            if candidate.is_file() {
+                if let Some(n) = candidate.file_name() {
+                    let _ = std::fs::copy(&candidate, dir.join(n));
+                }
+            }
+        }
+    }
+    let _ = SPOOLED.set((copy.clone(), shown_name));
+    Ok((copy, guard))
+}
