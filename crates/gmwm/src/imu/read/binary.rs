@@ -113,6 +113,24 @@ fn check_ncols(ncols: usize) -> Result<(), ParamError> {
     }
 }
 
+/// Bytes per row of `ncols` interleaved values of `width` bytes.
+pub(crate) fn record_size(width: usize, ncols: usize) -> Result<usize, ParamError> {
+    check_ncols(ncols)?;
+    width.checked_mul(ncols).ok_or_else(|| {
+        ParamError::new(
+            "ncols",
+            ncols,
+            format!("a column count whose rows of {width}-byte values fit in memory"),
+        )
+    })
+}
+
+/// Opens a raw binary file of rows of `record` bytes and checks its size (non-empty, a whole
+/// number of rows).
+pub(crate) fn check_records(path: &Path, record: usize) -> Result<u64, ReadError> {
+    open_records(path, record).map(|(_, rows)| rows)
+}
+
 /// Reads a raw binary table (memory-mapped). The file must not change while it is read.
 /// `ncols` and the column names come from the options, else the sidecar.
 pub(crate) fn read_binary_table(
@@ -126,12 +144,13 @@ pub(crate) fn read_binary_table(
         .ncols
         .or_else(|| sidecar.and_then(|s| s.n_columns))
         .unwrap_or(1);
-    check_ncols(ncols)?;
+    let record = record_size(width, ncols)?;
+    // the size first: a column count (from a sidecar) is data, its names are only made for
+    // columns the file can hold
+    let (file, _rows) = open_records(path, record)?;
     let names = binary_names(sidecar, ncols);
     let sel = resolve_selection(path, &names, opts, sidecar)?;
-    let (file, _rows) = open_records(path, width * ncols)?;
     let bytes = map(path, &file)?;
-    let record = width * ncols;
     let column = |k: usize| -> Result<Vec<f64>, ReadError> {
         let values: Vec<f64> = bytes
             .chunks_exact(record)
@@ -243,7 +262,7 @@ impl BinaryChunks {
                 ncols,
             });
         }
-        let (file, rows) = open_records(path, width * ncols)?;
+        let (file, rows) = open_records(path, record_size(width, ncols)?)?;
         Ok(Self {
             path: path.to_path_buf(),
             reader: BufReader::with_capacity(BUF_CAPACITY, file),
@@ -381,7 +400,7 @@ impl RawRows {
     pub(crate) fn open(path: &Path, format: InputFormat, ncols: usize) -> Result<Self, ReadError> {
         let width = width_of(format)?;
         check_ncols(ncols)?;
-        let (file, rows) = open_records(path, width * ncols)?;
+        let (file, rows) = open_records(path, record_size(width, ncols)?)?;
         Ok(Self {
             path: path.to_path_buf(),
             file,
@@ -769,6 +788,15 @@ pub(crate) fn read_record_table(
             record_type.scale_accel()
         };
         let factor = freq * scale;
+        if let Some(i) = values.iter().position(|v| !(v * factor).is_finite()) {
+            return Err(ReadError::RecordRateOverflow {
+                path: path.to_path_buf(),
+                index: i as u64,
+                column: names[k].clone(),
+                raw: values[i],
+                freq_hz: freq,
+            });
+        }
         values.iter_mut().for_each(|v| *v *= factor);
         columns.push(Column {
             name: names[k].clone(),
@@ -805,7 +833,8 @@ pub(crate) fn read_record_table(
 /// [`ReadError::Io`], [`ReadError::Empty`], [`ReadError::BinarySize`] (size not a multiple of
 /// 32 or 56 bytes, with the bytes left over), [`ReadError::BinaryNonFinite`] (column 1 is the
 /// time), [`ReadError::RecordTimeNotIncreasing`] (with the 0-based record and both times),
-/// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span).
+/// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span),
+/// [`ReadError::RecordRateOverflow`] (an increment times the rate is not finite).
 pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<Imu, Error> {
     let opts = ReadOptions {
         format: InputFormat::ImuRecord(record_type),
