@@ -25,8 +25,11 @@ use gmwm::model::Model;
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 
+/// The body of a target: takes any bytes, panics on a broken property.
+pub type Body = fn(&[u8]);
+
 /// Every target: name (as in `fuzz/Cargo.toml` and `fuzz/corpus/<name>/`) and body.
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Body)] = &[
     ("text", text),
     ("raw_binary", raw_binary),
     ("imu_record", imu_record),

@@ -58,7 +58,8 @@ pub(crate) fn one_line(text: &str) -> String {
     out
 }
 
-/// A name taken from a file (a ROS topic or message type) made safe for a one-line message:
+/// A name taken from a file (a ROS topic or message type), or another library's message that
+/// quotes the file (serde's unknown variant), made safe for a one-line message:
 /// control characters escaped, cut to [`CAUSE_MAX`] characters with `...` appended (longer
 /// than [`quote`]'s cut, so that real names are shown whole).
 pub(crate) fn escape_name(text: &str) -> String {

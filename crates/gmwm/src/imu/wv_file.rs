@@ -9,7 +9,7 @@
 //! `n_coefficients`, `eta` (as `gmwm wv --json` writes them; defaults: Haar MODWT, alpha 0.05,
 //! classical, counts and eta3 degrees of freedom recomputed from `n`).
 
-use super::error::quote;
+use super::error::{escape_name, quote};
 use super::read::{sniff, ColumnSelector, Content};
 use super::ReadError;
 use crate::error::ParamError;
@@ -169,7 +169,8 @@ pub fn read_wv_json(
         path: path.to_path_buf(),
         source,
     })?;
-    let doc: FileDoc = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    // serde quotes the file (an unknown variant's text) unescaped: escape it to one line
+    let doc: FileDoc = serde_json::from_str(&text).map_err(|e| bad(escape_name(&e.to_string())))?;
     let series = doc
         .series
         .ok_or_else(|| bad("no \"series\" array at the top level".into()))?;
