@@ -19,7 +19,8 @@
 use gmwm::imu::ros::{list_topics, read_imu_messages, ImuMessages};
 use gmwm::imu::{
     allan_from_wv, is_wv_json, read_table, read_wv_json, ColumnSelector, HeaderMode, Imu,
-    ImuRecordType, InputFormat, ReadError, ReadOptions, Sidecar, Table,
+    ImuRecordType, InputFormat, ReadError, ReadOptions, Recording, RecordingOptions, Sidecar,
+    Table,
 };
 use gmwm::model::Model;
 use std::cell::RefCell;
@@ -273,8 +274,8 @@ fn check_messages(m: &ImuMessages) {
     );
 }
 
-/// A ROS recording (`x.<ext>`): the topic list, the single IMU topic, then each IMU topic
-/// listed (at most 4).
+/// A ROS recording (`x.<ext>`): the topic list, the single IMU topic, the recording opened for
+/// calibration ([`Recording::open`]), then each IMU topic listed (at most 4).
 fn ros(ext: &str, data: &[u8]) {
     let name = format!("x.{ext}");
     let path = scratch(ext, &[(&name, data)]);
@@ -287,6 +288,19 @@ fn ros(ext: &str, data: &[u8]) {
     };
     match read_imu_messages(&path, None) {
         Ok(m) => check_messages(&m),
+        Err(e) => check_error(&e),
+    }
+    // the calibration's entry point: messages to IMU axes, their rate and timing notes
+    match Recording::open(&path, &RecordingOptions::default()) {
+        Ok(r) => {
+            assert!(r.imu.freq_hz().is_finite() && r.imu.freq_hz() > 0.0);
+            for (_, axis) in r.imu.iter() {
+                assert!(axis.values().iter().all(|v| v.is_finite()));
+            }
+            for note in &r.notes {
+                assert!(!note.contains('\n'), "multi-line note: {note:?}");
+            }
+        }
         Err(e) => check_error(&e),
     }
     for t in topics.iter().filter(|t| t.is_imu()).take(4) {
