@@ -249,7 +249,21 @@ fn warn_implausible(input: &InputConfig) {
     {
         return;
     }
-    if let Ok(Some(layout)) = gmwm::imu::binary_layout(&input.file, &input.read) {
+    let layout = match gmwm::imu::binary_layout(&input.file, &input.read) {
+        Ok(layout) => layout,
+        // a size that is no whole number of rows (the reader says so next): the values are
+        // still looked at when the format was given, as text read as f64 often has that size
+        Err(_) => matches!(
+            input.read.format,
+            gmwm::imu::InputFormat::F64 | gmwm::imu::InputFormat::F32
+        )
+        .then(|| gmwm::imu::BinaryLayout {
+            format: input.read.format,
+            ncols: 1,
+            names: Vec::new(),
+        }),
+    };
+    if let Some(layout) = layout {
         if let Ok(Some(bad)) = gmwm::imu::plausible::raw_floats(&input.file, &layout) {
             eprintln!("gmwm: warning: {}", spool::shown(&bad.to_string()));
         }

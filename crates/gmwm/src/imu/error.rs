@@ -30,6 +30,54 @@ pub fn quote(text: &str) -> String {
     out
 }
 
+/// Longest message of another library (e.g. SQLite's, which may quote SQL from the file)
+/// kept in an error, in characters.
+pub(crate) const CAUSE_MAX: usize = 200;
+
+/// A message of another library made one line: runs of whitespace (newlines included) become
+/// one space, other control characters are escaped, cut to [`CAUSE_MAX`] characters with
+/// `...` appended.
+pub(crate) fn one_line(text: &str) -> String {
+    let mut out = String::new();
+    for (count, c) in text
+        .split_whitespace()
+        .flat_map(|w| std::iter::once(' ').chain(w.chars()))
+        .skip(1)
+        .enumerate()
+    {
+        if count == CAUSE_MAX {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A name taken from a file (a ROS topic or message type), or another library's message that
+/// quotes the file (serde's unknown variant), made safe for a one-line message:
+/// control characters escaped, cut to [`CAUSE_MAX`] characters with `...` appended (longer
+/// than [`quote`]'s cut, so that real names are shown whole).
+pub(crate) fn escape_name(text: &str) -> String {
+    let mut out = String::new();
+    for (count, c) in text.chars().enumerate() {
+        if count == CAUSE_MAX {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() || c == '\u{fffd}' {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// At most this many column names are listed in an error (the rest are counted).
 const LIST_MAX: usize = 20;
 
@@ -233,19 +281,6 @@ pub enum ReadError {
         /// File.
         path: PathBuf,
     },
-    /// Every column of the file is a time column: nothing is left to analyse.
-    #[error(
-        "{}: no column to analyse: every column is a time column (\"{}\" gives the time; \
-         --columns selects a column anyway)",
-        .path.display(),
-        quote(.column)
-    )]
-    OnlyTime {
-        /// File.
-        path: PathBuf,
-        /// The time column.
-        column: String,
-    },
     /// A JSON document was given where a table of samples is read.
     #[error(
         "{}: is JSON, not a table of samples (a wavelet variance saved by `gmwm wv --json` is \
@@ -272,6 +307,25 @@ pub enum ReadError {
         previous: f64,
         /// Its time, in seconds.
         value: f64,
+    },
+    /// An increment of a binary IMU record file times the rate and the scale (docs/methods.md §9.3)
+    /// is not a finite rate: the epochs' times (hence the rate) are implausible.
+    #[error(
+        "{}: record {index} (0-based): {column} increment {raw} times the rate {freq_hz} Hz \
+         and the scale is not a finite number; the epochs' times give an implausible rate",
+        .path.display()
+    )]
+    RecordRateOverflow {
+        /// File.
+        path: PathBuf,
+        /// 0-based index of the record.
+        index: u64,
+        /// Column (`gyro_x` ... `accel_z`).
+        column: String,
+        /// The raw increment.
+        raw: f64,
+        /// The rate derived from the epochs, in Hz.
+        freq_hz: f64,
     },
     /// A raw binary file does not hold a whole number of records.
     #[error(
@@ -322,6 +376,44 @@ pub enum ReadError {
         previous: f64,
         /// This time.
         value: f64,
+    },
+    /// Two consecutive time stamps, strictly increasing as read, can no longer be told apart
+    /// (or one is not finite) once converted to seconds after the first stamp: the stamps span
+    /// too wide a range for the resolution of f64 (a corrupt stamp, usually).
+    #[error(
+        "{}: {}: column {}: time {value} s after the first stamp ({first} s) does not follow          the previous one ({previous} s after it) once taken relative to the first stamp: the          stamps span too wide a range for their resolution",
+        .path.display(),
+        .line.map_or_else(|| format!("sample {row} (0-based)"), |l| format!("line {l}")),
+        quote(.column)
+    )]
+    TimeResolution {
+        /// File.
+        path: PathBuf,
+        /// 1-based physical line (text files).
+        line: Option<u64>,
+        /// 0-based row.
+        row: u64,
+        /// Name of the time column.
+        column: String,
+        /// The first stamp, in seconds.
+        first: f64,
+        /// The previous stamp, in seconds after the first.
+        previous: f64,
+        /// This stamp, in seconds after the first.
+        value: f64,
+    },
+    /// Every column of the file is a time column: there is nothing to analyse.
+    #[error(
+        "{}: no column to analyse: every column is a time column ({}); --columns selects a \
+         column anyway",
+        .path.display(),
+        name_list(.columns)
+    )]
+    NoDataColumn {
+        /// File.
+        path: PathBuf,
+        /// The time columns.
+        columns: Vec<String>,
     },
     /// The sampling frequency cannot be derived from the file.
     #[error("{}: sampling frequency cannot be derived: {reason}", .path.display())]

@@ -433,7 +433,11 @@ impl TimingReport {
             out.push(TimingWarning::Gaps {
                 column: self.column.clone(),
                 count: self.gaps.len(),
-                missing: self.gaps.iter().map(|g| g.missing).sum(),
+                // saturating: a gap of absurd length (a corrupt stamp) counts usize::MAX
+                missing: self
+                    .gaps
+                    .iter()
+                    .fold(0usize, |sum, g| sum.saturating_add(g.missing)),
                 largest: largest.clone(),
                 rate_hz: self.rate_hz,
             });

@@ -9,7 +9,7 @@
 //! `n_coefficients`, `eta` (as `gmwm wv --json` writes them; defaults: Haar MODWT, alpha 0.05,
 //! classical, counts and eta3 degrees of freedom recomputed from `n`).
 
-use super::error::quote;
+use super::error::{escape_name, quote};
 use super::read::{sniff, ColumnSelector, Content};
 use super::ReadError;
 use crate::error::ParamError;
@@ -169,8 +169,10 @@ pub fn read_wv_json(
         path: path.to_path_buf(),
         source,
     })?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| bad(format!("not valid JSON: {e}")))?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+        // serde may quote the file's text unescaped: escaped to one line
+        bad(format!("not valid JSON: {}", escape_name(&e.to_string())))
+    })?;
     if !value.is_object() {
         return Err(bad(format!(
             "the document is {}, not an object with a \"series\" array as `gmwm wv --json` \
@@ -178,7 +180,8 @@ pub fn read_wv_json(
             json_kind(&value)
         )));
     }
-    let doc: FileDoc = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
+    let doc: FileDoc =
+        serde_json::from_value(value).map_err(|e| bad(escape_name(&e.to_string())))?;
     let series = doc
         .series
         .ok_or_else(|| bad("no \"series\" array at the top level".into()))?;

@@ -729,7 +729,8 @@ impl Model {
 
 impl fmt::Display for Model {
     /// Canonical text: components joined by `+`; consecutive identical value-less GM/AR1
-    /// components collapse to `k*GM()`; values by name ([`Component`]'s `Display`).
+    /// components collapse to `k*GM()`, k at most [`MAX_MULTIPLIER`] (a longer run is split, so
+    /// that the text parses back); values by name ([`Component`]'s `Display`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let mut i = 0;
         let mut first = true;
@@ -737,7 +738,7 @@ impl fmt::Display for Model {
             let c = &self.components[i];
             let mut run = 1;
             if c.kind.may_repeat() && c.is_guess() {
-                while self.components.get(i + run) == Some(c) {
+                while run < MAX_MULTIPLIER && self.components.get(i + run) == Some(c) {
                     run += 1;
                 }
             }

@@ -162,6 +162,24 @@ fn check_ncols(ncols: usize) -> Result<(), ParamError> {
     }
 }
 
+/// Bytes per row of `ncols` interleaved values of `width` bytes.
+pub(crate) fn record_size(width: usize, ncols: usize) -> Result<usize, ParamError> {
+    check_ncols(ncols)?;
+    width.checked_mul(ncols).ok_or_else(|| {
+        ParamError::new(
+            "ncols",
+            ncols,
+            format!("a column count whose rows of {width}-byte values fit in memory"),
+        )
+    })
+}
+
+/// Opens a raw binary file of rows of `record` bytes and checks its size (non-empty, a whole
+/// number of rows).
+pub(crate) fn check_records(path: &Path, record: usize) -> Result<u64, ReadError> {
+    open_records(path, record).map(|(_, rows)| rows)
+}
+
 /// Reads a raw binary table with positioned reads ([`read_columns`]). `ncols` and the column
 /// names come from the options, else the sidecar.
 pub(crate) fn read_binary_table(
@@ -175,11 +193,12 @@ pub(crate) fn read_binary_table(
         .ncols
         .or_else(|| sidecar.and_then(|s| s.n_columns))
         .unwrap_or(1);
-    check_ncols(ncols)?;
+    let record = record_size(width, ncols)?;
+    // the size first: a column count (from a sidecar) is data, its names are only made for
+    // columns the file can hold
+    let (file, rows) = open_records(path, record)?;
     let names = binary_names(sidecar, ncols);
     let sel = resolve_selection(path, &names, opts, sidecar)?;
-    let record = width * ncols;
-    let (file, rows) = open_records(path, record)?;
     // the time column (if any) first, then the selected ones, in one pass over the file
     let wanted: Vec<usize> = sel.time.iter().chain(&sel.columns).copied().collect();
     let mut read = read_columns(path, &file, (rows, record, width), &wanted)?.into_iter();
@@ -291,7 +310,7 @@ impl BinaryChunks {
                 ncols,
             });
         }
-        let (file, rows) = open_records(path, width * ncols)?;
+        let (file, rows) = open_records(path, record_size(width, ncols)?)?;
         Ok(Self {
             path: path.to_path_buf(),
             reader: BufReader::with_capacity(BUF_CAPACITY, file),
@@ -429,7 +448,7 @@ impl RawRows {
     pub(crate) fn open(path: &Path, format: InputFormat, ncols: usize) -> Result<Self, ReadError> {
         let width = width_of(format)?;
         check_ncols(ncols)?;
-        let (file, rows) = open_records(path, width * ncols)?;
+        let (file, rows) = open_records(path, record_size(width, ncols)?)?;
         Ok(Self {
             path: path.to_path_buf(),
             file,
@@ -816,6 +835,15 @@ pub(crate) fn read_record_table(
             record_type.scale_accel()
         };
         let factor = freq * scale;
+        if let Some(i) = values.iter().position(|v| !(v * factor).is_finite()) {
+            return Err(ReadError::RecordRateOverflow {
+                path: path.to_path_buf(),
+                index: i as u64,
+                column: names[k].clone(),
+                raw: values[i],
+                freq_hz: freq,
+            });
+        }
         values.iter_mut().for_each(|v| *v *= factor);
         columns.push(Column {
             name: names[k].clone(),
@@ -852,7 +880,8 @@ pub(crate) fn read_record_table(
 /// [`ReadError::Io`], [`ReadError::Empty`], [`ReadError::BinarySize`] (size not a multiple of
 /// 32 or 56 bytes, with the bytes left over), [`ReadError::BinaryNonFinite`] (column 1 is the
 /// time), [`ReadError::RecordTimeNotIncreasing`] (with the 0-based record and both times),
-/// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span).
+/// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span),
+/// [`ReadError::RecordRateOverflow`] (an increment times the rate is not finite).
 pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<Imu, Error> {
     let opts = ReadOptions {
         format: InputFormat::ImuRecord(record_type),

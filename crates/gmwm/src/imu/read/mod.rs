@@ -520,17 +520,21 @@ impl BinaryLayout {
 /// ([`BinaryChunks`]).
 ///
 /// # Errors
-/// As [`resolve_format`] and [`find_sidecar`].
+/// As [`resolve_format`] and [`find_sidecar`]; [`ReadError::Empty`] or
+/// [`ReadError::BinarySize`] if the file does not hold a whole number of rows of `ncols`
+/// values; [`ParamError`] `ncols` for 0 columns.
 pub fn binary_layout(path: &Path, opts: &ReadOptions) -> Result<Option<BinaryLayout>, ReadError> {
     let sidecar = find_sidecar(path)?;
     let format = resolve_format(path, opts.format, sidecar.as_ref())?;
-    if format.value_width().is_none() {
+    let Some(width) = format.value_width() else {
         return Ok(None);
-    }
+    };
     let ncols = opts
         .ncols
         .or_else(|| sidecar.as_ref().and_then(|s| s.n_columns))
         .unwrap_or(1);
+    // a column count is data (a sidecar's): names are only made for columns the file can hold
+    binary::check_records(path, binary::record_size(width, ncols)?)?;
     Ok(Some(BinaryLayout {
         format,
         ncols,
@@ -578,7 +582,9 @@ pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<Strin
 /// Any [`ReadError`]: I/O, empty or header-only file, ragged row, non-numeric or non-finite cell
 /// (with its line and column), unknown column, binary size not a multiple of the record size,
 /// binary content without a binary format, corrupt gzip, unreadable sidecar, non-increasing
-/// time, invalid options.
+/// time, stamps too far apart to stay strictly increasing relative to the first one
+/// ([`ReadError::TimeResolution`]), only time columns ([`ReadError::NoDataColumn`]), IMU
+/// record increments whose rate is not finite, invalid options.
 pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
     if let Some(f) = opts.freq_hz {
         check_freq(f)?;
@@ -616,12 +622,17 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         })?,
     };
     if raw.columns.is_empty() {
-        if let Some(t) = &raw.time {
-            return Err(ReadError::OnlyTime {
-                path: path.to_path_buf(),
-                column: t.name.clone(),
-            });
-        }
+        // only time columns: the selection was the default one (an explicit one is never
+        // empty)
+        return Err(ReadError::NoDataColumn {
+            path: path.to_path_buf(),
+            columns: raw
+                .time
+                .iter()
+                .map(|t| t.name.clone())
+                .chain(raw.skipped)
+                .collect(),
+        });
     }
     let mut warnings = Vec::new();
     let (time, timing) = match raw.time {
@@ -638,6 +649,22 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
             if unit != TimeUnit::Seconds {
                 let k = unit.to_seconds();
                 col.values.iter_mut().for_each(|t| *t *= k);
+            }
+            // each reader checked the stamps as read; relative to the first one and in seconds
+            // they must still be finite and strictly increasing (Table::time)
+            let bad = (0..col.values.len()).find(|&i| {
+                !col.values[i].is_finite() || (i > 0 && col.values[i] <= col.values[i - 1])
+            });
+            if let Some(row) = bad {
+                return Err(ReadError::TimeResolution {
+                    path: path.to_path_buf(),
+                    line: raw.lines.as_ref().map(|l| l.line_of(row)),
+                    row: row as u64,
+                    column: col.name.clone(),
+                    first: raw.time_origin * unit.to_seconds(),
+                    previous: row.checked_sub(1).map_or(f64::NAN, |p| col.values[p]),
+                    value: col.values[row],
+                });
             }
             let mut report = check_times(&col.name, &col.values, unit, source);
             report.start_s = raw.time_origin * unit.to_seconds();

@@ -7,6 +7,7 @@
 //! for linear_acceleration (needs 196)`.
 
 use super::RosContainer;
+use crate::imu::error::escape_name;
 use std::fmt;
 use std::path::PathBuf;
 use thiserror::Error;
@@ -67,7 +68,7 @@ pub enum RosError {
     #[error(
         "{}: several sensor_msgs/Imu topics: {}; choose one with --topic",
         .path.display(),
-        .topics.join(", ")
+        topic_names(.topics)
     )]
     AmbiguousImuTopic {
         /// Path as given.
@@ -76,7 +77,12 @@ pub enum RosError {
         topics: Vec<String>,
     },
     /// The named topic is not in the recording.
-    #[error("{}: no topic {topic}; {}", .path.display(), topic_list(.available))]
+    #[error(
+        "{}: no topic {}; {}",
+        .path.display(),
+        escape_name(.topic),
+        topic_list(.available)
+    )]
     TopicNotFound {
         /// Path as given.
         path: PathBuf,
@@ -87,8 +93,10 @@ pub enum RosError {
     },
     /// The named topic carries another message type.
     #[error(
-        "{}: topic {topic} carries {message_type}, not sensor_msgs/Imu",
-        .path.display()
+        "{}: topic {} carries {}, not sensor_msgs/Imu",
+        .path.display(),
+        escape_name(.topic),
+        escape_name(.message_type)
     )]
     NotImu {
         /// Path as given.
@@ -108,8 +116,10 @@ pub enum RosError {
     },
     /// The topic's messages use a serialization this reader does not decode.
     #[error(
-        "{}: topic {topic}: message encoding \"{encoding}\" is not supported (expected cdr or ros1)",
-        .path.display()
+        "{}: topic {}: message encoding \"{}\" is not supported (expected cdr or ros1)",
+        .path.display(),
+        escape_name(.topic),
+        escape_name(.encoding)
     )]
     UnsupportedEncoding {
         /// Storage file.
@@ -121,8 +131,9 @@ pub enum RosError {
     },
     /// One message cannot be decoded or holds a non-finite value.
     #[error(
-        "{}: topic {topic}: message {index} (log time {}): {reason}",
+        "{}: topic {}: message {index} (log time {}): {reason}",
         .path.display(),
+        escape_name(.topic),
         format_ns(*.log_time_ns)
     )]
     Message {
@@ -175,19 +186,25 @@ pub enum MessageError {
     },
 }
 
+/// Names from the file, escaped ([`escape_name`]) and joined by `, `.
+fn topic_names(names: &[String]) -> String {
+    let names: Vec<String> = names.iter().map(|n| escape_name(n)).collect();
+    names.join(", ")
+}
+
 /// `topics: /a (T), /b (U)` or `the recording holds no topics`.
 fn topic_list(available: &[String]) -> String {
     if available.is_empty() {
         "the recording holds no topics".to_owned()
     } else {
-        format!("topics: {}", available.join(", "))
+        format!("topics: {}", topic_names(available))
     }
 }
 
 fn empty_topics(topics: &[String]) -> String {
     match topics {
-        [one] => format!("topic {one} holds"),
-        more => format!("IMU topics {} hold", more.join(", ")),
+        [one] => format!("topic {} holds", escape_name(one)),
+        more => format!("IMU topics {} hold", topic_names(more)),
     }
 }
 

@@ -7,6 +7,7 @@
 
 use super::error::RosError;
 use super::{Collector, Encoding, RosContainer};
+use crate::imu::error::one_line;
 use crate::imu::ReadError;
 use rusqlite::{Connection, OpenFlags};
 use std::collections::HashMap;
@@ -26,7 +27,8 @@ pub(crate) struct Topic {
 fn sql_error(path: &Path, e: rusqlite::Error) -> RosError {
     RosError::Sqlite {
         path: path.to_path_buf(),
-        reason: e.to_string(),
+        // SQLite's messages may quote the file's schema, newlines and all
+        reason: one_line(&e.to_string()),
     }
 }
 
