@@ -1290,11 +1290,11 @@ fn issue_15_standard_input_refusals() {
         gmwm().args(["wv", "-"]).pipe_stdin(f.path()).unwrap(),
         &["<stdin>", "give --freq"],
     );
+    let raw: Vec<u8> = (0..4096)
+        .flat_map(|i| (f64::from(i) * 0.37).sin().to_le_bytes())
+        .collect();
     common::assert_usage_error(
-        gmwm()
-            .args(["wv", "-", "--format", "f64"])
-            .pipe_stdin(f.path())
-            .unwrap(),
+        gmwm().args(["wv", "-", "--format", "f64"]).write_stdin(raw),
         &["<stdin>", "give --freq"],
     );
     // an output named after the input
