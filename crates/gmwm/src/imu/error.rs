@@ -15,9 +15,15 @@ pub const QUOTE_MAX: usize = 40;
 /// Text from a file made safe for a one-line message: control and other non-printable
 /// characters escaped (`\n`, `\u{0}`), cut to [`QUOTE_MAX`] characters with `...` appended.
 pub fn quote(text: &str) -> String {
+    escaped(text, QUOTE_MAX)
+}
+
+/// `text` with control characters (and U+FFFD) escaped, cut to `max` characters with `...`
+/// appended.
+fn escaped(text: &str, max: usize) -> String {
     let mut out = String::new();
     for (count, c) in text.chars().enumerate() {
-        if count == QUOTE_MAX {
+        if count == max {
             out.push_str("...");
             break;
         }
@@ -63,19 +69,7 @@ pub(crate) fn one_line(text: &str) -> String {
 /// control characters escaped, cut to [`CAUSE_MAX`] characters with `...` appended (longer
 /// than [`quote`]'s cut, so that real names are shown whole).
 pub(crate) fn escape_name(text: &str) -> String {
-    let mut out = String::new();
-    for (count, c) in text.chars().enumerate() {
-        if count == CAUSE_MAX {
-            out.push_str("...");
-            break;
-        }
-        if c.is_control() || c == '\u{fffd}' {
-            out.extend(c.escape_debug());
-        } else {
-            out.push(c);
-        }
-    }
-    out
+    escaped(text, CAUSE_MAX)
 }
 
 /// At most this many column names are listed in an error (the rest are counted).
