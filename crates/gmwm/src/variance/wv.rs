@@ -1475,62 +1475,32 @@ crate::variance::simd::multiversion! {
     /// [`level_span`] with the old values taken from a ring segment, each replaced by the new
     /// value (the same roundings, one pass over the segment instead of a read and a copy).
     fn level_span_ring(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64
-        => level_span_ring_impl
-}
-
-#[inline(always)]
-fn level_span_ring_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64 {
-    let skip = skip.min(new.len());
-    let (new_skip, new_kept) = new.split_at(skip);
-    let (ring_skip, ring_kept) = ring.split_at_mut(skip);
-    let (out_skip, out_kept) = output.split_at_mut(skip);
-    for ((o, &v), r) in out_skip.iter_mut().zip(new_skip).zip(ring_skip) {
-        *o = 0.5 * (v + *r);
-        *r = v;
-    }
-    let mut acc = [0.0f64; 4];
-    let mut outs = out_kept.chunks_exact_mut(4);
-    let mut news = new_kept.chunks_exact(4);
-    let mut rings = ring_kept.chunks_exact_mut(4);
-    for ((o, v), r) in (&mut outs).zip(&mut news).zip(&mut rings) {
-        for k in 0..4 {
-            let u = r[k];
-            o[k] = 0.5 * (v[k] + u);
-            let w = v[k] - u;
-            acc[k] += w * w;
-            r[k] = v[k];
-        }
-    }
-    let mut tail = 0.0;
-    for ((o, &v), r) in outs
-        .into_remainder()
-        .iter_mut()
-        .zip(news.remainder())
-        .zip(rings.into_remainder())
-    {
-        let u = *r;
-        *o = 0.5 * (v + u);
-        tail += (v - u) * (v - u);
-        *r = v;
-    }
-    0.25 * ((acc[0] + acc[1]) + (acc[2] + acc[3]) + tail)
+        => level_span_ring_impl::<false>
 }
 
 crate::variance::simd::multiversion! {
     /// [`level_span_ring`] where every old value is a zero before the series start: the ring is
     /// written, not read (the same roundings as reading zeros from it).
     fn level_span_fresh(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64
-        => level_span_fresh_impl
+        => level_span_ring_impl::<true>
 }
 
+/// Both ring kernels: the old value is the ring's, or 0 when `FRESH` (the ring is then only
+/// written); a constant parameter, so each instance is its own loop.
 #[inline(always)]
-fn level_span_fresh_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip: usize) -> f64 {
+fn level_span_ring_impl<const FRESH: bool>(
+    new: &[f64],
+    ring: &mut [f64],
+    output: &mut [f64],
+    skip: usize,
+) -> f64 {
+    let old = |r: &f64| if FRESH { 0.0 } else { *r };
     let skip = skip.min(new.len());
     let (new_skip, new_kept) = new.split_at(skip);
     let (ring_skip, ring_kept) = ring.split_at_mut(skip);
     let (out_skip, out_kept) = output.split_at_mut(skip);
     for ((o, &v), r) in out_skip.iter_mut().zip(new_skip).zip(ring_skip) {
-        *o = 0.5 * (v + 0.0);
+        *o = 0.5 * (v + old(r));
         *r = v;
     }
     let mut acc = [0.0f64; 4];
@@ -1539,7 +1509,7 @@ fn level_span_fresh_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip
     let mut rings = ring_kept.chunks_exact_mut(4);
     for ((o, v), r) in (&mut outs).zip(&mut news).zip(&mut rings) {
         for k in 0..4 {
-            let u = 0.0;
+            let u = old(&r[k]);
             o[k] = 0.5 * (v[k] + u);
             let w = v[k] - u;
             acc[k] += w * w;
@@ -1553,7 +1523,7 @@ fn level_span_fresh_impl(new: &[f64], ring: &mut [f64], output: &mut [f64], skip
         .zip(news.remainder())
         .zip(rings.into_remainder())
     {
-        let u = 0.0;
+        let u = old(r);
         *o = 0.5 * (v + u);
         tail += (v - u) * (v - u);
         *r = v;
