@@ -73,6 +73,7 @@ fn report(table: &Table) {
         note(file, &t.to_string());
     }
     note_not_analysed(file, &table.skipped);
+    note(file, &table.samples.to_string());
     for w in &table.warnings {
         match w {
             ReadWarning::FreqDisagrees {
@@ -217,6 +218,8 @@ pub struct LoadedRecording {
     pub source: gmwm::imu::RecordingSource,
     /// What the time stamps say, when there are stamps (a time column or ROS header stamps).
     pub timing: Option<gmwm::imu::TimingReport>,
+    /// How many samples were read and used per axis (row accounting).
+    pub samples: gmwm::imu::SampleAccount,
     /// What the reader noticed, one line each.
     pub notes: Vec<String>,
 }
@@ -241,6 +244,7 @@ pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
         topic: rec.topic,
         source: rec.source,
         timing: rec.timing,
+        samples: rec.samples,
         notes: rec.notes,
     })
 }
@@ -259,17 +263,39 @@ pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
         }
         None => Vec::new(),
     };
+    let samples = streamed_samples(input, &columns)?;
     Ok(LoadedRecording {
         path: shown_path(&input.file),
-        columns,
         imu: None,
         topic: None,
         source: gmwm::imu::RecordingSource::Table,
         timing: None,
         notes: gmwm::imu::recording::left_out_note(&skipped)
             .into_iter()
+            .chain([samples.to_string()])
             .collect(),
+        samples,
+        columns,
     })
+}
+
+/// The account of a raw binary file streamed whole: every row read and used in `columns`.
+fn streamed_samples(
+    input: &InputConfig,
+    columns: &[(String, gmwm::imu::SensorInfo)],
+) -> Result<gmwm::imu::SampleAccount> {
+    let names = columns.iter().map(|(n, _)| n.clone()).collect();
+    let rows = match gmwm::imu::binary_layout(&input.file, &input.read)? {
+        Some(layout) => {
+            let width = layout.format.value_width().unwrap_or(8) * layout.ncols;
+            let bytes = std::fs::metadata(&input.file)
+                .with_context(|| input.file.display().to_string())?
+                .len();
+            bytes / width.max(1) as u64
+        }
+        None => 0,
+    };
+    Ok(gmwm::imu::SampleAccount::all_used(names, "row", rows))
 }
 
 /// A ROS recording read as a table: the IMU topic's six axes at the header stamps' rate.
@@ -295,6 +321,7 @@ fn load_ros(input: &InputConfig) -> Result<Loaded> {
         warnings: Vec::new(),
         skipped: Vec::new(),
         record_type: None,
+        samples: rec.samples,
     };
     Ok(Loaded { table, freq_hz })
 }

@@ -450,3 +450,81 @@ fn help_documents_the_input_detection() {
         assert!(help.contains(needle), "{needle:?} not in --help");
     }
 }
+
+/// Row accounting (issue 15): every command that reads a recording says on stderr how many
+/// rows it read and how many samples of each column it used, and what held none; the
+/// calibration JSON carries the same account as `rows`; a streamed raw file says it too.
+#[test]
+fn every_command_accounts_for_the_rows_it_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(
+        dir.path(),
+        "gyro.csv",
+        "WN(sigma2=1e-4)+RW(gamma2=1e-10)",
+        4096,
+        100.0,
+        3,
+    );
+    // a blank line and a header: 4096 rows, 1 header line, 1 blank line
+    let text = std::fs::read_to_string(&sim).unwrap();
+    let (_, rest) = text.split_once('\n').unwrap();
+    let p = write(
+        dir.path(),
+        "gyro_x.csv",
+        format!("gyro_x\n\n{rest}").as_bytes(),
+    );
+    let want = "4096 rows read, 4096 samples used in each of";
+    let none = "no samples in 1 header line, 1 blank line; nothing dropped or filled in";
+    for args in [
+        vec!["wv"],
+        vec!["avar"],
+        vec!["fit", "--model", "WN()+RW()"],
+        vec!["select", "--model", "WN()+RW()"],
+    ] {
+        let out = gmwm()
+            .args(&args)
+            .arg(&p)
+            .args(["--freq", "100"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {stderr}");
+        let line = stderr
+            .lines()
+            .find(|l| l.starts_with("gmwm: note: ") && l.contains(want))
+            .unwrap_or_else(|| panic!("{args:?}: no account in {stderr:?}"));
+        assert!(line.contains(none), "{args:?}: {line}");
+    }
+    let (doc, _) = json_and_stderr(
+        gmwm()
+            .args(["calibrate", "--freq", "100", "--json", "-"])
+            .arg(&p),
+    );
+    let rows = &doc["rows"];
+    assert_eq!(rows["read"], 4096, "{rows}");
+    assert_eq!(rows["used"], 4096);
+    assert_eq!(rows["unit"], "row");
+    assert_eq!(rows["missing"], 0);
+    assert_eq!(rows["without_samples"][1]["what"], "blank line");
+    assert!(doc["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|n| n.as_str().unwrap().contains(want)));
+    // raw binary, streamed by `gmwm wv`: every row
+    let raw: Vec<u8> = (0..1000u32)
+        .flat_map(|i| f64::from(i % 7).to_le_bytes())
+        .collect();
+    let p = write(dir.path(), "raw.f64", &raw);
+    let out = gmwm()
+        .args(["wv", "--freq", "10"])
+        .arg(&p)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("1000 rows read, 1000 samples used in each of 1 column (col1); nothing dropped or filled in"),
+        "{stderr}"
+    );
+}

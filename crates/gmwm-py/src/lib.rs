@@ -689,6 +689,7 @@ fn read<'py>(
         if !table.skipped.is_empty() {
             notes.push(format!("not analysed: {}", table.skipped.join(", ")));
         }
+        notes.push(table.samples.to_string());
         notes.extend(table.warnings.iter().map(ToString::to_string));
         Ok((table.columns, table.freq_hz, units, notes))
     });
@@ -802,14 +803,14 @@ fn calibrate(
         reported: std::sync::Mutex::new(0),
     };
     // the recording: a file read as the CLI reads it, or the given columns
-    let (imu, file, notes, topic_read) = match (path, arrays) {
+    let (imu, file, notes, topic_read, rows) = match (path, arrays) {
         (Some(path), None) => {
             let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
             let opts = RecordingOptions { read, topic };
             let rec = py
                 .detach(|| Recording::open(&path, &opts))
                 .map_err(engine)?;
-            (rec.imu, rec.path, rec.notes, rec.topic)
+            (rec.imu, rec.path, rec.notes, rec.topic, Some(rec.samples))
         }
         (None, Some(arrays)) => {
             let names = names.ok_or_else(|| err("arrays need names"))?;
@@ -843,7 +844,7 @@ fn calibrate(
                 })
                 .collect();
             let imu = Imu::new(owned, infos, freq).map_err(engine)?;
-            (imu, PathBuf::from("<array>"), Vec::new(), None)
+            (imu, PathBuf::from("<array>"), Vec::new(), None, None)
         }
         _ => return Err(err("give a path or arrays, not both")),
     };
@@ -852,7 +853,11 @@ fn calibrate(
         let report = Calibration::new(options).run_with_progress(&imu, &reporter)?;
         let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
         Ok(json(&gmwm::document::calibration(
-            &file, &notes, &report, &sets,
+            &file,
+            &notes,
+            rows.as_ref(),
+            &report,
+            &sets,
         )))
     });
     doc.map_err(engine)

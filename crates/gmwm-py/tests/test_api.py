@@ -190,6 +190,11 @@ def test_implied_and_read():
     rec = gmwm.read(str(ADIS), columns=["gyro_x", "accel_z"])
     assert rec.names == ["gyro_x", "accel_z"] and rec.freq_hz == 100
     assert rec.units["gyro_x"].startswith("deg/s") and len(rec) == 1_000_000
+    # the reader's row accounting is among its notes
+    assert any(
+        n.startswith("1000000 rows read, 1000000 samples used in each of 2 columns (gyro_x, accel_z)")
+        for n in rec.notes
+    ), rec.notes
 
 
 # ---------------------------------------------------------------- bad input raises, never crashes

@@ -6,6 +6,7 @@ use crate::calib::{CalibrationReport, NavSet};
 use crate::fit::{
     Ar1GmForms, CanonicalModel, CanonicalTerm, NavParameter, ParameterEstimate, Reading,
 };
+use crate::imu::SampleAccount;
 use crate::inference::{Inference, JTest, VSource};
 use crate::selection::{SelectionRow, SelectionRule};
 use crate::{GmwmFit, ModelSelection};
@@ -223,11 +224,13 @@ pub fn selections(items: &[(String, ModelSelection)]) -> Value {
     to_value(&Doc { selections })
 }
 
-/// The document of `gmwm calibrate --json`: `file`, `notes` (what the reader noticed), the
+/// The document of `gmwm calibrate --json`: `file`, `notes` (what the reader noticed), `rows`
+/// (the reader's [`SampleAccount`], when the samples came from a file), the
 /// [`CalibrationReport`]'s fields, and `exported` (the navigation sets as written).
 pub fn calibration(
     file: &std::path::Path,
     notes: &[String],
+    rows: Option<&SampleAccount>,
     report: &CalibrationReport,
     exported: &[NavSet],
 ) -> Value {
@@ -235,6 +238,8 @@ pub fn calibration(
     struct Doc<'a> {
         file: &'a std::path::Path,
         notes: &'a [String],
+        #[serde(skip_serializing_if = "Option::is_none")]
+        rows: Option<&'a SampleAccount>,
         #[serde(flatten)]
         calibration: &'a CalibrationReport,
         exported: &'a [NavSet],
@@ -242,6 +247,7 @@ pub fn calibration(
     to_value(&Doc {
         file,
         notes,
+        rows,
         calibration: report,
         exported,
     })

@@ -1438,3 +1438,80 @@ fn wic_select_wv_equals_select_on_the_series() {
     assert_eq!(from_wv.selected(), from_series.selected());
     assert_eq!(from_wv.candidates(), from_series.candidates());
 }
+
+/// Row accounting: the rows read, the samples used in each selected column, the header and
+/// blank lines that hold none and the samples the stamps' gaps lack, counted exactly for
+/// text (with blank and whitespace-only lines and a gap), raw binary and IMU records.
+#[test]
+fn read_accounts_for_every_row() {
+    let d = tempfile::tempdir().unwrap();
+    // 2 blank lines before the header, a whitespace-only and an empty line between rows, a
+    // step of 4 nominal steps (3 samples missing), 7 data rows
+    let text = "\n\ntime,gx,gy,label_count\n0,1,2,3\n   \n0.01,2,3,4\n\n0.02,3,4,5\n0.06,1,2,3\n\
+                0.07,2,2,2\n0.08,4,1,0\n0.09,5,5,5\n";
+    let p = write(&d, "gaps.csv", text.as_bytes());
+    let opts = ReadOptions {
+        columns: names(&["gx", "gy"]),
+        ..ReadOptions::default()
+    };
+    let t = read_table(&p, &opts).unwrap();
+    let s = &t.samples;
+    assert_eq!(s.columns, ["gx", "gy"]);
+    assert_eq!((s.unit, s.read, s.used, s.missing), ("row", 7, 7, 3));
+    let parts: Vec<(u64, &str)> = s
+        .without_samples
+        .iter()
+        .map(|w| (w.count, w.what.as_str()))
+        .collect();
+    assert_eq!(parts, [(1, "header line"), (4, "blank line")]);
+    assert_eq!(
+        s.to_string(),
+        "7 rows read, 7 samples used in each of 2 columns (gx, gy); no samples in 1 header \
+         line, 4 blank lines; nothing dropped; 3 samples missing in the time stamps' gaps, not \
+         filled in (analysed as contiguous)"
+    );
+    // gzip: the same account
+    let gz = write(&d, "gaps.csv.gz", &gzip(text.as_bytes()));
+    assert_eq!(read_table(&gz, &opts).unwrap().samples, t.samples);
+    // no header, no blank line, no time column
+    let p = write(&d, "plain.csv", b"1,2\n3,4\n5,6\n");
+    let s = read(&p).unwrap().samples;
+    assert_eq!((s.read, s.used, s.missing), (3, 3, 0));
+    assert!(s.without_samples.is_empty());
+    assert!(
+        s.to_string().ends_with("; nothing dropped or filled in"),
+        "{s}"
+    );
+    // raw binary: rows of ncols values
+    let p = write(&d, "raw.f64", &f64_bytes(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]));
+    let s = read_table(
+        &p,
+        &ReadOptions {
+            ncols: Some(2),
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap()
+    .samples;
+    assert_eq!((s.unit, s.read, s.used), ("row", 3, 3));
+    assert_eq!(s.columns, ["col1", "col2"]);
+    // IMU records: one sample of each axis per record
+    let t = ImuRecordType::ALL[0];
+    let b: Vec<u8> = (0..5)
+        .flat_map(|i| record(t, 100.0 + f64::from(i) * 0.0025, [1, 2, 3, 4, 5, 6]))
+        .collect();
+    let p = write(&d, "rec.bin", &b);
+    let s = read_table(
+        &p,
+        &ReadOptions {
+            format: InputFormat::ImuRecord(t),
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap()
+    .samples;
+    assert_eq!(
+        (s.unit, s.read, s.used, s.columns.len()),
+        ("record", 5, 5, 6)
+    );
+}

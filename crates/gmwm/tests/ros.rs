@@ -693,3 +693,47 @@ fn ros_flipped_bytes_never_panic() {
         }
     }
 }
+
+/// Row accounting of a ROS recording: the messages read on the chosen IMU topic, all used in
+/// each axis (or each selected one), and the messages on the other topics (the second IMU
+/// topic, /chatter and /tf, as the container lists them) counted as holding no sample of it.
+#[test]
+fn ros_recording_accounts_for_other_topics() {
+    let f = fixtures();
+    for fx in &f.two_imu {
+        let opts = gmwm::imu::RecordingOptions {
+            topic: Some("/imu1".into()),
+            ..Default::default()
+        };
+        let rec = gmwm::imu::Recording::open(&fx.path, &opts).unwrap();
+        let s = &rec.samples;
+        assert_eq!(
+            (s.unit, s.read, s.used, s.missing),
+            ("message", 300, 300, 0)
+        );
+        assert_eq!(s.columns.len(), 6);
+        assert_eq!(s.without_samples.len(), 1);
+        let others: u64 = topics(&fx.path)
+            .iter()
+            .filter(|t| t.topic != "/imu1")
+            .map(|t| t.messages)
+            .sum();
+        assert!(others >= 300, "/imu0 alone has 300");
+        assert_eq!(s.without_samples[0].count, others, "{}", fx.path.display());
+        assert!(rec.notes.contains(&s.to_string()));
+        assert!(
+            s.to_string()
+                .contains(&format!("no samples in {others} messages on other topics")),
+            "{s}"
+        );
+        let opts = gmwm::imu::RecordingOptions {
+            read: gmwm::imu::ReadOptions {
+                columns: vec!["gyro_z".parse().unwrap()],
+                ..Default::default()
+            },
+            ..opts
+        };
+        let rec = gmwm::imu::Recording::open(&fx.path, &opts).unwrap();
+        assert_eq!(rec.samples.columns, ["gyro_z"]);
+    }
+}

@@ -136,7 +136,13 @@ pub fn execute_in(
         }
     }
     let json_to_stdout = config.json.as_deref() == Some(Path::new("-"));
-    let doc = gmwm::document::calibration(&recording.path, &recording.notes, &report, &sets);
+    let doc = gmwm::document::calibration(
+        &recording.path,
+        &recording.notes,
+        Some(&recording.samples),
+        &report,
+        &sets,
+    );
     if let Some(path) = report_path {
         match write_report(config, path, &recording, &report, &sets, &doc) {
             Ok(figures) => {

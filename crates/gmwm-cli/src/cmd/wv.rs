@@ -55,11 +55,20 @@ pub(crate) fn stream_columns(
     };
     // the errors name the file (and the column, or the row of a bad value)
     let streamed = binary_columns_wv(&input.file, layout, &columns, freq_hz, opts)?;
-    Ok(columns
+    let named: Vec<(String, StreamedColumn)> = columns
         .iter()
         .map(|&c| layout.names[c - 1].clone())
         .zip(streamed)
-        .collect())
+        .collect();
+    if let Some((_, first)) = named.first() {
+        let account = gmwm::imu::SampleAccount::all_used(
+            named.iter().map(|(n, _)| n.clone()).collect(),
+            "row",
+            first.wv.n() as u64,
+        );
+        note(&input.file, &account.to_string());
+    }
+    Ok(named)
 }
 
 fn stream_freq(path: &std::path::Path) -> Result<f64> {

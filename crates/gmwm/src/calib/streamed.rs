@@ -166,9 +166,10 @@ impl Calibration {
             );
             (c?, r?)
         };
+        let left_out = pooled.as_ref().map_or(0, |(_, left_out)| *left_out);
         let robust = pooled
             .zip(robust_opts)
-            .map(|(p, o)| robust_wvs(p, &classical, &o));
+            .map(|((p, _), o)| robust_wvs(p, &classical, &o));
         // an axis whose WV fails (a constant column, say) is left out with a check line, as
         // the in-memory pipeline does; only when every axis fails is that an error
         let mut checks = Vec::new();
@@ -217,9 +218,15 @@ impl Calibration {
             .and_then(|s| s.name.clone())
             .or_else(|| path.file_name().map(|f| f.to_string_lossy().into_owned()));
         checks.push(format!(
-            "streamed from the file ({n} samples per axis, at least {}): the Allan variance from the WV (exact), starting values from the WV; the contamination check compares the scales up to {} samples with a robust WV estimated on blocks of {ROBUST_BLOCK} samples",
+            "streamed from the file ({n} samples per axis, at least {}): the Allan variance from the WV (exact), starting values from the WV; the contamination check compares the scales up to {} samples with a robust WV estimated on blocks of {ROBUST_BLOCK} samples{}",
             self.options().stream_from,
-            1usize << levels.min(ROBUST_LEVELS)
+            1usize << levels.min(ROBUST_LEVELS),
+            match left_out {
+                0 => String::new(),
+                k => format!(
+                    " (the last {k} samples, too few for 64 windows of its coarsest scale, are left out of it; the WV uses them)"
+                ),
+            }
         ));
         Ok(self.run_axes(name.as_deref(), freq_hz, n, axes, checks, progress)?)
     }
@@ -318,13 +325,14 @@ fn classical_pass(
 /// counts (`None` once a block has no root at that level).
 type Pooled = Vec<Vec<Option<(f64, usize)>>>;
 
-/// The blocks' robust WVs of each column, pooled (module docs).
+/// The blocks' robust WVs of each column, pooled (module docs), and the samples of the short
+/// last block left out.
 fn robust_pass(
     path: &Path,
     layout: &BinaryLayout,
     columns: &[usize],
     opts: &WvOptions,
-) -> Result<Pooled, Error> {
+) -> Result<(Pooled, usize), Error> {
     let levels = opts.levels.unwrap_or(ROBUST_LEVELS);
     let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, ROBUST_BLOCK)?;
     // per column and level: sum of count x estimate, sum of counts; None once undefined
@@ -334,7 +342,7 @@ fn robust_pass(
     while let Some(rows) = chunks.next_chunk_of(columns, &mut buffers)? {
         // a short last block holding fewer than 64 windows of the coarsest level is left out
         if rows < 64 << levels && blocks > 0 {
-            break;
+            return Ok((pooled, rows));
         }
         blocks += 1;
         let block_levels = levels.min(default_levels(rows, Transform::Modwt, WaveletFilter::Haar));
@@ -366,7 +374,7 @@ fn robust_pass(
             }
         }
     }
-    Ok(pooled)
+    Ok((pooled, 0))
 }
 
 /// The pooled robust WV of each column (module docs); `classical` gives the intervals'

@@ -10,7 +10,8 @@
 //! - [`read_wv_json`]: a wavelet variance computed elsewhere (`gmwm wv --json`), to fit again;
 //! - [`write::SeriesWriter`]: series to CSV, TSV, gzip or raw binary by file name;
 //! - [`plausible::raw_floats`]: whether raw floats look like samples (f64 read as f32, ...);
-//! - [`Imu`]: gyroscope/accelerometer axes with a common rate (docs/methods.md §9.1).
+//! - [`Imu`]: gyroscope/accelerometer axes with a common rate (docs/methods.md §9.1);
+//! - [`SampleAccount`]: how many samples a reader read and used per column, and what held none.
 //!
 //! This module knows no statistics; every error is a [`ReadError`] (or a
 //! [`ParamError`](crate::error::ParamError) for impossible options) naming the file, line and
@@ -32,6 +33,7 @@ pub mod plausible;
 pub mod read;
 pub mod recording;
 pub mod ros;
+mod samples;
 mod sensor;
 pub mod sidecar;
 pub mod timing;
@@ -45,6 +47,7 @@ pub use read::{
     InputFormat, ReadOptions, ReadWarning, Table,
 };
 pub use recording::{Recording, RecordingOptions, RecordingSource};
+pub use samples::{SampleAccount, Tally};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
 pub use sidecar::{find_sidecar, ColumnSummary, Sidecar, SidecarColumn, SidecarUnits};
 pub use timing::{

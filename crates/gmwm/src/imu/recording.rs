@@ -5,7 +5,7 @@
 use super::read::{read_table, Column, InputFormat, ReadOptions, ReadWarning, RATE_TOLERANCE};
 use super::ros::{container_of, read_imu_messages, ImuMessages};
 use super::timing::{check_times, TimeUnit, TimingReport, UnitSource};
-use super::{Imu, ReadError, Sensor, SensorInfo};
+use super::{Imu, ReadError, SampleAccount, Sensor, SensorInfo};
 use crate::Error;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -54,7 +54,10 @@ pub struct Recording {
     pub topic: Option<String>,
     /// What the time stamps say (rate, gaps, duplicates, reordering), when there are stamps.
     pub timing: Option<TimingReport>,
-    /// What the reader noticed (time column, rate, gaps, units), one line each.
+    /// How many samples were read and used per axis, and what held none (row accounting).
+    pub samples: SampleAccount,
+    /// What the reader noticed (time column, rate, gaps, units, the samples' account), one
+    /// line each.
     pub notes: Vec<String>,
 }
 
@@ -92,6 +95,7 @@ impl Recording {
             notes.push(timing.to_string());
         }
         notes.extend(left_out_note(&table.skipped));
+        notes.push(table.samples.to_string());
         notes.extend(table.warnings.iter().map(ToString::to_string));
         let source = match table.record_type {
             Some(t) => RecordingSource::Records {
@@ -100,6 +104,7 @@ impl Recording {
             None => RecordingSource::Table,
         };
         let timing = table.timing.clone();
+        let samples = table.samples.clone();
         let imu = Imu::from_table(table)?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -107,6 +112,7 @@ impl Recording {
             source,
             topic: None,
             timing,
+            samples,
             notes,
         })
     }
@@ -161,11 +167,23 @@ impl Recording {
         }
         let topic = msgs.topic.clone();
         let container = msgs.container.to_string();
+        let other_messages = msgs.other_messages;
         let mut imu = imu_of_messages(msgs, freq_hz)?;
         if !opts.read.columns.is_empty() {
             imu = imu.select(path, &opts.read.columns)?;
         }
+        let samples = SampleAccount {
+            missing: timing.missing_samples() as u64,
+            ..SampleAccount::all_used(
+                imu.axes().iter().map(|a| a.column.name.clone()).collect(),
+                "message",
+                imu.len() as u64,
+            )
+            .without(other_messages, "message on other topics")
+        };
+        notes.push(samples.to_string());
         Ok(Self {
+            samples,
             path: path.to_path_buf(),
             imu,
             source: RecordingSource::Ros {

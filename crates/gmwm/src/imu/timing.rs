@@ -421,6 +421,14 @@ pub fn check_times(
 }
 
 impl TimingReport {
+    /// Samples missing over all gaps at the nominal rate (saturating: a gap of absurd length,
+    /// a corrupt stamp, counts `usize::MAX`).
+    pub fn missing_samples(&self) -> usize {
+        self.gaps
+            .iter()
+            .fold(0usize, |sum, g| sum.saturating_add(g.missing))
+    }
+
     /// The soft problems of the stamps, one per kind: gaps (count, largest, where), duplicates,
     /// reordering, jitter above [`JITTER_WARN`].
     pub fn warnings(&self) -> Vec<TimingWarning> {
@@ -433,11 +441,7 @@ impl TimingReport {
             out.push(TimingWarning::Gaps {
                 column: self.column.clone(),
                 count: self.gaps.len(),
-                // saturating: a gap of absurd length (a corrupt stamp) counts usize::MAX
-                missing: self
-                    .gaps
-                    .iter()
-                    .fold(0usize, |sum, g| sum.saturating_add(g.missing)),
+                missing: self.missing_samples(),
                 largest: largest.clone(),
                 rate_hz: self.rate_hz,
             });

@@ -252,6 +252,8 @@ pub(crate) fn read_binary_table(
         freq_hz: None,
         lines: None,
         skipped: sel.skipped,
+        header_lines: 0,
+        blank_lines: 0,
     })
 }
 
@@ -863,6 +865,8 @@ pub(crate) fn read_record_table(
         freq_hz: Some(freq),
         lines: None,
         skipped: Vec::new(),
+        header_lines: 0,
+        blank_lines: 0,
     })
 }
 

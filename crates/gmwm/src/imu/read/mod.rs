@@ -10,6 +10,7 @@ pub(crate) mod text;
 pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordType};
 
 use super::error::quote;
+use super::samples::SampleAccount;
 use super::sidecar::{find_sidecar, Sidecar};
 use super::timing::{
     check_times, fmt_hz, infer_unit, time_column_unit, TimeUnit, TimingReport, TimingWarning,
@@ -300,6 +301,8 @@ pub struct Table {
     /// The binary IMU record type the table was decoded from, if any (docs/methods.md §9.1
     /// `stype`).
     pub record_type: Option<ImuRecordType>,
+    /// How many samples were read and used per column, and what held none (row accounting).
+    pub samples: SampleAccount,
 }
 
 impl Table {
@@ -721,7 +724,22 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         // silently replaced by a default
         check_freq(f)?;
     }
+    let samples = SampleAccount {
+        missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
+        ..SampleAccount::all_used(
+            raw.columns.iter().map(|c| c.name.clone()).collect(),
+            if matches!(format, InputFormat::ImuRecord(_)) {
+                "record"
+            } else {
+                "row"
+            },
+            raw.columns.first().map_or(0, |c| c.values.len() as u64),
+        )
+        .without(raw.header_lines, "header line")
+        .without(raw.blank_lines, "blank line")
+    };
     Ok(Table {
+        samples,
         path: path.to_path_buf(),
         columns: raw.columns,
         freq_hz,
@@ -754,6 +772,10 @@ pub(crate) struct RawTable {
     pub(crate) lines: Option<LineMap>,
     /// Columns left out of the default selection.
     pub(crate) skipped: Vec<String>,
+    /// Header lines (text files: 0 or 1).
+    pub(crate) header_lines: u64,
+    /// Blank lines before the last data row (text files).
+    pub(crate) blank_lines: u64,
 }
 
 /// Physical line of each data row of a text file, stored as the rows where the line stops

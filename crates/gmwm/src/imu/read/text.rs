@@ -191,7 +191,10 @@ pub(crate) fn read_text_table(
                 .chain(Cursor::new(&b"\n"[..])),
         );
     // Next non-blank record and its 1-based physical line; a record made of one empty field
-    // is a blank (or whitespace-only) line and is skipped.
+    // is a blank (or whitespace-only) line and is skipped; the csv reader skips empty lines
+    // itself, so the blank lines before a record are counted from the jump in line numbers.
+    let mut blank_lines = 0u64;
+    let mut last_line = 0u64;
     let mut next = |rec: &mut ByteRecord| -> Result<Option<u64>, ReadError> {
         loop {
             let more = rdr.read_byte_record(rec).map_err(|e| match e.into_kind() {
@@ -207,7 +210,10 @@ pub(crate) fn read_text_table(
             if rec.len() == 1 && rec.get(0).is_some_and(|f| f.trim_ascii().is_empty()) {
                 continue;
             }
-            return Ok(Some(rdr.position().line().saturating_sub(1)));
+            let line = rdr.position().line().saturating_sub(1);
+            blank_lines += line.saturating_sub(last_line + 1);
+            last_line = line;
+            return Ok(Some(line));
         }
     };
 
@@ -297,6 +303,8 @@ pub(crate) fn read_text_table(
         freq_hz: None,
         lines: sel.time.map(|_| rows.lines),
         skipped: sel.skipped,
+        header_lines: u64::from(has_header),
+        blank_lines,
     })
 }
 

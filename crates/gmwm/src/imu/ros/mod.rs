@@ -124,6 +124,8 @@ pub struct ImuMessages {
     pub angular_velocity: [Vec<f64>; 3],
     /// `linear_acceleration` x, y, z in m/s^2.
     pub linear_acceleration: [Vec<f64>; 3],
+    /// Messages of the recording on other topics (not read).
+    pub other_messages: u64,
 }
 
 impl ImuMessages {
@@ -781,6 +783,11 @@ pub fn read_imu_messages(path: &Path, topic: Option<&str>) -> Result<ImuMessages
         log_time_ns: out.log_time_ns,
         angular_velocity: out.angular_velocity,
         linear_acceleration: out.linear_acceleration,
+        other_messages: topics
+            .iter()
+            .map(|t| t.messages)
+            .sum::<u64>()
+            .saturating_sub(chosen.messages),
     })
 }
 
