@@ -379,6 +379,8 @@ fn calibrate_one(
     }
     let mut one = config.clone();
     one.input.file = p.recording.clone();
+    // the single-file command's warning on raw floats no sensor gives, per recording
+    crate::warn_implausible(&one.input);
     one.exports = exports;
     one.json = Some(json);
     let mode = Mode {
@@ -420,6 +422,7 @@ fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<Pa
     }
     let mut one = config.clone();
     one.input.file = p.recording.clone();
+    crate::warn_implausible(&one.input);
     one.output = Style::Json;
     let items = crate::cmd::wv::compute(&one)?;
     let mut doc = Vec::new();

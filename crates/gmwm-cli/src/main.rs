@@ -243,7 +243,7 @@ fn prepare_input(config: &mut Config) -> anyhow::Result<Option<spool::Spool>> {
 /// A warning when FILE is raw f64/f32 whose first values no sensor gives
 /// ([`gmwm::imu::plausible::raw_floats`]); silent when it is not raw floats or cannot be read
 /// (the reader then says why).
-fn warn_implausible(input: &InputConfig) {
+pub(crate) fn warn_implausible(input: &InputConfig) {
     if input.read.format == gmwm::imu::InputFormat::Auto
         && (gmwm::imu::ros::container_of(&input.file).is_some() || input::is_wv(input))
     {

@@ -481,3 +481,43 @@ fn one_file_runs_as_before_unless_a_batch_flag_is_given() {
     assert!(table.contains("1 recording: 1 calibrated"), "{table}");
     assert!(out.join("imu.calibration.json").is_file());
 }
+
+/// A recording of the batch whose raw floats no sensor gives (f64 read as `--format f32`) gets
+/// the single-file command's warning, naming it, in `gmwm wv` and `gmwm calibrate`.
+#[test]
+fn batch_warns_of_implausible_raw_floats_per_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    // small doubles whose halves, read as f32, are finite but far beyond any sensor
+    let bytes: Vec<u8> = (0..N)
+        .flat_map(|i| (0.01 * (i % 7) as f64).to_le_bytes())
+        .collect();
+    let bad = dir.path().join("doubles.f32");
+    std::fs::write(&bad, bytes).unwrap();
+    // a sidecar naming the column a gyroscope axis, so that calibrate takes it
+    std::fs::write(
+        dir.path().join("doubles.f32.json"),
+        r#"{"n_columns": 1, "columns": [{"name": "gyro_x"}]}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    for args in [
+        vec!["wv", "--format", "f32", "--freq", "100"],
+        [
+            vec!["calibrate", "--format", "f32", "--freq", "100"],
+            FAST.to_vec(),
+        ]
+        .concat(),
+    ] {
+        let (_, stderr) = run(
+            gmwm()
+                .args(&args)
+                .arg(dir.path())
+                .arg("--out-dir")
+                .arg(&out)
+                .arg("--force"),
+            0,
+        );
+        let warning = format!("gmwm: warning: {}: read as f32", bad.display());
+        assert!(stderr.contains(&warning), "{args:?}: {stderr}");
+    }
+}

@@ -686,9 +686,7 @@ fn read<'py>(
         if let Some(t) = &table.timing {
             notes.push(t.to_string());
         }
-        if !table.skipped.is_empty() {
-            notes.push(format!("not analysed: {}", table.skipped.join(", ")));
-        }
+        notes.extend(gmwm::imu::recording::left_out_note(&table.skipped));
         notes.push(table.samples.to_string());
         notes.extend(table.warnings.iter().map(ToString::to_string));
         Ok((table.columns, table.freq_hz, units, notes))

@@ -241,5 +241,9 @@ fn imu_of_messages(msgs: ImuMessages, freq_hz: f64) -> Result<Imu, Error> {
 
 /// The note on the columns a reader left out (`None` when it left out none).
 pub fn left_out_note(skipped: &[String]) -> Option<String> {
-    (!skipped.is_empty()).then(|| format!("columns left out: {}", skipped.join(", ")))
+    (!skipped.is_empty()).then(|| {
+        // names from a file: escaped and cut, so that the note stays one line
+        let names: Vec<String> = skipped.iter().map(|n| super::quote(n)).collect();
+        format!("columns left out: {}", names.join(", "))
+    })
 }

@@ -98,7 +98,12 @@ impl fmt::Display for SampleAccount {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         const SHOWN: usize = 6;
         let k = self.columns.len();
-        let mut names = self.columns[..k.min(SHOWN)].join(", ");
+        // names from a file: escaped and cut, so that the account stays one line
+        let shown: Vec<String> = self.columns[..k.min(SHOWN)]
+            .iter()
+            .map(|n| super::quote(n))
+            .collect();
+        let mut names = shown.join(", ");
         if k > SHOWN {
             names.push_str(&format!(", ... ({} more)", k - SHOWN));
         }
