@@ -71,7 +71,7 @@ impl StorageFile {
         let len = file.metadata().map_err(io)?.len();
         let len = usize::try_from(len).map_err(|_| {
             io(std::io::Error::new(
-                ErrorKind::FileTooLarge,
+                ErrorKind::Unsupported,
                 format!("{len} bytes do not fit this platform's address space"),
             ))
         })?;

@@ -80,6 +80,9 @@ fn check_magic(file: &mut StorageFile) -> Result<(), ReadError> {
     Ok(())
 }
 
+/// Called for each record: (opcode, body, position).
+type RecordVisitor<'v> = dyn FnMut(u8, &[u8], usize) -> Result<(), ReadError> + 'v;
+
 /// Iterates the records of `buf` from `from` (opcode u8, length u64, body): calls
 /// `visit(opcode, body, position)` for each opcode in `wanted` (the others' bodies are not
 /// read), stopping after a DataEnd record. `chunk_at` is the file offset of the chunk `buf` is
@@ -90,7 +93,7 @@ fn records<B: Bytes>(
     from: usize,
     chunk_at: Option<u64>,
     wanted: &dyn Fn(u8) -> bool,
-    visit: &mut dyn FnMut(u8, &[u8], usize) -> Result<(), ReadError>,
+    visit: &mut RecordVisitor<'_>,
 ) -> Result<(), ReadError> {
     let at = |pos: usize| match chunk_at {
         None => format!("record at byte {pos}"),
