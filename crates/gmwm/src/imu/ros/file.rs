@@ -15,7 +15,12 @@ use std::path::{Path, PathBuf};
 
 /// Smallest read: runs of small records (index records, messages outside chunks) come from one
 /// read of this many bytes.
+#[cfg(not(fuzzing))]
 const MIN_READ: usize = 64 << 10;
+/// Under cargo-fuzz (`--cfg fuzzing`) the inputs are a few KB: a 16-byte smallest read makes
+/// them move the window at almost every record, so that its refills are fuzzed too.
+#[cfg(fuzzing)]
+const MIN_READ: usize = 16;
 
 /// Bytes addressed by position: a storage file read on demand, a part of one, or a decompressed
 /// chunk in memory. Positions are file offsets (chunk offsets for a chunk).
@@ -55,6 +60,8 @@ pub(crate) struct StorageFile {
     /// Bytes `[start, start + window.len())` of the file.
     window: Vec<u8>,
     start: usize,
+    /// Smallest read ([`MIN_READ`]; smaller in tests).
+    min_read: usize,
 }
 
 impl StorageFile {
@@ -81,6 +88,7 @@ impl StorageFile {
             len,
             window: Vec::new(),
             start: 0,
+            min_read: MIN_READ,
         })
     }
 
@@ -129,8 +137,8 @@ impl Bytes for StorageFile {
         if pos >= self.start && end <= have {
             return Ok(&self.window[pos - self.start..end - self.start]);
         }
-        // read at least MIN_READ bytes from `pos`, keeping the bytes already held from there
-        let want = n.max(MIN_READ).min(self.len - pos);
+        // read at least `min_read` bytes from `pos`, keeping the bytes already held from there
+        let want = n.max(self.min_read).min(self.len - pos);
         let keep = if pos >= self.start && pos < have {
             self.window.copy_within(pos - self.start.., 0);
             have - pos
@@ -201,6 +209,37 @@ mod tests {
         let bytes: Vec<u8> = (0..300_000u32).map(|i| (i * 7 + i / 251) as u8).collect();
         let (_f, mut s) = file(&bytes);
         assert_eq!(s.len(), bytes.len());
+        // random ranges, mostly forward and overlapping like a parser's, with small and
+        // default windows
+        for min_read in [1, 16, 4096, MIN_READ] {
+            s.min_read = min_read;
+            s.release();
+            let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+            let mut pos = 0usize;
+            let mut largest = 0;
+            for _ in 0..20_000 {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                let n = match x % 4 {
+                    0 => (x >> 8) as usize % 8,
+                    1 => (x >> 8) as usize % 300,
+                    2 => (x >> 8) as usize % 20_000,
+                    _ => (x >> 8) as usize % 200_000,
+                };
+                pos = match (x >> 40) % 8 {
+                    0 => (x >> 20) as usize % bytes.len(),
+                    1 => pos.saturating_sub((x >> 20) as usize % 1000),
+                    _ => pos + (x >> 20) as usize % 64,
+                } % bytes.len();
+                let n = n.min(bytes.len() - pos);
+                assert_eq!(s.get(pos, n).unwrap(), &bytes[pos..pos + n], "{pos} {n}");
+                // the window never outgrows the largest request
+                largest = largest.max(n);
+                assert!(s.window.len() <= largest.max(min_read));
+            }
+        }
+        s.min_read = MIN_READ;
         // forward, overlapping, backward, large, at the end
         for &(pos, n) in &[
             (0, 4),
