@@ -29,7 +29,7 @@ scratch=${GMWM_FUZZ_DIR:-${TMPDIR:-/tmp}/gmwm-fuzz}
 mkdir -p "$scratch"
 
 # debug assertions and overflow checks on (cargo-fuzz's default), no sanitizer: the readers are
-# safe Rust but for their read-only memory maps, and ASan would halve the executions per second
+# safe Rust (files are read, none is memory-mapped), and ASan would halve the executions per second
 cargo +nightly fuzz build -s none
 
 status=0

@@ -9,7 +9,7 @@
 //! 0, a positive finite rate; raw binary values are exactly the bytes decoded; a parsed model's
 //! canonical text parses back to the same model; a sidecar survives a JSON round trip.
 //!
-//! The readers take paths (they memory-map or query files), so the input is written to a small
+//! The readers take paths (they read or query files), so the input is written to a small
 //! file in a per-thread scratch directory (under `/dev/shm` where it exists), one subdirectory
 //! per target so that one target's sidecars are never seen by another.
 //!

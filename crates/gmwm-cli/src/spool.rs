@@ -1,5 +1,5 @@
 //! Standard input (`-`) and pipes as FILE. The readers look at a file more than once (its
-//! first bytes, then the data; raw binary is memory-mapped), which a pipe cannot give: the
+//! first bytes, then the data; raw binary is read at positions), which a pipe cannot give: the
 //! stream is copied once to a private temporary folder, read from there, and removed at the
 //! end. Messages name it as the user did (`<stdin>`, or the FIFO's path), not the copy.
 

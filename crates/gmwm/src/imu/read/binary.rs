@@ -1,10 +1,11 @@
 //! Raw little-endian binary: interleaved f64/f32 columns, and the IMU epoch records of
 //! docs/methods.md §9.2.
 //!
-//! Values are decoded with `from_le_bytes` (never text parsing). Whole-file reads memory-map the
-//! file; [`BinaryChunks`] reads fixed-size blocks so that series of 10^9 samples can be consumed
+//! Values are decoded with `from_le_bytes` (never text parsing). Whole-file reads read the file
+//! by positioned reads into one buffer (`super::positioned`); [`BinaryChunks`] reads fixed-size blocks so that series of 10^9 samples can be consumed
 //! in bounded memory.
 
+use super::positioned::read_at;
 use super::{binary_names, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
 use crate::error::{Error, ParamError};
 use crate::imu::timing::{check_times, TimeUnit, UnitSource};
@@ -102,16 +103,7 @@ fn for_each_record_run(
     while row < rows {
         let n = (rows - row).min(TABLE_CHUNK_ROWS) as usize;
         let bytes = &mut buf[..n * record];
-        read_exact_at(file, bytes, row * record as u64).map_err(|e| {
-            if e.kind() == std::io::ErrorKind::UnexpectedEof {
-                io_error(
-                    path,
-                    std::io::Error::new(e.kind(), "the file shrank while it was read"),
-                )
-            } else {
-                io_error(path, e)
-            }
-        })?;
+        read_at(path, file, bytes, row * record as u64)?;
         f(row as usize, bytes)?;
         row += n as u64;
     }
@@ -545,11 +537,10 @@ impl RawRows {
             // one f64 column: straight into the values, whose bytes are the file's
             let values = &mut out[0];
             values.resize(n, 0.0);
-            return read_exact_at(&self.file, as_bytes(values), at)
-                .map_err(|e| io_error(&self.path, e));
+            return read_at(&self.path, &self.file, as_bytes(values), at);
         }
         bytes.resize(n * record, 0);
-        read_exact_at(&self.file, bytes, at).map_err(|e| io_error(&self.path, e))?;
+        read_at(&self.path, &self.file, bytes, at)?;
         let width = self.width;
         for (&column, values) in columns.iter().zip(out.iter_mut()) {
             debug_assert!(column < self.ncols);
@@ -567,39 +558,6 @@ impl RawRows {
         }
         Ok(())
     }
-}
-
-/// `pread` of the whole buffer at `offset`.
-#[cfg(unix)]
-fn read_exact_at(file: &File, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
-    std::os::unix::fs::FileExt::read_exact_at(file, buf, offset)
-}
-
-/// Positioned reads are not available on this platform.
-#[cfg(not(any(unix, windows)))]
-fn read_exact_at(_: &File, _: &mut [u8], _: u64) -> std::io::Result<()> {
-    Err(std::io::Error::new(
-        std::io::ErrorKind::Unsupported,
-        "positioned reads are not supported on this platform",
-    ))
-}
-
-/// `pread` of the whole buffer at `offset`.
-#[cfg(windows)]
-fn read_exact_at(file: &File, mut buf: &mut [u8], mut offset: u64) -> std::io::Result<()> {
-    use std::os::windows::fs::FileExt;
-    while !buf.is_empty() {
-        match file.seek_read(buf, offset) {
-            Ok(0) => return Err(std::io::ErrorKind::UnexpectedEof.into()),
-            Ok(k) => {
-                buf = &mut buf[k..];
-                offset += k as u64;
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(())
 }
 
 /// Calls `f` on consecutive chunks of one column of a raw binary file (see [`BinaryChunks`]);
@@ -756,8 +714,9 @@ pub(crate) const RECORD_COLUMNS: [&str; 6] = [
 ];
 
 /// Reads the selected columns of a binary IMU record file (docs/methods.md §9.2–9.3),
-/// memory-mapped: the times are decoded once (checked finite and strictly increasing), then each
-/// selected column is decoded and scaled in one pass straight from the map, so no raw copy is held.
+/// read by positioned reads ([`for_each_record_run`]) in one pass: each record's time is decoded
+/// (checked finite and strictly increasing) and its selected columns decoded, so no raw copy of
+/// the file is held.
 pub(crate) fn read_record_table(
     path: &Path,
     record_type: ImuRecordType,
@@ -878,7 +837,8 @@ pub(crate) fn read_record_table(
 /// [`Imu::timing`] reports the epochs' gaps. The same columns are read by
 /// [`read_table`](super::read_table) with [`InputFormat::ImuRecord`].
 ///
-/// The file is memory-mapped and must not change while it is read.
+/// A file truncated while it is read gives [`ReadError::Io`] (`the file shrank while it was
+/// read`).
 ///
 /// # Errors
 /// [`ReadError::Io`], [`ReadError::Empty`], [`ReadError::BinarySize`] (size not a multiple of

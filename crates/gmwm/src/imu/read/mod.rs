@@ -5,6 +5,7 @@
 //! the selected columns and resolves the sampling frequency (see [`read_table`]).
 
 pub(crate) mod binary;
+pub(crate) mod positioned;
 pub(crate) mod text;
 
 pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordType};

@@ -1,5 +1,6 @@
-//! MCAP (<https://mcap.dev/spec>), memory-mapped, through the `mcap` crate's summary reader and
-//! record parser; chunks are decompressed here (pure-Rust zstd and lz4).
+//! MCAP (<https://mcap.dev/spec>), read record by record ([`StorageFile`]), through the `mcap`
+//! crate's summary reader and record parser; chunks are decompressed here (pure-Rust zstd and
+//! lz4).
 //!
 //! Topics are listed from the summary (channels, schemas, statistics) when the file has one,
 //! else from a scan of the data section. Messages are read chunk by chunk: with chunk indexes,
@@ -8,9 +9,13 @@
 
 use super::decompress::{Codec, Decompressor};
 use super::error::RosError;
-use super::{Collector, Encoding, Release, RosContainer};
+use super::file::{Bytes, Memory, StorageFile};
+use super::{Collector, Encoding, RosContainer};
+use crate::imu::ReadError;
 use mcap::records::{op, Record};
+use mcap::sans_io::summary_reader::{SummaryReadEvent, SummaryReader, SummaryReaderOptions};
 use std::collections::{BTreeMap, HashMap};
+use std::io::SeekFrom;
 use std::path::Path;
 
 /// One channel (topic + schema + encoding) of an MCAP file.
@@ -50,78 +55,93 @@ fn describe(e: &mcap::McapError) -> String {
 }
 
 /// Checks both magics (a file without the end magic was cut short or never closed).
-fn check_magic(path: &Path, map: &[u8]) -> Result<(), RosError> {
-    if !map.starts_with(mcap::MAGIC) {
+fn check_magic(file: &mut StorageFile) -> Result<(), ReadError> {
+    let path = file.path().to_path_buf();
+    let len = file.len();
+    let m = mcap::MAGIC.len();
+    if file.get(0, m.min(len))? != mcap::MAGIC {
         return Err(RosError::NotRecording {
-            path: path.to_path_buf(),
+            path,
             expected: "expected the MCAP magic (0x89 MCAP0 \\r\\n) at the start of an .mcap file"
                 .into(),
-        });
+        }
+        .into());
     }
-    if map.len() < 2 * mcap::MAGIC.len() || !map.ends_with(mcap::MAGIC) {
+    if len < 2 * m || file.get(len - m, m)? != mcap::MAGIC {
         return Err(corrupt(
-            path,
+            &path,
             format!(
-                "the file ({} bytes) does not end with the MCAP magic: it is cut short or the \
-                 recorder never closed it",
-                map.len()
+                "the file ({len} bytes) does not end with the MCAP magic: it is cut short or the \
+                 recorder never closed it"
             ),
-        ));
+        )
+        .into());
     }
     Ok(())
 }
 
-/// Iterates the records of `buf` (opcode u8, length u64, body): calls `visit(opcode, body,
-/// offset)` for each, stopping after a DataEnd record. `base` is the file offset of `buf[0]`
-/// (None inside a decompressed chunk) for messages.
-fn records<'a>(
+/// Called for each record: (opcode, body, position).
+type RecordVisitor<'v> = dyn FnMut(u8, &[u8], usize) -> Result<(), ReadError> + 'v;
+
+/// Iterates the records of `buf` from `from` (opcode u8, length u64, body): calls
+/// `visit(opcode, body, position)` for each opcode in `wanted` (the others' bodies are not
+/// read), stopping after a DataEnd record. `chunk_at` is the file offset of the chunk `buf` is
+/// (None for the file itself), for messages.
+fn records<B: Bytes>(
     path: &Path,
-    buf: &'a [u8],
+    buf: &mut B,
+    from: usize,
     chunk_at: Option<u64>,
-    visit: &mut dyn FnMut(u8, &'a [u8], usize) -> Result<(), RosError>,
-) -> Result<(), RosError> {
+    wanted: &dyn Fn(u8) -> bool,
+    visit: &mut RecordVisitor<'_>,
+) -> Result<(), ReadError> {
     let at = |pos: usize| match chunk_at {
         None => format!("record at byte {pos}"),
         Some(c) => format!("chunk at byte {c}: record at byte {pos} of the chunk"),
     };
-    let mut pos = 0;
-    while pos < buf.len() {
-        let Some(head) = buf.get(pos..pos + 9) else {
+    let end = buf.end();
+    let mut pos = from;
+    while pos < end {
+        if end - pos < 9 {
             return Err(corrupt(
                 path,
                 format!("{}: 9-byte record header is cut off", at(pos)),
-            ));
-        };
+            )
+            .into());
+        }
+        let head = buf.get(pos, 9)?;
         let opcode = head[0];
         let mut len = [0u8; 8];
         len.copy_from_slice(&head[1..9]);
         let len = u64::from_le_bytes(len);
-        let body = usize::try_from(len)
+        let remain = end - pos - 9;
+        let n = usize::try_from(len)
             .ok()
-            .and_then(|l| buf.get(pos + 9..(pos + 9).checked_add(l)?))
+            .filter(|&l| l <= remain)
             .ok_or_else(|| {
                 corrupt(
                     path,
                     format!(
                         "{}: record (opcode 0x{opcode:02x}) of {len} bytes runs past the end \
-                         ({} bytes remain)",
+                         ({remain} bytes remain)",
                         at(pos),
-                        buf.len() - pos - 9
                     ),
                 )
             })?;
-        visit(opcode, body, pos)?;
+        if wanted(opcode) {
+            visit(opcode, buf.get(pos + 9, n)?, pos)?;
+        }
         if opcode == op::DATA_END {
             break;
         }
-        pos += 9 + body.len();
+        pos += 9 + n;
     }
     Ok(())
 }
 
 /// Called for each record of a chunk: (opcode, body, chunk offset in the file, record offset
 /// in the decompressed chunk).
-type ChunkVisitor<'v> = dyn FnMut(u8, &[u8], u64, usize) -> Result<(), RosError> + 'v;
+type ChunkVisitor<'v> = dyn FnMut(u8, &[u8], u64, usize) -> Result<(), ReadError> + 'v;
 
 /// Decompresses a chunk record's body if needed and walks its records.
 fn chunk(
@@ -131,20 +151,12 @@ fn chunk(
     dec: &mut Decompressor,
     buf: &mut Vec<u8>,
     visit: &mut ChunkVisitor<'_>,
-) -> Result<(), RosError> {
+) -> Result<(), ReadError> {
     let (header, data) = match mcap::parse_record(op::CHUNK, body) {
         Ok(Record::Chunk { header, data }) => (header, data),
-        Ok(_) => {
-            return Err(corrupt(
-                path,
-                format!("chunk at byte {offset}: not a chunk"),
-            ))
-        }
+        Ok(_) => return Err(corrupt(path, format!("chunk at byte {offset}: not a chunk")).into()),
         Err(e) => {
-            return Err(corrupt(
-                path,
-                format!("chunk at byte {offset}: {}", describe(&e)),
-            ))
+            return Err(corrupt(path, format!("chunk at byte {offset}: {}", describe(&e))).into())
         }
     };
     let codec = match header.compression.as_str() {
@@ -156,7 +168,8 @@ fn chunk(
                 path: path.to_path_buf(),
                 what: format!("MCAP chunk compression \"{other}\""),
                 hint: "supported: none, zstd, lz4",
-            })
+            }
+            .into())
         }
     };
     let size = usize::try_from(header.uncompressed_size).map_err(|_| {
@@ -178,7 +191,8 @@ fn chunk(
                          says {size}",
                         data.len()
                     ),
-                ));
+                )
+                .into());
             }
             &data
         }
@@ -188,9 +202,14 @@ fn chunk(
             buf
         }
     };
-    records(path, inner, Some(offset), &mut |opcode, body, pos| {
-        visit(opcode, body, offset, pos)
-    })
+    records(
+        path,
+        &mut Memory(inner),
+        0,
+        Some(offset),
+        &|_| true,
+        &mut |opcode, body, pos| visit(opcode, body, offset, pos),
+    )
 }
 
 /// Collects schemas and channels met in a scan, and counts messages per channel.
@@ -202,7 +221,7 @@ struct Scan {
 }
 
 impl Scan {
-    fn record(&mut self, path: &Path, opcode: u8, body: &[u8], at: &str) -> Result<(), RosError> {
+    fn record(&mut self, path: &Path, opcode: u8, body: &[u8], at: &str) -> Result<(), ReadError> {
         let parse = || {
             mcap::parse_record(opcode, body)
                 .map_err(|e| corrupt(path, format!("{at}: {}", describe(&e))))
@@ -233,11 +252,52 @@ impl Scan {
     }
 }
 
+/// The summary section, if the file has one: the `mcap` crate's summary reader fed by
+/// positioned reads of the file as opened (reads stop at its size then, as a read of the whole
+/// file would).
+fn summary(file: &StorageFile) -> Result<Option<mcap::Summary>, ReadError> {
+    let path = file.path();
+    let len = file.len() as u64;
+    let fail = |e: mcap::McapError| -> ReadError {
+        corrupt(path, format!("summary section: {}", describe(&e))).into()
+    };
+    let mut reader =
+        SummaryReader::new_with_options(SummaryReaderOptions::default().with_file_size(len));
+    let mut pos: u64 = 0;
+    while let Some(event) = reader.next_event() {
+        match event.map_err(fail)? {
+            SummaryReadEvent::ReadRequest(n) => {
+                let k = usize::try_from(len.saturating_sub(pos)).map_or(n, |left| left.min(n));
+                let into = &mut reader.insert(n)[..k];
+                file.read_into(pos as usize, into)?;
+                reader.notify_read(k);
+                pos += k as u64;
+            }
+            SummaryReadEvent::SeekRequest(to) => {
+                let target = match to {
+                    SeekFrom::Start(p) => Some(p),
+                    SeekFrom::End(d) => len.checked_add_signed(d),
+                    SeekFrom::Current(d) => pos.checked_add_signed(d),
+                };
+                pos = target.ok_or_else(|| {
+                    fail(mcap::McapError::Io(std::io::Error::new(
+                        std::io::ErrorKind::InvalidInput,
+                        "invalid seek to a negative or overflowing position",
+                    )))
+                })?;
+                reader.notify_seeked(pos);
+            }
+        }
+    }
+    Ok(reader.finish())
+}
+
 /// Lists the channels with their message counts.
-pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
-    check_magic(path, map)?;
-    let summary = mcap::Summary::read(map)
-        .map_err(|e| corrupt(path, format!("summary section: {}", describe(&e))))?;
+pub(crate) fn catalog(file: &mut StorageFile) -> Result<Catalog, ReadError> {
+    let path = file.path().to_path_buf();
+    let path = path.as_path();
+    check_magic(file)?;
+    let summary = summary(file)?;
     if let Some(s) = summary.as_ref() {
         if let Some(stats) = s.stats.as_ref() {
             let mut channels: Vec<Channel> = s
@@ -267,23 +327,29 @@ pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
     let mut scan = Scan::default();
     let mut dec = Decompressor::new();
     let mut buf = Vec::new();
-    let data = &map[mcap::MAGIC.len()..map.len() - mcap::MAGIC.len()];
-    let base = mcap::MAGIC.len();
-    records(path, data, None, &mut |opcode, body, pos| {
-        let offset = (base + pos) as u64;
-        if opcode == op::CHUNK {
-            chunk(path, body, offset, &mut dec, &mut buf, &mut |o, b, c, p| {
-                scan.record(
-                    path,
-                    o,
-                    b,
-                    &format!("chunk at byte {c}: record at byte {p} of the chunk"),
-                )
-            })
-        } else {
-            scan.record(path, opcode, body, &format!("record at byte {offset}"))
-        }
-    })?;
+    let data_end = file.len() - mcap::MAGIC.len();
+    records(
+        path,
+        &mut file.region(data_end),
+        mcap::MAGIC.len(),
+        None,
+        &|opcode| matches!(opcode, op::CHUNK | op::SCHEMA | op::CHANNEL | op::MESSAGE),
+        &mut |opcode, body, pos| {
+            let offset = pos as u64;
+            if opcode == op::CHUNK {
+                chunk(path, body, offset, &mut dec, &mut buf, &mut |o, b, c, p| {
+                    scan.record(
+                        path,
+                        o,
+                        b,
+                        &format!("chunk at byte {c}: record at byte {p} of the chunk"),
+                    )
+                })
+            } else {
+                scan.record(path, opcode, body, &format!("record at byte {offset}"))
+            }
+        },
+    )?;
     let channels = scan
         .channels
         .into_iter()
@@ -300,31 +366,27 @@ pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
 
 /// Reads the messages of the channels in `wanted` (id -> encoding) into `out`, in file order.
 pub(crate) fn read(
-    path: &Path,
-    mapped: &memmap2::Mmap,
+    file: &mut StorageFile,
     catalog: &Catalog,
     wanted: &HashMap<u16, Encoding>,
     out: &mut Collector<'_>,
-) -> Result<(), RosError> {
-    let map: &[u8] = mapped;
-    check_magic(path, map)?;
-    let mut release = Release::new(mapped);
+) -> Result<(), ReadError> {
+    let path = file.path().to_path_buf();
+    let path = path.as_path();
+    check_magic(file)?;
     let mut dec = Decompressor::new();
     let mut buf = Vec::new();
-    let mut message = |body: &[u8], at: &dyn Fn() -> String| -> Result<(), RosError> {
+    let mut message = |body: &[u8], at: &dyn Fn() -> String| -> Result<(), ReadError> {
         let Some(id) = body.get(..2).map(|b| u16::from_le_bytes([b[0], b[1]])) else {
-            return Err(corrupt(
-                path,
-                format!("{}: message record is cut off", at()),
-            ));
+            return Err(corrupt(path, format!("{}: message record is cut off", at())).into());
         };
         let Some(&encoding) = wanted.get(&id) else {
             return Ok(());
         };
         let (header, data) = match mcap::parse_record(op::MESSAGE, body) {
             Ok(Record::Message { header, data }) => (header, data),
-            Ok(_) => return Err(corrupt(path, format!("{}: not a message", at()))),
-            Err(e) => return Err(corrupt(path, format!("{}: {}", at(), describe(&e)))),
+            Ok(_) => return Err(corrupt(path, format!("{}: not a message", at())).into()),
+            Err(e) => return Err(corrupt(path, format!("{}: {}", at(), describe(&e))).into()),
         };
         let log_time = i64::try_from(header.log_time).map_err(|_| {
             corrupt(
@@ -336,7 +398,7 @@ pub(crate) fn read(
                 ),
             )
         })?;
-        out.push(encoding, log_time, &data)
+        Ok(out.push(encoding, log_time, &data)?)
     };
     let indexes = catalog
         .summary
@@ -356,21 +418,26 @@ pub(crate) fn read(
         chunks.sort_by_key(|c| c.chunk_start_offset);
         for c in chunks {
             let offset = c.chunk_start_offset;
-            let record = usize::try_from(offset)
+            let missing = || {
+                corrupt(
+                    path,
+                    format!(
+                        "the chunk index points to a chunk at byte {offset} ({} bytes) that is \
+                         not there",
+                        c.chunk_length
+                    ),
+                )
+            };
+            // checked against the size before anything is read
+            let (start, length) = usize::try_from(offset)
                 .ok()
                 .zip(usize::try_from(c.chunk_length).ok())
-                .and_then(|(s, l)| map.get(s..s.checked_add(l)?))
-                .filter(|r| r.len() >= 9 && r[0] == op::CHUNK)
-                .ok_or_else(|| {
-                    corrupt(
-                        path,
-                        format!(
-                            "the chunk index points to a chunk at byte {offset} ({} bytes) that \
-                             is not there",
-                            c.chunk_length
-                        ),
-                    )
-                })?;
+                .filter(|&(s, l)| l >= 9 && s.checked_add(l).is_some_and(|e| e <= file.len()))
+                .ok_or_else(missing)?;
+            let record = file.get(start, length)?;
+            if record[0] != op::CHUNK {
+                return Err(missing().into());
+            }
             chunk(
                 path,
                 &record[9..],
@@ -387,27 +454,31 @@ pub(crate) fn read(
                     }
                 },
             )?;
-            release.upto(record.as_ptr() as usize - map.as_ptr() as usize + record.len());
         }
         return Ok(());
     }
-    let data = &map[mcap::MAGIC.len()..map.len() - mcap::MAGIC.len()];
-    let base = mcap::MAGIC.len();
-    records(path, data, None, &mut |opcode, body, pos| {
-        let offset = (base + pos) as u64;
-        release.upto(base + pos);
-        match opcode {
-            op::CHUNK => chunk(path, body, offset, &mut dec, &mut buf, &mut |o, b, c, p| {
-                if o == op::MESSAGE {
-                    message(b, &|| {
-                        format!("chunk at byte {c}: record at byte {p} of the chunk")
-                    })
-                } else {
-                    Ok(())
-                }
-            }),
-            op::MESSAGE => message(body, &|| format!("record at byte {offset}")),
-            _ => Ok(()),
-        }
-    })
+    let data_end = file.len() - mcap::MAGIC.len();
+    records(
+        path,
+        &mut file.region(data_end),
+        mcap::MAGIC.len(),
+        None,
+        &|opcode| opcode == op::CHUNK || opcode == op::MESSAGE,
+        &mut |opcode, body, pos| {
+            let offset = pos as u64;
+            match opcode {
+                op::CHUNK => chunk(path, body, offset, &mut dec, &mut buf, &mut |o, b, c, p| {
+                    if o == op::MESSAGE {
+                        message(b, &|| {
+                            format!("chunk at byte {c}: record at byte {p} of the chunk")
+                        })
+                    } else {
+                        Ok(())
+                    }
+                }),
+                op::MESSAGE => message(body, &|| format!("record at byte {offset}")),
+                _ => Ok(()),
+            }
+        },
+    )
 }

@@ -12,8 +12,11 @@
 //! Messages are returned in log (receive) time order, ties in file order; both the header stamp
 //! and the log time of every message are kept.
 //!
-//! Files are memory-mapped (ROS1, MCAP) or queried row by row (sqlite3): only one decompressed
-//! chunk and the output vectors are held, about 64 bytes per message.
+//! ROS1 bags and MCAP files are read record by record with positioned reads (not
+//! memory-mapped), sqlite3 databases queried row by row: only one chunk (as read and
+//! decompressed) and the output vectors are held, about 64 bytes per message. A file truncated
+//! by another process while it is read gives [`ReadError::Io`] (`the file shrank while it was
+//! read`).
 //!
 //! ```no_run
 //! use gmwm::imu::ros::{list_topics, read_imu_messages};
@@ -30,6 +33,7 @@
 mod cdr;
 mod decompress;
 mod error;
+mod file;
 mod mcap;
 mod ros1;
 mod sqlite;
@@ -37,7 +41,7 @@ mod sqlite;
 pub use error::{MessageError, RosError};
 
 use crate::imu::ReadError;
-use memmap2::Mmap;
+use file::StorageFile;
 use serde::Serialize;
 use std::collections::{HashMap, HashSet};
 use std::fmt;
@@ -476,53 +480,10 @@ pub fn container_of(path: &Path) -> Option<RosContainer> {
     source(path).ok().map(|s| s.container)
 }
 
-/// Read ranges are handed back to the kernel in steps of this many bytes (see [`Release`]).
-const RELEASE_STEP: usize = 8 << 20;
-
-/// Hands the pages of a memory map that have been decoded back to the kernel, so that the
-/// resident set holds the output and about one step of the file instead of the whole file.
-pub(crate) struct Release<'m> {
-    map: &'m Mmap,
-    done: usize,
-}
-
-impl<'m> Release<'m> {
-    pub(crate) fn new(map: &'m Mmap) -> Self {
-        Self { map, done: 0 }
-    }
-
-    /// Everything before `pos` has been read; release it once a step has accumulated.
-    pub(crate) fn upto(&mut self, pos: usize) {
-        if pos >= self.done.saturating_add(RELEASE_STEP) && pos <= self.map.len() {
-            #[cfg(unix)]
-            {
-                // SAFETY: a private, read-only file mapping that is never written: MADV_DONTNEED
-                // only drops its resident pages, and any later access faults them in again
-                // from the file with the same contents.
-                let _ = unsafe {
-                    self.map.unchecked_advise_range(
-                        memmap2::UncheckedAdvice::DontNeed,
-                        self.done,
-                        pos - self.done,
-                    )
-                };
-            }
-            self.done = pos;
-        }
-    }
-}
-
-fn map_file(path: &Path) -> Result<Mmap, ReadError> {
-    let file = File::open(path).map_err(|e| io_error(path, e))?;
-    // SAFETY: read-only private map; as with any map, the file must not be truncated by
-    // another process while it is read (documented on the public readers).
-    unsafe { Mmap::map(&file) }.map_err(|e| io_error(path, e))
-}
-
 /// One storage file, opened and catalogued.
 enum Opened {
-    Ros1(PathBuf, Mmap, ros1::Catalog),
-    Mcap(PathBuf, Mmap, mcap::Catalog),
+    Ros1(StorageFile, ros1::Catalog),
+    Mcap(StorageFile, mcap::Catalog),
     Sqlite(PathBuf, rusqlite::Connection, Vec<sqlite::Topic>),
 }
 
@@ -530,12 +491,12 @@ impl Opened {
     /// (topic, type, messages) of every connection/channel/topic row.
     fn entries(&self) -> Vec<(&str, &str, u64)> {
         match self {
-            Opened::Ros1(_, _, c) => c
+            Opened::Ros1(_, c) => c
                 .connections
                 .iter()
                 .map(|c| (c.topic.as_str(), c.message_type.as_str(), c.messages))
                 .collect(),
-            Opened::Mcap(_, _, c) => c
+            Opened::Mcap(_, c) => c
                 .channels
                 .iter()
                 .map(|c| (c.topic.as_str(), c.message_type.as_str(), c.messages))
@@ -549,16 +510,16 @@ impl Opened {
 
     fn size(&self) -> u64 {
         match self {
-            Opened::Ros1(_, m, _) | Opened::Mcap(_, m, _) => m.len() as u64,
+            Opened::Ros1(f, _) | Opened::Mcap(f, _) => f.len() as u64,
             Opened::Sqlite(p, _, _) => std::fs::metadata(p).map(|m| m.len()).unwrap_or(0),
         }
     }
 
     /// Reads the IMU messages of `topic` into `out`.
-    fn read(&self, topic: &str, out: &mut Collector<'_>) -> Result<(), RosError> {
+    fn read(&mut self, topic: &str, out: &mut Collector<'_>) -> Result<(), ReadError> {
         match self {
-            Opened::Ros1(path, map, cat) => {
-                out.file.clone_from(path);
+            Opened::Ros1(file, cat) => {
+                out.file = file.path().to_path_buf();
                 let wanted: HashSet<u32> = cat
                     .connections
                     .iter()
@@ -568,20 +529,24 @@ impl Opened {
                 if wanted.is_empty() {
                     return Ok(());
                 }
-                ros1::read(path, map, cat, &wanted, out)
+                let read = ros1::read(file, cat, &wanted, out);
+                file.release();
+                read
             }
-            Opened::Mcap(path, map, cat) => {
-                out.file.clone_from(path);
+            Opened::Mcap(file, cat) => {
+                out.file = file.path().to_path_buf();
                 let mut wanted = HashMap::new();
                 for c in &cat.channels {
                     if c.topic == topic && is_imu_type(&c.message_type) {
-                        wanted.insert(c.id, encoding(path, topic, &c.encoding)?);
+                        wanted.insert(c.id, encoding(file.path(), topic, &c.encoding)?);
                     }
                 }
                 if wanted.is_empty() {
                     return Ok(());
                 }
-                mcap::read(path, map, cat, &wanted, out)
+                let read = mcap::read(file, cat, &wanted, out);
+                file.release();
+                read
             }
             Opened::Sqlite(path, db, topics) => {
                 out.file.clone_from(path);
@@ -594,7 +559,7 @@ impl Opened {
                 if wanted.is_empty() {
                     return Ok(());
                 }
-                sqlite::read(path, db, &wanted, out)
+                Ok(sqlite::read(path, db, &wanted, out)?)
             }
         }
     }
@@ -610,14 +575,16 @@ fn open(source: &Source) -> Result<Vec<Opened>, ReadError> {
         };
         out.push(match container {
             RosContainer::Ros1Bag => {
-                let map = map_file(f)?;
-                let cat = ros1::catalog(f, &map)?;
-                Opened::Ros1(f.clone(), map, cat)
+                let mut file = StorageFile::open(f)?;
+                let cat = ros1::catalog(&mut file)?;
+                file.release();
+                Opened::Ros1(file, cat)
             }
             RosContainer::Mcap => {
-                let map = map_file(f)?;
-                let cat = mcap::catalog(f, &map)?;
-                Opened::Mcap(f.clone(), map, cat)
+                let mut file = StorageFile::open(f)?;
+                let cat = mcap::catalog(&mut file)?;
+                file.release();
+                Opened::Mcap(file, cat)
             }
             RosContainer::Sqlite3 => {
                 let db = sqlite::open(f)?;
@@ -739,8 +706,8 @@ pub fn choose_topic<'t>(
 ///
 /// Messages are returned in log-time order (ROS1: receive time; MCAP: log time; sqlite3: the
 /// `timestamp` column), ties in file order. Every message's length is checked against the
-/// message definition and its six measurements must be finite. The file is memory-mapped and
-/// must not be truncated while it is read. Cost: one pass over the chunks holding the topic
+/// message definition and its six measurements must be finite. A file truncated while it is
+/// read gives [`ReadError::Io`] (`the file shrank while it was read`). Cost: one pass over the chunks holding the topic
 /// (plus one counting pass for sqlite3 and unindexed files); memory: the output (64 bytes per
 /// message) and one decompressed chunk.
 ///
@@ -750,13 +717,13 @@ pub fn choose_topic<'t>(
 /// message or a non-finite value.
 pub fn read_imu_messages(path: &Path, topic: Option<&str>) -> Result<ImuMessages, ReadError> {
     let source = source(path)?;
-    let opened = open(&source)?;
+    let mut opened = open(&source)?;
     let topics = merged_topics(&opened);
     let chosen = choose_topic(path, &topics, topic)?;
     let bytes: u64 = opened.iter().map(Opened::size).sum();
     let capacity = chosen.messages.min(bytes / MIN_BYTES_PER_MESSAGE);
     let mut out = Collector::new(&chosen.topic, usize::try_from(capacity).unwrap_or(0));
-    for o in &opened {
+    for o in &mut opened {
         o.read(&chosen.topic, &mut out)?;
     }
     if out.log_time_ns.len() as u64 != chosen.messages {
@@ -862,6 +829,88 @@ mod tests {
             e,
             "x.bag: several sensor_msgs/Imu topics: /a, /b; choose one with --topic"
         );
+    }
+
+    /// Writes a recording of `n` messages on /imu0 with the real writer (Python `rosbags`,
+    /// `tests/fixtures/write_imu_bag.py`) and returns its storage file.
+    fn written(dir: &Path, container: &str, compression: &str, n: usize) -> PathBuf {
+        let script = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/fixtures/write_imu_bag.py"
+        );
+        let out = dir.join(container);
+        let status = std::process::Command::new("python3")
+            .arg(script)
+            .args(["--container", container, "--compression", compression])
+            .arg("--out")
+            .arg(&out)
+            .args(["--n", &n.to_string(), "--rate", "200", "--seed", "3"])
+            .args(["--gyro-wn-density", "1e-4", "--gyro-rw-density", "1e-6"])
+            .args(["--accel-wn-density", "1e-3", "--accel-rw-density", "1e-5"])
+            .args(["--extra-topic", "/status:std_msgs/msg/String"])
+            .output()
+            .expect("python3 runs (the ROS tests need: python3 -m pip install rosbags)");
+        assert!(
+            status.status.success(),
+            "write_imu_bag.py failed (needs: python3 -m pip install rosbags):\n{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+        match container {
+            "ros1" => out,
+            _ => {
+                let source = source(&out).unwrap();
+                assert_eq!(source.files.len(), 1);
+                source.files[0].clone()
+            }
+        }
+    }
+
+    /// Opens and catalogues `path`, cuts the file to `keep` of its bytes, then reads /imu0.
+    fn read_after_truncation(path: &Path, keep: f64) -> Result<usize, ReadError> {
+        let source = source(path).unwrap();
+        let mut opened = open(&source).unwrap();
+        let topics = merged_topics(&opened);
+        let chosen = choose_topic(path, &topics, None).unwrap();
+        let size = std::fs::metadata(path).unwrap().len();
+        let file = std::fs::OpenOptions::new().write(true).open(path).unwrap();
+        file.set_len((size as f64 * keep) as u64).unwrap();
+        let mut out = Collector::new(&chosen.topic, 0);
+        for o in &mut opened {
+            o.read(&chosen.topic, &mut out)?;
+        }
+        Ok(out.log_time_ns.len())
+    }
+
+    #[test]
+    fn a_file_truncated_after_it_was_catalogued_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        // 7000 messages: three chunks of the writers' 1 MiB
+        for (container, compression) in [("ros1", "none"), ("ros1", "lz4"), ("mcap", "zstd")] {
+            let sub = dir.path().join(format!("{container}-{compression}"));
+            std::fs::create_dir(&sub).unwrap();
+            let path = written(&sub, container, compression, 7000);
+            // untouched, every message is read
+            let source = source(&path).unwrap();
+            let mut opened = open(&source).unwrap();
+            let mut out = Collector::new("/imu0", 0);
+            for o in &mut opened {
+                o.read("/imu0", &mut out).unwrap();
+            }
+            assert_eq!(out.log_time_ns.len(), 7000, "{container} {compression}");
+            for keep in [0.0, 0.5, 0.99] {
+                let copy = sub.join(format!("cut-{keep}"));
+                std::fs::copy(&path, &copy).unwrap();
+                let e = read_after_truncation(&copy, keep).unwrap_err();
+                assert!(
+                    matches!(&e, ReadError::Io { path, .. } if path == &copy),
+                    "{container} {compression} {keep}: {e:?}"
+                );
+                assert_eq!(
+                    e.to_string(),
+                    format!("{}: the file shrank while it was read", copy.display()),
+                );
+            }
+        }
     }
 
     #[test]

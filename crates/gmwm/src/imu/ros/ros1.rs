@@ -1,4 +1,5 @@
-//! ROS1 bag format 2.0 (<http://wiki.ros.org/Bags/Format/2.0>), memory-mapped.
+//! ROS1 bag format 2.0 (<http://wiki.ros.org/Bags/Format/2.0>), read record by record
+//! ([`StorageFile`]).
 //!
 //! The file is `#ROSBAG V2.0\n` followed by records: `header_len u32, header, data_len u32,
 //! data`, the header being `field_len u32, name=value` fields with an `op` byte. The bag header
@@ -6,11 +7,14 @@
 //! (0x07) and message (0x02) records; after `index_pos` come the connections and one chunk info
 //! (0x06, per-connection message counts) per chunk. Topics are listed from that index (or from a
 //! scan of the chunks when the bag was never indexed); messages are read by walking the chunks
-//! that hold the topic, in file order, each chunk decompressed into one reused buffer.
+//! that hold the topic, in file order, each chunk read whole into the file's window and
+//! decompressed into one reused buffer; the other chunks' data is not read.
 
 use super::decompress::{Codec, Decompressor};
 use super::error::RosError;
-use super::{Collector, Encoding, Release, RosContainer};
+use super::file::{Bytes, Memory, StorageFile};
+use super::{Collector, Encoding, RosContainer};
+use crate::imu::ReadError;
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 
@@ -71,60 +75,66 @@ fn u64_le(b: &[u8]) -> Option<u64> {
     Some(u64::from_le_bytes(s))
 }
 
-/// The record starting at `pos` of `buf`, and the position after it.
-fn record(buf: &[u8], pos: usize, origin: Origin) -> Result<(Record<'_>, usize), String> {
-    let left = buf.len() - pos;
-    let hlen = u32_le(buf, pos).ok_or_else(|| {
-        format!(
+/// The record starting at `pos` of `buf`, and the position after it; its data is read only if
+/// `with_data(op)` (else it is empty). Lengths are checked against `buf.end()` before anything is
+/// read.
+fn record<'b, B: Bytes>(
+    path: &Path,
+    buf: &'b mut B,
+    pos: usize,
+    origin: Origin,
+    with_data: impl FnOnce(u8) -> bool,
+) -> Result<(Record<'b>, usize), ReadError> {
+    let end = buf.end();
+    let left = end - pos;
+    let fail = |reason: String| -> ReadError { corrupt(path, reason).into() };
+    if left < 4 {
+        return Err(fail(format!(
             "{}: header length needs 4 bytes, {left} remain",
             at(origin, pos)
-        )
-    })? as usize;
+        )));
+    }
+    let hlen = u32_le(buf.get(pos, 4)?, 0).unwrap_or(0) as usize;
     let h0 = pos + 4;
-    let h1 = h0
-        .checked_add(hlen)
-        .filter(|&e| e <= buf.len())
-        .ok_or_else(|| {
-            format!(
-                "{}: header of {hlen} bytes runs past the end ({} bytes remain)",
-                at(origin, pos),
-                left - 4
-            )
-        })?;
-    let dlen = u32_le(buf, h1)
-        .ok_or_else(|| format!("{}: data length is cut off", at(origin, pos)))?
-        as usize;
+    let h1 = h0.checked_add(hlen).filter(|&e| e <= end).ok_or_else(|| {
+        fail(format!(
+            "{}: header of {hlen} bytes runs past the end ({} bytes remain)",
+            at(origin, pos),
+            left - 4
+        ))
+    })?;
+    if end - h1 < 4 {
+        return Err(fail(format!("{}: data length is cut off", at(origin, pos))));
+    }
+    let dlen = u32_le(buf.get(h1, 4)?, 0).unwrap_or(0) as usize;
     let d0 = h1 + 4;
-    let d1 = d0
-        .checked_add(dlen)
-        .filter(|&e| e <= buf.len())
-        .ok_or_else(|| {
-            format!(
-                "{}: data of {dlen} bytes runs past the end ({} bytes remain)",
-                at(origin, pos),
-                buf.len() - d0
-            )
-        })?;
-    let header = &buf[h0..h1];
-    let op = match field(header, b"op").map_err(|e| format!("{}: {e}", at(origin, pos)))? {
+    let d1 = d0.checked_add(dlen).filter(|&e| e <= end).ok_or_else(|| {
+        fail(format!(
+            "{}: data of {dlen} bytes runs past the end ({} bytes remain)",
+            at(origin, pos),
+            end - d0
+        ))
+    })?;
+    let op = match field(buf.get(h0, hlen)?, b"op")
+        .map_err(|e| fail(format!("{}: {e}", at(origin, pos))))?
+    {
         Some([op]) => *op,
         Some(v) => {
-            return Err(format!(
+            return Err(fail(format!(
                 "{}: op field has {} bytes, expected 1",
                 at(origin, pos),
                 v.len()
-            ))
+            )))
         }
-        None => return Err(format!("{}: header has no op field", at(origin, pos))),
+        None => return Err(fail(format!("{}: header has no op field", at(origin, pos)))),
     };
-    Ok((
-        Record {
-            op,
-            header,
-            data: &buf[d0..d1],
-        },
-        d1,
-    ))
+    let (header, data): (&[u8], &[u8]) = if with_data(op) {
+        let bytes = buf.get(h0, d1 - h0)?;
+        (&bytes[..hlen], &bytes[hlen + 4..])
+    } else {
+        (buf.get(h0, hlen)?, &[])
+    };
+    Ok((Record { op, header, data }, d1))
 }
 
 /// The value of field `name` in a record header (`len u32, name=value` repeated).
@@ -200,15 +210,19 @@ fn corrupt(path: &Path, reason: String) -> RosError {
 }
 
 /// The bag header: (index_pos, conn_count, chunk_count) and the position after it.
-fn bag_header(path: &Path, map: &[u8]) -> Result<(u64, u32, u32, usize), RosError> {
-    if !map.starts_with(MAGIC) {
+fn bag_header(file: &mut StorageFile) -> Result<(u64, u32, u32, usize), ReadError> {
+    let path = file.path().to_path_buf();
+    let path = path.as_path();
+    let n = MAGIC.len().min(file.len());
+    if file.get(0, n)? != MAGIC {
         return Err(RosError::NotRecording {
             path: path.to_path_buf(),
             expected: "expected \"#ROSBAG V2.0\" at the start of a ROS1 bag".into(),
-        });
+        }
+        .into());
     }
     let pos = MAGIC.len();
-    let (rec, next) = record(map, pos, Origin::File).map_err(|e| corrupt(path, e))?;
+    let (rec, next) = record(path, file, pos, Origin::File, |_| false)?;
     if rec.op != OP_BAG_HEADER {
         return Err(corrupt(
             path,
@@ -217,7 +231,8 @@ fn bag_header(path: &Path, map: &[u8]) -> Result<(u64, u32, u32, usize), RosErro
                 at(Origin::File, pos),
                 rec.op
             ),
-        ));
+        )
+        .into());
     }
     let what = "bag header";
     let index_pos = need_u64(rec.header, "index_pos", what).map_err(|e| corrupt(path, e))?;
@@ -227,12 +242,15 @@ fn bag_header(path: &Path, map: &[u8]) -> Result<(u64, u32, u32, usize), RosErro
 }
 
 /// Lists the connections with their message counts.
-pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
-    let (index_pos, conn_count, chunk_count, first) = bag_header(path, map)?;
+pub(crate) fn catalog(file: &mut StorageFile) -> Result<Catalog, ReadError> {
+    let path = file.path().to_path_buf();
+    let path = path.as_path();
+    let (index_pos, conn_count, chunk_count, first) = bag_header(file)?;
     if index_pos == 0 {
         // never indexed (recording interrupted): count by walking every chunk
         let mut conns: BTreeMap<u32, Connection> = BTreeMap::new();
-        walk(path, map, first, map.len(), None, None, &mut |item| {
+        let end = file.len();
+        walk(path, file, first, end, None, &mut |item| {
             match item {
                 Item::Connection(c) => {
                     conns.entry(c.id).or_insert(c);
@@ -252,22 +270,24 @@ pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
     }
     let start = usize::try_from(index_pos)
         .ok()
-        .filter(|&p| p >= first && p <= map.len())
+        .filter(|&p| p >= first && p <= file.len())
         .ok_or_else(|| {
             corrupt(
                 path,
                 format!(
                     "the bag header puts the index at byte {index_pos}, past the end of the \
                      file ({} bytes): the file is cut short",
-                    map.len()
+                    file.len()
                 ),
             )
         })?;
     let mut conns: BTreeMap<u32, Connection> = BTreeMap::new();
     let mut chunks = Vec::new();
     let mut pos = start;
-    while pos < map.len() {
-        let (rec, next) = record(map, pos, Origin::File).map_err(|e| corrupt(path, e))?;
+    while pos < file.len() {
+        let (rec, next) = record(path, file, pos, Origin::File, |op| {
+            op == OP_CONNECTION || op == OP_CHUNK_INFO
+        })?;
         match rec.op {
             OP_CONNECTION => {
                 let c = connection(&rec)
@@ -288,7 +308,8 @@ pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
                             rec.data.len(),
                             u64::from(count) * 8
                         ),
-                    ));
+                    )
+                    .into());
                 }
                 let mut ids = Vec::with_capacity(count as usize);
                 for pair in rec.data.chunks_exact(8) {
@@ -318,7 +339,8 @@ pub(crate) fn catalog(path: &Path, map: &[u8]) -> Result<Catalog, RosError> {
                  declares {conn_count} and {chunk_count}",
                 chunks.len()
             ),
-        ));
+        )
+        .into());
     }
     Ok(Catalog {
         connections: conns.into_values().collect(),
@@ -336,31 +358,38 @@ enum Item<'a> {
     },
 }
 
-/// Walks the records in `map[from..to]`, opening the chunks (all of them, or those at the
-/// positions in `only`), and hands connections and messages to `visit` in file order.
+/// Called with each connection and message of a walk.
+type Visitor<'v> = dyn FnMut(Item<'_>) -> Result<(), ReadError> + 'v;
+
+/// Walks the records in `[from, to)` of the file, opening the chunks (all of them, or those at
+/// the positions in `only`; the others' data is not read), and hands connections and messages
+/// to `visit` in file order.
 fn walk(
     path: &Path,
-    map: &[u8],
+    file: &mut StorageFile,
     from: usize,
     to: usize,
     only: Option<&HashSet<u64>>,
-    mut release: Option<&mut Release<'_>>,
-    visit: &mut dyn FnMut(Item<'_>) -> Result<(), RosError>,
-) -> Result<(), RosError> {
-    let region = &map[..to];
+    visit: &mut Visitor<'_>,
+) -> Result<(), ReadError> {
+    let mut region = file.region(to);
+    let end = region.end();
     let mut dec = Decompressor::new();
     let mut buf = Vec::new();
     let mut pos = from;
-    while pos < region.len() {
-        let (rec, next) = record(region, pos, Origin::File).map_err(|e| corrupt(path, e))?;
+    while pos < end {
+        let open = |p: usize| only.map_or(true, |o| o.contains(&(p as u64)));
+        let (rec, next) = record(path, &mut region, pos, Origin::File, |op| match op {
+            OP_CHUNK => open(pos),
+            OP_CONNECTION | OP_MESSAGE => true,
+            _ => false,
+        })?;
         match rec.op {
-            OP_CHUNK if only.map_or(true, |o| o.contains(&(pos as u64))) => {
+            OP_CHUNK if open(pos) => {
+                let fail = |e: String| corrupt(path, format!("{}: {e}", at(Origin::File, pos)));
                 let what = "chunk record";
-                let compression = need(rec.header, "compression", what)
-                    .map_err(|e| corrupt(path, format!("{}: {e}", at(Origin::File, pos))))?;
-                let size = need_u32(rec.header, "size", what)
-                    .map_err(|e| corrupt(path, format!("{}: {e}", at(Origin::File, pos))))?
-                    as usize;
+                let compression = need(rec.header, "compression", what).map_err(fail)?;
+                let size = need_u32(rec.header, "size", what).map_err(fail)? as usize;
                 let codec = match compression {
                     b"none" => None,
                     b"lz4" => Some(Codec::Lz4),
@@ -373,7 +402,8 @@ fn walk(
                                 String::from_utf8_lossy(other)
                             ),
                             hint: "supported: none, lz4, bz2",
-                        })
+                        }
+                        .into())
                     }
                 };
                 let inner: &[u8] = match codec {
@@ -386,15 +416,14 @@ fn walk(
                                     at(Origin::File, pos),
                                     rec.data.len()
                                 ),
-                            ));
+                            )
+                            .into());
                         }
                         rec.data
                     }
                     Some(codec) => {
                         dec.decompress(codec, rec.data, size, &mut buf)
-                            .map_err(|e| {
-                                corrupt(path, format!("{}: {e}", at(Origin::File, pos)))
-                            })?;
+                            .map_err(fail)?;
                         &buf
                     }
                 };
@@ -409,9 +438,6 @@ fn walk(
             _ => {}
         }
         pos = next;
-        if let Some(r) = release.as_deref_mut() {
-            r.upto(pos);
-        }
     }
     Ok(())
 }
@@ -420,12 +446,13 @@ fn walk_chunk(
     path: &Path,
     chunk: &[u8],
     chunk_pos: u64,
-    visit: &mut dyn FnMut(Item<'_>) -> Result<(), RosError>,
-) -> Result<(), RosError> {
+    visit: &mut Visitor<'_>,
+) -> Result<(), ReadError> {
     let origin = Origin::Chunk(chunk_pos);
+    let mut chunk = Memory(chunk);
     let mut pos = 0;
-    while pos < chunk.len() {
-        let (rec, next) = record(chunk, pos, origin).map_err(|e| corrupt(path, e))?;
+    while pos < chunk.end() {
+        let (rec, next) = record(path, &mut chunk, pos, origin, |_| true)?;
         match rec.op {
             OP_MESSAGE => message(path, &rec, origin, pos, visit)?,
             OP_CONNECTION => {
@@ -445,8 +472,8 @@ fn message(
     rec: &Record<'_>,
     origin: Origin,
     pos: usize,
-    visit: &mut dyn FnMut(Item<'_>) -> Result<(), RosError>,
-) -> Result<(), RosError> {
+    visit: &mut Visitor<'_>,
+) -> Result<(), ReadError> {
     let conn = need_u32(rec.header, "conn", "message record")
         .map_err(|e| corrupt(path, format!("{}: {e}", at(origin, pos))))?;
     let time_ns =
@@ -460,16 +487,16 @@ fn message(
 
 /// Reads the messages of the connections `wanted` into `out`, in file order.
 pub(crate) fn read(
-    path: &Path,
-    map: &memmap2::Mmap,
+    file: &mut StorageFile,
     catalog: &Catalog,
     wanted: &HashSet<u32>,
     out: &mut Collector<'_>,
-) -> Result<(), RosError> {
-    let (index_pos, _, _, first) = bag_header(path, map)?;
+) -> Result<(), ReadError> {
+    let path = file.path().to_path_buf();
+    let (index_pos, _, _, first) = bag_header(file)?;
     let to = match index_pos {
-        0 => map.len(),
-        p => usize::try_from(p).unwrap_or(map.len()).min(map.len()),
+        0 => file.len(),
+        p => usize::try_from(p).unwrap_or(file.len()).min(file.len()),
     };
     let only: Option<HashSet<u64>> = catalog.chunks.as_ref().map(|chunks| {
         chunks
@@ -478,20 +505,18 @@ pub(crate) fn read(
             .map(|(p, _)| *p)
             .collect()
     });
-    let mut release = Release::new(map);
     walk(
-        path,
-        map,
+        &path,
+        file,
         first,
         to,
         only.as_ref(),
-        Some(&mut release),
         &mut |item| match item {
             Item::Message {
                 conn,
                 time_ns,
                 data,
-            } if wanted.contains(&conn) => out.push(Encoding::Ros1, time_ns, data),
+            } if wanted.contains(&conn) => Ok(out.push(Encoding::Ros1, time_ns, data)?),
             _ => Ok(()),
         },
     )
