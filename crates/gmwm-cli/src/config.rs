@@ -92,6 +92,9 @@ pub struct InputConfig {
     pub read: ReadOptions,
     /// `--topic`: the IMU topic of a ROS recording.
     pub topic: Option<String>,
+    /// `--stream-from`: rows from which a text or IMU-record recording is streamed
+    /// ([`gmwm::calib::STREAM_FROM`] by default).
+    pub stream_from: u64,
 }
 
 /// `--columns` entries: all digits → a 1-based index, anything else a name.
@@ -159,6 +162,7 @@ impl TryFrom<&InputArgs> for InputConfig {
             file: a.file.clone(),
             read,
             topic: a.topic.clone(),
+            stream_from: a.stream_from.unwrap_or(gmwm::calib::STREAM_FROM),
         })
     }
 }
@@ -1235,6 +1239,7 @@ mod tests {
             time_column: None,
             time_unit: None,
             topic: None,
+            stream_from: None,
         };
         assert_eq!(
             InputConfig::try_from(&args).unwrap_err().to_string(),

@@ -68,12 +68,26 @@ pub fn note_not_analysed(file: &Path, skipped: &[String]) {
 /// Prints what the reader found: the time column and its rate, the columns left out, then
 /// every warning, each once.
 fn report(table: &Table) {
-    let file = &table.path;
-    if let Some(t) = &table.timing {
+    report_parts(
+        &table.path,
+        table.timing.as_ref(),
+        &table.skipped,
+        &table.warnings,
+    );
+}
+
+/// [`report`] of a table's parts (a streamed table's too).
+pub(crate) fn report_parts(
+    file: &std::path::Path,
+    timing: Option<&gmwm::imu::TimingReport>,
+    skipped: &[String],
+    warnings: &[ReadWarning],
+) {
+    if let Some(t) = timing {
         note(file, &t.to_string());
     }
-    note_not_analysed(file, &table.skipped);
-    for w in &table.warnings {
+    note_not_analysed(file, skipped);
+    for w in warnings {
         match w {
             ReadWarning::FreqDisagrees {
                 given_hz,

@@ -584,12 +584,6 @@ impl StepStats {
         }
     }
 
-    /// Whether a bound was passed (module docs of [`StepStats`]): the stamps must be checked
-    /// in memory.
-    pub(crate) fn overflowed(&self) -> bool {
-        self.overflow
-    }
-
     /// The report [`check_times`] gives of the stamps pushed (with the gaps' lines), `None`
     /// when a bound was passed.
     pub(crate) fn finish(

@@ -5,6 +5,7 @@
 //! the selected columns and resolves the sampling frequency (see [`read_table`]).
 
 pub(crate) mod binary;
+pub mod stream;
 pub(crate) mod text;
 
 pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordType};
@@ -479,7 +480,7 @@ fn other_encoding(path: &Path) -> Option<ReadError> {
 }
 
 /// Whether the start of a plain file breaks lines with a carriage return alone.
-fn cr_line_ends(path: &Path) -> bool {
+pub(crate) fn cr_line_ends(path: &Path) -> bool {
     let head = head(path);
     !head.contains(&b'\n') && head.iter().filter(|&&b| b == b'\r').count() > 1
 }
@@ -686,11 +687,45 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         }
         None => (None, None),
     };
+    let freq_hz = resolve_rate(
+        path,
+        opts,
+        raw.freq_hz,
+        timing.as_ref(),
+        sidecar.as_ref(),
+        &mut warnings,
+    )?;
+    Ok(Table {
+        path: path.to_path_buf(),
+        columns: raw.columns,
+        freq_hz,
+        sidecar,
+        time,
+        timing,
+        warnings,
+        skipped: raw.skipped,
+        record_type: match format {
+            InputFormat::ImuRecord(t) => Some(t),
+            _ => None,
+        },
+    })
+}
+
+/// The sampling rate of a table (first match wins, as documented on [`read_table`]) and the
+/// warnings of a rate that disagrees with the time column's: shared by [`read_table`] and the
+/// streamed readers ([`stream`]).
+pub(crate) fn resolve_rate(
+    path: &Path,
+    opts: &ReadOptions,
+    format_hz: Option<f64>,
+    timing: Option<&TimingReport>,
+    sidecar: Option<&Sidecar>,
+    warnings: &mut Vec<ReadWarning>,
+) -> Result<Option<f64>, ReadError> {
     let time_hz = timing
-        .as_ref()
         .filter(|r| r.rate_hz.is_finite() && r.rate_hz > 0.0)
-        .map(|r| (r.column.clone(), raw.freq_hz.unwrap_or(r.rate_hz)));
-    let sidecar_hz = sidecar.as_ref().and_then(|s| s.sampling_frequency_hz);
+        .map(|r| (r.column.clone(), format_hz.unwrap_or(r.rate_hz)));
+    let sidecar_hz = sidecar.and_then(|s| s.sampling_frequency_hz);
     let disagree = |a: f64, b: f64| (a - b).abs() > RATE_TOLERANCE * b;
     if let Some((column, time_hz)) = &time_hz {
         if let Some(given_hz) = opts.freq_hz.filter(|&g| disagree(g, *time_hz)) {
@@ -714,27 +749,26 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
     let freq_hz = opts
         .freq_hz
         .or(time_hz.map(|(_, f)| f))
-        .or(raw.freq_hz)
+        .or(format_hz)
         .or(sidecar_hz);
     if let Some(f) = freq_hz {
         // a rate from the options, the time column or the sidecar must be usable: never
         // silently replaced by a default
         check_freq(f)?;
     }
-    Ok(Table {
-        path: path.to_path_buf(),
-        columns: raw.columns,
-        freq_hz,
-        sidecar,
-        time,
-        timing,
-        warnings,
-        skipped: raw.skipped,
-        record_type: match format {
-            InputFormat::ImuRecord(t) => Some(t),
-            _ => None,
-        },
-    })
+    Ok(freq_hz)
+}
+
+/// The warnings of a timing report, each naming the file.
+pub(crate) fn timing_warnings(path: &Path, report: &TimingReport) -> Vec<ReadWarning> {
+    report
+        .warnings()
+        .into_iter()
+        .map(|warning| ReadWarning::Timing {
+            path: path.to_path_buf(),
+            warning,
+        })
+        .collect()
 }
 
 /// Columns and time as decoded by a format reader, before unit, sidecar and frequency
