@@ -673,7 +673,9 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
         let wv = wv_options(&a.estimator)?;
         check_haar(&a.estimator, &wv)?;
         let full_model = a.model.as_deref().unwrap_or(DEFAULT_FULL_MODEL).parse()?;
+        let input: InputConfig = (&a.input).try_into()?;
         let options = CalibrationOptions {
+            stream_from: input.stream_from,
             full_model,
             wv,
             covariance: a.covariance.into(),
@@ -694,7 +696,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             (None, false) => Adjustment::Estimate,
         };
         Ok(Self {
-            input: (&a.input).try_into()?,
+            input,
             options,
             exports,
             adjustment,

@@ -286,6 +286,43 @@ pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
     })
 }
 
+/// A text or IMU-record recording the calibration streams, read once into its spool
+/// ([`gmwm::imu::read::stream::StreamedTable`]): its columns, what each measures, and what the
+/// reader noticed, as [`load_recording`] gives them.
+pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> LoadedRecording {
+    let record = t.record_type.is_some();
+    let mut notes = gmwm::imu::recording::table_notes(
+        t.record_type,
+        t.timing.as_ref(),
+        &t.skipped,
+        &t.warnings,
+    );
+    notes.extend(t.notes.iter().cloned());
+    LoadedRecording {
+        path: shown_path(&t.path),
+        columns: t
+            .names
+            .iter()
+            .map(|n| {
+                (
+                    n.clone(),
+                    gmwm::imu::SensorInfo::of_column(n, t.sidecar.as_ref(), record),
+                )
+            })
+            .collect(),
+        imu: None,
+        topic: None,
+        source: match t.record_type {
+            Some(r) => gmwm::imu::RecordingSource::Records {
+                record_type: r.name().to_string(),
+            },
+            None => gmwm::imu::RecordingSource::Table,
+        },
+        timing: t.timing.clone(),
+        notes,
+    }
+}
+
 /// A ROS recording read as a table: the IMU topic's six axes at the header stamps' rate.
 fn load_ros(input: &InputConfig) -> Result<Loaded> {
     let rec = gmwm::imu::Recording::open(

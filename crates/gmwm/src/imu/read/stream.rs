@@ -148,7 +148,7 @@ impl StreamedTable {
         }
         match format {
             InputFormat::ImuRecord(t) => open_records_stream(path, t, opts, sidecar),
-            InputFormat::F64 | InputFormat::F32 | InputFormat::Auto => Err(ParamError::new(
+            InputFormat::F64 | InputFormat::F32 => Err(ParamError::new(
                 "format",
                 format.to_string(),
                 "text or binary IMU records for a streamed read (raw binary streams as it is)",
@@ -190,6 +190,12 @@ impl StreamedTable {
             .into_iter()
             .map(|c| c.wv)
             .collect())
+    }
+
+    /// The spool as a raw binary recording: its path and layout (the selected columns, then
+    /// the relative stamps and their lines when there is a time column).
+    pub(crate) fn spooled(&self) -> (&Path, BinaryLayout) {
+        (&self.spool.path, self.layout())
     }
 
     fn layout(&self) -> BinaryLayout {
