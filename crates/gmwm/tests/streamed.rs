@@ -221,7 +221,12 @@ fn same_as_in_memory(path: &Path, read: &ReadOptions) -> (Table, StreamedTable) 
         let m = wavelet_variance(&c.values, freq, &WvOptions::default()).unwrap();
         assert_eq!(m.wv().len(), s.wv().len());
         for (a, b) in m.wv().iter().zip(s.wv()) {
-            assert!(rel(*b, *a) < 1e-12, "{} {}: {a} {b}", path.display(), c.name);
+            assert!(
+                rel(*b, *a) < 1e-12,
+                "{} {}: {a} {b}",
+                path.display(),
+                c.name
+            );
         }
         assert_eq!(m.n_coefficients(), s.n_coefficients());
     }
@@ -254,10 +259,16 @@ fn streamed_records_equal_in_memory_for_every_type() {
         let mut state = 7u64;
         let mut time = 1000.0;
         for i in 0..20_000 {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let c = |k: u64| ((state >> (8 * k)) % 2001) as i32 - 1000;
             // a gap of 50 epochs and quantised jitter
-            time += if i == 5000 { 0.25 } else { 0.005 + 1e-6 * (i % 3) as f64 };
+            time += if i == 5000 {
+                0.25
+            } else {
+                0.005 + 1e-6 * (i % 3) as f64
+            };
             bytes.extend(crate::read::record(
                 t,
                 time,
@@ -290,7 +301,9 @@ fn streamed_text_with_time_column_equals_in_memory() {
     let n = 50_000;
     let mut state = 3u64;
     let mut next = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let mut ns = String::from("timestamp,gyro_x,accel_y,temp\n");
@@ -308,7 +321,11 @@ fn streamed_text_with_time_column_equals_in_memory() {
     }
     // more rows than the streamed check holds distinct steps
     for i in 0..(gmwm::imu::timing::STREAM_DISTINCT_STEPS + 5000) {
-        s.push_str(&format!("{},{}\n", 0.005 * i as f64 + 1e-5 * next(), next()));
+        s.push_str(&format!(
+            "{},{}\n",
+            0.005 * i as f64 + 1e-5 * next(),
+            next()
+        ));
     }
     let write = |name: &str, text: &str| {
         let path = dir.path().join(name);
@@ -322,9 +339,17 @@ fn streamed_text_with_time_column_equals_in_memory() {
     assert_eq!(table.skipped, ["temp"]);
     assert!(streamed.notes.is_empty(), "{:?}", streamed.notes);
     let (_, streamed) = same_as_in_memory(&write("ms.csv", &ms), &ReadOptions::default());
-    assert!(streamed.notes[0].contains("inferred"), "{:?}", streamed.notes);
+    assert!(
+        streamed.notes[0].contains("inferred"),
+        "{:?}",
+        streamed.notes
+    );
     let (_, streamed) = same_as_in_memory(&write("s.csv", &s), &ReadOptions::default());
-    assert!(streamed.notes[0].contains("distinct steps"), "{:?}", streamed.notes);
+    assert!(
+        streamed.notes[0].contains("distinct steps"),
+        "{:?}",
+        streamed.notes
+    );
     // a bad cell: the same error, with its line
     let bad = ns.replacen(",9.8", ",x9.8", 1);
     let path = write("bad.csv", &bad);

@@ -90,8 +90,7 @@ pub fn execute_in(
         && calibration.streams(&config.input.file, &config.input.read)?;
     // text and IMU records are read once, into a spool the calibration streams from
     let table = if streamed
-        && gmwm::imu::read::stream::streamed_size(&config.input.file, &config.input.read)?
-            .is_some()
+        && gmwm::imu::read::stream::streamed_size(&config.input.file, &config.input.read)?.is_some()
     {
         Some(gmwm::imu::read::stream::StreamedTable::open(
             &config.input.file,
@@ -121,9 +120,7 @@ pub fn execute_in(
             .map_err(gmwm::Error::from),
         None => match &table {
             Some(t) => calibration.run_table(t, &Ticks(&progress)),
-            None => {
-                calibration.run_file(&config.input.file, &config.input.read, &Ticks(&progress))
-            }
+            None => calibration.run_file(&config.input.file, &config.input.read, &Ticks(&progress)),
         },
     }
     .with_context(|| recording.path.display().to_string())?;

@@ -27,10 +27,10 @@
 
 use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
 use crate::error::{Error, ParamError};
+use crate::imu::read::stream::{streams_from, StreamedTable};
 use crate::imu::{
     binary_layout, find_sidecar, BinaryChunks, BinaryLayout, ReadError, ReadOptions, SensorInfo,
 };
-use crate::imu::read::stream::{streams_from, StreamedTable};
 use crate::inference::Progress;
 use crate::variance::binary_wavelet_variance;
 use crate::variance::ci::eta3;
@@ -71,8 +71,7 @@ impl Calibration {
     }
 
     fn streams_table(&self, path: &Path, read: &ReadOptions) -> Result<bool, Error> {
-        Ok(self.classical_haar()
-            && streams_from(path, read, self.options().stream_from)?)
+        Ok(self.classical_haar() && streams_from(path, read, self.options().stream_from)?)
     }
 
     fn stream_layout(
@@ -232,7 +231,7 @@ impl Calibration {
                 || {
                     classical_pass(
                         path,
-                        &layout,
+                        layout,
                         &streamed,
                         levels,
                         freq_hz,
@@ -242,7 +241,7 @@ impl Calibration {
                 || {
                     robust_opts
                         .as_ref()
-                        .map(|o| robust_pass(path, &layout, &streamed, o))
+                        .map(|o| robust_pass(path, layout, &streamed, o))
                         .transpose()
                 },
             );

@@ -614,7 +614,7 @@ impl StepStats {
         let sorted = || {
             counted
                 .iter()
-                .flat_map(|&(d, c)| std::iter::repeat_n(d, c as usize))
+                .flat_map(|&(d, c)| std::iter::repeat(d).take(c as usize))
         };
         let mut gaps = Vec::new();
         let (rate_hz, jitter) = match weighted_median(&mut counted.clone()) {
@@ -627,8 +627,11 @@ impl StepStats {
                     // every step held is a gap: others may have been let go
                     return None;
                 }
-                let mut large: Vec<Step> =
-                    held.into_iter().map(|s| s.0).filter(|s| s.d > limit).collect();
+                let mut large: Vec<Step> = held
+                    .into_iter()
+                    .map(|s| s.0)
+                    .filter(|s| s.d > limit)
+                    .collect();
                 large.sort_unstable_by_key(|s| s.row);
                 gaps = large
                     .into_iter()
@@ -953,7 +956,13 @@ mod tests {
         let mut t = Vec::new();
         let mut now = 0.0;
         for i in 0..(3 * STREAM_LARGEST_STEPS) {
-            now += if i % 1000 == 7 { 5.0 } else if i % 2 == 0 { 1.25 } else { 1.0 };
+            now += if i % 1000 == 7 {
+                5.0
+            } else if i % 2 == 0 {
+                1.25
+            } else {
+                1.0
+            };
             t.push(now);
         }
         let a = check_times("t", &t, TimeUnit::Seconds, UnitSource::Stated);

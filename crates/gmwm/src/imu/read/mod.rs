@@ -674,15 +674,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
                     g.line = Some(lines.line_of(g.row));
                 }
             }
-            warnings.extend(
-                report
-                    .warnings()
-                    .into_iter()
-                    .map(|warning| ReadWarning::Timing {
-                        path: path.to_path_buf(),
-                        warning,
-                    }),
-            );
+            warnings.extend(timing_warnings(path, &report));
             (Some(col), Some(report))
         }
         None => (None, None),

@@ -21,7 +21,17 @@
 //!
 //! The values, the selection, the errors (with file and line), the time report and the rate
 //! are those of [`read_table`](super::read_table) on the same file (tests:
-//! `crates/gmwm/tests/streamed.rs`).
+//! `crates/gmwm/tests/streamed.rs`); the WVs equal the in-memory ones within 1e-12 (the same
+//! values, the squares summed in another grouping).
+//!
+//! Cost (measured on a busy 2-core machine, indicative, `gmwm wv FILE --json` on a CSV of a
+//! `time [s]` column and six columns at 200 Hz, streamed with `--stream-from 1` against the
+//! in-memory reader, back to back): 10^6 rows, 35 MB peak RSS against 79 MB, 0.70 s against
+//! 0.73 s (plain), 1.05 s against 1.01 s (gzip); 10^7 rows, 77 MB against 711 MB, 9.3 s
+//! against 6.7 s (plain, 690 MB), 13.1 s against 10.1 s (gzip, 270 MB). The RSS grows from
+//! 10^6 to 10^7 rows only by the rings of levels 19 and 20 of the WV (8 MiB a column at
+//! most, [`binary_wavelet_variance`](crate::variance::binary_wavelet_variance)), not with N;
+//! the time is the one parse of the in-memory reader, plus writing and reading the spool.
 
 use super::binary::{
     decode, decode_i32, for_each_record_run, non_finite, open_records, RECORD_COLUMNS,
@@ -208,16 +218,12 @@ impl StreamedTable {
         }
     }
 
-    /// An error about the spool, about the recording instead.
+    /// An error about a column of the spool, about the recording's column instead.
     fn rename(&self, e: ReadError) -> ReadError {
         match e {
             ReadError::Series { column, source, .. } => ReadError::Series {
                 path: self.path.clone(),
                 column,
-                source,
-            },
-            ReadError::Io { source, .. } => ReadError::Io {
-                path: self.spool.path.clone(),
                 source,
             },
             e => e,
@@ -252,12 +258,7 @@ impl Spool {
                 .create_new(true)
                 .open(&path)
             {
-                Ok(f) => {
-                    return Ok((
-                        Self { path, ncols },
-                        BufWriter::with_capacity(1 << 20, f),
-                    ))
-                }
+                Ok(f) => return Ok((Self { path, ncols }, BufWriter::with_capacity(1 << 20, f))),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
                 Err(e) => return Err(io(&path, e)),
             }
@@ -267,7 +268,8 @@ impl Spool {
     /// Reads column `k` (0-based) back.
     fn column(&self, k: usize) -> Result<Vec<f64>, ReadError> {
         let mut out = Vec::new();
-        let mut chunks = super::BinaryChunks::open(&self.path, InputFormat::F64, self.ncols, k + 1, 1 << 16)?;
+        let mut chunks =
+            super::BinaryChunks::open(&self.path, InputFormat::F64, self.ncols, k + 1, 1 << 16)?;
         while let Some(c) = chunks.next_chunk()? {
             out.extend_from_slice(c);
         }
@@ -407,7 +409,12 @@ fn open_text_stream(
         source,
     })?;
     drop(out);
-    let names: Vec<String> = pass.sel.columns.iter().map(|&k| pass.names[k].clone()).collect();
+    let names: Vec<String> = pass
+        .sel
+        .columns
+        .iter()
+        .map(|&k| pass.names[k].clone())
+        .collect();
     if names.is_empty() {
         return Err(ReadError::NoDataColumn {
             path: path.to_path_buf(),
@@ -423,13 +430,7 @@ fn open_text_stream(
     let mut notes = Vec::new();
     let timing = match check {
         None => None,
-        Some(check) => Some(finish_check(
-            path,
-            check,
-            &spool,
-            names.len(),
-            &mut notes,
-        )?),
+        Some(check) => Some(finish_check(path, check, &spool, names.len(), &mut notes)?),
     };
     finish(
         path,
@@ -484,8 +485,8 @@ fn finish_check(
         let k = unit.to_seconds();
         values.iter_mut().for_each(|t| *t *= k);
     }
-    if let Some(row) = (0..values.len())
-        .find(|&i| !values[i].is_finite() || (i > 0 && values[i] <= values[i - 1]))
+    if let Some(row) =
+        (0..values.len()).find(|&i| !values[i].is_finite() || (i > 0 && values[i] <= values[i - 1]))
     {
         return Err(ReadError::TimeResolution {
             path: path.to_path_buf(),

@@ -169,19 +169,26 @@ pub(crate) fn read_text_table(
     let mut values: Vec<Vec<f64>> = Vec::new();
     let mut time = Vec::new();
     let mut lines = LineMap::default();
-    let pass = for_each_text_row(path, format, opts, sidecar, |_, _| Ok(()), |row, stamp| {
-        if values.is_empty() {
-            values = vec![Vec::new(); row.len()];
-        }
-        for (v, &x) in values.iter_mut().zip(row) {
-            v.push(x);
-        }
-        if let Some((rel, line, _)) = stamp {
-            time.push(rel);
-            lines.push(line);
-        }
-        Ok(())
-    })?;
+    let pass = for_each_text_row(
+        path,
+        format,
+        opts,
+        sidecar,
+        |_, _| Ok(()),
+        |row, stamp| {
+            if values.is_empty() {
+                values = vec![Vec::new(); row.len()];
+            }
+            for (v, &x) in values.iter_mut().zip(row) {
+                v.push(x);
+            }
+            if let Some((rel, line, _)) = stamp {
+                time.push(rel);
+                lines.push(line);
+            }
+            Ok(())
+        },
+    )?;
     if values.is_empty() {
         values = vec![Vec::new(); pass.sel.columns.len()];
     }
