@@ -1,5 +1,8 @@
-//! Calibration of a raw binary recording streamed from its file, in memory bounded whatever
-//! its length (a day at 1 kHz is 8.6·10^7 samples an axis).
+//! Calibration of a recording streamed from its file, in memory bounded whatever its length
+//! (a day at 1 kHz is 8.6·10^7 samples an axis): a raw binary recording as it is, text and
+//! binary IMU records through the raw f64 spool that
+//! [`StreamedTable`](crate::imu::read::stream::StreamedTable) writes in its one pass over the
+//! file ([`Calibration::run_table`]).
 //!
 //! The pipeline of [`Calibration::run`] needs the samples only for four things, and each has a
 //! streamed form:
@@ -23,7 +26,10 @@
 //!
 //! Memory: that of [`binary_wavelet_variance`] (the rings up to level 20, 8 MiB an axis, and a
 //! few chunks of rows per thread) and one block per axis for the robust check: tens of MB an
-//! axis whatever the length.
+//! axis whatever the length. Measured (`gmwm calibrate FILE.csv.gz --stream-from 1`, six axes
+//! and a time column at 200 Hz, a busy 2-core machine, indicative): 10^6 rows 171 MB peak RSS
+//! (in memory: 98 MB), 10^7 rows 346 MB (in memory: 796 MB), in 29 s against 30 s in memory;
+//! from 2^21 rows on, the robust check's blocks are full and the memory stays there.
 
 use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
 use crate::error::{Error, ParamError};

@@ -29,9 +29,11 @@
 //! in-memory reader, back to back): 10^6 rows, 35 MB peak RSS against 79 MB, 0.70 s against
 //! 0.73 s (plain), 1.05 s against 1.01 s (gzip); 10^7 rows, 77 MB against 711 MB, 9.3 s
 //! against 6.7 s (plain, 690 MB), 13.1 s against 10.1 s (gzip, 270 MB). The RSS grows from
-//! 10^6 to 10^7 rows only by the rings of levels 19 and 20 of the WV (8 MiB a column at
-//! most, [`binary_wavelet_variance`](crate::variance::binary_wavelet_variance)), not with N;
-//! the time is the one parse of the in-memory reader, plus writing and reading the spool.
+//! 10^6 to 10^7 rows mostly by the rings of levels 19 and 20 of the WV (8 MiB a column at
+//! most, [`binary_wavelet_variance`](crate::variance::binary_wavelet_variance)); at 3·10^7
+//! rows (gzip, 806 MB) it is 98 MB (44 s), where the in-memory reader would hold 1.4 GB of
+//! columns. The time is the one parse of the in-memory reader, plus writing and reading the
+//! spool.
 
 use super::binary::{
     decode, decode_i32, for_each_record_run, non_finite, open_records, RECORD_COLUMNS,
@@ -59,7 +61,7 @@ use std::path::{Path, PathBuf};
 /// use gmwm::imu::read::stream::StreamedTable;
 /// let table = StreamedTable::open("imu.csv.gz".as_ref(), &Default::default())?;
 /// let wvs = table.wavelet_variance(table.freq_hz.unwrap_or(1.0), &Default::default())?;
-/// println!("{} rows, {}", table.rows, wvs[0].wv);
+/// println!("{} rows, {:?}", table.rows, wvs[0].wv());
 /// # Ok::<(), gmwm::imu::ReadError>(())
 /// ```
 #[derive(Debug)]
