@@ -1,7 +1,7 @@
 //! Calibration of a recording streamed from its file, in memory bounded whatever its length
 //! (a day at 1 kHz is 8.6·10^7 samples an axis): a raw binary recording as it is, text and
 //! binary IMU records through the raw f64 spool that
-//! [`StreamedTable`](crate::imu::read::stream::StreamedTable) writes in its one pass over the
+//! [`StreamedTable`] writes in its one pass over the
 //! file ([`Calibration::run_table`]).
 //!
 //! The pipeline of [`Calibration::run`] needs the samples only for four things, and each has a
@@ -61,7 +61,7 @@ impl Calibration {
     /// MODWT WV: a raw binary f64/f32 file (by `read.format`, its name or its sidecar) of at
     /// least `stream_from` rows whose columns have no time column; or text or binary IMU
     /// records of at least `stream_from` rows
-    /// ([`streams_from`](crate::imu::read::stream::streams_from): a text file counts a row for
+    /// ([`streams_from`]: a text file counts a row for
     /// every 8 bytes, its rows being known only once read).
     ///
     /// # Errors

@@ -462,7 +462,7 @@ pub fn check_times(
     }
 }
 
-/// Distinct positive steps a streamed check ([`StepStats`]) holds: 2^16. Stamps from a clock
+/// Distinct positive steps a streamed check (`StepStats`) holds: 2^16. Stamps from a clock
 /// are quantised, so their steps take few values (a 200 Hz log stamped in ns: a handful; the
 /// relative stamps of a text file in seconds: a few a binade); beyond this many the check
 /// cannot be exact in bounded memory, and the readers check the column in memory instead.

@@ -1,6 +1,6 @@
 //! Streamed readers of text (CSV/TSV, plain or gzip) and binary IMU records: one pass over the
-//! file through the in-memory readers' own parser ([`super::text::for_each_text_row`], the
-//! record decoding of [`super::binary`]), the selected columns written as raw little-endian
+//! file through the in-memory readers' own parser (`text::for_each_text_row`, the
+//! record decoding of `binary`), the selected columns written as raw little-endian
 //! f64 to a spool file (deleted when the [`StreamedTable`] is dropped) that the streamed
 //! wavelet variance reads like any raw binary recording
 //! ([`binary_columns_wv`]), and the time column checked as it goes by.
@@ -11,7 +11,7 @@
 //! read back, its raw f64 copy can, by several threads at once. The spool takes
 //! `8 · columns · rows` bytes of disk in [`std::env::temp_dir`] (`TMPDIR`), none of memory.
 //!
-//! The time column: [`StepStats`] gives the report of [`check_times`] bit for bit without
+//! The time column: `timing::StepStats` gives the report of [`check_times`] bit for bit without
 //! holding the stamps, from the distinct steps and the largest ones. When its bounds are
 //! passed (more than [`STREAM_DISTINCT_STEPS`](crate::imu::timing::STREAM_DISTINCT_STEPS)
 //! distinct steps, or more gaps than it holds), or when the unit of the stamps must be
@@ -298,7 +298,7 @@ fn write_row(out: &mut BufWriter<File>, spool: &Path, row: &[f64]) -> Result<(),
 
 /// The time column's check while streaming: stamps converted to seconds and checked strictly
 /// increasing (as [`read_table`](super::read_table) checks them after the conversion), then
-/// pushed to [`StepStats`] when the unit is known.
+/// pushed to `StepStats` when the unit is known.
 struct TimeCheck {
     column: String,
     unit: Option<(TimeUnit, UnitSource)>,
