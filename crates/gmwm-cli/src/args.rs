@@ -682,6 +682,12 @@ pub struct InputArgs {
     /// [default: its only IMU topic; `gmwm topics FILE` lists them].
     #[arg(long, value_name = "TOPIC")]
     pub topic: Option<String>,
+    /// `gmwm wv` and `gmwm calibrate`: read a text or binary IMU record recording of at least
+    /// ROWS rows streamed (one pass, memory bounded whatever its length) instead of loading
+    /// it; a text file counts one row for every 8 bytes, its rows being known only once read
+    /// [default: 16777216 = 2^24].
+    #[arg(long, value_name = "ROWS", value_parser = clap::value_parser!(u64).range(1..))]
+    pub stream_from: Option<u64>,
 }
 
 /// `--time-unit`.

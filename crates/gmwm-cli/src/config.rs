@@ -92,6 +92,9 @@ pub struct InputConfig {
     pub read: ReadOptions,
     /// `--topic`: the IMU topic of a ROS recording.
     pub topic: Option<String>,
+    /// `--stream-from`: rows from which a text or IMU-record recording is streamed
+    /// ([`gmwm::calib::STREAM_FROM`] by default).
+    pub stream_from: u64,
 }
 
 /// `--columns` entries: all digits → a 1-based index, anything else a name.
@@ -159,6 +162,7 @@ impl TryFrom<&InputArgs> for InputConfig {
             file: a.file.clone(),
             read,
             topic: a.topic.clone(),
+            stream_from: a.stream_from.unwrap_or(gmwm::calib::STREAM_FROM),
         })
     }
 }
@@ -669,7 +673,9 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
         let wv = wv_options(&a.estimator)?;
         check_haar(&a.estimator, &wv)?;
         let full_model = a.model.as_deref().unwrap_or(DEFAULT_FULL_MODEL).parse()?;
+        let input: InputConfig = (&a.input).try_into()?;
         let options = CalibrationOptions {
+            stream_from: input.stream_from,
             full_model,
             wv,
             covariance: a.covariance.into(),
@@ -681,7 +687,6 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             accel_unit: a.accel_unit,
             // the contamination check compares with the robust WV at --eff
             robust_check: Some(robust_at_eff(&a.estimator)?),
-            ..CalibrationOptions::default()
         };
         let exports = exports(a)?;
         let adjustment = match (a.inflate, a.conservative) {
@@ -690,7 +695,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             (None, false) => Adjustment::Estimate,
         };
         Ok(Self {
-            input: (&a.input).try_into()?,
+            input,
             options,
             exports,
             adjustment,
@@ -1235,6 +1240,7 @@ mod tests {
             time_column: None,
             time_unit: None,
             topic: None,
+            stream_from: None,
         };
         assert_eq!(
             InputConfig::try_from(&args).unwrap_err().to_string(),

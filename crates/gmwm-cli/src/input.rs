@@ -68,13 +68,29 @@ pub fn note_not_analysed(file: &Path, skipped: &[String]) {
 /// Prints what the reader found: the time column and its rate, the columns left out, then
 /// every warning, each once.
 fn report(table: &Table) {
-    let file = &table.path;
-    if let Some(t) = &table.timing {
+    report_parts(
+        &table.path,
+        table.timing.as_ref(),
+        &table.skipped,
+        &table.samples,
+        &table.warnings,
+    );
+}
+
+/// [`report`] of a table's parts (a streamed table's too).
+pub(crate) fn report_parts(
+    file: &std::path::Path,
+    timing: Option<&gmwm::imu::TimingReport>,
+    skipped: &[String],
+    samples: &gmwm::imu::SampleAccount,
+    warnings: &[ReadWarning],
+) {
+    if let Some(t) = timing {
         note(file, &t.to_string());
     }
-    note_not_analysed(file, &table.skipped);
-    note(file, &table.samples.to_string());
-    for w in &table.warnings {
+    note_not_analysed(file, skipped);
+    note(file, &samples.to_string());
+    for w in warnings {
         match w {
             ReadWarning::FreqDisagrees {
                 given_hz,
@@ -296,6 +312,45 @@ fn streamed_samples(
         None => 0,
     };
     Ok(gmwm::imu::SampleAccount::all_used(names, "row", rows))
+}
+
+/// A text or IMU-record recording the calibration streams, read once into its spool
+/// ([`gmwm::imu::read::stream::StreamedTable`]): its columns, what each measures, and what the
+/// reader noticed, as [`load_recording`] gives them.
+pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> LoadedRecording {
+    let record = t.record_type.is_some();
+    let mut notes = gmwm::imu::recording::table_notes(
+        t.record_type,
+        t.timing.as_ref(),
+        &t.skipped,
+        &t.samples,
+        &t.warnings,
+    );
+    notes.extend(t.notes.iter().cloned());
+    LoadedRecording {
+        path: shown_path(&t.path),
+        columns: t
+            .names
+            .iter()
+            .map(|n| {
+                (
+                    n.clone(),
+                    gmwm::imu::SensorInfo::of_column(n, t.sidecar.as_ref(), record),
+                )
+            })
+            .collect(),
+        imu: None,
+        topic: None,
+        source: match t.record_type {
+            Some(r) => gmwm::imu::RecordingSource::Records {
+                record_type: r.name().to_string(),
+            },
+            None => gmwm::imu::RecordingSource::Table,
+        },
+        timing: t.timing.clone(),
+        samples: t.samples.clone(),
+        notes,
+    }
 }
 
 /// A ROS recording read as a table: the IMU topic's six axes at the header stamps' rate.

@@ -247,3 +247,172 @@ fn streamed_columns_are_the_ones_the_loader_analyses() {
     assert_eq!(doc["series"][0]["name"], "counter");
     assert_eq!(doc["series"][1]["name"], "gyro_x");
 }
+
+// ---- issue 14: text and binary IMU records streamed (`--stream-from`) ----
+
+/// `gmwm wv FILE --json` with extra flags: the document and stderr.
+fn wv_doc(file: &Path, extra: &[&str]) -> (serde_json::Value, String) {
+    let out = gmwm()
+        .arg("wv")
+        .arg(file)
+        .arg("--json")
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    (
+        serde_json::from_slice(&out.stdout).unwrap(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Streamed (`--stream-from 1`) and loaded (the default: these files are below 2^24 rows)
+/// give the same series, N, rate and WV within 1e-12 (the same values, summed in another
+/// grouping, as for raw binary above), and the same notes and warnings on stderr.
+fn streamed_equals_loaded(file: &Path, extra: &[&str]) -> usize {
+    let (a, ea) = wv_doc(file, &[extra, &["--stream-from", "1"]].concat());
+    let (b, eb) = wv_doc(file, extra);
+    assert_eq!(ea, eb, "{}: stderr", file.display());
+    let (sa, sb) = (
+        a["series"].as_array().unwrap(),
+        b["series"].as_array().unwrap(),
+    );
+    assert_eq!(sa.len(), sb.len(), "{}", file.display());
+    for (x, y) in sa.iter().zip(sb) {
+        assert_eq!(x["name"], y["name"]);
+        assert_eq!(x["n"], y["n"]);
+        assert_eq!(x["freq_hz"], y["freq_hz"]);
+        let (wx, wy) = (x["wv"].as_array().unwrap(), y["wv"].as_array().unwrap());
+        assert_eq!(wx.len(), wy.len());
+        for (u, v) in wx.iter().zip(wy) {
+            let (u, v) = (u.as_f64().unwrap(), v.as_f64().unwrap());
+            assert!(((u - v) / v).abs() < TOL, "{}: {u} {v}", file.display());
+        }
+    }
+    sa.len()
+}
+
+#[test]
+fn streamed_text_equals_loaded_on_every_shared_recording() {
+    let mut names: Vec<String> = std::fs::read_dir(shared_data())
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".csv.gz"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 7);
+    let series: usize = names
+        .iter()
+        .map(|n| streamed_equals_loaded(&shared_data().join(n), &[]))
+        .sum();
+    assert!(series >= 37, "{series}");
+}
+
+fn record_bytes(kind: &str, time: f64, counts: [i32; 6]) -> Vec<u8> {
+    let mut out = time.to_le_bytes().to_vec();
+    for c in counts {
+        if matches!(kind, "ixsea" | "navchip-flt") {
+            out.extend_from_slice(&f64::from(c).to_le_bytes());
+        } else {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    out
+}
+
+#[test]
+fn streamed_records_equal_loaded_for_every_type() {
+    let dir = tempfile::tempdir().unwrap();
+    for kind in [
+        "imar",
+        "ln200",
+        "ln200ig",
+        "ixsea",
+        "navchip-int",
+        "navchip-flt",
+    ] {
+        let path = dir.path().join(format!("{kind}.bin"));
+        let mut bytes = Vec::new();
+        let mut state = 11u64;
+        for i in 0..30_000u32 {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let c = |k: u64| ((state >> (8 * k)) % 2001) as i32 - 1000;
+            // 400 Hz with a gap of 40 epochs
+            let time = 50.0 + f64::from(i + if i >= 9000 { 40 } else { 0 }) / 400.0;
+            bytes.extend(record_bytes(
+                kind,
+                time,
+                [c(0), c(1), c(2), c(3), c(4), 8000 + c(5)],
+            ));
+        }
+        std::fs::write(&path, bytes).unwrap();
+        assert_eq!(streamed_equals_loaded(&path, &["--format", kind]), 6);
+    }
+}
+
+#[test]
+fn streamed_csv_with_time_column_equals_loaded() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("imu.csv");
+    let mut text = String::from("timestamp [ns],gyro_x,gyro_y,accel_z,temp\n");
+    let mut t: i64 = 1_700_000_000_000_000_000;
+    for i in 0..40_000i64 {
+        t += 5_000_000 + (i * 7919 % 97) * 1000 + if i % 15_000 == 3 { 60_000_000 } else { 0 };
+        let x = ((i * 31337) % 1000) as f64 / 1000.0;
+        text.push_str(&format!("{t},{x},{},{},{}\n", 1.0 - x, 9.8 + x * 1e-3, 25));
+    }
+    std::fs::write(&path, text).unwrap();
+    assert_eq!(streamed_equals_loaded(&path, &[]), 3);
+    let (_, stderr) = wv_doc(&path, &["--stream-from", "1"]);
+    assert!(stderr.contains("gap"), "{stderr}");
+    assert!(stderr.contains("not analysed"), "{stderr}");
+}
+
+/// `gmwm calibrate` of a CSV streamed: the spool's streamed calibration, which says so, with
+/// the same axes as the loaded one.
+#[test]
+fn calibrate_streams_a_csv_from_the_threshold() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = common::simulate(
+        dir.path(),
+        "sim.f64",
+        "WN(sigma2=1e-4)+RW(gamma2=1e-10)",
+        200_000,
+        100.0,
+        3,
+    );
+    let values: Vec<f64> = std::fs::read(&sim)
+        .unwrap()
+        .chunks_exact(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let path = dir.path().join("imu.csv");
+    let mut text = String::from("time,gyro_x,accel_x\n");
+    for (i, v) in values.iter().enumerate() {
+        text.push_str(&format!("{},{v},{}\n", i as f64 / 100.0, 9.8 + v));
+    }
+    std::fs::write(&path, text).unwrap();
+    let report = |extra: &[&str]| {
+        run_json(
+            gmwm()
+                .arg("calibrate")
+                .arg(&path)
+                .args(["--json", "-"])
+                .args(extra),
+        )
+    };
+    let streamed = report(&["--stream-from", "1"]);
+    let loaded = report(&[]);
+    let s = streamed.to_string();
+    assert!(s.contains("streamed from the file"), "{s}");
+    assert!(!loaded.to_string().contains("streamed from the file"));
+    let axes = |d: &serde_json::Value| -> Vec<String> {
+        d["report"]["axes"]
+            .as_array()
+            .map(|a| a.iter().map(|x| x["column"].to_string()).collect())
+            .unwrap_or_default()
+    };
+    assert_eq!(axes(&streamed), axes(&loaded));
+}

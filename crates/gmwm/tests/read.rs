@@ -1254,7 +1254,7 @@ fn scales(t: ImuRecordType) -> (f64, f64) {
     }
 }
 
-fn record(t: ImuRecordType, time: f64, counts: [i32; 6]) -> Vec<u8> {
+pub(crate) fn record(t: ImuRecordType, time: f64, counts: [i32; 6]) -> Vec<u8> {
     if t.is_double() {
         double_record(time, counts.map(f64::from))
     } else {

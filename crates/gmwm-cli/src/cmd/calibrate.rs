@@ -88,10 +88,21 @@ pub fn execute_in(
     // a long raw binary recording is calibrated while streamed from the file (bounded memory)
     let streamed = config.input.topic.is_none()
         && calibration.streams(&config.input.file, &config.input.read)?;
-    let recording = if streamed {
-        crate::input::streamed_recording(&config.input)?
+    // text and IMU records are read once, into a spool the calibration streams from
+    let table = if streamed
+        && gmwm::imu::read::stream::streamed_size(&config.input.file, &config.input.read)?.is_some()
+    {
+        Some(gmwm::imu::read::stream::StreamedTable::open(
+            &config.input.file,
+            &config.input.read,
+        )?)
     } else {
-        crate::input::load_recording(&config.input)?
+        None
+    };
+    let recording = match &table {
+        Some(t) => crate::input::streamed_table_recording(t),
+        None if streamed => crate::input::streamed_recording(&config.input)?,
+        None => crate::input::load_recording(&config.input)?,
     };
     if !exports.is_empty() {
         check_units_known(config, &recording)?;
@@ -107,7 +118,10 @@ pub fn execute_in(
         Some(imu) => calibration
             .run_with_progress(imu, &Ticks(&progress))
             .map_err(gmwm::Error::from),
-        None => calibration.run_file(&config.input.file, &config.input.read, &Ticks(&progress)),
+        None => match &table {
+            Some(t) => calibration.run_table(t, &Ticks(&progress)),
+            None => calibration.run_file(&config.input.file, &config.input.read, &Ticks(&progress)),
+        },
     }
     .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();

@@ -93,6 +93,55 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
     })
 }
 
+/// Text or binary IMU records of at least `--stream-from` rows (a text file: 8 bytes a row),
+/// with the classical Haar MODWT estimator, stream
+/// ([`gmwm::imu::read::stream::StreamedTable`]): one pass over the file, memory bounded.
+pub(crate) fn streams_text(input: &InputConfig, opts: &WvOptions) -> Result<bool> {
+    if crate::spool::is_stdin(&input.file)
+        || opts.robust.is_some()
+        || opts.transform != Transform::Modwt
+        || opts.filter != WaveletFilter::Haar
+    {
+        return Ok(false);
+    }
+    Ok(gmwm::imu::read::stream::streams_from(
+        &input.file,
+        &input.read,
+        input.stream_from,
+    )?)
+}
+
+/// The selected columns of a text or IMU-record recording, streamed: as the in-memory path
+/// reads them (columns, rate, notes and timing warnings), the WV of each.
+fn run_streamed_table(
+    input: &InputConfig,
+    opts: &WvOptions,
+) -> Result<Vec<(String, WaveletVariance)>> {
+    let table = gmwm::imu::read::stream::StreamedTable::open(&input.file, &input.read)?;
+    crate::input::report_parts(
+        &table.path,
+        table.timing.as_ref(),
+        &table.skipped,
+        &table.samples,
+        &table.warnings,
+    );
+    for n in &table.notes {
+        note(&input.file, n);
+    }
+    let freq_hz = match table.freq_hz {
+        Some(f) => f,
+        None => {
+            eprintln!(
+                "gmwm: warning: {}: no sampling rate (no --freq, time column or JSON sidecar); using 1 Hz, so tau_s is in samples",
+                input.file.display()
+            );
+            1.0
+        }
+    };
+    let wvs = table.wavelet_variance(freq_hz, opts)?;
+    Ok(table.names.iter().cloned().zip(wvs).collect())
+}
+
 /// A saved wavelet variance as it is (no recomputation).
 fn run_saved(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
     let file = &config.input.file;
@@ -134,6 +183,9 @@ pub fn compute(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
     }
     if let Some(layout) = streamable(input, opts)? {
         return run_streaming(input, &layout, opts);
+    }
+    if streams_text(input, opts)? {
+        return run_streamed_table(input, opts);
     }
     let loaded = load(input)?;
     let items = analyse_columns(&loaded, &input.file, |x| {

@@ -84,19 +84,13 @@ impl Recording {
             .into());
         }
         let table = read_table(path, &opts.read)?;
-        let mut notes = Vec::new();
-        if let Some(t) = table.record_type {
-            notes.push(format!(
-                "{t} records: rates are the increments x the rate from the time stamps x the \
-                 type's scale factors (docs/methods.md §9.3), in rad/s and m/s^2"
-            ));
-        }
-        if let Some(timing) = &table.timing {
-            notes.push(timing.to_string());
-        }
-        notes.extend(left_out_note(&table.skipped));
-        notes.push(table.samples.to_string());
-        notes.extend(table.warnings.iter().map(ToString::to_string));
+        let notes = table_notes(
+            table.record_type,
+            table.timing.as_ref(),
+            &table.skipped,
+            &table.samples,
+            &table.warnings,
+        );
         let source = match table.record_type {
             Some(t) => RecordingSource::Records {
                 record_type: t.name().to_string(),
@@ -237,6 +231,32 @@ fn imu_of_messages(msgs: ImuMessages, freq_hz: f64) -> Result<Imu, Error> {
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_default();
     Ok(Imu::new(columns, info, freq_hz)?.with_name(name))
+}
+
+/// What the reader of a table noticed, one line each: how IMU records are scaled, the time
+/// column's report, the columns left out, the samples' account, the warnings
+/// ([`Recording::notes`]; a streamed table's too).
+pub fn table_notes(
+    record_type: Option<crate::imu::ImuRecordType>,
+    timing: Option<&TimingReport>,
+    skipped: &[String],
+    samples: &SampleAccount,
+    warnings: &[crate::imu::ReadWarning],
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    if let Some(t) = record_type {
+        notes.push(format!(
+            "{t} records: rates are the increments x the rate from the time stamps x the \
+             type's scale factors (docs/methods.md §9.3), in rad/s and m/s^2"
+        ));
+    }
+    if let Some(timing) = timing {
+        notes.push(timing.to_string());
+    }
+    notes.extend(left_out_note(skipped));
+    notes.push(samples.to_string());
+    notes.extend(warnings.iter().map(ToString::to_string));
+    notes
 }
 
 /// The note on the columns a reader left out (`None` when it left out none).

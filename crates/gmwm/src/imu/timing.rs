@@ -333,15 +333,75 @@ fn round_significant(x: f64) -> f64 {
     }
 }
 
-/// Mean of the positive steps no longer than `limit`; `None` if there is none.
-fn mean_within(steps: impl Iterator<Item = f64>, limit: f64) -> Option<f64> {
+/// Mean of the positive steps no longer than `limit`, `sorted` being the positive steps in
+/// ascending order (each repeated as often as it occurs); `None` if there is none. Summed in
+/// ascending order, so that the mean depends on the multiset of steps only: the streamed check
+/// ([`StepStats`]), which holds each distinct step once with its count, adds the same values in
+/// the same order and gets the same bits.
+fn mean_within(sorted: impl Iterator<Item = f64>, limit: f64) -> Option<f64> {
     let mut sum = NeumaierSum::default();
     let mut count = 0usize;
-    for d in steps.filter(|&d| d > 0.0 && d <= limit) {
+    for d in sorted.take_while(|&d| d <= limit) {
         sum.add(d);
         count += 1;
     }
     (count > 0).then(|| sum.total() / count as f64)
+}
+
+/// The weighted median of `(value, count)` pairs (sorted in place by value), as [`median`]
+/// takes it of the values each repeated `count` times; `None` when empty.
+fn weighted_median(v: &mut [(f64, u64)]) -> Option<f64> {
+    let total: u64 = v.iter().map(|p| p.1).sum();
+    if total == 0 {
+        return None;
+    }
+    v.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    // the value of 0-based rank r
+    let at = |r: u64| {
+        let mut seen = 0;
+        for &(x, c) in v.iter() {
+            seen += c;
+            if r < seen {
+                return x;
+            }
+        }
+        v[v.len() - 1].0
+    };
+    let m = total / 2;
+    Some(if total % 2 == 1 {
+        at(m)
+    } else {
+        0.5 * (at(m - 1) + at(m))
+    })
+}
+
+/// `(samples - 1) / span`, NaN for a zero span.
+fn mean_rate(samples: usize, span_s: f64) -> f64 {
+    if span_s > 0.0 {
+        (samples - 1) as f64 / span_s
+    } else {
+        f64::NAN
+    }
+}
+
+/// The nominal step (module docs) from the median positive step and the positive steps in
+/// ascending order: a provisional one over the steps within twice the median, then the mean
+/// of the regular steps, those within [`GAP_FACTOR`] of it.
+fn nominal_step<I: Iterator<Item = f64>>(med: f64, sorted: impl Fn() -> I) -> f64 {
+    let provisional = mean_within(sorted(), 2.0 * med).unwrap_or(med);
+    mean_within(sorted(), GAP_FACTOR * provisional).unwrap_or(provisional)
+}
+
+/// The gap before 0-based sample `row`, a step `d` starting `time_s` after the first stamp.
+fn gap(row: usize, time_s: f64, d: f64, nominal: f64) -> Gap {
+    let missing = ((d / nominal).round() as usize).saturating_sub(1).max(1);
+    Gap {
+        row,
+        line: None,
+        time_s,
+        duration_s: d - nominal,
+        missing,
+    }
 }
 
 /// Checks time stamps in seconds (any order; duplicates and reordering are counted, not
@@ -367,39 +427,21 @@ pub fn check_times(
             (lo.min(t), hi.max(t))
         });
     let span_s = if times_s.is_empty() { 0.0 } else { hi - lo };
-    let mean_rate_hz = if span_s > 0.0 {
-        (times_s.len() - 1) as f64 / span_s
-    } else {
-        f64::NAN
-    };
+    let mean_rate_hz = mean_rate(times_s.len(), span_s);
     let first = times_s.first().copied().unwrap_or(0.0);
     let mut gaps = Vec::new();
     let (rate_hz, jitter) = match median(&mut buffer) {
         None => (f64::NAN, f64::NAN),
         Some(med) => {
-            // provisional nominal step over the steps within twice the median, then the
-            // regular steps are those within GAP_FACTOR of it
-            let provisional = mean_within(steps(), 2.0 * med).unwrap_or(med);
-            let limit = GAP_FACTOR * provisional;
-            let nominal = mean_within(steps(), limit).unwrap_or(provisional);
+            // `buffer` is sorted now
+            let nominal = nominal_step(med, || buffer.iter().copied());
             for (i, d) in steps().enumerate() {
                 if d > GAP_FACTOR * nominal {
-                    let missing = ((d / nominal).round() as usize).saturating_sub(1).max(1);
-                    gaps.push(Gap {
-                        row: i + 1,
-                        line: None,
-                        time_s: times_s[i] - first,
-                        duration_s: d - nominal,
-                        missing,
-                    });
+                    gaps.push(gap(i + 1, times_s[i] - first, d, nominal));
                 }
             }
-            buffer.clear();
-            buffer.extend(
-                steps()
-                    .filter(|&d| d > 0.0 && d <= GAP_FACTOR * nominal)
-                    .map(|d| (d - nominal).abs()),
-            );
+            buffer.retain(|&d| d <= GAP_FACTOR * nominal);
+            buffer.iter_mut().for_each(|d| *d = (*d - nominal).abs());
             let mad = median(&mut buffer).unwrap_or(0.0);
             (round_significant(1.0 / nominal), MAD_TO_SD * mad / nominal)
         }
@@ -417,6 +459,210 @@ pub fn check_times(
         duplicates,
         reordered,
         jitter,
+    }
+}
+
+/// Distinct positive steps a streamed check (`StepStats`) holds: 2^16. Stamps from a clock
+/// are quantised, so their steps take few values (a 200 Hz log stamped in ns: a handful; the
+/// relative stamps of a text file in seconds: a few a binade); beyond this many the check
+/// cannot be exact in bounded memory, and the readers check the column in memory instead.
+pub const STREAM_DISTINCT_STEPS: usize = 1 << 16;
+
+/// Largest steps a streamed check holds with their place, to find the gaps among them once the
+/// nominal step is known: 2^16 (more gaps than this: checked in memory, as
+/// [`STREAM_DISTINCT_STEPS`]).
+pub const STREAM_LARGEST_STEPS: usize = 1 << 16;
+
+/// A step with its place, for the gaps of [`StepStats`].
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    d: f64,
+    row: usize,
+    time_s: f64,
+    line: Option<u64>,
+}
+
+impl PartialEq for Step {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == std::cmp::Ordering::Equal
+    }
+}
+impl Eq for Step {}
+impl PartialOrd for Step {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Step {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.d.total_cmp(&other.d).then(self.row.cmp(&other.row))
+    }
+}
+
+/// [`check_times`] streamed: the stamps are pushed one by one and never held; the report is
+/// the same, bit for bit (tests: `streamed_check_equals_check_times`), from
+/// - the counts, extremes and first stamp, in one pass;
+/// - each distinct positive step once with its count (at most [`STREAM_DISTINCT_STEPS`]):
+///   the median, both means (summed in ascending order, as [`check_times`] sums them) and the
+///   jitter's median deviation are those of the multiset of steps, exact from it;
+/// - the [`STREAM_LARGEST_STEPS`] largest steps with their rows and lines: the gaps are the
+///   steps above 1.5 nominal steps, all among them unless every step held is a gap.
+///
+/// [`finish`](Self::finish) gives `None` when a bound was passed (the caller then checks the
+/// column in memory). Memory: at most about 6 MB whatever the number of stamps.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct StepStats {
+    samples: usize,
+    first: f64,
+    previous: f64,
+    lo: f64,
+    hi: f64,
+    duplicates: usize,
+    reordered: usize,
+    /// Positive steps by their bits (ordered as the values) and their counts.
+    steps: std::collections::BTreeMap<u64, u64>,
+    /// The last positive step and how many times it repeated since it was put in `steps`.
+    run: Option<(u64, u64)>,
+    largest: std::collections::BinaryHeap<std::cmp::Reverse<Step>>,
+    overflow: bool,
+}
+
+impl StepStats {
+    /// Pushes the next stamp (seconds), on physical line `line` of a text file if known.
+    #[inline]
+    pub(crate) fn push(&mut self, t: f64, line: Option<u64>) {
+        if self.samples == 0 {
+            self.first = t;
+            self.lo = f64::INFINITY;
+            self.hi = f64::NEG_INFINITY;
+        } else {
+            let d = t - self.previous;
+            if d == 0.0 {
+                self.duplicates += 1;
+            } else if d < 0.0 {
+                self.reordered += 1;
+            } else if d > 0.0 {
+                self.positive(d, line);
+            }
+        }
+        self.lo = self.lo.min(t);
+        self.hi = self.hi.max(t);
+        self.previous = t;
+        self.samples += 1;
+    }
+
+    #[inline]
+    fn positive(&mut self, d: f64, line: Option<u64>) {
+        let bits = d.to_bits();
+        match &mut self.run {
+            Some((b, c)) if *b == bits => *c += 1,
+            run => {
+                if let Some((b, c)) = run.replace((bits, 1)) {
+                    if !self.overflow {
+                        *self.steps.entry(b).or_insert(0) += c;
+                        if self.steps.len() > STREAM_DISTINCT_STEPS {
+                            // the report cannot be exact: the memory is let go
+                            self.overflow = true;
+                            self.steps = Default::default();
+                        }
+                    }
+                }
+            }
+        }
+        let full = self.largest.len() >= STREAM_LARGEST_STEPS;
+        if full && self.largest.peek().is_some_and(|m| d <= m.0.d) {
+            return;
+        }
+        self.largest.push(std::cmp::Reverse(Step {
+            d,
+            row: self.samples,
+            time_s: self.previous - self.first,
+            line,
+        }));
+        if full {
+            self.largest.pop();
+        }
+    }
+
+    /// The report [`check_times`] gives of the stamps pushed (with the gaps' lines), `None`
+    /// when a bound was passed.
+    pub(crate) fn finish(
+        mut self,
+        column: &str,
+        unit: TimeUnit,
+        unit_source: UnitSource,
+    ) -> Option<TimingReport> {
+        if let Some((b, c)) = self.run.take() {
+            if !self.overflow {
+                *self.steps.entry(b).or_insert(0) += c;
+            }
+        }
+        if self.overflow || self.steps.len() > STREAM_DISTINCT_STEPS {
+            return None;
+        }
+        let span_s = if self.samples == 0 {
+            0.0
+        } else {
+            self.hi - self.lo
+        };
+        let first = if self.samples == 0 { 0.0 } else { self.first };
+        let counted: Vec<(f64, u64)> = self
+            .steps
+            .iter()
+            .map(|(&b, &c)| (f64::from_bits(b), c))
+            .collect();
+        let sorted = || {
+            counted
+                .iter()
+                .flat_map(|&(d, c)| std::iter::repeat(d).take(c as usize))
+        };
+        let mut gaps = Vec::new();
+        let (rate_hz, jitter) = match weighted_median(&mut counted.clone()) {
+            None => (f64::NAN, f64::NAN),
+            Some(med) => {
+                let nominal = nominal_step(med, sorted);
+                let limit = GAP_FACTOR * nominal;
+                let held = self.largest.into_vec();
+                if held.len() >= STREAM_LARGEST_STEPS && held.iter().all(|s| s.0.d > limit) {
+                    // every step held is a gap: others may have been let go
+                    return None;
+                }
+                let mut large: Vec<Step> = held
+                    .into_iter()
+                    .map(|s| s.0)
+                    .filter(|s| s.d > limit)
+                    .collect();
+                large.sort_unstable_by_key(|s| s.row);
+                gaps = large
+                    .into_iter()
+                    .map(|s| Gap {
+                        line: s.line,
+                        ..gap(s.row, s.time_s, s.d, nominal)
+                    })
+                    .collect();
+                let mut deviations: Vec<(f64, u64)> = counted
+                    .iter()
+                    .filter(|&&(d, _)| d <= limit)
+                    .map(|&(d, c)| ((d - nominal).abs(), c))
+                    .collect();
+                let mad = weighted_median(&mut deviations).unwrap_or(0.0);
+                (round_significant(1.0 / nominal), MAD_TO_SD * mad / nominal)
+            }
+        };
+        Some(TimingReport {
+            column: column.to_string(),
+            unit,
+            unit_source,
+            samples: self.samples,
+            start_s: first,
+            span_s,
+            rate_hz,
+            mean_rate_hz: mean_rate(self.samples, span_s),
+            gaps,
+            duplicates: self.duplicates,
+            reordered: self.reordered,
+            jitter,
+        })
     }
 }
 
@@ -610,6 +856,123 @@ impl fmt::Display for TimingWarning {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The streamed check gives the report of `check_times`, bit for bit, on stamps with
+    /// gaps, jitter, duplicates and reordering (and the lines it was given).
+    fn streamed(t: &[f64]) -> Option<TimingReport> {
+        let mut s = StepStats::default();
+        for &x in t {
+            s.push(x, None);
+        }
+        s.finish("t", TimeUnit::Seconds, UnitSource::Stated)
+    }
+
+    fn same(a: &TimingReport, b: &TimingReport) -> bool {
+        let bits = |x: f64| x.to_bits();
+        a.samples == b.samples
+            && bits(a.start_s) == bits(b.start_s)
+            && bits(a.span_s) == bits(b.span_s)
+            && bits(a.rate_hz) == bits(b.rate_hz)
+            && bits(a.mean_rate_hz) == bits(b.mean_rate_hz)
+            && bits(a.jitter) == bits(b.jitter)
+            && a.duplicates == b.duplicates
+            && a.reordered == b.reordered
+            && a.gaps.len() == b.gaps.len()
+            && a.gaps.iter().zip(&b.gaps).all(|(x, y)| {
+                x.row == y.row
+                    && x.missing == y.missing
+                    && bits(x.time_s) == bits(y.time_s)
+                    && bits(x.duration_s) == bits(y.duration_s)
+            })
+            && a.warnings() == b.warnings()
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
+        #[test]
+        fn streamed_check_equals_check_times(
+            n in 0usize..3000,
+            period in 1e-4f64..1.0,
+            quantum_exp in 0u32..4,
+            jitter in 0.0f64..0.4,
+            events in proptest::collection::vec((0usize..3000, 0u8..4, 1u32..200), 0..40),
+            seed in 0u64..u64::MAX,
+        ) {
+            // stamps in units of a clock quantum (whole numbers, as a clock gives them, or
+            // seconds with the roundings of a decimal file), with jitter, gaps, repeats and
+            // stamps out of order
+            let mut state = seed | 1;
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let quantum = [1e-9, 1e-6, 1e-3, 0.0][quantum_exp as usize];
+            let mut t = Vec::with_capacity(n);
+            let mut now = 0.0f64;
+            for i in 0..n {
+                now += period * (1.0 + jitter * (next() - 0.5));
+                for &(at, kind, size) in &events {
+                    if at == i {
+                        match kind {
+                            0 => now += period * f64::from(size),
+                            1 if !t.is_empty() => now = *t.last().unwrap(),
+                            2 => now -= period * f64::from(size % 5),
+                            _ => {}
+                        }
+                    }
+                }
+                let v = if quantum > 0.0 { (now / quantum).round() * quantum } else { now };
+                t.push(v);
+            }
+            let a = check_times("t", &t, TimeUnit::Seconds, UnitSource::Stated);
+            let b = streamed(&t).expect("within the bounds");
+            proptest::prop_assert!(same(&a, &b), "{a:?}\n{b:?}");
+        }
+    }
+
+    #[test]
+    fn streamed_check_of_nothing_and_one_stamp() {
+        for t in [&[][..], &[5.0][..], &[1.0, 1.0][..], &[2.0, 1.0][..]] {
+            let a = check_times("t", t, TimeUnit::Seconds, UnitSource::Stated);
+            let b = streamed(t).unwrap();
+            assert!(same(&a, &b), "{a:?} {b:?}");
+        }
+    }
+
+    #[test]
+    fn streamed_check_gives_up_beyond_its_bounds() {
+        // every step distinct: more distinct steps than held
+        let t: Vec<f64> = (0..STREAM_DISTINCT_STEPS as u64 + 10)
+            .map(|i| (i * i) as f64)
+            .collect();
+        assert!(streamed(&t).is_none());
+        // more gaps than held steps
+        let mut t = Vec::new();
+        let mut now = 0.0;
+        for i in 0..(4 * STREAM_LARGEST_STEPS) {
+            now += if i % 3 == 2 { 5.0 } else { 1.0 };
+            t.push(now);
+        }
+        assert!(streamed(&t).is_none());
+        // many large steps, but fewer gaps than held: exact
+        let mut t = Vec::new();
+        let mut now = 0.0;
+        for i in 0..(3 * STREAM_LARGEST_STEPS) {
+            now += if i % 1000 == 7 {
+                5.0
+            } else if i % 2 == 0 {
+                1.25
+            } else {
+                1.0
+            };
+            t.push(now);
+        }
+        let a = check_times("t", &t, TimeUnit::Seconds, UnitSource::Stated);
+        assert!(same(&a, &streamed(&t).unwrap()));
+        assert!(!a.gaps.is_empty());
+    }
 
     #[test]
     fn time_unit_from_str_display_and_factor() {

@@ -24,7 +24,7 @@ const BUF_CAPACITY: usize = 1 << 20;
 /// # Panics
 /// If `bytes` is shorter than the width (an internal invariant: callers slice whole records).
 #[inline]
-fn decode(bytes: &[u8], width: usize) -> f64 {
+pub(crate) fn decode(bytes: &[u8], width: usize) -> f64 {
     if width == 8 {
         let mut a = [0u8; 8];
         a.copy_from_slice(&bytes[..8]);
@@ -37,7 +37,7 @@ fn decode(bytes: &[u8], width: usize) -> f64 {
 }
 
 #[inline]
-fn decode_i32(bytes: &[u8]) -> f64 {
+pub(crate) fn decode_i32(bytes: &[u8]) -> f64 {
     let mut a = [0u8; 4];
     a.copy_from_slice(&bytes[..4]);
     f64::from(i32::from_le_bytes(a))
@@ -52,7 +52,7 @@ fn io_error(path: &Path, source: std::io::Error) -> ReadError {
 }
 
 #[cold]
-fn non_finite(path: &Path, index: usize, column: usize, value: f64) -> ReadError {
+pub(crate) fn non_finite(path: &Path, index: usize, column: usize, value: f64) -> ReadError {
     ReadError::BinaryNonFinite {
         path: path.to_path_buf(),
         index: index as u64,
@@ -63,7 +63,7 @@ fn non_finite(path: &Path, index: usize, column: usize, value: f64) -> ReadError
 
 /// Opens a binary file and checks its size: non-empty and a whole number of `record` bytes.
 /// Returns the file and the number of records.
-fn open_records(path: &Path, record: usize) -> Result<(File, u64), ReadError> {
+pub(crate) fn open_records(path: &Path, record: usize) -> Result<(File, u64), ReadError> {
     let file = File::open(path).map_err(|e| io_error(path, e))?;
     let size = file.metadata().map_err(|e| io_error(path, e))?.len();
     let record = record as u64;
@@ -92,7 +92,7 @@ const TABLE_CHUNK_ROWS: u64 = 1 << 16;
 /// memory map: a file truncated or rewritten by another process while it is read gives an error
 /// (or the bytes read), never undefined behaviour, and the resident set is the output plus one
 /// buffer.
-fn for_each_record_run(
+pub(crate) fn for_each_record_run(
     path: &Path,
     file: &File,
     (rows, record): (u64, usize),

@@ -6,6 +6,7 @@
 
 pub(crate) mod binary;
 pub(crate) mod positioned;
+pub mod stream;
 pub(crate) mod text;
 
 pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordType};
@@ -483,7 +484,7 @@ fn other_encoding(path: &Path) -> Option<ReadError> {
 }
 
 /// Whether the start of a plain file breaks lines with a carriage return alone.
-fn cr_line_ends(path: &Path) -> bool {
+pub(crate) fn cr_line_ends(path: &Path) -> bool {
     let head = head(path);
     !head.contains(&b'\n') && head.iter().filter(|&&b| b == b'\r').count() > 1
 }
@@ -677,54 +678,19 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
                     g.line = Some(lines.line_of(g.row));
                 }
             }
-            warnings.extend(
-                report
-                    .warnings()
-                    .into_iter()
-                    .map(|warning| ReadWarning::Timing {
-                        path: path.to_path_buf(),
-                        warning,
-                    }),
-            );
+            warnings.extend(timing_warnings(path, &report));
             (Some(col), Some(report))
         }
         None => (None, None),
     };
-    let time_hz = timing
-        .as_ref()
-        .filter(|r| r.rate_hz.is_finite() && r.rate_hz > 0.0)
-        .map(|r| (r.column.clone(), raw.freq_hz.unwrap_or(r.rate_hz)));
-    let sidecar_hz = sidecar.as_ref().and_then(|s| s.sampling_frequency_hz);
-    let disagree = |a: f64, b: f64| (a - b).abs() > RATE_TOLERANCE * b;
-    if let Some((column, time_hz)) = &time_hz {
-        if let Some(given_hz) = opts.freq_hz.filter(|&g| disagree(g, *time_hz)) {
-            warnings.push(ReadWarning::FreqDisagrees {
-                path: path.to_path_buf(),
-                given_hz,
-                column: column.clone(),
-                time_hz: *time_hz,
-            });
-        } else if let Some(sidecar_hz) = sidecar_hz.filter(|&s| disagree(s, *time_hz)) {
-            if opts.freq_hz.is_none() {
-                warnings.push(ReadWarning::SidecarFreqDisagrees {
-                    path: path.to_path_buf(),
-                    sidecar_hz,
-                    column: column.clone(),
-                    time_hz: *time_hz,
-                });
-            }
-        }
-    }
-    let freq_hz = opts
-        .freq_hz
-        .or(time_hz.map(|(_, f)| f))
-        .or(raw.freq_hz)
-        .or(sidecar_hz);
-    if let Some(f) = freq_hz {
-        // a rate from the options, the time column or the sidecar must be usable: never
-        // silently replaced by a default
-        check_freq(f)?;
-    }
+    let freq_hz = resolve_rate(
+        path,
+        opts,
+        raw.freq_hz,
+        timing.as_ref(),
+        sidecar.as_ref(),
+        &mut warnings,
+    )?;
     let samples = SampleAccount {
         missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
         ..SampleAccount::all_used(
@@ -754,6 +720,66 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
             _ => None,
         },
     })
+}
+
+/// The sampling rate of a table (first match wins, as documented on [`read_table`]) and the
+/// warnings of a rate that disagrees with the time column's: shared by [`read_table`] and the
+/// streamed readers ([`stream`]).
+pub(crate) fn resolve_rate(
+    path: &Path,
+    opts: &ReadOptions,
+    format_hz: Option<f64>,
+    timing: Option<&TimingReport>,
+    sidecar: Option<&Sidecar>,
+    warnings: &mut Vec<ReadWarning>,
+) -> Result<Option<f64>, ReadError> {
+    let time_hz = timing
+        .filter(|r| r.rate_hz.is_finite() && r.rate_hz > 0.0)
+        .map(|r| (r.column.clone(), format_hz.unwrap_or(r.rate_hz)));
+    let sidecar_hz = sidecar.and_then(|s| s.sampling_frequency_hz);
+    let disagree = |a: f64, b: f64| (a - b).abs() > RATE_TOLERANCE * b;
+    if let Some((column, time_hz)) = &time_hz {
+        if let Some(given_hz) = opts.freq_hz.filter(|&g| disagree(g, *time_hz)) {
+            warnings.push(ReadWarning::FreqDisagrees {
+                path: path.to_path_buf(),
+                given_hz,
+                column: column.clone(),
+                time_hz: *time_hz,
+            });
+        } else if let Some(sidecar_hz) = sidecar_hz.filter(|&s| disagree(s, *time_hz)) {
+            if opts.freq_hz.is_none() {
+                warnings.push(ReadWarning::SidecarFreqDisagrees {
+                    path: path.to_path_buf(),
+                    sidecar_hz,
+                    column: column.clone(),
+                    time_hz: *time_hz,
+                });
+            }
+        }
+    }
+    let freq_hz = opts
+        .freq_hz
+        .or(time_hz.map(|(_, f)| f))
+        .or(format_hz)
+        .or(sidecar_hz);
+    if let Some(f) = freq_hz {
+        // a rate from the options, the time column or the sidecar must be usable: never
+        // silently replaced by a default
+        check_freq(f)?;
+    }
+    Ok(freq_hz)
+}
+
+/// The warnings of a timing report, each naming the file.
+pub(crate) fn timing_warnings(path: &Path, report: &TimingReport) -> Vec<ReadWarning> {
+    report
+        .warnings()
+        .into_iter()
+        .map(|warning| ReadWarning::Timing {
+            path: path.to_path_buf(),
+            warning,
+        })
+        .collect()
 }
 
 /// Columns and time as decoded by a format reader, before unit, sidecar and frequency

@@ -148,13 +148,97 @@ fn parse_simple_decimal(bytes: &[u8]) -> Option<f64> {
     Some(if negative { -v } else { v })
 }
 
-/// Reads a delimited text file (see [`super::read_table`] for the options).
+/// What a pass over a text file found besides its rows: the column names, the selection,
+/// the first stamp and the number of data rows.
+pub(crate) struct TextPass {
+    pub(crate) names: Vec<String>,
+    pub(crate) sel: super::Selection,
+    /// The first stamp as read (0 without a time column).
+    pub(crate) time_origin: f64,
+    pub(crate) rows: usize,
+    /// Header lines (0 or 1).
+    pub(crate) header_lines: u64,
+    /// Blank lines before the last data row.
+    pub(crate) blank_lines: u64,
+}
+
+/// Reads a delimited text file (see [`super::read_table`] for the options) into memory: the
+/// pass of [`for_each_text_row`], collected.
 pub(crate) fn read_text_table(
     path: &Path,
     format: InputFormat,
     opts: &ReadOptions,
     sidecar: Option<&Sidecar>,
 ) -> Result<RawTable, ReadError> {
+    let mut values: Vec<Vec<f64>> = Vec::new();
+    let mut time = Vec::new();
+    let mut lines = LineMap::default();
+    let pass = for_each_text_row(
+        path,
+        format,
+        opts,
+        sidecar,
+        |_, _| Ok(()),
+        |row, stamp| {
+            if values.is_empty() {
+                values = vec![Vec::new(); row.len()];
+            }
+            for (v, &x) in values.iter_mut().zip(row) {
+                v.push(x);
+            }
+            if let Some((rel, line, _)) = stamp {
+                time.push(rel);
+                lines.push(line);
+            }
+            Ok(())
+        },
+    )?;
+    if values.is_empty() {
+        values = vec![Vec::new(); pass.sel.columns.len()];
+    }
+    let names = &pass.names;
+    let columns = pass
+        .sel
+        .columns
+        .iter()
+        .zip(values)
+        .map(|(&k, values)| Column {
+            name: names[k].clone(),
+            values,
+        })
+        .collect();
+    let time = pass.sel.time.map(|k| Column {
+        name: names[k].clone(),
+        values: time,
+    });
+    Ok(RawTable {
+        columns,
+        time,
+        time_origin: pass.time_origin,
+        time_unit: pass.sel.time_unit,
+        freq_hz: None,
+        lines: pass.sel.time.map(|_| lines),
+        skipped: pass.sel.skipped,
+        header_lines: pass.header_lines,
+        blank_lines: pass.blank_lines,
+    })
+}
+
+/// One pass over a delimited text file: `row` is called on each data row with the selected
+/// cells (in the selection's order) and, with a time column, the stamp relative to the first
+/// one (exact for whole numbers, checked strictly increasing), the row's physical line and the
+/// first stamp as read. The
+/// one parser of text files (`head` is called with the names and the selection before the
+/// first row): [`read_text_table`] collects its rows, the streamed readers
+/// ([`super::stream`]) spool them.
+pub(crate) fn for_each_text_row(
+    path: &Path,
+    format: InputFormat,
+    opts: &ReadOptions,
+    sidecar: Option<&Sidecar>,
+    head: impl FnOnce(&[String], &super::Selection) -> Result<(), ReadError>,
+    mut row: impl FnMut(&[f64], Option<(f64, u64, f64)>) -> Result<(), ReadError>,
+) -> Result<TextPass, ReadError> {
     let Source { mut reader, gzip } = open(path)?;
     let stream_error = |e: io::Error| {
         if gzip {
@@ -245,6 +329,7 @@ pub(crate) fn read_text_table(
         (0..ncols).map(default_name).collect()
     };
     let sel = resolve_selection(path, &names, opts, sidecar)?;
+    head(&names, &sel)?;
 
     let mut rows = Rows {
         path,
@@ -253,23 +338,19 @@ pub(crate) fn read_text_table(
         first_line: first_line_no,
         columns: &sel.columns,
         time_index: sel.time,
-        values: vec![Vec::new(); sel.columns.len()],
-        time: Vec::new(),
+        cells: Vec::with_capacity(sel.columns.len()),
+        previous: None,
         origin: None,
         previous_abs: 0.0,
-        lines: LineMap::default(),
+        n: 0,
     };
     if !has_header {
-        rows.push(&rec, first_line_no)?;
+        rows.push(&rec, first_line_no, &mut row)?;
     }
     while let Some(line) = next(&mut rec)? {
-        rows.push(&rec, line)?;
+        rows.push(&rec, line, &mut row)?;
     }
-    let n = if sel.columns.is_empty() {
-        rows.time.len()
-    } else {
-        rows.values[0].len()
-    };
+    let n = rows.n;
     if n == 0 {
         return Err(if has_header {
             ReadError::HeaderOnly {
@@ -281,28 +362,12 @@ pub(crate) fn read_text_table(
             }
         });
     }
-    let columns = sel
-        .columns
-        .iter()
-        .zip(rows.values)
-        .map(|(&k, values)| Column {
-            name: names[k].clone(),
-            values,
-        })
-        .collect();
     let time_origin = rows.origin.map_or(0.0, |o| o.0);
-    let time = sel.time.map(|k| Column {
-        name: names[k].clone(),
-        values: rows.time,
-    });
-    Ok(RawTable {
-        columns,
-        time,
+    Ok(TextPass {
+        names,
+        sel,
         time_origin,
-        time_unit: sel.time_unit,
-        freq_hz: None,
-        lines: sel.time.map(|_| rows.lines),
-        skipped: sel.skipped,
+        rows: n,
         header_lines: u64::from(has_header),
         blank_lines,
     })
@@ -316,27 +381,38 @@ struct Rows<'a> {
     first_line: u64,
     columns: &'a [usize],
     time_index: Option<usize>,
-    values: Vec<Vec<f64>>,
-    /// Time stamps relative to the first one, in the column's unit.
-    time: Vec<f64>,
+    /// The selected cells of the row being read.
+    cells: Vec<f64>,
+    /// The previous stamp relative to the first one, in the column's unit.
+    previous: Option<f64>,
+    /// Data rows read.
+    n: usize,
     /// The first stamp: its value and, if it is a whole number, its exact integer.
     origin: Option<(f64, Option<i64>)>,
     /// The previous stamp as read (for messages).
     previous_abs: f64,
-    /// Physical lines of the rows (kept only with a time column, for the gaps' lines).
-    lines: LineMap,
 }
 
 impl Rows<'_> {
     #[inline]
-    fn push(&mut self, rec: &ByteRecord, line: u64) -> Result<(), ReadError> {
+    fn push(
+        &mut self,
+        rec: &ByteRecord,
+        line: u64,
+        row: &mut impl FnMut(&[f64], Option<(f64, u64, f64)>) -> Result<(), ReadError>,
+    ) -> Result<(), ReadError> {
         if rec.len() != self.ncols {
             return Err(self.ragged(line, rec.len()));
         }
-        for (j, &k) in self.columns.iter().enumerate() {
-            let v = self.cell(rec, k, line)?;
-            self.values[j].push(v);
+        let mut cells = std::mem::take(&mut self.cells);
+        cells.clear();
+        for &k in self.columns {
+            match self.cell(rec, k, line) {
+                Ok(v) => cells.push(v),
+                Err(e) => return Err(e),
+            }
         }
+        let mut stamp = None;
         if let Some(k) = self.time_index {
             let t = self.cell(rec, k, line)?;
             // whole-number stamps (ns since 1970 are ~1.7e18, beyond f64's 2^53) are taken
@@ -347,16 +423,19 @@ impl Rows<'_> {
                 (Some(o), Some(v)) => v.checked_sub(o).map_or(t - origin.0, |d| d as f64),
                 _ => t - origin.0,
             };
-            if let Some(&previous) = self.time.last() {
+            if let Some(previous) = self.previous {
                 if rel <= previous {
                     return Err(self.not_increasing(k, line, self.previous_abs, t));
                 }
             }
             self.previous_abs = t;
-            self.time.push(rel);
-            self.lines.push(line);
+            self.previous = Some(rel);
+            stamp = Some((rel, line, origin.0));
         }
-        Ok(())
+        self.n += 1;
+        let result = row(&cells, stamp);
+        self.cells = cells;
+        result
     }
 
     #[inline]
