@@ -1,14 +1,15 @@
-//! Issue 16 items 1–2 "must show": the multi-recording GMWM (docs/methods.md §5.10) and the
+//! Issue 16 items 1–2 "must show": the multi-recording GMWM (docs/methods.md §5.11) and the
 //! same-model test (§7.7) against known truths, and one clear error per mismatched input.
 //!
 //! Truth of the Monte Carlo studies: `WN(sigma2 = 1) + RW(gamma2 = 1e-4)` at 1 Hz (both
 //! processes visible: the RW crosses the WN near scale 2^8). Replicate `i` of a study with
 //! master seed `s` simulates recording `k` with `replicate_seed(replicate_seed(s, i), k)`.
 //! The CI-run tests are sized to a few seconds in release; the `#[ignore]` studies give the
-//! figures of docs/methods.md §5.10 and §7.7.
+//! figures of docs/methods.md §5.11 and §7.7.
 
 use gmwm::fit::{FitError, Gmwm, Objective, Parametrisation, PhiOrder, Recording, TransformPreset};
 use gmwm::inference::same_model::{compare_wvs, same_model_test, SameModelOptions};
+use gmwm::inference::{infer, InferenceOptions};
 use gmwm::model::Model;
 use gmwm::sim::{replicate_seed, simulate_model};
 use gmwm::{wavelet_variance, Weighting, Weights, WvOptions};
@@ -54,7 +55,11 @@ fn pooled_objective_is_the_sum_of_the_recordings_own_objectives() {
         assert_eq!(fit.recordings()[k].levels, r.levels());
         sum += q;
     }
-    assert!((fit.objective() / sum - 1.0).abs() < 1e-10, "{} vs {sum}", fit.objective());
+    assert!(
+        (fit.objective() / sum - 1.0).abs() < 1e-10,
+        "{} vs {sum}",
+        fit.objective()
+    );
     // the pooled minimum is no higher than Q_pool at any separate estimate
     for r in fit.recordings() {
         let at_sep: f64 = recs
@@ -95,8 +100,14 @@ fn mismatched_recordings_give_one_clear_error_each() {
     let b = Recording::from_series(&x, 200.0, &opts, Weighting::Fast).unwrap();
     let g = Gmwm::parse("WN()+RW()").unwrap().with_draws(500);
     let e = g.fit_pooled(&[a.clone(), b]).unwrap_err();
-    assert!(matches!(e, FitError::RateMismatch { recording: 2, .. }), "{e}");
-    assert!(e.to_string().contains("200 Hz") && e.to_string().contains("100 Hz"), "{e}");
+    assert!(
+        matches!(e, FitError::RateMismatch { recording: 2, .. }),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("200 Hz") && e.to_string().contains("100 Hz"),
+        "{e}"
+    );
     // within RATE_TOLERANCE (1%): accepted
     let close = Recording::from_series(&x, 100.5, &opts, Weighting::Fast).unwrap();
     g.fit_pooled(&[a.clone(), close]).unwrap();
@@ -105,7 +116,14 @@ fn mismatched_recordings_give_one_clear_error_each() {
     let g3 = Gmwm::parse("AR1()+WN()").unwrap().with_draws(500);
     let e = g3.fit_pooled(&[a.clone(), short]).unwrap_err();
     assert!(
-        matches!(e, FitError::RecordingTooShort { recording: 2, n: 8, .. }),
+        matches!(
+            e,
+            FitError::RecordingTooShort {
+                recording: 2,
+                n: 8,
+                ..
+            }
+        ),
         "{e}"
     );
     assert!(e.to_string().contains("too short"), "{e}");
@@ -116,10 +134,22 @@ fn mismatched_recordings_give_one_clear_error_each() {
     };
     let r = Recording::from_series(&x, 100.0, &robust, Weighting::Fast).unwrap();
     let e = g.fit_pooled(&[a.clone(), r]).unwrap_err();
-    assert!(matches!(e, FitError::EstimatorMismatch { recording: 2 }), "{e}");
+    assert!(
+        matches!(e, FitError::EstimatorMismatch { recording: 2 }),
+        "{e}"
+    );
     // the same-model test needs two recordings
     let e = same_model_test(&g, &[a], &SameModelOptions::default()).unwrap_err();
-    assert!(matches!(e, FitError::TooFewRecordings { needed: 2, found: 1 }), "{e}");
+    assert!(
+        matches!(
+            e,
+            FitError::TooFewRecordings {
+                needed: 2,
+                found: 1
+            }
+        ),
+        "{e}"
+    );
     let e = g.fit_pooled(&[]).unwrap_err();
     assert!(matches!(e, FitError::TooFewRecordings { .. }), "{e}");
 }
@@ -129,12 +159,17 @@ fn rmse(rows: &[Vec<f64>], k: usize) -> f64 {
     (rows.iter().map(|t| (t[k] - THETA[k]).powi(2)).sum::<f64>() / rows.len() as f64).sqrt()
 }
 
-/// MS-GMWM at K = 4 recordings of lengths 2000, 4000, 8000, 16000 over `r` replicates:
-/// (pooled estimates, estimates of the longest recording alone, pooled interval coverage).
-fn precision_study(r: usize, seed: u64) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, [usize; 2]) {
+/// MS-GMWM at K = 4 recordings of lengths `m` x (2000, 4000, 8000, 16000) over `r`
+/// replicates: (pooled estimates, estimates of the longest recording alone, pooled interval
+/// coverage, the longest recording's own sandwich interval coverage).
+fn precision_study(
+    r: usize,
+    m: usize,
+    seed: u64,
+) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, [usize; 2], [usize; 2]) {
     let truth = Model::parse(TRUTH).unwrap();
-    let lengths = [2000, 4000, 8000, 16000];
-    let out: Vec<(Vec<f64>, Vec<f64>, [bool; 2])> = (0..r as u64)
+    let lengths = [2000 * m, 4000 * m, 8000 * m, 16000 * m];
+    let out: Vec<(Vec<f64>, Vec<f64>, [bool; 2], [bool; 2])> = (0..r as u64)
         .into_par_iter()
         .map(|i| {
             let recs = recordings(&truth, &lengths, replicate_seed(seed, i));
@@ -143,47 +178,64 @@ fn precision_study(r: usize, seed: u64) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, [usize
             assert!(fit.convergence().converged, "replicate {i}");
             let single = g.fit_wv(recs[3].wv(), 1.0, &THETA).unwrap();
             let (ci, _) = fit.sandwich(0.05, replicate_seed(seed, i)).unwrap();
-            let cover = [0, 1].map(|k| {
-                ci[k].ci_low.unwrap() <= THETA[k] && THETA[k] <= ci[k].ci_high.unwrap()
+            let cover = [0, 1]
+                .map(|k| ci[k].ci_low.unwrap() <= THETA[k] && THETA[k] <= ci[k].ci_high.unwrap());
+            let inf = infer(
+                &g,
+                &single,
+                recs[3].n(),
+                &recs[3].wv().options(),
+                &InferenceOptions::default(),
+            )
+            .unwrap();
+            let own = [0, 1].map(|k| {
+                let q = &inf.parameters()[k];
+                q.ci_low.unwrap() <= THETA[k] && THETA[k] <= q.ci_high.unwrap()
             });
-            (fit.theta().to_vec(), single.theta().to_vec(), cover)
+            (fit.theta().to_vec(), single.theta().to_vec(), cover, own)
         })
         .collect();
-    let mut covered = [0, 0];
-    for (_, _, c) in &out {
+    let (mut covered, mut single_covered) = ([0, 0], [0, 0]);
+    for (_, _, c, o) in &out {
         for k in 0..2 {
             covered[k] += usize::from(c[k]);
+            single_covered[k] += usize::from(o[k]);
         }
     }
     (
         out.iter().map(|o| o.0.clone()).collect(),
         out.iter().map(|o| o.1.clone()).collect(),
         covered,
+        single_covered,
     )
 }
 
-fn check_precision(r: usize, seed: u64) {
-    let (pooled, single, covered) = precision_study(r, seed);
+fn check_precision(r: usize, m: usize, seed: u64) {
+    let (pooled, single, covered, single_covered) = precision_study(r, m, seed);
     let se = (0.95 * 0.05 / r as f64).sqrt();
     for (k, name) in ["WN sigma2", "RW gamma2"].iter().enumerate() {
         let (rp, rs) = (rmse(&pooled, k), rmse(&single, k));
         let cov = covered[k] as f64 / r as f64;
         eprintln!(
-            "{name}: RMSE pooled {rp:.4e}, best single (N = 16000) {rs:.4e}, ratio {:.3}; \
-             95% coverage {cov:.3} ({}/{r})",
+            "{name} (lengths x{m}): RMSE pooled {rp:.4e}, best single {rs:.4e}, ratio {:.3}; \
+             95% coverage pooled {cov:.3} ({}/{r}), best single's own sandwich {}/{r}",
             rp / rs,
-            covered[k]
+            covered[k],
+            single_covered[k]
         );
         // at least as precise as the best single-recording fit; the pooled fit adds 14000
         // samples to the 16000, so it must be clearly better, not within noise
         assert!(rp <= rs, "{name}: pooled RMSE {rp:e} > single {rs:e}");
-        assert!((cov - 0.95).abs() <= 3.0 * se, "{name}: coverage {cov} (R = {r})");
+        assert!(
+            (cov - 0.95).abs() <= 3.0 * se,
+            "{name}: coverage {cov} (R = {r})"
+        );
     }
 }
 
 #[test]
 fn ms_gmwm_is_at_least_as_precise_as_the_best_single_fit_and_covers() {
-    check_precision(200, 2016);
+    check_precision(200, 1, 2016);
 }
 
 /// Size of the same-model test at 5% (asymptotic p-value) over `r` replicates of K = 3
@@ -260,7 +312,11 @@ fn same_model_bootstrap_p_value_is_a_rank() {
     };
     let t = same_model_test(&estimator(), &recs, &opts).unwrap();
     let p = t.p_value_bootstrap.unwrap();
-    let exceed = t.bootstrap_statistics.iter().filter(|&&s| s >= t.statistic).count();
+    let exceed = t
+        .bootstrap_statistics
+        .iter()
+        .filter(|&&s| s >= t.statistic)
+        .count();
     assert_eq!(p, (1 + exceed) as f64 / 20.0);
     assert_eq!(t.bootstrap_statistics.len(), 19);
     // deterministic for a seed (whatever the thread count: the seeds are per replicate)
@@ -284,14 +340,23 @@ fn wv_comparison_flags_only_real_differences() {
     // 1.5 x the series scales the WV by 2.25: every fine scale (many coefficients) differs
     let z: Vec<f64> = x.iter().map(|v| 1.5 * v).collect();
     let d = compare_wvs(&wavelet_variance(&z, 1.0, &opts).unwrap(), &a).unwrap();
-    assert!(d[..6].iter().all(|c| c.differs && (c.log_ratio - 2.25f64.ln()).abs() < 1e-9));
+    assert!(d[..6]
+        .iter()
+        .all(|c| c.differs && (c.log_ratio - 2.25f64.ln()).abs() < 1e-9));
     let _ = Weights::fast(&a).unwrap();
 }
 
 #[test]
-#[ignore = "full study, ~minutes: figures of docs/methods.md §5.10 and §7.7"]
+#[ignore = "full study, ~minutes: figures of docs/methods.md §5.11 and §7.7"]
 fn pooled_studies_full() {
-    check_precision(1000, 42);
+    for m in [1, 8] {
+        let (_, _, c, o) = precision_study(1000, m, 42);
+        eprintln!("lengths x{m}: pooled coverage {c:?}/1000, best single's own {o:?}/1000");
+    }
+    let (pooled, single, _, _) = precision_study(1000, 1, 42);
+    for k in 0..2 {
+        eprintln!("RMSE ratio {k}: {:.3}", rmse(&pooled, k) / rmse(&single, k));
+    }
     check_size(1000, 4242);
     for n in [2000, 4000] {
         let hits = power_study(400, n, 7);

@@ -29,9 +29,9 @@ pub use active::{SubModel, NEGLIGIBLE_WV_SHARE};
 pub use canonical::{CanonicalModel, CanonicalTerm, Reading, SEPARATION_LIMIT};
 pub use gmwm::{Gmwm, GmwmFit, DEFAULT_BOOTSTRAP_REPLICATES};
 pub use objective::Objective;
-pub use pooled::{PooledFit, PooledRecording, Recording};
 pub(crate) use optimize::minimize;
 pub use optimize::{Convergence, LmOptions, StopReason};
+pub use pooled::{PooledFit, PooledRecording, Recording};
 pub use report::{Ar1GmForms, NavParameter, ParameterEstimate};
 pub use start::{starting_values, Dominance, StartInputs, StartOptions, StartValues};
 
@@ -136,7 +136,7 @@ pub enum FitError {
         /// The filter of the WV.
         filter: WaveletFilter,
     },
-    /// Too few recordings for a multi-recording computation (docs/methods.md §5.10, §7.7).
+    /// Too few recordings for a multi-recording computation (docs/methods.md §5.11, §7.7).
     #[error("{found} recording(s) given; this needs at least {needed}")]
     TooFewRecordings {
         /// Needed.

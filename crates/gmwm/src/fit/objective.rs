@@ -134,7 +134,7 @@ impl Objective {
         })
     }
 
-    /// The pooled objective of several WVs of the same model (docs/methods.md §5.10):
+    /// The pooled objective of several WVs of the same model (docs/methods.md §5.11):
     /// `Q(theta) = sum_k (nu2_hat_k - nu2_(J_k)(theta))' Omega_k (nu2_hat_k - nu2_(J_k)(theta))`,
     /// one block per recording with its own levels `J_k` and weights. `blocks` gives each
     /// recording's WV and its whitening: `Err` a diagonal one (`sqrt(omega_j)`), `Ok` a full

@@ -1,4 +1,4 @@
-//! Multi-recording GMWM (MS-GMWM, docs/methods.md §5.10): one model fitted to K recordings of
+//! Multi-recording GMWM (MS-GMWM, docs/methods.md §5.11): one model fitted to K recordings of
 //! the same sensor, each recording's WV weighted by its own precision.
 //!
 //! # Estimator
@@ -47,13 +47,15 @@
 //! objective from the estimate.
 
 use super::weights::FullWeights;
-use super::{minimize, FitError, Gmwm, Objective, Parametrisation, StartInputs, Weighting, Weights};
+use super::{
+    minimize, FitError, Gmwm, Objective, Parametrisation, StartInputs, Weighting, Weights,
+};
 use crate::imu::read::RATE_TOLERANCE;
 use crate::inference::asymptotic::{sandwich, scales, z_value, ZConvention};
 use crate::inference::covariance::{wv_covariance, CovarianceMethod};
 use crate::inference::progress::NoProgress;
-use crate::inference::ParameterInference;
 use crate::inference::IntervalScale;
+use crate::inference::ParameterInference;
 use crate::model::Model;
 use crate::sim::{replicate_seed, Simulator};
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
@@ -132,7 +134,7 @@ impl Recording {
 }
 
 /// The checks every pooled computation starts with: at least `min` recordings, one rate,
-/// one WV estimator, and at least as many levels as parameters in each (docs/methods.md §5.10).
+/// one WV estimator, and at least as many levels as parameters in each (docs/methods.md §5.11).
 pub(crate) fn check_recordings(
     model: &Model,
     recordings: &[Recording],
@@ -239,7 +241,7 @@ pub(crate) fn best_of(
     }
 }
 
-/// A multi-recording GMWM fit (docs/methods.md §5.10).
+/// A multi-recording GMWM fit (docs/methods.md §5.11).
 ///
 /// Wire format: `model` (text with the estimates), `theta`, `param_names`, `objective`
 /// (`Q_pool`), `convergence`, `freq_hz`, `recordings[]` (`n`, `levels`, `objective` (its
@@ -318,7 +320,7 @@ impl PooledFit {
         &self.inputs
     }
 
-    /// docs/methods.md §5.10: the sandwich covariance `H V H'` on the stacked Jacobian, the
+    /// docs/methods.md §5.11: the sandwich covariance `H V H'` on the stacked Jacobian, the
     /// block-diagonal weights and the block-diagonal exact covariance of the recordings' WVs at
     /// the pooled estimate (a bootstrap V of [`POOLED_V_REPLICATES`] replicates seeded with
     /// `seed` where the exact one does not cover the model), and the `1 - alpha` intervals of
@@ -385,7 +387,7 @@ impl PooledFit {
             .collect()
     }
 
-    /// docs/methods.md §5.10: the parametric bootstrap of the pooled estimate. Replicate `b`
+    /// docs/methods.md §5.11: the parametric bootstrap of the pooled estimate. Replicate `b`
     /// simulates every recording at its own length from the pooled estimate (recording `k` with
     /// the seed `replicate_seed(replicate_seed(seed, b), k)`), computes its WV with the
     /// recording's settings and fast weights, and refits the pooled objective from the
@@ -412,7 +414,8 @@ impl PooledFit {
         (0..replicates)
             .into_par_iter()
             .map(|b| {
-                let recs = simulate_recordings(&self.model, &self.inputs, replicate_seed(seed, b as u64))?;
+                let recs =
+                    simulate_recordings(&self.model, &self.inputs, replicate_seed(seed, b as u64))?;
                 let (preset, phi_order, _) = gmwm.settings();
                 let param = Parametrisation::new(gmwm.model(), preset, phi_order, self.freq_hz)?;
                 let obj = pooled_objective(gmwm.model(), param, &recs, None, self.freq_hz)?;
@@ -472,7 +475,8 @@ pub(crate) fn simulate_recordings(
     like.iter()
         .enumerate()
         .map(|(k, r)| {
-            let mut sim = Simulator::for_model(model, r.wv.freq_hz, replicate_seed(seed, k as u64))?;
+            let mut sim =
+                Simulator::for_model(model, r.wv.freq_hz, replicate_seed(seed, k as u64))?;
             let mut x = vec![0.0; r.n()];
             sim.fill(&mut x);
             let wv = wavelet_variance(&x, r.wv.freq_hz, &r.wv.options())?;
@@ -487,7 +491,7 @@ pub(crate) fn simulate_recordings(
 }
 
 impl Gmwm {
-    /// docs/methods.md §5.10: fits this estimator's model to all `recordings` at once (module
+    /// docs/methods.md §5.11: fits this estimator's model to all `recordings` at once (module
     /// doc): the separate fits give the starts, the pooled objective is minimised from each.
     ///
     /// ```
@@ -543,14 +547,13 @@ impl Gmwm {
             .map(|(r, s)| {
                 let j = r.levels();
                 let nu = implied.wv[..j].to_vec();
-                let qk = r
-                    .wv
-                    .wv
-                    .iter()
-                    .zip(&nu)
-                    .zip(&r.weights.omega)
-                    .map(|((h, n), w)| w * (h - n) * (h - n))
-                    .sum();
+                let qk =
+                    r.wv.wv
+                        .iter()
+                        .zip(&nu)
+                        .zip(&r.weights.omega)
+                        .map(|((h, n), w)| w * (h - n) * (h - n))
+                        .sum();
                 PooledRecording {
                     n: r.n(),
                     levels: j,

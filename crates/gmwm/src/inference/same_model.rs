@@ -288,7 +288,9 @@ pub fn same_model_test_of(
         None => (None, Vec::new()),
         Some(b) => {
             if b < 1 {
-                return Err(ParamError::new("bootstrap replicates", b, "must be at least 1").into());
+                return Err(
+                    ParamError::new("bootstrap replicates", b, "must be at least 1").into(),
+                );
             }
             let truth = gmwm.model().with_values(&d.theta_r)?;
             let stats: Vec<f64> = (0..b)
@@ -357,7 +359,10 @@ pub struct WvComparison {
 ///
 /// # Errors
 /// [`ParamError`] when the two WVs' interval levels differ or `alpha` is not in (0, 1).
-pub fn compare_wvs(a: &WaveletVariance, b: &WaveletVariance) -> Result<Vec<WvComparison>, ParamError> {
+pub fn compare_wvs(
+    a: &WaveletVariance,
+    b: &WaveletVariance,
+) -> Result<Vec<WvComparison>, ParamError> {
     if (a.alpha() - b.alpha()).abs() > 1e-12 {
         return Err(ParamError::new(
             "alpha",
