@@ -63,7 +63,7 @@ pub enum Command {
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
         allow_negative_numbers = true,
-        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200"
+        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three"
     )]
     Fit(FitArgs),
     /// Select a model by the Wavelet Information Criterion on each selected column (docs/methods.md
@@ -412,7 +412,9 @@ Examples:
   gmwm select sim.csv.gz --candidates \"AR1()+WN()+RW();2*AR1()+WN()+RW();3*AR1()+WN()+QN()+RW()\"
       a list of candidates; their common denominator is added and plays the full model
   gmwm select imu.csv.gz --model \"2*GM()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7
-  gmwm select imu.csv.gz --model \"2*AR1()+WN()+RW()\" --rule parsimonious";
+  gmwm select imu.csv.gz --model \"2*AR1()+WN()+RW()\" --rule parsimonious
+  gmwm select a.csv b.csv c.csv --pool --model \"2*AR1()+WN()+RW()\"
+      the sub-models ranked by the WIC of the pooled fit (one model for all recordings)";
 
 /// `gmwm select`.
 #[derive(Debug, Args)]
@@ -462,6 +464,13 @@ pub struct SelectArgs {
     /// shown. JSON and CSV hold every row.
     #[arg(long, value_name = "K", default_value_t = 10, value_parser = whole)]
     pub top: usize,
+    /// Select one model for all FILEs on the pooled criterion (recordings of one sensor at
+    /// one rate, docs/methods.md §5.11): `gmwm select a.csv b.csv --pool --model M`.
+    #[arg(long)]
+    pub pool: bool,
+    /// More recordings, with --pool.
+    #[arg(value_name = "FILE", requires = "pool")]
+    pub more: Vec<PathBuf>,
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,

@@ -30,6 +30,9 @@ fn run(cli: &Cli) -> anyhow::Result<()> {
         args::Command::Fit(a) if a.pool => {
             return stdout_run(|out| cmd::same_model::run_pooled_fit(a, out))
         }
+        args::Command::Select(a) if a.pool => {
+            return stdout_run(|out| cmd::same_model::run_pooled_select(a, out))
+        }
         _ => {}
     }
     let mut config = Config::try_from(&cli.command)?;

@@ -46,7 +46,10 @@ fn pooled_objective_is_the_sum_of_the_recordings_own_objectives() {
     for (k, r) in recs.iter().enumerate() {
         let param =
             Parametrisation::new(&model, TransformPreset::Imu, PhiOrder::Ordered, 1.0).unwrap();
-        let q = Objective::new(&model, param, r.wv().wv(), r.weights(), 1.0)
+        // the step-2 weights the fit used (docs/methods.md §5.11)
+        let w = fit.inputs()[k].weights();
+        assert_eq!(fit.inputs()[k].wv(), r.wv());
+        let q = Objective::new(&model, param, r.wv().wv(), w, 1.0)
             .unwrap()
             .value_at_theta(fit.theta())
             .unwrap();
@@ -62,7 +65,8 @@ fn pooled_objective_is_the_sum_of_the_recordings_own_objectives() {
     );
     // the pooled minimum is no higher than Q_pool at any separate estimate
     for r in fit.recordings() {
-        let at_sep: f64 = recs
+        let at_sep: f64 = fit
+            .inputs()
             .iter()
             .map(|rec| {
                 let param =
@@ -83,7 +87,16 @@ fn pooled_fit_of_one_recording_is_the_single_fit() {
     let truth = Model::parse(TRUTH).unwrap();
     let recs = recordings(&truth, &[10000], 5);
     let pooled = estimator().fit_pooled(&recs).unwrap();
-    let single = estimator().fit_wv(recs[0].wv(), 1.0, &THETA).unwrap();
+    // the single fit with the pooled fit's step-2 weights, from the step-1 (fast) estimate
+    let step1 = estimator().fit_wv(recs[0].wv(), 1.0, &THETA).unwrap();
+    let single = estimator()
+        .fit_weighted(
+            recs[0].wv().wv(),
+            pooled.inputs()[0].weights().clone(),
+            1.0,
+            step1.theta(),
+        )
+        .unwrap();
     for k in 0..2 {
         // two LM runs on the same least-squares problem from the same start; they stop within
         // the step tolerance of each other

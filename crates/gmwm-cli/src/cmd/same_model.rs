@@ -4,8 +4,8 @@
 //! `gmwm::inference::same_model`); this module reads the files, checks that they can be pooled
 //! (one rate, one unit per sensor, the same columns) and renders.
 
-use crate::args::{FitArgs, FormatArg, HeaderArg, InputArgs};
-use crate::config::{FitConfig, InputConfig};
+use crate::args::{FitArgs, FormatArg, HeaderArg, InputArgs, SelectArgs};
+use crate::config::{FitConfig, InputConfig, SelectConfig};
 use crate::input::{load, Loaded};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -60,6 +60,10 @@ pub struct SameModelArgs {
     /// Seed of the searches and of the bootstrap.
     #[arg(long, value_name = "S", default_value_t = 1337)]
     pub seed: u64,
+    /// Also draw every recording's WV with the pooled model's implied WV, one panel per
+    /// column, to FILE (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -324,7 +328,13 @@ pub fn run_pooled_fit(args: &FitArgs, out: &mut impl Write) -> Result<()> {
         }
         writeln!(
             out,
-            "  per recording: Q_k at the pooled estimate, own fit's Q_k and estimates"
+            "  per recording: Q_k at the pooled estimate ({} weights), its own fast fit's Q_k and \
+             estimates",
+            if fit.reweighted() {
+                "model-variance"
+            } else {
+                "fast"
+            }
         )?;
         for (r, info) in fit.recordings().iter().zip(&pool.info) {
             let own: Vec<String> = r
@@ -341,6 +351,96 @@ pub fn run_pooled_fit(args: &FitArgs, out: &mut impl Write) -> Result<()> {
                 own.join(", ")
             )?;
         }
+    }
+    Ok(())
+}
+
+/// `gmwm select FILE... --pool`: the nested candidates of --model ranked by the pooled WIC.
+pub fn run_pooled_select(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
+    let config = SelectConfig::try_from(args)?;
+    let Some(text) = &args.model else {
+        return Err(crate::UsageError(
+            "--pool selects among the sub-models of --model; --candidates is not supported with \
+             --pool"
+                .into(),
+        )
+        .into());
+    };
+    let model: Model = text.parse()?;
+    let mut gmwm = Gmwm::new(model.without_values()).with_seed(args.seed);
+    if let Some(g) = args.draws {
+        gmwm = gmwm.with_draws(g.max(1));
+    }
+    let mut files = vec![config.input.file.clone()];
+    files.extend(args.more.iter().cloned());
+    let pool = read_pool(&files, &config.input, &config.wv, Weighting::Fast)?;
+    let mut rows = Vec::new();
+    for (column, recs) in &pool.columns {
+        let s = gmwm::selection::select_pooled(&gmwm, recs, args.seed)
+            .map_err(|e| named(e, &pool.files, column))?;
+        rows.push((column.clone(), s));
+    }
+    if args.output.json {
+        #[derive(Serialize)]
+        struct Sel<'a> {
+            column: &'a str,
+            selected: &'a str,
+            selected_fit: String,
+            candidates: &'a [gmwm::selection::PooledCandidate],
+        }
+        #[derive(Serialize)]
+        struct Doc<'a> {
+            recordings: &'a [RecordingInfo],
+            selections: Vec<Sel<'a>>,
+        }
+        let selections = rows
+            .iter()
+            .map(|(c, s)| Sel {
+                column: c,
+                selected: &s.candidates[0].candidate,
+                selected_fit: s.selected.model().to_string(),
+                candidates: &s.candidates,
+            })
+            .collect();
+        serde_json::to_writer_pretty(
+            &mut *out,
+            &Doc {
+                recordings: &pool.info,
+                selections,
+            },
+        )?;
+        writeln!(out)?;
+        return Ok(());
+    }
+    write_recordings(&pool.info, out)?;
+    for (column, s) in &rows {
+        writeln!(out)?;
+        writeln!(
+            out,
+            "{column}: pooled WIC over {} recordings, {} candidates",
+            pool.info.len(),
+            s.candidates.len()
+        )?;
+        writeln!(
+            out,
+            "  {:<3} {:<32} {:>12} {:>12} {:>12} {:>10}",
+            "#", "candidate", "Q_pool", "optimism", "WIC", "dWIC"
+        )?;
+        let best = s.candidates[0].wic;
+        let top = if args.top == 0 { usize::MAX } else { args.top };
+        for (i, c) in s.candidates.iter().take(top).enumerate() {
+            writeln!(
+                out,
+                "  {:<3} {:<32} {:>12.5e} {:>12.5e} {:>12.5e} {:>10.3e}",
+                i + 1,
+                c.candidate,
+                c.objective,
+                c.optimism,
+                c.wic,
+                c.wic - best
+            )?;
+        }
+        writeln!(out, "  selected: {}", s.selected.model())?;
     }
     Ok(())
 }
@@ -443,6 +543,7 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
         seed: args.seed,
     };
     let mut tests = Vec::new();
+    let mut fits = Vec::new();
     for (column, recs) in &pool.columns {
         let pooled = gmwm
             .fit_pooled(recs)
@@ -489,6 +590,28 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
             pooled_theta: t.theta_restricted.clone(),
             param_names: pooled.param_names().to_vec(),
         });
+        fits.push((column.clone(), pooled));
+    }
+    if let Some(path) = &args.plot {
+        let labels: Vec<String> = pool
+            .files
+            .iter()
+            .map(|f| {
+                f.file_name()
+                    .map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into())
+            })
+            .collect();
+        let columns: Vec<gmwm_plot::Column<'_, PooledFit>> = fits
+            .iter()
+            .map(|(name, fit)| gmwm_plot::Column::new(name, "u", fit))
+            .collect();
+        gmwm_plot::pooled_figure(&columns, &labels)
+            .save(path)
+            .map_err(|e| match e {
+                gmwm_plot::PlotError::Io { .. } => anyhow::Error::from(e),
+                other => anyhow::anyhow!("{}: {other}", path.display()),
+            })?;
+        eprintln!("gmwm: wrote {}", path.display());
     }
     if args.json {
         #[derive(Serialize)]

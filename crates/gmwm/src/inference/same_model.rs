@@ -333,7 +333,7 @@ fn replicate_statistic(
         .map(|r| gmwm.fit_weighted(r.wv().wv(), r.weights().clone(), r.wv().freq_hz(), start))
         .collect::<Result<_, _>>()?;
     let starts: Vec<Vec<f64>> = separate.iter().map(|f| f.theta().to_vec()).collect();
-    let pooled = gmwm.fit_pooled_from(recs, &separate, &starts)?;
+    let pooled = gmwm.fit_pooled_from(recs, Some(&separate), &starts)?;
     Ok(distance(gmwm, &pooled, &starts, seed)?.statistic())
 }
 
