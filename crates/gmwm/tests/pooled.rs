@@ -172,17 +172,18 @@ fn rmse(rows: &[Vec<f64>], k: usize) -> f64 {
     (rows.iter().map(|t| (t[k] - THETA[k]).powi(2)).sum::<f64>() / rows.len() as f64).sqrt()
 }
 
+/// One replicate: pooled and single estimates, pooled and single coverage per parameter.
+type Replicate = (Vec<f64>, Vec<f64>, [bool; 2], [bool; 2]);
+/// A study: pooled and single estimates per replicate, pooled and single coverage counts.
+type Study = (Vec<Vec<f64>>, Vec<Vec<f64>>, [usize; 2], [usize; 2]);
+
 /// MS-GMWM at K = 4 recordings of lengths `m` x (2000, 4000, 8000, 16000) over `r`
 /// replicates: (pooled estimates, estimates of the longest recording alone, pooled interval
 /// coverage, the longest recording's own sandwich interval coverage).
-fn precision_study(
-    r: usize,
-    m: usize,
-    seed: u64,
-) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, [usize; 2], [usize; 2]) {
+fn precision_study(r: usize, m: usize, seed: u64) -> Study {
     let truth = Model::parse(TRUTH).unwrap();
     let lengths = [2000 * m, 4000 * m, 8000 * m, 16000 * m];
-    let out: Vec<(Vec<f64>, Vec<f64>, [bool; 2], [bool; 2])> = (0..r as u64)
+    let out: Vec<Replicate> = (0..r as u64)
         .into_par_iter()
         .map(|i| {
             let recs = recordings(&truth, &lengths, replicate_seed(seed, i));

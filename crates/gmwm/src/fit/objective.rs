@@ -188,13 +188,13 @@ impl Objective {
                             big[(at + r) * total + at + c] = m[(r, c)];
                         }
                     }
-                    sqrt_omega.extend(std::iter::repeat_n(1.0, j));
+                    sqrt_omega.extend(std::iter::repeat(1.0).take(j));
                 }
                 (Err(d), Some(big)) => {
                     for r in 0..j {
                         big[(at + r) * total + at + r] = d.omega[r].sqrt();
                     }
-                    sqrt_omega.extend(std::iter::repeat_n(1.0, j));
+                    sqrt_omega.extend(std::iter::repeat(1.0).take(j));
                 }
                 (Err(d), None) => sqrt_omega.extend(d.omega.iter().map(|w| w.sqrt())),
                 (Ok(_), None) => unreachable!("a full block makes the whitening full"),

@@ -228,7 +228,7 @@ pub(crate) fn best_of(
         };
         match minimize(objective, &u0, &options) {
             Ok(m) => {
-                if best.as_ref().is_none_or(|b| m.objective < b.1) {
+                if !matches!(&best, Some(b) if b.1 <= m.objective) {
                     let theta = Parametrisation::canonical_order(model, &m.theta)?;
                     best = Some((theta, m.objective, m.convergence));
                 }
