@@ -68,12 +68,18 @@ impl TryFrom<&Command> for Config {
             Command::Avar(a) => Self::Avar(a.try_into()?),
             Command::Simulate(a) => Self::Simulate(a.try_into()?),
             Command::Implied(a) => Self::Implied(a.try_into()?),
-            Command::Fit(a) => Self::Fit(a.try_into()?),
-            Command::Select(a) => Self::Select(a.try_into()?),
             Command::Calibrate(a) => calibrate_or_batch(a)?,
             Command::Topics(a) => Self::Topics(a.into()),
             Command::Plot(a) => Self::Plot(a.try_into()?),
             Command::Report(a) => Self::Report(a.try_into()?),
+            // run by cmd::same_model before this conversion (main::run)
+            Command::SameModel(_)
+            | Command::Fit(FitArgs { pool: true, .. })
+            | Command::Select(SelectArgs { pool: true, .. }) => {
+                anyhow::bail!("internal: several recordings are not one configuration")
+            }
+            Command::Fit(a) => Self::Fit(a.try_into()?),
+            Command::Select(a) => Self::Select(a.try_into()?),
         })
     }
 }
@@ -1088,8 +1094,20 @@ impl TryFrom<&PlotArgs> for PlotConfig {
                     robust,
                 })
             }
-            PlotCommand::Fit { args, .. } => PlotKind::Fit(args.try_into()?),
-            PlotCommand::Select { args, .. } => PlotKind::Select(args.try_into()?),
+            PlotCommand::Fit { args, .. } => {
+                anyhow::ensure!(
+                    !args.pool,
+                    "--pool: gmwm plot fit draws one recording's fit; use gmwm fit --pool --json"
+                );
+                PlotKind::Fit(args.try_into()?)
+            }
+            PlotCommand::Select { args, .. } => {
+                anyhow::ensure!(
+                    !args.pool,
+                    "--pool: gmwm plot select draws one recording's selection; use gmwm select --pool"
+                );
+                PlotKind::Select(args.try_into()?)
+            }
             PlotCommand::Ieee { args, .. } => PlotKind::Ieee(args.try_into()?),
         };
         Ok(Self { figure, kind })

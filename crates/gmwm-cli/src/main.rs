@@ -24,6 +24,17 @@ use std::process::ExitCode;
 /// Validates the flags into the subcommand's configuration, before any file is read, then
 /// runs it.
 fn run(cli: &Cli) -> anyhow::Result<()> {
+    // several recordings at once (issue 16): their own path, cmd::same_model
+    match &cli.command {
+        args::Command::SameModel(a) => return stdout_run(|out| cmd::same_model::run(a, out)),
+        args::Command::Fit(a) if a.pool => {
+            return stdout_run(|out| cmd::same_model::run_pooled_fit(a, out))
+        }
+        args::Command::Select(a) if a.pool => {
+            return stdout_run(|out| cmd::same_model::run_pooled_select(a, out))
+        }
+        _ => {}
+    }
     let mut config = Config::try_from(&cli.command)?;
     let _spool = prepare_input(&mut config)?;
     check_outputs(&config)?;
@@ -136,6 +147,16 @@ impl<W: Write> Write for Stdout<W> {
 
 fn named_stdout(e: std::io::Error) -> std::io::Error {
     std::io::Error::new(e.kind(), format!("standard output: {e}"))
+}
+
+/// Runs `f` on buffered standard output and flushes it.
+fn stdout_run(
+    f: impl FnOnce(&mut BufWriter<Stdout<std::io::StdoutLock<'static>>>) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let mut out = BufWriter::new(Stdout(std::io::stdout().lock()));
+    f(&mut out)?;
+    out.flush()?;
+    Ok(())
 }
 
 fn execute(config: &Config) -> anyhow::Result<()> {

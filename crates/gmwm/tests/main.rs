@@ -17,6 +17,7 @@ mod ieee;
 mod inference;
 mod methods_reference;
 mod model;
+mod pooled;
 mod process;
 mod read;
 mod robust;

@@ -7,6 +7,7 @@ pub mod fit;
 pub mod implied;
 pub mod plot;
 pub mod report;
+pub mod same_model;
 pub mod select;
 pub mod simulate;
 pub mod topics;

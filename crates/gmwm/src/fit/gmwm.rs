@@ -147,6 +147,12 @@ impl Gmwm {
         &self.model
     }
 
+    /// Transform preset, phi order and optimiser options (for the fits built outside this
+    /// file, e.g. [`super::pooled`]).
+    pub(crate) fn settings(&self) -> (TransformPreset, PhiOrder, LmOptions) {
+        (self.preset, self.phi_order, self.options)
+    }
+
     /// This estimator's settings (weighting, transforms, phi order, optimiser, search) for
     /// another model, in guess mode.
     pub fn for_model(&self, model: Model) -> Gmwm {

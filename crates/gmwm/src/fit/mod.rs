@@ -15,6 +15,7 @@ pub mod canonical;
 pub mod gmwm;
 pub mod objective;
 pub(crate) mod optimize;
+pub mod pooled;
 pub mod report;
 pub(crate) mod revive;
 pub mod start;
@@ -30,6 +31,7 @@ pub use gmwm::{Gmwm, GmwmFit, DEFAULT_BOOTSTRAP_REPLICATES};
 pub use objective::Objective;
 pub(crate) use optimize::minimize;
 pub use optimize::{Convergence, LmOptions, StopReason};
+pub use pooled::{PooledFit, PooledRecording, Recording};
 pub use report::{Ar1GmForms, NavParameter, ParameterEstimate};
 pub use start::{starting_values, Dominance, StartInputs, StartOptions, StartValues};
 
@@ -133,6 +135,47 @@ pub enum FitError {
     NotHaar {
         /// The filter of the WV.
         filter: WaveletFilter,
+    },
+    /// Too few recordings for a multi-recording computation (docs/methods.md §5.11, §7.7).
+    #[error("{found} recording(s) given; this needs at least {needed}")]
+    TooFewRecordings {
+        /// Needed.
+        needed: usize,
+        /// Given.
+        found: usize,
+    },
+    /// A recording's sampling rate differs from the first one's by more than
+    /// [`crate::imu::read::RATE_TOLERANCE`]: the model's parameters are per sample.
+    #[error(
+        "recording {recording} is sampled at {rate} Hz but recording 1 at {first_rate} Hz:          a pooled fit needs one rate (the model's parameters are per sample); resample or          fit them separately"
+    )]
+    RateMismatch {
+        /// 1-based recording.
+        recording: usize,
+        /// Its rate.
+        rate: f64,
+        /// The first recording's rate.
+        first_rate: f64,
+    },
+    /// A recording's WV uses another estimator (classical/robust, transform) than the first.
+    #[error("recording {recording}: its wavelet variance uses other settings (robust, transform) than recording 1's; pool WVs of one estimator")]
+    EstimatorMismatch {
+        /// 1-based recording.
+        recording: usize,
+    },
+    /// A recording has fewer levels than the model has parameters.
+    #[error(
+        "recording {recording} ({n} samples) has {levels} wavelet-variance levels, fewer than          the model's {params} parameters: it is too short for this model"
+    )]
+    RecordingTooShort {
+        /// 1-based recording.
+        recording: usize,
+        /// Its length.
+        n: usize,
+        /// Its levels.
+        levels: usize,
+        /// Parameters (plus one for a robust WV).
+        params: usize,
     },
     /// A computation the fit builds on could not run: the series, a parameter or the model is
     /// unusable.

@@ -26,6 +26,10 @@ pub struct Objective {
     /// then unused.
     whitening: Option<Vec<f64>>,
     freq_hz: f64,
+    /// Stacked (pooled) objective ([`Objective::stacked`]): the 0-based WV level of each entry
+    /// of `nu_hat` and the number of levels the implied WV is evaluated at; `None` for one WV,
+    /// whose entry `j` is level `j + 1`.
+    stack: Option<(Vec<usize>, usize)>,
 }
 
 /// Residuals and their Jacobian at one `u` (reused buffers).
@@ -126,7 +130,81 @@ impl Objective {
             sqrt_omega,
             whitening,
             freq_hz,
+            stack: None,
         })
+    }
+
+    /// The pooled objective of several WVs of the same model (docs/methods.md §5.11):
+    /// `Q(theta) = sum_k (nu2_hat_k - nu2_(J_k)(theta))' Omega_k (nu2_hat_k - nu2_(J_k)(theta))`,
+    /// one block per recording with its own levels `J_k` and weights. `blocks` gives each
+    /// recording's WV and its whitening: `Err` a diagonal one (`sqrt(omega_j)`), `Ok` a full
+    /// [`FullWeights`] (block `k` of a block-diagonal `W`). The least-squares problem is the
+    /// concatenation of the blocks' whitened residuals, so the optimiser, the value and the
+    /// gradient are those of one WV.
+    ///
+    /// # Errors
+    /// As [`Objective::new`] on the concatenation; [`FitError::Length`] when a block's weights
+    /// and WV differ in size or no block is given.
+    pub(crate) fn stacked(
+        model: &Model,
+        param: Parametrisation,
+        blocks: &[(&[f64], Result<&FullWeights, &Weights>)],
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        if blocks.is_empty() {
+            return Err(FitError::Length {
+                what: "recordings",
+                expected: 1,
+                found: 0,
+            });
+        }
+        let total: usize = blocks.iter().map(|(nu, _)| nu.len()).sum();
+        let full = blocks.iter().any(|(_, w)| w.is_ok());
+        let mut nu_hat = Vec::with_capacity(total);
+        let mut level_of = Vec::with_capacity(total);
+        let mut sqrt_omega = Vec::with_capacity(total);
+        let mut whitening = full.then(|| vec![0.0; total * total]);
+        let mut at = 0;
+        for (nu, w) in blocks {
+            let j = nu.len();
+            let levels = match w {
+                Ok(f) => f.levels(),
+                Err(d) => d.levels(),
+            };
+            if levels != j {
+                return Err(FitError::Length {
+                    what: "weights",
+                    expected: j,
+                    found: levels,
+                });
+            }
+            nu_hat.extend_from_slice(nu);
+            level_of.extend(0..j);
+            match (w, whitening.as_mut()) {
+                (Ok(f), Some(big)) => {
+                    let m = f.whitening();
+                    for r in 0..j {
+                        for c in 0..=r {
+                            big[(at + r) * total + at + c] = m[(r, c)];
+                        }
+                    }
+                    sqrt_omega.extend(std::iter::repeat(1.0).take(j));
+                }
+                (Err(d), Some(big)) => {
+                    for r in 0..j {
+                        big[(at + r) * total + at + r] = d.omega[r].sqrt();
+                    }
+                    sqrt_omega.extend(std::iter::repeat(1.0).take(j));
+                }
+                (Err(d), None) => sqrt_omega.extend(d.omega.iter().map(|w| w.sqrt())),
+                (Ok(_), None) => unreachable!("a full block makes the whitening full"),
+            }
+            at += j;
+        }
+        let jmax = blocks.iter().map(|(nu, _)| nu.len()).max().unwrap_or(0);
+        let mut obj = Self::build(model, param, &nu_hat, sqrt_omega, whitening, freq_hz)?;
+        obj.stack = Some((level_of, jmax));
+        Ok(obj)
     }
 
     /// Number of levels J.
@@ -194,10 +272,30 @@ impl Objective {
         nu: &mut [f64],
         a: Option<&mut [f64]>,
     ) -> Result<(), crate::InputError> {
-        let levels = self.levels();
         let np = self.n_params();
         nu.fill(0.0);
         let mut a = a;
+        if let Some((level_of, jmax)) = &self.stack {
+            // evaluate once at the deepest recording's levels, then gather per entry
+            let mut one = vec![0.0; *jmax];
+            let mut jac = a.is_some().then(|| vec![0.0; jmax * np]);
+            self.model.for_each_process(theta, self.freq_hz, |p, col| {
+                p.add_wv(&mut one);
+                if let Some(jac) = jac.as_deref_mut() {
+                    for (j, row) in p.jacobian(*jmax).iter().enumerate() {
+                        jac[j * np + col..j * np + col + row.len()].copy_from_slice(row);
+                    }
+                }
+            })?;
+            for (i, &j) in level_of.iter().enumerate() {
+                nu[i] = one[j];
+                if let (Some(a), Some(jac)) = (a.as_deref_mut(), jac.as_deref()) {
+                    a[i * np..(i + 1) * np].copy_from_slice(&jac[j * np..(j + 1) * np]);
+                }
+            }
+            return Ok(());
+        }
+        let levels = self.levels();
         self.model.for_each_process(theta, self.freq_hz, |p, col| {
             p.add_wv(nu);
             if let Some(a) = a.as_deref_mut() {
@@ -206,6 +304,34 @@ impl Objective {
                 }
             }
         })
+    }
+
+    /// Whitened residuals at theta (original parametrisation): `sqrt(omega_j) (nu2_hat_j -
+    /// nu2_j)`, or `W (nu2_hat - nu2)` with a full weighting; their squares sum to
+    /// [`Objective::value_at_theta`].
+    ///
+    /// # Errors
+    /// As [`Objective::value_at_theta`].
+    pub(crate) fn residuals_at_theta(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+        if theta.len() != self.n_params() {
+            return Err(FitError::Length {
+                what: "theta",
+                expected: self.n_params(),
+                found: theta.len(),
+            });
+        }
+        let mut nu = vec![0.0; self.levels()];
+        self.implied(theta, &mut nu, None)?;
+        let e: Vec<f64> = self
+            .nu_hat
+            .iter()
+            .zip(&nu)
+            .zip(&self.sqrt_omega)
+            .map(|((h, n), s)| s * (h - n))
+            .collect();
+        let mut r = vec![0.0; e.len()];
+        self.whiten(&e, &mut r);
+        Ok(r)
     }
 
     /// A fresh evaluation buffer.

@@ -10,6 +10,7 @@ pub mod bootstrap;
 pub mod covariance;
 pub mod gof;
 pub mod progress;
+pub mod same_model;
 pub mod summary;
 
 pub use asymptotic::{sandwich, wald_interval, z_value, IntervalScale, Sandwich, ZConvention};
@@ -19,6 +20,10 @@ pub use bootstrap::{
 pub use covariance::{wv_covariance, CovarianceMethod, VSource, WvCovariance};
 pub use gof::{j_test, JTest};
 pub use progress::{NoProgress, Progress};
+pub use same_model::{
+    compare_wvs, same_model_test, same_model_test_of, SameModelOptions, SameModelTest,
+    ScaleContribution, WvComparison,
+};
 pub use summary::{
     infer, infer_with_covariance, infer_with_progress, BootstrapGof, Inference, InferenceMethod,
     InferenceOptions, InferenceWarning, ParameterInference, VShape,

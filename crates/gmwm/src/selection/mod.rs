@@ -87,6 +87,7 @@
 pub mod candidates;
 pub mod imu;
 pub mod optimism;
+pub mod pooled;
 pub mod wic;
 
 pub use candidates::{common_denominator, nested_candidates, terms, MAX_NESTED_TERMS};
@@ -94,6 +95,7 @@ pub use imu::{auto_imu, AxisSelection, ImuSelection};
 pub use optimism::{
     asymptotic_optimism, bootstrap_optimism, d_matrix, OptimismConvention, OptimismMethod,
 };
+pub use pooled::{select_pooled, PooledCandidate, PooledSelection};
 pub use wic::{
     CandidateScore, ModelSelection, RowStatus, SelectionRow, SelectionRule, SelectionTable, Wic,
 };

@@ -1,0 +1,669 @@
+//! Multi-recording GMWM (MS-GMWM, docs/methods.md §5.11): one model fitted to K recordings of
+//! the same sensor, each recording's WV weighted by its own precision.
+//!
+//! # Estimator
+//! Recording `k` (length `N_k`, `J_k` levels, empirical WV `nu2_hat_k`, diagonal weights
+//! `Omega_k` of its own, e.g. the fast weights from its own CIs) contributes its own GMWM
+//! objective; the pooled estimate minimises their sum
+//!
+//! ```text
+//! Q_pool(theta) = sum_k Q_k(theta),  Q_k(theta) = sum_{j <= J_k} omega_kj (nu2_hat_kj - nu2_j(theta))^2
+//! ```
+//!
+//! The implied WV `nu2_j(theta)` does not depend on `N_k`, so recordings of different lengths
+//! share it level by level; a long recording has more levels and tighter weights and counts
+//! more, as it should. It is one least-squares problem on the concatenated whitened residuals
+//! ([`super::Objective`] in its stacked form), minimised by the crate's Levenberg–Marquardt.
+//!
+//! **Rate.** The model's parameters are per sample (WN, RW, AR1 phi, ...), so the recordings
+//! must share one sampling rate: rates differing by more than
+//! [`RATE_TOLERANCE`](crate::imu::read::RATE_TOLERANCE) (relative) are refused
+//! ([`FitError::RateMismatch`]); the fit uses the first recording's rate.
+//!
+//! **Starting values.** Each recording is first fitted alone (the two-stage fit with the §6
+//! search, [`Gmwm::fit_from_wv`] without the bootstrap rounds); the pooled objective is
+//! minimised (stage 2) from each of the K separate estimates and the lowest `Q_pool` is kept.
+//!
+//! **Weights, two steps.** Step 1 minimises `Q_pool` with each recording's own weights (fast
+//! by default, from its own CIs; diag needs the series, [`Recording::from_series`]). Step 2
+//! replaces them by `omega_kj = 1 / V_k,jj(theta_1)`, the model's variance of recording k's
+//! WV at level j at the step-1 estimate and `N_k` (exact, §1.10), and minimises again from
+//! `theta_1`. Reason: a fast weight `1 / (hi - lo)^2` scales with `1 / nu2_hat_kj^2`, so a
+//! level that came out low is weighted up and the estimate is biased down by a fraction that
+//! does not shrink when recordings are added, while the standard error does: with K = 4
+//! recordings the random-walk intervals of step 1 alone covered 0.908 (1000 replicates, the
+//! longest recording's own fit 0.947). Step-2 weights depend on the data only through
+//! `theta_1`. The bootstrap rounds of §5.2 are not run. `PooledFit::inputs` carries the
+//! step-2 weights, which the sandwich uses.
+//!
+//! # Inference
+//! Recordings are independent, so with `A` the stacked Jacobians `[A_1; ...; A_K]` (each
+//! `A_k` the `J_k x p` Jacobian of the implied WV at `theta_hat`), `Omega = diag(Omega_k)`
+//! and `V = diag(V_k)` (block diagonal, `V_k` the covariance of `nu2_hat_k`, exact at the
+//! pooled estimate and `N_k`, docs/methods.md §1.10), the first-order expansion of the pooled
+//! first-order condition `A' Omega (nu2_hat - nu2(theta_hat)) = 0` gives
+//!
+//! ```text
+//! theta_hat - theta_0 ~ (A' Omega A)^{-1} A' Omega (nu2_hat - nu2(theta_0)),
+//! Cov(theta_hat) ~ H V H',  H = (A' Omega A)^{-1} A' Omega = (sum_k A_k' Omega_k A_k)^{-1} [A_1' Omega_1, ..., A_K' Omega_K]
+//! ```
+//!
+//! the sandwich of §7.1 on the stacked matrices ([`PooledFit::sandwich`]); the intervals are
+//! those of §7.2 (log scale for variances, atanh for coefficients). The parametric bootstrap
+//! ([`PooledFit::bootstrap`]) simulates every replicate's K recordings at their own lengths
+//! from the pooled estimate, recomputes their WVs and fast weights and refits the pooled
+//! objective from the estimate.
+
+use super::weights::FullWeights;
+use super::{
+    minimize, FitError, Gmwm, Objective, Parametrisation, StartInputs, Weighting, Weights,
+};
+use crate::imu::read::RATE_TOLERANCE;
+use crate::inference::asymptotic::{sandwich, scales, z_value, ZConvention};
+use crate::inference::covariance::{wv_covariance, CovarianceMethod};
+use crate::inference::progress::NoProgress;
+use crate::inference::IntervalScale;
+use crate::inference::ParameterInference;
+use crate::model::Model;
+use crate::sim::{replicate_seed, Simulator};
+use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// Replicates of the bootstrap V used when the exact WV covariance does not cover the model
+/// (as the single-recording inference, docs/methods.md §7.4).
+pub const POOLED_V_REPLICATES: usize = 100;
+
+/// One recording of a pooled fit: its WV, its weights and the search inputs (N, range).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    pub(crate) wv: WaveletVariance,
+    pub(crate) weights: Weights,
+    pub(crate) inputs: StartInputs,
+}
+
+impl Recording {
+    /// The recording of the series `x` at `freq_hz`: its WV (`wv_opts`) and the weights of
+    /// `weighting` (the bootstrap weighting gives the fast weights, module doc).
+    ///
+    /// # Errors
+    /// As [`wavelet_variance`] and [`Weights::new`]; [`FitError::NotHaar`].
+    pub fn from_series(
+        x: &[f64],
+        freq_hz: f64,
+        wv_opts: &WvOptions,
+        weighting: Weighting,
+    ) -> Result<Self, FitError> {
+        super::check_haar(wv_opts.filter)?;
+        let wv = wavelet_variance(x, freq_hz, wv_opts)?;
+        let weights = Weights::new(weighting, &wv, Some(x))?;
+        Ok(Self {
+            wv,
+            weights,
+            inputs: StartInputs::from_series(x),
+        })
+    }
+
+    /// The recording of a precomputed WV with its fast weights (N from the WV, range 0).
+    ///
+    /// # Errors
+    /// As [`Weights::fast`]; [`FitError::NotHaar`].
+    pub fn from_wv(wv: WaveletVariance) -> Result<Self, FitError> {
+        super::check_haar(wv.filter)?;
+        let weights = Weights::fast(&wv)?;
+        let inputs = StartInputs::from_wv(&wv);
+        Ok(Self {
+            wv,
+            weights,
+            inputs,
+        })
+    }
+
+    /// The recording's WV.
+    pub fn wv(&self) -> &WaveletVariance {
+        &self.wv
+    }
+
+    /// Its weights.
+    pub fn weights(&self) -> &Weights {
+        &self.weights
+    }
+
+    /// Series length N.
+    pub fn n(&self) -> usize {
+        self.wv.n
+    }
+
+    /// Number of levels `J_k`.
+    pub fn levels(&self) -> usize {
+        self.wv.levels()
+    }
+}
+
+/// The checks every pooled computation starts with: at least `min` recordings, one rate,
+/// one WV estimator, and at least as many levels as parameters in each (docs/methods.md §5.11).
+pub(crate) fn check_recordings(
+    model: &Model,
+    recordings: &[Recording],
+    min: usize,
+) -> Result<(), FitError> {
+    if recordings.len() < min {
+        return Err(FitError::TooFewRecordings {
+            needed: min,
+            found: recordings.len(),
+        });
+    }
+    let first = &recordings[0].wv;
+    let params = model.n_params();
+    for (k, r) in recordings.iter().enumerate() {
+        let f = r.wv.freq_hz;
+        if (f - first.freq_hz).abs() > RATE_TOLERANCE * first.freq_hz {
+            return Err(FitError::RateMismatch {
+                recording: k + 1,
+                rate: f,
+                first_rate: first.freq_hz,
+            });
+        }
+        if r.wv.robust != first.robust || r.wv.transform != first.transform {
+            return Err(FitError::EstimatorMismatch { recording: k + 1 });
+        }
+        super::check_haar(r.wv.filter)?;
+        let needed = params + usize::from(r.wv.robust.is_some());
+        if r.levels() < needed {
+            return Err(FitError::RecordingTooShort {
+                recording: k + 1,
+                n: r.n(),
+                levels: r.levels(),
+                params: needed,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The stacked objective of `model` over `recordings` with each one's diagonal weights, or
+/// with the full weights `full[k]` when given.
+pub(crate) fn pooled_objective(
+    model: &Model,
+    param: Parametrisation,
+    recordings: &[Recording],
+    full: Option<&[FullWeights]>,
+    freq_hz: f64,
+) -> Result<Objective, FitError> {
+    let blocks: Vec<(&[f64], Result<&FullWeights, &Weights>)> = recordings
+        .iter()
+        .enumerate()
+        .map(|(k, r)| {
+            let w = match full {
+                Some(f) => Ok(&f[k]),
+                None => Err(&r.weights),
+            };
+            (&r.wv.wv[..], w)
+        })
+        .collect();
+    Objective::stacked(model, param, &blocks, freq_hz)
+}
+
+/// The minimum of `objective` over several starts (theta, original parametrisation; starts
+/// the transforms refuse are skipped): `(theta, Q, convergence)` of the lowest.
+pub(crate) fn best_of(
+    gmwm: &Gmwm,
+    objective: &Objective,
+    starts: &[Vec<f64>],
+) -> Result<(Vec<f64>, f64, super::Convergence), FitError> {
+    let (_, _, options) = gmwm.settings();
+    let model = objective.model();
+    let mut best: Option<(Vec<f64>, f64, super::Convergence)> = None;
+    let mut first_err = None;
+    for s in starts {
+        let u0 = match Parametrisation::canonical_order(model, s)
+            .and_then(|t| objective.parametrisation().to_u_restart(&t))
+        {
+            Ok(u) => u,
+            Err(e) => {
+                first_err.get_or_insert(e);
+                continue;
+            }
+        };
+        match minimize(objective, &u0, &options) {
+            Ok(m) => {
+                if !matches!(&best, Some(b) if b.1 <= m.objective) {
+                    let theta = Parametrisation::canonical_order(model, &m.theta)?;
+                    best = Some((theta, m.objective, m.convergence));
+                }
+            }
+            Err(e) => {
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    match (best, first_err) {
+        (Some(b), _) => Ok(b),
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(FitError::Length {
+            what: "starting values",
+            expected: 1,
+            found: 0,
+        }),
+    }
+}
+
+/// The stacked matrices of a pooled fit ([`PooledFit::stacked`]).
+pub(crate) struct Stacked {
+    pub(crate) a: DMatrix<f64>,
+    pub(crate) omega: DVector<f64>,
+    pub(crate) v: DMatrix<f64>,
+    pub(crate) hessian: Vec<Vec<Vec<f64>>>,
+    pub(crate) implied: Vec<f64>,
+    pub(crate) nu_hat: Vec<f64>,
+}
+
+/// A multi-recording GMWM fit (docs/methods.md §5.11).
+///
+/// Wire format: `model` (text with the estimates), `theta`, `param_names`, `objective`
+/// (`Q_pool`), `convergence`, `freq_hz`, `reweighted` (step 2 ran), `recordings[]` (`n`, `levels`, `objective` (its
+/// `Q_k` at the pooled estimate), `nu_hat`, `implied_wv`, `separate` (its own fit's `theta`
+/// and `objective`)).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PooledFit {
+    pub(crate) model: Model,
+    pub(crate) theta: Vec<f64>,
+    pub(crate) param_names: Vec<String>,
+    pub(crate) objective: f64,
+    pub(crate) convergence: super::Convergence,
+    pub(crate) freq_hz: f64,
+    pub(crate) recordings: Vec<PooledRecording>,
+    #[serde(skip)]
+    pub(crate) inputs: Vec<Recording>,
+    /// Whether step 2 (model-variance weights, module doc) ran; `false`: the step-1 weights.
+    pub(crate) reweighted: bool,
+}
+
+/// One recording's part of a [`PooledFit`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PooledRecording {
+    /// Series length `N_k`.
+    pub n: usize,
+    /// Levels `J_k`.
+    pub levels: usize,
+    /// `Q_k(theta_hat)`, its own objective at the pooled estimate.
+    pub objective: f64,
+    /// Its empirical WV.
+    pub nu_hat: Vec<f64>,
+    /// The pooled model's implied WV at its levels.
+    pub implied_wv: Vec<f64>,
+    /// Its own (separate) fit's estimates, model order.
+    pub separate_theta: Vec<f64>,
+    /// Its own fit's objective `Q_k(theta_hat_k)`.
+    pub separate_objective: f64,
+}
+
+impl PooledFit {
+    /// The model with the pooled estimates.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// Pooled estimates, model order (original parametrisation).
+    pub fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+
+    /// Labels of `theta`.
+    pub fn param_names(&self) -> &[String] {
+        &self.param_names
+    }
+
+    /// `Q_pool(theta_hat) = sum_k Q_k(theta_hat)`.
+    pub fn objective(&self) -> f64 {
+        self.objective
+    }
+
+    /// How the optimiser ended.
+    pub fn convergence(&self) -> super::Convergence {
+        self.convergence
+    }
+
+    /// Sampling rate in Hz (the first recording's).
+    pub fn freq_hz(&self) -> f64 {
+        self.freq_hz
+    }
+
+    /// Per-recording parts, input order.
+    pub fn recordings(&self) -> &[PooledRecording] {
+        &self.recordings
+    }
+
+    /// Whether the step-2 weights (the model's WV variances at the step-1 estimate) were
+    /// used; `false` when they could not be formed and the step-1 weights were kept.
+    pub fn reweighted(&self) -> bool {
+        self.reweighted
+    }
+
+    /// The inputs the fit was made on, with the weights of its final step.
+    pub fn inputs(&self) -> &[Recording] {
+        &self.inputs
+    }
+
+    /// docs/methods.md §5.11: the sandwich covariance `H V H'` on the stacked Jacobian, the
+    /// block-diagonal weights and the block-diagonal exact covariance of the recordings' WVs at
+    /// the pooled estimate (a bootstrap V of [`POOLED_V_REPLICATES`] replicates seeded with
+    /// `seed` where the exact one does not cover the model), and the `1 - alpha` intervals of
+    /// §7.2 on the transformed scale. Returns the parameters and the `p x p` covariance.
+    ///
+    /// # Errors
+    /// [`FitError::Input`] for a bad `alpha`, a parameter without influence on the implied WV
+    /// (a component fitted to nothing: fit the smaller model) or a failed covariance.
+    pub fn sandwich(
+        &self,
+        alpha: f64,
+        seed: u64,
+    ) -> Result<(Vec<ParameterInference>, DMatrix<f64>), FitError> {
+        let z = z_value(alpha, ZConvention::TwoSided)?;
+        let st = self.stacked(&self.model, seed)?;
+        let s = sandwich(&st.a, &DMatrix::from_diagonal(&st.omega), &st.v)?;
+        Ok((self.intervals(&s.psi, z, alpha), s.psi))
+    }
+
+    /// The stacked matrices of the pooled problem at the estimate (module doc): `A` (sum J_k x
+    /// p), the diagonal of `Omega`, the block-diagonal `V` of the WVs under `v_model` (exact,
+    /// or a bootstrap of [`POOLED_V_REPLICATES`] seeded by `seed`), the stacked model Hessian
+    /// (§4.6), the implied and the empirical WV.
+    pub(crate) fn stacked(&self, v_model: &Model, seed: u64) -> Result<Stacked, FitError> {
+        let p = self.theta.len();
+        let jmax = self.inputs.iter().map(Recording::levels).max().unwrap_or(0);
+        let jac = self.model.jacobian(jmax, self.freq_hz)?;
+        let hess = self.model.hessian(jmax, self.freq_hz)?;
+        let implied = self.model.implied_wv(jmax, self.freq_hz)?.wv;
+        let total: usize = self.inputs.iter().map(Recording::levels).sum();
+        let mut a = DMatrix::zeros(total, p);
+        let mut omega = DVector::zeros(total);
+        let mut v = DMatrix::zeros(total, total);
+        let mut hessian = Vec::with_capacity(total);
+        let mut nu = Vec::with_capacity(total);
+        let mut nu_hat = Vec::with_capacity(total);
+        let mut at = 0;
+        for (k, r) in self.inputs.iter().enumerate() {
+            let j = r.levels();
+            let vk = wv_covariance(
+                v_model,
+                r.n(),
+                self.freq_hz,
+                &r.wv.options(),
+                CovarianceMethod::Auto,
+                POOLED_V_REPLICATES,
+                replicate_seed(seed, k as u64),
+                &NoProgress,
+            )?;
+            v.view_mut((at, at), (j, j)).copy_from(&vk.v);
+            for l in 0..j {
+                omega[at + l] = r.weights.omega[l];
+                for c in 0..p {
+                    a[(at + l, c)] = jac[l][c];
+                }
+                hessian.push(hess[l].clone());
+                nu.push(implied[l]);
+                nu_hat.push(r.wv.wv[l]);
+            }
+            at += j;
+        }
+        Ok(Stacked {
+            a,
+            omega,
+            v,
+            hessian,
+            implied: nu,
+            nu_hat,
+        })
+    }
+
+    /// Intervals of §7.2 from a covariance of the estimates.
+    fn intervals(&self, psi: &DMatrix<f64>, z: f64, _alpha: f64) -> Vec<ParameterInference> {
+        let g = scales(&self.model, IntervalScale::Transformed);
+        (0..self.theta.len())
+            .map(|k| {
+                let se = psi[(k, k)].max(0.0).sqrt();
+                let se_g = se * g[k].derivative(self.theta[k]).abs();
+                let (lo, hi) = g[k].interval(self.theta[k], se_g, z);
+                ParameterInference {
+                    name: self.param_names[k].clone(),
+                    estimate: self.theta[k],
+                    se: Some(se),
+                    ci_low: Some(lo),
+                    ci_high: Some(hi),
+                }
+            })
+            .collect()
+    }
+
+    /// docs/methods.md §5.11: the parametric bootstrap of the pooled estimate. Replicate `b`
+    /// simulates every recording at its own length from the pooled estimate (recording `k` with
+    /// the seed `replicate_seed(replicate_seed(seed, b), k)`), computes its WV with the
+    /// recording's settings and fast weights, and refits the pooled objective from the
+    /// estimate. Returns the replicate estimates (B x p, replicate order); the same for any
+    /// thread count.
+    ///
+    /// # Errors
+    /// [`FitError::Input`] for `replicates < 2`; errors of the simulation, the WVs and the fits.
+    pub fn bootstrap(
+        &self,
+        gmwm: &Gmwm,
+        replicates: usize,
+        seed: u64,
+    ) -> Result<Vec<Vec<f64>>, FitError> {
+        if replicates < 2 {
+            return Err(crate::ParamError::new(
+                "bootstrap replicates",
+                replicates,
+                "must be at least 2",
+            )
+            .into());
+        }
+        let gmwm = gmwm.for_model(self.model.without_values());
+        (0..replicates)
+            .into_par_iter()
+            .map(|b| {
+                let recs =
+                    simulate_recordings(&self.model, &self.inputs, replicate_seed(seed, b as u64))?;
+                let fit = gmwm.fit_pooled_from(&recs, None, std::slice::from_ref(&self.theta))?;
+                Ok(fit.theta)
+            })
+            .collect()
+    }
+
+    /// [`PooledFit::bootstrap`] summarised: per parameter the replicate SD and the §7.2
+    /// interval with the SE of the transformed estimates (as the single-recording bootstrap
+    /// inference, docs/methods.md §7.4).
+    ///
+    /// # Errors
+    /// As [`PooledFit::bootstrap`]; [`FitError::Input`] for a bad `alpha`.
+    pub fn bootstrap_inference(
+        &self,
+        gmwm: &Gmwm,
+        replicates: usize,
+        seed: u64,
+        alpha: f64,
+    ) -> Result<Vec<ParameterInference>, FitError> {
+        let z = z_value(alpha, ZConvention::TwoSided)?;
+        let est = self.bootstrap(gmwm, replicates, seed)?;
+        let g = scales(&self.model, IntervalScale::Transformed);
+        Ok((0..self.theta.len())
+            .map(|k| {
+                let raw: Vec<f64> = est.iter().map(|t| t[k]).collect();
+                let tr: Vec<f64> = raw.iter().map(|&x| g[k].forward(x)).collect();
+                let (lo, hi) = g[k].interval(self.theta[k], sd(&tr), z);
+                ParameterInference {
+                    name: self.param_names[k].clone(),
+                    estimate: self.theta[k],
+                    se: Some(sd(&raw)),
+                    ci_low: Some(lo),
+                    ci_high: Some(hi),
+                }
+            })
+            .collect())
+    }
+}
+
+/// Sample standard deviation (divisor n - 1).
+fn sd(x: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+/// One parametric-bootstrap draw of K recordings from `model` (all values set): recording `k`
+/// at its own length, seed `replicate_seed(seed, k)`, its WV with its own settings and fast
+/// weights (diag weights when the originals are diag is not kept: fast, docs/methods.md §7.4).
+pub(crate) fn simulate_recordings(
+    model: &Model,
+    like: &[Recording],
+    seed: u64,
+) -> Result<Vec<Recording>, FitError> {
+    like.iter()
+        .enumerate()
+        .map(|(k, r)| {
+            let mut sim =
+                Simulator::for_model(model, r.wv.freq_hz, replicate_seed(seed, k as u64))?;
+            let mut x = vec![0.0; r.n()];
+            sim.fill(&mut x);
+            let wv = wavelet_variance(&x, r.wv.freq_hz, &r.wv.options())?;
+            let weights = Weights::fast(&wv)?;
+            Ok(Recording {
+                wv,
+                weights,
+                inputs: StartInputs::from_series(&x),
+            })
+        })
+        .collect()
+}
+
+impl Gmwm {
+    /// docs/methods.md §5.11: fits this estimator's model to all `recordings` at once (module
+    /// doc): the separate fits give the starts, the pooled objective is minimised from each.
+    ///
+    /// ```
+    /// use gmwm::fit::{Gmwm, Recording};
+    /// use gmwm::{model::Model, sim::simulate_model, Weighting, WvOptions};
+    /// let truth = Model::parse("WN(sigma2=1)+RW(gamma2=1e-4)").unwrap();
+    /// let recs: Vec<Recording> = [4000, 8000, 16000]
+    ///     .iter()
+    ///     .enumerate()
+    ///     .map(|(k, &n)| {
+    ///         let x = simulate_model(&truth, n, 1.0, k as u64).unwrap();
+    ///         Recording::from_series(&x, 1.0, &WvOptions::default(), Weighting::Fast).unwrap()
+    ///     })
+    ///     .collect();
+    /// let fit = Gmwm::parse("WN()+RW()").unwrap().with_draws(2000).fit_pooled(&recs).unwrap();
+    /// assert!((fit.theta()[0] - 1.0).abs() < 0.05);
+    /// assert_eq!(fit.recordings().len(), 3);
+    /// ```
+    ///
+    /// # Errors
+    /// [`FitError::TooFewRecordings`] for no recording; [`FitError::RateMismatch`],
+    /// [`FitError::EstimatorMismatch`], [`FitError::RecordingTooShort`] naming the recording
+    /// (1-based); errors of the separate fits and the optimiser.
+    pub fn fit_pooled(&self, recordings: &[Recording]) -> Result<PooledFit, FitError> {
+        check_recordings(self.model(), recordings, 1)?;
+        let separate: Vec<super::GmwmFit> = recordings
+            .par_iter()
+            .map(|r| self.fit_auto(&r.wv, r.weights.clone(), r.inputs))
+            .collect::<Result<_, _>>()?;
+        let starts: Vec<Vec<f64>> = separate.iter().map(|f| f.theta.clone()).collect();
+        self.fit_pooled_from(recordings, Some(&separate), &starts)
+    }
+
+    /// The pooled fit from given starts, with the separate fits attached.
+    pub(crate) fn fit_pooled_from(
+        &self,
+        recordings: &[Recording],
+        separate: Option<&[super::GmwmFit]>,
+        starts: &[Vec<f64>],
+    ) -> Result<PooledFit, FitError> {
+        let freq_hz = recordings[0].wv.freq_hz;
+        let (preset, phi_order, _) = self.settings();
+        let param = Parametrisation::new(self.model(), preset, phi_order, freq_hz)?;
+        let param_names = param.names().to_vec();
+        let objective = pooled_objective(self.model(), param.clone(), recordings, None, freq_hz)?;
+        let (theta1, q1, conv1) = best_of(self, &objective, starts)?;
+        // step 2 (module doc): each recording weighted by the model's variance of its WV at
+        // the step-1 estimate, which does not move with the recording's own WV
+        let model1 = self.model().with_values(&theta1)?;
+        let step2: Result<Vec<Recording>, FitError> = recordings
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let v = wv_covariance(
+                    &model1,
+                    r.n(),
+                    freq_hz,
+                    &r.wv.options(),
+                    CovarianceMethod::Auto,
+                    POOLED_V_REPLICATES,
+                    replicate_seed(self.start_options.seed, k as u64),
+                    &NoProgress,
+                )?;
+                let diag = (0..r.levels()).map(|l| v.v[(l, l)]).collect();
+                Ok(Recording {
+                    weights: Weights::from_v(diag, "model variance of the WV")?,
+                    ..r.clone()
+                })
+            })
+            .collect();
+        // a step-1 model whose WV variance is not usable (a component at the edge of its
+        // domain, e.g. a collapsed AR1) keeps the step-1 weights: `reweighted` says which
+        let (recordings, theta, q, convergence, reweighted) = match step2 {
+            Ok(recs) => {
+                let objective = pooled_objective(self.model(), param, &recs, None, freq_hz)?;
+                match best_of(self, &objective, std::slice::from_ref(&theta1)) {
+                    Ok((theta, q, mut c)) => {
+                        c.iterations += conv1.iterations;
+                        c.evaluations += conv1.evaluations;
+                        (recs, theta, q, c, true)
+                    }
+                    Err(_) => (recordings.to_vec(), theta1, q1, conv1, false),
+                }
+            }
+            Err(_) => (recordings.to_vec(), theta1, q1, conv1, false),
+        };
+        let model = self.model().with_values(&theta)?;
+        let jmax = recordings.iter().map(Recording::levels).max().unwrap_or(0);
+        let implied = model.implied_wv(jmax, freq_hz)?;
+        let parts = recordings
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let s = separate.map(|s| &s[k]);
+                let j = r.levels();
+                let nu = implied.wv[..j].to_vec();
+                let qk =
+                    r.wv.wv
+                        .iter()
+                        .zip(&nu)
+                        .zip(&r.weights.omega)
+                        .map(|((h, n), w)| w * (h - n) * (h - n))
+                        .sum();
+                PooledRecording {
+                    n: r.n(),
+                    levels: j,
+                    objective: qk,
+                    nu_hat: r.wv.wv.clone(),
+                    implied_wv: nu,
+                    separate_theta: s.map(|s| s.theta.clone()).unwrap_or_default(),
+                    separate_objective: s.map_or(f64::NAN, |s| s.objective),
+                }
+            })
+            .collect();
+        Ok(PooledFit {
+            model,
+            theta,
+            param_names,
+            objective: q,
+            convergence,
+            freq_hz,
+            recordings: parts,
+            inputs: recordings,
+            reweighted,
+        })
+    }
+}
