@@ -531,6 +531,7 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
         time_column: None,
         time_unit: None,
         topic: None,
+        stream_from: None,
     };
     let base = InputConfig::try_from(&input_args)?;
     let wv = WvOptions {
