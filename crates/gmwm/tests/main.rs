@@ -23,6 +23,7 @@ mod robust;
 mod ros;
 mod scale;
 mod selection;
+mod shared;
 mod sim;
 mod streamed;
 mod units;

@@ -26,6 +26,38 @@ pub struct Objective {
     /// then unused.
     whitening: Option<Vec<f64>>,
     freq_hz: f64,
+    /// A stacked layout of several models' implied WVs ([`Stack`]); `model` is then the first
+    /// block's template.
+    stack: Option<Stack>,
+}
+
+/// The stacked moments of a multi-series fit (the shared-process estimator,
+/// `crate::shared`): the target is `rows.len()` blocks of `levels` moments each, and block `r`
+/// is modelled by the sum of the implied WVs of the model blocks `rows[r]`; the parameter
+/// vector is the concatenation of the model blocks' parameters.
+#[derive(Debug, Clone)]
+pub(crate) struct Stack {
+    /// Model blocks (templates) in parameter order.
+    pub(crate) blocks: Vec<Model>,
+    /// Per block of moments, the model blocks whose implied WVs add up to it.
+    pub(crate) rows: Vec<Vec<usize>>,
+    /// Levels per block of moments.
+    pub(crate) levels: usize,
+}
+
+impl Stack {
+    /// Parameter offset of each model block.
+    pub(crate) fn offsets(&self) -> Vec<usize> {
+        let mut at = 0;
+        self.blocks
+            .iter()
+            .map(|m| {
+                let o = at;
+                at += m.n_params();
+                o
+            })
+            .collect()
+    }
 }
 
 /// Residuals and their Jacobian at one `u` (reused buffers).
@@ -60,6 +92,66 @@ impl Objective {
     ) -> Result<Self, FitError> {
         let sqrt_omega = weights.omega.iter().map(|w| w.sqrt()).collect();
         Self::build(model, param, nu_hat, sqrt_omega, None, freq_hz)
+    }
+
+    /// The objective of stacked moments (module [`Stack`]) with diagonal weights: unlike a WV,
+    /// a moment may be zero or negative (a cross-covariance).
+    ///
+    /// # Errors
+    /// [`FitError::Length`] when the sizes disagree; [`FitError::BadWv`] for a non-finite
+    /// moment or weight; [`FitError::TooFewLevels`] with more parameters than moments.
+    pub(crate) fn stacked(
+        stack: Stack,
+        param: Parametrisation,
+        moments: &[f64],
+        omega: &[f64],
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        let rows = stack.rows.len() * stack.levels;
+        let p: usize = stack.blocks.iter().map(Model::n_params).sum();
+        for (what, found) in [("moments", moments.len()), ("weights", omega.len())] {
+            if found != rows {
+                return Err(FitError::Length {
+                    what,
+                    expected: rows,
+                    found,
+                });
+            }
+        }
+        if param.n_params() != p {
+            return Err(FitError::Length {
+                what: "parametrisation",
+                expected: p,
+                found: param.n_params(),
+            });
+        }
+        if let Some((j, &value)) = moments
+            .iter()
+            .zip(omega)
+            .enumerate()
+            .find(|(_, (m, w))| !(m.is_finite() && w.is_finite() && **w > 0.0))
+            .map(|(j, (m, _))| (j, m))
+        {
+            return Err(FitError::BadWv {
+                level: j % stack.levels + 1,
+                value,
+            });
+        }
+        if p > rows {
+            return Err(FitError::TooFewLevels {
+                params: p,
+                levels: rows,
+            });
+        }
+        Ok(Self {
+            model: stack.blocks[0].without_values(),
+            param,
+            nu_hat: moments.to_vec(),
+            sqrt_omega: omega.iter().map(|w| w.sqrt()).collect(),
+            whitening: None,
+            freq_hz,
+            stack: Some(stack),
+        })
     }
 
     /// The objective with a full weighting `Omega = V^{-1}` (docs/methods.md §5.1 with a
@@ -126,6 +218,7 @@ impl Objective {
             sqrt_omega,
             whitening,
             freq_hz,
+            stack: None,
         })
     }
 
@@ -188,7 +281,7 @@ impl Objective {
 
     /// Implied WV `nu2(theta)` and, if asked, its Jacobian `A` (row-major J x p, docs/methods.md
     /// §4.5, original parametrisation) into the given buffers.
-    fn implied(
+    pub(crate) fn implied(
         &self,
         theta: &[f64],
         nu: &mut [f64],
@@ -198,6 +291,30 @@ impl Objective {
         let np = self.n_params();
         nu.fill(0.0);
         let mut a = a;
+        if let Some(stack) = &self.stack {
+            // block r of moments: the sum of its model blocks' implied WVs (Stack)
+            let lv = stack.levels;
+            if let Some(a) = a.as_deref_mut() {
+                a.fill(0.0);
+            }
+            let offsets = stack.offsets();
+            for (r, blocks) in stack.rows.iter().enumerate() {
+                for &b in blocks {
+                    let (model, off) = (&stack.blocks[b], offsets[b]);
+                    let part = &theta[off..off + model.n_params()];
+                    model.for_each_process(part, self.freq_hz, |p, col| {
+                        p.add_wv(&mut nu[r * lv..(r + 1) * lv]);
+                        if let Some(a) = a.as_deref_mut() {
+                            for (j, row) in p.jacobian(lv).iter().enumerate() {
+                                let at = (r * lv + j) * np + off + col;
+                                a[at..at + row.len()].copy_from_slice(row);
+                            }
+                        }
+                    })?;
+                }
+            }
+            return Ok(());
+        }
         self.model.for_each_process(theta, self.freq_hz, |p, col| {
             p.add_wv(nu);
             if let Some(a) = a.as_deref_mut() {
