@@ -56,6 +56,10 @@ pub enum Config {
     Report(ReportConfig),
     /// `gmwm calibrate` or `gmwm wv` over many recordings.
     Batch(BatchConfig),
+    /// `gmwm shared`.
+    Shared(crate::cmd::shared::SharedConfig),
+    /// `gmwm monitor`.
+    Monitor(crate::cmd::monitor::MonitorConfig),
 }
 
 impl TryFrom<&Command> for Config {
@@ -74,6 +78,8 @@ impl TryFrom<&Command> for Config {
             Command::Topics(a) => Self::Topics(a.into()),
             Command::Plot(a) => Self::Plot(a.try_into()?),
             Command::Report(a) => Self::Report(a.try_into()?),
+            Command::Shared(a) => Self::Shared(a.try_into()?),
+            Command::Monitor(a) => Self::Monitor(a.try_into()?),
         })
     }
 }

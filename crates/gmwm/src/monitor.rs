@@ -21,12 +21,15 @@
 //! `eta_j = 2 nu_j^2 / V_jj(L)`.
 //!
 //! The robust WV (§2) has the same centre at Gaussian data and `1 / eff` times the variance
-//! (§1.10), so its law is taken as `nu_j chi2(eff eta_j) / (eff eta_j)`. With `k` levels
-//! tested, each gets the two-sided level `alpha / k` (Bonferroni), so a window of a series that
-//! follows the model is flagged with probability at most `alpha`:
+//! (§1.10), so its law is taken as `nu_j chi2(eff eta_j) / (eff eta_j)`. Both estimators are
+//! tested at each of the `k` levels: the robust one sees a change of the noise process (a step
+//! in variance, a new correlated error) and ignores isolated outliers, the classical one sees the
+//! outliers (a burst of spikes) too. Each of the `2k` tests gets the two-sided level
+//! `alpha / (2k)` (Bonferroni), so a window of a series that follows the model is flagged with
+//! probability at most `alpha`:
 //!
-//! `band_j = [nu_j q(alpha / (2k); r_j) / r_j,  nu_j q(1 - alpha / (2k); r_j) / r_j]`,
-//! `r_j = eff eta_j`, `q` the chi-square quantile.
+//! `band_j = [nu_j q(alpha / (4k); r_j) / r_j,  nu_j q(1 - alpha / (4k); r_j) / r_j]`,
+//! `r_j = eff eta_j` (robust) or `eta_j` (classical), `q` the chi-square quantile.
 //!
 //! The rate of false flags is per window (about `alpha` of the windows of a clean recording,
 //! fewer since the levels are positively correlated), not per recording: over `W` windows expect
@@ -34,8 +37,9 @@
 //! a negative AR coefficient) falls back to `eta_j` of §1.7 (`M_j / 2^j`), which the report says.
 //!
 //! # Rule (docs/methods.md §16.4)
-//! A window is flagged when its robust WV leaves the band at one level or more; each level out
-//! is reported with its direction and ratio to the model's WV. Adjacent or overlapping flagged
+//! A window is flagged when its robust or its classical WV leaves its band at one level or more;
+//! each level out is reported with the estimator, its direction and its ratio to the model's WV
+//! (classical out and robust in: outliers; robust out: the process changed). Adjacent or overlapping flagged
 //! windows are merged into one event.
 
 use crate::error::{Error, InputError, ParamError};
@@ -82,6 +86,10 @@ impl Default for MonitorOptions {
 pub struct LevelOut {
     /// Level `j` (scale `2^j` samples).
     pub level: usize,
+    /// `"robust"` (the robust WV left the robust band: the noise process changed) or
+    /// `"classical"` (the classical WV left its band: outliers such as spikes, which the
+    /// robust WV ignores).
+    pub estimator: &'static str,
     /// `"high"` (above the band) or `"low"`.
     pub side: &'static str,
     /// The window's robust WV over the model's WV.
@@ -101,6 +109,8 @@ pub struct MonitorWindow {
     pub end_s: f64,
     /// The window's robust WV at the tested levels.
     pub wv: Vec<f64>,
+    /// The window's classical WV at the tested levels.
+    pub classical_wv: Vec<f64>,
     /// Whether it leaves the band at some level.
     pub flagged: bool,
     /// The levels out of the band.
@@ -135,7 +145,7 @@ pub struct MonitorReport {
     pub step: usize,
     /// Probability bound of a false flag per window.
     pub alpha: f64,
-    /// Per-level level (`alpha / levels`, Bonferroni).
+    /// Level of each of the `2 k` tests of a window (`alpha / (2 k)`, Bonferroni).
     pub alpha_level: f64,
     /// Robust efficiency.
     pub eff: f64,
@@ -145,10 +155,14 @@ pub struct MonitorReport {
     pub model_wv: Vec<f64>,
     /// Equivalent degrees of freedom of a window's classical WV (§16.3).
     pub eta: Vec<f64>,
-    /// Band, lower ends.
+    /// Band of the robust WV, lower ends.
     pub band_low: Vec<f64>,
-    /// Band, upper ends.
+    /// Band of the robust WV, upper ends.
     pub band_high: Vec<f64>,
+    /// Band of the classical WV, lower ends.
+    pub classical_band_low: Vec<f64>,
+    /// Band of the classical WV, upper ends.
+    pub classical_band_high: Vec<f64>,
     /// Whether `eta` comes from the exact covariance (`false`: §1.7's `M_j / 2^j`).
     pub exact_eta: bool,
     /// Every window.
@@ -252,10 +266,17 @@ pub fn monitor(
             false,
         ),
     };
-    let alpha_level = opts.alpha / levels as f64;
+    let alpha_level = opts.alpha / (2 * levels) as f64;
     let mut band_low = Vec::with_capacity(levels);
     let mut band_high = Vec::with_capacity(levels);
+    let mut c_low = Vec::with_capacity(levels);
+    let mut c_high = Vec::with_capacity(levels);
     for j in 0..levels {
+        let e = eta[j];
+        if e.is_finite() && e > 0.0 {
+            c_low.push(nu[j] * chi_square_quantile(alpha_level / 2.0, e)? / e);
+            c_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, e)? / e);
+        }
         let r = opts.robust.eff * eta[j];
         if !(r.is_finite() && r > 0.0) {
             return Err(InputError::from(ParamError::new(
@@ -278,35 +299,45 @@ pub fn monitor(
         robust: Some(opts.robust),
         ..WvOptions::default()
     };
+    let classical_opts = WvOptions {
+        robust: None,
+        ..wv_opts
+    };
     use rayon::prelude::*;
     let windows: Vec<MonitorWindow> = starts
         .par_iter()
         .map(|&a| -> Result<MonitorWindow, Error> {
-            let wv = wavelet_variance(&x[a..a + big], freq_hz, &wv_opts)?;
-            let values = wv.wv().to_vec();
-            let out: Vec<LevelOut> = (0..levels)
-                .filter_map(|j| {
-                    let v = values[j];
-                    let side = if v > band_high[j] {
-                        "high"
-                    } else if v < band_low[j] {
-                        "low"
-                    } else {
-                        return None;
-                    };
-                    Some(LevelOut {
-                        level: j + 1,
-                        side,
-                        ratio: v / nu[j],
+            let part = &x[a..a + big];
+            let values = wavelet_variance(part, freq_hz, &wv_opts)?.wv().to_vec();
+            let classical = wavelet_variance(part, freq_hz, &classical_opts)?.wv().to_vec();
+            let check = |estimator, v: &[f64], lo: &[f64], hi: &[f64]| {
+                (0..levels)
+                    .filter_map(|j| {
+                        let side = if v[j] > hi[j] {
+                            "high"
+                        } else if v[j] < lo[j] {
+                            "low"
+                        } else {
+                            return None;
+                        };
+                        Some(LevelOut {
+                            level: j + 1,
+                            estimator,
+                            side,
+                            ratio: v[j] / nu[j],
+                        })
                     })
-                })
-                .collect();
+                    .collect::<Vec<_>>()
+            };
+            let mut out = check("robust", &values, &band_low, &band_high);
+            out.extend(check("classical", &classical, &c_low, &c_high));
             Ok(MonitorWindow {
                 start: a,
                 end: a + big,
                 start_s: a as f64 / freq_hz,
                 end_s: (a + big) as f64 / freq_hz,
                 wv: values,
+                classical_wv: classical,
                 flagged: !out.is_empty(),
                 out,
             })
@@ -343,6 +374,8 @@ pub fn monitor(
         eta,
         band_low,
         band_high,
+        classical_band_low: c_low,
+        classical_band_high: c_high,
         exact_eta,
         windows,
         events,

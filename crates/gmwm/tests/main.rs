@@ -17,6 +17,7 @@ mod ieee;
 mod inference;
 mod methods_reference;
 mod model;
+mod monitor;
 mod process;
 mod read;
 mod robust;

@@ -105,7 +105,8 @@ fn shared_study() {
 /// The exact covariance of the stacked moments (`gmwm::variance::cross`) against the Monte
 /// Carlo covariance of 400 simulated triads (N = 4096, 6 levels): the variance of every moment
 /// within 30% (4 SE of a variance estimated from 400 draws, `sqrt(2/400) = 7%`), their mean
-/// ratio within 5%.
+/// log ratio within 0.1 (the 18 rows are correlated across neighbouring levels, about 6
+/// independent ones: 3 SE of their mean is 0.09).
 #[test]
 fn stacked_moment_covariance_matches_monte_carlo() {
     use gmwm::variance::cross::{stacked_moment_covariance, wavelet_cross_covariance};
@@ -152,7 +153,7 @@ fn stacked_moment_covariance_matches_monte_carlo() {
         assert!((ratio - 1.0).abs() < 0.3, "moment {i}: Monte Carlo {var:e}, exact {:e}", v[(i, i)]);
         log_sum += ratio.ln();
     }
-    assert!((log_sum / k as f64).abs() < 0.05, "mean log ratio {}", log_sum / k as f64);
+    assert!((log_sum / k as f64).abs() < 0.1, "mean log ratio {}", log_sum / k as f64);
 }
 
 /// Bad inputs: one clear error each, never a panic.
