@@ -11,7 +11,13 @@ use std::path::{Path, PathBuf};
 fn triad(dir: &Path, n: usize) -> PathBuf {
     use gmwm::model::Model;
     use gmwm::sim::simulate_model;
-    let v = simulate_model(&Model::parse("AR1(phi=0.99, sigma2=0.02)").unwrap(), n, 1.0, 1).unwrap();
+    let v = simulate_model(
+        &Model::parse("AR1(phi=0.99, sigma2=0.02)").unwrap(),
+        n,
+        1.0,
+        1,
+    )
+    .unwrap();
     let cols: Vec<Vec<f64>> = (0..4u64)
         .map(|i| {
             let u = simulate_model(&Model::parse("WN(sigma2=1)").unwrap(), n, 1.0, 10 + i).unwrap();
@@ -25,15 +31,17 @@ fn triad(dir: &Path, n: usize) -> PathBuf {
     let path = dir.join("triad.csv");
     let mut f = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
     writeln!(f, "gyro_x,gyro_y,gyro_z,accel_x").unwrap();
-    for t in 0..n {
-        writeln!(f, "{},{},{},{}", cols[0][t], cols[1][t], cols[2][t], cols[3][t]).unwrap();
+    for row in (0..n).map(|t| cols.iter().map(|c| c[t].to_string()).collect::<Vec<_>>()) {
+        writeln!(f, "{}", row.join(",")).unwrap();
     }
     path
 }
 
 fn shared(file: &Path) -> assert_cmd::Command {
     let mut c = gmwm();
-    c.arg("shared").arg(file).args(["--freq", "1", "--shared", "AR1()", "--model", "WN()"]);
+    c.arg("shared")
+        .arg(file)
+        .args(["--freq", "1", "--shared", "AR1()", "--model", "WN()"]);
     c
 }
 
@@ -44,7 +52,10 @@ fn shared_detects_a_shared_process() {
     let doc = run_json(shared(&file).args(["--columns", "gyro_x,gyro_y,gyro_z", "--json"]));
     assert!(doc["test"]["p_value"].as_f64().unwrap() < 0.01, "{doc}");
     assert_eq!(doc["parameters"][0]["block"], "shared");
-    let table = shared(&file).args(["--columns", "gyro_x,gyro_y"]).output().unwrap();
+    let table = shared(&file)
+        .args(["--columns", "gyro_x,gyro_y"])
+        .output()
+        .unwrap();
     assert!(table.status.success());
     assert!(String::from_utf8_lossy(&table.stdout).contains("no shared process: T ="));
 }
@@ -54,9 +65,15 @@ fn shared_refuses_bad_inputs() {
     let dir = tempfile::tempdir().unwrap();
     let file = triad(dir.path(), 8192);
     // one column
-    assert_one_line_error(shared(&file).args(["--columns", "gyro_x"]), &["at least 2 columns"]);
+    assert_one_line_error(
+        shared(&file).args(["--columns", "gyro_x"]),
+        &["at least 2 columns"],
+    );
     // a column that is not there
-    assert_one_line_error(shared(&file).args(["--columns", "gyro_x,gyro_q"]), &["gyro_q"]);
+    assert_one_line_error(
+        shared(&file).args(["--columns", "gyro_x,gyro_q"]),
+        &["gyro_q"],
+    );
     // two sensors
     assert_one_line_error(
         shared(&file).args(["--columns", "gyro_x,accel_x"]),
@@ -65,8 +82,13 @@ fn shared_refuses_bad_inputs() {
     // too short for the model
     let short = triad(dir.path(), 8);
     let mut c = gmwm();
-    c.arg("shared").arg(&short).args(["--freq", "1", "--shared", "GM()", "--model", "WN()+RW()"]);
-    assert_one_line_error(c.args(["--columns", "gyro_x,gyro_y"]), &["too short", "parameters"]);
+    c.arg("shared")
+        .arg(&short)
+        .args(["--freq", "1", "--shared", "GM()", "--model", "WN()+RW()"]);
+    assert_one_line_error(
+        c.args(["--columns", "gyro_x,gyro_y"]),
+        &["too short", "parameters"],
+    );
 }
 
 /// A calibration JSON of the fields `gmwm monitor` reads.
@@ -85,7 +107,10 @@ fn calibration(dir: &Path, freq: f64, model: &str) -> PathBuf {
 
 fn monitor(file: &Path, cal: &Path) -> assert_cmd::Command {
     let mut c = gmwm();
-    c.arg("monitor").arg(file).args(["--freq", "1", "--model-from"]).arg(cal);
+    c.arg("monitor")
+        .arg(file)
+        .args(["--freq", "1", "--model-from"])
+        .arg(cal);
     c
 }
 
@@ -94,10 +119,14 @@ fn monitor_runs_against_a_calibration() {
     let dir = tempfile::tempdir().unwrap();
     let file = triad(dir.path(), 8192);
     let cal = calibration(dir.path(), 1.0, "AR1(phi=0.99, sigma2=0.02)+WN(sigma2=1)");
-    let doc = run_json(monitor(&file, &cal).args(["--columns", "gyro_x", "--window", "2048", "--json"]));
+    let doc =
+        run_json(monitor(&file, &cal).args(["--columns", "gyro_x", "--window", "2048", "--json"]));
     assert_eq!(doc[0]["column"], "gyro_x");
     assert_eq!(doc[0]["windows"].as_array().unwrap().len(), 7);
-    let table = monitor(&file, &cal).args(["--columns", "gyro_x,gyro_y", "--window", "2048s"]).output().unwrap();
+    let table = monitor(&file, &cal)
+        .args(["--columns", "gyro_x,gyro_y", "--window", "2048s"])
+        .output()
+        .unwrap();
     assert!(table.status.success(), "{table:?}");
     assert!(String::from_utf8_lossy(&table.stdout).contains("flagged"));
 }

@@ -290,7 +290,10 @@ pub fn monitor(
         band_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, r)? / r);
     }
     // window starts
-    let mut starts: Vec<usize> = (0..).map(|k| k * step).take_while(|s| s + big <= n).collect();
+    let mut starts: Vec<usize> = (0..)
+        .map(|k| k * step)
+        .take_while(|s| s + big <= n)
+        .collect();
     if starts.last().is_some_and(|&s| s + big < n) {
         starts.push(n - big);
     }
@@ -309,7 +312,9 @@ pub fn monitor(
         .map(|&a| -> Result<MonitorWindow, Error> {
             let part = &x[a..a + big];
             let values = wavelet_variance(part, freq_hz, &wv_opts)?.wv().to_vec();
-            let classical = wavelet_variance(part, freq_hz, &classical_opts)?.wv().to_vec();
+            let classical = wavelet_variance(part, freq_hz, &classical_opts)?
+                .wv()
+                .to_vec();
             let check = |estimator, v: &[f64], lo: &[f64], hi: &[f64]| {
                 (0..levels)
                     .filter_map(|j| {

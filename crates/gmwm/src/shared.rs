@@ -337,15 +337,18 @@ pub fn fit_shared(
         rows,
         levels,
     };
-    let param_of = |m: &Model| {
-        Parametrisation::new(m, TransformPreset::Imu, PhiOrder::Free, freq_hz)
-    };
+    let param_of =
+        |m: &Model| Parametrisation::new(m, TransformPreset::Imu, PhiOrder::Free, freq_hz);
     let mut labelled = vec![("shared", param_of(&shared_t)?)];
     for (name, _) in axes {
         labelled.push((name, param_of(&spec_t)?));
     }
     let param = Parametrisation::concat(&labelled).ok_or_else(|| {
-        ParamError::new("model", "ordered AR1/GM chain", "scalar transforms (internal)")
+        ParamError::new(
+            "model",
+            "ordered AR1/GM chain",
+            "scalar transforms (internal)",
+        )
     })?;
 
     // starting values (module docs)
@@ -355,12 +358,7 @@ pub fn fit_shared(
             .with_draws(opts.draws)
             .with_phi_order(PhiOrder::Free)
     };
-    let floor_of = |j: usize| {
-        wvs.iter()
-            .map(|w| w.wv()[j])
-            .fold(f64::INFINITY, f64::min)
-            * 1e-3
-    };
+    let floor_of = |j: usize| wvs.iter().map(|w| w.wv()[j]).fold(f64::INFINITY, f64::min) * 1e-3;
     let mean_cross: Vec<f64> = (0..levels)
         .map(|j| {
             let m = cross.iter().map(|c| c[j]).sum::<f64>() / cross.len() as f64;
@@ -430,7 +428,7 @@ pub fn fit_shared(
             .to_u_restart(s)
             .and_then(|u0| minimize(&obj1, &u0, &lm));
         match attempt {
-            Ok(m) if best.as_ref().is_none_or(|b| m.objective < b.objective) => best = Some(m),
+            Ok(m) if best.as_ref().map_or(true, |b| m.objective < b.objective) => best = Some(m),
             Ok(_) => {}
             Err(e) => last_err = Some(e),
         }
@@ -619,7 +617,9 @@ const INACTIVE_INFLUENCE: f64 = 1e-7;
 /// `c' Sigma^+ c` on the correlation scale (eigenvalues below [`EIGEN_CUTOFF`] times the
 /// largest dropped) and the rank used, the degrees of freedom of its chi-square law.
 fn quadratic_form(sigma: &DMatrix<f64>, c: &nalgebra::DVector<f64>) -> (f64, usize) {
-    let d: Vec<f64> = (0..c.len()).map(|i| sigma[(i, i)].max(0.0).sqrt()).collect();
+    let d: Vec<f64> = (0..c.len())
+        .map(|i| sigma[(i, i)].max(0.0).sqrt())
+        .collect();
     if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
         return (0.0, 0);
     }

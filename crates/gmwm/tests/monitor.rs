@@ -43,7 +43,8 @@ fn monitor_flags_injected_faults_where_they_are() {
         x[t] += 30.0;
     }
     let step = 700_000..730_000;
-    let extra = simulate_model(&Model::parse("WN(sigma2=3)").unwrap(), step.len(), 100.0, 9).unwrap();
+    let extra =
+        simulate_model(&Model::parse("WN(sigma2=3)").unwrap(), step.len(), 100.0, 9).unwrap();
     for (t, e) in step.clone().zip(extra) {
         x[t] += e;
     }
@@ -59,18 +60,32 @@ fn monitor_flags_injected_faults_where_they_are() {
         // a window holding the whole burst, or a quarter of a window of the step, must be
         // flagged; one that only grazes a fault may or may not be
         if overlap(w, &spikes) == spikes.len() {
-            assert!(w.out.iter().any(|o| o.estimator == "classical"), "spikes missed: {w:?}");
+            assert!(
+                w.out.iter().any(|o| o.estimator == "classical"),
+                "spikes missed: {w:?}"
+            );
         } else if overlap(w, &step) >= (1 << 12) {
-            assert!(w.out.iter().any(|o| o.estimator == "robust"), "step missed: {:?}", w.start);
+            assert!(
+                w.out.iter().any(|o| o.estimator == "robust"),
+                "step missed: {:?}",
+                w.start
+            );
         } else if overlaps(w, &spikes) || overlaps(w, &step) {
             continue;
         } else if w.flagged {
             elsewhere += 1;
         }
     }
-    assert!(elsewhere <= 2, "{elsewhere} windows flagged away from the faults");
+    assert!(
+        elsewhere <= 2,
+        "{elsewhere} windows flagged away from the faults"
+    );
     // one event per fault, plus one per stray window
-    assert!((2..=2 + elsewhere).contains(&r.events.len()), "{:?}", r.events);
+    assert!(
+        (2..=2 + elsewhere).contains(&r.events.len()),
+        "{:?}",
+        r.events
+    );
 }
 
 /// Bad inputs: one clear error each.
@@ -81,6 +96,15 @@ fn monitor_refuses_bad_inputs() {
     let e = monitor(&x, 100.0, &model, &opts()).unwrap_err();
     assert!(e.to_string().contains("window"), "{e}");
     let guess = Model::parse("GM()+WN()").unwrap();
-    let e = monitor(&x, 100.0, &guess, &MonitorOptions { window: 512, ..opts() }).unwrap_err();
+    let e = monitor(
+        &x,
+        100.0,
+        &guess,
+        &MonitorOptions {
+            window: 512,
+            ..opts()
+        },
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("every parameter"), "{e}");
 }

@@ -18,13 +18,24 @@ const SPECIFIC: [&str; 3] = [
 
 /// One simulated triad of `n` samples (with or without the shared GM), fitted.
 fn replicate(n: usize, seed: u64, with_shared: bool) -> SharedFit {
-    let v = simulate_model(&Model::parse(SHARED).unwrap(), n, FREQ, replicate_seed(seed, 0)).unwrap();
+    let v = simulate_model(
+        &Model::parse(SHARED).unwrap(),
+        n,
+        FREQ,
+        replicate_seed(seed, 0),
+    )
+    .unwrap();
     let axes: Vec<Vec<f64>> = SPECIFIC
         .iter()
         .enumerate()
         .map(|(i, m)| {
-            let u = simulate_model(&Model::parse(m).unwrap(), n, FREQ, replicate_seed(seed, 1 + i as u64))
-                .unwrap();
+            let u = simulate_model(
+                &Model::parse(m).unwrap(),
+                n,
+                FREQ,
+                replicate_seed(seed, 1 + i as u64),
+            )
+            .unwrap();
             if with_shared {
                 u.iter().zip(&v).map(|(a, b)| a + b).collect()
             } else {
@@ -62,7 +73,8 @@ fn study(n: usize, reps: u64, seed: u64, with_shared: bool) -> (u64, u64, u64, u
             (inside(0, 0.5), inside(1, 0.05), fit.test.p_value < 0.05)
         })
         .collect();
-    let count = |f: &dyn Fn(&(bool, bool, bool)) -> bool| out.iter().filter(|o| f(o)).count() as u64;
+    let count =
+        |f: &dyn Fn(&(bool, bool, bool)) -> bool| out.iter().filter(|o| f(o)).count() as u64;
     (
         reps,
         count(&|o| o.0),
@@ -79,10 +91,19 @@ fn study(n: usize, reps: u64, seed: u64, with_shared: bool) -> (u64, u64, u64, u
 #[test]
 fn shared_gm_is_recovered_and_the_test_holds_its_size() {
     let (reps, beta, s2, _, rejected) = study(1 << 15, 200, 11, true);
-    assert!(beta as f64 >= 0.93 * reps as f64, "beta covered {beta}/{reps}");
-    assert!(s2 as f64 >= 0.93 * reps as f64, "sigma2_gm covered {s2}/{reps}");
+    assert!(
+        beta as f64 >= 0.93 * reps as f64,
+        "beta covered {beta}/{reps}"
+    );
+    assert!(
+        s2 as f64 >= 0.93 * reps as f64,
+        "sigma2_gm covered {s2}/{reps}"
+    );
     // with the shared GM the test has power: it rejects in (nearly) every triad
-    assert!(rejected as f64 >= 0.99 * reps as f64, "power {rejected}/{reps}");
+    assert!(
+        rejected as f64 >= 0.99 * reps as f64,
+        "power {rejected}/{reps}"
+    );
     let (reps, _, _, _, rejected) = study(1 << 15, 200, 12, false);
     let se = (0.05f64 * 0.95 / reps as f64).sqrt();
     let rate = rejected as f64 / reps as f64;
@@ -116,18 +137,31 @@ fn stacked_moment_covariance_matches_monte_carlo() {
     let moments: Vec<Vec<f64>> = (0..reps)
         .into_par_iter()
         .map(|r| {
-            let v = simulate_model(&Model::parse("AR1(phi=0.9, sigma2=0.2)").unwrap(), n, 1.0, replicate_seed(5, 3 * r))
-                .unwrap();
+            let v = simulate_model(
+                &Model::parse("AR1(phi=0.9, sigma2=0.2)").unwrap(),
+                n,
+                1.0,
+                replicate_seed(5, 3 * r),
+            )
+            .unwrap();
             let axes: Vec<Vec<f64>> = ["WN(sigma2=1)", "WN(sigma2=2)+RW(gamma2=1e-3)"]
                 .iter()
                 .enumerate()
                 .map(|(i, m)| {
-                    let u = simulate_model(&Model::parse(m).unwrap(), n, 1.0, replicate_seed(5, 3 * r + 1 + i as u64))
-                        .unwrap();
+                    let u = simulate_model(
+                        &Model::parse(m).unwrap(),
+                        n,
+                        1.0,
+                        replicate_seed(5, 3 * r + 1 + i as u64),
+                    )
+                    .unwrap();
                     u.iter().zip(&v).map(|(a, b)| a + b).collect()
                 })
                 .collect();
-            let o = WvOptions { levels: Some(j), ..WvOptions::default() };
+            let o = WvOptions {
+                levels: Some(j),
+                ..WvOptions::default()
+            };
             let mut m = Vec::new();
             for x in &axes {
                 m.extend(wavelet_variance(x, 1.0, &o).unwrap().wv().iter().copied());
@@ -150,10 +184,18 @@ fn stacked_moment_covariance_matches_monte_carlo() {
         let mean = moments.iter().map(|m| m[i]).sum::<f64>() / reps as f64;
         let var = moments.iter().map(|m| (m[i] - mean).powi(2)).sum::<f64>() / (reps - 1) as f64;
         let ratio = var / v[(i, i)];
-        assert!((ratio - 1.0).abs() < 0.3, "moment {i}: Monte Carlo {var:e}, exact {:e}", v[(i, i)]);
+        assert!(
+            (ratio - 1.0).abs() < 0.3,
+            "moment {i}: Monte Carlo {var:e}, exact {:e}",
+            v[(i, i)]
+        );
         log_sum += ratio.ln();
     }
-    assert!((log_sum / k as f64).abs() < 0.1, "mean log ratio {}", log_sum / k as f64);
+    assert!(
+        (log_sum / k as f64).abs() < 0.1,
+        "mean log ratio {}",
+        log_sum / k as f64
+    );
 }
 
 /// Bad inputs: one clear error each, never a panic.
@@ -168,12 +210,21 @@ fn shared_refuses_bad_inputs() {
     let short = &x[..4000];
     let diff = fit_shared(&[("x", &x), ("y", short)], 1.0, &shared, &spec, &o).unwrap_err();
     assert!(diff.to_string().contains("as many samples"), "{diff}");
-    let dr = fit_shared(&[("x", &x), ("y", &x)], 1.0, &shared, &"WN()+DR()".parse().unwrap(), &o)
-        .unwrap_err();
+    let dr = fit_shared(
+        &[("x", &x), ("y", &x)],
+        1.0,
+        &shared,
+        &"WN()+DR()".parse().unwrap(),
+        &o,
+    )
+    .unwrap_err();
     assert!(dr.to_string().contains("DR"), "{dr}");
     let tiny = &x[..8];
     let e = fit_shared(&[("x", tiny), ("y", tiny)], 1.0, &shared, &spec, &o).unwrap_err();
-    assert!(matches!(e, gmwm::Error::Fit(gmwm::FitError::TooFewLevels { .. })), "{e:?}");
+    assert!(
+        matches!(e, gmwm::Error::Fit(gmwm::FitError::TooFewLevels { .. })),
+        "{e:?}"
+    );
     let mut bad = x.clone();
     bad[7] = f64::NAN;
     assert!(fit_shared(&[("x", &x), ("y", &bad)], 1.0, &shared, &spec, &o).is_err());

@@ -132,7 +132,11 @@ impl TryFrom<&MonitorArgs> for MonitorConfig {
             input: InputConfig::try_from(&a.input)?,
             calibration: a.model_from.clone(),
             window: Span::parse("--window", &a.window)?,
-            step: a.step.as_deref().map(|s| Span::parse("--step", s)).transpose()?,
+            step: a
+                .step
+                .as_deref()
+                .map(|s| Span::parse("--step", s))
+                .transpose()?,
             options: MonitorOptions {
                 alpha: a.alpha,
                 robust,
@@ -221,8 +225,11 @@ pub fn compute(config: &MonitorConfig) -> Result<Vec<AxisMonitor>> {
     let infos = gmwm::imu::SensorInfo::of_table(&loaded.table);
     let mut items = Vec::new();
     for (col, info) in loaded.table.columns.iter().zip(&infos) {
-        let cal = cal_axes.iter().find(|a| a.column == col.name).with_context(|| {
-            format!(
+        let cal = cal_axes
+            .iter()
+            .find(|a| a.column == col.name)
+            .with_context(|| {
+                format!(
                 "{file}: column {} is not in {cal_shown} (it has {}); choose --columns among them",
                 col.name,
                 cal_axes
@@ -231,7 +238,7 @@ pub fn compute(config: &MonitorConfig) -> Result<Vec<AxisMonitor>> {
                     .collect::<Vec<_>>()
                     .join(", ")
             )
-        })?;
+            })?;
         let file_unit = info.unit.as_deref();
         if let (Some(f), Some(c)) = (file_unit, cal.data_unit.as_deref()) {
             let same = match (f.parse::<SignalUnit>(), c.parse::<SignalUnit>()) {

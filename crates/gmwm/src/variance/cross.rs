@@ -73,12 +73,9 @@ pub fn wavelet_cross_covariance(
     levels: usize,
 ) -> Result<Vec<f64>, InputError> {
     if x.len() != y.len() {
-        return Err(ParamError::new(
-            "y",
-            y.len(),
-            format!("as many samples as x ({})", x.len()),
-        )
-        .into());
+        return Err(
+            ParamError::new("y", y.len(), format!("as many samples as x ({})", x.len())).into(),
+        );
     }
     let opts = WvOptions {
         levels: Some(levels),
@@ -211,10 +208,15 @@ mod tests {
             assert!((block - &c).abs().max() <= 1e-12 * c.abs().max());
         }
         // the cross-covariance of independent white noises: Var c_j = nu_1 nu_2 sum rho^2 / M
-        let m0 = stacked_moment_covariance(&[], &spec[..1].repeat(2), n, 1).unwrap();
+        let two = vec![spec[0].clone(), spec[0].clone()];
+        let m0 = stacked_moment_covariance(&[], &two, n, 1).unwrap();
         // level 1 of WN(1): coefficients (x_t - x_{t-1}) / 2, rho(1) = -1/2; nu = 1/2
         let mm = (n - 1) as f64;
         let want = 0.25 * (mm + 2.0 * (mm - 1.0) * 0.25) / (mm * mm);
-        assert!((m0[(2, 2)] - want).abs() < 1e-12 * want, "{} {want}", m0[(2, 2)]);
+        assert!(
+            (m0[(2, 2)] - want).abs() < 1e-12 * want,
+            "{} {want}",
+            m0[(2, 2)]
+        );
     }
 }
