@@ -93,7 +93,7 @@ fn shared_refuses_bad_inputs() {
 
 /// A calibration JSON of the fields `gmwm monitor` reads.
 fn calibration(dir: &Path, freq: f64, model: &str) -> PathBuf {
-    let path = dir.join("cal.calibration.json");
+    let path = dir.join(format!("cal{freq}.calibration.json"));
     let doc = serde_json::json!({
         "freq_hz": freq,
         "axes": [
@@ -139,7 +139,7 @@ fn monitor_refuses_mismatched_inputs() {
     // a column the calibration does not have
     assert_one_line_error(
         monitor(&file, &cal).args(["--columns", "gyro_z", "--window", "2048"]),
-        &["gyro_z", "is not in", "cal.calibration.json"],
+        &["gyro_z", "is not in", "cal1.calibration.json"],
     );
     // another rate
     let other = calibration(dir.path(), 100.0, "WN(sigma2=1)");
