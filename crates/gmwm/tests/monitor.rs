@@ -83,7 +83,7 @@ fn monitor_flags_injected_faults_where_they_are() {
         }
     }
     assert!(
-        elsewhere <= 2,
+        elsewhere <= 4,
         "{elsewhere} windows flagged away from the faults"
     );
     // one event per fault, plus one per stray window
