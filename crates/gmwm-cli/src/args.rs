@@ -93,6 +93,15 @@ pub enum Command {
     /// contributions.
     #[command(after_long_help = crate::cmd::same_model::EXAMPLES)]
     SameModel(crate::cmd::same_model::SameModelArgs),
+    /// Fit a latent process shared by several axes (x_i = V + U_i, paper §IV-A) from their
+    /// wavelet variances and cross-covariances, with intervals and a test of "no shared
+    /// process" (docs/methods.md §15).
+    #[command(allow_negative_numbers = true, after_long_help = crate::cmd::shared::EXAMPLES)]
+    Shared(crate::cmd::shared::SharedArgs),
+    /// Flag the windows of a long recording whose robust wavelet variance leaves the band of a
+    /// calibrated model (paper §IV-C, docs/methods.md §16), with their times.
+    #[command(allow_negative_numbers = true, after_long_help = crate::cmd::monitor::EXAMPLES)]
+    Monitor(crate::cmd::monitor::MonitorArgs),
 }
 
 const CALIBRATE_EXAMPLES: &str = "\

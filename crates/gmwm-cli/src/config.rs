@@ -56,6 +56,10 @@ pub enum Config {
     Report(ReportConfig),
     /// `gmwm calibrate` or `gmwm wv` over many recordings.
     Batch(BatchConfig),
+    /// `gmwm shared`.
+    Shared(crate::cmd::shared::SharedConfig),
+    /// `gmwm monitor`.
+    Monitor(crate::cmd::monitor::MonitorConfig),
 }
 
 impl TryFrom<&Command> for Config {
@@ -80,6 +84,8 @@ impl TryFrom<&Command> for Config {
             }
             Command::Fit(a) => Self::Fit(a.try_into()?),
             Command::Select(a) => Self::Select(a.try_into()?),
+            Command::Shared(a) => Self::Shared(a.try_into()?),
+            Command::Monitor(a) => Self::Monitor(a.try_into()?),
         })
     }
 }

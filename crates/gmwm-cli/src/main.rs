@@ -175,6 +175,8 @@ fn execute(config: &Config) -> anyhow::Result<()> {
         Config::Plot(c) => cmd::plot::run(c, &mut out)?,
         Config::Report(c) => cmd::report::run(c, &mut out)?,
         Config::Batch(c) => batch::run(c, &mut out)?,
+        Config::Shared(c) => cmd::shared::run(c, &mut out)?,
+        Config::Monitor(c) => cmd::monitor::run(c, &mut out)?,
     }
     out.flush()?;
     Ok(())
@@ -189,6 +191,8 @@ fn input_mut(config: &mut Config) -> Option<&mut InputConfig> {
         Config::Select(c) => &mut c.input,
         Config::Calibrate(c) => &mut c.input,
         Config::Report(c) => &mut c.calibrate.input,
+        Config::Shared(c) => &mut c.input,
+        Config::Monitor(c) => &mut c.input,
         Config::Plot(c) => match &mut c.kind {
             PlotKind::Wv(c) => &mut c.input,
             PlotKind::Avar(c) | PlotKind::Ieee(c) => &mut c.input,

@@ -26,10 +26,46 @@ pub struct Objective {
     /// then unused.
     whitening: Option<Vec<f64>>,
     freq_hz: f64,
-    /// Stacked (pooled) objective ([`Objective::stacked`]): the 0-based WV level of each entry
-    /// of `nu_hat` and the number of levels the implied WV is evaluated at; `None` for one WV,
-    /// whose entry `j` is level `j + 1`.
-    stack: Option<(Vec<usize>, usize)>,
+    /// A stacked layout of several WVs or moments ([`Stack`]); `model` is then the first
+    /// block's template.
+    stack: Option<Stack>,
+}
+
+/// The stacked moments of a multi-series fit: `rows.len()` blocks of moments, block `r`
+/// holding levels `1..=levels[r]` and modelled by the sum of the implied WVs of the model
+/// blocks `rows[r]`; the parameter vector is the concatenation of the model blocks'
+/// parameters. A pooled fit (`crate::fit::pooled`, docs/methods.md §5.11) is one model block
+/// and one row per recording, each with its own levels; the shared-process estimator
+/// (`crate::shared`) has a shared and a specific block per axis, and rows of equal length for
+/// the axes' WVs and their cross-covariances.
+#[derive(Debug, Clone)]
+pub(crate) struct Stack {
+    /// Model blocks (templates) in parameter order.
+    pub(crate) blocks: Vec<Model>,
+    /// Per block of moments, the model blocks whose implied WVs add up to it.
+    pub(crate) rows: Vec<Vec<usize>>,
+    /// Levels of each block of moments.
+    pub(crate) levels: Vec<usize>,
+}
+
+impl Stack {
+    /// Parameter offset of each model block.
+    pub(crate) fn offsets(&self) -> Vec<usize> {
+        let mut at = 0;
+        self.blocks
+            .iter()
+            .map(|m| {
+                let o = at;
+                at += m.n_params();
+                o
+            })
+            .collect()
+    }
+
+    /// Number of moments: the rows' levels summed.
+    pub(crate) fn moments(&self) -> usize {
+        self.levels.iter().sum()
+    }
 }
 
 /// Residuals and their Jacobian at one `u` (reused buffers).
@@ -64,6 +100,74 @@ impl Objective {
     ) -> Result<Self, FitError> {
         let sqrt_omega = weights.omega.iter().map(|w| w.sqrt()).collect();
         Self::build(model, param, nu_hat, sqrt_omega, None, freq_hz)
+    }
+
+    /// The objective of stacked moments (module [`Stack`]) with diagonal weights: unlike a WV,
+    /// a moment may be zero or negative (a cross-covariance).
+    ///
+    /// # Errors
+    /// [`FitError::Length`] when the sizes disagree; [`FitError::BadWv`] for a non-finite
+    /// moment or weight; [`FitError::TooFewLevels`] with more parameters than moments.
+    pub(crate) fn stacked_moments(
+        stack: Stack,
+        param: Parametrisation,
+        moments: &[f64],
+        omega: &[f64],
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        let rows = stack.moments();
+        let p: usize = stack.blocks.iter().map(Model::n_params).sum();
+        for (what, found) in [("moments", moments.len()), ("weights", omega.len())] {
+            if found != rows {
+                return Err(FitError::Length {
+                    what,
+                    expected: rows,
+                    found,
+                });
+            }
+        }
+        if param.n_params() != p {
+            return Err(FitError::Length {
+                what: "parametrisation",
+                expected: p,
+                found: param.n_params(),
+            });
+        }
+        if let Some((j, &value)) = moments
+            .iter()
+            .zip(omega)
+            .enumerate()
+            .find(|(_, (m, w))| !(m.is_finite() && w.is_finite() && **w > 0.0))
+            .map(|(j, (m, _))| (j, m))
+        {
+            // the level within its block of moments
+            let mut level = j;
+            for &l in &stack.levels {
+                if level < l {
+                    break;
+                }
+                level -= l;
+            }
+            return Err(FitError::BadWv {
+                level: level + 1,
+                value,
+            });
+        }
+        if p > rows {
+            return Err(FitError::TooFewLevels {
+                params: p,
+                levels: rows,
+            });
+        }
+        Ok(Self {
+            model: stack.blocks[0].without_values(),
+            param,
+            nu_hat: moments.to_vec(),
+            sqrt_omega: omega.iter().map(|w| w.sqrt()).collect(),
+            whitening: None,
+            freq_hz,
+            stack: Some(stack),
+        })
     }
 
     /// The objective with a full weighting `Omega = V^{-1}` (docs/methods.md §5.1 with a
@@ -161,7 +265,6 @@ impl Objective {
         let total: usize = blocks.iter().map(|(nu, _)| nu.len()).sum();
         let full = blocks.iter().any(|(_, w)| w.is_ok());
         let mut nu_hat = Vec::with_capacity(total);
-        let mut level_of = Vec::with_capacity(total);
         let mut sqrt_omega = Vec::with_capacity(total);
         let mut whitening = full.then(|| vec![0.0; total * total]);
         let mut at = 0;
@@ -179,7 +282,6 @@ impl Objective {
                 });
             }
             nu_hat.extend_from_slice(nu);
-            level_of.extend(0..j);
             match (w, whitening.as_mut()) {
                 (Ok(f), Some(big)) => {
                     let m = f.whitening();
@@ -201,9 +303,12 @@ impl Objective {
             }
             at += j;
         }
-        let jmax = blocks.iter().map(|(nu, _)| nu.len()).max().unwrap_or(0);
         let mut obj = Self::build(model, param, &nu_hat, sqrt_omega, whitening, freq_hz)?;
-        obj.stack = Some((level_of, jmax));
+        obj.stack = Some(Stack {
+            blocks: vec![model.without_values()],
+            rows: vec![vec![0]; blocks.len()],
+            levels: blocks.iter().map(|(nu, _)| nu.len()).collect(),
+        });
         Ok(obj)
     }
 
@@ -266,7 +371,7 @@ impl Objective {
 
     /// Implied WV `nu2(theta)` and, if asked, its Jacobian `A` (row-major J x p, docs/methods.md
     /// §4.5, original parametrisation) into the given buffers.
-    fn implied(
+    pub(crate) fn implied(
         &self,
         theta: &[f64],
         nu: &mut [f64],
@@ -275,22 +380,42 @@ impl Objective {
         let np = self.n_params();
         nu.fill(0.0);
         let mut a = a;
-        if let Some((level_of, jmax)) = &self.stack {
-            // evaluate once at the deepest recording's levels, then gather per entry
-            let mut one = vec![0.0; *jmax];
-            let mut jac = a.is_some().then(|| vec![0.0; jmax * np]);
-            self.model.for_each_process(theta, self.freq_hz, |p, col| {
-                p.add_wv(&mut one);
-                if let Some(jac) = jac.as_deref_mut() {
-                    for (j, row) in p.jacobian(*jmax).iter().enumerate() {
-                        jac[j * np + col..j * np + col + row.len()].copy_from_slice(row);
+        if let Some(stack) = &self.stack {
+            // each model block's implied WV (and Jacobian) once, at the deepest row's levels;
+            // entry j of row r is the sum over the row's blocks at level j (Stack)
+            let jmax = stack.levels.iter().copied().max().unwrap_or(0);
+            let offsets = stack.offsets();
+            let mut wv = vec![0.0; stack.blocks.len() * jmax];
+            let mut jac: Vec<Vec<f64>> = Vec::with_capacity(stack.blocks.len());
+            for (b, model) in stack.blocks.iter().enumerate() {
+                let pb = model.n_params();
+                let part = &theta[offsets[b]..offsets[b] + pb];
+                let mut jb = vec![0.0; if a.is_some() { jmax * pb } else { 0 }];
+                model.for_each_process(part, self.freq_hz, |p, col| {
+                    p.add_wv(&mut wv[b * jmax..(b + 1) * jmax]);
+                    if !jb.is_empty() {
+                        for (j, row) in p.jacobian(jmax).iter().enumerate() {
+                            jb[j * pb + col..j * pb + col + row.len()].copy_from_slice(row);
+                        }
                     }
-                }
-            })?;
-            for (i, &j) in level_of.iter().enumerate() {
-                nu[i] = one[j];
-                if let (Some(a), Some(jac)) = (a.as_deref_mut(), jac.as_deref()) {
-                    a[i * np..(i + 1) * np].copy_from_slice(&jac[j * np..(j + 1) * np]);
+                })?;
+                jac.push(jb);
+            }
+            if let Some(a) = a.as_deref_mut() {
+                a.fill(0.0);
+            }
+            let mut i = 0;
+            for (r, blocks) in stack.rows.iter().enumerate() {
+                for j in 0..stack.levels[r] {
+                    for &b in blocks {
+                        nu[i] += wv[b * jmax + j];
+                        if let Some(a) = a.as_deref_mut() {
+                            let pb = stack.blocks[b].n_params();
+                            let at = i * np + offsets[b];
+                            a[at..at + pb].copy_from_slice(&jac[b][j * pb..(j + 1) * pb]);
+                        }
+                    }
+                    i += 1;
                 }
             }
             return Ok(());

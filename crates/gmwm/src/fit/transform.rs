@@ -259,6 +259,28 @@ impl Parametrisation {
         self.single.len()
     }
 
+    /// The parametrisation of the concatenated parameters of several models (the blocks of a
+    /// stacked fit, `crate::shared`), names prefixed by each block's label. The blocks must
+    /// use scalar transforms only ([`PhiOrder::Free`] or at most one AR1/GM each): `None`
+    /// when a block carries an ordered chain.
+    pub(crate) fn concat(blocks: &[(&str, Parametrisation)]) -> Option<Self> {
+        if blocks.iter().any(|(_, b)| b.is_ordered()) {
+            return None;
+        }
+        let mut out = Self {
+            single: Vec::new(),
+            ordered: Vec::new(),
+            width: 1.0,
+            names: Vec::new(),
+        };
+        for (label, b) in blocks {
+            out.single.extend_from_slice(&b.single);
+            out.names
+                .extend(b.names.iter().map(|n| format!("{label}.{n}")));
+        }
+        Some(out)
+    }
+
     /// Parameter labels, `KIND[component].name` (e.g. `GM[0].beta`).
     pub fn names(&self) -> &[String] {
         &self.names

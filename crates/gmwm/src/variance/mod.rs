@@ -4,6 +4,7 @@
 pub mod allan;
 pub mod ci;
 pub mod cov;
+pub mod cross;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
 pub mod implied_cov;

@@ -1,0 +1,389 @@
+//! Fault detection with the robust wavelet variance (paper §IV-C; docs/methods.md §16): a window
+//! moves along a long recording, and a window whose robust WV leaves the band a calibrated model
+//! predicts for a window of that length is flagged, with its times.
+//!
+//! # Windows (docs/methods.md §16.1)
+//! Windows of `L` samples start at `0, s, 2s, ...` (`s` the step) while they fit in the series;
+//! when the last one stops short of the end, one more window ends at the last sample. Window
+//! `w` covers samples `[a_w, a_w + L)`, times `a_w / f` to `(a_w + L) / f` seconds from the first
+//! sample.
+//!
+//! # Levels (docs/methods.md §16.2)
+//! The levels `j` whose boundary-free coefficient count `M_j = L - 2^j + 1` gives at least
+//! [`MIN_ETA`] equivalent degrees of freedom by §1.7 (`M_j / 2^j >= 8`): coarser levels are too
+//! noisy in one window to show anything but gross faults (capped by `--levels`).
+//!
+//! # Band (docs/methods.md §16.3)
+//! Under the model, the classical WV of a window at level `j` is approximately
+//! `nu_j chi2(eta_j) / eta_j` (§1.7), with the equivalent degrees of freedom matched to the
+//! model's exact variance for a window of `L` samples (`crate::variance::implied_cov`):
+//!
+//! `eta_j = 2 nu_j^2 / V_jj(L)`.
+//!
+//! The robust WV (§2) has the same centre at Gaussian data and `1 / eff` times the variance
+//! (§1.10), so its law is taken as `nu_j chi2(eff eta_j) / (eff eta_j)`. Both estimators are
+//! tested at each of the `k` levels: the robust one sees a change of the noise process (a step
+//! in variance, a new correlated error) and ignores isolated outliers, the classical one sees the
+//! outliers (a burst of spikes) too. Each of the `2k` tests gets the two-sided level
+//! `alpha / (2k)` (Bonferroni), so a window of a series that follows the model is flagged with
+//! probability at most `alpha`:
+//!
+//! `band_j = [nu_j q(alpha / (4k); r_j) / r_j,  nu_j q(1 - alpha / (4k); r_j) / r_j]`,
+//! `r_j = eff eta_j` (robust) or `eta_j` (classical), `q` the chi-square quantile.
+//!
+//! The rate of false flags is per window (about `alpha` of the windows of a clean recording,
+//! fewer since the levels are positively correlated), not per recording: over `W` windows expect
+//! up to `alpha W` flags by chance. A model the exact covariance does not cover (a generic ARMA,
+//! a negative AR coefficient) falls back to `eta_j` of §1.7 (`M_j / 2^j`), which the report says.
+//!
+//! # Rule (docs/methods.md §16.4)
+//! A window is flagged when its robust or its classical WV leaves its band at one level or more;
+//! each level out is reported with the estimator, its direction and its ratio to the model's WV
+//! (classical out and robust in: outliers; robust out: the process changed). Adjacent or overlapping flagged
+//! windows are merged into one event.
+
+use crate::error::{Error, InputError, ParamError};
+use crate::model::Model;
+use crate::variance::ci::{check_alpha, chi_square_quantile};
+use crate::variance::implied_cov::exact_wv_covariance;
+use crate::variance::robust::RobustOptions;
+use crate::variance::wv::{wavelet_variance, WvOptions};
+use serde::Serialize;
+
+/// Smallest equivalent degrees of freedom `M_j / 2^j` (§1.7) of a level the monitor tests.
+pub const MIN_ETA: f64 = 8.0;
+
+/// Settings of [`monitor`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MonitorOptions {
+    /// Window length `L` in samples; default 2^16 (11 min at 100 Hz: levels up to 2^12 samples).
+    pub window: usize,
+    /// Step between window starts in samples; default half a window.
+    pub step: Option<usize>,
+    /// Probability that a window of a series following the model is flagged (at most); default
+    /// 0.01.
+    pub alpha: f64,
+    /// Robust estimator (§2); default `eff = 0.6`.
+    pub robust: RobustOptions,
+    /// Largest level tested; default `None` (every level with `M_j / 2^j >= MIN_ETA`).
+    pub levels: Option<usize>,
+}
+
+impl Default for MonitorOptions {
+    fn default() -> Self {
+        Self {
+            window: 1 << 16,
+            step: None,
+            alpha: 0.01,
+            robust: RobustOptions::default(),
+            levels: None,
+        }
+    }
+}
+
+/// One level of a window outside the band.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LevelOut {
+    /// Level `j` (scale `2^j` samples).
+    pub level: usize,
+    /// `"robust"` (the robust WV left the robust band: the noise process changed) or
+    /// `"classical"` (the classical WV left its band: outliers such as spikes, which the
+    /// robust WV ignores).
+    pub estimator: &'static str,
+    /// `"high"` (above the band) or `"low"`.
+    pub side: &'static str,
+    /// The window's robust WV over the model's WV.
+    pub ratio: f64,
+}
+
+/// One window.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MonitorWindow {
+    /// First sample (0-based).
+    pub start: usize,
+    /// One past the last sample.
+    pub end: usize,
+    /// `start / f` (s from the first sample).
+    pub start_s: f64,
+    /// `end / f` (s).
+    pub end_s: f64,
+    /// The window's robust WV at the tested levels.
+    pub wv: Vec<f64>,
+    /// The window's classical WV at the tested levels.
+    pub classical_wv: Vec<f64>,
+    /// Whether it leaves the band at some level.
+    pub flagged: bool,
+    /// The levels out of the band.
+    pub out: Vec<LevelOut>,
+}
+
+/// A run of flagged windows (overlapping or adjacent), merged.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MonitorEvent {
+    /// First sample of the first flagged window.
+    pub start: usize,
+    /// One past the last sample of the last one.
+    pub end: usize,
+    /// Seconds from the first sample.
+    pub start_s: f64,
+    /// Seconds from the first sample.
+    pub end_s: f64,
+    /// Flagged windows merged.
+    pub windows: usize,
+}
+
+/// Result of [`monitor`] for one series.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MonitorReport {
+    /// The model (with values) the band comes from.
+    pub model: String,
+    /// Sampling rate (Hz).
+    pub freq_hz: f64,
+    /// Window length (samples).
+    pub window: usize,
+    /// Step (samples).
+    pub step: usize,
+    /// Probability bound of a false flag per window.
+    pub alpha: f64,
+    /// Level of each of the `2 k` tests of a window (`alpha / (2 k)`, Bonferroni).
+    pub alpha_level: f64,
+    /// Robust efficiency.
+    pub eff: f64,
+    /// Scales `2^j / f` of the tested levels (s).
+    pub tau_s: Vec<f64>,
+    /// The model's WV at those levels.
+    pub model_wv: Vec<f64>,
+    /// Equivalent degrees of freedom of a window's classical WV (§16.3).
+    pub eta: Vec<f64>,
+    /// Band of the robust WV, lower ends.
+    pub band_low: Vec<f64>,
+    /// Band of the robust WV, upper ends.
+    pub band_high: Vec<f64>,
+    /// Band of the classical WV, lower ends.
+    pub classical_band_low: Vec<f64>,
+    /// Band of the classical WV, upper ends.
+    pub classical_band_high: Vec<f64>,
+    /// Whether `eta` comes from the exact covariance (`false`: §1.7's `M_j / 2^j`).
+    pub exact_eta: bool,
+    /// Every window.
+    pub windows: Vec<MonitorWindow>,
+    /// Merged runs of flagged windows.
+    pub events: Vec<MonitorEvent>,
+    /// Number of flagged windows.
+    pub flagged: usize,
+}
+
+/// Runs the robust-WV monitor (module docs, docs/methods.md §16) over `x` sampled at `freq_hz`
+/// against `model` (every value given, e.g. a calibration's estimate).
+///
+/// ```
+/// use gmwm::model::Model;
+/// use gmwm::monitor::{monitor, MonitorOptions};
+/// use gmwm::sim::simulate_model;
+/// let model = Model::parse("WN(sigma2=1)").unwrap();
+/// let mut x = simulate_model(&model, 1 << 15, 1.0, 1).unwrap();
+/// for v in &mut x[20_000..21_000] { *v *= 3.0; } // a burst of extra noise
+/// let opts = MonitorOptions { window: 4096, ..MonitorOptions::default() };
+/// let r = monitor(&x, 1.0, &model, &opts).unwrap();
+/// assert!(r.windows.iter().filter(|w| w.flagged).all(|w| w.start < 21_000 && w.end > 20_000));
+/// assert!(r.flagged >= 1);
+/// ```
+///
+/// # Errors
+/// [`ParamError`] for a model without all its values, a window shorter than 16 samples or
+/// longer than the series (naming `window`), a zero step, a bad `alpha`; as
+/// [`wavelet_variance`] for a series with non-finite values.
+pub fn monitor(
+    x: &[f64],
+    freq_hz: f64,
+    model: &Model,
+    opts: &MonitorOptions,
+) -> Result<MonitorReport, Error> {
+    check_alpha(opts.alpha)?;
+    if !(freq_hz.is_finite() && freq_hz > 0.0) {
+        return Err(ParamError::new("freq", freq_hz, "a positive number of hertz").into());
+    }
+    if !model.is_fully_specified() {
+        return Err(ParamError::new(
+            "model",
+            model.to_string(),
+            "every parameter given (a calibrated model)",
+        )
+        .into());
+    }
+    let n = x.len();
+    let big = opts.window;
+    if big < 16 {
+        return Err(ParamError::new("window", big, "at least 16 samples").into());
+    }
+    if big > n {
+        return Err(ParamError::new(
+            "window",
+            big,
+            format!("at most the recording's {n} samples"),
+        )
+        .into());
+    }
+    let step = opts.step.unwrap_or((big / 2).max(1));
+    if step == 0 {
+        return Err(ParamError::new("step", step, "at least 1 sample").into());
+    }
+    // levels with M_j / 2^j >= MIN_ETA
+    let mut levels = (1..60)
+        .take_while(|&j| {
+            let t = (1usize << j) as f64;
+            (big as f64 - t + 1.0) / t >= MIN_ETA
+        })
+        .last()
+        .unwrap_or(0);
+    if let Some(cap) = opts.levels {
+        levels = levels.min(cap);
+    }
+    if levels == 0 {
+        return Err(ParamError::new(
+            "window",
+            big,
+            format!("a window long enough for one level with M_j / 2^j >= {MIN_ETA} (18 samples)"),
+        )
+        .into());
+    }
+    let implied = model.implied_wv(levels, freq_hz)?;
+    let nu = implied.wv.clone();
+    let (eta, exact_eta) = match exact_wv_covariance(model, big, freq_hz, levels) {
+        Ok(v) => (
+            (0..levels)
+                .map(|j| 2.0 * nu[j] * nu[j] / v[(j, j)])
+                .collect::<Vec<f64>>(),
+            true,
+        ),
+        Err(_) => (
+            (1..=levels)
+                .map(|j| {
+                    let t = (1usize << j) as f64;
+                    ((big as f64 - t + 1.0) / t).max(1.0)
+                })
+                .collect(),
+            false,
+        ),
+    };
+    let alpha_level = opts.alpha / (2 * levels) as f64;
+    let mut band_low = Vec::with_capacity(levels);
+    let mut band_high = Vec::with_capacity(levels);
+    let mut c_low = Vec::with_capacity(levels);
+    let mut c_high = Vec::with_capacity(levels);
+    for j in 0..levels {
+        let e = eta[j];
+        if e.is_finite() && e > 0.0 {
+            c_low.push(nu[j] * chi_square_quantile(alpha_level / 2.0, e)? / e);
+            c_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, e)? / e);
+        }
+        let r = opts.robust.eff * eta[j];
+        if !(r.is_finite() && r > 0.0) {
+            return Err(InputError::from(ParamError::new(
+                "model",
+                model.to_string(),
+                "a model with a positive finite WV variance at every tested level",
+            ))
+            .into());
+        }
+        band_low.push(nu[j] * chi_square_quantile(alpha_level / 2.0, r)? / r);
+        band_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, r)? / r);
+    }
+    // window starts
+    let mut starts: Vec<usize> = (0..)
+        .map(|k| k * step)
+        .take_while(|s| s + big <= n)
+        .collect();
+    if starts.last().is_some_and(|&s| s + big < n) {
+        starts.push(n - big);
+    }
+    let wv_opts = WvOptions {
+        levels: Some(levels),
+        robust: Some(opts.robust),
+        ..WvOptions::default()
+    };
+    let classical_opts = WvOptions {
+        robust: None,
+        ..wv_opts
+    };
+    use rayon::prelude::*;
+    let windows: Vec<MonitorWindow> = starts
+        .par_iter()
+        .map(|&a| -> Result<MonitorWindow, Error> {
+            let part = &x[a..a + big];
+            let values = wavelet_variance(part, freq_hz, &wv_opts)?.wv().to_vec();
+            let classical = wavelet_variance(part, freq_hz, &classical_opts)?
+                .wv()
+                .to_vec();
+            let check = |estimator, v: &[f64], lo: &[f64], hi: &[f64]| {
+                (0..levels)
+                    .filter_map(|j| {
+                        let side = if v[j] > hi[j] {
+                            "high"
+                        } else if v[j] < lo[j] {
+                            "low"
+                        } else {
+                            return None;
+                        };
+                        Some(LevelOut {
+                            level: j + 1,
+                            estimator,
+                            side,
+                            ratio: v[j] / nu[j],
+                        })
+                    })
+                    .collect::<Vec<_>>()
+            };
+            let mut out = check("robust", &values, &band_low, &band_high);
+            out.extend(check("classical", &classical, &c_low, &c_high));
+            Ok(MonitorWindow {
+                start: a,
+                end: a + big,
+                start_s: a as f64 / freq_hz,
+                end_s: (a + big) as f64 / freq_hz,
+                wv: values,
+                classical_wv: classical,
+                flagged: !out.is_empty(),
+                out,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut events: Vec<MonitorEvent> = Vec::new();
+    for w in windows.iter().filter(|w| w.flagged) {
+        match events.last_mut() {
+            Some(e) if w.start <= e.end => {
+                e.end = w.end;
+                e.end_s = w.end_s;
+                e.windows += 1;
+            }
+            _ => events.push(MonitorEvent {
+                start: w.start,
+                end: w.end,
+                start_s: w.start_s,
+                end_s: w.end_s,
+                windows: 1,
+            }),
+        }
+    }
+    let flagged = windows.iter().filter(|w| w.flagged).count();
+    Ok(MonitorReport {
+        model: model.to_string(),
+        freq_hz,
+        window: big,
+        step,
+        alpha: opts.alpha,
+        alpha_level,
+        eff: opts.robust.eff,
+        tau_s: implied.tau_s.clone(),
+        model_wv: nu,
+        eta,
+        band_low,
+        band_high,
+        classical_band_low: c_low,
+        classical_band_high: c_high,
+        exact_eta,
+        windows,
+        events,
+        flagged,
+    })
+}
