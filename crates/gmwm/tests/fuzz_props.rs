@@ -325,6 +325,25 @@ fn fuzz_regression_topic_names_escaped() {
     assert!(s.contains("\\0"), "{s}");
 }
 
+/// An MCAP chunk whose compression field runs into the chunk's records (a newline, NUL bytes):
+/// the unsupported-compression error printed it raw, over several lines.
+#[test]
+fn fuzz_regression_chunk_compression_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.mcap");
+    std::fs::write(&path, fixture("mcap", "chunk_compression_newline")).unwrap();
+    let e = gmwm::imu::ros::read_imu_messages(&path, None).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            gmwm::imu::ReadError::Ros(gmwm::imu::ros::RosError::UnsupportedCompression { .. })
+        ),
+        "{e:?}"
+    );
+    let s = one_line(&e);
+    assert!(s.contains("MCAP chunk compression \"$\\n\\0"), "{s}");
+}
+
 /// Not found by the fuzzers in their runs but a known allocation bomb of the same family: a
 /// sidecar stating 10^12 (or 2^64 - 1) interleaved columns of a 96-byte file; the column names
 /// were made before the size was checked, and `8 * ncols` overflowed.

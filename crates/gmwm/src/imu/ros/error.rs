@@ -47,11 +47,12 @@ pub enum RosError {
         reason: String,
     },
     /// A compression this reader cannot decode (chunk or whole-file compression).
-    #[error("{}: {what} is not supported; {hint}", .path.display())]
+    #[error("{}: {} is not supported; {hint}", .path.display(), escape_name(.what))]
     UnsupportedCompression {
         /// Storage file.
         path: PathBuf,
-        /// What is compressed how, e.g. `MCAP chunk compression "brotli"`.
+        /// What is compressed how, e.g. `MCAP chunk compression "brotli"` (the name is the
+        /// file's: control characters are escaped in the message).
         what: String,
         /// What is supported or how to convert.
         hint: &'static str,
