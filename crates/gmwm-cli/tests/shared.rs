@@ -58,6 +58,22 @@ fn shared_detects_a_shared_process() {
         .unwrap();
     assert!(table.status.success());
     assert!(String::from_utf8_lossy(&table.stdout).contains("no shared process: T ="));
+    // --plot draws the WVs and the cross-covariances, with the test in a title
+    let svg = dir.path().join("shared.svg");
+    let out = shared(&file)
+        .args(["--columns", "gyro_x,gyro_y,gyro_z", "--plot"])
+        .arg(&svg)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    for needle in [
+        "gyro_x–gyro_y cross-covariance",
+        "shared AR1 (implied)",
+        "no shared process: T =",
+    ] {
+        assert!(text.contains(needle), "{needle} not in the figure");
+    }
 }
 
 #[test]

@@ -17,6 +17,7 @@ pub const EXAMPLES: &str = "The shared model is one text (--shared), the axis-sp
 every axis gets with its own parameters; the columns must be of one sensor and unit.\n\n\
 Examples:\n  gmwm shared imu.csv.gz --shared \"GM()\" --model \"WN()+RW()\" --columns gyro_x,gyro_y,gyro_z\n  \
 gmwm shared imu.csv.gz --shared \"GM()\" --model \"WN()+RW()\" --columns gyro_x,gyro_y,gyro_z --json\n  \
+gmwm shared imu.csv.gz --shared \"GM()\" --model \"WN()+RW()\" --columns gyro_x,gyro_y,gyro_z --plot shared.png\n  \
 gmwm shared imu.csv.gz --shared \"AR1()\" --model \"WN()+QN()+RW()\" --columns accel_x,accel_y --levels 14";
 
 /// `gmwm shared` flags.
@@ -43,6 +44,10 @@ pub struct SharedArgs {
     /// Draws of each starting-value search.
     #[arg(long = "G", value_name = "G", default_value_t = 2000)]
     pub draws: usize,
+    /// Also draw the axes' WVs, their cross-covariances and the shared process's implied WV
+    /// with its band to FILE (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<std::path::PathBuf>,
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,
@@ -59,6 +64,8 @@ pub struct SharedConfig {
     pub specific: Model,
     /// Estimator settings.
     pub options: SharedOptions,
+    /// `--plot`.
+    pub plot: Option<std::path::PathBuf>,
     /// Table, JSON or CSV.
     pub output: OutputConfig,
 }
@@ -89,6 +96,7 @@ impl TryFrom<&SharedArgs> for SharedConfig {
                 draws: a.draws,
                 ..SharedOptions::default()
             },
+            plot: a.plot.clone(),
             output: OutputConfig::from(&a.output),
         })
     }
@@ -96,12 +104,25 @@ impl TryFrom<&SharedArgs> for SharedConfig {
 
 /// Runs the subcommand.
 pub fn run(config: &SharedConfig, out: &mut impl Write) -> Result<()> {
-    let fit = compute(config)?;
+    let (fit, unit) = compute(config)?;
+    if let Some(path) = &config.plot {
+        // the sidecar's unit text may be a sentence: its unit when it names one, else u
+        let unit = unit
+            .and_then(|u| u.parse::<gmwm::units::SignalUnit>().ok())
+            .map_or_else(|| "u".to_string(), |u| u.symbol().to_string());
+        gmwm_plot::shared_figure(&fit, &unit)
+            .save(path)
+            .map_err(|e| match e {
+                gmwm_plot::PlotError::Io { .. } => anyhow::Error::from(e),
+                other => anyhow::anyhow!("{}: {other}", path.display()),
+            })?;
+        eprintln!("gmwm: wrote {}", path.display());
+    }
     render(&fit, config.output, out)
 }
 
-/// Reads the columns, checks they are one sensor in one unit, fits.
-pub fn compute(config: &SharedConfig) -> Result<SharedFit> {
+/// Reads the columns, checks they are one sensor in one unit, fits; the fit and that unit.
+pub fn compute(config: &SharedConfig) -> Result<(SharedFit, Option<String>)> {
     let file = config.input.file.display().to_string();
     let loaded = load(&config.input)?;
     let table = &loaded.table;
@@ -144,14 +165,15 @@ pub fn compute(config: &SharedConfig) -> Result<SharedFit> {
         .iter()
         .map(|c| (c.name.as_str(), c.values.as_slice()))
         .collect();
-    fit_shared(
+    let fit = fit_shared(
         &axes,
         loaded.freq_hz,
         &config.shared,
         &config.specific,
         &config.options,
     )
-    .map_err(|e| short_context(e, &file, &config.shared, &config.specific))
+    .map_err(|e| short_context(e, &file, &config.shared, &config.specific))?;
+    Ok((fit, infos[0].unit.clone()))
 }
 
 /// The engine's error with the file and, for a recording too short for the model, the fix.
