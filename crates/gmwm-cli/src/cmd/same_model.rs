@@ -83,6 +83,8 @@ struct Pool {
     files: Vec<PathBuf>,
     info: Vec<RecordingInfo>,
     columns: Vec<(String, Vec<Recording>)>,
+    /// Each column's unit for figures (`u` when the first file's sidecar names none).
+    units: Vec<String>,
 }
 
 /// A unit stated by a sidecar, without its comment (`deg/s (inferred ...)` -> `deg/s`).
@@ -184,10 +186,19 @@ fn read_pool(
             levels: r.levels(),
         })
         .collect();
+    let units = gmwm::imu::SensorInfo::of_table(&loaded[0].table)
+        .into_iter()
+        .map(|i| {
+            i.unit
+                .and_then(|u| u.parse::<gmwm::units::SignalUnit>().ok())
+                .map_or_else(|| "u".to_string(), |u| u.symbol().to_string())
+        })
+        .collect();
     Ok(Pool {
         files: files.to_vec(),
         info,
         columns,
+        units,
     })
 }
 
@@ -604,7 +615,13 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
             .collect();
         let columns: Vec<gmwm_plot::Column<'_, PooledFit>> = fits
             .iter()
-            .map(|(name, fit)| gmwm_plot::Column::new(name, "u", fit))
+            .map(|(name, fit)| {
+                let k = pool.columns.iter().position(|(c, _)| c == name);
+                let unit = k
+                    .and_then(|k| pool.units.get(k))
+                    .map_or("u", String::as_str);
+                gmwm_plot::Column::new(name, unit, fit)
+            })
             .collect();
         gmwm_plot::pooled_figure(&columns, &labels)
             .save(path)
