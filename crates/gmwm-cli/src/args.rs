@@ -14,7 +14,12 @@ Examples:
   gmwm wv log.bin --format f64 --ncols 6 --columns 1 --freq 400
   gmwm wv ln200.bin --format ln200 --columns gyro_x
   gmwm wv euroc_imu0.csv                      time column and units from the EuRoC header
-  gmwm select imu.csv.gz --model \"3*AR1()+WN()+RW()+QN()+DR()\"";
+  gmwm select imu.csv.gz --model \"3*AR1()+WN()+RW()+QN()+DR()\"
+  gmwm calibrate imu.csv.gz --gyro-unit deg/s --accel-unit g --kalibr imu.yaml
+  gmwm fit run1.csv run2.csv run3.csv --pool --model \"2*AR1()+RW()\"   one model, three recordings
+  gmwm same-model run*.csv --model \"2*AR1()+RW()\" --columns gyro_x   do they share one model?
+  gmwm shared imu.csv.gz --shared \"GM()\" --model \"WN()+RW()\" --columns gyro_x,gyro_y,gyro_z
+  gmwm monitor day.csv.gz --model-from cal/day.calibration.json    flag windows off the model";
 
 /// Stochastic error calibration of inertial sensors with the Generalized Method of Wavelet
 /// Moments: wavelet, Allan and Hadamard variances of IMU recordings.
