@@ -81,15 +81,20 @@ pub fn wavelet_cross_covariance(
         levels: Some(levels),
         ..WvOptions::default()
     };
-    let sum: Vec<f64> = x.iter().zip(y).map(|(a, b)| a + b).collect();
-    let plus = wavelet_variance(&sum, 1.0, &opts)?;
-    drop(sum);
-    let diff: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).collect();
-    let minus = wavelet_variance(&diff, 1.0, &opts)?;
+    // x + y or x - y is constant (y = -x, y = x): its coefficients, hence its WV, are exactly
+    // zero, where the WV estimator refuses a constant series
+    let wv_of = |z: Vec<f64>| -> Result<Vec<f64>, InputError> {
+        if z.iter().all(|&v| v == z[0]) && !z.is_empty() {
+            let other = wavelet_variance(x, 1.0, &opts)?;
+            return Ok(vec![0.0; other.wv().len()]);
+        }
+        Ok(wavelet_variance(&z, 1.0, &opts)?.wv().to_vec())
+    };
+    let plus = wv_of(x.iter().zip(y).map(|(a, b)| a + b).collect())?;
+    let minus = wv_of(x.iter().zip(y).map(|(a, b)| a - b).collect())?;
     Ok(plus
-        .wv()
         .iter()
-        .zip(minus.wv())
+        .zip(&minus)
         .map(|(p, m)| (p - m) / 4.0)
         .collect())
 }
