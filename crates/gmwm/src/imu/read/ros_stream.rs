@@ -10,6 +10,14 @@
 //! streamed pass; the topic is then read again in memory by [`read_imu_messages`] (64 bytes a
 //! message), sorted and spooled, and the notes say so. A streamed check beyond its bounds is
 //! redone on its stamps read back from the spool (8 bytes a message), with a note.
+//!
+//! Memory: the reorder buffer (about 330 KB), the decoder's one chunk, the two checks (a few
+//! KB for clock-quantised stamps, 6 MB at most) and the streamed WV; not the 64 bytes a
+//! message of the in-memory reader. Measured (busy 2-core machine, indicative; `gmwm wv FILE
+//! --json`, 10^6 messages at 200 Hz written by `write_imu_bag.py`, plus 10^5 String messages
+//! on the bag; `--stream-from 1` against the in-memory default): ROS1 bag (386 MB,
+//! uncompressed) 35 MB peak RSS against 87 MB, 0.31 s against 0.33 s; MCAP zstd 35 MB against
+//! 86 MB, 0.64 s against 0.56 s. The WVs agreed within 3e-16.
 
 use super::stream::{write_row, Spool, StreamedTable};
 use crate::imu::recording::{

@@ -1,4 +1,6 @@
-//! Streamed readers of text (CSV/TSV, plain or gzip) and binary IMU records: one pass over the
+//! Streamed readers of text (CSV/TSV, plain or gzip), binary IMU records and ROS recordings'
+//! IMU topics ([`StreamedTable::open_recording`]; the ROS reader in `read::ros_stream`, its
+//! messages put in log-time order by a bounded reorder buffer): one pass over the
 //! file through the in-memory readers' own parser (`text::for_each_text_row`, the
 //! record decoding of `binary`), the selected columns written as raw little-endian
 //! f64 to a spool file (deleted when the [`StreamedTable`] is dropped) that the streamed

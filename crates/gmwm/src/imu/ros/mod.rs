@@ -16,7 +16,9 @@
 //! memory-mapped), sqlite3 databases queried row by row: only one chunk (as read and
 //! decompressed) and the output vectors are held, about 64 bytes per message. A file truncated
 //! by another process while it is read gives [`ReadError::Io`] (`the file shrank while it was
-//! read`).
+//! read`). The same decoder also feeds the streamed reader
+//! ([`StreamedTable::open_recording`](crate::imu::read::stream::StreamedTable::open_recording)),
+//! which holds none of the messages.
 //!
 //! ```no_run
 //! use gmwm::imu::ros::{list_topics, read_imu_messages};
