@@ -597,7 +597,7 @@ impl Opened {
                 if wanted.is_empty() {
                     return Ok(());
                 }
-                Ok(sqlite::read(path, db, &wanted, out)?)
+                sqlite::read(path, db, &wanted, out)
             }
         }
     }
@@ -1004,11 +1004,12 @@ mod tests {
 
     #[test]
     fn sort_is_stable_and_moves_every_vector() {
-        let mut c = Gathered::default();
-        c.log_time_ns = vec![3, 1, 2, 1];
-        c.header_stamp_ns = vec![30, 10, 20, 11];
-        c.angular_velocity = [vec![3.0, 1.0, 2.0, 1.5], vec![0.0; 4], vec![0.0; 4]];
-        c.linear_acceleration = [vec![0.0; 4], vec![0.0; 4], vec![-3.0, -1.0, -2.0, -1.5]];
+        let mut c = Gathered {
+            log_time_ns: vec![3, 1, 2, 1],
+            header_stamp_ns: vec![30, 10, 20, 11],
+            angular_velocity: [vec![3.0, 1.0, 2.0, 1.5], vec![0.0; 4], vec![0.0; 4]],
+            linear_acceleration: [vec![0.0; 4], vec![0.0; 4], vec![-3.0, -1.0, -2.0, -1.5]],
+        };
         c.sort();
         assert_eq!(c.log_time_ns, [1, 1, 2, 3]);
         assert_eq!(c.header_stamp_ns, [10, 11, 20, 30]);
