@@ -748,6 +748,15 @@ fn ros_recording_accounts_for_other_topics() {
 /// messages, and the streamed pass differs from the in-memory kernel only in how it groups
 /// the compensated sums of squares.
 fn ros_streamed_equals_in_memory(path: &Path, opts: &gmwm::imu::RecordingOptions) {
+    ros_streamed_equals_in_memory_noting(path, opts, &[]);
+}
+
+/// [`ros_streamed_equals_in_memory`], the streamed reader adding the notes `added`.
+fn ros_streamed_equals_in_memory_noting(
+    path: &Path,
+    opts: &gmwm::imu::RecordingOptions,
+    added: &[&str],
+) {
     use gmwm::imu::read::stream::StreamedTable;
     let rec = gmwm::imu::Recording::open(path, opts).unwrap();
     let s = StreamedTable::open_recording(path, opts).unwrap();
@@ -766,7 +775,13 @@ fn ros_streamed_equals_in_memory(path: &Path, opts: &gmwm::imu::RecordingOptions
     );
     assert_eq!(s.timing, rec.timing, "{shown}");
     assert_eq!(s.samples, rec.samples, "{shown}");
-    assert_eq!(s.notes, rec.notes, "{shown}");
+    let notes: Vec<String> = rec
+        .notes
+        .iter()
+        .cloned()
+        .chain(added.iter().map(|a| a.to_string()))
+        .collect();
+    assert_eq!(s.notes, notes, "{shown}");
     assert_eq!(s.topic, rec.topic);
     let infos: Vec<_> = rec.imu.axes().iter().map(|a| a.info.clone()).collect();
     assert_eq!(s.sensor_infos(), infos, "{shown}");
@@ -851,5 +866,33 @@ fn ros_streamed_errors_are_the_in_memory_ones() {
         let m = gmwm::imu::Recording::open(path, &opts).unwrap_err();
         let s = StreamedTable::open_recording(path, &opts).unwrap_err();
         assert_eq!(s.to_string(), m.to_string(), "{}", path.display());
+    }
+}
+
+/// Log times out of order in the file (the writer's `--late EVERY:BY`: every EVERY-th message
+/// written BY messages late): within the reorder buffer (4096 messages) the streamed reader
+/// puts them back in order on the fly; beyond it, it reads the topic again in memory and says
+/// so. Either way it gives what `Recording::open` gives.
+#[test]
+fn ros_streamed_log_times_out_of_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let fallback = "log times out of order beyond the streamed reader's buffer (4096 messages): \
+                    the topic was read again in memory (64 bytes a message), sorted and spooled";
+    for container in ["ros1", "mcap", "sqlite3"] {
+        for (late, added) in [("7:10", &[][..]), ("97:5000", &[fallback][..])] {
+            let name = format!("{container}-{}", late.replace(':', "-"));
+            let delay = LOG_DELAY_NS.to_string();
+            let args = ["--late", late, "--log-delay-ns", &delay];
+            let fx = make(dir.path(), &name, container, N, 4, &args);
+            let msgs = read(&fx.path);
+            assert_exact(&msgs, &fx, "/imu0");
+            // sqlite3 is read ordered by its timestamp column: never out of order
+            let added = if container == "sqlite3" {
+                &[][..]
+            } else {
+                added
+            };
+            ros_streamed_equals_in_memory_noting(&fx.path, &Default::default(), added);
+        }
     }
 }
