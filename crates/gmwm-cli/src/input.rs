@@ -318,34 +318,32 @@ fn streamed_samples(
 /// ([`gmwm::imu::read::stream::StreamedTable`]): its columns, what each measures, and what the
 /// reader noticed, as [`load_recording`] gives them.
 pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> LoadedRecording {
-    let record = t.record_type.is_some();
-    let mut notes = gmwm::imu::recording::table_notes(
-        t.record_type,
-        t.timing.as_ref(),
-        &t.skipped,
-        &t.samples,
-        &t.warnings,
-    );
+    // a ROS topic's notes are all of them, as the in-memory reader gives them
+    let mut notes = match t.topic {
+        Some(_) => Vec::new(),
+        None => gmwm::imu::recording::table_notes(
+            t.record_type,
+            t.timing.as_ref(),
+            &t.skipped,
+            &t.samples,
+            &t.warnings,
+        ),
+    };
     notes.extend(t.notes.iter().cloned());
     LoadedRecording {
         path: shown_path(&t.path),
-        columns: t
-            .names
-            .iter()
-            .map(|n| {
-                (
-                    n.clone(),
-                    gmwm::imu::SensorInfo::of_column(n, t.sidecar.as_ref(), record),
-                )
-            })
-            .collect(),
+        columns: t.names.iter().cloned().zip(t.sensor_infos()).collect(),
         imu: None,
-        topic: None,
-        source: match t.record_type {
-            Some(r) => gmwm::imu::RecordingSource::Records {
+        topic: t.topic.clone(),
+        source: match (t.record_type, &t.topic, t.container) {
+            (_, Some(topic), Some(container)) => gmwm::imu::RecordingSource::Ros {
+                container: container.to_string(),
+                topic: topic.clone(),
+            },
+            (Some(r), _, _) => gmwm::imu::RecordingSource::Records {
                 record_type: r.name().to_string(),
             },
-            None => gmwm::imu::RecordingSource::Table,
+            _ => gmwm::imu::RecordingSource::Table,
         },
         timing: t.timing.clone(),
         samples: t.samples.clone(),

@@ -86,15 +86,22 @@ pub fn execute_in(
     check_outputs(config, report_path)?;
     let calibration = Calibration::new(config.options.clone());
     // a long raw binary recording is calibrated while streamed from the file (bounded memory)
-    let streamed = config.input.topic.is_none()
+    // (a topic is for ROS recordings: with another file, the in-memory reader refuses it)
+    let ros = config.input.read.format == gmwm::imu::InputFormat::Auto
+        && gmwm::imu::ros::container_of(&config.input.file).is_some();
+    let streamed = (config.input.topic.is_none() || ros)
         && calibration.streams(&config.input.file, &config.input.read)?;
-    // text and IMU records are read once, into a spool the calibration streams from
+    // text, IMU records and ROS recordings are read once, into a spool the calibration
+    // streams from
     let table = if streamed
         && gmwm::imu::read::stream::streamed_size(&config.input.file, &config.input.read)?.is_some()
     {
-        Some(gmwm::imu::read::stream::StreamedTable::open(
+        Some(gmwm::imu::read::stream::StreamedTable::open_recording(
             &config.input.file,
-            &config.input.read,
+            &gmwm::imu::RecordingOptions {
+                read: config.input.read.clone(),
+                topic: config.input.topic.clone(),
+            },
         )?)
     } else {
         None

@@ -93,8 +93,9 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
     })
 }
 
-/// Text or binary IMU records of at least `--stream-from` rows (a text file: 8 bytes a row),
-/// with the classical Haar MODWT estimator, stream
+/// Text, binary IMU records or a ROS recording of at least `--stream-from` rows (a text file:
+/// 8 bytes a row; a ROS recording: the messages of its largest IMU topic), with the classical
+/// Haar MODWT estimator, stream
 /// ([`gmwm::imu::read::stream::StreamedTable`]): one pass over the file, memory bounded.
 pub(crate) fn streams_text(input: &InputConfig, opts: &WvOptions) -> Result<bool> {
     if crate::spool::is_stdin(&input.file)
@@ -117,14 +118,23 @@ fn run_streamed_table(
     input: &InputConfig,
     opts: &WvOptions,
 ) -> Result<Vec<(String, WaveletVariance)>> {
-    let table = gmwm::imu::read::stream::StreamedTable::open(&input.file, &input.read)?;
-    crate::input::report_parts(
-        &table.path,
-        table.timing.as_ref(),
-        &table.skipped,
-        &table.samples,
-        &table.warnings,
-    );
+    let table = gmwm::imu::read::stream::StreamedTable::open_recording(
+        &input.file,
+        &gmwm::imu::RecordingOptions {
+            read: input.read.clone(),
+            topic: input.topic.clone(),
+        },
+    )?;
+    if table.topic.is_none() {
+        // a ROS topic's notes say all of it, as the in-memory path prints them
+        crate::input::report_parts(
+            &table.path,
+            table.timing.as_ref(),
+            &table.skipped,
+            &table.samples,
+            &table.warnings,
+        );
+    }
     for n in &table.notes {
         note(&input.file, n);
     }

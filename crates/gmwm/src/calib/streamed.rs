@@ -170,12 +170,7 @@ impl Calibration {
     ) -> Result<CalibrationReport, Error> {
         let (spool, layout) = table.spooled();
         let columns: Vec<usize> = (1..=table.names.len()).collect();
-        let record = table.record_type.is_some();
-        let infos: Vec<SensorInfo> = table
-            .names
-            .iter()
-            .map(|n| SensorInfo::of_column(n, table.sidecar.as_ref(), record))
-            .collect();
+        let infos: Vec<SensorInfo> = table.sensor_infos();
         let freq_hz = table.freq_hz.ok_or_else(|| ReadError::FreqNotDerivable {
             path: table.path.clone(),
             reason: "no freq_hz given, no time column, no sampling_frequency_hz in a sidecar",

@@ -3,7 +3,7 @@
 //! noticed.
 
 use super::read::{read_table, Column, InputFormat, ReadOptions, ReadWarning, RATE_TOLERANCE};
-use super::ros::{container_of, read_imu_messages, ImuMessages};
+use super::ros::{container_of, read_imu_messages, ImuMessages, RosContainer};
 use super::timing::{check_times, TimeUnit, TimingReport, UnitSource};
 use super::{Imu, ReadError, SampleAccount, Sensor, SensorInfo};
 use crate::Error;
@@ -117,78 +117,138 @@ impl Recording {
     /// checked and reported.
     fn open_ros(path: &Path, opts: &RecordingOptions) -> Result<Self, Error> {
         let msgs = read_imu_messages(path, opts.topic.as_deref())?;
-        let mut notes = vec![format!(
-            "{} topic {} (sensor_msgs/Imu{}): {} messages; angular velocity in rad/s and linear acceleration in m/s^2 by the message definition",
-            msgs.container,
-            msgs.topic,
-            msgs.frame_id
-                .as_deref()
-                .map(|f| format!(", frame {f}"))
-                .unwrap_or_default(),
-            msgs.len()
-        )];
-        let mut timing = stamps_report("header.stamp", &msgs.header_stamp_ns);
-        if !(timing.rate_hz.is_finite() && timing.rate_hz > 0.0) {
-            notes.push(
-                "the header stamps do not advance: the rate comes from the bag's log times"
-                    .to_string(),
-            );
-            timing = stamps_report("log time", &msgs.log_time_ns);
-        }
-        notes.push(timing.to_string());
-        notes.extend(timing.warnings().iter().map(ToString::to_string));
-        let freq_hz = match opts.read.freq_hz {
-            Some(f) => {
-                if (f / timing.rate_hz - 1.0).abs() > RATE_TOLERANCE {
-                    let disagrees = ReadWarning::FreqDisagrees {
-                        path: path.to_path_buf(),
-                        given_hz: f,
-                        column: timing.column.clone(),
-                        time_hz: timing.rate_hz,
-                    };
-                    notes.push(disagrees.to_string());
-                }
-                f
-            }
-            None => timing.rate_hz,
+        let about = RosAbout {
+            container: msgs.container,
+            topic: msgs.topic.clone(),
+            frame_id: msgs.frame_id.clone(),
+            messages: msgs.len() as u64,
+            other_messages: msgs.other_messages,
         };
-        if !(freq_hz.is_finite() && freq_hz > 0.0) {
-            return Err(ReadError::FreqNotDerivable {
-                path: path.to_path_buf(),
-                reason: "the stamps of the IMU topic do not advance; give the rate",
-            }
-            .into());
-        }
-        let topic = msgs.topic.clone();
-        let container = msgs.container.to_string();
-        let other_messages = msgs.other_messages;
+        let header = stamps_report(HEADER_STAMP, &msgs.header_stamp_ns);
+        let (mut notes, timing, freq_hz) =
+            ros_timing(path, &about, opts.read.freq_hz, header, || {
+                Ok(stamps_report(LOG_TIME, &msgs.log_time_ns))
+            })?;
         let mut imu = imu_of_messages(msgs, freq_hz)?;
         if !opts.read.columns.is_empty() {
             imu = imu.select(path, &opts.read.columns)?;
         }
-        let samples = SampleAccount {
-            missing: timing.missing_samples() as u64,
-            ..SampleAccount::all_used(
-                imu.axes().iter().map(|a| a.column.name.clone()).collect(),
-                "message",
-                imu.len() as u64,
-            )
-            .without(other_messages, "message on other topics")
-        };
+        let names = imu.axes().iter().map(|a| a.column.name.clone()).collect();
+        let samples = ros_samples(names, &about, &timing);
         notes.push(samples.to_string());
         Ok(Self {
             samples,
             path: path.to_path_buf(),
             imu,
             source: RecordingSource::Ros {
-                container,
-                topic: topic.clone(),
+                container: about.container.to_string(),
+                topic: about.topic.clone(),
             },
-            topic: Some(topic),
+            topic: Some(about.topic),
             timing: Some(timing),
             notes,
         })
     }
+}
+
+/// The column of a ROS topic's timing report from the header stamps.
+pub(crate) const HEADER_STAMP: &str = "header.stamp";
+/// The column of a ROS topic's timing report from the log times.
+pub(crate) const LOG_TIME: &str = "log time";
+
+/// What a ROS topic read was, for the notes.
+pub(crate) struct RosAbout {
+    pub(crate) container: RosContainer,
+    pub(crate) topic: String,
+    pub(crate) frame_id: Option<String>,
+    pub(crate) messages: u64,
+    pub(crate) other_messages: u64,
+}
+
+/// The notes (topic, timing, its warnings, the rate), the timing report and the rate of a ROS
+/// topic read: the header stamps' report, or the log times' (`log`) when the header stamps do
+/// not advance; the rate `--freq` else the report's. The samples' note is the caller's.
+pub(crate) fn ros_timing(
+    path: &Path,
+    about: &RosAbout,
+    given_hz: Option<f64>,
+    header: TimingReport,
+    log: impl FnOnce() -> Result<TimingReport, ReadError>,
+) -> Result<(Vec<String>, TimingReport, f64), ReadError> {
+    let mut notes = vec![format!(
+        "{} topic {} (sensor_msgs/Imu{}): {} messages; angular velocity in rad/s and linear acceleration in m/s^2 by the message definition",
+        about.container,
+        about.topic,
+        about
+            .frame_id
+            .as_deref()
+            .map(|f| format!(", frame {f}"))
+            .unwrap_or_default(),
+        about.messages
+    )];
+    let mut timing = header;
+    if !(timing.rate_hz.is_finite() && timing.rate_hz > 0.0) {
+        notes.push(
+            "the header stamps do not advance: the rate comes from the bag's log times".to_string(),
+        );
+        timing = log()?;
+    }
+    notes.push(timing.to_string());
+    notes.extend(timing.warnings().iter().map(ToString::to_string));
+    let freq_hz = match given_hz {
+        Some(f) => {
+            if (f / timing.rate_hz - 1.0).abs() > RATE_TOLERANCE {
+                let disagrees = ReadWarning::FreqDisagrees {
+                    path: path.to_path_buf(),
+                    given_hz: f,
+                    column: timing.column.clone(),
+                    time_hz: timing.rate_hz,
+                };
+                notes.push(disagrees.to_string());
+            }
+            f
+        }
+        None => timing.rate_hz,
+    };
+    if !(freq_hz.is_finite() && freq_hz > 0.0) {
+        return Err(ReadError::FreqNotDerivable {
+            path: path.to_path_buf(),
+            reason: "the stamps of the IMU topic do not advance; give the rate",
+        });
+    }
+    Ok((notes, timing, freq_hz))
+}
+
+/// The samples' account of a ROS topic read into the axes `names`.
+pub(crate) fn ros_samples(
+    names: Vec<String>,
+    about: &RosAbout,
+    timing: &TimingReport,
+) -> SampleAccount {
+    SampleAccount {
+        missing: timing.missing_samples() as u64,
+        ..SampleAccount::all_used(names, "message", about.messages)
+            .without(about.other_messages, "message on other topics")
+    }
+}
+
+/// The axes of a ROS topic (0-based among gyro_x .. accel_z) that `columns` selects, as
+/// [`Imu::select`] selects them (all six when `columns` is empty).
+pub(crate) fn ros_selection(
+    path: &Path,
+    columns: &[super::read::ColumnSelector],
+) -> Result<Vec<usize>, ReadError> {
+    let all = imu_of_columns(std::array::from_fn(|_| vec![0.0]), 1.0, String::new())?;
+    if columns.is_empty() {
+        return Ok((0..6).collect());
+    }
+    let names: Vec<String> = all.axes().iter().map(|a| a.column.name.clone()).collect();
+    let kept = all.select(path, columns)?;
+    Ok(kept
+        .axes()
+        .iter()
+        .filter_map(|a| names.iter().position(|n| *n == a.column.name))
+        .collect())
 }
 
 /// The timing report of nanosecond stamps, in seconds after the first (whole nanoseconds
@@ -206,17 +266,37 @@ fn stamps_report(column: &str, ns: &[i64]) -> TimingReport {
 fn imu_of_messages(msgs: ImuMessages, freq_hz: f64) -> Result<Imu, Error> {
     let [gx, gy, gz] = msgs.angular_velocity;
     let [ax, ay, az] = msgs.linear_acceleration;
+    let name = msgs
+        .path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok(imu_of_columns([gx, gy, gz, ax, ay, az], freq_hz, name)?)
+}
+
+/// The names of the six axes of a ROS topic.
+pub(crate) const ROS_AXES: [&str; 6] = [
+    "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
+];
+
+/// The six axes of a ROS topic: gyro_x .. accel_z, in rad/s and m/s^2.
+fn imu_of_columns(
+    values: [Vec<f64>; 6],
+    freq_hz: f64,
+    name: String,
+) -> Result<Imu, crate::error::ParamError> {
     let mut columns = Vec::with_capacity(6);
     let mut info = Vec::with_capacity(6);
-    for (k, values) in [gx, gy, gz, ax, ay, az].into_iter().enumerate() {
+    for (k, values) in values.into_iter().enumerate() {
         let (sensor, prefix, unit) = if k < 3 {
             (Sensor::Gyroscope, "gyro", "rad/s")
         } else {
             (Sensor::Accelerometer, "accel", "m/s^2")
         };
         let axis = ["x", "y", "z"][k % 3];
+        debug_assert_eq!(ROS_AXES[k], format!("{prefix}_{axis}"));
         columns.push(Column {
-            name: format!("{prefix}_{axis}"),
+            name: ROS_AXES[k].to_string(),
             values,
         });
         info.push(SensorInfo {
@@ -225,11 +305,6 @@ fn imu_of_messages(msgs: ImuMessages, freq_hz: f64) -> Result<Imu, Error> {
             unit: Some(unit.to_string()),
         });
     }
-    let name = msgs
-        .path
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_default();
     Ok(Imu::new(columns, info, freq_hz)?.with_name(name))
 }
 

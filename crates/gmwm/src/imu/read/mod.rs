@@ -6,6 +6,7 @@
 
 pub(crate) mod binary;
 pub(crate) mod positioned;
+mod ros_stream;
 pub mod stream;
 pub(crate) mod text;
 

@@ -1,4 +1,6 @@
-//! Streamed readers of text (CSV/TSV, plain or gzip) and binary IMU records: one pass over the
+//! Streamed readers of text (CSV/TSV, plain or gzip), binary IMU records and ROS recordings'
+//! IMU topics ([`StreamedTable::open_recording`]; the ROS reader in `read::ros_stream`, its
+//! messages put in log-time order by a bounded reorder buffer): one pass over the
 //! file through the in-memory readers' own parser (`text::for_each_text_row`, the
 //! record decoding of `binary`), the selected columns written as raw little-endian
 //! f64 to a spool file (deleted when the [`StreamedTable`] is dropped) that the streamed
@@ -88,18 +90,28 @@ pub struct StreamedTable {
     /// [`Table::samples`](super::Table)).
     pub samples: SampleAccount,
     /// What the streamed reader did that the in-memory one does not (the stamps checked in
-    /// memory beyond the bounds of the streamed check), one line each.
+    /// memory beyond the bounds of the streamed check), one line each. For a ROS recording,
+    /// every note of [`Recording::notes`](crate::imu::Recording) (the topic, the timing, the
+    /// samples' account), then the streamed reader's own.
     pub notes: Vec<String>,
+    /// The `sensor_msgs/Imu` topic, for a ROS recording.
+    pub topic: Option<String>,
+    /// The container, for a ROS recording.
+    pub container: Option<crate::imu::ros::RosContainer>,
     spool: Spool,
 }
 
-/// Whether `path` is read by [`StreamedTable::open`]: text or binary IMU records (by
-/// `opts.format`, the name, the sidecar or the content); `Ok(None)` for other files (raw
-/// binary, which streams as it is, and ROS recordings), else the file's size in bytes.
+/// Whether `path` is read by [`StreamedTable::open_recording`]: text or binary IMU records (by
+/// `opts.format`, the name, the sidecar or the content) or a ROS recording (format `auto`);
+/// `Ok(None)` for other files (raw binary, which streams as it is), else the file's size in
+/// bytes (0 for a rosbag2 folder).
 ///
 /// # Errors
 /// As [`resolve_format`].
 pub fn streamed_size(path: &Path, opts: &ReadOptions) -> Result<Option<u64>, ReadError> {
+    if is_ros(path, opts) {
+        return Ok(Some(std::fs::metadata(path).map_or(0, |m| m.len())));
+    }
     if crate::imu::ros::container_of(path).is_some() || path.is_dir() {
         return Ok(None);
     }
@@ -121,11 +133,18 @@ pub fn streamed_size(path: &Path, opts: &ReadOptions) -> Result<Option<u64>, Rea
 /// records the exact count (the size over the record's), for text, whose rows are known only
 /// once read, the file's size in bytes over 8 (a text row of numbers takes more than 8 bytes
 /// a column, so this is never below what the rule means for raw f64: a text file of
-/// `stream_from` rows streams).
+/// `stream_from` rows streams); for a ROS recording, the messages of its largest IMU topic
+/// ([`imu_messages_count`](crate::imu::ros::imu_messages_count), from the index or the
+/// statistics).
 ///
 /// # Errors
-/// As [`streamed_size`].
+/// As [`streamed_size`]; for a ROS recording, as
+/// [`list_topics`](crate::imu::ros::list_topics).
 pub fn streams_from(path: &Path, opts: &ReadOptions, stream_from: u64) -> Result<bool, ReadError> {
+    if is_ros(path, opts) {
+        let rows = crate::imu::ros::imu_messages_count(path)?;
+        return Ok(rows > 0 && rows >= stream_from.max(1));
+    }
     let Some(size) = streamed_size(path, opts)? else {
         return Ok(false);
     };
@@ -137,7 +156,43 @@ pub fn streams_from(path: &Path, opts: &ReadOptions, stream_from: u64) -> Result
     Ok(rows >= stream_from.max(1))
 }
 
+/// Whether `path` is read as a ROS recording ([`Recording::open`](crate::imu::Recording)'s
+/// rule: format `auto` and a ROS container).
+fn is_ros(path: &Path, opts: &ReadOptions) -> bool {
+    opts.format == InputFormat::Auto && crate::imu::ros::container_of(path).is_some()
+}
+
 impl StreamedTable {
+    /// Reads the recording `path` as [`Recording::open`](crate::imu::Recording) would with
+    /// `opts`: a ROS recording's IMU topic (streamed into a bounded reorder buffer, then
+    /// spooled: `imu::read::ros_stream`), else as
+    /// [`open`](Self::open).
+    ///
+    /// # Errors
+    /// Those of [`Recording::open`](crate::imu::Recording) on the same file; [`ReadError::Io`]
+    /// for the spool; [`ParamError`] `topic` for a topic given with a file that is not a ROS
+    /// recording.
+    pub fn open_recording(
+        path: &Path,
+        opts: &crate::imu::RecordingOptions,
+    ) -> Result<Self, ReadError> {
+        if is_ros(path, &opts.read) {
+            return super::ros_stream::open(path, opts);
+        }
+        if let Some(topic) = &opts.topic {
+            return Err(ParamError::new(
+                "topic",
+                topic,
+                format!(
+                    "a topic of a ROS recording; {} is not one (ROS1 bag, MCAP, rosbag2 sqlite3)",
+                    path.display()
+                ),
+            )
+            .into());
+        }
+        Self::open(path, &opts.read)
+    }
+
     /// Reads `path` (text or binary IMU records, see [`streamed_size`]) in one pass, as
     /// [`read_table`](super::read_table) would with `opts`, spooling the selected columns.
     ///
@@ -207,6 +262,46 @@ impl StreamedTable {
             .collect())
     }
 
+    /// A ROS topic's streamed table (`imu::read::ros_stream`).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn ros(
+        path: &Path,
+        names: Vec<String>,
+        (rows, freq_hz): (u64, f64),
+        timing: TimingReport,
+        samples: SampleAccount,
+        notes: Vec<String>,
+        (topic, container): (String, crate::imu::ros::RosContainer),
+        spool: Spool,
+    ) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            names,
+            rows,
+            freq_hz: Some(freq_hz),
+            sidecar: None,
+            timing: Some(timing),
+            warnings: Vec::new(),
+            skipped: Vec::new(),
+            record_type: None,
+            samples,
+            notes,
+            topic: Some(topic),
+            container: Some(container),
+            spool,
+        }
+    }
+
+    /// What each selected column measures: by its name, the sidecar, and for binary IMU
+    /// records and ROS topics their units (rad/s, m/s^2).
+    pub fn sensor_infos(&self) -> Vec<crate::imu::SensorInfo> {
+        let known = self.record_type.is_some() || self.topic.is_some();
+        self.names
+            .iter()
+            .map(|n| crate::imu::SensorInfo::of_column(n, self.sidecar.as_ref(), known))
+            .collect()
+    }
+
     /// The spool as a raw binary recording: its path and layout (the selected columns, then
     /// the relative stamps and their lines when there is a time column).
     pub(crate) fn spooled(&self) -> (&Path, BinaryLayout) {
@@ -238,13 +333,13 @@ impl StreamedTable {
 
 /// A raw f64 file in the temporary directory, removed when dropped.
 #[derive(Debug)]
-struct Spool {
-    path: PathBuf,
-    ncols: usize,
+pub(super) struct Spool {
+    pub(super) path: PathBuf,
+    pub(super) ncols: usize,
 }
 
 impl Spool {
-    fn create(ncols: usize) -> Result<(Self, BufWriter<File>), ReadError> {
+    pub(super) fn create(ncols: usize) -> Result<(Self, BufWriter<File>), ReadError> {
         use std::sync::atomic::{AtomicU64, Ordering};
         static NEXT: AtomicU64 = AtomicU64::new(0);
         let dir = std::env::temp_dir();
@@ -271,7 +366,7 @@ impl Spool {
     }
 
     /// Reads column `k` (0-based) back.
-    fn column(&self, k: usize) -> Result<Vec<f64>, ReadError> {
+    pub(super) fn column(&self, k: usize) -> Result<Vec<f64>, ReadError> {
         let mut out = Vec::new();
         let mut chunks =
             super::BinaryChunks::open(&self.path, InputFormat::F64, self.ncols, k + 1, 1 << 16)?;
@@ -288,7 +383,11 @@ impl Drop for Spool {
     }
 }
 
-fn write_row(out: &mut BufWriter<File>, spool: &Path, row: &[f64]) -> Result<(), ReadError> {
+pub(super) fn write_row(
+    out: &mut BufWriter<File>,
+    spool: &Path,
+    row: &[f64],
+) -> Result<(), ReadError> {
     for v in row {
         out.write_all(&v.to_le_bytes())
             .map_err(|source| ReadError::Io {
@@ -557,6 +656,8 @@ fn finish(
         skipped,
         record_type: None,
         notes,
+        topic: None,
+        container: None,
         spool,
     })
 }

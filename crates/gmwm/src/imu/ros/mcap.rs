@@ -398,7 +398,7 @@ pub(crate) fn read(
                 ),
             )
         })?;
-        Ok(out.push(encoding, log_time, &data)?)
+        out.push(encoding, log_time, &data)
     };
     let indexes = catalog
         .summary

@@ -16,7 +16,9 @@
 //! memory-mapped), sqlite3 databases queried row by row: only one chunk (as read and
 //! decompressed) and the output vectors are held, about 64 bytes per message. A file truncated
 //! by another process while it is read gives [`ReadError::Io`] (`the file shrank while it was
-//! read`).
+//! read`). The same decoder also feeds the streamed reader
+//! ([`StreamedTable::open_recording`](crate::imu::read::stream::StreamedTable::open_recording)),
+//! which holds none of the messages.
 //!
 //! ```no_run
 //! use gmwm::imu::ros::{list_topics, read_imu_messages};
@@ -168,7 +170,16 @@ fn encoding(path: &Path, topic: &str, name: &str) -> Result<Encoding, RosError> 
 /// (`compression_mode: message`); a CDR message starts with 0x00.
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
 
-/// Decodes messages into the output vectors, checking each.
+/// Where [`Collector`] puts each decoded, checked message, in file order: the in-memory
+/// vectors ([`Gathered`]) or a streamed reader's reorder buffer.
+pub(crate) trait MessageSink {
+    /// One message: its header stamp and log time (ns), and its six values (angular velocity
+    /// x, y, z then linear acceleration x, y, z, all finite).
+    fn message(&mut self, header_ns: i64, log_ns: i64, values: [f64; 6]) -> Result<(), ReadError>;
+}
+
+/// The one decoder of IMU messages: decodes and checks each message and hands it to a
+/// [`MessageSink`].
 pub(crate) struct Collector<'a> {
     /// Storage file being read (for messages).
     file: PathBuf,
@@ -176,24 +187,20 @@ pub(crate) struct Collector<'a> {
     scratch: Vec<u8>,
     topic: &'a str,
     frame_id: Option<String>,
-    header_stamp_ns: Vec<i64>,
-    log_time_ns: Vec<i64>,
-    angular_velocity: [Vec<f64>; 3],
-    linear_acceleration: [Vec<f64>; 3],
+    /// Messages decoded so far.
+    count: u64,
+    sink: &'a mut dyn MessageSink,
 }
 
 impl<'a> Collector<'a> {
-    fn new(topic: &'a str, capacity: usize) -> Self {
-        let f = || Vec::with_capacity(capacity);
+    pub(crate) fn new(topic: &'a str, sink: &'a mut dyn MessageSink) -> Self {
         Self {
             file: PathBuf::new(),
             scratch: Vec::new(),
             topic,
             frame_id: None,
-            header_stamp_ns: Vec::with_capacity(capacity),
-            log_time_ns: Vec::with_capacity(capacity),
-            angular_velocity: [f(), f(), f()],
-            linear_acceleration: [f(), f(), f()],
+            count: 0,
+            sink,
         }
     }
 
@@ -202,19 +209,19 @@ impl<'a> Collector<'a> {
         RosError::Message {
             path: self.file.clone(),
             topic: self.topic.to_owned(),
-            index: self.log_time_ns.len() as u64,
+            index: self.count,
             log_time_ns,
             reason,
         }
     }
 
-    /// Decodes one message logged at `log_time_ns` and appends it.
+    /// Decodes one message logged at `log_time_ns` and hands it to the sink.
     pub(crate) fn push(
         &mut self,
         encoding: Encoding,
         log_time_ns: i64,
         data: &[u8],
-    ) -> Result<(), RosError> {
+    ) -> Result<(), ReadError> {
         let mut scratch = std::mem::take(&mut self.scratch);
         let data = if encoding == Encoding::Cdr && data.starts_with(&ZSTD_MAGIC) {
             scratch.clear();
@@ -233,25 +240,56 @@ impl<'a> Collector<'a> {
         let [ax, ay, az] = m.linear_acceleration;
         let values = [gx, gy, gz, ax, ay, az];
         if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-            return Err(self.error(
-                log_time_ns,
-                MessageError::NonFinite {
-                    field: cdr::VALUE_FIELDS[k],
-                    value: values[k],
-                },
-            ));
+            return Err(self
+                .error(
+                    log_time_ns,
+                    MessageError::NonFinite {
+                        field: cdr::VALUE_FIELDS[k],
+                        value: values[k],
+                    },
+                )
+                .into());
         }
-        if self.log_time_ns.is_empty() && !m.frame_id.is_empty() {
+        if self.count == 0 && !m.frame_id.is_empty() {
             self.frame_id = Some(String::from_utf8_lossy(m.frame_id).into_owned());
         }
-        self.header_stamp_ns.push(m.stamp_ns);
-        self.log_time_ns.push(log_time_ns);
+        self.sink.message(m.stamp_ns, log_time_ns, values)?;
+        self.count += 1;
+        self.scratch = scratch;
+        Ok(())
+    }
+}
+
+/// The in-memory sink: every message in vectors, sorted by log time at the end.
+#[derive(Debug, Default)]
+struct Gathered {
+    header_stamp_ns: Vec<i64>,
+    log_time_ns: Vec<i64>,
+    angular_velocity: [Vec<f64>; 3],
+    linear_acceleration: [Vec<f64>; 3],
+}
+
+impl MessageSink for Gathered {
+    fn message(&mut self, header_ns: i64, log_ns: i64, values: [f64; 6]) -> Result<(), ReadError> {
+        self.header_stamp_ns.push(header_ns);
+        self.log_time_ns.push(log_ns);
         for a in 0..3 {
             self.angular_velocity[a].push(values[a]);
             self.linear_acceleration[a].push(values[3 + a]);
         }
-        self.scratch = scratch;
         Ok(())
+    }
+}
+
+impl Gathered {
+    fn with_capacity(capacity: usize) -> Self {
+        let f = || Vec::with_capacity(capacity);
+        Self {
+            header_stamp_ns: Vec::with_capacity(capacity),
+            log_time_ns: Vec::with_capacity(capacity),
+            angular_velocity: [f(), f(), f()],
+            linear_acceleration: [f(), f(), f()],
+        }
     }
 
     /// Sorts by log time (stable: ties keep reading order) unless already sorted.
@@ -559,7 +597,7 @@ impl Opened {
                 if wanted.is_empty() {
                     return Ok(());
                 }
-                Ok(sqlite::read(path, db, &wanted, out)?)
+                sqlite::read(path, db, &wanted, out)
             }
         }
     }
@@ -716,46 +754,95 @@ pub fn choose_topic<'t>(
 /// [`RosError::Message`] naming the topic and 0-based message index for a short or garbled
 /// message or a non-finite value.
 pub fn read_imu_messages(path: &Path, topic: Option<&str>) -> Result<ImuMessages, ReadError> {
+    let mut out = Gathered::default();
+    let read = read_topic(path, topic, |chosen, bytes| {
+        let capacity = chosen.messages.min(bytes / MIN_BYTES_PER_MESSAGE);
+        out = Gathered::with_capacity(usize::try_from(capacity).unwrap_or(0));
+        &mut out
+    })?;
+    out.sort();
+    Ok(ImuMessages {
+        path: path.to_path_buf(),
+        container: read.container,
+        topic: read.topic,
+        frame_id: read.frame_id,
+        header_stamp_ns: out.header_stamp_ns,
+        log_time_ns: out.log_time_ns,
+        angular_velocity: out.angular_velocity,
+        linear_acceleration: out.linear_acceleration,
+        other_messages: read.other_messages,
+    })
+}
+
+/// What [`read_topic`] read, apart from the messages.
+#[derive(Debug, Clone)]
+pub(crate) struct TopicRead {
+    pub(crate) container: RosContainer,
+    pub(crate) topic: String,
+    /// `header.frame_id` of the first message in file order (`None` if empty).
+    pub(crate) frame_id: Option<String>,
+    /// Messages on the topic (as counted by the index, and read).
+    pub(crate) messages: u64,
+    /// Messages on other topics.
+    pub(crate) other_messages: u64,
+}
+
+/// Reads the IMU messages of `topic` (as [`read_imu_messages`] chooses it) in file order into
+/// the sink `sink` gives once the topic is chosen (from the chosen topic and the recording's
+/// size in bytes), checking the count against the index.
+pub(crate) fn read_topic<'s>(
+    path: &Path,
+    topic: Option<&str>,
+    sink: impl FnOnce(&TopicInfo, u64) -> &'s mut dyn MessageSink,
+) -> Result<TopicRead, ReadError> {
     let source = source(path)?;
     let mut opened = open(&source)?;
     let topics = merged_topics(&opened);
     let chosen = choose_topic(path, &topics, topic)?;
     let bytes: u64 = opened.iter().map(Opened::size).sum();
-    let capacity = chosen.messages.min(bytes / MIN_BYTES_PER_MESSAGE);
-    let mut out = Collector::new(&chosen.topic, usize::try_from(capacity).unwrap_or(0));
+    let mut out = Collector::new(&chosen.topic, sink(chosen, bytes));
     for o in &mut opened {
         o.read(&chosen.topic, &mut out)?;
     }
-    if out.log_time_ns.len() as u64 != chosen.messages {
+    if out.count != chosen.messages {
         // the index (ROS1), statistics (MCAP) or COUNT(*) (sqlite3) disagrees with the data
         return Err(RosError::Corrupt {
             path: path.to_path_buf(),
             container: source.container,
             reason: format!(
                 "the index counts {} messages on {}, the data holds {}",
-                chosen.messages,
-                chosen.topic,
-                out.log_time_ns.len()
+                chosen.messages, chosen.topic, out.count
             ),
         }
         .into());
     }
-    out.sort();
-    Ok(ImuMessages {
-        path: path.to_path_buf(),
+    Ok(TopicRead {
         container: source.container,
         topic: chosen.topic.clone(),
         frame_id: out.frame_id,
-        header_stamp_ns: out.header_stamp_ns,
-        log_time_ns: out.log_time_ns,
-        angular_velocity: out.angular_velocity,
-        linear_acceleration: out.linear_acceleration,
+        messages: chosen.messages,
         other_messages: topics
             .iter()
             .map(|t| t.messages)
             .sum::<u64>()
             .saturating_sub(chosen.messages),
     })
+}
+
+/// Messages of the largest `sensor_msgs/Imu` topic of a recording, from the index (ROS1),
+/// the statistics (MCAP) or `COUNT(*)` (sqlite3): what a streamed read holds at most (0 when
+/// there is no IMU topic).
+///
+/// # Errors
+/// As [`list_topics`].
+pub fn imu_messages_count(path: &Path) -> Result<u64, ReadError> {
+    let (_, topics) = list_topics(path)?;
+    Ok(topics
+        .iter()
+        .filter(|t| t.is_imu())
+        .map(|t| t.messages)
+        .max()
+        .unwrap_or(0))
 }
 
 #[cfg(test)]
@@ -874,11 +961,12 @@ mod tests {
         let size = std::fs::metadata(path).unwrap().len();
         let file = std::fs::OpenOptions::new().write(true).open(path).unwrap();
         file.set_len((size as f64 * keep) as u64).unwrap();
-        let mut out = Collector::new(&chosen.topic, 0);
+        let mut sink = Gathered::default();
+        let mut out = Collector::new(&chosen.topic, &mut sink);
         for o in &mut opened {
             o.read(&chosen.topic, &mut out)?;
         }
-        Ok(out.log_time_ns.len())
+        Ok(sink.log_time_ns.len())
     }
 
     #[test]
@@ -892,11 +980,12 @@ mod tests {
             // untouched, every message is read
             let source = source(&path).unwrap();
             let mut opened = open(&source).unwrap();
-            let mut out = Collector::new("/imu0", 0);
+            let mut sink = Gathered::default();
+            let mut out = Collector::new("/imu0", &mut sink);
             for o in &mut opened {
                 o.read("/imu0", &mut out).unwrap();
             }
-            assert_eq!(out.log_time_ns.len(), 7000, "{container} {compression}");
+            assert_eq!(sink.log_time_ns.len(), 7000, "{container} {compression}");
             for keep in [0.0, 0.5, 0.99] {
                 let copy = sub.join(format!("cut-{keep}"));
                 std::fs::copy(&path, &copy).unwrap();
@@ -915,11 +1004,12 @@ mod tests {
 
     #[test]
     fn sort_is_stable_and_moves_every_vector() {
-        let mut c = Collector::new("/a", 0);
-        c.log_time_ns = vec![3, 1, 2, 1];
-        c.header_stamp_ns = vec![30, 10, 20, 11];
-        c.angular_velocity = [vec![3.0, 1.0, 2.0, 1.5], vec![0.0; 4], vec![0.0; 4]];
-        c.linear_acceleration = [vec![0.0; 4], vec![0.0; 4], vec![-3.0, -1.0, -2.0, -1.5]];
+        let mut c = Gathered {
+            log_time_ns: vec![3, 1, 2, 1],
+            header_stamp_ns: vec![30, 10, 20, 11],
+            angular_velocity: [vec![3.0, 1.0, 2.0, 1.5], vec![0.0; 4], vec![0.0; 4]],
+            linear_acceleration: [vec![0.0; 4], vec![0.0; 4], vec![-3.0, -1.0, -2.0, -1.5]],
+        };
         c.sort();
         assert_eq!(c.log_time_ns, [1, 1, 2, 3]);
         assert_eq!(c.header_stamp_ns, [10, 11, 20, 30]);

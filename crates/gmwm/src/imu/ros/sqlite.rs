@@ -143,7 +143,7 @@ pub(crate) fn read(
     db: &Connection,
     wanted: &HashMap<i64, Encoding>,
     out: &mut Collector<'_>,
-) -> Result<(), RosError> {
+) -> Result<(), ReadError> {
     let err = |e| sql_error(path, e);
     // ids come from the database itself (integers): safe to inline
     let ids: Vec<String> = wanted.keys().map(i64::to_string).collect();
