@@ -241,7 +241,7 @@ fn union_model(shared: &Model, specific: &Model) -> Model {
 /// # Errors
 /// [`ParamError`] for fewer than two axes, axes of different lengths, a DR term or a rate that
 /// is not positive; as [`wavelet_variance`] for a series with non-finite values or too short
-/// for the levels; [`FitError`] (e.g. `TooFewLevels`) when the series is too short for the
+/// for the levels; [`FitError`](crate::FitError) (e.g. `TooFewLevels`) when the series is too short for the
 /// model; a [`ParamError`] from the exact covariance for a term it does not cover.
 pub fn fit_shared(
     axes: &[(&str, &[f64])],

@@ -17,7 +17,7 @@
 //!
 //! **Rate.** The model's parameters are per sample (WN, RW, AR1 phi, ...), so the recordings
 //! must share one sampling rate: rates differing by more than
-//! [`RATE_TOLERANCE`](crate::imu::read::RATE_TOLERANCE) (relative) are refused
+//! [`RATE_TOLERANCE`] (relative) are refused
 //! ([`FitError::RateMismatch`]); the fit uses the first recording's rate.
 //!
 //! **Starting values.** Each recording is first fitted alone (the two-stage fit with the §6
