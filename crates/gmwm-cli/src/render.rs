@@ -121,6 +121,22 @@ fn json<T: Serialize>(out: &mut impl Write, items: &[Named<T>]) -> Result<()> {
     Ok(())
 }
 
+/// Writes `fig` to `path` (SVG or PNG by the name); a drawing error names the file (a write
+/// error names it already).
+pub fn save_figure(fig: &gmwm_plot::Figure, path: &std::path::Path) -> Result<()> {
+    fig.save(path).map_err(|e| match e {
+        gmwm_plot::PlotError::Io { .. } => anyhow::Error::from(e),
+        other => anyhow::anyhow!("{}: {other}", path.display()),
+    })
+}
+
+/// The unit a figure labels a column with: the sensor unit a sidecar's text names
+/// (`deg/s (inferred ...)` -> `deg/s`), else `u`.
+pub fn figure_unit(unit: Option<&str>) -> String {
+    unit.and_then(|u| u.parse::<gmwm::units::SignalUnit>().ok())
+        .map_or_else(|| "u".to_string(), |u| u.symbol().to_string())
+}
+
 /// Quotes a CSV field when needed.
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {

@@ -66,11 +66,7 @@ fn save(fig: Figure, args: &FigureConfig, out: &mut impl Write) -> Result<()> {
     let (w, h) = fig.size;
     let size = (args.width.unwrap_or(w), args.height.unwrap_or(h));
     let fig = fig.with_size(size);
-    fig.save(&args.output).map_err(|e| match e {
-        // a write error names the file already
-        gmwm_plot::PlotError::Io { .. } => anyhow::Error::from(e),
-        other => anyhow::anyhow!("{}: {other}", args.output.display()),
-    })?;
+    crate::render::save_figure(&fig, &args.output)?;
     writeln!(
         out,
         "wrote {} ({}x{} px, {} panel(s))",

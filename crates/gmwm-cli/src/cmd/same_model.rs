@@ -188,11 +188,7 @@ fn read_pool(
         .collect();
     let units = gmwm::imu::SensorInfo::of_table(&loaded[0].table)
         .into_iter()
-        .map(|i| {
-            i.unit
-                .and_then(|u| u.parse::<gmwm::units::SignalUnit>().ok())
-                .map_or_else(|| "u".to_string(), |u| u.symbol().to_string())
-        })
+        .map(|i| crate::render::figure_unit(i.unit.as_deref()))
         .collect();
     Ok(Pool {
         files: files.to_vec(),
@@ -623,12 +619,7 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
                 gmwm_plot::Column::new(name, unit, fit)
             })
             .collect();
-        gmwm_plot::pooled_figure(&columns, &labels)
-            .save(path)
-            .map_err(|e| match e {
-                gmwm_plot::PlotError::Io { .. } => anyhow::Error::from(e),
-                other => anyhow::anyhow!("{}: {other}", path.display()),
-            })?;
+        crate::render::save_figure(&gmwm_plot::pooled_figure(&columns, &labels), path)?;
         eprintln!("gmwm: wrote {}", path.display());
     }
     if args.json {

@@ -106,16 +106,8 @@ impl TryFrom<&SharedArgs> for SharedConfig {
 pub fn run(config: &SharedConfig, out: &mut impl Write) -> Result<()> {
     let (fit, unit) = compute(config)?;
     if let Some(path) = &config.plot {
-        // the sidecar's unit text may be a sentence: its unit when it names one, else u
-        let unit = unit
-            .and_then(|u| u.parse::<gmwm::units::SignalUnit>().ok())
-            .map_or_else(|| "u".to_string(), |u| u.symbol().to_string());
-        gmwm_plot::shared_figure(&fit, &unit)
-            .save(path)
-            .map_err(|e| match e {
-                gmwm_plot::PlotError::Io { .. } => anyhow::Error::from(e),
-                other => anyhow::anyhow!("{}: {other}", path.display()),
-            })?;
+        let unit = crate::render::figure_unit(unit.as_deref());
+        crate::render::save_figure(&gmwm_plot::shared_figure(&fit, &unit), path)?;
         eprintln!("gmwm: wrote {}", path.display());
     }
     render(&fit, config.output, out)

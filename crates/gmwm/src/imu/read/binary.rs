@@ -713,18 +713,13 @@ pub(crate) const RECORD_COLUMNS: [&str; 6] = [
     "gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z",
 ];
 
-/// Reads the selected columns of a binary IMU record file (docs/methods.md §9.2–9.3),
-/// read by positioned reads ([`for_each_record_run`]) in one pass: each record's time is decoded
-/// (checked finite and strictly increasing) and its selected columns decoded, so no raw copy of
-/// the file is held.
-pub(crate) fn read_record_table(
+/// The selected columns of IMU records (`RECORD_COLUMNS`, by `opts.columns`): the time is the
+/// records' own, so a time column or unit option is refused. Shared by the in-memory and the
+/// streamed record readers.
+pub(crate) fn record_selection(
     path: &Path,
-    record_type: ImuRecordType,
     opts: &ReadOptions,
-) -> Result<RawTable, ReadError> {
-    let record = record_type.record_size();
-    let names: Vec<String> = RECORD_COLUMNS.iter().map(|n| n.to_string()).collect();
-    // the time is the records' own
+) -> Result<super::Selection, ReadError> {
     if let Some(t) = &opts.time_column {
         return Err(ParamError::new(
             "time column",
@@ -741,11 +736,25 @@ pub(crate) fn read_record_table(
         )
         .into());
     }
+    let names: Vec<String> = RECORD_COLUMNS.iter().map(|n| n.to_string()).collect();
     let select = ReadOptions {
         time_column: None,
         ..opts.clone()
     };
-    let sel = resolve_selection(path, &names, &select, None)?;
+    resolve_selection(path, &names, &select, None)
+}
+
+/// Reads the selected columns of a binary IMU record file (docs/methods.md §9.2–9.3),
+/// read by positioned reads ([`for_each_record_run`]) in one pass: each record's time is decoded
+/// (checked finite and strictly increasing) and its selected columns decoded, so no raw copy of
+/// the file is held.
+pub(crate) fn read_record_table(
+    path: &Path,
+    record_type: ImuRecordType,
+    opts: &ReadOptions,
+) -> Result<RawTable, ReadError> {
+    let record = record_type.record_size();
+    let sel = record_selection(path, opts)?;
     let (file, rows) = open_records(path, record)?;
     let capacity = usize::try_from(rows).unwrap_or(usize::MAX);
     let mut time: Vec<f64> = Vec::with_capacity(capacity);
@@ -800,14 +809,14 @@ pub(crate) fn read_record_table(
             return Err(ReadError::RecordRateOverflow {
                 path: path.to_path_buf(),
                 index: i as u64,
-                column: names[k].clone(),
+                column: RECORD_COLUMNS[k].to_string(),
                 raw: values[i],
                 freq_hz: freq,
             });
         }
         values.iter_mut().for_each(|v| *v *= factor);
         columns.push(Column {
-            name: names[k].clone(),
+            name: RECORD_COLUMNS[k].to_string(),
             values,
         });
     }

@@ -38,12 +38,13 @@
 //! spool.
 
 use super::binary::{
-    decode, decode_i32, for_each_record_run, non_finite, open_records, RECORD_COLUMNS,
+    decode, decode_i32, for_each_record_run, non_finite, open_records, record_selection,
+    RECORD_COLUMNS,
 };
 use super::text::for_each_text_row;
 use super::{
-    resolve_format, resolve_rate, resolve_selection, timing_warnings, BinaryLayout, InputFormat,
-    ReadOptions, ReadWarning,
+    resolve_format, resolve_rate, timing_warnings, BinaryLayout, InputFormat, ReadOptions,
+    ReadWarning,
 };
 use crate::error::ParamError;
 use crate::imu::sidecar::{find_sidecar, Sidecar};
@@ -674,27 +675,7 @@ fn open_records_stream(
 ) -> Result<StreamedTable, ReadError> {
     let record = record_type.record_size();
     let names: Vec<String> = RECORD_COLUMNS.iter().map(|n| n.to_string()).collect();
-    if let Some(t) = &opts.time_column {
-        return Err(ParamError::new(
-            "time column",
-            t,
-            "no time column: IMU records carry their own time (docs/methods.md §9.2)",
-        )
-        .into());
-    }
-    if let Some(u) = opts.time_unit {
-        return Err(ParamError::new(
-            "time unit",
-            u,
-            "no unit: IMU record times are in seconds (docs/methods.md §9.2)",
-        )
-        .into());
-    }
-    let select = ReadOptions {
-        time_column: None,
-        ..opts.clone()
-    };
-    let sel = resolve_selection(path, &names, &select, None)?;
+    let sel = record_selection(path, opts)?;
     let (file, rows) = open_records(path, record)?;
     let raw = |r: &[u8], k: usize| {
         if record_type.is_double() {
