@@ -344,6 +344,25 @@ fn fuzz_regression_chunk_compression_escaped() {
     assert!(s.contains("MCAP chunk compression \"$\\n\\0"), "{s}");
 }
 
+/// The `db3` fuzzer's crash (long run, 2026-11-24, 2.3 M executions): a topic named with tabs
+/// and newlines went raw into the recording's first note, breaking the one-line rule; the
+/// topic and the frame are now escaped.
+#[test]
+fn fuzz_regression_topic_name_escaped_in_notes() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.db3");
+    std::fs::write(&path, fixture("db3", "topic_name_newlines")).unwrap();
+    let rec = gmwm::imu::Recording::open(&path, &Default::default()).unwrap();
+    for n in &rec.notes {
+        assert!(!n.contains('\n') && !n.contains('\t'), "{n:?}");
+    }
+    assert!(
+        rec.notes[0].contains("topic \\t\\n\\t8\\n"),
+        "{:?}",
+        rec.notes[0]
+    );
+}
+
 /// Not found by the fuzzers in their runs but a known allocation bomb of the same family: a
 /// sidecar stating 10^12 (or 2^64 - 1) interleaved columns of a 96-byte file; the column names
 /// were made before the size was checked, and `8 * ncols` overflowed.

@@ -178,11 +178,12 @@ pub(crate) fn ros_timing(
     let mut notes = vec![format!(
         "{} topic {} (sensor_msgs/Imu{}): {} messages; angular velocity in rad/s and linear acceleration in m/s^2 by the message definition",
         about.container,
-        about.topic,
+        // names from the file: escaped, so that the note stays one line
+        super::quote(&about.topic),
         about
             .frame_id
             .as_deref()
-            .map(|f| format!(", frame {f}"))
+            .map(|f| format!(", frame {}", super::quote(f)))
             .unwrap_or_default(),
         about.messages
     )];
