@@ -114,7 +114,7 @@ fn shared_gm_is_recovered_and_the_test_holds_its_size() {
 /// shared GM. `cargo test --release -p gmwm --test integration shared_study -- --ignored
 /// --nocapture`.
 #[test]
-#[ignore]
+#[ignore = "full study, ~27 min: N = 2^16, 1000 triads each way; figures in docs/methods/multi-axis.md §15"]
 fn shared_study() {
     let (reps, beta, s2, both, rejected) = study(1 << 16, 1000, 21, true);
     println!("with shared GM: {reps} triads, beta covered {beta}, sigma2_gm covered {s2}, both {both}, test rejected {rejected}");
