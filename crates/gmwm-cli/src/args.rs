@@ -155,6 +155,11 @@ pub struct CalibrateCommand {
     /// More recordings.
     #[command(flatten)]
     pub batch: BatchArgs,
+    /// One calibration of all the recordings given (files, folders, globs): one model for the
+    /// sensor, fitted to their pooled wavelet variances (docs/methods.md §5.12), instead of
+    /// one calibration each.
+    #[arg(long)]
+    pub pool: bool,
 }
 
 /// `gmwm wv`: the wavelet-variance flags and the batch flags.

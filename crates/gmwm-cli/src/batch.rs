@@ -167,6 +167,15 @@ fn expand(inputs: &[PathBuf], format: InputFormat) -> Result<Vec<Found>> {
     Ok(out)
 }
 
+/// The recordings that the FILE arguments `inputs` name, expanded as in batch mode (folders,
+/// globs), in order, each once: the inputs of `calibrate --pool`.
+pub fn recordings(inputs: &[PathBuf], format: InputFormat) -> Result<Vec<PathBuf>> {
+    Ok(expand(inputs, format)?
+        .into_iter()
+        .map(|f| f.path)
+        .collect())
+}
+
 /// One recording of the batch and where its outputs go.
 #[derive(Debug, Clone)]
 struct Planned {

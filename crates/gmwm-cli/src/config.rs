@@ -656,6 +656,9 @@ pub struct CalibrateConfig {
     pub rostopic: Option<String>,
     /// `--report FILE`: the HTML report too.
     pub report: Option<PathBuf>,
+    /// `--pool`: every FILE argument as given (files, folders, globs), calibrated as one
+    /// sensor; empty for one recording.
+    pub pool: Vec<PathBuf>,
 }
 
 /// The files of `--kalibr` and `--export STACK FILE`, Kalibr first.
@@ -719,6 +722,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             json: a.json.clone(),
             rostopic: a.rostopic.clone(),
             report: a.report.clone(),
+            pool: Vec::new(),
         })
     }
 }
@@ -810,6 +814,19 @@ fn check_suffix(flag: &str, path: &Path) -> Result<()> {
 
 fn calibrate_or_batch(a: &CalibrateCommand) -> Result<Config> {
     let (args, batch) = (&a.args, &a.batch);
+    if a.pool {
+        if batch.out_dir.is_some() || batch.force {
+            return Err(UsageError(
+                "--pool writes one calibration of all the recordings: --out-dir and --force \
+                 are for batch mode (one calibration each)"
+                    .into(),
+            )
+            .into());
+        }
+        let mut config: CalibrateConfig = args.try_into()?;
+        config.pool = batch_inputs(&args.input.file, batch);
+        return Ok(Config::Calibrate(config));
+    }
     if !is_batch(&args.input.file, batch) {
         return Ok(Config::Calibrate(args.try_into()?));
     }

@@ -223,6 +223,23 @@ fn prepare_input(config: &mut Config) -> anyhow::Result<Option<spool::Spool>> {
         }
         return Ok(None);
     }
+    if let Config::Calibrate(c) = config {
+        if let Some(p) = c.pool.iter().find(|p| spool::is_stream(p)) {
+            return Err(UsageError(format!(
+                "{}: --pool reads several recordings from files; give standard input or a \
+                 pipe to a one-recording command",
+                if p.as_os_str() == "-" {
+                    spool::STDIN.to_string()
+                } else {
+                    p.display().to_string()
+                }
+            ))
+            .into());
+        }
+        if !c.pool.is_empty() {
+            return Ok(None);
+        }
+    }
     let mut guard = None;
     if let Config::Topics(t) = config {
         if spool::is_stream(&t.file) {

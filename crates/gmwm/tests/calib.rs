@@ -301,3 +301,151 @@ fn calibration_bounds_an_undetected_random_walk() {
         .iter()
         .any(|n| n.contains("no random walk detected")));
 }
+
+// ---------------------------------------------------------------------------------------------
+// The pooled calibration (`gmwm calibrate --pool`, docs/methods.md §5.12)
+
+/// A gyro-only IMU of `n` samples at `freq_hz` from `truth`, in `unit` (`scale` of its rad/s).
+fn gyro_imu(truth: &Model, n: usize, freq_hz: f64, seed: u64, unit: &str, scale: f64) -> Imu {
+    let x = simulate_model(truth, n, freq_hz, seed)
+        .unwrap()
+        .into_iter()
+        .map(|v| v / scale)
+        .collect();
+    Imu::new(
+        vec![column("gyro_x", x)],
+        vec![info(Sensor::Gyroscope, Some(unit))],
+        freq_hz,
+    )
+    .unwrap()
+}
+
+/// Three recordings of one gyro (2^15, 2^16 and 2^17 samples, one in deg/s): the pooled
+/// calibration reads off N within 3% and K within 30% of the truth, both intervals covering
+/// it, N's interval narrower than the longest recording's alone (the pooled WV has the
+/// recordings' degrees of freedom summed), every recording agreeing with the one model, the
+/// unit conversion said, the recordings listed.
+#[test]
+fn pooled_calibration_reads_off_known_noise_from_recordings_of_different_lengths() {
+    let t = truth(GYRO_N, GYRO_K, None);
+    let deg = std::f64::consts::PI / 180.0;
+    let imus = [
+        gyro_imu(&t, 1 << 15, FREQ, 21, "rad/s", 1.0),
+        gyro_imu(&t, 1 << 16, FREQ, 22, "deg/s", deg),
+        gyro_imu(&t, 1 << 17, FREQ, 23, "rad/s", 1.0),
+    ];
+    let named: Vec<(&str, &Imu)> = ["a.csv", "b.csv", "c.csv"].into_iter().zip(&imus).collect();
+    let cal = Calibration::new(options());
+    let report = cal.run_pooled(&named).unwrap();
+    assert_eq!(report.recordings.len(), 3);
+    assert_eq!(report.recordings[1].name, "b.csv");
+    assert_eq!(report.samples, (1 << 15) + (1 << 16) + (1 << 17));
+    assert!(
+        report.checks.iter().any(|c| c.contains("rad/s, deg/s")),
+        "{:?}",
+        report.checks
+    );
+    let gyro = &report.axes[0];
+    assert_eq!(gyro.data_unit.as_deref(), Some("rad/s"));
+    let n = gyro.noise_density.as_ref().unwrap();
+    let k = gyro.random_walk.as_ref().unwrap();
+    assert!((n.value / GYRO_N - 1.0).abs() < 0.03, "N = {}", n.value);
+    assert!((k.value / GYRO_K - 1.0).abs() < 0.3, "K = {}", k.value);
+    for (e, t) in [(n, GYRO_N), (k, GYRO_K)] {
+        let (lo, hi) = (e.ci_low.unwrap(), e.ci_high.unwrap());
+        assert!(lo < t && t < hi, "{lo} < {t} < {hi}");
+    }
+    let agree: Vec<&String> = gyro
+        .notes
+        .iter()
+        .filter(|n| n.starts_with("recording "))
+        .collect();
+    assert_eq!(agree.len(), 3, "{:?}", gyro.notes);
+    assert!(agree.iter().all(|n| n.contains("agrees")), "{agree:?}");
+    assert!(!report.checks.iter().any(|c| c.contains("may not share")));
+    // the longest recording alone: a wider interval on N
+    let alone = cal.run(&imus[2]).unwrap();
+    let one = alone.axes[0].noise_density.as_ref().unwrap();
+    let width = |e: &gmwm::calib::Estimate| e.ci_high.unwrap() / e.ci_low.unwrap();
+    assert!(width(n) < width(one), "{} vs {}", width(n), width(one));
+}
+
+/// A recording whose white noise is four times the others' is named as differing from the
+/// others (scale by scale, no model), and the report's checks point to the same-model test.
+#[test]
+fn pooled_calibration_names_a_recording_of_another_model() {
+    let t = truth(GYRO_N, GYRO_K, None);
+    let loud = truth(2.0 * GYRO_N, GYRO_K, None);
+    let imus = [
+        gyro_imu(&t, 1 << 16, FREQ, 31, "rad/s", 1.0),
+        gyro_imu(&t, 1 << 16, FREQ, 32, "rad/s", 1.0),
+        gyro_imu(&loud, 1 << 16, FREQ, 33, "rad/s", 1.0),
+    ];
+    let named: Vec<(&str, &Imu)> = ["a", "b", "loud"].into_iter().zip(&imus).collect();
+    let report = Calibration::new(options()).run_pooled(&named).unwrap();
+    let notes = &report.axes[0].notes;
+    let loud_note = notes
+        .iter()
+        .find(|n| n.starts_with("recording loud"))
+        .unwrap();
+    assert!(
+        loud_note.contains("differs from the other recordings'"),
+        "{loud_note}"
+    );
+    for quiet in ["recording a:", "recording b:"] {
+        let note = notes.iter().find(|n| n.starts_with(quiet)).unwrap();
+        // against a pool holding the loud recording, the quiet ones differ too, by less
+        assert!(note.contains("WV"), "{note}");
+    }
+    assert!(
+        report
+            .checks
+            .iter()
+            .any(|c| c.contains("may not share one model") && c.contains("gyro_x")),
+        "{:?}",
+        report.checks
+    );
+}
+
+/// Recordings that cannot be pooled: one error each, naming the recording.
+#[test]
+fn pooled_calibration_refuses_mismatched_recordings() {
+    let t = truth(GYRO_N, GYRO_K, None);
+    let a = gyro_imu(&t, 1 << 12, FREQ, 41, "rad/s", 1.0);
+    let cal = Calibration::new(options());
+    let err = |named: &[(&str, &Imu)]| cal.run_pooled(named).unwrap_err().to_string();
+    let fast = gyro_imu(&t, 1 << 12, 200.0, 42, "rad/s", 1.0);
+    let e = err(&[("a", &a), ("fast", &fast)]);
+    assert!(e.starts_with("fast: sampled at 200 Hz"), "{e}");
+    let unknown = Imu::new(
+        vec![column(
+            "gyro_x",
+            vec![0.1, 0.2, 0.3, 0.1, 0.0, 0.2, 0.1, 0.3],
+        )],
+        vec![info(Sensor::Gyroscope, None)],
+        FREQ,
+    )
+    .unwrap();
+    let e = err(&[("a", &a), ("u", &unknown)]);
+    assert!(
+        e.starts_with("u: column gyro_x: unit unknown, while a states rad/s"),
+        "{e}"
+    );
+    let other = Imu::new(
+        vec![column("gyro_y", vec![0.1, 0.2, 0.3, 0.1])],
+        vec![SensorInfo {
+            axis: "Y".into(),
+            ..info(Sensor::Gyroscope, Some("rad/s"))
+        }],
+        FREQ,
+    )
+    .unwrap();
+    let e = err(&[("a", &a), ("y", &other)]);
+    assert!(e.starts_with("y: no column gyro_x (a has it)"), "{e}");
+    let e = err(&[("a", &a)]);
+    assert!(e.contains("at least two"), "{e}");
+    assert!(matches!(
+        cal.run_pooled(&[("a", &a), ("y", &other)]),
+        Err(CalibError::Pool { .. })
+    ));
+}

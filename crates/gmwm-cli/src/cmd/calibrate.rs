@@ -83,7 +83,92 @@ pub fn execute_in(
 ) -> Result<Calibrated> {
     let print_summary = mode.print_summary;
     let exports = &config.exports;
-    check_outputs(config, report_path)?;
+    let (recording, report) = if config.pool.is_empty() {
+        check_outputs(config, report_path)?;
+        calibrate_one(config, mode)?
+    } else {
+        calibrate_pooled(config, report_path, mode)?
+    };
+    // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
+    // says so in a comment
+    let rostopic = config.rostopic.clone().or_else(|| recording.topic.clone());
+    let sets = report.nav_sets(config.policy, config.adjustment, rostopic.as_deref());
+    // every file that can be written is, then the failures are reported together
+    let mut written = Vec::new();
+    let mut paths = Vec::new();
+    let mut failed = Vec::new();
+    for (format, path) in exports {
+        for set in &sets {
+            let target = per_axis_path(path, &set.label);
+            let result = render(*format, &set.noise)
+                .map_err(anyhow::Error::from)
+                // the file is named below
+                .and_then(|text| Ok(crate::output::write_io(&target, text.as_bytes())?));
+            match result {
+                Ok(()) => {
+                    written.push(format!("{} ({format})", target.display()));
+                    paths.push(target);
+                }
+                Err(e) => failed.push(format!("{} ({format}): {e}", target.display())),
+            }
+        }
+    }
+    let json_to_stdout = config.json.as_deref() == Some(Path::new("-"));
+    let doc = gmwm::document::calibration(
+        &recording.path,
+        &recording.notes,
+        // a pooled calibration's accounts are its recordings' (their notes)
+        config.pool.is_empty().then_some(&recording.samples),
+        &report,
+        &sets,
+    );
+    if let Some(path) = report_path {
+        match write_report(config, path, &recording, &report, &sets, &doc) {
+            Ok(figures) => {
+                written.push(format!(
+                    "{} (HTML report, {figures} figures)",
+                    path.display()
+                ));
+                paths.push(path.to_path_buf());
+            }
+            Err(e) => failed.push(format!("{} (HTML report): {e:#}", path.display())),
+        }
+    }
+    if let Some(path) = &config.json {
+        if json_to_stdout {
+            serde_json::to_writer_pretty(&mut *out, &doc)?;
+            writeln!(out)?;
+        } else {
+            crate::output::write_json(path, &doc)?;
+            written.push(format!("{} (JSON)", path.display()));
+            paths.push(path.clone());
+        }
+    }
+    if !json_to_stdout {
+        if print_summary {
+            summary(&recording, &report, out)?;
+        }
+        for w in &written {
+            writeln!(out, "wrote {w}")?;
+        }
+    }
+    out.flush()?;
+    if !failed.is_empty() {
+        anyhow::bail!("not written: {}", failed.join("; "));
+    }
+    Ok(Calibrated {
+        axes: report.axes.len(),
+        explained: report.axes.iter().filter(|a| a.verdict.explains_wv).count(),
+        written: paths,
+    })
+}
+
+/// One recording read (streamed when long) and calibrated.
+fn calibrate_one(
+    config: &CalibrateConfig,
+    mode: Mode,
+) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
+    let exports = &config.exports;
     let calibration = Calibration::new(config.options.clone());
     // a long raw binary recording is calibrated while streamed from the file (bounded memory)
     // (a topic is for ROS recordings: with another file, the in-memory reader refuses it)
@@ -132,77 +217,78 @@ pub fn execute_in(
     }
     .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();
-    // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
-    // says so in a comment
-    let rostopic = config.rostopic.clone().or_else(|| recording.topic.clone());
-    let sets = report.nav_sets(config.policy, config.adjustment, rostopic.as_deref());
-    // every file that can be written is, then the failures are reported together
-    let mut written = Vec::new();
-    let mut paths = Vec::new();
-    let mut failed = Vec::new();
-    for (format, path) in exports {
-        for set in &sets {
-            let target = per_axis_path(path, &set.label);
-            let result = render(*format, &set.noise)
-                .map_err(anyhow::Error::from)
-                // the file is named below
-                .and_then(|text| Ok(crate::output::write_io(&target, text.as_bytes())?));
-            match result {
-                Ok(()) => {
-                    written.push(format!("{} ({format})", target.display()));
-                    paths.push(target);
-                }
-                Err(e) => failed.push(format!("{} ({format}): {e}", target.display())),
-            }
-        }
+    Ok((recording, report))
+}
+
+/// `--pool`: every recording the FILE arguments name, read into memory and calibrated as one
+/// sensor (docs/methods.md §5.12). The recording returned stands for them all: the first's
+/// path, source and topic, every recording's notes.
+fn calibrate_pooled(
+    config: &CalibrateConfig,
+    report_path: Option<&Path>,
+    mode: Mode,
+) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
+    let files = crate::batch::recordings(&config.pool, config.input.read.format)?;
+    if files.len() < 2 {
+        return Err(UsageError(format!(
+            "--pool calibrates several recordings as one sensor: {} found in {}; give two or more",
+            files.len(),
+            config
+                .pool
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
+        ))
+        .into());
     }
-    let json_to_stdout = config.json.as_deref() == Some(Path::new("-"));
-    let doc = gmwm::document::calibration(
-        &recording.path,
-        &recording.notes,
-        Some(&recording.samples),
-        &report,
-        &sets,
-    );
-    if let Some(path) = report_path {
-        match write_report(config, path, &recording, &report, &sets, &doc) {
-            Ok(figures) => {
-                written.push(format!(
-                    "{} (HTML report, {figures} figures)",
-                    path.display()
-                ));
-                paths.push(path.to_path_buf());
-            }
-            Err(e) => failed.push(format!("{} (HTML report): {e:#}", path.display())),
+    let mut loaded = Vec::with_capacity(files.len());
+    for f in &files {
+        let one = CalibrateConfig {
+            input: crate::config::InputConfig {
+                file: f.clone(),
+                ..config.input.clone()
+            },
+            ..config.clone()
+        };
+        check_outputs(&one, report_path)?;
+        let recording = crate::input::load_recording(&one.input)?;
+        if !config.exports.is_empty() {
+            check_units_known(config, &recording)?;
         }
+        loaded.push(recording);
     }
-    if let Some(path) = &config.json {
-        if json_to_stdout {
-            serde_json::to_writer_pretty(&mut *out, &doc)?;
-            writeln!(out)?;
-        } else {
-            crate::output::write_json(path, &doc)?;
-            written.push(format!("{} (JSON)", path.display()));
-            paths.push(path.clone());
-        }
-    }
-    if !json_to_stdout {
-        if print_summary {
-            summary(&recording, &report, out)?;
-        }
-        for w in &written {
-            writeln!(out, "wrote {w}")?;
-        }
-    }
-    out.flush()?;
-    if !failed.is_empty() {
-        anyhow::bail!("not written: {}", failed.join("; "));
-    }
-    Ok(Calibrated {
-        axes: report.axes.len(),
-        explained: report.axes.iter().filter(|a| a.verdict.explains_wv).count(),
-        written: paths,
-    })
+    let calibration = Calibration::new(config.options.clone());
+    let names: Vec<String> = loaded
+        .iter()
+        .map(|r| crate::spool::shown(&r.path.display().to_string()))
+        .collect();
+    let named: Vec<(&str, &gmwm::imu::Imu)> = names
+        .iter()
+        .zip(&loaded)
+        .filter_map(|(n, r)| Some((n.as_str(), r.imu.as_ref()?)))
+        .collect();
+    let per_axis = calibration.candidates_per_axis()?;
+    let axes = loaded[0].columns.len();
+    let progress = if mode.batch {
+        indicatif::ProgressBar::hidden()
+    } else {
+        bar((axes * per_axis) as u64, "calibrating", "candidate fits")
+    };
+    let report = calibration
+        .run_pooled_with_progress(&named, &Ticks(&progress))
+        .map_err(gmwm::Error::from)?;
+    progress.finish_and_clear();
+    // each recording's notes, named by it
+    let notes = names
+        .iter()
+        .zip(&loaded)
+        .flat_map(|(name, r)| r.notes.iter().map(move |n| format!("{name}: {n}")))
+        .collect();
+    let mut first = loaded.swap_remove(0);
+    first.notes = notes;
+    first.timing = None;
+    Ok((first, report))
 }
 
 /// The HTML report: the calibration rendered by gmwm-plot with the filter files as exported
@@ -374,11 +460,19 @@ fn summary(
     out: &mut impl Write,
 ) -> Result<()> {
     let hours = report.duration_s / 3600.0;
+    let title = match &report.name {
+        Some(name) if !report.recordings.is_empty() => name.clone(),
+        _ => recording.path.display().to_string(),
+    };
     writeln!(
         out,
-        "{}: {} samples per axis at {} Hz ({}), {}",
-        recording.path.display(),
+        "{title}: {} samples per axis{} at {} Hz ({}), {}",
         report.samples,
+        if report.recordings.is_empty() {
+            ""
+        } else {
+            " in all"
+        },
         num(report.freq_hz),
         if hours >= 1.0 {
             format!("{hours:.2} h")

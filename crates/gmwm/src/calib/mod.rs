@@ -4,6 +4,7 @@ pub mod export;
 pub mod ieee;
 pub mod nav;
 pub mod pipeline;
+pub mod pooled;
 pub mod streamed;
 
 pub use contamination::{compare_classical_robust, Contamination, FitUses};
@@ -12,4 +13,5 @@ pub use pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,
     EstimateStatus, FitVerdict, GaussMarkovBias, DEFAULT_FULL_MODEL,
 };
+pub use pooled::PooledInput;
 pub use streamed::{ROBUST_BLOCK, ROBUST_LEVELS, STREAM_FROM};

@@ -15,6 +15,7 @@ use crate::process::{Ar1, Gm};
 use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
 use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms};
 use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
+use crate::variance::pooled::PooledWv;
 use crate::variance::robust::RobustOptions;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use rayon::prelude::*;
@@ -133,6 +134,14 @@ pub enum CalibError {
         column: String,
         /// Cause.
         source: FitError,
+    },
+    /// Recordings that cannot be pooled into one calibration (docs/methods.md §5.12).
+    #[error("{recording}: {reason}")]
+    Pool {
+        /// The recording, as named by the caller.
+        recording: String,
+        /// What is wrong.
+        reason: String,
     },
     /// The Allan variance or a setting was unusable.
     #[error("column {column}: {source}")]
@@ -301,6 +310,10 @@ pub struct CalibrationReport {
     pub axes: Vec<AxisCalibration>,
     /// Checks on the recording as a whole that a user should read, one line each.
     pub checks: Vec<String>,
+    /// The recordings of a pooled calibration ([`Calibration::run_pooled`]), input order;
+    /// empty (and left out of the JSON) for one recording.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub recordings: Vec<super::pooled::PooledInput>,
 }
 
 /// Longest scale, in seconds, below which a recording is reported as too short to show the
@@ -475,11 +488,12 @@ impl Calibration {
             alpha: self.options.wv.alpha,
             axes,
             checks,
+            recordings: Vec::new(),
         })
     }
 
     /// The unit of one axis: the option for its kind, else the recording's text parsed.
-    fn unit_of(
+    pub(crate) fn unit_of(
         &self,
         column: &str,
         kind: Option<SignalKind>,
@@ -588,6 +602,16 @@ impl Calibration {
         let selection = match &data {
             AxisData::Series(x) => wic.select_with_progress(x, freq_hz, progress),
             AxisData::Streamed { wv, .. } => wic.select_wv_with_progress(wv, progress),
+            AxisData::Pooled { classical, robust } => match (self.options.wv.robust, robust) {
+                (None, _) => wic.select_pooled_wv_with_progress(classical, progress),
+                (Some(_), Some(Ok(r))) => wic.select_pooled_wv_with_progress(r, progress),
+                (Some(_), Some(Err(e))) => {
+                    return Err(engine(
+                        crate::ParamError::new("robust wavelet variance", e, "computable").into(),
+                    ))
+                }
+                (Some(_), None) => unreachable!("run_pooled computes the robust WV it fits"),
+            },
         }
         .map_err(|source| CalibError::Selection {
             column: column.to_string(),
@@ -642,6 +666,10 @@ impl Calibration {
             .map_err(engine)?,
             // docs/methods.md §3.4: the overlapping AV is twice the classical Haar WV, exactly
             AxisData::Streamed { wv, .. } => allan_from_wv(wv).map_err(|e| engine(e.into()))?,
+            // and the pooled AV the same mean of the recordings' AVs as the pooled WV's
+            AxisData::Pooled { classical, .. } => {
+                allan_from_wv(classical.wv()).map_err(|e| engine(e.into()))?
+            }
         };
         let ieee = ieee_readoff(&allan).map_err(|e| engine(e.into()))?;
         let z = inference.z;
@@ -759,6 +787,27 @@ impl Calibration {
         let alpha = self.options.wv.alpha;
         let x = match data {
             AxisData::Series(x) => *x,
+            AxisData::Pooled { classical, robust } => {
+                let uses = match self.options.wv.robust {
+                    Some(_) => FitUses::Robust,
+                    None => FitUses::Classical,
+                };
+                return match robust {
+                    Some(Ok(r)) => Some(compare_classical_robust(
+                        classical.wv().clone(),
+                        r.wv().clone(),
+                        uses,
+                        alpha,
+                    )),
+                    Some(Err(e)) => {
+                        notes.push(format!(
+                            "the classical and robust WVs could not be compared: {e}"
+                        ));
+                        None
+                    }
+                    None => None,
+                };
+            }
             AxisData::Streamed { robust, .. } => {
                 return match robust {
                     Some(Ok(r)) => Some(compare_classical_robust(
@@ -818,6 +867,13 @@ pub(crate) enum AxisData<'a> {
         wv: Box<WaveletVariance>,
         robust: Option<Result<Box<WaveletVariance>, String>>,
     },
+    /// The pooled WVs of several recordings (docs/methods.md §5.12), already in SI: the
+    /// classical one and the robust one (the fit's when the options ask for a robust WV, else
+    /// the contamination check's; `None`: neither).
+    Pooled {
+        classical: Box<PooledWv>,
+        robust: Option<Result<Box<PooledWv>, String>>,
+    },
 }
 
 impl AxisData<'_> {
@@ -825,6 +881,7 @@ impl AxisData<'_> {
         match self {
             AxisData::Series(x) => x.len(),
             AxisData::Streamed { wv, .. } => wv.n,
+            AxisData::Pooled { classical, .. } => classical.wv().n(),
         }
     }
 }

@@ -168,3 +168,46 @@ pub fn wv_covariance(
         replicates: Some(replicates),
     })
 }
+
+/// `V` of a pooled WV (docs/methods.md §5.12, [`crate::variance::pooled`]): `sum_k D_k V_k D_k'`
+/// with `V_k` the covariance of recording k's WV by [`wv_covariance`] at its own length and
+/// levels (a bootstrap one seeded with `replicate_seed(seed, k)`) and `D_k` its weights. The
+/// source is exact when every `V_k` is.
+///
+/// # Errors
+/// As [`wv_covariance`].
+pub(crate) fn pooled_wv_covariance(
+    model: &Model,
+    pooled: &crate::variance::pooled::PooledWv,
+    method: CovarianceMethod,
+    replicates: usize,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<WvCovariance, InputError> {
+    let levels = pooled.wv().levels();
+    let mut v = DMatrix::zeros(levels, levels);
+    let mut simulated = None;
+    for (k, part) in pooled.parts().iter().enumerate() {
+        let vk = wv_covariance(
+            model,
+            part.n(),
+            part.freq_hz(),
+            &part.options(),
+            method,
+            replicates,
+            crate::sim::replicate_seed(seed, k as u64),
+            progress,
+        )?;
+        let w = pooled.weights(k);
+        for a in 0..w.len() {
+            for b in 0..w.len() {
+                v[(a, b)] += w[a] * w[b] * vk.v[(a, b)];
+            }
+        }
+        simulated = simulated.or(vk.replicates);
+    }
+    Ok(WvCovariance {
+        v,
+        replicates: simulated,
+    })
+}

@@ -9,12 +9,15 @@ use super::SelectionError;
 use crate::error::check_freq;
 use crate::fit::canonical::wv_separation;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
-use crate::inference::covariance::{wv_covariance, CovarianceMethod, VSource};
+use crate::inference::covariance::{
+    pooled_wv_covariance, wv_covariance, CovarianceMethod, VSource,
+};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{NoProgress, Progress};
 use crate::model::{Model, ProcessKind};
 use crate::sim::bootstrap::map_replicates;
 use crate::sim::replicate_seed;
+use crate::variance::pooled::PooledWv;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -340,7 +343,7 @@ impl Wic {
         check_freq(freq_hz)?;
         check_haar(self.wv_options.filter)?;
         let wv = wavelet_variance(x, freq_hz, &self.wv_options)?;
-        self.select_from(&wv, StartInputs::from_series(x), progress)
+        self.select_from(&wv, StartInputs::from_series(x), None, progress)
     }
 
     /// [`Wic::select`] on a wavelet variance computed before (e.g. read by
@@ -369,14 +372,43 @@ impl Wic {
         self.check_settings()?;
         check_freq(wv.freq_hz)?;
         check_haar(wv.filter)?;
-        self.select_from(wv, StartInputs::from_wv(wv), progress)
+        self.select_from(wv, StartInputs::from_wv(wv), None, progress)
     }
 
-    /// Steps 1 (after the WV) to 5 of [`Wic::select`].
+    /// [`Wic::select_wv`] on the pooled WV of several recordings (docs/methods.md §5.12, what
+    /// `gmwm calibrate --pool` runs): the same steps on `pooled.wv()`, with the pooled WV's
+    /// own covariance ([`PooledWv`]'s, every recording's V at its own length) behind the
+    /// optimism and the WIC differences' standard errors.
+    ///
+    /// # Errors
+    /// As [`Wic::select_wv`]; [`SelectionError::Setting`] for the bootstrap optimism, which
+    /// simulates one series where the pooled WV comes from several.
+    pub fn select_pooled_wv_with_progress(
+        &self,
+        pooled: &PooledWv,
+        progress: &dyn Progress,
+    ) -> Result<ModelSelection, SelectionError> {
+        self.check_settings()?;
+        if self.method == OptimismMethod::Bootstrap {
+            return Err(SelectionError::Setting {
+                name: "optimism",
+                value: "bootstrap".into(),
+                expected: "the asymptotic optimism for a pooled WV (the bootstrap simulates one series; the pooled WV comes from several)",
+            });
+        }
+        let wv = pooled.wv();
+        check_freq(wv.freq_hz)?;
+        check_haar(wv.filter)?;
+        self.select_from(wv, StartInputs::from_wv(wv), Some(pooled), progress)
+    }
+
+    /// Steps 1 (after the WV) to 5 of [`Wic::select`]; `pooled` is the pooled WV that `wv` is,
+    /// whose covariance is its recordings' (docs/methods.md §5.12).
     fn select_from(
         &self,
         wv: &WaveletVariance,
         inputs: StartInputs,
+        pooled: Option<&PooledWv>,
         progress: &dyn Progress,
     ) -> Result<ModelSelection, SelectionError> {
         let freq_hz = wv.freq_hz;
@@ -402,16 +434,28 @@ impl Wic {
         };
         // V of the full model: the asymptotic optimism's, and with either optimism the
         // sampling covariance behind the WIC differences' standard errors (step 5)
-        let covariance = wv_covariance(
-            &full_fit.active_model().map_err(fit_error(&self.full))?,
-            wv.n,
-            freq_hz,
-            &replicate_opts,
-            self.covariance,
-            self.bootstrap,
-            self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET),
-            &NoProgress,
-        )?;
+        let full_active = full_fit.active_model().map_err(fit_error(&self.full))?;
+        let v_seed = self.seed.wrapping_add(BOOTSTRAP_SEED_OFFSET);
+        let covariance = match pooled {
+            Some(p) => pooled_wv_covariance(
+                &full_active,
+                p,
+                self.covariance,
+                self.bootstrap,
+                v_seed,
+                &NoProgress,
+            )?,
+            None => wv_covariance(
+                &full_active,
+                wv.n,
+                freq_hz,
+                &replicate_opts,
+                self.covariance,
+                self.bootstrap,
+                v_seed,
+                &NoProgress,
+            )?,
+        };
         let v = covariance.v;
         let omega = DMatrix::from_diagonal(&DVector::from_column_slice(&full_fit.weights.omega));
         let context = Context {

@@ -8,6 +8,7 @@ pub mod cross;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
 pub mod implied_cov;
+pub mod pooled;
 pub mod robust;
 pub(crate) mod simd;
 pub(crate) mod stream;
