@@ -176,3 +176,154 @@ fn mismatched_inputs_give_one_clear_error_each() {
         &["--bootstrap"],
     );
 }
+
+/// A gyro recording: `gmwm simulate`'s column renamed gyro_x, with a sidecar stating the rate
+/// and (when given) the unit.
+fn gyro(dir: &Path, name: &str, n: usize, freq: f64, seed: u64, unit: Option<&str>) -> PathBuf {
+    let path = simulate(dir, name, TRUTH, n, freq, seed);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let body = text.split_once('\n').unwrap().1;
+    std::fs::write(&path, format!("gyro_x\n{body}")).unwrap();
+    let units = unit.map_or(String::new(), |u| {
+        format!(r#", "units": {{"gyro": "{u}"}}"#)
+    });
+    std::fs::write(
+        dir.join(format!("{name}.json")),
+        format!(r#"{{"sampling_frequency_hz": {freq}{units}}}"#),
+    )
+    .unwrap();
+    path
+}
+
+/// `calibrate --pool`: one calibration of three recordings (one in deg/s), its JSON listing
+/// them, the table titled by the pool; a folder of recordings works as FILE too.
+#[test]
+fn calibrate_pool_gives_one_calibration_of_all_recordings() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let files = [
+        gyro(d, "r1.csv", 20000, 100.0, 1, Some("rad/s")),
+        gyro(d, "r2.csv", 40000, 100.0, 2, Some("deg/s")),
+        gyro(d, "r3.csv", 60000, 100.0, 3, Some("rad/s")),
+    ];
+    let doc = run_json(gmwm().arg("calibrate").args(&files).args([
+        "--pool",
+        "--model",
+        "WN()+RW()",
+        "--G",
+        "500",
+        "--json",
+        "-",
+    ]));
+    let recs = doc["recordings"].as_array().unwrap();
+    assert_eq!(recs.len(), 3);
+    assert!(recs[1]["name"].as_str().unwrap().ends_with("r2.csv"));
+    assert_eq!(recs[2]["samples"], 60000);
+    assert_eq!(doc["samples"], 120000);
+    let axis = &doc["axes"][0];
+    assert_eq!(axis["column"], "gyro_x");
+    assert_eq!(axis["data_unit"], "rad/s");
+    // r2 holds rad/s-scale values labelled deg/s: the pool mixes two scales and says so
+    let notes: Vec<&str> = axis["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    let r2 = notes.iter().find(|n| n.contains("r2.csv:")).unwrap();
+    assert!(r2.contains("differs from the other recordings'"), "{r2}");
+    let checks = doc["checks"].as_array().unwrap();
+    assert!(
+        checks
+            .iter()
+            .any(|c| c.as_str().unwrap().contains("rad/s, deg/s")),
+        "{checks:?}"
+    );
+    // the three in rad/s as a folder: all agree, N near sqrt(sigma2 / f) = 0.1
+    std::fs::remove_file(&files[1]).unwrap();
+    std::fs::remove_file(d.join("r2.csv.json")).unwrap();
+    gyro(d, "r2.csv", 40000, 100.0, 2, Some("rad/s"));
+    let out = gmwm()
+        .arg("calibrate")
+        .arg(d)
+        .args(["--pool", "--model", "WN()+RW()", "--G", "500"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.starts_with("3 recordings pooled: "), "{table}");
+    assert!(table.contains("samples per axis in all"), "{table}");
+    assert!(!table.contains("may not share"), "{table}");
+    let doc = run_json(gmwm().arg("calibrate").arg(d).args([
+        "--pool",
+        "--model",
+        "WN()+RW()",
+        "--G",
+        "500",
+        "--json",
+        "-",
+    ]));
+    let n = doc["axes"][0]["noise_density"]["value"].as_f64().unwrap();
+    assert!((n / 0.1 - 1.0).abs() < 0.03, "N = {n}");
+}
+
+#[test]
+fn calibrate_pool_refuses_mismatched_recordings_one_line_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = gyro(d, "a.csv", 4000, 100.0, 1, Some("rad/s"));
+    let cal = |files: &[&PathBuf], extra: &[&str]| {
+        let mut c = gmwm();
+        c.arg("calibrate")
+            .args(files)
+            .args(["--pool", "--model", "WN()+RW()", "--G", "200"])
+            .args(extra);
+        c
+    };
+    // another rate
+    let b = gyro(d, "b.csv", 4000, 200.0, 2, Some("rad/s"));
+    assert_one_line_error(
+        &mut cal(&[&a, &b], &[]),
+        &["b.csv", "200 Hz", "100 Hz", "one rate"],
+    );
+    // a unit stated in one recording and not in another
+    let u = gyro(d, "u.csv", 4000, 100.0, 3, None);
+    assert_one_line_error(
+        &mut cal(&[&a, &u], &[]),
+        &["u.csv", "gyro_x", "unit unknown", "a.csv", "rad/s"],
+    );
+    // a column missing
+    let y = d.join("y.csv");
+    std::fs::write(&y, "gyro_y\n1\n2\n3\n4\n5\n6\n7\n8\n").unwrap();
+    std::fs::write(
+        d.join("y.csv.json"),
+        r#"{"sampling_frequency_hz": 100, "units": {"gyro": "rad/s"}}"#,
+    )
+    .unwrap();
+    assert_one_line_error(
+        &mut cal(&[&a, &y], &[]),
+        &["y.csv", "no column gyro_x", "a.csv"],
+    );
+    // a recording too short for any wavelet variance
+    let short = d.join("short.csv");
+    std::fs::write(&short, "gyro_x\n0.1\n").unwrap();
+    std::fs::write(
+        d.join("short.csv.json"),
+        r#"{"sampling_frequency_hz": 100, "units": {"gyro": "rad/s"}}"#,
+    )
+    .unwrap();
+    assert_one_line_error(&mut cal(&[&a, &short], &[]), &["short.csv", "gyro_x"]);
+    // one recording
+    assert_usage_error(&mut cal(&[&a], &[]), &["--pool", "1 found", "two or more"]);
+    // batch flags, standard input
+    assert_usage_error(
+        &mut cal(&[&a, &b], &["--out-dir", "o"]),
+        &["--pool", "--out-dir", "batch mode"],
+    );
+    let dash = PathBuf::from("-");
+    assert_usage_error(&mut cal(&[&a, &dash], &[]), &["standard input", "--pool"]);
+}
