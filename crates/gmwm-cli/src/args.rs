@@ -129,7 +129,9 @@ Examples:
   gmwm calibrate log.bin --format ln200 --axis-policy per-axis --kalibr imu.yaml
   gmwm calibrate imu.csv.gz --model \"2*AR1()+WN()+RW()\" --inflate 2 --export vins vins.yaml
   gmwm calibrate runs/ --out-dir calib/ --kalibr imu.yaml      every recording in runs/
-  gmwm calibrate 'runs/*.csv.gz' a.bag --json summary.json      a glob (quoted) and a file";
+  gmwm calibrate 'runs/*.csv.gz' a.bag --json summary.json      a glob (quoted) and a file
+  gmwm calibrate imu1.csv.gz imu2.csv.gz imu3.csv.gz --pool --kalibr imu.yaml
+      one calibration of three recordings of one sensor (their pooled wavelet variance)";
 
 const WV_EXAMPLES: &str = "\
 Many recordings (batch mode: several FILEs, a folder, a quoted glob, or --out-dir/--force):

@@ -751,8 +751,8 @@ pub enum BatchJob {
     /// standard output); the export and report files of `config` are suffixes of each
     /// recording's stem (checked to be bare file names); `config.json` is unused.
     Calibrate {
-        /// The calibration and its file suffixes.
-        config: CalibrateConfig,
+        /// The calibration and its file suffixes (boxed: the variants differ in size).
+        config: Box<CalibrateConfig>,
         /// `--json FILE|-`: the summary as JSON.
         json: Option<PathBuf>,
     },
@@ -847,7 +847,10 @@ fn calibrate_or_batch(a: &CalibrateCommand) -> Result<Config> {
         inputs: batch_inputs(&args.input.file, batch),
         out_dir: batch.out_dir.clone(),
         force: batch.force,
-        job: BatchJob::Calibrate { config, json },
+        job: BatchJob::Calibrate {
+            config: Box::new(config),
+            json,
+        },
     }))
 }
 

@@ -255,7 +255,10 @@ fn calibrate_pool_gives_one_calibration_of_all_recordings() {
         String::from_utf8_lossy(&out.stderr)
     );
     let table = String::from_utf8_lossy(&out.stdout);
-    assert!(table.starts_with("3 recordings pooled: "), "{table}");
+    assert!(
+        table.starts_with("3 recordings pooled: 120000 samples per axis in all"),
+        "{table}"
+    );
     assert!(table.contains("samples per axis in all"), "{table}");
     assert!(!table.contains("may not share"), "{table}");
     let doc = run_json(gmwm().arg("calibrate").arg(d).args([
@@ -269,6 +272,28 @@ fn calibrate_pool_gives_one_calibration_of_all_recordings() {
     ]));
     let n = doc["axes"][0]["noise_density"]["value"].as_f64().unwrap();
     assert!((n / 0.1 - 1.0).abs() < 0.03, "N = {n}");
+    assert_eq!(doc["axes"][0]["recording_wvs"].as_array().unwrap().len(), 3);
+    // the HTML report lists the recordings and draws each one's WV with the pooled one
+    let html = dir.path().join("pooled.html");
+    let out = gmwm()
+        .arg("calibrate")
+        .args(&files)
+        .args(["--pool", "--model", "WN()+RW()", "--G", "500", "--report"])
+        .arg(&html)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(page.contains("<th>recordings</th>"));
+    assert!(page.contains("<section id=\"recordings\">"));
+    assert!(
+        page.contains("Each recording&#39;s wavelet variance and the pooled one")
+            || page.contains("Each recording's wavelet variance and the pooled one")
+    );
 }
 
 #[test]

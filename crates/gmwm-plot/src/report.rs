@@ -6,7 +6,8 @@
 //! `gmwm calibrate --json` writes it) is embedded in the page.
 
 use crate::figures::{
-    compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column, Layout, WIC_ROWS,
+    compare_figure, fit_figure, ieee_figure, recordings_figure, selection_figure, wv_figure,
+    Column, Layout, WIC_ROWS,
 };
 use crate::style::number;
 use crate::{Figure, PlotError};
@@ -150,11 +151,39 @@ fn summary(out: &mut String, report: &CalibrationReport, ctx: &ReportContext) {
     } else {
         format!("{} s", number(report.duration_s))
     };
+    // a pooled calibration lists its recordings where one recording names its file
+    let file = if report.recordings.is_empty() {
+        ("file", esc(&ctx.file))
+    } else {
+        (
+            "recordings",
+            report
+                .recordings
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{}: {} samples ({} s)",
+                        esc(&r.name),
+                        r.samples,
+                        number(r.duration_s)
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join("<br>"),
+        )
+    };
     let kv = vec![
-        ("file", esc(&ctx.file)),
+        file,
         ("read as", esc(&ctx.source)),
         ("name", esc(report.name.as_deref().unwrap_or("—"))),
-        ("samples per axis", report.samples.to_string()),
+        (
+            if report.recordings.is_empty() {
+                "samples per axis"
+            } else {
+                "samples per axis, all recordings"
+            },
+            report.samples.to_string(),
+        ),
         ("sampling rate", format!("{} Hz", number(report.freq_hz))),
         ("length", duration),
         (
@@ -532,6 +561,38 @@ pub fn render(report: &CalibrationReport, ctx: &ReportContext) -> Result<String,
         ),
     )?);
     out.push_str("</section>\n");
+    if !report.recordings.is_empty() {
+        let pairs: Vec<(gmwm::WaveletVariance, Vec<gmwm::WaveletVariance>)> = report
+            .axes
+            .iter()
+            .map(|a| (a.wv.clone(), a.recording_wvs.clone()))
+            .collect();
+        let columns: Vec<Column<'_, _>> = report
+            .axes
+            .iter()
+            .zip(&pairs)
+            .map(|(a, p)| column(a, p))
+            .collect();
+        // the recordings by file name: their folders are in the table above
+        let labels: Vec<String> = report
+            .recordings
+            .iter()
+            .map(|r| {
+                std::path::Path::new(&r.name)
+                    .file_name()
+                    .map_or(r.name.clone(), |f| f.to_string_lossy().into_owned())
+            })
+            .collect();
+        out.push_str("<section id=\"recordings\"><h2>Recordings</h2>\n");
+        out.push_str(&figure_html(
+            &recordings_figure(&columns, &labels),
+            &format!(
+                "Each recording's wavelet variance and the pooled one that was calibrated (grey, with its {:.0}% interval). The notes of each axis compare every recording with the others, scale by scale.",
+                100.0 * (1.0 - report.alpha)
+            ),
+        )?);
+        out.push_str("</section>\n");
+    }
     for a in &report.axes {
         axis_section(&mut out, a, report.alpha)?;
     }

@@ -481,7 +481,7 @@ fn pooled_calibration_coverage(r: usize) -> (f64, f64, f64, f64) {
                 let e = e.as_ref().unwrap();
                 let ok = match (e.ci_low, e.ci_high) {
                     (None, None) => false,
-                    (lo, hi) => lo.is_none_or(|l| l < truth) && hi.is_none_or(|h| truth < h),
+                    (lo, hi) => lo.map_or(true, |l| l < truth) && hi.map_or(true, |h| truth < h),
                 };
                 (f64::from(u8::from(ok)), e.value)
             };
@@ -509,7 +509,10 @@ fn pooled_calibration_intervals_cover() {
     let r = 100;
     let (cn, ck, zn, zk) = pooled_calibration_coverage(r);
     let bound = 0.95 - 3.0 * (0.95f64 * 0.05 / r as f64).sqrt();
-    assert!(cn >= bound && ck >= bound, "coverage N {cn}, K {ck} (bound {bound})");
+    assert!(
+        cn >= bound && ck >= bound,
+        "coverage N {cn}, K {ck} (bound {bound})"
+    );
     // N: the WN term is estimated from every level; its relative bias is far below its SE
     assert!(zn.abs() < 3.0, "N bias z = {zn}");
     // K: from the few coarse levels where the random walk shows (these recordings last 82 to

@@ -325,7 +325,15 @@ fn write_report(
         }
     }
     let ctx = gmwm_plot::report::ReportContext {
-        file: crate::spool::shown(&config.input.file.display().to_string()),
+        file: match report.recordings.len() {
+            0 => crate::spool::shown(&config.input.file.display().to_string()),
+            _ => report
+                .recordings
+                .iter()
+                .map(|r| r.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        },
         source: match &recording.source {
             gmwm::imu::RecordingSource::Records { record_type } => {
                 format!("binary IMU records ({record_type})")

@@ -231,7 +231,7 @@ pub struct FitVerdict {
 /// `model` (the selected candidate), `canonical_model`, `identified_model`, `noise_density`, `random_walk`,
 /// `bias_instability`, `quantization`, `rate_ramp` ([`Estimate`] or null),
 /// `gauss_markov_bias`, `ieee`, `verdict`, `canonical`, `inference`, `selection` (the table),
-/// `wv`, `allan`, `notes`.
+/// `wv`, `allan`, `notes`, and for a pooled calibration `recording_wvs`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AxisCalibration {
     /// Column name.
@@ -286,6 +286,11 @@ pub struct AxisCalibration {
     pub contamination: Option<Contamination>,
     /// What the read-off did that a user should know, one line each.
     pub notes: Vec<String>,
+    /// A pooled calibration's recordings' own WVs of this axis (unit², the estimator of
+    /// `wv`), input order, which `wv` pools; empty (and left out of the JSON) for one
+    /// recording.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub recording_wvs: Vec<WaveletVariance>,
 }
 
 /// The calibration of a recording: one [`AxisCalibration`] per gyroscope and accelerometer
@@ -770,6 +775,7 @@ impl Calibration {
             allan,
             contamination,
             notes,
+            recording_wvs: Vec::new(),
         })
     }
 

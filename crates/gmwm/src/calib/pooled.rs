@@ -202,7 +202,9 @@ impl Calibration {
             })
             .collect();
         let mut data = Vec::with_capacity(columns.len());
-        let mut agreement: Vec<(Vec<String>, usize)> = Vec::with_capacity(columns.len());
+        // per column: the recordings' lines and how many differ, and their WVs
+        type Agreement = ((Vec<String>, usize), Vec<WaveletVariance>);
+        let mut agreement: Vec<Agreement> = Vec::with_capacity(columns.len());
         let mut wvs = wvs.into_iter();
         for (column, _, _, _) in &columns {
             let mut classical = Vec::with_capacity(recordings.len());
@@ -234,12 +236,13 @@ impl Calibration {
                 (Some(_), Some(Ok(r))) => r.parts(),
                 _ => classical.parts(),
             };
-            agreement.push(recording_agreement(fitted, &names).map_err(|e| {
-                CalibError::Engine {
+            agreement.push((
+                recording_agreement(fitted, &names).map_err(|e| CalibError::Engine {
                     column: column.to_string(),
                     source: e.into(),
-                }
-            })?);
+                })?,
+                fitted.to_vec(),
+            ));
             data.push((classical, robust));
         }
         // the pooled WVs are in SI already; the first recording's unit names the data's
@@ -263,7 +266,7 @@ impl Calibration {
             )
             .collect();
         let samples: usize = recordings.iter().map(|(_, imu)| imu.len()).sum();
-        let label = format!("{} recordings pooled: {}", names.len(), names.join(", "));
+        let label = format!("{} recordings pooled", names.len());
         let mut report = self.run_axes(Some(&label), freq_hz, samples, axes, checks, progress)?;
         report.recordings = recordings
             .iter()
@@ -275,9 +278,10 @@ impl Calibration {
             .collect();
         // the per-recording lines, on the axes calibrated (an axis may be left out)
         let mut disagreeing = Vec::new();
-        for ((column, _, _, _), (lines, differing)) in columns.iter().zip(agreement) {
+        for ((column, _, _, _), ((lines, differing), wvs)) in columns.iter().zip(agreement) {
             if let Some(a) = report.axes.iter_mut().find(|a| a.column == *column) {
                 a.notes.extend(lines);
+                a.recording_wvs = wvs;
                 if differing > 0 {
                     disagreeing.push(format!("{column} ({differing} of {})", names.len()));
                 }
