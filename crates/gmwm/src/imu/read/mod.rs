@@ -898,8 +898,14 @@ pub(crate) fn resolve_selection(
             skipped: Vec::new(),
         });
     }
+    // masks, not searches: a header of n columns costs O(n) (a fuzzed header of thousands of
+    // columns made the searches quadratic)
+    let mut is_time = vec![false; names.len()];
+    for &(t, _) in &times {
+        is_time[t] = true;
+    }
     let data: Vec<usize> = (0..names.len())
-        .filter(|&k| Some(k) != time && !times.iter().any(|&(t, _)| t == k))
+        .filter(|&k| Some(k) != time && !is_time[k])
         .collect();
     let is_axis = |k: usize| {
         SensorInfo::infer(&names[k]).is_some()
@@ -910,8 +916,12 @@ pub(crate) fn resolve_selection(
     };
     let axes: Vec<usize> = data.iter().copied().filter(|&k| is_axis(k)).collect();
     let columns = if axes.is_empty() { data } else { axes };
+    let mut selected = vec![false; names.len()];
+    for &k in &columns {
+        selected[k] = true;
+    }
     let skipped = (0..names.len())
-        .filter(|&k| Some(k) != time && !columns.contains(&k))
+        .filter(|&k| Some(k) != time && !selected[k])
         .map(|k| names[k].clone())
         .collect();
     Ok(Selection {
