@@ -176,3 +176,60 @@ fn monitor_refuses_mismatched_inputs() {
         &["bad.json", "not a calibration JSON"],
     );
 }
+
+/// `--against`: a calibration JSON without the empirical WV is monitored against the model
+/// (auto) and refused with `--against wv` in one line; a real calibration's JSON is monitored
+/// against its WV on request, saying so in the JSON and the table.
+#[test]
+fn monitor_against_the_calibration_wv() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = triad(dir.path(), 8192);
+    let bare = calibration(dir.path(), 1.0, "AR1(phi=0.99, sigma2=0.02)+WN(sigma2=1)");
+    let doc =
+        run_json(monitor(&file, &bare).args(["--columns", "gyro_x", "--window", "2048", "--json"]));
+    assert_eq!(doc[0]["reference"], "model");
+    assert_one_line_error(
+        monitor(&file, &bare).args(["--columns", "gyro_x", "--window", "2048", "--against", "wv"]),
+        &["gyro_x", "no empirical WV", "--against model"],
+    );
+    let cal = dir.path().join("cal.json");
+    let out = gmwm()
+        .arg("calibrate")
+        .arg(&file)
+        .args([
+            "--freq",
+            "1",
+            "--columns",
+            "gyro_x",
+            "--model",
+            "AR1()+WN()",
+            "--G",
+            "500",
+        ])
+        .arg("--json")
+        .arg(&cal)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc = run_json(monitor(&file, &cal).args([
+        "--columns",
+        "gyro_x",
+        "--window",
+        "2048",
+        "--against",
+        "wv",
+        "--json",
+    ]));
+    assert_eq!(doc[0]["reference"], "calibration WV");
+    let table = monitor(&file, &cal)
+        .args(["--columns", "gyro_x", "--window", "2048", "--against", "wv"])
+        .output()
+        .unwrap();
+    assert!(
+        String::from_utf8_lossy(&table.stdout).contains("against the calibration's empirical WV")
+    );
+}

@@ -36,6 +36,20 @@
 //! up to `alpha W` flags by chance. A model the exact covariance does not cover (a generic ARMA,
 //! a negative AR coefficient) falls back to `eta_j` of §1.7 (`M_j / 2^j`), which the report says.
 //!
+//! # Against the calibration's WV (docs/methods.md §16.6)
+//! The band above assumes the model is exact. A calibrated model that misfits its own
+//! recording's WV by a few percent (real IMUs, where the J-test rejects) is outside the band of
+//! long windows at the fine scales, whose equivalent degrees of freedom run to tens of
+//! thousands, so nearly every window is flagged for the misfit, not for a fault.
+//! [`monitor_against`] with [`Reference::Wv`] centres each band on the calibration's empirical
+//! WV instead (the robust band on its robust WV, which on contaminated data lies below the
+//! classical one) and widens it by that WV's own uncertainty: with `s2_j = (ln(hi_j / lo_j) /
+//! (2 z))^2` the variance of `ln nu2_hat_j` from its `1 - alpha_c` interval (`z` its normal
+//! quantile, as §7.7), and `2 / r` that of a window's `ln WV`, the band uses the degrees of
+//! freedom `r' = 2 / (2 / r + s2_j)` of their sum. The model still gives the shape of the
+//! window's variance (`eta_j`). A window is then flagged when it differs from the calibrated
+//! recording, whatever the model.
+//!
 //! # Rule (docs/methods.md §16.4)
 //! A window is flagged when its robust or its classical WV leaves its band at one level or more;
 //! each level out is reported with the estimator, its direction and its ratio to the model's WV
@@ -47,7 +61,7 @@ use crate::model::Model;
 use crate::variance::ci::{check_alpha, chi_square_quantile};
 use crate::variance::implied_cov::exact_wv_covariance;
 use crate::variance::robust::RobustOptions;
-use crate::variance::wv::{wavelet_variance, WvOptions};
+use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use serde::Serialize;
 
 /// Smallest equivalent degrees of freedom `M_j / 2^j` (§1.7) of a level the monitor tests.
@@ -92,7 +106,8 @@ pub struct LevelOut {
     pub estimator: &'static str,
     /// `"high"` (above the band) or `"low"`.
     pub side: &'static str,
-    /// The window's robust WV over the model's WV.
+    /// The window's WV (of `estimator`) over the reference WV (the model's, or the
+    /// calibration's).
     pub ratio: f64,
 }
 
@@ -132,11 +147,51 @@ pub struct MonitorEvent {
     pub windows: usize,
 }
 
+/// What each window's WV is compared with (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reference<'a> {
+    /// The model's implied WV (docs/methods.md §16.3).
+    Model,
+    /// The calibration's empirical WVs with their intervals (docs/methods.md §16.6): for a
+    /// model that misfits the recording it was calibrated on. The windows' classical WV is
+    /// compared with `classical`, their robust WV with `robust` (at the levels where it is
+    /// defined; elsewhere, or without it, with `classical`).
+    Wv {
+        /// The calibration's classical WV.
+        classical: &'a WaveletVariance,
+        /// Its robust WV (the contamination check's), if any.
+        robust: Option<&'a WaveletVariance>,
+    },
+}
+
+/// The centre of a band at each level and the variance of its logarithm (docs/methods.md
+/// §16.6): `w`'s value and `(ln(hi / lo) / (2 z))^2` at the first `levels` levels, `None` at a
+/// level where `w` has no positive finite value and interval.
+fn centre(w: &WaveletVariance, levels: usize) -> Result<Vec<Option<(f64, f64)>>, Error> {
+    let z =
+        crate::inference::asymptotic::z_value(w.alpha(), crate::inference::ZConvention::TwoSided)?;
+    Ok((0..levels)
+        .map(|j| {
+            let (v, lo, hi) = (*w.wv().get(j)?, *w.ci_low().get(j)?, *w.ci_high().get(j)?);
+            (v.is_finite() && v > 0.0 && lo > 0.0 && hi.is_finite() && hi >= lo)
+                .then(|| (v, ((hi / lo).ln() / (2.0 * z)).powi(2)))
+        })
+        .collect())
+}
+
 /// Result of [`monitor`] for one series.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MonitorReport {
     /// The model (with values) the band comes from.
     pub model: String,
+    /// What the windows are compared with: `"model"` (its implied WV) or `"calibration WV"`
+    /// (the calibration's empirical WV, docs/methods.md §16.6).
+    pub reference: &'static str,
+    /// The centre of the classical WV's bands at the tested levels: the model's WV or the
+    /// calibration's.
+    pub reference_wv: Vec<f64>,
+    /// The centre of the robust WV's bands: the model's WV or the calibration's robust WV.
+    pub robust_reference_wv: Vec<f64>,
     /// Sampling rate (Hz).
     pub freq_hz: f64,
     /// Window length (samples).
@@ -153,7 +208,8 @@ pub struct MonitorReport {
     pub tau_s: Vec<f64>,
     /// The model's WV at those levels.
     pub model_wv: Vec<f64>,
-    /// Equivalent degrees of freedom of a window's classical WV (§16.3).
+    /// Equivalent degrees of freedom of a window's classical WV (§16.3), before the
+    /// reference's own uncertainty (§16.6).
     pub eta: Vec<f64>,
     /// Band of the robust WV, lower ends.
     pub band_low: Vec<f64>,
@@ -197,6 +253,23 @@ pub fn monitor(
     x: &[f64],
     freq_hz: f64,
     model: &Model,
+    opts: &MonitorOptions,
+) -> Result<MonitorReport, Error> {
+    monitor_against(x, freq_hz, model, Reference::Model, opts)
+}
+
+/// [`monitor`] with the windows compared with `reference` (module doc): the model's WV, or the
+/// calibration's empirical WV (at the levels both the window and it have), the model then
+/// giving the shape of a window's variance.
+///
+/// # Errors
+/// As [`monitor`]; [`ParamError`] for a reference WV of another rate or with a level that is
+/// not positive and finite.
+pub fn monitor_against(
+    x: &[f64],
+    freq_hz: f64,
+    model: &Model,
+    reference: Reference<'_>,
     opts: &MonitorOptions,
 ) -> Result<MonitorReport, Error> {
     check_alpha(opts.alpha)?;
@@ -247,12 +320,51 @@ pub fn monitor(
         )
         .into());
     }
+    if let Reference::Wv { classical: w, .. } = reference {
+        if ((w.freq_hz() - freq_hz) / freq_hz).abs() > 1e-6 {
+            return Err(ParamError::new(
+                "reference WV",
+                format!("at {} Hz", w.freq_hz()),
+                format!("the recording's rate, {freq_hz} Hz"),
+            )
+            .into());
+        }
+        levels = levels.min(w.levels());
+    }
     let implied = model.implied_wv(levels, freq_hz)?;
-    let nu = implied.wv.clone();
+    let model_wv = implied.wv.clone();
+    // the bands' centres (classical, robust) and the log-scale variances of those centres
+    // (docs/methods.md §16.6)
+    let none = vec![0.0; levels];
+    let ((nu, centre_var), (nu_r, centre_var_r)) = match reference {
+        Reference::Model => ((model_wv.clone(), none.clone()), (model_wv.clone(), none)),
+        Reference::Wv { classical, robust } => {
+            let c = centre(classical, levels)?;
+            let r = robust.map(|r| centre(r, levels)).transpose()?;
+            let mut out = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
+            for j in 0..levels {
+                let Some((v, var)) = c[j] else {
+                    return Err(ParamError::new(
+                        "reference WV",
+                        format!("level {}", j + 1),
+                        "a positive finite value with its interval",
+                    )
+                    .into());
+                };
+                let (vr, var_r) = r.as_ref().and_then(|r| r[j]).unwrap_or((v, var));
+                out.0 .0.push(v);
+                out.0 .1.push(var);
+                out.1 .0.push(vr);
+                out.1 .1.push(var_r);
+            }
+            out
+        }
+    };
+    let widened = |r: f64, var: f64| 2.0 / (2.0 / r + var);
     let (eta, exact_eta) = match exact_wv_covariance(model, big, freq_hz, levels) {
         Ok(v) => (
             (0..levels)
-                .map(|j| 2.0 * nu[j] * nu[j] / v[(j, j)])
+                .map(|j| 2.0 * model_wv[j] * model_wv[j] / v[(j, j)])
                 .collect::<Vec<f64>>(),
             true,
         ),
@@ -272,12 +384,12 @@ pub fn monitor(
     let mut c_low = Vec::with_capacity(levels);
     let mut c_high = Vec::with_capacity(levels);
     for j in 0..levels {
-        let e = eta[j];
+        let e = widened(eta[j], centre_var[j]);
         if e.is_finite() && e > 0.0 {
             c_low.push(nu[j] * chi_square_quantile(alpha_level / 2.0, e)? / e);
             c_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, e)? / e);
         }
-        let r = opts.robust.eff * eta[j];
+        let r = widened(opts.robust.eff * eta[j], centre_var_r[j]);
         if !(r.is_finite() && r > 0.0) {
             return Err(InputError::from(ParamError::new(
                 "model",
@@ -286,8 +398,8 @@ pub fn monitor(
             ))
             .into());
         }
-        band_low.push(nu[j] * chi_square_quantile(alpha_level / 2.0, r)? / r);
-        band_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, r)? / r);
+        band_low.push(nu_r[j] * chi_square_quantile(alpha_level / 2.0, r)? / r);
+        band_high.push(nu_r[j] * chi_square_quantile(1.0 - alpha_level / 2.0, r)? / r);
     }
     // window starts
     let mut starts: Vec<usize> = (0..)
@@ -315,7 +427,7 @@ pub fn monitor(
             let classical = wavelet_variance(part, freq_hz, &classical_opts)?
                 .wv()
                 .to_vec();
-            let check = |estimator, v: &[f64], lo: &[f64], hi: &[f64]| {
+            let check = |estimator, v: &[f64], lo: &[f64], hi: &[f64], nu: &[f64]| {
                 (0..levels)
                     .filter_map(|j| {
                         let side = if v[j] > hi[j] {
@@ -334,8 +446,8 @@ pub fn monitor(
                     })
                     .collect::<Vec<_>>()
             };
-            let mut out = check("robust", &values, &band_low, &band_high);
-            out.extend(check("classical", &classical, &c_low, &c_high));
+            let mut out = check("robust", &values, &band_low, &band_high, &nu_r);
+            out.extend(check("classical", &classical, &c_low, &c_high, &nu));
             Ok(MonitorWindow {
                 start: a,
                 end: a + big,
@@ -368,6 +480,12 @@ pub fn monitor(
     let flagged = windows.iter().filter(|w| w.flagged).count();
     Ok(MonitorReport {
         model: model.to_string(),
+        reference: match reference {
+            Reference::Model => "model",
+            Reference::Wv { .. } => "calibration WV",
+        },
+        reference_wv: nu,
+        robust_reference_wv: nu_r,
         freq_hz,
         window: big,
         step,
@@ -375,7 +493,7 @@ pub fn monitor(
         alpha_level,
         eff: opts.robust.eff,
         tau_s: implied.tau_s.clone(),
-        model_wv: nu,
+        model_wv,
         eta,
         band_low,
         band_high,

@@ -3,7 +3,7 @@
 //! windows at most.
 
 use gmwm::model::Model;
-use gmwm::monitor::{monitor, MonitorOptions};
+use gmwm::monitor::{monitor, monitor_against, MonitorOptions, Reference};
 use gmwm::sim::simulate_model;
 
 const MODEL: &str = "GM(beta=0.5, sigma2_gm=0.05)+WN(sigma2=1)+RW(gamma2=1e-7)";
@@ -113,4 +113,83 @@ fn monitor_refuses_bad_inputs() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("every parameter"), "{e}");
+}
+
+/// docs/methods.md §16.6: a model that misfits by a few percent at the fine scales (WN alone,
+/// where the truth adds a small fast GM) flags nearly every long window against its own WV,
+/// while against the calibration's empirical WV (from another, longer recording of the same
+/// process) at most alpha of the windows plus 3 binomial SE are flagged; and a step in
+/// variance is still flagged there.
+#[test]
+fn monitor_against_the_calibration_wv_ignores_model_misfit_and_keeps_faults() {
+    let truth = Model::parse("GM(beta=40, sigma2_gm=0.05)+WN(sigma2=1)").unwrap();
+    let misfit = Model::parse("WN(sigma2=1.05)").unwrap();
+    let reference = simulate_model(&truth, 1 << 22, 100.0, 21).unwrap();
+    let cal = gmwm::wavelet_variance(&reference, 100.0, &gmwm::WvOptions::default()).unwrap();
+    let robust_cal = gmwm::wavelet_variance(
+        &reference,
+        100.0,
+        &gmwm::WvOptions {
+            robust: Some(gmwm::RobustOptions::default()),
+            ..gmwm::WvOptions::default()
+        },
+    )
+    .unwrap();
+    let mut x = simulate_model(&truth, 1 << 20, 100.0, 22).unwrap();
+    let o = opts();
+    let against_model = monitor(&x, 100.0, &misfit, &o).unwrap();
+    let against_wv = |x: &[f64]| {
+        monitor_against(
+            x,
+            100.0,
+            &misfit,
+            Reference::Wv {
+                classical: &cal,
+                robust: Some(&robust_cal),
+            },
+            &o,
+        )
+        .unwrap()
+    };
+    let clean = against_wv(&x);
+    let w = clean.windows.len() as f64;
+    assert!(
+        against_model.flagged as f64 > 0.9 * w,
+        "against the misfit model: {} of {w}",
+        against_model.flagged
+    );
+    let bound = 0.05 * w + 3.0 * (0.05 * 0.95 * w).sqrt();
+    assert!(
+        (clean.flagged as f64) <= bound,
+        "against the calibration WV: {} of {w} flagged",
+        clean.flagged
+    );
+    assert_eq!(clean.reference, "calibration WV");
+    assert_eq!(clean.reference_wv[0], cal.wv()[0]);
+    // a variance step over 30000 samples is flagged in every window holding a quarter of it
+    let step = 500_000..530_000;
+    let extra = simulate_model(
+        &Model::parse("WN(sigma2=3)").unwrap(),
+        step.len(),
+        100.0,
+        23,
+    )
+    .unwrap();
+    for (t, e) in step.clone().zip(extra) {
+        x[t] += e;
+    }
+    let faulty = against_wv(&x);
+    for win in &faulty.windows {
+        let held = win
+            .end
+            .min(step.end)
+            .saturating_sub(win.start.max(step.start));
+        if held >= win.end - win.start || held >= (1 << 14) / 4 {
+            assert!(
+                win.flagged,
+                "window {}..{} holds {held} samples of the step",
+                win.start, win.end
+            );
+        }
+    }
 }

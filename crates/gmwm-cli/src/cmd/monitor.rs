@@ -9,7 +9,7 @@ use crate::render::Style;
 use anyhow::{Context, Result};
 use clap::Args;
 use gmwm::model::Model;
-use gmwm::monitor::{monitor, MonitorOptions, MonitorReport};
+use gmwm::monitor::{monitor_against, MonitorOptions, MonitorReport, Reference};
 use gmwm::units::SignalUnit;
 use serde::Serialize;
 use std::io::Write;
@@ -19,7 +19,10 @@ use std::path::PathBuf;
 pub const EXAMPLES: &str = "Each window's robust WV (docs/methods.md §2) is compared with the band the calibrated \
 model predicts for a window of that length (chi-square with the model's equivalent degrees of \
 freedom, Bonferroni over the levels); a window outside at some level is flagged. About --alpha \
-of the windows of a recording that follows the model are flagged by chance.\n\n\
+of the windows of a recording that follows the model are flagged by chance. Where the \
+calibration's verdict says the model misfits its WV, the windows are compared with that \
+empirical WV and its interval instead (--against auto, the default; docs/methods/multi-axis.md \
+§16.6): a misfit of a few percent would otherwise flag nearly every long window.\n\n\
 Examples:\n  gmwm calibrate imu.csv.gz --out-dir cal && gmwm monitor imu.csv.gz --model-from cal/imu.calibration.json\n  \
 gmwm monitor long.csv.gz --model-from cal/imu.calibration.json --columns gyro_x --window 600s --step 60s\n  \
 gmwm monitor long.csv.gz --model-from cal/imu.calibration.json --window 65536 --json";
@@ -49,9 +52,26 @@ pub struct MonitorArgs {
     /// Largest level tested [default: every level with M_j / 2^j >= 8].
     #[arg(long, value_name = "J")]
     pub levels: Option<usize>,
+    /// What each window is compared with: the calibrated model's WV (model), the calibration's
+    /// empirical WV with its interval (wv), or the model where the calibration's verdict says it
+    /// explains the WV and the empirical WV where it misfits (auto; docs/methods/multi-axis.md
+    /// §16.6).
+    #[arg(long, value_enum, default_value_t = Against::Auto)]
+    pub against: Against,
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,
+}
+
+/// `--against`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Against {
+    /// The model where it explains the calibration's WV, else that WV.
+    Auto,
+    /// The calibrated model's implied WV.
+    Model,
+    /// The calibration's empirical WV.
+    Wv,
 }
 
 /// A length given as samples or as a duration.
@@ -112,6 +132,8 @@ pub struct MonitorConfig {
     pub step: Option<Span>,
     /// Engine settings (window and step filled in once the rate is known).
     pub options: MonitorOptions,
+    /// `--against`.
+    pub against: Against,
     /// Table or JSON.
     pub output: OutputConfig,
 }
@@ -143,6 +165,7 @@ impl TryFrom<&MonitorArgs> for MonitorConfig {
                 levels: a.levels,
                 ..MonitorOptions::default()
             },
+            against: a.against,
             output: OutputConfig::from(&a.output),
         })
     }
@@ -154,6 +177,12 @@ struct CalibratedAxis {
     data_unit: Option<String>,
     unit: String,
     model: Model,
+    /// Its empirical WV (`wv`), in `unit`.
+    wv: Option<gmwm::WaveletVariance>,
+    /// Its robust WV (`contamination.robust`), when the calibration computed one.
+    robust_wv: Option<gmwm::WaveletVariance>,
+    /// Its verdict's `explains_wv`.
+    explains_wv: Option<bool>,
 }
 
 /// The rate and the per-axis models of a calibration JSON.
@@ -179,11 +208,26 @@ fn read_calibration(path: &std::path::Path) -> Result<(f64, Vec<CalibratedAxis>)
             .with_context(|| format!("{shown}: axis {column}: no fitted model (fit.model)"))?;
         let model = Model::parse(model_text)
             .with_context(|| format!("{shown}: axis {column}: fit.model {model_text:?}"))?;
+        let wv_at = |value: &serde_json::Value, what: &str| -> Result<_> {
+            match value {
+                serde_json::Value::Null => Ok(None),
+                w => Ok(Some(
+                    serde_json::from_value::<gmwm::WaveletVariance>(w.clone()).with_context(
+                        || format!("{shown}: axis {column}: {what} is not a wavelet variance"),
+                    )?,
+                )),
+            }
+        };
+        let wv = wv_at(&a["wv"], "wv")?;
+        let robust_wv = wv_at(&a["contamination"]["robust"], "contamination.robust")?;
         out.push(CalibratedAxis {
             column,
             data_unit: a["data_unit"].as_str().map(str::to_string),
             unit: a["unit"].as_str().unwrap_or_default().to_string(),
             model,
+            wv,
+            robust_wv,
+            explains_wv: a["verdict"]["explains_wv"].as_bool(),
         });
     }
     Ok((freq, out))
@@ -269,7 +313,23 @@ pub fn compute(config: &MonitorConfig) -> Result<Vec<AxisMonitor>> {
                 opts.window
             );
         }
-        let report = monitor(&x, freq, &cal.model, &opts)
+        let use_wv = match config.against {
+            Against::Model => false,
+            Against::Wv => true,
+            Against::Auto => cal.explains_wv == Some(false) && cal.wv.is_some(),
+        };
+        let reference = match (use_wv, &cal.wv) {
+            (false, _) => Reference::Model,
+            (true, Some(w)) => Reference::Wv {
+                classical: w,
+                robust: cal.robust_wv.as_ref(),
+            },
+            (true, None) => anyhow::bail!(
+                "{cal_shown}: axis {}: no empirical WV (wv) to monitor against: use --against model",
+                col.name
+            ),
+        };
+        let report = monitor_against(&x, freq, &cal.model, reference, &opts)
             .map_err(|e| anyhow::Error::new(e).context(format!("{file}: column {}", col.name)))?;
         let event_stamps = loaded.table.time.as_ref().map(|t| {
             let start = loaded
@@ -321,6 +381,14 @@ pub fn render(axes: &[AxisMonitor], style: Style, out: &mut impl Write) -> Resul
             r.alpha,
             r.alpha_level,
             r.model
+        )?;
+        writeln!(
+            out,
+            "  against {}",
+            match r.reference {
+                "model" => "the model's WV",
+                _ => "the calibration's empirical WV and its interval (--against model: the model's WV)",
+            }
         )?;
         writeln!(
             out,
