@@ -798,38 +798,12 @@ impl Calibration {
                     Some(_) => FitUses::Robust,
                     None => FitUses::Classical,
                 };
-                return match robust {
-                    Some(Ok(r)) => Some(compare_classical_robust(
-                        classical.wv().clone(),
-                        r.wv().clone(),
-                        uses,
-                        alpha,
-                    )),
-                    Some(Err(e)) => {
-                        notes.push(format!(
-                            "the classical and robust WVs could not be compared: {e}"
-                        ));
-                        None
-                    }
-                    None => None,
-                };
+                let robust = robust.as_ref().map(|r| r.as_ref().map(|p| p.wv()));
+                return compared(classical.wv(), robust, uses, alpha, notes);
             }
             AxisData::Streamed { robust, .. } => {
-                return match robust {
-                    Some(Ok(r)) => Some(compare_classical_robust(
-                        wv.clone(),
-                        (**r).clone(),
-                        FitUses::Classical,
-                        alpha,
-                    )),
-                    Some(Err(e)) => {
-                        notes.push(format!(
-                            "the classical and robust WVs could not be compared: {e}"
-                        ));
-                        None
-                    }
-                    None => None,
-                };
+                let robust = robust.as_ref().map(|r| r.as_ref().map(|w| &**w));
+                return compared(wv, robust, FitUses::Classical, alpha, notes);
             }
         };
         let other = WvOptions {
@@ -851,6 +825,31 @@ impl Calibration {
                 ));
                 None
             }
+        }
+    }
+}
+
+/// The contamination check of WVs computed before (streamed or pooled): `robust` is `None`
+/// when the check is off, an error text when the robust WV could not be computed (a note).
+fn compared(
+    classical: &WaveletVariance,
+    robust: Option<Result<&WaveletVariance, &String>>,
+    uses: FitUses,
+    alpha: f64,
+    notes: &mut Vec<String>,
+) -> Option<Contamination> {
+    match robust? {
+        Ok(r) => Some(compare_classical_robust(
+            classical.clone(),
+            r.clone(),
+            uses,
+            alpha,
+        )),
+        Err(e) => {
+            notes.push(format!(
+                "the classical and robust WVs could not be compared: {e}"
+            ));
+            None
         }
     }
 }
