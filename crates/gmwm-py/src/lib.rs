@@ -701,15 +701,17 @@ fn read<'py>(
 }
 
 /// The calibration of an IMU (the pipeline of `gmwm calibrate`), returning the
-/// `gmwm calibrate --json` document: of the recording at `path` (read as the CLI reads it), or
-/// of `arrays` named `names` with `units` at `freq`.
+/// `gmwm calibrate --json` document: of the recording at `path` (read as the CLI reads it), of
+/// `arrays` named `names` with `units` at `freq`, or of the recordings at `paths` calibrated as
+/// one sensor (`gmwm calibrate --pool`).
 #[pyfunction]
-#[pyo3(signature = (path=None, arrays=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, progress=None))]
+#[pyo3(signature = (path=None, arrays=None, paths=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn calibrate(
     py: Python<'_>,
     path: Option<PathBuf>,
     arrays: Option<Borrowed<'_>>,
+    paths: Option<Vec<PathBuf>>,
     names: Option<Vec<String>>,
     units: Option<Vec<Option<String>>>,
     freq: Option<f64>,
@@ -800,6 +802,51 @@ fn calibrate(
         total: AtomicUsize::new(0),
         reported: std::sync::Mutex::new(0),
     };
+    // several recordings of one sensor: each read as the CLI reads it, pooled
+    if let Some(paths) = paths {
+        if path.is_some() || arrays.is_some() {
+            return Err(err(
+                "give paths alone (a pooled calibration), or a path, or arrays",
+            ));
+        }
+        let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+        let opts = RecordingOptions { read, topic };
+        let recordings = py
+            .detach(|| {
+                paths
+                    .iter()
+                    .map(|p| Recording::open(p, &opts))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(engine)?;
+        let labels: Vec<String> = recordings
+            .iter()
+            .map(|r| r.path.display().to_string())
+            .collect();
+        let notes: Vec<String> = labels
+            .iter()
+            .zip(&recordings)
+            .flat_map(|(l, r)| r.notes.iter().map(move |n| format!("{l}: {n}")))
+            .collect();
+        let rostopic = rostopic.or_else(|| recordings.first().and_then(|r| r.topic.clone()));
+        let doc = py.detach(|| -> Result<String, gmwm::calib::CalibError> {
+            let named: Vec<(&str, &Imu)> = labels
+                .iter()
+                .zip(&recordings)
+                .map(|(l, r)| (l.as_str(), &r.imu))
+                .collect();
+            let report = Calibration::new(options).run_pooled_with_progress(&named, &reporter)?;
+            let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
+            let file = recordings
+                .first()
+                .map(|r| r.path.clone())
+                .unwrap_or_default();
+            Ok(json(&gmwm::document::calibration(
+                &file, &notes, None, &report, &sets,
+            )))
+        });
+        return doc.map_err(engine);
+    }
     // the recording: a file read as the CLI reads it, or the given columns
     let (imu, file, notes, topic_read, rows) = match (path, arrays) {
         (Some(path), None) => {

@@ -91,6 +91,25 @@ def test_calibrate_to_dict_is_the_cli_json():
     assert table.loc[0, "noise_density"] == cli["axes"][0]["noise_density"]["value"]
 
 
+def test_calibrate_pooled_is_the_cli_json():
+    second = ADIS.parent / "adis_16405_imu2.csv.gz"
+    py = gmwm.calibrate_pooled(
+        [str(ADIS), str(second)], columns=["gyro_x"], model="2*AR1()+WN()+RW()", bootstrap=10, G=2000
+    )
+    out = subprocess.run(
+        [str(GMWM_BIN), "calibrate", str(ADIS), str(second), "--pool", "--columns", "gyro_x",
+         "--model", "2*AR1()+WN()+RW()", "--bootstrap", "10", "--G", "2000", "--json", "-"],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert out.returncode == 0, out.stderr
+    cli = json.loads(out.stdout)
+    assert py.to_dict() == cli
+    assert [r["name"] for r in cli["recordings"]] == [str(ADIS), str(second)]
+    assert cli["samples"] == 2_000_000
+    with pytest.raises(gmwm.GmwmError, match="at least two"):
+        gmwm.calibrate_pooled([str(ADIS)], columns=["gyro_x"])
+
+
 # ---------------------------------------------------------------- arrays: dtypes and layouts
 
 

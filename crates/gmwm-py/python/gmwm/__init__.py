@@ -47,6 +47,7 @@ __all__ = [
     "fit",
     "select",
     "calibrate",
+    "calibrate_pooled",
     "calibrate_many",
     "read",
     "Recording",
@@ -248,6 +249,25 @@ def calibrate(
             arrays=arrays, names=cols, units=list(units) if units is not None else None,
             freq=rate, draws=G, progress=progress, **options,
         )
+    return CalibrationResult(json.loads(doc))
+
+
+def calibrate_pooled(
+    paths: Sequence[Union[str, "os.PathLike[str]"]],
+    *,
+    freq: Optional[float] = None,
+    G: Optional[int] = None,
+    progress: Progress = None,
+    **options,
+) -> CalibrationResult:
+    """One calibration of several recordings of one sensor (``gmwm calibrate FILE... --pool``,
+    docs/methods.md §5.12): their wavelet variances pooled level by level, the pipeline of
+    :func:`calibrate` on the pooled one. The result's ``recordings`` lists the inputs; each axis'
+    notes compare every recording with the others, scale by scale. Options as :func:`calibrate`
+    for a path."""
+    doc = _native.calibrate(
+        paths=[os.fspath(p) for p in paths], freq=freq, draws=G, progress=progress, **options
+    )
     return CalibrationResult(json.loads(doc))
 
 

@@ -47,7 +47,8 @@ def read(path: str, columns: Optional[Sequence[str]] = ..., freq: Optional[float
          ) -> Tuple[List[str], List[F64], Optional[float], List[Optional[str]], List[str]]:
     """A recording's columns as the CLI reads them: names, arrays, rate, units, notes."""
 
-def calibrate(path: Optional[str] = ..., arrays: Optional[Sequence[F64]] = ..., names: Optional[Sequence[str]] = ...,
+def calibrate(path: Optional[str] = ..., arrays: Optional[Sequence[F64]] = ...,
+              paths: Optional[Sequence[str]] = ..., names: Optional[Sequence[str]] = ...,
               units: Optional[Sequence[Optional[str]]] = ..., freq: Optional[float] = ...,
               columns: Optional[Sequence[str]] = ..., format: str = ..., ncols: Optional[int] = ...,
               header: str = ..., time_column: Optional[str] = ..., time_unit: Optional[str] = ...,
@@ -57,7 +58,8 @@ def calibrate(path: Optional[str] = ..., arrays: Optional[Sequence[F64]] = ..., 
               seed: int = ..., eff: float = ..., robust_convention: str = ..., robust: bool = ...,
               alpha: float = ..., axis_policy: str = ..., inflate: Optional[float] = ...,
               conservative: bool = ..., rostopic: Optional[str] = ..., progress: Progress = ...) -> str:
-    """The calibration pipeline of `gmwm calibrate` on a recording or on arrays."""
+    """The calibration pipeline of `gmwm calibrate` on a recording, on arrays, or on several
+    recordings of one sensor (`paths`: `gmwm calibrate --pool`)."""
 
 def copies() -> int:
     """Columns copied so far because they were not contiguous float64."""
