@@ -415,3 +415,24 @@ fn fuzz_regression_wv_json_unknown_variant_one_line() {
     let s = e.to_string();
     assert!(!s.contains('\n') && s.contains("x.json"), "{s}");
 }
+
+/// The `mcap` fuzzer's crash (long run, 2026-11-24, 0.93 M executions): a topic named with a
+/// newline went raw into the "index counts N messages on TOPIC" reason of a corrupt file; the
+/// topic is now quoted there, and every corrupt-file reason is escaped when displayed.
+#[test]
+fn fuzz_regression_index_count_topic_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.mcap");
+    std::fs::write(&path, fixture("mcap", "index_count_topic_newline")).unwrap();
+    // two IMU topics: the fuzz target reads each by name
+    let e = gmwm::imu::ros::read_imu_messages(&path, Some("/i\nu0")).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            gmwm::imu::ReadError::Ros(gmwm::imu::ros::RosError::Corrupt { .. })
+        ),
+        "{e:?}"
+    );
+    let s = one_line(&e);
+    assert!(s.contains("the index counts 2 messages on /i\\nu0"), "{s}");
+}

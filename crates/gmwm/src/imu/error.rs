@@ -18,6 +18,12 @@ pub fn quote(text: &str) -> String {
     escaped(text, QUOTE_MAX)
 }
 
+/// `text` with control characters (and U+FFFD) escaped, whole: for a message of the engine's
+/// own that may hold text from a file.
+pub(crate) fn escape_control(text: &str) -> String {
+    escaped(text, usize::MAX)
+}
+
 /// `text` with control characters (and U+FFFD) escaped, cut to `max` characters with `...`
 /// appended.
 fn escaped(text: &str, max: usize) -> String {

@@ -7,7 +7,7 @@
 //! for linear_acceleration (needs 196)`.
 
 use super::RosContainer;
-use crate::imu::error::escape_name;
+use crate::imu::error::{escape_control, escape_name};
 use std::fmt;
 use std::path::PathBuf;
 use thiserror::Error;
@@ -28,7 +28,7 @@ pub enum RosError {
         expected: String,
     },
     /// The container's structure is broken: cut short, or a record/index is inconsistent.
-    #[error("{}: corrupt or truncated {container}: {reason}", .path.display())]
+    #[error("{}: corrupt or truncated {container}: {}", .path.display(), escape_control(.reason))]
     Corrupt {
         /// Storage file.
         path: PathBuf,

@@ -811,7 +811,9 @@ pub(crate) fn read_topic<'s>(
             container: source.container,
             reason: format!(
                 "the index counts {} messages on {}, the data holds {}",
-                chosen.messages, chosen.topic, out.count
+                chosen.messages,
+                crate::imu::quote(&chosen.topic),
+                out.count
             ),
         }
         .into());
