@@ -328,12 +328,12 @@ fn recording_agreement(
             Some(worst) => {
                 let verdict = if outside.len() > allowed {
                     differing += 1;
-                    "differs from"
+                    "differs from the other recordings'"
                 } else {
-                    "agrees (within chance) with"
+                    "agrees with the other recordings' within chance: it differs"
                 };
                 format!(
-                    "recording {name}: its WV {verdict} the other recordings' at {} of {} scales ({level} level), the largest difference {:+.0}% at {} s (z = {:.1})",
+                    "recording {name}: its WV {verdict} at {} of {} scales ({level} level), the largest difference {:+.0}% at {} s (z = {:.1})",
                     outside.len(),
                     scales.len(),
                     100.0 * worst.log_ratio.exp_m1(),
