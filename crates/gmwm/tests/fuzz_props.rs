@@ -436,3 +436,17 @@ fn fuzz_regression_index_count_topic_escaped() {
     let s = one_line(&e);
     assert!(s.contains("the index counts 2 messages on /i\\nu0"), "{s}");
 }
+
+/// The `mcap` fuzzer's crash (long run, 2026-11-24, 2.58 M executions): a chunk record in the
+/// summary section, holding a record longer than the chunk, made the `mcap` crate's remaining
+/// count underflow (a panic with overflow checks, a wrapped count without). The summary is now
+/// walked first and a chunk there refused.
+#[test]
+fn fuzz_regression_chunk_in_summary_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.mcap");
+    std::fs::write(&path, fixture("mcap", "chunk_in_summary_overflow")).unwrap();
+    let e = gmwm::imu::ros::list_topics(&path).unwrap_err();
+    let s = one_line(&e);
+    assert!(s.contains("summary section: a chunk record at byte"), "{s}");
+}

@@ -252,10 +252,61 @@ impl Scan {
     }
 }
 
+/// Footer record: opcode, length, `summary_start`, `summary_offset_start`, `summary_crc`.
+const FOOTER_LEN: usize = 1 + 8 + 8 + 8 + 4;
+
+/// Refuses a summary section holding a chunk record before the `mcap` crate reads it. The
+/// format puts only schemas, channels, indexes, statistics and offsets there; the crate's
+/// summary reader opens a chunk found there anyway, and a record inside it longer than the
+/// chunk makes its remaining count underflow (`mcap` 0.26.0, `linear_reader.rs:745`; the `mcap`
+/// fuzzer's long run). Footers and records this walk cannot follow are left to the crate,
+/// which reports them.
+fn check_summary_records(file: &StorageFile) -> Result<(), ReadError> {
+    let len = file.len();
+    let m = mcap::MAGIC.len();
+    let Some(footer) = len.checked_sub(m + FOOTER_LEN).filter(|&f| f >= m) else {
+        return Ok(());
+    };
+    let mut buf = [0u8; FOOTER_LEN];
+    file.read_into(footer, &mut buf)?;
+    if buf[0] != op::FOOTER {
+        return Ok(());
+    }
+    let u64_at = |b: &[u8]| u64::from_le_bytes(b.try_into().expect("8 bytes"));
+    let Ok(mut pos) = usize::try_from(u64_at(&buf[9..17])) else {
+        return Ok(());
+    };
+    if pos == 0 {
+        return Ok(());
+    }
+    let mut header = [0u8; 9];
+    while pos < footer && footer - pos >= header.len() {
+        file.read_into(pos, &mut header)?;
+        if header[0] == op::CHUNK {
+            return Err(corrupt(
+                file.path(),
+                format!(
+                    "summary section: a chunk record at byte {pos} (the summary holds only schemas, channels, indexes and statistics)"
+                ),
+            )
+            .into());
+        }
+        match usize::try_from(u64_at(&header[1..9]))
+            .ok()
+            .and_then(|n| pos.checked_add(header.len())?.checked_add(n))
+        {
+            Some(next) => pos = next,
+            None => break,
+        }
+    }
+    Ok(())
+}
+
 /// The summary section, if the file has one: the `mcap` crate's summary reader fed by
 /// positioned reads of the file as opened (reads stop at its size then, as a read of the whole
 /// file would).
 fn summary(file: &StorageFile) -> Result<Option<mcap::Summary>, ReadError> {
+    check_summary_records(file)?;
     let path = file.path();
     let len = file.len() as u64;
     let fail = |e: mcap::McapError| -> ReadError {
