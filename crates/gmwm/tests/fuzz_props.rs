@@ -450,3 +450,24 @@ fn fuzz_regression_chunk_in_summary_refused() {
     let s = one_line(&e);
     assert!(s.contains("summary section: a chunk record at byte"), "{s}");
 }
+
+/// The `mcap` fuzzer's crash (long run, 2026-11-24, 5.15 M executions): statistics whose
+/// per-channel message counts sum beyond `u64::MAX` overflowed the count of messages on other
+/// topics (a panic with overflow checks); the counts are now summed saturating, and the read
+/// ends in an error naming the file, not a panic.
+#[test]
+fn fuzz_regression_message_counts_sum_saturates() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.mcap");
+    std::fs::write(&path, fixture("mcap", "message_counts_overflow")).unwrap();
+    let (_, topics) = gmwm::imu::ros::list_topics(&path).unwrap();
+    let total = topics
+        .iter()
+        .fold(0u64, |n, t| n.saturating_add(t.messages));
+    assert_eq!(total, u64::MAX, "{topics:?}");
+    for t in topics.iter().filter(|t| t.is_imu()) {
+        if let Err(e) = gmwm::imu::ros::read_imu_messages(&path, Some(&t.topic)) {
+            one_line(&e);
+        }
+    }
+}

@@ -643,7 +643,7 @@ fn merged_topics(opened: &[Opened]) -> Vec<TopicInfo> {
                 .iter_mut()
                 .find(|t| t.topic == topic && t.message_type == message_type)
             {
-                Some(t) => t.messages += messages,
+                Some(t) => t.messages = t.messages.saturating_add(messages),
                 None => topics.push(TopicInfo {
                     topic: topic.to_owned(),
                     message_type: message_type.to_owned(),
@@ -823,10 +823,10 @@ pub(crate) fn read_topic<'s>(
         topic: chosen.topic.clone(),
         frame_id: out.frame_id,
         messages: chosen.messages,
+        // counts from the file's index or statistics: summed without overflow
         other_messages: topics
             .iter()
-            .map(|t| t.messages)
-            .sum::<u64>()
+            .fold(0u64, |n, t| n.saturating_add(t.messages))
             .saturating_sub(chosen.messages),
     })
 }
