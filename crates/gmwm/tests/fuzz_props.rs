@@ -471,3 +471,19 @@ fn fuzz_regression_message_counts_sum_saturates() {
         }
     }
 }
+
+/// The `mcap` fuzzer's crash (CI's short run, 2026-11-24): a compressed chunk declaring
+/// `u64::MAX` uncompressed bytes overflowed the decoder's read limit (size + 1, a panic with
+/// overflow checks); the limit now saturates and the chunk is refused by its size check.
+#[test]
+fn fuzz_regression_declared_size_max() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.mcap");
+    std::fs::write(&path, fixture("mcap", "declared_size_max")).unwrap();
+    if let Err(e) = gmwm::imu::ros::list_topics(&path) {
+        one_line(&e);
+    }
+    if let Err(e) = gmwm::imu::ros::read_imu_messages(&path, None) {
+        one_line(&e);
+    }
+}

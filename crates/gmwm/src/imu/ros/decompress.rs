@@ -39,7 +39,9 @@ impl Decompressor {
         dst.clear();
         // the declared size is data: never reserve more than a generous ratio of the input
         dst.reserve(size.min(src.len().saturating_mul(1024).max(MIN_RESERVE)));
-        let limit = size as u64 + 1;
+        // one byte beyond the declared size shows a stream that is longer (a declared size of
+        // u64::MAX from the file reads to the end of the stream)
+        let limit = (size as u64).saturating_add(1);
         let res = match codec {
             Codec::Lz4 => lz4_flex::frame::FrameDecoder::new(src)
                 .take(limit)
