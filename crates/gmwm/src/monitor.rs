@@ -165,18 +165,16 @@ pub enum Reference<'a> {
 }
 
 /// The centre of a band at each level and the variance of its logarithm (docs/methods.md
-/// §16.6): `w`'s value and `(ln(hi / lo) / (2 z))^2` at the first `levels` levels, `None` at a
-/// level where `w` has no positive finite value and interval.
-fn centre(w: &WaveletVariance, levels: usize) -> Result<Vec<Option<(f64, f64)>>, Error> {
-    let z =
-        crate::inference::asymptotic::z_value(w.alpha(), crate::inference::ZConvention::TwoSided)?;
-    Ok((0..levels)
+/// §16.6): `w`'s value and [`WaveletVariance::log_variance`] at the first `levels` levels,
+/// `None` at a level where `w` has no positive finite value or degrees of freedom.
+fn centre(w: &WaveletVariance, levels: usize) -> Vec<Option<(f64, f64)>> {
+    let log_var = w.log_variance();
+    (0..levels)
         .map(|j| {
-            let (v, lo, hi) = (*w.wv().get(j)?, *w.ci_low().get(j)?, *w.ci_high().get(j)?);
-            (v.is_finite() && v > 0.0 && lo > 0.0 && hi.is_finite() && hi >= lo)
-                .then(|| (v, ((hi / lo).ln() / (2.0 * z)).powi(2)))
+            let (v, var) = (*w.wv().get(j)?, *log_var.get(j)?);
+            (v.is_finite() && v > 0.0 && var.is_finite() && var > 0.0).then_some((v, var))
         })
-        .collect())
+        .collect()
 }
 
 /// Result of [`monitor`] for one series.
@@ -339,15 +337,15 @@ pub fn monitor_against(
     let ((nu, centre_var), (nu_r, centre_var_r)) = match reference {
         Reference::Model => ((model_wv.clone(), none.clone()), (model_wv.clone(), none)),
         Reference::Wv { classical, robust } => {
-            let c = centre(classical, levels)?;
-            let r = robust.map(|r| centre(r, levels)).transpose()?;
+            let c = centre(classical, levels);
+            let r = robust.map(|r| centre(r, levels));
             let mut out = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
             for j in 0..levels {
                 let Some((v, var)) = c[j] else {
                     return Err(ParamError::new(
                         "reference WV",
                         format!("level {}", j + 1),
-                        "a positive finite value with its interval",
+                        "a positive finite value with positive degrees of freedom (eta)",
                     )
                     .into());
                 };
