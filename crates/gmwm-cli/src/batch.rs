@@ -450,9 +450,10 @@ fn run_one(config: &BatchConfig, p: &Planned) -> Outcome {
         BatchJob::Calibrate { config: c, .. } => calibrate_one(c, p, config.force),
         BatchJob::Wv { config: c, .. } => wv_one(c, p, config.force),
     }))
-    .unwrap_or_else(|_| {
+    .unwrap_or_else(|payload| {
         Err(anyhow::anyhow!(
-            "internal error (a panic; please report it)"
+            "internal error: {} (a bug: please report it with the command and this input)",
+            crate::panic::report(payload.as_ref())
         ))
     });
     match result {

@@ -10,6 +10,7 @@ mod cmd;
 mod config;
 mod input;
 mod output;
+mod panic;
 mod progress;
 mod render;
 mod spool;
@@ -376,11 +377,23 @@ fn parse() -> Result<Cli, ExitCode> {
 }
 
 fn main() -> ExitCode {
+    panic::install();
     let cli = match parse() {
         Ok(cli) => cli,
         Err(code) => return code,
     };
-    match run(&cli) {
+    let result = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&cli))) {
+        Ok(result) => result,
+        Err(payload) => {
+            eprintln!(
+                "gmwm: internal error: {} (a bug: please report it with the command and its input)",
+                spool::shown(&panic::report(payload.as_ref()))
+            );
+            // Rust's own exit code for a panic
+            return ExitCode::from(101);
+        }
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {

@@ -451,6 +451,27 @@ fn fuzz_regression_chunk_in_summary_refused() {
     assert!(s.contains("summary section: a chunk record at byte"), "{s}");
 }
 
+/// The `mcap` fuzzer's crash (long run, 2026-11-24 second session, 1.53 M executions): an
+/// attachment record in the summary section with fewer than 4 bytes after its header for the
+/// CRC made the `mcap` crate slice out of bounds (0.26.0, `read.rs:176`). The summary walk
+/// now refuses attachments there too (the format keeps them in the data section).
+#[test]
+fn fuzz_regression_attachment_in_summary_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("x.mcap");
+    std::fs::write(&path, fixture("mcap", "attachment_in_summary_short")).unwrap();
+    let e = gmwm::imu::ros::list_topics(&path).unwrap_err();
+    let s = one_line(&e);
+    assert!(
+        s.contains("summary section: an attachment record at byte"),
+        "{s}"
+    );
+    assert!(
+        !s.contains("mcap crate"),
+        "refused before the crate reads it: {s}"
+    );
+}
+
 /// The `mcap` fuzzer's crash (long run, 2026-11-24, 5.15 M executions): statistics whose
 /// per-channel message counts sum beyond `u64::MAX` overflowed the count of messages on other
 /// topics (a panic with overflow checks); the counts are now summed saturating, and the read

@@ -54,6 +54,48 @@ fn describe(e: &mcap::McapError) -> String {
     }
 }
 
+/// Runs `read`, a use of the `mcap` crate, and turns a panic inside it into a corrupt-file
+/// error naming `what` was read. The crate's readers have had arithmetic bugs on crafted files
+/// (0.26.0: an underflow in its linear reader, docs in `check_summary_records`); the workspace
+/// builds the crate with overflow checks in release too (Cargo.toml), so another such bug stops
+/// here as a panic, where unchecked arithmetic would wrap into a bogus length. Our own code
+/// inside `read` is not expected to panic; the fuzz targets abort on any panic (libFuzzer's
+/// hook), so the guard hides nothing from them.
+fn guarded<T>(
+    path: &Path,
+    what: &dyn Fn() -> String,
+    read: impl FnOnce() -> Result<T, ReadError>,
+) -> Result<T, ReadError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)).unwrap_or_else(|payload| {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "no message".to_string());
+        Err(corrupt(
+            path,
+            format!(
+                "{}: the mcap crate's reader failed on it ({message})",
+                what()
+            ),
+        )
+        .into())
+    })
+}
+
+/// One record parsed by the `mcap` crate ([`guarded`]); `at` says where it is for an error.
+fn parse<'a>(
+    path: &Path,
+    opcode: u8,
+    body: &'a [u8],
+    at: &dyn Fn() -> String,
+) -> Result<Record<'a>, ReadError> {
+    guarded(path, at, || {
+        mcap::parse_record(opcode, body)
+            .map_err(|e| corrupt(path, format!("{}: {}", at(), describe(&e))).into())
+    })
+}
+
 /// Checks both magics (a file without the end magic was cut short or never closed).
 fn check_magic(file: &mut StorageFile) -> Result<(), ReadError> {
     let path = file.path().to_path_buf();
@@ -152,12 +194,10 @@ fn chunk(
     buf: &mut Vec<u8>,
     visit: &mut ChunkVisitor<'_>,
 ) -> Result<(), ReadError> {
-    let (header, data) = match mcap::parse_record(op::CHUNK, body) {
-        Ok(Record::Chunk { header, data }) => (header, data),
-        Ok(_) => return Err(corrupt(path, format!("chunk at byte {offset}: not a chunk")).into()),
-        Err(e) => {
-            return Err(corrupt(path, format!("chunk at byte {offset}: {}", describe(&e))).into())
-        }
+    let at = || format!("chunk at byte {offset}");
+    let (header, data) = match parse(path, op::CHUNK, body, &at)? {
+        Record::Chunk { header, data } => (header, data),
+        _ => return Err(corrupt(path, format!("{}: not a chunk", at())).into()),
     };
     let codec = match header.compression.as_str() {
         "" => None,
@@ -222,10 +262,7 @@ struct Scan {
 
 impl Scan {
     fn record(&mut self, path: &Path, opcode: u8, body: &[u8], at: &str) -> Result<(), ReadError> {
-        let parse = || {
-            mcap::parse_record(opcode, body)
-                .map_err(|e| corrupt(path, format!("{at}: {}", describe(&e))))
-        };
+        let parse = || parse(path, opcode, body, &|| at.to_string());
         match opcode {
             op::SCHEMA => {
                 if let Record::Schema { header, .. } = parse()? {
@@ -255,11 +292,13 @@ impl Scan {
 /// Footer record: opcode, length, `summary_start`, `summary_offset_start`, `summary_crc`.
 const FOOTER_LEN: usize = 1 + 8 + 8 + 8 + 4;
 
-/// Refuses a summary section holding a chunk record before the `mcap` crate reads it. The
-/// format puts only schemas, channels, indexes, statistics and offsets there; the crate's
-/// summary reader opens a chunk found there anyway, and a record inside it longer than the
-/// chunk makes its remaining count underflow (`mcap` 0.26.0, `linear_reader.rs:745`; the `mcap`
-/// fuzzer's long run). Footers and records this walk cannot follow are left to the crate,
+/// Refuses a summary section holding a chunk or an attachment record before the `mcap` crate
+/// reads it. The format keeps both in the data section; the summary holds only schemas,
+/// channels, indexes and statistics. The crate's summary reader parses them there anyway, and
+/// both have crashed it (`mcap` 0.26.0, the `mcap` fuzzer's long runs): a record inside a chunk
+/// longer than the chunk makes its remaining count underflow (`linear_reader.rs:745`), and an
+/// attachment with fewer than 4 bytes left for its CRC after its header makes it slice out of
+/// bounds (`read.rs:176`). Footers and records this walk cannot follow are left to the crate,
 /// which reports them.
 fn check_summary_records(file: &StorageFile) -> Result<(), ReadError> {
     let len = file.len();
@@ -282,11 +321,16 @@ fn check_summary_records(file: &StorageFile) -> Result<(), ReadError> {
     let mut header = [0u8; 9];
     while pos < footer && footer - pos >= header.len() {
         file.read_into(pos, &mut header)?;
-        if header[0] == op::CHUNK {
+        let misplaced = match header[0] {
+            op::CHUNK => Some("a chunk"),
+            op::ATTACHMENT => Some("an attachment"),
+            _ => None,
+        };
+        if let Some(record) = misplaced {
             return Err(corrupt(
                 file.path(),
                 format!(
-                    "summary section: a chunk record at byte {pos} (the summary holds only schemas, channels, indexes and statistics)"
+                    "summary section: {record} record at byte {pos} (the format keeps it in the data section; the summary holds only schemas, channels, indexes and statistics)"
                 ),
             )
             .into());
@@ -307,6 +351,13 @@ fn check_summary_records(file: &StorageFile) -> Result<(), ReadError> {
 /// file would).
 fn summary(file: &StorageFile) -> Result<Option<mcap::Summary>, ReadError> {
     check_summary_records(file)?;
+    guarded(file.path(), &|| "summary section".to_string(), || {
+        crate_summary(file)
+    })
+}
+
+/// [`summary`] as the `mcap` crate's summary reader gives it, unguarded.
+fn crate_summary(file: &StorageFile) -> Result<Option<mcap::Summary>, ReadError> {
     let path = file.path();
     let len = file.len() as u64;
     let fail = |e: mcap::McapError| -> ReadError {
@@ -434,10 +485,9 @@ pub(crate) fn read(
         let Some(&encoding) = wanted.get(&id) else {
             return Ok(());
         };
-        let (header, data) = match mcap::parse_record(op::MESSAGE, body) {
-            Ok(Record::Message { header, data }) => (header, data),
-            Ok(_) => return Err(corrupt(path, format!("{}: not a message", at())).into()),
-            Err(e) => return Err(corrupt(path, format!("{}: {}", at(), describe(&e))).into()),
+        let (header, data) = match parse(path, op::MESSAGE, body, at)? {
+            Record::Message { header, data } => (header, data),
+            _ => return Err(corrupt(path, format!("{}: not a message", at())).into()),
         };
         let log_time = i64::try_from(header.log_time).map_err(|_| {
             corrupt(
@@ -532,4 +582,33 @@ pub(crate) fn read(
             }
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The guard meets a real bug of the `mcap` crate: its summary reader, fed a chunk in the
+    /// summary section (the fuzzer's `chunk_in_summary_overflow`) without our check before it,
+    /// underflows (0.26.0). Tests build with overflow checks, as release builds the crate
+    /// (Cargo.toml), so it panics; the guard must return a corrupt-file error instead.
+    #[test]
+    fn a_panic_in_the_mcap_crate_becomes_a_corrupt_file_error() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures/fuzz/mcap/chunk_in_summary_overflow");
+        let file = StorageFile::open(&path).unwrap();
+        let err = guarded(&path, &|| "summary section".to_string(), || {
+            crate_summary(&file)
+        })
+        .unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.contains("summary section: the mcap crate's reader failed on it (attempt to subtract with overflow)"),
+            "{text}"
+        );
+        assert!(text.contains("chunk_in_summary_overflow"), "{text}");
+        // and the reader proper refuses it before the crate sees it
+        let text = summary(&file).unwrap_err().to_string();
+        assert!(!text.contains("mcap crate"), "{text}");
+    }
 }
