@@ -174,6 +174,15 @@ fn fixture(target: &str, name: &str) -> Vec<u8> {
     std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
+/// A fixture written to a temporary file named `file_name` (the readers choose a container by
+/// its extension); the directory lives as long as the guard returned with the path.
+fn fixture_file(target: &str, name: &str, file_name: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(file_name);
+    std::fs::write(&path, fixture(target, name)).unwrap();
+    (dir, path)
+}
+
 /// Writes `files` into a fresh directory and reads the first one with `opts`.
 fn read_files(
     files: &[(&str, &[u8])],
@@ -306,9 +315,7 @@ fn fuzz_regression_gap_count_overflows() {
 /// A corrupt rosbag2 sqlite3 schema: SQLite's message quotes the schema, newlines and all.
 #[test]
 fn fuzz_regression_sqlite_message_one_line() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.db3");
-    std::fs::write(&path, fixture("db3", "sqlite_message_multiline")).unwrap();
+    let (_dir, path) = fixture_file("db3", "sqlite_message_multiline", "x.db3");
     let e = gmwm::imu::ros::list_topics(&path).unwrap_err();
     assert!(one_line(&e).contains("malformed database schema"), "{e}");
 }
@@ -317,9 +324,7 @@ fn fuzz_regression_sqlite_message_one_line() {
 /// the message definition): the topic list in the error was printed raw.
 #[test]
 fn fuzz_regression_topic_names_escaped() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.bag");
-    std::fs::write(&path, fixture("ros1_bag", "topic_type_control_chars")).unwrap();
+    let (_dir, path) = fixture_file("ros1_bag", "topic_type_control_chars", "x.bag");
     let e = gmwm::imu::ros::read_imu_messages(&path, None).unwrap_err();
     let s = one_line(&e);
     assert!(s.contains("\\0"), "{s}");
@@ -329,9 +334,7 @@ fn fuzz_regression_topic_names_escaped() {
 /// the unsupported-compression error printed it raw, over several lines.
 #[test]
 fn fuzz_regression_chunk_compression_escaped() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.mcap");
-    std::fs::write(&path, fixture("mcap", "chunk_compression_newline")).unwrap();
+    let (_dir, path) = fixture_file("mcap", "chunk_compression_newline", "x.mcap");
     let e = gmwm::imu::ros::read_imu_messages(&path, None).unwrap_err();
     assert!(
         matches!(
@@ -349,9 +352,7 @@ fn fuzz_regression_chunk_compression_escaped() {
 /// topic and the frame are now escaped.
 #[test]
 fn fuzz_regression_topic_name_escaped_in_notes() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.db3");
-    std::fs::write(&path, fixture("db3", "topic_name_newlines")).unwrap();
+    let (_dir, path) = fixture_file("db3", "topic_name_newlines", "x.db3");
     let rec = gmwm::imu::Recording::open(&path, &Default::default()).unwrap();
     for n in &rec.notes {
         assert!(!n.contains('\n') && !n.contains('\t'), "{n:?}");
@@ -406,9 +407,7 @@ fn fuzz_regression_long_gm_run_round_trips() {
 /// the variant unescaped, and the error was printed on two lines.
 #[test]
 fn fuzz_regression_wv_json_unknown_variant_one_line() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.json");
-    std::fs::write(&path, fixture("wv_json", "unknown_variant_with_newline")).unwrap();
+    let (_dir, path) = fixture_file("wv_json", "unknown_variant_with_newline", "x.json");
     let e = gmwm::imu::read_wv_json(&path, None).unwrap_err();
     assert!(matches!(e, gmwm::imu::ReadError::WvJson { .. }), "{e:?}");
     // one line whichever stage of the JSON reading refuses it
@@ -421,9 +420,7 @@ fn fuzz_regression_wv_json_unknown_variant_one_line() {
 /// topic is now quoted there, and every corrupt-file reason is escaped when displayed.
 #[test]
 fn fuzz_regression_index_count_topic_escaped() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.mcap");
-    std::fs::write(&path, fixture("mcap", "index_count_topic_newline")).unwrap();
+    let (_dir, path) = fixture_file("mcap", "index_count_topic_newline", "x.mcap");
     // two IMU topics: the fuzz target reads each by name
     let e = gmwm::imu::ros::read_imu_messages(&path, Some("/i\nu0")).unwrap_err();
     assert!(
@@ -443,9 +440,7 @@ fn fuzz_regression_index_count_topic_escaped() {
 /// walked first and a chunk there refused.
 #[test]
 fn fuzz_regression_chunk_in_summary_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.mcap");
-    std::fs::write(&path, fixture("mcap", "chunk_in_summary_overflow")).unwrap();
+    let (_dir, path) = fixture_file("mcap", "chunk_in_summary_overflow", "x.mcap");
     let e = gmwm::imu::ros::list_topics(&path).unwrap_err();
     let s = one_line(&e);
     assert!(s.contains("summary section: a chunk record at byte"), "{s}");
@@ -457,9 +452,7 @@ fn fuzz_regression_chunk_in_summary_refused() {
 /// now refuses attachments there too (the format keeps them in the data section).
 #[test]
 fn fuzz_regression_attachment_in_summary_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.mcap");
-    std::fs::write(&path, fixture("mcap", "attachment_in_summary_short")).unwrap();
+    let (_dir, path) = fixture_file("mcap", "attachment_in_summary_short", "x.mcap");
     let e = gmwm::imu::ros::list_topics(&path).unwrap_err();
     let s = one_line(&e);
     assert!(
@@ -478,9 +471,7 @@ fn fuzz_regression_attachment_in_summary_refused() {
 /// ends in an error naming the file, not a panic.
 #[test]
 fn fuzz_regression_message_counts_sum_saturates() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.mcap");
-    std::fs::write(&path, fixture("mcap", "message_counts_overflow")).unwrap();
+    let (_dir, path) = fixture_file("mcap", "message_counts_overflow", "x.mcap");
     let (_, topics) = gmwm::imu::ros::list_topics(&path).unwrap();
     let total = topics
         .iter()
@@ -498,9 +489,7 @@ fn fuzz_regression_message_counts_sum_saturates() {
 /// overflow checks); the limit now saturates and the chunk is refused by its size check.
 #[test]
 fn fuzz_regression_declared_size_max() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("x.mcap");
-    std::fs::write(&path, fixture("mcap", "declared_size_max")).unwrap();
+    let (_dir, path) = fixture_file("mcap", "declared_size_max", "x.mcap");
     if let Err(e) = gmwm::imu::ros::list_topics(&path) {
         one_line(&e);
     }
