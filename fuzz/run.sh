@@ -37,6 +37,9 @@ for t in "${targets[@]}"; do
   mkdir -p "$scratch/$t/corpus" "$scratch/$t/artifacts"
   log="$scratch/$t/$mode.log"
   start=$SECONDS
+  # the scratch directory outlives runs: count only what this run writes
+  stamp="$scratch/$t/.started"
+  touch "$stamp"
   # the seed corpus's largest input (a sqlite3 page set, a bag) sets the length bound
   max_len=$(( $(find "corpus/$t" -type f -printf '%s\n' | sort -n | tail -1) * 2 ))
   if [ "$max_len" -lt 4096 ]; then max_len=4096; fi
@@ -54,9 +57,11 @@ for t in "${targets[@]}"; do
   cov=$(grep -o 'cov: [0-9]*' <<<"$last" | grep -o '[0-9]*' || true)
   ft=$(grep -o 'ft: [0-9]*' <<<"$last" | grep -o '[0-9]*' || true)
   corpus=$(grep -o 'corp: [0-9]*/[0-9]*[a-zA-Z]*' <<<"$last" | cut -d' ' -f2 || true)
-  crashes=$(find "$scratch/$t/artifacts" -type f | wc -l)
+  crashes=$(find "$scratch/$t/artifacts" -type f -newer "$stamp" | wc -l)
+  earlier=$(find "$scratch/$t/artifacts" -type f ! -newer "$stamp" | wc -l)
   echo "$t: $result, ${execs:-?} executions, ${rate:-?} exec/s, cov ${cov:-?}, ft ${ft:-?}," \
-    "corpus ${corpus:-?}, ${crashes} crash/timeout/oom inputs, $((SECONDS - start)) s"
+    "corpus ${corpus:-?}, ${crashes} crash/timeout/oom inputs (${earlier} from earlier runs)," \
+    "$((SECONDS - start)) s"
   if [ "$result" != ok ]; then
     tail -n 40 "$log" >&2
     echo "fuzz target $t failed: input(s) in $scratch/$t/artifacts, log $log" >&2
