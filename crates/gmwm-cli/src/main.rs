@@ -382,18 +382,7 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(code) => return code,
     };
-    let result = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(&cli))) {
-        Ok(result) => result,
-        Err(payload) => {
-            eprintln!(
-                "gmwm: internal error: {} (a bug: please report it with the command and its input)",
-                spool::shown(&panic::report(payload.as_ref()))
-            );
-            // Rust's own exit code for a panic
-            return ExitCode::from(101);
-        }
-    };
-    match result {
+    match run(&cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {

@@ -1,17 +1,13 @@
-//! Panics as one line. A panic is a bug, never a verdict on the input, but its default report
-//! (two lines and a backtrace hint, printed where it happens) would also appear for the panics
-//! the engine catches and turns into errors (the MCAP reader's guard around the `mcap` crate).
-//! The hook only keeps the message and place; [`report`] gives them to whoever catches the
-//! panic at the top (`main`, a batch's recording), which prints one line. With `RUST_BACKTRACE`
-//! set the default report is printed as well.
+//! A panic as one line. A panic is a bug, never a verdict on the input; Rust's default report
+//! spreads it over two lines and a backtrace hint. The hook prints it where it happens (so no
+//! panic goes unsaid, whichever thread it is on) as one line, control characters escaped, and
+//! the process still ends with Rust's exit code for a panic, 101. With `RUST_BACKTRACE` set
+//! the default report follows, backtrace and all.
 
 use std::any::Any;
-use std::sync::Mutex;
 
-/// The last panic's message and place, kept by the hook.
-static LAST: Mutex<Option<String>> = Mutex::new(None);
-
-fn message(payload: &(dyn Any + Send)) -> &str {
+/// A panic's message (its payload when that is text).
+pub(crate) fn message(payload: &(dyn Any + Send)) -> &str {
     payload
         .downcast_ref::<&str>()
         .copied()
@@ -19,32 +15,47 @@ fn message(payload: &(dyn Any + Send)) -> &str {
         .unwrap_or("no message")
 }
 
-/// Installs the hook (once, first thing in `main`).
+/// `message` on one line: runs of white space as one space, other control characters escaped.
+pub(crate) fn one_line(message: &str) -> String {
+    let mut text = String::new();
+    for c in message
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+        .chars()
+    {
+        if c.is_control() {
+            text.extend(c.escape_default());
+        } else {
+            text.push(c);
+        }
+    }
+    text
+}
+
+/// The line the hook prints for a panic with `message` at `place` (`FILE:LINE`).
+fn line(place: Option<String>, message: &str) -> String {
+    let place = place.map(|p| format!(" at {p}")).unwrap_or_default();
+    format!(
+        "gmwm: internal error: panicked{place}: {} (a bug: please report it with the command \
+         and its input)",
+        one_line(message)
+    )
+}
+
+/// Installs the hook (first thing in `main`).
 pub(crate) fn install() {
     let default = std::panic::take_hook();
     let backtrace = std::env::var_os("RUST_BACKTRACE").is_some_and(|v| v != "0");
     std::panic::set_hook(Box::new(move |info| {
         let place = info
             .location()
-            .map(|l| format!(" at {}:{}", l.file(), l.line()))
-            .unwrap_or_default();
-        let line = format!("panicked{place}: {}", message(info.payload()));
-        *LAST.lock().unwrap_or_else(|e| e.into_inner()) = Some(line);
+            .map(|l| format!("{}:{}", l.file(), l.line()));
+        eprintln!("{}", line(place, message(info.payload())));
         if backtrace {
             default(info);
         }
     }));
-}
-
-/// What a caught panic says, on one line, with its place when the hook kept it: "panicked at
-/// FILE:LINE: MESSAGE".
-pub(crate) fn report(payload: &(dyn Any + Send)) -> String {
-    let text = LAST
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .take()
-        .unwrap_or_else(|| format!("panicked: {}", message(payload)));
-    text.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 #[cfg(test)]
@@ -52,19 +63,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_caught_panic_reads_as_one_line_with_its_place() {
-        install();
-        let line = line!() + 1;
-        let caught = std::panic::catch_unwind(|| panic!("boom\n  on a second line"));
-        // back to the default hook, for the other tests of this binary
-        drop(std::panic::take_hook());
-        let text = report(caught.unwrap_err().as_ref());
+    fn a_panic_reads_as_one_line_with_its_place() {
+        let text = line(
+            Some("src/x.rs:7".into()),
+            "index 9 out of range\n  for slice\u{1b}[31m of length 3",
+        );
         assert_eq!(
             text,
-            format!("panicked at crates/gmwm-cli/src/panic.rs:{line}: boom on a second line")
+            "gmwm: internal error: panicked at src/x.rs:7: index 9 out of range for \
+             slice\\u{1b}[31m of length 3 (a bug: please report it with the command and its input)"
         );
-        // taken: a later report without a hook falls back on the payload
-        let payload: Box<dyn Any + Send> = Box::new("plain");
-        assert_eq!(report(payload.as_ref()), "panicked: plain");
+        let payload: Box<dyn Any + Send> = Box::new(String::from("owned"));
+        assert_eq!(message(payload.as_ref()), "owned");
+        let payload: Box<dyn Any + Send> = Box::new(7_u8);
+        assert_eq!(message(payload.as_ref()), "no message");
     }
 }

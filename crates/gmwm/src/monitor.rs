@@ -43,10 +43,10 @@
 //! thousands, so nearly every window is flagged for the misfit, not for a fault.
 //! [`monitor_against`] with [`Reference::Wv`] centres each band on the calibration's empirical
 //! WV instead (the robust band on its robust WV, which on contaminated data lies below the
-//! classical one) and widens it by that WV's own uncertainty: with `s2_j = (ln(hi_j / lo_j) /
-//! (2 z))^2` the variance of `ln nu2_hat_j` from its `1 - alpha_c` interval (`z` its normal
-//! quantile, as §7.7), and `2 / r` that of a window's `ln WV`, the band uses the degrees of
-//! freedom `r' = 2 / (2 / r + s2_j)` of their sum. The model still gives the shape of the
+//! classical one) and widens it by that WV's own uncertainty: with `s2_j` the variance of
+//! `ln nu2_hat_j` ([`WaveletVariance::log_variance`], `psi'(eta_j / 2) / eff`) and `2 / r` that
+//! of a window's `ln WV`, the band uses the degrees of freedom `r' = 2 / (2 / r + s2_j)` of
+//! their sum. The model still gives the shape of the
 //! window's variance (`eta_j`). A window is then flagged when it differs from the calibrated
 //! recording, whatever the model.
 //!
@@ -152,7 +152,7 @@ pub struct MonitorEvent {
 pub enum Reference<'a> {
     /// The model's implied WV (docs/methods.md §16.3).
     Model,
-    /// The calibration's empirical WVs with their intervals (docs/methods.md §16.6): for a
+    /// The calibration's empirical WVs with their degrees of freedom (docs/methods.md §16.6): for a
     /// model that misfits the recording it was calibrated on. The windows' classical WV is
     /// compared with `classical`, their robust WV with `robust` (at the levels where it is
     /// defined; elsewhere, or without it, with `classical`).
@@ -167,14 +167,24 @@ pub enum Reference<'a> {
 /// The centre of a band at each level and the variance of its logarithm (docs/methods.md
 /// §16.6): `w`'s value and [`WaveletVariance::log_variance`] at the first `levels` levels,
 /// `None` at a level where `w` has no positive finite value or degrees of freedom.
-fn centre(w: &WaveletVariance, levels: usize) -> Vec<Option<(f64, f64)>> {
+fn centre(w: &WaveletVariance, levels: usize) -> Result<Vec<Option<(f64, f64)>>, ParamError> {
+    if let Some(r) = w.robust {
+        // read from a calibration JSON, unchecked until here
+        RobustOptions::new(r.eff, r.convention).map_err(|_| {
+            ParamError::new(
+                "reference WV",
+                format!("robust efficiency {}", r.eff),
+                "an efficiency in (0, 0.99]",
+            )
+        })?;
+    }
     let log_var = w.log_variance();
-    (0..levels)
+    Ok((0..levels)
         .map(|j| {
             let (v, var) = (*w.wv().get(j)?, *log_var.get(j)?);
             (v.is_finite() && v > 0.0 && var.is_finite() && var > 0.0).then_some((v, var))
         })
-        .collect()
+        .collect())
 }
 
 /// Result of [`monitor`] for one series.
@@ -337,8 +347,8 @@ pub fn monitor_against(
     let ((nu, centre_var), (nu_r, centre_var_r)) = match reference {
         Reference::Model => ((model_wv.clone(), none.clone()), (model_wv.clone(), none)),
         Reference::Wv { classical, robust } => {
-            let c = centre(classical, levels);
-            let r = robust.map(|r| centre(r, levels));
+            let c = centre(classical, levels)?;
+            let r = robust.map(|r| centre(r, levels)).transpose()?;
             let mut out = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
             for j in 0..levels {
                 let Some((v, var)) = c[j] else {

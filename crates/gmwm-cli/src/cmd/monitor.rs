@@ -21,7 +21,7 @@ model predicts for a window of that length (chi-square with the model's equivale
 freedom, Bonferroni over the levels); a window outside at some level is flagged. About --alpha \
 of the windows of a recording that follows the model are flagged by chance. Where the \
 calibration's verdict says the model misfits its WV, the windows are compared with that \
-empirical WV and its interval instead (--against auto, the default; docs/methods/multi-axis.md \
+empirical WV and its uncertainty instead (--against auto, the default; docs/methods/multi-axis.md \
 §16.6): a misfit of a few percent would otherwise flag nearly every long window.\n\n\
 Examples:\n  gmwm calibrate imu.csv.gz --out-dir cal && gmwm monitor imu.csv.gz --model-from cal/imu.calibration.json\n  \
 gmwm monitor long.csv.gz --model-from cal/imu.calibration.json --columns gyro_x --window 600s --step 60s\n  \
@@ -53,7 +53,7 @@ pub struct MonitorArgs {
     #[arg(long, value_name = "J")]
     pub levels: Option<usize>,
     /// What each window is compared with: the calibrated model's WV (model), the calibration's
-    /// empirical WV with its interval (wv), or the model where the calibration's verdict says it
+    /// empirical WV with its uncertainty (wv), or the model where the calibration's verdict says it
     /// explains the WV and the empirical WV where it misfits (auto; docs/methods/multi-axis.md
     /// §16.6).
     #[arg(long, value_enum, default_value_t = Against::Auto)]

@@ -55,12 +55,12 @@ fn describe(e: &mcap::McapError) -> String {
 }
 
 /// Runs `read`, a use of the `mcap` crate, and turns a panic inside it into a corrupt-file
-/// error naming `what` was read. The crate's readers have had arithmetic bugs on crafted files
-/// (0.26.0: an underflow in its linear reader, docs in `check_summary_records`); the workspace
-/// builds the crate with overflow checks in release too (Cargo.toml), so another such bug stops
-/// here as a panic, where unchecked arithmetic would wrap into a bogus length. Our own code
-/// inside `read` is not expected to panic; the fuzz targets abort on any panic (libFuzzer's
-/// hook), so the guard hides nothing from them.
+/// error naming `what` was read. The crate's readers have crashed on crafted files (0.26.0, see
+/// `check_summary_records`); the workspace builds the crate with overflow checks in release
+/// too (Cargo.toml), so another such bug stops here as a panic, where unchecked arithmetic
+/// would wrap into a bogus length. A panic is still a bug (the CLI's panic hook prints it as
+/// such, one line, before this error); the guard only keeps it from ending the program or a
+/// batch. The fuzz targets abort on any panic (libFuzzer's hook), so it hides nothing from them.
 fn guarded<T>(
     path: &Path,
     what: &dyn Fn() -> String,
@@ -72,14 +72,7 @@ fn guarded<T>(
             .map(|s| (*s).to_string())
             .or_else(|| payload.downcast_ref::<String>().cloned())
             .unwrap_or_else(|| "no message".to_string());
-        Err(corrupt(
-            path,
-            format!(
-                "{}: the mcap crate's reader failed on it ({message})",
-                what()
-            ),
-        )
-        .into())
+        Err(corrupt(path, format!("{}: reading it panicked ({message})", what())).into())
     })
 }
 
@@ -590,25 +583,42 @@ mod tests {
 
     /// The guard meets a real bug of the `mcap` crate: its summary reader, fed a chunk in the
     /// summary section (the fuzzer's `chunk_in_summary_overflow`) without our check before it,
-    /// underflows (0.26.0). Tests build with overflow checks, as release builds the crate
-    /// (Cargo.toml), so it panics; the guard must return a corrupt-file error instead.
+    /// underflows (0.26.0; tests build with overflow checks, as release builds the crate). It
+    /// must come back as an error, and the reader proper must refuse the file before the crate
+    /// sees it.
     #[test]
-    fn a_panic_in_the_mcap_crate_becomes_a_corrupt_file_error() {
+    fn a_crate_bug_under_the_guard_is_an_error() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/fixtures/fuzz/mcap/chunk_in_summary_overflow");
         let file = StorageFile::open(&path).unwrap();
-        let err = guarded(&path, &|| "summary section".to_string(), || {
-            crate_summary(&file)
-        })
+        let what = || "summary section".to_string();
+        assert!(guarded(&path, &what, || crate_summary(&file)).is_err());
+        let text = summary(&file).unwrap_err().to_string();
+        assert!(text.contains("a chunk record at byte"), "{text}");
+    }
+
+    #[test]
+    fn a_panic_under_the_guard_is_a_corrupt_file_error() {
+        let path = Path::new("bag.mcap");
+        let err = guarded(
+            path,
+            &|| "chunk at byte 8".to_string(),
+            || -> Result<(), _> {
+                let n: Vec<u8> = Vec::new();
+                let _ = n[3];
+                Ok(())
+            },
+        )
         .unwrap_err();
-        let text = err.to_string();
         assert!(
-            text.contains("summary section: the mcap crate's reader failed on it (attempt to subtract with overflow)"),
+            matches!(err, ReadError::Ros(RosError::Corrupt { .. })),
+            "{err:?}"
+        );
+        let text = err.to_string();
+        assert!(text.contains("bag.mcap"), "{text}");
+        assert!(
+            text.contains("chunk at byte 8: reading it panicked (index out of bounds: the len is 0 but the index is 3)"),
             "{text}"
         );
-        assert!(text.contains("chunk_in_summary_overflow"), "{text}");
-        // and the reader proper refuses it before the crate sees it
-        let text = summary(&file).unwrap_err().to_string();
-        assert!(!text.contains("mcap crate"), "{text}");
     }
 }
