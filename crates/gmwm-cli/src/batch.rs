@@ -453,7 +453,7 @@ fn run_one(config: &BatchConfig, p: &Planned) -> Outcome {
     .unwrap_or_else(|payload| {
         Err(anyhow::anyhow!(
             "internal error: panicked: {} (a bug: please report it with the command and this input)",
-            crate::panic::one_line(crate::panic::message(payload.as_ref()))
+            crate::panic::describe(payload.as_ref())
         ))
     });
     match result {

@@ -6,8 +6,13 @@
 
 use std::any::Any;
 
+/// A caught panic's message on one line (for a batch's outcome; the hook has printed it).
+pub(crate) fn describe(payload: &(dyn Any + Send)) -> String {
+    one_line(message(payload))
+}
+
 /// A panic's message (its payload when that is text).
-pub(crate) fn message(payload: &(dyn Any + Send)) -> &str {
+fn message(payload: &(dyn Any + Send)) -> &str {
     payload
         .downcast_ref::<&str>()
         .copied()
@@ -16,7 +21,7 @@ pub(crate) fn message(payload: &(dyn Any + Send)) -> &str {
 }
 
 /// `message` on one line: runs of white space as one space, other control characters escaped.
-pub(crate) fn one_line(message: &str) -> String {
+fn one_line(message: &str) -> String {
     let mut text = String::new();
     for c in message
         .split_whitespace()

@@ -71,13 +71,30 @@ pub const DEFAULT_EFF: f64 = 0.6;
 /// the estimator stops being robust.
 pub const MAX_EFF: f64 = 0.99;
 
-/// Options of the robust estimator (docs/methods.md §2).
+/// Options of the robust estimator (docs/methods.md §2). Read from JSON (a saved WV, a
+/// calibration), they are checked as [`RobustOptions::new`] checks them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RobustOptionsDoc")]
 pub struct RobustOptions {
     /// Requested Gaussian efficiency in (0, 0.99] (docs/methods.md §2.3).
     pub eff: f64,
     /// Convention (docs/methods.md §2.3–§2.4).
     pub convention: RobustConvention,
+}
+
+/// [`RobustOptions`] as JSON holds them, before the check.
+#[derive(Deserialize)]
+struct RobustOptionsDoc {
+    eff: f64,
+    convention: RobustConvention,
+}
+
+impl TryFrom<RobustOptionsDoc> for RobustOptions {
+    type Error = ParamError;
+
+    fn try_from(doc: RobustOptionsDoc) -> Result<Self, ParamError> {
+        Self::new(doc.eff, doc.convention)
+    }
 }
 
 impl Default for RobustOptions {
@@ -998,6 +1015,20 @@ pub fn robust_ci(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Options read from JSON are checked as the constructor checks them: a saved WV or a
+    /// calibration with an efficiency outside (0, 0.99] is refused, naming `eff`.
+    #[test]
+    fn robust_options_from_json_are_checked() {
+        let ok: RobustOptions =
+            serde_json::from_str(r#"{"eff": 0.6, "convention": "exact"}"#).unwrap();
+        assert_eq!(ok, RobustOptions::default());
+        for eff in ["1.5", "0", "-0.2"] {
+            let text = format!(r#"{{"eff": {eff}, "convention": "exact"}}"#);
+            let e = serde_json::from_str::<RobustOptions>(&text).unwrap_err();
+            assert!(e.to_string().contains("eff"), "{eff}: {e}");
+        }
+    }
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
     use rand_distr::StandardNormal;

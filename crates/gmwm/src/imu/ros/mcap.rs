@@ -69,9 +69,9 @@ fn guarded<T>(
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)).unwrap_or_else(|payload| {
         let message = payload
             .downcast_ref::<&str>()
-            .map(|s| (*s).to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "no message".to_string());
+            .copied()
+            .or_else(|| payload.downcast_ref::<String>().map(String::as_str))
+            .unwrap_or("no message");
         Err(corrupt(path, format!("{}: reading it panicked ({message})", what())).into())
     })
 }
@@ -255,15 +255,15 @@ struct Scan {
 
 impl Scan {
     fn record(&mut self, path: &Path, opcode: u8, body: &[u8], at: &str) -> Result<(), ReadError> {
-        let parse = || parse(path, opcode, body, &|| at.to_string());
+        let parsed = || parse(path, opcode, body, &|| at.to_string());
         match opcode {
             op::SCHEMA => {
-                if let Record::Schema { header, .. } = parse()? {
+                if let Record::Schema { header, .. } = parsed()? {
                     self.schemas.entry(header.id).or_insert(header.name);
                 }
             }
             op::CHANNEL => {
-                if let Record::Channel(c) = parse()? {
+                if let Record::Channel(c) = parsed()? {
                     self.channels
                         .entry(c.id)
                         .or_insert((c.topic, c.schema_id, c.message_encoding));
