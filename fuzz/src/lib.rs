@@ -18,11 +18,11 @@
 
 use gmwm::imu::ros::{list_topics, read_imu_messages, ImuMessages};
 use gmwm::imu::{
-    allan_from_wv, is_wv_json, read_table, read_wv_json, ColumnSelector, HeaderMode, Imu,
-    ImuRecordType, InputFormat, ReadError, ReadOptions, Recording, RecordingOptions, Sidecar,
-    Table,
+    read_table, ColumnSelector, HeaderMode, Imu, ImuRecordType, InputFormat, ReadError,
+    ReadOptions, Recording, RecordingOptions, Sidecar, Table,
 };
 use gmwm::model::Model;
+use gmwm::variance::{allan_from_wv, is_wv_json, read_wv_json};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 

@@ -3,9 +3,8 @@
 
 use crate::config::InputConfig;
 use anyhow::{Context, Result};
-use gmwm::imu::{
-    is_wv_json, quote, read_table, read_wv_json, select_series, InputFormat, ReadWarning, Table,
-};
+use gmwm::imu::{quote, read_table, InputFormat, ReadWarning, Table};
+use gmwm::variance::{is_wv_json, read_wv_json, select_series};
 use gmwm::WaveletVariance;
 use std::path::Path;
 

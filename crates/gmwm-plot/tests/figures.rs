@@ -5,7 +5,8 @@
 //! for a person to look at.
 
 use gmwm::calib::ieee::ieee_readoff;
-use gmwm::imu::{read_table, read_wv_json, ReadOptions};
+use gmwm::imu::{read_table, ReadOptions};
+use gmwm::variance::read_wv_json;
 use gmwm::{allan_variance, AllanOptions, Gmwm, RobustOptions, WaveletVariance, Wic, WvOptions};
 use gmwm_plot::{
     allan_figure, compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column,

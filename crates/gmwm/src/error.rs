@@ -1,40 +1,10 @@
-//! Error types of the engine. Every fallible public function returns [`enum@Error`] or one of the
-//! module errors that convert into it.
+//! The leaf errors of the engine: a series that cannot be analysed, a parameter with an
+//! impossible value, a model that breaks a rule, and [`InputError`], the three together. They
+//! name no module of the engine, so every module can return them; each stage's own error
+//! (`ReadError`, `FitError`, `SelectionError`, `CalibError`, ...) holds them, and
+//! [`enum@crate::Error`], in the crate root above every module, holds those.
 
 use thiserror::Error;
-
-/// Any error the engine can return.
-#[derive(Debug, Error)]
-#[non_exhaustive]
-pub enum Error {
-    /// Reading or parsing an input file failed.
-    #[error(transparent)]
-    Read(#[from] crate::imu::ReadError),
-    /// A series is unusable for the requested computation.
-    #[error(transparent)]
-    Series(#[from] SeriesError),
-    /// A parameter or option has an impossible value.
-    #[error(transparent)]
-    Param(#[from] ParamError),
-    /// A model text could not be parsed or breaks a model rule (docs/methods.md §0.2).
-    #[error(transparent)]
-    ModelParse(#[from] crate::model::ModelParseError),
-    /// A model breaks a rule of docs/methods.md §0.2 or has an invalid value.
-    #[error(transparent)]
-    Model(#[from] crate::model::ModelError),
-    /// A GMWM fit could not be set up or evaluated (docs/methods.md §5).
-    #[error(transparent)]
-    Fit(#[from] crate::fit::FitError),
-    /// A WIC model selection could not be set up or run (docs/methods.md §8).
-    #[error(transparent)]
-    Selection(#[from] crate::selection::SelectionError),
-    /// Calibrating a recording failed.
-    #[error(transparent)]
-    Calibration(#[from] crate::calib::CalibError),
-    /// A navigation-stack file could not be rendered.
-    #[error(transparent)]
-    Export(#[from] crate::calib::export::ExportError),
-}
 
 /// A computation on data and a model could not run: the series, a parameter or the model is
 /// unusable.
@@ -43,7 +13,7 @@ pub enum Error {
 /// implied wavelet variances, simulation, the bootstrap of V). The stage errors
 /// ([`crate::fit::FitError`], [`crate::selection::SelectionError`],
 /// [`crate::calib::CalibError`]) hold one; it holds none of them, so the error types are
-/// siblings that all convert into [`enum@Error`], never a loop.
+/// siblings that all convert into [`enum@crate::Error`], never a loop.
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum InputError {
@@ -55,17 +25,7 @@ pub enum InputError {
     Param(#[from] ParamError),
     /// The model breaks a rule of docs/methods.md §0.2 or has an invalid value.
     #[error(transparent)]
-    Model(#[from] crate::model::ModelError),
-}
-
-impl From<InputError> for Error {
-    fn from(e: InputError) -> Self {
-        match e {
-            InputError::Series(e) => Error::Series(e),
-            InputError::Param(e) => Error::Param(e),
-            InputError::Model(e) => Error::Model(e),
-        }
-    }
+    Model(#[from] ModelError),
 }
 
 /// `From<ParamError | SeriesError | ModelError>` for a stage error with an `Input(InputError)`
@@ -82,14 +42,121 @@ macro_rules! input_error_from {
                 $stage::Input(e.into())
             }
         }
-        impl From<$crate::model::ModelError> for $stage {
-            fn from(e: $crate::model::ModelError) -> Self {
+        impl From<$crate::error::ModelError> for $stage {
+            fn from(e: $crate::error::ModelError) -> Self {
                 $stage::Input(e.into())
             }
         }
     };
 }
 pub(crate) use input_error_from;
+
+/// A model-rule violation (docs/methods.md §0.2) or an invalid component.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// A model needs at least one component.
+    #[error("a model needs at least one component, e.g. WN() or 3*GM()+WN()")]
+    Empty,
+    /// WN, QN, RW or DR (or an ARMA kind) appears more than once.
+    #[error(
+        "{kind} appears {count} times but may appear at most once; only GM and AR1 may repeat \
+         (docs/methods.md §0.2)"
+    )]
+    Repeated {
+        /// The repeated kind.
+        kind: String,
+        /// How many times it appears.
+        count: usize,
+    },
+    /// GM and AR1 in the same model.
+    #[error(
+        "GM and AR1 may not be mixed in one model (found {gm} GM and {ar1} AR1); use one of \
+         them (docs/methods.md §0.2)"
+    )]
+    GmAr1Mixed {
+        /// Number of GM components.
+        gm: usize,
+        /// Number of AR1 components.
+        ar1: usize,
+    },
+    /// Two ARMA-family terms (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)).
+    #[error(
+        "at most one ARMA-family term (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)) per model, found \
+         {first} and {second}; a sum of ARMAs is one ARMA of higher order"
+    )]
+    ArmaFamily {
+        /// The first ARMA-family term.
+        first: String,
+        /// The second one.
+        second: String,
+    },
+    /// An order of AR(p), MA(q) or ARMA(p,q) out of range.
+    #[error("{kind}: order {order} is invalid: expected {expected}")]
+    BadOrder {
+        /// The kind with the bad order.
+        kind: String,
+        /// The offending order.
+        order: usize,
+        /// What would be valid.
+        expected: &'static str,
+    },
+    /// A multiplier `k` in `k * gm()` outside 1..=[`MAX_MULTIPLIER`](crate::model::MAX_MULTIPLIER).
+    #[error("multiplier {k} is invalid: expected an integer from 1 to 100")]
+    BadMultiplier {
+        /// The multiplier given.
+        k: usize,
+    },
+    /// A parameter value outside its basic domain ([`ParamDomain`](crate::process::ParamDomain)).
+    #[error(
+        "component {component} (0-based) {kind}: {name} = {value} is invalid: expected {expected}"
+    )]
+    BadParameter {
+        /// 0-based component index in the model (0 for a standalone component).
+        component: usize,
+        /// Its kind.
+        kind: String,
+        /// The parameter name (docs/methods.md §0.2).
+        name: String,
+        /// The value given.
+        value: f64,
+        /// What would be valid.
+        expected: &'static str,
+    },
+    /// A parameter name the kind does not have.
+    #[error("{kind} has no parameter {name:?}; its parameters are {}", .valid.join(", "))]
+    UnknownParameter {
+        /// The kind.
+        kind: String,
+        /// The name given.
+        name: String,
+        /// The kind's parameter names.
+        valid: Vec<String>,
+    },
+    /// A component whose `values` length differs from its kind's parameter count.
+    #[error(
+        "component {component} (0-based) {kind} has {found} values; {kind} has {expected} \
+         parameters"
+    )]
+    WrongLength {
+        /// 0-based component index.
+        component: usize,
+        /// Its kind.
+        kind: String,
+        /// `kind.n_params()`.
+        expected: usize,
+        /// `values.len()`.
+        found: usize,
+    },
+    /// A parameter vector whose length differs from the model's parameter count.
+    #[error("theta has {found} values; the model has {expected} parameters")]
+    ThetaLength {
+        /// `Model::n_params()`.
+        expected: usize,
+        /// Length given.
+        found: usize,
+    },
+}
 
 /// A series that cannot be analysed.
 #[derive(Debug, Error, Clone, PartialEq)]

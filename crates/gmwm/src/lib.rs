@@ -37,6 +37,7 @@ pub(crate) mod math;
 pub mod model;
 pub mod monitor;
 pub mod process;
+pub mod progress;
 pub mod selection;
 pub mod shared;
 pub mod sim;
@@ -44,10 +45,53 @@ pub mod units;
 pub mod variance;
 pub mod wavelet;
 
-pub use error::{Error, InputError, ParamError, SeriesError};
+pub use error::{InputError, ParamError, SeriesError};
 pub use fit::{FitError, Gmwm, GmwmFit, Weighting, Weights};
 pub use selection::{auto_imu, ModelSelection, SelectionError, Wic};
 pub use variance::allan::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
 pub use variance::robust::{RobustConvention, RobustOptions};
 pub use variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};
 pub use wavelet::{Transform, WaveletFilter};
+
+/// Any error the engine can return.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Reading or parsing an input file failed.
+    #[error(transparent)]
+    Read(#[from] crate::imu::ReadError),
+    /// A series is unusable for the requested computation.
+    #[error(transparent)]
+    Series(#[from] SeriesError),
+    /// A parameter or option has an impossible value.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// A model text could not be parsed or breaks a model rule (docs/methods.md §0.2).
+    #[error(transparent)]
+    ModelParse(#[from] crate::model::ModelParseError),
+    /// A model breaks a rule of docs/methods.md §0.2 or has an invalid value.
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
+    /// A GMWM fit could not be set up or evaluated (docs/methods.md §5).
+    #[error(transparent)]
+    Fit(#[from] crate::fit::FitError),
+    /// A WIC model selection could not be set up or run (docs/methods.md §8).
+    #[error(transparent)]
+    Selection(#[from] crate::selection::SelectionError),
+    /// Calibrating a recording failed.
+    #[error(transparent)]
+    Calibration(#[from] crate::calib::CalibError),
+    /// A navigation-stack file could not be rendered.
+    #[error(transparent)]
+    Export(#[from] crate::calib::export::ExportError),
+}
+
+impl From<InputError> for Error {
+    fn from(e: InputError) -> Self {
+        match e {
+            InputError::Series(e) => Error::Series(e),
+            InputError::Param(e) => Error::Param(e),
+            InputError::Model(e) => Error::Model(e),
+        }
+    }
+}

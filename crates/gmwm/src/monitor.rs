@@ -56,7 +56,7 @@
 //! (classical out and robust in: outliers; robust out: the process changed). Adjacent or overlapping flagged
 //! windows are merged into one event.
 
-use crate::error::{Error, InputError, ParamError};
+use crate::error::{InputError as Error, ParamError};
 use crate::model::Model;
 use crate::variance::ci::{check_alpha, chi_square_quantile};
 use crate::variance::implied_cov::exact_wv_covariance;
@@ -389,12 +389,11 @@ pub fn monitor_against(
         }
         let r = widened(opts.robust.eff * eta[j], centre_var_r[j]);
         if !(r.is_finite() && r > 0.0) {
-            return Err(InputError::from(ParamError::new(
+            return Err(Error::Param(ParamError::new(
                 "model",
                 model.to_string(),
                 "a model with a positive finite WV variance at every tested level",
-            ))
-            .into());
+            )));
         }
         band_low.push(nu_r[j] * chi_square_quantile(alpha_level / 2.0, r)? / r);
         band_high.push(nu_r[j] * chi_square_quantile(1.0 - alpha_level / 2.0, r)? / r);

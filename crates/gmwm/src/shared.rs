@@ -55,9 +55,10 @@
 //! near-normal only when `eta_j` is not small. Its size is checked by Monte Carlo
 //! (`crates/gmwm/tests/shared.rs`).
 
-use crate::error::{Error, InputError, ParamError};
+use crate::error::{InputError, ParamError};
 use crate::fit::objective::Stack;
 use crate::fit::optimize::minimize;
+use crate::fit::FitError as Error;
 use crate::fit::{
     Convergence, Gmwm, GmwmFit, LmOptions, Objective, Parametrisation, PhiOrder, StartInputs,
     TransformPreset,
@@ -288,7 +289,7 @@ pub fn fit_shared(
     // levels as their parameters (docs/methods.md §5.7)
     let params = shared.n_params() + specific.n_params();
     if params > levels {
-        return Err(crate::fit::FitError::TooFewLevels { params, levels }.into());
+        return Err(crate::fit::FitError::TooFewLevels { params, levels });
     }
     let wv_opts = WvOptions {
         levels: Some(levels),
@@ -436,7 +437,7 @@ pub fn fit_shared(
     }
     let stage1 = match (best, last_err) {
         (Some(b), _) => b,
-        (None, Some(e)) => return Err(e.into()),
+        (None, Some(e)) => return Err(e),
         (None, None) => unreachable!("at least one start"),
     };
     let processes = |theta: &[f64]| -> Result<(Vec<Process>, Vec<Vec<Process>>), Error> {

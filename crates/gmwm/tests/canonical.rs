@@ -5,9 +5,9 @@
 use crate::common::{data_dir, read_column};
 use gmwm::fit::canonical::wv_separation;
 use gmwm::fit::{CanonicalModel, Gmwm, GmwmFit, Reading, StartInputs};
-use gmwm::imu::read_wv_json;
 use gmwm::model::{Model, ProcessKind};
 use gmwm::sim::simulate_model;
+use gmwm::variance::read_wv_json;
 use gmwm::{allan_variance, AllanOptions, WvOptions};
 
 fn model(text: &str) -> Model {

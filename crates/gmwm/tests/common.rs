@@ -109,7 +109,7 @@ pub fn edited_wv(
         CALLS.fetch_add(1, Ordering::Relaxed)
     ));
     std::fs::write(&path, doc.to_string()).unwrap();
-    let read = gmwm::imu::read_wv_json(&path, None);
+    let read = gmwm::variance::read_wv_json(&path, None);
     std::fs::remove_file(&path).ok();
     read.unwrap().remove(0).1
 }

@@ -153,7 +153,7 @@ fn wv_json_round_trip_and_refusals() {
         "tau": wv.tau(), "wv": wv.wv(), "ci_low": wv.ci_low(), "ci_high": wv.ci_high(),
         "n_coefficients": wv.n_coefficients(), "eta": wv.eta() } ] });
     std::fs::write(&full, doc.to_string()).unwrap();
-    let read = gmwm::imu::read_wv_json(&full, None).unwrap();
+    let read = gmwm::variance::read_wv_json(&full, None).unwrap();
     assert_eq!(read[0].0, "x");
     assert_eq!(read[0].1.wv(), wv.wv());
     assert_eq!(read[0].1.eta(), wv.eta());
@@ -161,7 +161,7 @@ fn wv_json_round_trip_and_refusals() {
     let doc = serde_json::json!({ "freq_hz": 10.0, "series": [ { "name": "x", "n": wv.n(),
         "tau": wv.tau(), "wv": wv.wv(), "ci_low": wv.ci_low(), "ci_high": wv.ci_high() } ] });
     std::fs::write(&minimal, doc.to_string()).unwrap();
-    let min = gmwm::imu::read_wv_json(&minimal, None).unwrap();
+    let min = gmwm::variance::read_wv_json(&minimal, None).unwrap();
     // counts and eta3 are recomputed from n exactly as the estimator does
     assert_eq!(min[0].1.n_coefficients(), wv.n_coefficients());
     assert_eq!(min[0].1.eta(), wv.eta());
@@ -174,7 +174,9 @@ fn wv_json_round_trip_and_refusals() {
     let bad = |doc: serde_json::Value, needle: &str| {
         let p = dir.path().join("bad.json");
         std::fs::write(&p, doc.to_string()).unwrap();
-        let e = gmwm::imu::read_wv_json(&p, None).unwrap_err().to_string();
+        let e = gmwm::variance::read_wv_json(&p, None)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("bad.json") && e.contains(needle), "{e}");
     };
     bad(serde_json::json!({"series": []}), "empty");

@@ -408,7 +408,7 @@ fn fuzz_regression_long_gm_run_round_trips() {
 #[test]
 fn fuzz_regression_wv_json_unknown_variant_one_line() {
     let (_dir, path) = fixture_file("wv_json", "unknown_variant_with_newline", "x.json");
-    let e = gmwm::imu::read_wv_json(&path, None).unwrap_err();
+    let e = gmwm::variance::read_wv_json(&path, None).unwrap_err();
     assert!(matches!(e, gmwm::imu::ReadError::WvJson { .. }), "{e:?}");
     // one line whichever stage of the JSON reading refuses it
     let s = e.to_string();

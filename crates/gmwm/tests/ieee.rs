@@ -3,10 +3,10 @@
 
 use crate::common::{read_column, rel_diff};
 use gmwm::calib::ieee::{ieee_readoff, IeeeReadoff, DOMINANCE};
-use gmwm::imu::{allan_from_wv, read_wv_json};
 use gmwm::process::{Process, Rw, Wn};
 use gmwm::sim::simulate;
 use gmwm::units::{to_datasheet, NoiseTerm, SignalKind, SignalUnit};
+use gmwm::variance::{allan_from_wv, read_wv_json};
 use gmwm::{allan_variance, AllanKind, AllanOptions, AllanVariance};
 
 /// A pure power law is read back through logarithms of a few dozen numbers: rounding only.

@@ -238,28 +238,28 @@ fn model_rule_violations_are_rejected() {
         (
             vec![wn(), rw(), wn()],
             Repeated {
-                kind: ProcessKind::Wn,
+                kind: "WN".into(),
                 count: 2,
             },
         ),
         (
             vec![qn(), qn(), qn()],
             Repeated {
-                kind: ProcessKind::Qn,
+                kind: "QN".into(),
                 count: 3,
             },
         ),
         (
             vec![dr(), dr()],
             Repeated {
-                kind: ProcessKind::Dr,
+                kind: "DR".into(),
                 count: 2,
             },
         ),
         (
             vec![rw(), rw()],
             Repeated {
-                kind: ProcessKind::Rw,
+                kind: "RW".into(),
                 count: 2,
             },
         ),
@@ -267,14 +267,14 @@ fn model_rule_violations_are_rejected() {
         (
             vec![ma1(), ar(2)],
             ArmaFamily {
-                first: ProcessKind::Ma1,
-                second: ProcessKind::Ar(2),
+                first: "MA1".into(),
+                second: "AR(2)".into(),
             },
         ),
         (
             vec![arma(1, 1), arma(1, 1)],
             Repeated {
-                kind: ProcessKind::Arma(1, 1),
+                kind: "ARMA(1,1)".into(),
                 count: 2,
             },
         ),
@@ -285,7 +285,7 @@ fn model_rule_violations_are_rejected() {
             }],
             WrongLength {
                 component: 0,
-                kind: ProcessKind::Wn,
+                kind: "WN".into(),
                 expected: 1,
                 found: 2,
             },
@@ -300,7 +300,7 @@ fn model_rule_violations_are_rejected() {
             ],
             BadParameter {
                 component: 1,
-                kind: ProcessKind::Gm,
+                kind: "GM".into(),
                 name: "beta".into(),
                 value: -1.0,
                 expected: "a finite rate > 0",

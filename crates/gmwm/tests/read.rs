@@ -7,11 +7,11 @@ use flate2::write::GzEncoder;
 use flate2::Compression;
 use gmwm::imu::write::write_sidecar;
 use gmwm::imu::{
-    allan_from_wv, binary_layout, for_each_chunk, is_wv_json, read_imu_record_file, read_table,
-    select_series, sniff, BinaryChunks, ColumnSelector, Content, HeaderMode, Imu, ImuRecordType,
-    InputFormat, ReadError, ReadOptions, ReadWarning, Sensor, SeriesWriter, Sidecar, SidecarColumn,
-    TimeUnit, TimingWarning, UnitSource,
+    binary_layout, for_each_chunk, read_imu_record_file, read_table, sniff, BinaryChunks,
+    ColumnSelector, Content, HeaderMode, Imu, ImuRecordType, InputFormat, ReadError, ReadOptions,
+    ReadWarning, Sensor, SeriesWriter, Sidecar, SidecarColumn, TimeUnit, TimingWarning, UnitSource,
 };
+use gmwm::variance::{allan_from_wv, is_wv_json, select_series};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 

@@ -221,10 +221,7 @@ fn shared_refuses_bad_inputs() {
     assert!(dr.to_string().contains("DR"), "{dr}");
     let tiny = &x[..8];
     let e = fit_shared(&[("x", tiny), ("y", tiny)], 1.0, &shared, &spec, &o).unwrap_err();
-    assert!(
-        matches!(e, gmwm::Error::Fit(gmwm::FitError::TooFewLevels { .. })),
-        "{e:?}"
-    );
+    assert!(matches!(e, gmwm::FitError::TooFewLevels { .. }), "{e:?}");
     let mut bad = x.clone();
     bad[7] = f64::NAN;
     assert!(fit_shared(&[("x", &x), ("y", &bad)], 1.0, &shared, &spec, &o).is_err());

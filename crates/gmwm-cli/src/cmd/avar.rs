@@ -4,7 +4,7 @@ use crate::config::AvarConfig;
 use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named, note};
 use crate::render;
 use anyhow::Result;
-use gmwm::imu::allan_from_wv;
+use gmwm::variance::allan_from_wv;
 use gmwm::{allan_variance, AllanVariance};
 use std::io::Write;
 

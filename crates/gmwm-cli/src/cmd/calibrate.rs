@@ -207,9 +207,7 @@ fn calibrate_one(
         bar((axes * per_axis) as u64, "calibrating", "candidate fits")
     };
     let report = match &recording.imu {
-        Some(imu) => calibration
-            .run_with_progress(imu, &Ticks(&progress))
-            .map_err(gmwm::Error::from),
+        Some(imu) => calibration.run_with_progress(imu, &Ticks(&progress)),
         None => match &table {
             Some(t) => calibration.run_table(t, &Ticks(&progress)),
             None => calibration.run_file(&config.input.file, &config.input.read, &Ticks(&progress)),

@@ -169,8 +169,8 @@ pub fn compute(config: &SharedConfig) -> Result<(SharedFit, Option<String>)> {
 }
 
 /// The engine's error with the file and, for a recording too short for the model, the fix.
-fn short_context(e: gmwm::Error, file: &str, shared: &Model, specific: &Model) -> anyhow::Error {
-    if let gmwm::Error::Fit(gmwm::FitError::TooFewLevels { params, levels }) = &e {
+fn short_context(e: gmwm::FitError, file: &str, shared: &Model, specific: &Model) -> anyhow::Error {
+    if let gmwm::FitError::TooFewLevels { params, levels } = &e {
         return anyhow::anyhow!(
             "{file}: too short for --shared {shared} --model {specific}: {params} parameters \
              but {levels} wavelet levels; give a longer recording or a smaller model"

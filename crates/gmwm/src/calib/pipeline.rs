@@ -6,7 +6,7 @@ use super::contamination::{compare_classical_robust, Contamination, FitUses};
 use super::ieee::{ieee_readoff, IeeeReadoff};
 use crate::fit::canonical::long_run_variance;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
-use crate::imu::{allan_from_wv, Imu, Sensor, SensorInfo};
+use crate::imu::{Imu, Sensor, SensorInfo};
 use crate::inference::{
     infer_with_covariance, CovarianceMethod, Inference, InferenceOptions, Progress,
 };
@@ -15,6 +15,7 @@ use crate::process::{Ar1, Gm};
 use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
 use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms};
 use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
+use crate::variance::allan_from_wv;
 use crate::variance::pooled::PooledWv;
 use crate::variance::robust::RobustOptions;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
@@ -151,7 +152,15 @@ pub enum CalibError {
         /// Cause.
         source: crate::InputError,
     },
+    /// Reading the recording failed.
+    #[error(transparent)]
+    Read(#[from] crate::imu::ReadError),
+    /// A setting or the recording's rate is unusable.
+    #[error(transparent)]
+    Input(#[from] crate::InputError),
 }
+
+crate::error::input_error_from!(CalibError);
 
 /// What kind of number an [`Estimate`] is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

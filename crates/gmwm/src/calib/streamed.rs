@@ -9,7 +9,7 @@
 //! - **the classical Haar WV**: streamed from the file for every axis at once
 //!   ([`binary_wavelet_variance`]); identical to the in-memory estimate within 1e-12;
 //! - **the Allan variance**: `AV(m) = 2 nu2(2m)`, exact from that WV (docs/methods.md §3.4,
-//!   [`allan_from_wv`](crate::imu::allan_from_wv));
+//!   [`allan_from_wv`](crate::variance::allan_from_wv));
 //! - **the model selection and the fit**: they use the WV only ([`crate::Wic::select_wv`]);
 //!   the starting values then come from the WV alone (no series range for drift draws), and
 //!   V is the exact covariance ([`crate::variance::implied_cov`]), which needs no series;
@@ -32,7 +32,8 @@
 //! from 2^21 rows on, the robust check's blocks are full and the memory stays there.
 
 use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
-use crate::error::{Error, ParamError};
+use crate::calib::CalibError as Error;
+use crate::error::ParamError;
 use crate::imu::read::stream::{streams_from, StreamedTable};
 use crate::imu::{
     binary_layout, find_sidecar, BinaryChunks, BinaryLayout, ReadError, ReadOptions, SensorInfo,
@@ -279,7 +280,7 @@ impl Calibration {
         }
         if !inertial.is_empty() && failed.len() == inertial.len() {
             if let Some(e) = first_error {
-                return Err(e.into());
+                return Err(e);
             }
         }
         let axes: Vec<InputAxis<'_>> = columns
@@ -306,7 +307,7 @@ impl Calibration {
                 ),
             }
         ));
-        Ok(self.run_axes(name, freq_hz, n, axes, checks, progress)?)
+        self.run_axes(name, freq_hz, n, axes, checks, progress)
     }
 }
 

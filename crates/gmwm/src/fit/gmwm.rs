@@ -71,8 +71,8 @@ impl Gmwm {
     /// Model text or model, parsed: `Gmwm::parse("3*GM()+WN()")`.
     ///
     /// # Errors
-    /// The model's parse error, as [`crate::Error::ModelParse`].
-    pub fn parse(text: &str) -> Result<Self, crate::Error> {
+    /// The model's [`ModelParseError`](crate::model::ModelParseError).
+    pub fn parse(text: &str) -> Result<Self, crate::model::ModelParseError> {
         Ok(Self::new(Model::parse(text)?))
     }
 

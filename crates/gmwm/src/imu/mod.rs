@@ -7,7 +7,6 @@
 //!   [`timing`]);
 //! - [`BinaryChunks`] / [`for_each_chunk`]: one column of a huge binary file in bounded memory;
 //! - [`read_imu_record_file`]: the binary IMU epoch records of docs/methods.md §9.2–9.3;
-//! - [`read_wv_json`]: a wavelet variance computed elsewhere (`gmwm wv --json`), to fit again;
 //! - [`write::SeriesWriter`]: series to CSV, TSV, gzip or raw binary by file name;
 //! - [`plausible::raw_floats`]: whether raw floats look like samples (f64 read as f32, ...);
 //! - [`Imu`]: gyroscope/accelerometer axes with a common rate (docs/methods.md §9.1);
@@ -38,8 +37,8 @@ mod sensor;
 pub mod sidecar;
 pub mod timing;
 pub mod write;
-pub mod wv_file;
 
+pub(crate) use error::escape_name;
 pub use error::{quote, ReadError, QUOTE_MAX};
 pub use read::{
     binary_layout, for_each_chunk, read_imu_record_file, read_table, resolve_format, sniff,
@@ -55,4 +54,3 @@ pub use timing::{
     UnitSource,
 };
 pub use write::{OutputFormat, SeriesWriter};
-pub use wv_file::{allan_from_wv, is_wv_json, read_wv_json, select_series};

@@ -6,7 +6,7 @@ use super::read::{read_table, Column, InputFormat, ReadOptions, ReadWarning, RAT
 use super::ros::{container_of, read_imu_messages, ImuMessages, RosContainer};
 use super::timing::{check_times, TimeUnit, TimingReport, UnitSource};
 use super::{Imu, ReadError, SampleAccount, Sensor, SensorInfo};
-use crate::Error;
+use crate::imu::ReadError as Error;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

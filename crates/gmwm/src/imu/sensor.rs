@@ -5,7 +5,8 @@ use super::read::{Column, ColumnSelector, ImuRecordType, ReadWarning, Table};
 use super::sidecar::Sidecar;
 use super::timing::TimingReport;
 use super::ReadError;
-use crate::error::{check_freq, Error, ParamError};
+use crate::error::{check_freq, ParamError};
+use crate::imu::ReadError as Error;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -325,8 +326,7 @@ impl Imu {
             return Err(ReadError::FreqNotDerivable {
                 path: table.path,
                 reason: "no freq_hz given, no time column, no sampling_frequency_hz in a sidecar",
-            }
-            .into());
+            });
         };
         let info = SensorInfo::of_table(&table);
         let sidecar = table.sidecar.as_ref();

@@ -7,9 +7,9 @@
 //! thread count or on the order in which rayon runs the replicates. Each worker thread reuses
 //! one series buffer: memory is `threads x N` samples plus what the caller keeps per replicate.
 
-use super::progress::Progress;
 use crate::error::ParamError;
 use crate::fit::{FitError, Gmwm, GmwmFit, StartInputs, Weighting, Weights};
+use crate::progress::Progress;
 pub use crate::sim::bootstrap::{map_replicates, wv_bootstrap, WvBootstrap};
 use crate::sim::replicate_seed;
 use crate::variance::wv::WvOptions;

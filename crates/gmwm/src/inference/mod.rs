@@ -1,25 +1,24 @@
 //! Inference on a GMWM fit (docs/methods.md §7): the parametric bootstrap of the wavelet variance
 //! and of the fit ([`bootstrap`], §7.4), and the covariance V of the WV, exact or bootstrapped
-//! ([`covariance`]), on which the bootstrap weighting (§5.2), the bootstrap
+//! ([`wv_covariance`], in `sim`), on which the bootstrap weighting (§5.2), the bootstrap
 //! covariance of the estimates and the WIC optimism (§8) rest; the sandwich covariance and
 //! intervals ([`asymptotic`], §7.1, §7.2, §7.6); the J-test ([`gof`], §7.3); and one entry
 //! point, [`infer`] ([`summary`], §7.5).
 
 pub mod asymptotic;
 pub mod bootstrap;
-pub mod covariance;
 pub mod gof;
-pub mod progress;
+mod pooled;
 pub mod same_model;
 pub mod summary;
 
+pub use crate::progress::{NoProgress, Progress};
+pub use crate::sim::covariance::{wv_covariance, CovarianceMethod, VSource, WvCovariance};
 pub use asymptotic::{sandwich, wald_interval, z_value, IntervalScale, Sandwich, ZConvention};
 pub use bootstrap::{
     fit_bootstrap, map_replicates, wv_bootstrap, FitBootstrap, FitBootstrapOptions, WvBootstrap,
 };
-pub use covariance::{wv_covariance, CovarianceMethod, VSource, WvCovariance};
 pub use gof::{j_test, JTest};
-pub use progress::{NoProgress, Progress};
 pub use same_model::{
     compare_wvs, same_model_test, same_model_test_of, SameModelOptions, SameModelTest,
     ScaleContribution, WvComparison,

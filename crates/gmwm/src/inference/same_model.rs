@@ -63,16 +63,16 @@
 //! two WVs and their intervals.
 
 use super::asymptotic::z_value;
-use super::covariance::{wv_covariance, CovarianceMethod};
 use super::gof::chi_square_upper_tail;
-use super::progress::NoProgress;
+use super::pooled::simulate_recordings;
 use crate::error::ParamError;
 use crate::fit::pooled::{
-    best_of, check_recordings, pooled_objective, simulate_recordings, PooledFit, Recording,
-    POOLED_V_REPLICATES,
+    best_of, check_recordings, pooled_objective, PooledFit, Recording, POOLED_V_REPLICATES,
 };
 use crate::fit::weights::FullWeights;
 use crate::fit::{FitError, Gmwm, GmwmFit, Objective, Parametrisation};
+use crate::progress::NoProgress;
+use crate::sim::covariance::{wv_covariance, CovarianceMethod};
 use crate::sim::replicate_seed;
 use crate::variance::wv::WaveletVariance;
 use rayon::prelude::*;

@@ -4,7 +4,7 @@
 //!
 //! # Choices (documented deviations from the package)
 //! - **V of the sandwich** (asymptotic mode): the *full* covariance of the WV vector at the
-//!   fitted model, exact by default ([`super::covariance`]; the bootstrap's limit, without its
+//!   fitted model, exact by default ([`crate::sim::covariance`]; the bootstrap's limit, without its
 //!   Monte Carlo noise), or the parametric bootstrap with `H = 100` replicates
 //!   ([`CovarianceMethod::Bootstrap`], and for models the exact formulas do not cover).
 //!   Adjacent WV levels are strongly correlated, and the sandwich `H V H'` is linear in V, so
@@ -26,11 +26,11 @@
 
 use super::asymptotic::{sandwich, scales, z_value, IntervalScale, ZConvention};
 use super::bootstrap::{fit_bootstrap, FitBootstrapOptions};
-use super::covariance::{wv_covariance, CovarianceMethod, VSource};
 use super::gof::{hartlap_factor, j_test, JTest};
-use super::progress::{NoProgress, Progress};
 use crate::error::ParamError;
 use crate::fit::{FitError, Gmwm, GmwmFit};
+use crate::progress::{NoProgress, Progress};
+use crate::sim::covariance::{wv_covariance, CovarianceMethod, VSource};
 use crate::variance::wv::WvOptions;
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
@@ -58,7 +58,7 @@ pub struct InferenceOptions {
     /// asymptotic sandwich (§7.1).
     pub bootstrap: Option<usize>,
     /// How the asymptotic mode's V is obtained (default [`CovarianceMethod::Auto`]: exact
-    /// when the model is covered, [`super::covariance`]).
+    /// when the model is covered, [`crate::sim::covariance`]).
     pub v_method: CovarianceMethod,
     /// Replicates H of a bootstrap V of the asymptotic mode (default 100, as the package).
     pub v_replicates: usize,

@@ -50,215 +50,17 @@ pub use builder::{
 pub use parse::{ModelParseError, ParseErrorKind};
 pub use realize::{ComponentWv, ImpliedWv};
 
-use crate::process::{spec, Occurs, Params, KINDS};
-use std::fmt;
-use thiserror::Error;
+pub use crate::error::ModelError;
+pub use crate::process::{ParamDomain, ProcessKind, MAX_ORDER};
 
-/// Largest order accepted for `AR(p)`, `MA(q)` and each order of `ARMA(p,q)`.
-///
-/// A guard against absurd allocations from typos such as `AR(20000000)`; IMU error models use
-/// orders of 1 to 3, and the implied WV of docs/methods.md §4.4 becomes numerically meaningless
-/// long before 100 lags.
-pub const MAX_ORDER: usize = 100;
+use crate::process::{spec, Occurs, KINDS};
+use std::fmt;
 
 /// Largest multiplier `k` accepted in `k*GM()` / `k*AR1()` (and by `k * gm()`).
 ///
 /// A guard against absurd allocations from typos; the package's largest automatic search
 /// (docs/methods.md §8.4) uses 3 GMs, and more than a handful is never identifiable.
 pub const MAX_MULTIPLIER: usize = 100;
-
-/// The kind of one latent process (docs/methods.md §0.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum ProcessKind {
-    /// White noise, parameter `sigma2`.
-    Wn,
-    /// Quantisation noise, parameter `q2` (Q^2).
-    Qn,
-    /// Random walk, parameter `gamma2` (increment variance).
-    Rw,
-    /// Deterministic drift, parameter `omega` (slope per sample).
-    Dr,
-    /// First-order autoregression, parameters `phi`, `sigma2`.
-    Ar1,
-    /// Gauss–Markov process (AR1 reparametrised with the sampling rate, docs/methods.md §4.3),
-    /// parameters `beta`, `sigma2_gm`.
-    Gm,
-    /// First-order moving average, parameters `theta`, `sigma2`.
-    Ma1,
-    /// ARMA(1,1), parameters `phi`, `theta`, `sigma2`.
-    Arma11,
-    /// Autoregression of order p, parameters `ar1..arp`, `sigma2`.
-    Ar(usize),
-    /// Moving average of order q, parameters `ma1..maq`, `sigma2`.
-    Ma(usize),
-    /// ARMA(p, q) (package name `SARIMA` without seasonal part), parameters `ar1..arp`,
-    /// `ma1..maq`, `sigma2`; R sign convention (docs/methods.md §0.2).
-    Arma(usize, usize),
-}
-
-/// The basic domain of one parameter value, checked whenever a value is given (docs/methods.md §5.3
-/// lists the transforms the optimiser applies on these domains).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum ParamDomain {
-    /// A variance (`sigma2`, `sigma2_gm`, `q2`, `gamma2`): finite and > 0 (log transform).
-    Variance,
-    /// The GM `beta`: finite and > 0 (`phi = exp(-beta / freq)` lies in (0, 1), docs/methods.md
-    /// §4.3).
-    Rate,
-    /// The AR1/MA1/ARMA11 coefficients `phi`, `theta`: in the open interval (-1, 1)
-    /// (the pseudo-logit domain of docs/methods.md §5.3).
-    UnitInterval,
-    /// Any finite number: DR `omega` and the `AR(p)`/`MA(q)`/`ARMA(p,q)` coefficients
-    /// (docs/methods.md §5.3 imposes no joint stationarity; the package's placeholders are -1
-    /// and -2).
-    Finite,
-}
-
-impl ParamDomain {
-    /// Whether `value` lies in this domain.
-    pub fn contains(self, value: f64) -> bool {
-        match self {
-            ParamDomain::Variance | ParamDomain::Rate => value.is_finite() && value > 0.0,
-            ParamDomain::UnitInterval => value > -1.0 && value < 1.0,
-            ParamDomain::Finite => value.is_finite(),
-        }
-    }
-
-    /// What a valid value looks like, for error messages.
-    pub fn expected(self) -> &'static str {
-        match self {
-            ParamDomain::Variance => "a finite variance > 0",
-            ParamDomain::Rate => "a finite rate > 0",
-            ParamDomain::UnitInterval => "a value in the open interval (-1, 1)",
-            ParamDomain::Finite => "a finite number",
-        }
-    }
-}
-
-impl ProcessKind {
-    /// The canonical name: `"WN"`, `"AR1"`, `"AR(2)"`, `"ARMA(2,1)"` (docs/methods.md §0.2).
-    pub fn name(&self) -> String {
-        let spec = spec(*self);
-        match &spec.orders {
-            None => spec.name.to_string(),
-            Some(o) => {
-                let orders: Vec<String> = o.written(self.orders()).map(|v| v.to_string()).collect();
-                format!("{}({})", spec.name, orders.join(","))
-            }
-        }
-    }
-
-    /// The name without orders: `"AR"` for `AR(2)`, `"WN"` for `WN`.
-    pub fn base_name(&self) -> &'static str {
-        spec(*self).name
-    }
-
-    /// Parameter names in `theta` order (docs/methods.md §0.2): WN `sigma2`; QN `q2`; RW `gamma2`;
-    /// DR `omega`; AR1 `phi, sigma2`; GM `beta, sigma2_gm`; MA1 `theta, sigma2`; ARMA11
-    /// `phi, theta, sigma2`; AR(p) `ar1..arp, sigma2`; MA(q) `ma1..maq, sigma2`; ARMA(p,q)
-    /// `ar1..arp, ma1..maq, sigma2`.
-    pub fn param_names(&self) -> Vec<String> {
-        match spec(*self).params {
-            Params::Fixed(list, _) => list.iter().map(|(n, _)| n.to_string()).collect(),
-            Params::Arma => {
-                let (p, q) = self.orders();
-                (1..=p)
-                    .map(|i| format!("ar{i}"))
-                    .chain((1..=q).map(|i| format!("ma{i}")))
-                    .chain(std::iter::once("sigma2".to_string()))
-                    .collect()
-            }
-        }
-    }
-
-    /// Number of parameters, `param_names().len()`.
-    pub fn n_params(&self) -> usize {
-        match spec(*self).params {
-            Params::Fixed(list, _) => list.len(),
-            Params::Arma => {
-                let (p, q) = self.orders();
-                p.saturating_add(q).saturating_add(1)
-            }
-        }
-    }
-
-    /// The index of a parameter by name (ASCII case-insensitive), if the kind has it.
-    pub fn param_index(&self, name: &str) -> Option<usize> {
-        self.param_names()
-            .iter()
-            .position(|n| n.eq_ignore_ascii_case(name))
-    }
-
-    /// The basic domain of parameter `index` (see [`ParamDomain`]); `None` past the end.
-    pub fn param_domain(&self, index: usize) -> Option<ParamDomain> {
-        match spec(*self).params {
-            Params::Fixed(list, _) => list.get(index).map(|(_, d)| *d),
-            // coefficients are any finite number, the innovation variance comes last
-            Params::Arma => match self.n_params() {
-                n if index + 1 == n => Some(ParamDomain::Variance),
-                n if index < n => Some(ParamDomain::Finite),
-                _ => None,
-            },
-        }
-    }
-
-    /// The AR and MA orders `(p, q)` of the ARMA-family kinds; `(0, 0)` for the others except
-    /// AR1 `(1, 0)`, MA1 `(0, 1)`, ARMA11 `(1, 1)`.
-    pub fn orders(&self) -> (usize, usize) {
-        match *self {
-            ProcessKind::Ar(p) => (p, 0),
-            ProcessKind::Ma(q) => (0, q),
-            ProcessKind::Arma(p, q) => (p, q),
-            other => match spec(other).params {
-                Params::Fixed(_, orders) => orders,
-                Params::Arma => (0, 0),
-            },
-        }
-    }
-
-    /// Whether the kind may repeat in a model (`k*GM()`, `k*AR1()`; docs/methods.md §0.2).
-    pub fn may_repeat(&self) -> bool {
-        spec(*self).occurs == Occurs::Repeats
-    }
-
-    /// Whether the kind belongs to the ARMA family (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)), of
-    /// which a model holds at most one term.
-    pub fn is_arma_family(&self) -> bool {
-        spec(*self).occurs == Occurs::ArmaFamily
-    }
-
-    /// Checks the orders of `AR(p)`, `MA(q)`, `ARMA(p,q)` (1..=[`MAX_ORDER`], `p + q >= 1`).
-    ///
-    /// # Errors
-    /// [`ModelError::BadOrder`].
-    pub fn check_orders(&self) -> Result<(), ModelError> {
-        let Some(o) = &spec(*self).orders else {
-            return Ok(());
-        };
-        let bad = |order: usize, expected: &'static str| {
-            Err(ModelError::BadOrder {
-                kind: *self,
-                order,
-                expected,
-            })
-        };
-        let (p, q) = self.orders();
-        if let Some(order) = o.written((p, q)).find(|v| !(o.min..=MAX_ORDER).contains(v)) {
-            return bad(order, o.expected);
-        }
-        if p == 0 && q == 0 {
-            return bad(0, o.all_zero);
-        }
-        Ok(())
-    }
-}
-
-impl fmt::Display for ProcessKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.name())
-    }
-}
 
 /// One term of a model: a process kind and its (optional) parameter values (docs/methods.md
 /// §0.2–§0.3).
@@ -310,7 +112,7 @@ impl Component {
             .kind
             .param_index(name)
             .ok_or_else(|| ModelError::UnknownParameter {
-                kind: self.kind,
+                kind: self.kind.name(),
                 name: name.to_string(),
                 valid: self.kind.param_names(),
             })?;
@@ -337,7 +139,7 @@ impl Component {
         if self.values.len() != self.kind.n_params() {
             return Err(ModelError::WrongLength {
                 component,
-                kind: self.kind,
+                kind: self.kind.name(),
                 expected: self.kind.n_params(),
                 found: self.values.len(),
             });
@@ -364,7 +166,7 @@ pub(crate) fn check_value(
     } else {
         Err(ModelError::BadParameter {
             component,
-            kind,
+            kind: kind.name(),
             name: kind.param_names().get(index).cloned().unwrap_or_default(),
             value,
             expected: domain.expected(),
@@ -418,113 +220,6 @@ pub fn format_value(v: f64) -> String {
     }
 }
 
-/// A model-rule violation (docs/methods.md §0.2) or an invalid component.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[non_exhaustive]
-pub enum ModelError {
-    /// A model needs at least one component.
-    #[error("a model needs at least one component, e.g. WN() or 3*GM()+WN()")]
-    Empty,
-    /// WN, QN, RW or DR (or an ARMA kind) appears more than once.
-    #[error(
-        "{kind} appears {count} times but may appear at most once; only GM and AR1 may repeat \
-         (docs/methods.md §0.2)"
-    )]
-    Repeated {
-        /// The repeated kind.
-        kind: ProcessKind,
-        /// How many times it appears.
-        count: usize,
-    },
-    /// GM and AR1 in the same model.
-    #[error(
-        "GM and AR1 may not be mixed in one model (found {gm} GM and {ar1} AR1); use one of \
-         them (docs/methods.md §0.2)"
-    )]
-    GmAr1Mixed {
-        /// Number of GM components.
-        gm: usize,
-        /// Number of AR1 components.
-        ar1: usize,
-    },
-    /// Two ARMA-family terms (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)).
-    #[error(
-        "at most one ARMA-family term (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)) per model, found \
-         {first} and {second}; a sum of ARMAs is one ARMA of higher order"
-    )]
-    ArmaFamily {
-        /// The first ARMA-family term.
-        first: ProcessKind,
-        /// The second one.
-        second: ProcessKind,
-    },
-    /// An order of AR(p), MA(q) or ARMA(p,q) out of range.
-    #[error("{kind}: order {order} is invalid: expected {expected}")]
-    BadOrder {
-        /// The kind with the bad order.
-        kind: ProcessKind,
-        /// The offending order.
-        order: usize,
-        /// What would be valid.
-        expected: &'static str,
-    },
-    /// A multiplier `k` in `k * gm()` outside 1..=[`MAX_MULTIPLIER`].
-    #[error("multiplier {k} is invalid: expected an integer from 1 to 100")]
-    BadMultiplier {
-        /// The multiplier given.
-        k: usize,
-    },
-    /// A parameter value outside its basic domain ([`ParamDomain`]).
-    #[error(
-        "component {component} (0-based) {kind}: {name} = {value} is invalid: expected {expected}"
-    )]
-    BadParameter {
-        /// 0-based component index in the model (0 for a standalone component).
-        component: usize,
-        /// Its kind.
-        kind: ProcessKind,
-        /// The parameter name (docs/methods.md §0.2).
-        name: String,
-        /// The value given.
-        value: f64,
-        /// What would be valid.
-        expected: &'static str,
-    },
-    /// A parameter name the kind does not have.
-    #[error("{kind} has no parameter {name:?}; its parameters are {}", .valid.join(", "))]
-    UnknownParameter {
-        /// The kind.
-        kind: ProcessKind,
-        /// The name given.
-        name: String,
-        /// The kind's parameter names.
-        valid: Vec<String>,
-    },
-    /// A component whose `values` length differs from its kind's parameter count.
-    #[error(
-        "component {component} (0-based) {kind} has {found} values; {kind} has {expected} \
-         parameters"
-    )]
-    WrongLength {
-        /// 0-based component index.
-        component: usize,
-        /// Its kind.
-        kind: ProcessKind,
-        /// `kind.n_params()`.
-        expected: usize,
-        /// `values.len()`.
-        found: usize,
-    },
-    /// A parameter vector whose length differs from the model's parameter count.
-    #[error("theta has {found} values; the model has {expected} parameters")]
-    ThetaLength {
-        /// `Model::n_params()`.
-        expected: usize,
-        /// Length given.
-        found: usize,
-    },
-}
-
 /// A validated latent error model: an ordered, non-empty sum of components obeying the rules of
 /// docs/methods.md §0.2 (see the [module docs](self)).
 ///
@@ -554,7 +249,7 @@ pub(crate) fn validate(components: &[Component]) -> Result<(), (usize, ModelErro
             return Err((
                 at[1],
                 ModelError::Repeated {
-                    kind,
+                    kind: kind.name(),
                     count: at.len(),
                 },
             ));
@@ -587,14 +282,17 @@ pub(crate) fn validate(components: &[Component]) -> Result<(), (usize, ModelErro
         let (first, second) = (components[arma[0]].kind, components[arma[1]].kind);
         let err = if first == second {
             ModelError::Repeated {
-                kind: first,
+                kind: first.name(),
                 count: arma
                     .iter()
                     .filter(|&&i| components[i].kind == first)
                     .count(),
             }
         } else {
-            ModelError::ArmaFamily { first, second }
+            ModelError::ArmaFamily {
+                first: first.name(),
+                second: second.name(),
+            }
         };
         return Err((arma[1], err));
     }

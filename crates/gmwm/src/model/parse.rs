@@ -486,7 +486,7 @@ impl<'a> Parser<'a> {
             (o.make)(0, order)
         };
         let rule = ModelError::BadOrder {
-            kind,
+            kind: kind.name(),
             order,
             expected: o.expected,
         };
@@ -621,7 +621,7 @@ impl<'a> Parser<'a> {
                         value_at,
                         ParseErrorKind::Rule(ModelError::BadParameter {
                             component,
-                            kind,
+                            kind: kind.name(),
                             name: names[index].clone(),
                             value: v,
                             expected: domain.expected(),

@@ -12,7 +12,7 @@
 //! is evaluated with `exp_m1` (its condition number there is below ~12). Derivatives are exact
 //! derivatives of this evaluation (forward-mode jets), so they inherit its accuracy.
 
-use crate::sim::sampler::SimRng;
+use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -20,9 +20,9 @@ use super::{
     LatentProcess, Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
-use crate::model::ParamDomain;
-use crate::sim::sampler::{normal, Sampler};
-use crate::sim::StartMode;
+use crate::process::sampler::{normal, Sampler};
+use crate::process::ParamDomain;
+use crate::process::StartMode;
 
 /// `AR1(phi, sigma2)`: may repeat (`k*AR1()`), not with GM.
 pub(crate) const AR1_SPEC: Spec = Spec {
@@ -527,7 +527,7 @@ mod tests {
     fn blocked_ar1_is_the_recursion() {
         for &phi in &[-0.9, 0.5, 0.999, 1.0 - 1e-7] {
             let sd = 0.3;
-            let rng = crate::sim::sampler::stream(7, 0);
+            let rng = crate::process::sampler::stream(7, 0);
             let mut blocked = Ar1Sampler::new(rng.clone(), phi, sd, 1.5);
             let mut out = vec![0.0; 1003];
             let (head, tail) = out.split_at_mut(5);

@@ -2,7 +2,7 @@
 //! empty) as special cases. R sign convention: AR polynomial `1 - sum ar_i B^i`, MA polynomial
 //! `1 + sum ma_i B^i`.
 
-use crate::sim::sampler::SimRng;
+use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -10,9 +10,9 @@ use super::{
     Spec,
 };
 use crate::error::ParamError;
-use crate::model::ProcessKind;
-use crate::sim::sampler::{normal, Sampler, Step};
-use crate::sim::StartMode;
+use crate::process::sampler::{normal, Sampler, Step};
+use crate::process::ProcessKind;
+use crate::process::StartMode;
 
 /// `AR(p)`, `p` from 1 to [`MAX_ORDER`](crate::model::MAX_ORDER): of the ARMA family.
 pub(crate) const AR_SPEC: Spec = Spec {

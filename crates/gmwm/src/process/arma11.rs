@@ -8,7 +8,7 @@
 //! and the AR1 part uses the stable evaluation of [`super::ar1`]. This is used for
 //! `phi > 1/2`; below, the closed form is used as written.
 
-use crate::sim::sampler::SimRng;
+use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::ar1::ar1_wv_jet;
@@ -17,9 +17,9 @@ use super::{
     LatentProcess, Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
-use crate::model::ParamDomain;
-use crate::sim::sampler::{normal, Sampler, Step};
-use crate::sim::StartMode;
+use crate::process::sampler::{normal, Sampler, Step};
+use crate::process::ParamDomain;
+use crate::process::StartMode;
 
 /// `ARMA11(phi, theta, sigma2)`: of the ARMA family.
 pub(crate) const SPEC: Spec = Spec {

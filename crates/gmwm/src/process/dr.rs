@@ -1,13 +1,13 @@
 //! Deterministic drift (docs/methods.md §0.2, §4.2, §10.1).
 
-use crate::sim::sampler::SimRng;
+use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{add_scaled, half_widths, LatentProcess, Occurs, Params, Simulate, Spec};
 use crate::error::ParamError;
-use crate::model::ParamDomain;
-use crate::sim::sampler::{Sampler, Step};
-use crate::sim::StartMode;
+use crate::process::sampler::{Sampler, Step};
+use crate::process::ParamDomain;
+use crate::process::StartMode;
 
 /// `DR(omega)`: may appear once in a model; `omega` has any sign.
 pub(crate) const SPEC: Spec = Spec {

@@ -1,6 +1,6 @@
 //! First-order moving average (docs/methods.md §0.2, §4.2, §4.5, §4.6, §10.1).
 
-use crate::sim::sampler::SimRng;
+use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -8,9 +8,9 @@ use super::{
     Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
-use crate::model::ParamDomain;
-use crate::sim::sampler::{normal, Sampler, Step};
-use crate::sim::StartMode;
+use crate::process::sampler::{normal, Sampler, Step};
+use crate::process::ParamDomain;
+use crate::process::StartMode;
 
 /// `MA1(theta, sigma2)`: an ARMA(0, 1), of the ARMA family.
 pub(crate) const SPEC: Spec = Spec {

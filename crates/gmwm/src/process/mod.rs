@@ -8,7 +8,7 @@
 //! Each process's module holds all of its facts: its name and parameters in the model language
 //! (with their domains), its validating constructor, its implied WV and derivatives, its
 //! spectral density, and how it is simulated (docs/methods.md §10.1). One table maps a
-//! [`ProcessKind`](crate::model::ProcessKind) to those facts; the model language, the model's
+//! [`ProcessKind`] to those facts; the model language, the model's
 //! validation and the simulator ([`crate::sim`]) read it.
 //!
 //! Derivatives of the closed forms are exact (forward-mode automatic differentiation of the
@@ -22,9 +22,11 @@ pub mod ar1;
 pub mod arma;
 pub mod arma11;
 pub mod dr;
+mod kind;
 pub mod ma1;
 pub mod qn;
 pub mod rw;
+pub(crate) mod sampler;
 pub mod spectral;
 mod table;
 pub mod wn;
@@ -38,12 +40,12 @@ pub use qn::Qn;
 pub use rw::Rw;
 pub use wn::Wn;
 
+pub use kind::{ParamDomain, ProcessKind, MAX_ORDER};
+pub use sampler::StartMode;
 pub(crate) use table::{spec, Occurs, Orders, Params, Spec, KINDS};
 
 use crate::error::ParamError;
-use crate::sim::sampler::Sampler;
-use crate::sim::sampler::SimRng;
-use crate::sim::StartMode;
+use sampler::{Sampler, SimRng};
 
 /// A latent process with an implied Haar wavelet variance (docs/methods.md §4). Object safe.
 pub trait LatentProcess {

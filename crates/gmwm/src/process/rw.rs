@@ -1,6 +1,6 @@
 //! Random walk (docs/methods.md §0.2, §4.2, §10.1).
 
-use crate::sim::sampler::SimRng;
+use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::ar1::Ar1Sampler;
@@ -8,9 +8,9 @@ use super::{
     add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
-use crate::model::ParamDomain;
-use crate::sim::sampler::Sampler;
-use crate::sim::StartMode;
+use crate::process::sampler::Sampler;
+use crate::process::ParamDomain;
+use crate::process::StartMode;
 
 /// `RW(gamma2)`: may appear once in a model.
 pub(crate) const SPEC: Spec = Spec {

@@ -17,7 +17,7 @@
 
 use super::{ar1, arma, arma11, dr, ma1, qn, rw, wn, Process};
 use crate::error::ParamError;
-use crate::model::{ParamDomain, ProcessKind};
+use crate::process::{ParamDomain, ProcessKind};
 
 /// The facts of one process kind (see the module docs).
 pub(crate) struct Spec {

@@ -1,15 +1,15 @@
 //! White noise (docs/methods.md §0.2, §4.2, §10.1).
 
-use crate::sim::sampler::SimRng;
+use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
 use super::{
     add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Simulate, Spec,
 };
 use crate::error::ParamError;
-use crate::model::ParamDomain;
-use crate::sim::sampler::{normal, Sampler, Step};
-use crate::sim::StartMode;
+use crate::process::sampler::{normal, Sampler, Step};
+use crate::process::ParamDomain;
+use crate::process::StartMode;
 
 /// `WN(sigma2)`: may appear once in a model.
 pub(crate) const SPEC: Spec = Spec {

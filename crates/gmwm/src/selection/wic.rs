@@ -9,13 +9,11 @@ use super::SelectionError;
 use crate::error::check_freq;
 use crate::fit::canonical::wv_separation;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
-use crate::inference::covariance::{
-    pooled_wv_covariance, wv_covariance, CovarianceMethod, VSource,
-};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{NoProgress, Progress};
 use crate::model::{Model, ProcessKind};
 use crate::sim::bootstrap::map_replicates;
+use crate::sim::covariance::{pooled_wv_covariance, wv_covariance, CovarianceMethod, VSource};
 use crate::sim::replicate_seed;
 use crate::variance::pooled::PooledWv;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
@@ -347,7 +345,7 @@ impl Wic {
     }
 
     /// [`Wic::select`] on a wavelet variance computed before (e.g. read by
-    /// [`read_wv_json`](crate::imu::read_wv_json)) instead of a series: the same steps, the
+    /// [`read_wv_json`](crate::variance::read_wv_json)) instead of a series: the same steps, the
     /// starting values from the WV alone ([`StartInputs::from_wv`]: no series range for drift
     /// draws), the bootstrap V simulated at the WV's `n` and rate with its own estimator
     /// settings (transform, filter, alpha, robustness, levels); the `wv_options` of this

@@ -8,9 +8,9 @@
 //! (docs/methods.md §7.4).
 
 pub mod bootstrap;
+pub mod covariance;
 pub mod demo;
 mod model;
-pub(crate) mod sampler;
 mod simulator;
 
 pub use demo::{DemoSensor, DEMO_FREQ_HZ, DEMO_MODEL};

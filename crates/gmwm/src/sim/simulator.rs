@@ -13,28 +13,11 @@
 //! simulated as its exact AR1 at its sampling rate (docs/methods.md §4.3). Random streams cannot
 //! match R's Mersenne Twister, so only the laws match the package (docs/methods.md §12).
 
-use super::sampler::{stream, Sampler};
 use crate::error::ParamError;
 use crate::process::qn::qn_value;
+use crate::process::sampler::{stream, Sampler};
 use crate::process::Process;
-use serde::{Deserialize, Serialize};
-
-/// How the autoregressive components (AR1, GM, ARMA11, ARMA) start.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum StartMode {
-    /// Default of the port (docs/methods.md §10.1): every sample follows the stationary law. AR1
-    /// and ARMA11 draw their initial state exactly from it; a generic ARMA(p, q) runs a burn-in of
-    /// `p + q + ceil(ln(1e-12) / ln(rho))` samples, `rho` the largest modulus of the inverse
-    /// AR roots, so the leftover transient is below `1e-12` relative.
-    #[default]
-    Stationary,
-    /// The package (docs/methods.md §10.1, §13.21): AR1 and ARMA11 start at `x = 0` (the first kept
-    /// value is `w_1`, resp. `w_1 + theta w_0`); a generic ARMA follows R's `arima.sim`
-    /// (first `q` MA outputs set to 0, AR recursion from zeros, burn-in
-    /// `p + q + ceil(6 / ln(min root modulus))`). The burn-in innovations come first in the
-    /// component's stream (R draws them after the kept ones); the law is the same.
-    Zero,
-}
+pub use crate::process::StartMode;
 
 /// A streaming simulator of a sum of independent [`Process`]es (docs/methods.md §10.2,
 /// `gen_model`).

@@ -5,6 +5,7 @@ pub mod allan;
 pub mod ci;
 pub mod cov;
 pub mod cross;
+mod file;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
 pub mod implied_cov;
@@ -14,6 +15,7 @@ pub(crate) mod simd;
 pub(crate) mod stream;
 pub mod wv;
 
+pub use file::{allan_from_wv, is_wv_json, read_wv_json, select_series};
 pub use stream::{binary_columns_wv, binary_wavelet_variance, StreamedColumn};
 pub use wv::{default_levels, kept_count};
 

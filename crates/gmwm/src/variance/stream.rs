@@ -15,6 +15,7 @@
 
 use crate::error::{check_freq, InputError, ParamError, SeriesError};
 use crate::imu::read::binary::RawRows;
+use crate::imu::read::stream::StreamedTable;
 use crate::imu::{BinaryLayout, ReadError};
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::check_alpha;
@@ -949,6 +950,44 @@ fn top_block_impl(
     };
     let kept = &scratch[skip.min(len)..];
     (carry, sum_plain(kept), sum_squares(kept))
+}
+
+/// The streamed wavelet variance of a recording read in one pass and spooled
+/// ([`StreamedTable`]): its spool read like any raw binary recording.
+impl StreamedTable {
+    /// The classical Haar MODWT wavelet variance of the selected columns `columns` (0-based
+    /// among [`names`](Self::names)), streamed from the spool
+    /// ([`binary_columns_wv`]: the same bits as for a raw binary file of the same values).
+    ///
+    /// # Errors
+    /// As [`binary_columns_wv`], naming the recording (not the spool).
+    pub fn columns_wv(
+        &self,
+        columns: &[usize],
+        freq_hz: f64,
+        opts: &WvOptions,
+    ) -> Result<Vec<StreamedColumn>, ReadError> {
+        let one_based: Vec<usize> = columns.iter().map(|c| c + 1).collect();
+        let (path, layout) = self.spool();
+        binary_columns_wv(path, &layout, &one_based, freq_hz, opts).map_err(|e| self.rename(e))
+    }
+
+    /// [`columns_wv`](Self::columns_wv) of every selected column, the WVs only.
+    ///
+    /// # Errors
+    /// As [`columns_wv`](Self::columns_wv).
+    pub fn wavelet_variance(
+        &self,
+        freq_hz: f64,
+        opts: &WvOptions,
+    ) -> Result<Vec<WaveletVariance>, ReadError> {
+        let all: Vec<usize> = (0..self.names.len()).collect();
+        Ok(self
+            .columns_wv(&all, freq_hz, opts)?
+            .into_iter()
+            .map(|c| c.wv)
+            .collect())
+    }
 }
 
 #[cfg(test)]

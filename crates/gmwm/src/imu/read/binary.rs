@@ -7,8 +7,9 @@
 
 use super::positioned::read_at;
 use super::{binary_names, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
-use crate::error::{Error, ParamError};
+use crate::error::ParamError;
 use crate::imu::timing::{check_times, TimeUnit, UnitSource};
+use crate::imu::ReadError as Error;
 use crate::imu::{Imu, ReadError, Sidecar};
 use std::fmt;
 use std::fs::File;

@@ -5,7 +5,7 @@
 //! record decoding of `binary`), the selected columns written as raw little-endian
 //! f64 to a spool file (deleted when the [`StreamedTable`] is dropped) that the streamed
 //! wavelet variance reads like any raw binary recording
-//! ([`binary_columns_wv`]), and the time column checked as it goes by.
+//! (`variance::binary_columns_wv`), and the time column checked as it goes by.
 //!
 //! Why a spool: the Haar wavelet variance at level j needs the samples `2^j` back, and the
 //! levels above 20 of the streamed pass read them back from the file (the rings would
@@ -32,7 +32,7 @@
 //! 0.73 s (plain), 1.05 s against 1.01 s (gzip); 10^7 rows, 77 MB against 711 MB, 9.3 s
 //! against 6.7 s (plain, 690 MB), 13.1 s against 10.1 s (gzip, 270 MB). The RSS grows from
 //! 10^6 to 10^7 rows mostly by the rings of levels 19 and 20 of the WV (8 MiB a column at
-//! most, [`binary_wavelet_variance`](crate::variance::binary_wavelet_variance)); at 3·10^7
+//! most, `variance::binary_wavelet_variance`); at 3·10^7
 //! rows (gzip, 806 MB) it is 98 MB (44 s), where the in-memory reader would hold 1.4 GB of
 //! columns. The time is the one parse of the in-memory reader, plus writing and reading the
 //! spool.
@@ -50,8 +50,6 @@ use crate::error::ParamError;
 use crate::imu::sidecar::{find_sidecar, Sidecar};
 use crate::imu::timing::{check_times, infer_unit, StepStats, TimeUnit, TimingReport, UnitSource};
 use crate::imu::{ImuRecordType, ReadError, SampleAccount};
-use crate::variance::{binary_columns_wv, StreamedColumn};
-use crate::WvOptions;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -229,38 +227,10 @@ impl StreamedTable {
         }
     }
 
-    /// The classical Haar MODWT wavelet variance of the selected columns `columns` (0-based
-    /// among [`names`](Self::names)), streamed from the spool
-    /// ([`binary_columns_wv`]: the same bits as for a raw binary file of the same values).
-    ///
-    /// # Errors
-    /// As [`binary_columns_wv`], naming the recording (not the spool).
-    pub fn columns_wv(
-        &self,
-        columns: &[usize],
-        freq_hz: f64,
-        opts: &WvOptions,
-    ) -> Result<Vec<StreamedColumn>, ReadError> {
-        let one_based: Vec<usize> = columns.iter().map(|c| c + 1).collect();
-        binary_columns_wv(&self.spool.path, &self.layout(), &one_based, freq_hz, opts)
-            .map_err(|e| self.rename(e))
-    }
-
-    /// [`columns_wv`](Self::columns_wv) of every selected column, the WVs only.
-    ///
-    /// # Errors
-    /// As [`columns_wv`](Self::columns_wv).
-    pub fn wavelet_variance(
-        &self,
-        freq_hz: f64,
-        opts: &WvOptions,
-    ) -> Result<Vec<crate::WaveletVariance>, ReadError> {
-        let all: Vec<usize> = (0..self.names.len()).collect();
-        Ok(self
-            .columns_wv(&all, freq_hz, opts)?
-            .into_iter()
-            .map(|c| c.wv)
-            .collect())
+    /// The spool's path and layout: the selected columns as raw little-endian f64, which the
+    /// streamed wavelet variance reads like any raw binary recording.
+    pub(crate) fn spool(&self) -> (&Path, BinaryLayout) {
+        (&self.spool.path, self.layout())
     }
 
     /// A ROS topic's streamed table (`imu::read::ros_stream`).
@@ -320,7 +290,7 @@ impl StreamedTable {
     }
 
     /// An error about a column of the spool, about the recording's column instead.
-    fn rename(&self, e: ReadError) -> ReadError {
+    pub(crate) fn rename(&self, e: ReadError) -> ReadError {
         match e {
             ReadError::Series { column, source, .. } => ReadError::Series {
                 path: self.path.clone(),

@@ -9,14 +9,13 @@
 //! `n_coefficients`, `eta` (as `gmwm wv --json` writes them; defaults: Haar MODWT, alpha 0.05,
 //! classical, counts and eta3 degrees of freedom recomputed from `n`).
 
-use super::error::{escape_name, quote};
-use super::read::{sniff, ColumnSelector, Content};
-use super::ReadError;
+use super::allan::{package_error, AllanKind, AllanVariance, AvConvention};
+use super::ci::eta3;
+use super::robust::RobustOptions;
+use super::wv::{kept_count, WaveletVariance};
 use crate::error::ParamError;
-use crate::variance::allan::{package_error, AllanKind, AllanVariance, AvConvention};
-use crate::variance::ci::eta3;
-use crate::variance::robust::RobustOptions;
-use crate::variance::wv::{kept_count, WaveletVariance};
+use crate::imu::read::{sniff, ColumnSelector, Content};
+use crate::imu::{escape_name, quote, ReadError};
 use crate::wavelet::{Transform, WaveletFilter};
 use serde::Deserialize;
 use std::path::Path;

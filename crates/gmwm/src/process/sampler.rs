@@ -10,6 +10,7 @@
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
 use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// One step of a process's recursion: the next value of its path.
@@ -80,4 +81,21 @@ pub(crate) fn stream(seed: u64, index: usize) -> SimRng {
         rng.jump();
     }
     rng
+}
+
+/// How the autoregressive components (AR1, GM, ARMA11, ARMA) start.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StartMode {
+    /// Default of the port (docs/methods.md §10.1): every sample follows the stationary law. AR1
+    /// and ARMA11 draw their initial state exactly from it; a generic ARMA(p, q) runs a burn-in of
+    /// `p + q + ceil(ln(1e-12) / ln(rho))` samples, `rho` the largest modulus of the inverse
+    /// AR roots, so the leftover transient is below `1e-12` relative.
+    #[default]
+    Stationary,
+    /// The package (docs/methods.md §10.1, §13.21): AR1 and ARMA11 start at `x = 0` (the first kept
+    /// value is `w_1`, resp. `w_1 + theta w_0`); a generic ARMA follows R's `arima.sim`
+    /// (first `q` MA outputs set to 0, AR recursion from zeros, burn-in
+    /// `p + q + ceil(6 / ln(min root modulus))`). The burn-in innovations come first in the
+    /// component's stream (R draws them after the kept ones); the law is the same.
+    Zero,
 }

@@ -11,10 +11,10 @@
 //! the model's processes and the estimator are covered and falls back to the bootstrap
 //! otherwise; [`CovarianceMethod::Bootstrap`] reproduces the package.
 
-use super::progress::Progress;
+use super::bootstrap::{map_replicates, WvBootstrap};
 use crate::error::InputError;
 use crate::model::Model;
-use crate::sim::bootstrap::{map_replicates, WvBootstrap};
+use crate::progress::Progress;
 use crate::variance::implied_cov::exact_covariance_of;
 use crate::variance::wv::WvOptions;
 use crate::wavelet::{Transform, WaveletFilter};
