@@ -665,7 +665,7 @@ pub struct CalibrateConfig {
 fn exports(a: &CalibrateArgs) -> Result<Vec<(ExportFormat, PathBuf)>> {
     let mut out = Vec::new();
     if let Some(p) = &a.kalibr {
-        out.push((ExportFormat::Kalibr, p.clone()));
+        out.push((ExportFormat::KALIBR, p.clone()));
     }
     for pair in a.export.chunks(2) {
         let [stack, file] = pair else {
@@ -673,7 +673,8 @@ fn exports(a: &CalibrateArgs) -> Result<Vec<(ExportFormat, PathBuf)>> {
         };
         let format: ExportFormat = stack.parse().map_err(|_| {
             UsageError(format!(
-                "invalid --export {stack}: one of kalibr, openvins, vins, orbslam3, px4"
+                "invalid --export {stack}: one of {}",
+                ExportFormat::names()
             ))
         })?;
         out.push((format, PathBuf::from(file)));
@@ -1513,9 +1514,9 @@ mod tests {
         assert_eq!(
             c.exports,
             [
-                (ExportFormat::Kalibr, PathBuf::from("k.yaml")),
-                (ExportFormat::Px4, PathBuf::from("p.sdf")),
-                (ExportFormat::OpenVins, PathBuf::from("o.yaml")),
+                (ExportFormat::KALIBR, PathBuf::from("k.yaml")),
+                (ExportFormat::PX4, PathBuf::from("p.sdf")),
+                (ExportFormat::OPENVINS, PathBuf::from("o.yaml")),
             ]
         );
         assert_eq!(c.adjustment, Adjustment::Inflate(2.0));

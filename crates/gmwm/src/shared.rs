@@ -64,8 +64,8 @@ use crate::fit::{
     TransformPreset,
 };
 use crate::inference::asymptotic::{sandwich, wald_interval, z_value, IntervalScale, ZConvention};
-use crate::model::{Component, Model, ProcessKind};
-use crate::process::Process;
+use crate::model::{Component, Model};
+use crate::process::{spec, Process, Role};
 use crate::variance::cross::{axis_pairs, stacked_moment_covariance, wavelet_cross_covariance};
 use crate::variance::wv::{default_levels, wavelet_variance, WaveletVariance, WvOptions};
 use crate::wavelet::{Transform, WaveletFilter};
@@ -196,7 +196,7 @@ impl SharedFit {
 }
 
 fn refuse_drift(model: &Model, which: &'static str) -> Result<(), ParamError> {
-    if model.count(ProcessKind::Dr) > 0 {
+    if model.kinds().iter().any(|&k| spec(k).role == Role::Drift) {
         return Err(ParamError::new(
             which,
             model.to_string(),

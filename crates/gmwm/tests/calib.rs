@@ -170,7 +170,7 @@ fn calibration_without_unit_reports_data_unit() {
     assert_eq!(n.unit, "u/√Hz");
     let sets = r.nav_sets(AxisPolicy::Worst, Adjustment::Estimate, None);
     assert_eq!(sets[0].noise.gyroscope.noise_density, None);
-    let err = render(ExportFormat::Kalibr, &sets[0].noise).unwrap_err();
+    let err = render(ExportFormat::KALIBR, &sets[0].noise).unwrap_err();
     assert!(err.to_string().contains("gyroscope_noise_density"), "{err}");
 }
 
@@ -199,7 +199,7 @@ fn nav_sets_follow_policy_and_adjustment() {
         per.iter().map(|s| &s.label).collect::<Vec<_>>()
     );
     assert_eq!(per[0].label, "x");
-    let yaml = render(ExportFormat::Kalibr, &worst.noise).unwrap();
+    let yaml = render(ExportFormat::KALIBR, &worst.noise).unwrap();
     assert!(yaml.contains("gyroscope_noise_density"));
 }
 

@@ -305,8 +305,8 @@ fn write_report(
         .iter()
         .map(|(f, p)| (*f, Some(p.as_path())))
         .collect();
-    if !formats.iter().any(|(f, _)| *f == ExportFormat::Kalibr) {
-        formats.insert(0, (ExportFormat::Kalibr, None));
+    if !formats.iter().any(|(f, _)| *f == ExportFormat::KALIBR) {
+        formats.insert(0, (ExportFormat::KALIBR, None));
     }
     let mut files = Vec::new();
     for (format, target) in &formats {

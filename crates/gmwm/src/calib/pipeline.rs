@@ -10,8 +10,8 @@ use crate::imu::{Imu, Sensor, SensorInfo};
 use crate::inference::{
     infer_with_covariance, CovarianceMethod, Inference, InferenceOptions, Progress,
 };
-use crate::model::{Model, ProcessKind};
-use crate::process::{Ar1, Gm};
+use crate::model::Model;
+use crate::process::{spec, Role};
 use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
 use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms};
 use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
@@ -552,7 +552,11 @@ impl Calibration {
         }
     }
 
-    /// One axis (module doc).
+    /// One axis (module doc), step by step: its unit and SI values ([`Calibration::unit_of`],
+    /// [`in_si`]), the selection ([`Calibration::select`]), the identified fit with its
+    /// inference and canonical model ([`Calibration::identify`]), the Allan variance and the
+    /// IEEE read-off ([`allan_of`]), the navigation read-offs ([`Readoff::read`]), the verdict
+    /// ([`verdict`]), the readings and the contamination check.
     #[allow(clippy::too_many_arguments)]
     fn axis(
         &self,
@@ -568,20 +572,10 @@ impl Calibration {
         let unit = self.unit_of(column, kind, recorded_unit, &mut notes)?;
         // every result in SI: the samples (or the streamed WVs) are converted once, before any
         // statistic
-        let to_si = unit.map_or(1.0, |u| u.to_si());
-        let si_values: Option<Vec<f64>> = match data {
-            AxisData::Series(values) if to_si != 1.0 => {
-                Some(values.iter().map(|v| v * to_si).collect())
-            }
-            _ => None,
-        };
+        let si_values = in_si(&data, unit);
         let data = match (&si_values, data) {
             (Some(x), _) => AxisData::Series(x),
-            (None, AxisData::Streamed { wv, robust }) if to_si != 1.0 => AxisData::Streamed {
-                wv: Box::new(wv.scaled(to_si * to_si)),
-                robust: robust.map(|r| r.map(|w| Box::new(w.scaled(to_si * to_si)))),
-            },
-            (None, d) => d,
+            (None, d) => d.scaled(unit.map_or(1.0, |u| u.to_si())),
         };
         let samples = data.samples();
         // a kind without a known unit reads in the data unit: no SI names, no datasheet forms
@@ -592,19 +586,73 @@ impl Calibration {
             (Some(_), Some(k)) => SignalUnit::si(k).symbol().to_string(),
             _ => "u".to_string(),
         };
-        let engine = |source: crate::InputError| CalibError::Engine {
+        let errors = AxisErrors { column };
+        let selection = self.select(&data, freq_hz, progress, &errors)?;
+        let wv = selection.fit.empirical.clone().ok_or_else(|| {
+            errors.fit(FitError::Length {
+                what: "stored WV",
+                expected: selection.fit.nu_hat.len(),
+                found: 0,
+            })
+        })?;
+        let (fit, inference, canonical) = self.identify(&selection).map_err(|e| errors.fit(e))?;
+        let allan =
+            allan_of(&data, freq_hz, self.options.wv.alpha).map_err(|e| errors.engine(e))?;
+        let ieee = ieee_readoff(&allan).map_err(|e| errors.engine(e.into()))?;
+        let readoff = Readoff::new(
+            &fit,
+            &canonical,
+            &inference,
+            unit_kind,
+            &unit_label,
+            freq_hz,
+        );
+        let read = readoff.read(&allan, &ieee, &mut notes);
+        let verdict = verdict(&fit, &wv, &inference, self.options.wv.alpha);
+        notes.extend(readings(&selection, &canonical));
+        let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
+        Ok(AxisCalibration {
             column: column.to_string(),
-            source,
-        };
-        let fit_error = |source: FitError| CalibError::Fit {
-            column: column.to_string(),
-            source,
-        };
+            kind,
+            axis: axis_label.to_string(),
+            data_unit: unit
+                .map(|u| u.symbol().to_string())
+                .or_else(|| recorded_unit.map(str::to_string)),
+            unit: unit_label,
+            samples,
+            model: selection.selected.to_string(),
+            canonical_model: canonical.model.to_string(),
+            identified_model: fit.model.without_values().to_string(),
+            noise_density: read.noise_density,
+            random_walk: read.random_walk,
+            bias_instability: read.bias_instability,
+            quantization: read.quantization,
+            rate_ramp: read.rate_ramp,
+            gauss_markov_bias: read.gauss_markov_bias,
+            ieee,
+            verdict,
+            canonical,
+            inference,
+            fit,
+            selection,
+            wv,
+            allan,
+            contamination,
+            notes,
+            recording_wvs: Vec::new(),
+        })
+    }
+
+    /// The WIC selection of the full model's sub-models on the axis' WV (docs/methods.md §8).
+    fn select(
+        &self,
+        data: &AxisData<'_>,
+        freq_hz: f64,
+        progress: &dyn Progress,
+        errors: &AxisErrors<'_>,
+    ) -> Result<ModelSelection, CalibError> {
         let mut wic = Wic::nested(self.options.full_model.clone())
-            .map_err(|source| CalibError::Selection {
-                column: column.to_string(),
-                source: Box::new(source),
-            })?
+            .map_err(|source| errors.selection(source))?
             .with_bootstrap(self.options.bootstrap)
             .with_covariance(self.options.covariance)
             .with_seed(self.options.seed)
@@ -613,33 +661,30 @@ impl Calibration {
         if let Some(g) = self.options.draws {
             wic = wic.with_draws(g);
         }
-        let selection = match &data {
+        match data {
             AxisData::Series(x) => wic.select_with_progress(x, freq_hz, progress),
             AxisData::Streamed { wv, .. } => wic.select_wv_with_progress(wv, progress),
             AxisData::Pooled { classical, robust } => match (self.options.wv.robust, robust) {
                 (None, _) => wic.select_pooled_wv_with_progress(classical, progress),
                 (Some(_), Some(Ok(r))) => wic.select_pooled_wv_with_progress(r, progress),
                 (Some(_), Some(Err(e))) => {
-                    return Err(engine(
+                    return Err(errors.engine(
                         crate::ParamError::new("robust wavelet variance", e, "computable").into(),
                     ))
                 }
                 (Some(_), None) => unreachable!("run_pooled computes the robust WV it fits"),
             },
         }
-        .map_err(|source| CalibError::Selection {
-            column: column.to_string(),
-            source: Box::new(source),
-        })?;
-        let wv = selection.fit.empirical.clone().ok_or_else(|| {
-            fit_error(FitError::Length {
-                what: "stored WV",
-                expected: selection.fit.nu_hat.len(),
-                found: 0,
-            })
-        })?;
-        // the identified fit: the canonical model's reduced model, fitted (a candidate of the
-        // selection when it is one) so that every reported term has estimates and intervals
+        .map_err(|source| errors.selection(source))
+    }
+
+    /// The identified fit (the canonical model's reduced model, fitted: a candidate of the
+    /// selection when it is one) so that every reported term has estimates and intervals, its
+    /// inference on the selection's V, and its canonical model.
+    fn identify(
+        &self,
+        selection: &ModelSelection,
+    ) -> Result<(GmwmFit, Inference, CanonicalModel), FitError> {
         let reduced = &selection.selected_canonical.reduced;
         let fit = match selection.candidate_fit(reduced) {
             Some(f) => f.clone(),
@@ -648,7 +693,7 @@ impl Calibration {
                 if let Some(d) = self.options.draws {
                     g = g.with_draws(d);
                 }
-                g.update(&selection.fit).map_err(fit_error)?
+                g.update(&selection.fit)?
             }
         };
         let gmwm = Gmwm::new(fit.model.clone());
@@ -663,129 +708,9 @@ impl Calibration {
                 seed: self.options.seed,
                 ..InferenceOptions::default()
             },
-        )
-        .map_err(fit_error)?;
-        let canonical = fit
-            .canonical_with(selection.separation_limit)
-            .map_err(fit_error)?;
-        let allan = match &data {
-            AxisData::Series(x) => allan_variance(
-                x,
-                freq_hz,
-                &AllanOptions {
-                    alpha: self.options.wv.alpha,
-                    ..AllanOptions::default()
-                },
-            )
-            .map_err(engine)?,
-            // docs/methods.md §3.4: the overlapping AV is twice the classical Haar WV, exactly
-            AxisData::Streamed { wv, .. } => allan_from_wv(wv).map_err(|e| engine(e.into()))?,
-            // and the pooled AV the same mean of the recordings' AVs as the pooled WV's
-            AxisData::Pooled { classical, .. } => {
-                allan_from_wv(classical.wv()).map_err(|e| engine(e.into()))?
-            }
-        };
-        let ieee = ieee_readoff(&allan).map_err(|e| engine(e.into()))?;
-        let z = inference.z;
-        let readoff = Readoff {
-            undetermined: std::cell::RefCell::new(Vec::new()),
-            offsets: fit
-                .model
-                .components()
-                .iter()
-                .scan(0, |k, c| {
-                    let o = *k;
-                    *k += c.kind.n_params();
-                    Some(o)
-                })
-                .collect(),
-            fit: &fit,
-            canonical: &canonical,
-            inference: &inference,
-            kind: unit_kind,
-            unit: &unit_label,
-            freq_hz,
-            z,
-        };
-        let noise_density = readoff.noise_density(&mut notes);
-        let random_walk = readoff.random_walk(&mut notes).or_else(|| {
-            let (bound, tau_s) = random_walk_upper_bound(&allan)?;
-            notes.push(format!(
-                "no random walk detected: its density is at most {} (the upper end of the Allan variance's band at {} s, where the bound is tightest), the value a filter can take as conservative",
-                crate::fit::report::significant(bound, 4),
-                crate::fit::report::significant(tau_s, 4)
-            ));
-            Some(Estimate {
-                status: EstimateStatus::UpperBound,
-                ..readoff.estimate(
-                    NoiseTerm::RandomWalk,
-                    bound,
-                    (None, Some(bound)),
-                    format!(
-                        "not detected: upper bound from the Allan variance's band at {} s",
-                        crate::fit::report::significant(tau_s, 4)
-                    ),
-                )
-            })
-        });
-        let quantization = readoff.single(ProcessKind::Qn, NoiseTerm::Quantization, "QN term");
-        let rate_ramp = readoff.single(ProcessKind::Dr, NoiseTerm::RateRamp, "DR term");
-        let gauss_markov_bias = readoff.gauss_markov();
-        let bias_instability = ieee.b.value.map(|value| {
-            readoff.estimate(
-                NoiseTerm::BiasInstability,
-                value,
-                (ieee.b.ci_low, ieee.b.ci_high),
-                "IEEE 952: min Allan deviation / 0.664".to_string(),
-            )
-        });
-        let verdict = verdict(&fit, &wv, &inference, self.options.wv.alpha);
-        // how the selected fit reads as the canonical model (a drift read as a random walk,
-        // ...), then what the identified fit adds
-        let mut readings: Vec<String> = selection
-            .selected_canonical
-            .readings
-            .iter()
-            .map(ToString::to_string)
-            .collect();
-        for r in &canonical.readings {
-            let text = r.to_string();
-            if !readings.contains(&text) {
-                readings.push(text);
-            }
-        }
-        notes.extend(readings);
-        let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
-        Ok(AxisCalibration {
-            column: column.to_string(),
-            kind,
-            axis: axis_label.to_string(),
-            data_unit: unit
-                .map(|u| u.symbol().to_string())
-                .or_else(|| recorded_unit.map(str::to_string)),
-            unit: unit_label,
-            samples,
-            model: selection.selected.to_string(),
-            canonical_model: canonical.model.to_string(),
-            identified_model: fit.model.without_values().to_string(),
-            noise_density,
-            random_walk,
-            bias_instability,
-            quantization,
-            rate_ramp,
-            gauss_markov_bias,
-            ieee,
-            verdict,
-            canonical,
-            inference,
-            fit,
-            selection,
-            wv,
-            allan,
-            contamination,
-            notes,
-            recording_wvs: Vec::new(),
-        })
+        )?;
+        let canonical = fit.canonical_with(selection.separation_limit)?;
+        Ok((fit, inference, canonical))
     }
 
     /// The classical WV of the axis against the robust one ([`compare_classical_robust`]);
@@ -863,6 +788,93 @@ fn compared(
     }
 }
 
+/// The column an axis' errors name.
+struct AxisErrors<'a> {
+    column: &'a str,
+}
+
+impl AxisErrors<'_> {
+    fn engine(&self, source: crate::InputError) -> CalibError {
+        CalibError::Engine {
+            column: self.column.to_string(),
+            source,
+        }
+    }
+    fn fit(&self, source: FitError) -> CalibError {
+        CalibError::Fit {
+            column: self.column.to_string(),
+            source,
+        }
+    }
+    fn selection(&self, source: SelectionError) -> CalibError {
+        CalibError::Selection {
+            column: self.column.to_string(),
+            source: Box::new(source),
+        }
+    }
+}
+
+/// The samples in SI when the unit converts them (`None` when they are SI already or are not
+/// in memory).
+fn in_si(data: &AxisData<'_>, unit: Option<SignalUnit>) -> Option<Vec<f64>> {
+    let to_si = unit.map_or(1.0, |u| u.to_si());
+    match data {
+        AxisData::Series(values) if to_si != 1.0 => {
+            Some(values.iter().map(|v| v * to_si).collect())
+        }
+        _ => None,
+    }
+}
+
+/// The overlapping Allan variance of an axis: of its samples, or twice its classical Haar WV
+/// (docs/methods.md §3.4: exactly the same), pooled as the pooled WV is.
+fn allan_of(
+    data: &AxisData<'_>,
+    freq_hz: f64,
+    alpha: f64,
+) -> Result<AllanVariance, crate::InputError> {
+    Ok(match data {
+        AxisData::Series(x) => allan_variance(
+            x,
+            freq_hz,
+            &AllanOptions {
+                alpha,
+                ..AllanOptions::default()
+            },
+        )?,
+        AxisData::Streamed { wv, .. } => allan_from_wv(wv)?,
+        AxisData::Pooled { classical, .. } => allan_from_wv(classical.wv())?,
+    })
+}
+
+/// How the selected fit reads as the canonical model (a drift read as a random walk, ...),
+/// then what the identified fit's canonical model adds.
+fn readings(selection: &ModelSelection, canonical: &CanonicalModel) -> Vec<String> {
+    let mut readings: Vec<String> = selection
+        .selected_canonical
+        .readings
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    for r in &canonical.readings {
+        let text = r.to_string();
+        if !readings.contains(&text) {
+            readings.push(text);
+        }
+    }
+    readings
+}
+
+/// The navigation read-offs of one axis ([`Readoff::read`]).
+struct ReadOffs {
+    noise_density: Option<Estimate>,
+    random_walk: Option<Estimate>,
+    bias_instability: Option<Estimate>,
+    quantization: Option<Estimate>,
+    rate_ramp: Option<Estimate>,
+    gauss_markov_bias: Option<GaussMarkovBias>,
+}
+
 /// One column of a recording, as the pipeline takes it.
 pub(crate) struct InputAxis<'a> {
     pub(crate) column: &'a str,
@@ -891,6 +903,18 @@ pub(crate) enum AxisData<'a> {
 }
 
 impl AxisData<'_> {
+    /// The data times `to_si` in every value (its WVs times `to_si^2`); the samples in memory
+    /// are converted by [`in_si`] instead.
+    fn scaled(self, to_si: f64) -> Self {
+        match self {
+            AxisData::Streamed { wv, robust } if to_si != 1.0 => AxisData::Streamed {
+                wv: Box::new(wv.scaled(to_si * to_si)),
+                robust: robust.map(|r| r.map(|w| Box::new(w.scaled(to_si * to_si)))),
+            },
+            d => d,
+        }
+    }
+
     fn samples(&self) -> usize {
         match self {
             AxisData::Series(x) => x.len(),
@@ -917,7 +941,83 @@ struct Readoff<'a> {
     z: f64,
 }
 
-impl Readoff<'_> {
+impl<'a> Readoff<'a> {
+    fn new(
+        fit: &'a GmwmFit,
+        canonical: &'a CanonicalModel,
+        inference: &'a Inference,
+        kind: Option<SignalKind>,
+        unit: &'a str,
+        freq_hz: f64,
+    ) -> Self {
+        Readoff {
+            undetermined: std::cell::RefCell::new(Vec::new()),
+            offsets: fit
+                .model
+                .components()
+                .iter()
+                .scan(0, |k, c| {
+                    let o = *k;
+                    *k += c.kind.n_params();
+                    Some(o)
+                })
+                .collect(),
+            fit,
+            canonical,
+            inference,
+            kind,
+            unit,
+            freq_hz,
+            z: inference.z,
+        }
+    }
+
+    /// Every read-off of the axis: N, K (an upper bound from the Allan variance's band when no
+    /// term carries a random walk), Q, R, the Gauss–Markov bias and B of the IEEE read-off;
+    /// what a user should know goes to `notes`.
+    fn read(&self, allan: &AllanVariance, ieee: &IeeeReadoff, notes: &mut Vec<String>) -> ReadOffs {
+        let noise_density = self.noise_density(notes);
+        let random_walk = self.random_walk(notes).or_else(|| {
+            let (bound, tau_s) = random_walk_upper_bound(allan)?;
+            notes.push(format!(
+                "no random walk detected: its density is at most {} (the upper end of the Allan variance's band at {} s, where the bound is tightest), the value a filter can take as conservative",
+                crate::fit::report::significant(bound, 4),
+                crate::fit::report::significant(tau_s, 4)
+            ));
+            Some(Estimate {
+                status: EstimateStatus::UpperBound,
+                ..self.estimate(
+                    NoiseTerm::RandomWalk,
+                    bound,
+                    (None, Some(bound)),
+                    format!(
+                        "not detected: upper bound from the Allan variance's band at {} s",
+                        crate::fit::report::significant(tau_s, 4)
+                    ),
+                )
+            })
+        });
+        let quantization = self.single(Role::Quantization, NoiseTerm::Quantization);
+        let rate_ramp = self.single(Role::Drift, NoiseTerm::RateRamp);
+        let gauss_markov_bias = self.gauss_markov();
+        let bias_instability = ieee.b.value.map(|value| {
+            self.estimate(
+                NoiseTerm::BiasInstability,
+                value,
+                (ieee.b.ci_low, ieee.b.ci_high),
+                "IEEE 952: min Allan deviation / 0.664".to_string(),
+            )
+        });
+        ReadOffs {
+            noise_density,
+            random_walk,
+            bias_instability,
+            quantization,
+            rate_ramp,
+            gauss_markov_bias,
+        }
+    }
+
     /// Index of the first parameter of each component of the fit.
     fn offsets(&self) -> &[usize] {
         &self.offsets
@@ -1007,21 +1107,11 @@ impl Readoff<'_> {
     /// `sigma2 / (1 - phi)^2` of an AR1/GM (the white noise it is at long scales).
     fn white_variance(&self, c: usize, theta: &[f64]) -> Option<f64> {
         let o = *self.offsets().get(c)?;
-        match self.fit.model.components().get(c)?.kind {
-            ProcessKind::Wn => Some(theta[o]),
-            ProcessKind::Ar1 => Some(long_run_variance(Ar1 {
-                phi: theta[o],
-                sigma2: theta[o + 1],
-            })),
-            ProcessKind::Gm => Some(long_run_variance(
-                Gm {
-                    beta: theta[o],
-                    sigma2_gm: theta[o + 1],
-                    freq_hz: self.freq_hz,
-                }
-                .to_ar1(),
-            )),
-            _ => None,
+        let kind = self.fit.model.components().get(c)?.kind;
+        let values = &theta[o..o + kind.n_params()];
+        match spec(kind) {
+            s if s.role == Role::WhiteNoise => Some(values[0]),
+            s => Some(long_run_variance((s.markov?.ar1)(values, self.freq_hz))),
         }
     }
 
@@ -1029,7 +1119,7 @@ impl Readoff<'_> {
     /// long-run density (saying so).
     fn noise_density(&self, notes: &mut Vec<String>) -> Option<Estimate> {
         let f = self.freq_hz;
-        let (from, source) = match self.canonical.term(ProcessKind::Wn) {
+        let (from, source) = match self.canonical.term_of(Role::WhiteNoise) {
             Some(t) => (t.from.clone(), "WN term".to_string()),
             None => {
                 let fastest = self.fastest_correlated()?;
@@ -1054,7 +1144,7 @@ impl Readoff<'_> {
             &from,
             &q,
             self.canonical
-                .physical(ProcessKind::Wn, "white_noise_density"),
+                .physical_of(Role::WhiteNoise, "white_noise_density"),
         );
         Some(self.estimate(NoiseTerm::NoiseDensity, value, (lo, hi), source))
     }
@@ -1086,7 +1176,7 @@ impl Readoff<'_> {
         self.canonical
             .terms
             .iter()
-            .filter(|t| matches!(t.kind, ProcessKind::Ar1 | ProcessKind::Gm) && t.from.len() == 1)
+            .filter(|t| spec(t.kind).role == Role::Correlated && t.from.len() == 1)
             .map(|t| t.from[0])
             .collect()
     }
@@ -1106,12 +1196,10 @@ impl Readoff<'_> {
             .filter(|(c, _)| kept.contains(c))
             .filter_map(|(c, comp)| {
                 let o = offsets[c];
-                let t = match comp.kind {
-                    ProcessKind::Ar1 if theta[o] > 0.0 => -1.0 / (theta[o].ln() * self.freq_hz),
-                    ProcessKind::Gm => 1.0 / theta[o],
-                    _ => return None,
-                };
-                t.is_finite().then_some((c, t))
+                let values = &theta[o..o + comp.kind.n_params()];
+                let t = (spec(comp.kind).markov?.correlation_time_s)(values, self.freq_hz);
+                // an AR1 with phi <= 0 has no correlation time
+                (t > 0.0 && t.is_finite()).then_some((c, t))
             })
             .collect();
         out.sort_by(|a, b| a.1.total_cmp(&b.1));
@@ -1122,7 +1210,7 @@ impl Readoff<'_> {
     /// driving-noise density (docs/methods.md §14.4, saying so).
     fn random_walk(&self, notes: &mut Vec<String>) -> Option<Estimate> {
         let f = self.freq_hz;
-        if let Some(t) = self.canonical.term(ProcessKind::Rw) {
+        if let Some(t) = self.canonical.term_of(Role::RandomWalk) {
             let from = t.from.clone();
             let o = self.params_of(&from);
             let q = |theta: &[f64]| (o.iter().map(|&k| theta[k]).sum::<f64>() * f).sqrt();
@@ -1130,7 +1218,7 @@ impl Readoff<'_> {
                 &from,
                 &q,
                 self.canonical
-                    .physical(ProcessKind::Rw, "rate_random_walk_density"),
+                    .physical_of(Role::RandomWalk, "rate_random_walk_density"),
             );
             return Some(self.estimate(
                 NoiseTerm::RandomWalk,
@@ -1170,9 +1258,11 @@ impl Readoff<'_> {
         out.0.is_finite().then_some(out)
     }
 
-    /// Q or R from the canonical term of `kind` (one parameter, monotone in it).
-    fn single(&self, kind: ProcessKind, term: NoiseTerm, source: &str) -> Option<Estimate> {
-        let t = self.canonical.term(kind)?;
+    /// Q or R from the canonical term of a role (one parameter, monotone in it).
+    fn single(&self, role: Role, term: NoiseTerm) -> Option<Estimate> {
+        let t = self.canonical.term_of(role)?;
+        let kind = t.kind;
+        let source = format!("{} term", t.process);
         let name = t.physical.first()?.name;
         let from = t.from.clone();
         let o = self.params_of(&from);
@@ -1185,7 +1275,7 @@ impl Readoff<'_> {
                 .map_or(f64::NAN, |p| p.value)
         };
         let (value, lo, hi) = self.checked(&from, &q, Some(t.physical[0].value));
-        Some(self.estimate(term, value, (lo, hi), source.to_string()))
+        Some(self.estimate(term, value, (lo, hi), source))
     }
 
     /// The slowest correlated term the canonical model keeps, as a Gauss–Markov bias: the bias

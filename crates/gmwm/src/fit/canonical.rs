@@ -99,7 +99,7 @@ use super::active::active_components;
 use super::report::{physical_parameters, significant, NavParameter};
 use super::{FitError, Gmwm, GmwmFit, PhiOrder};
 use crate::model::{Component, ImpliedWv, Model, ProcessKind};
-use crate::process::{Ar1, Gm};
+use crate::process::{kind_of, spec, Ar1, Role};
 use serde::Serialize;
 use std::fmt;
 
@@ -463,11 +463,25 @@ impl CanonicalModel {
             .map(|p| p.value)
     }
 
+    /// The first term of a role (the white noise, the random walk, ...).
+    pub(crate) fn term_of(&self, role: Role) -> Option<&CanonicalTerm> {
+        self.terms.iter().find(|t| spec(t.kind).role == role)
+    }
+
+    /// The value of the physical quantity `name` of the term of a role.
+    pub(crate) fn physical_of(&self, role: Role, name: &str) -> Option<f64> {
+        self.term_of(role)?
+            .physical
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.value)
+    }
+
     /// Number of correlated-noise terms (AR1/GM).
     pub fn correlated_terms(&self) -> usize {
         self.terms
             .iter()
-            .filter(|t| matches!(t.kind, ProcessKind::Ar1 | ProcessKind::Gm))
+            .filter(|t| spec(t.kind).role == Role::Correlated)
             .count()
     }
 }
@@ -515,41 +529,22 @@ impl Part {
             .collect()
     }
 
-    /// The per-sample AR1 form of an AR1/GM part (docs/methods.md §4.3).
+    /// The per-sample AR1 form of a correlated part (docs/methods.md §4.3).
     fn ar1(&self, freq_hz: f64) -> Option<Ar1> {
-        let v = self.values();
-        match self.kind() {
-            ProcessKind::Ar1 => Some(Ar1 {
-                phi: v[0],
-                sigma2: v[1],
-            }),
-            ProcessKind::Gm => Some(
-                Gm {
-                    beta: v[0],
-                    sigma2_gm: v[1],
-                    freq_hz,
-                }
-                .to_ar1(),
-            ),
-            _ => None,
-        }
+        let markov = spec(self.kind()).markov?;
+        Some((markov.ar1)(&self.values(), freq_hz))
     }
 
-    /// Correlation time in seconds of an AR1/GM part: `1 / beta` for a GM (exact even where
-    /// phi underflows), `-1 / (f ln phi)` for an AR1 (0 for `phi <= 0`).
+    /// Correlation time in seconds of a correlated part: `1 / beta` for a GM (exact even
+    /// where phi underflows), `-1 / (f ln phi)` for an AR1 (0 for `phi <= 0`).
     fn correlation_time_s(&self, freq_hz: f64) -> Option<f64> {
-        match self.kind() {
-            ProcessKind::Gm => Some(1.0 / self.values()[0]),
-            ProcessKind::Ar1 => {
-                let phi = self.values()[0];
-                Some(if phi > 0.0 {
-                    -1.0 / (phi.ln() * freq_hz)
-                } else {
-                    0.0
-                })
-            }
-            _ => None,
-        }
+        let markov = spec(self.kind()).markov?;
+        Some((markov.correlation_time_s)(&self.values(), freq_hz))
+    }
+
+    /// What the part is to a navigation filter.
+    fn role(&self) -> Role {
+        spec(self.kind()).role
     }
 
     /// Rule 3: the correlation time is below the sampling interval.
@@ -559,15 +554,9 @@ impl Part {
     }
 }
 
-/// An AR1/GM part of `kind` with the AR1 form `ar1` (GM through docs/methods.md §4.3).
+/// A correlated part of `kind` with the AR1 form `ar1` (GM through docs/methods.md §4.3).
 fn part_from_ar1(kind: ProcessKind, ar1: Ar1, freq_hz: f64, from: Vec<usize>) -> Option<Part> {
-    let values = match kind {
-        ProcessKind::Gm => {
-            let gm = ar1.to_gm(freq_hz).ok()?;
-            vec![gm.beta, gm.sigma2_gm]
-        }
-        _ => vec![ar1.phi, ar1.sigma2],
-    };
+    let values = (spec(kind).markov?.from_ar1)(ar1, freq_hz)?;
     Some(Part {
         component: Component::new(kind, values.into_iter().map(Some).collect()).ok()?,
         from,
@@ -580,8 +569,10 @@ pub(crate) fn long_run_variance(ar1: Ar1) -> f64 {
     ar1.sigma2 / ((1.0 - ar1.phi) * (1.0 - ar1.phi))
 }
 
-/// Adds a one-parameter term (WN, RW) to `parts`: to the existing one's value, or as a new part.
-fn add_single(parts: &mut Vec<Part>, kind: ProcessKind, value: f64, from: &[usize]) -> Option<()> {
+/// Adds a one-parameter term of a role (white noise, random walk) to `parts`: to the existing
+/// one's value, or as a new part.
+fn add_single(parts: &mut Vec<Part>, role: Role, value: f64, from: &[usize]) -> Option<()> {
+    let kind = kind_of(role);
     match parts.iter_mut().find(|p| p.kind() == kind) {
         Some(p) => {
             let v = p.values()[0] + value;
@@ -750,11 +741,11 @@ impl GmwmFit {
                         sampling_interval_s: 1.0 / freq,
                         separation: wv_separation(&state.implied.wv, &read, &log_variance),
                     });
-                    add_single(&mut terms_parts, ProcessKind::Wn, sigma2, &p.from)
+                    add_single(&mut terms_parts, Role::WhiteNoise, sigma2, &p.from)
                         .ok_or_else(|| bad_value("white noise", sigma2))?;
                 }
-                _ if p.kind() == ProcessKind::Wn => {
-                    add_single(&mut terms_parts, ProcessKind::Wn, p.values()[0], &p.from)
+                _ if p.role() == Role::WhiteNoise => {
+                    add_single(&mut terms_parts, Role::WhiteNoise, p.values()[0], &p.from)
                         .ok_or_else(|| bad_value("white noise", p.values()[0]))?;
                 }
                 _ => terms_parts.push(p.clone()),
@@ -819,7 +810,7 @@ impl GmwmFit {
             if rises_everywhere(&state.implied, k) {
                 let mut next = parts.clone();
                 next.remove(k);
-                if add_single(&mut next, ProcessKind::Rw, ar1.sigma2, &p.from).is_some() {
+                if add_single(&mut next, Role::RandomWalk, ar1.sigma2, &p.from).is_some() {
                     out.push(Reduction {
                         parts: next,
                         reading: Reading::RandomWalkAtObservedScales {
@@ -836,7 +827,8 @@ impl GmwmFit {
             if falls_everywhere(&state.implied, k) {
                 let mut next = parts.clone();
                 next.remove(k);
-                if add_single(&mut next, ProcessKind::Wn, long_run_variance(ar1), &p.from).is_some()
+                if add_single(&mut next, Role::WhiteNoise, long_run_variance(ar1), &p.from)
+                    .is_some()
                 {
                     out.push(Reduction {
                         parts: next,
@@ -891,17 +883,17 @@ impl GmwmFit {
                 rising: None,
             });
         }
-        if let Some(k) = parts.iter().position(|p| p.kind() == ProcessKind::Dr) {
+        if let Some(k) = parts.iter().position(|p| p.role() == Role::Drift) {
             let omega = parts[k].values()[0];
             let tau_last = (self.nu_hat.len() as f64).exp2();
             let mut next = parts.clone();
             let from = next.remove(k).from;
-            let has_rw = next.iter().any(|p| p.kind() == ProcessKind::Rw);
+            let has_rw = next.iter().any(|p| p.role() == Role::RandomWalk);
             let gamma2 = 0.75 * omega * omega * tau_last;
             let ok = if has_rw {
                 Some(())
             } else {
-                add_single(&mut next, ProcessKind::Rw, gamma2, &from)
+                add_single(&mut next, Role::RandomWalk, gamma2, &from)
             };
             if ok.is_some() && (has_rw || gamma2 > 0.0) {
                 out.push(Reduction {
@@ -1000,21 +992,14 @@ fn model_of(parts: &[Part]) -> Result<Model, crate::model::ModelError> {
     Model::new(parts.iter().map(|p| p.component.clone()).collect())
 }
 
-/// Canonical term order: AR1/GM by decreasing correlation time (phi decreasing), then WN, QN,
-/// RW, DR, then anything else in the given order.
+/// Canonical term order: by role ([`Role`]: correlated terms by decreasing correlation time
+/// (phi decreasing), then WN, QN, RW, DR, then anything else), in the given order within a
+/// role.
 fn canonical_order(mut parts: Vec<Part>, freq_hz: f64) -> Vec<Part> {
-    let rank = |p: &Part| match p.kind() {
-        ProcessKind::Ar1 | ProcessKind::Gm => 0,
-        ProcessKind::Wn => 1,
-        ProcessKind::Qn => 2,
-        ProcessKind::Rw => 3,
-        ProcessKind::Dr => 4,
-        _ => 5,
-    };
     let phi = |p: &Part| p.ar1(freq_hz).map_or(0.0, |a| a.phi);
     parts.sort_by(|a, b| {
-        rank(a)
-            .cmp(&rank(b))
+        a.role()
+            .cmp(&b.role())
             .then_with(|| phi(b).total_cmp(&phi(a)))
     });
     parts

@@ -19,7 +19,7 @@
 //! matrix needs.
 
 use super::GmwmFit;
-use crate::model::ProcessKind;
+use crate::process::{spec, ProcessKind};
 use serde::Serialize;
 use std::fmt;
 
@@ -133,21 +133,19 @@ impl GmwmFit {
 }
 
 impl Ar1GmForms {
-    /// Both forms of an AR1 (`theta = [phi, sigma2]`) or GM (`[beta, sigma2_gm]`) component
-    /// at `freq_hz` (docs/methods.md §4.3); `None` for other kinds.
+    /// Both forms of a correlated component (AR1 `theta = [phi, sigma2]`, GM `[beta,
+    /// sigma2_gm]`) at `freq_hz` (docs/methods.md §4.3); `None` for other kinds.
     pub(crate) fn of(
         kind: ProcessKind,
         index: usize,
         theta: &[f64],
         freq_hz: f64,
     ) -> Option<Ar1GmForms> {
-        let dt = 1.0 / freq_hz;
-        let (a, b) = (*theta.first()?, *theta.get(1)?);
-        let (phi, sigma2, beta, sigma2_gm) = match kind {
-            ProcessKind::Ar1 => (a, b, -a.ln() / dt, b / (1.0 - a * a)),
-            ProcessKind::Gm => ((-a * dt).exp(), -b * (-2.0 * a * dt).exp_m1(), a, b),
-            _ => return None,
-        };
+        let markov = spec(kind).markov?;
+        if theta.len() < 2 {
+            return None;
+        }
+        let (phi, sigma2, beta, sigma2_gm) = (markov.forms)(theta, freq_hz);
         Some(Ar1GmForms {
             process: kind.name(),
             index,
@@ -161,8 +159,9 @@ impl Ar1GmForms {
 }
 
 /// The physical parameters of one component (module table) with parameters `theta` (docs/methods.md
-/// §0.2 order) at `freq_hz`; `unit` names the data unit (`"u"` when `None`); empty for the MA
-/// and ARMA kinds. `index` is the component's position, copied into each entry.
+/// §0.2 order) at `freq_hz`, as its kind reads them off ([`Spec`](crate::process::Spec)); `unit`
+/// names the data unit (`"u"` when `None`); empty for the MA and ARMA kinds. `index` is the
+/// component's position, copied into each entry.
 pub(crate) fn physical_parameters(
     kind: ProcessKind,
     index: usize,
@@ -170,47 +169,19 @@ pub(crate) fn physical_parameters(
     freq_hz: f64,
     unit: Option<&str>,
 ) -> Vec<NavParameter> {
-    let u = unit.unwrap_or("u");
-    let f = freq_hz;
-    let v = theta.first().copied().unwrap_or(f64::NAN);
-    let entry = |name, value, unit: String| NavParameter {
-        process: kind.name(),
-        index,
-        name,
-        value,
-        unit,
-    };
-    match kind {
-        ProcessKind::Wn => vec![entry(
-            "white_noise_density",
-            (v / f).sqrt(),
-            format!("{u}/sqrt(Hz)"),
-        )],
-        ProcessKind::Qn => vec![entry(
-            "quantization_coefficient",
-            v.sqrt() / f,
-            format!("{u}*s"),
-        )],
-        ProcessKind::Rw => vec![entry(
-            "rate_random_walk_density",
-            (v * f).sqrt(),
-            format!("{u}*sqrt(Hz)"),
-        )],
-        ProcessKind::Dr => vec![entry("drift_rate", v * f, format!("{u}/s"))],
-        ProcessKind::Ar1 | ProcessKind::Gm => match Ar1GmForms::of(kind, index, theta, f) {
-            Some(g) => vec![
-                entry("correlation_time", g.correlation_time_s, "s".to_string()),
-                entry("gm_std", g.sigma2_gm.sqrt(), u.to_string()),
-                entry(
-                    "driving_noise_density",
-                    (2.0 * g.beta * g.sigma2_gm).sqrt(),
-                    format!("{u}*sqrt(Hz)"),
-                ),
-            ],
-            None => Vec::new(),
-        },
-        _ => Vec::new(),
+    if theta.is_empty() {
+        return Vec::new();
     }
+    (spec(kind).physical)(theta, freq_hz, unit.unwrap_or("u"))
+        .into_iter()
+        .map(|(name, value, unit)| NavParameter {
+            process: kind.name(),
+            index,
+            name,
+            value,
+            unit,
+        })
+        .collect()
 }
 
 /// Six significant digits ([`significant`]).

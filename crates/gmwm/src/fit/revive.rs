@@ -24,6 +24,7 @@
 use super::active::active_components;
 use super::FitError;
 use crate::model::{Component, ImpliedWv, Model, ProcessKind};
+use crate::process::{spec, UnitShape};
 
 /// Revivals per fit at most (each one a further minimisation).
 pub(crate) const MAX_REVIVALS: usize = 3;
@@ -85,31 +86,10 @@ pub(crate) fn revival_start(
     }))
 }
 
-/// A unit-scale parameter vector (scale parameter last) and the map from the WV multiplier
-/// `t` to the scale parameter.
-type UnitShape = (Vec<f64>, fn(f64) -> f64);
-
-/// The unit shapes of a component kind; empty for the ARMA family (not revived).
+/// The unit shapes of a component kind ([`Spec::unit_shapes`](crate::process::Spec)); none
+/// for the ARMA family (not revived).
 fn unit_shapes(kind: ProcessKind, levels: usize, freq_hz: f64) -> Vec<UnitShape> {
-    let identity: fn(f64) -> f64 = |t| t;
-    match kind {
-        ProcessKind::Wn | ProcessKind::Qn | ProcessKind::Rw => vec![(vec![1.0], identity)],
-        ProcessKind::Dr => vec![(vec![1.0], f64::sqrt)],
-        ProcessKind::Ar1 | ProcessKind::Gm => (0..=2 * levels + 4)
-            .map(|m| {
-                // correlation length 2^((m - 2) / 2) samples: 0.5 ... 2^(J + 1)
-                let length = 2f64.powf((m as f64 - 2.0) / 2.0);
-                let phi = (-1.0 / length).exp();
-                let first = if kind == ProcessKind::Gm {
-                    -phi.ln() * freq_hz
-                } else {
-                    phi
-                };
-                (vec![first, 1.0], identity)
-            })
-            .collect(),
-        _ => Vec::new(),
-    }
+    (spec(kind).unit_shapes)(levels, freq_hz)
 }
 
 #[cfg(test)]

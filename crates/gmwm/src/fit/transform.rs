@@ -12,122 +12,10 @@
 //! `beta = -freq ln(1 - c)`. Label switching then cannot happen and §5.6 needs no reordering.
 
 use super::FitError;
-use crate::model::{Model, ProcessKind};
+use crate::model::Model;
+pub use crate::process::{logistic, ParamTransform, TransformPreset, RESTART_EDGE};
+use crate::process::{spec, ChainSlot as Slot};
 use serde::{Deserialize, Serialize};
-
-/// Logistic function `1 / (1 + e^{-u})`, evaluated without overflow for either sign of `u`.
-pub fn logistic(u: f64) -> f64 {
-    if u >= 0.0 {
-        1.0 / (1.0 + (-u).exp())
-    } else {
-        let e = u.exp();
-        e / (1.0 + e)
-    }
-}
-
-/// One scalar transform `theta = g(u)` (docs/methods.md §5.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ParamTransform {
-    /// `u = theta`.
-    Identity,
-    /// `u = ln theta`, theta in (0, inf): variances, GM beta.
-    Log,
-    /// `u = ln(theta / (1 - theta))`, theta in (0, 1).
-    Logit,
-    /// Pseudo-logit `u = ln((1 + theta) / (1 - theta))`, theta in (-1, 1); inverse
-    /// `2 / (1 + e^{-u}) - 1`.
-    PseudoLogit,
-    /// Logit2 `u = ln((theta + 2) / (2 - theta))`, theta in (-2, 2); inverse `4 / (1 + e^{-u}) - 2`.
-    Logit2,
-    /// `u = ln |theta|`, inverse `e^u`: the DR slope, whose sign is lost (the estimate is >= 0).
-    LogAbs,
-}
-
-impl ParamTransform {
-    /// The open domain of theta, in words (for error messages).
-    pub fn domain(self) -> &'static str {
-        match self {
-            ParamTransform::Identity => "a finite number",
-            ParamTransform::Log => "a finite number > 0",
-            ParamTransform::Logit => "a number in (0, 1)",
-            ParamTransform::PseudoLogit => "a number in (-1, 1)",
-            ParamTransform::Logit2 => "a number in (-2, 2)",
-            ParamTransform::LogAbs => "a finite non-zero number",
-        }
-    }
-
-    /// docs/methods.md §5.3: `u = g^{-1}(theta)`; `None` when theta is outside the open domain.
-    pub fn to_u(self, theta: f64) -> Option<f64> {
-        if !theta.is_finite() {
-            return None;
-        }
-        let u = match self {
-            ParamTransform::Identity => theta,
-            ParamTransform::Log if theta > 0.0 => theta.ln(),
-            ParamTransform::Logit if theta > 0.0 && theta < 1.0 => (theta / (1.0 - theta)).ln(),
-            ParamTransform::PseudoLogit if theta.abs() < 1.0 => 2.0 * theta.atanh(),
-            ParamTransform::Logit2 if theta.abs() < 2.0 => ((theta + 2.0) / (2.0 - theta)).ln(),
-            ParamTransform::LogAbs if theta != 0.0 => theta.abs().ln(),
-            _ => return None,
-        };
-        u.is_finite().then_some(u)
-    }
-
-    /// `theta` moved just inside the domain when it lies exactly on its closed edge (an
-    /// estimate whose `u` ran off to +-inf rounds onto it: a variance or drift of 0, a phi of
-    /// 0 or 1); other values unchanged. See [`Parametrisation::to_u_restart`].
-    pub fn inside(self, theta: f64) -> f64 {
-        let e = RESTART_EDGE;
-        match self {
-            ParamTransform::Log | ParamTransform::LogAbs if theta == 0.0 => f64::MIN_POSITIVE,
-            ParamTransform::Logit if theta == 0.0 => e,
-            ParamTransform::Logit if theta == 1.0 => 1.0 - e,
-            ParamTransform::PseudoLogit if theta.abs() == 1.0 => theta * (1.0 - e),
-            ParamTransform::Logit2 if theta.abs() == 2.0 => theta * (1.0 - e),
-            _ => theta,
-        }
-    }
-
-    /// docs/methods.md §5.3: `theta = g(u)`.
-    pub fn from_u(self, u: f64) -> f64 {
-        match self {
-            ParamTransform::Identity => u,
-            ParamTransform::Log | ParamTransform::LogAbs => u.exp(),
-            ParamTransform::Logit => logistic(u),
-            // 2 logistic(u) - 1 = tanh(u / 2), without the cancellation near u = 0
-            ParamTransform::PseudoLogit => (0.5 * u).tanh(),
-            ParamTransform::Logit2 => 2.0 * (0.5 * u).tanh(),
-        }
-    }
-
-    /// `d theta / d u` at `u`.
-    pub fn dtheta_du(self, u: f64) -> f64 {
-        let s = || logistic(u) * logistic(-u);
-        match self {
-            ParamTransform::Identity => 1.0,
-            ParamTransform::Log | ParamTransform::LogAbs => u.exp(),
-            ParamTransform::Logit => s(),
-            ParamTransform::PseudoLogit => 2.0 * s(),
-            ParamTransform::Logit2 => 4.0 * s(),
-        }
-    }
-}
-
-/// Relative distance from the edge of its domain at which an estimate on the edge restarts
-/// ([`Parametrisation::to_u_restart`]): a phi of 0 restarts at 1e-9, of 1 at 1 - 1e-9.
-pub const RESTART_EDGE: f64 = 1e-9;
-
-/// Which table of docs/methods.md §5.3 to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum TransformPreset {
-    /// model.type "imu" (the package default since 2020, §5.7): AR1/GM `phi` in (0, 1).
-    #[default]
-    Imu,
-    /// model.type "ssm": AR1 `phi` in (-1, 1); ARMA coefficients of order > 1 in (-2, 2).
-    Ssm,
-}
 
 /// How several AR1/GM components are parametrised (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -139,15 +27,6 @@ pub enum PhiOrder {
     Ordered,
     /// Each `phi` (GM: `beta`) on its own, as the package (no ordering constraint).
     Free,
-}
-
-/// What an ordered slot holds.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Slot {
-    /// AR1 `phi`.
-    Phi,
-    /// GM `beta` at this rate (Hz).
-    Beta(f64),
 }
 
 /// The map `u -> theta` of a whole model (docs/methods.md §5.3).
@@ -181,11 +60,10 @@ impl Parametrisation {
         order: PhiOrder,
         freq_hz: f64,
     ) -> Result<Self, FitError> {
-        use ParamTransform as T;
-        let ssm = preset == TransformPreset::Ssm;
-        let n_ordered = model.count(ProcessKind::Ar1) + model.count(ProcessKind::Gm);
+        let specs: Vec<_> = model.components().iter().map(|c| spec(c.kind)).collect();
+        let n_ordered = specs.iter().filter(|s| s.chain.is_some()).count();
         let chain = order == PhiOrder::Ordered && n_ordered >= 2;
-        if model.uses_gm() && !(freq_hz.is_finite() && freq_hz > 0.0) {
+        if specs.iter().any(|s| s.needs_rate) && !(freq_hz.is_finite() && freq_hz > 0.0) {
             return Err(FitError::BadStart(
                 crate::ParamError::new("freq", freq_hz, "must be a positive number of hertz")
                     .into(),
@@ -194,58 +72,31 @@ impl Parametrisation {
         let mut single = Vec::with_capacity(model.n_params());
         let mut ordered = Vec::new();
         let mut names = Vec::with_capacity(model.n_params());
-        for (ci, c) in model.components().iter().enumerate() {
+        // the chain's `1 - phi` spans `1 - lo`, `lo` the highest lower end of its phis (a GM's
+        // phi lies in (0, 1) whatever the preset; an AR1's follows it)
+        let mut lo = f64::NEG_INFINITY;
+        for (ci, (c, s)) in model.components().iter().zip(&specs).enumerate() {
             let kind = c.kind;
             for name in kind.param_names() {
                 names.push(format!("{}[{ci}].{name}", kind.base_name()));
             }
-            let coef = |order: usize| {
-                if ssm && order > 1 {
-                    T::Logit2
-                } else {
-                    T::PseudoLogit
-                }
-            };
-            let unit = if ssm { T::PseudoLogit } else { T::Logit };
             let at = single.len();
-            match kind {
-                ProcessKind::Wn | ProcessKind::Qn | ProcessKind::Rw => single.push(Some(T::Log)),
-                ProcessKind::Dr => single.push(Some(T::LogAbs)),
-                ProcessKind::Ar1 | ProcessKind::Gm => {
-                    if chain {
-                        let slot = if kind == ProcessKind::Gm {
-                            Slot::Beta(freq_hz)
-                        } else {
-                            Slot::Phi
-                        };
-                        ordered.push((at, ci, slot));
-                        single.push(None);
-                    } else if kind == ProcessKind::Gm {
-                        single.push(Some(T::Log));
-                    } else {
-                        single.push(Some(unit));
-                    }
-                    single.push(Some(T::Log));
-                }
-                ProcessKind::Ma1 => single.extend([Some(unit), Some(T::Log)]),
-                ProcessKind::Arma11 => {
-                    single.extend([Some(T::PseudoLogit), Some(T::PseudoLogit), Some(T::Log)])
-                }
-                ProcessKind::Ar(_) | ProcessKind::Ma(_) | ProcessKind::Arma(..) => {
-                    let (p, q) = kind.orders();
-                    let (tp, tq) = if ssm {
-                        (coef(p), coef(q))
-                    } else {
-                        (T::PseudoLogit, T::PseudoLogit)
-                    };
-                    single.extend(std::iter::repeat(Some(tp)).take(p));
-                    single.extend(std::iter::repeat(Some(tq)).take(q));
-                    single.push(Some(T::Log));
+            let mut transforms: Vec<Option<ParamTransform>> =
+                (s.transforms)(kind, preset).into_iter().map(Some).collect();
+            if let Some(slot) = s.chain.map(|slot| slot(freq_hz)) {
+                lo = lo.max(slot.lower(preset));
+                if chain {
+                    ordered.push((at, ci, slot));
+                    transforms[0] = None;
                 }
             }
+            single.extend(transforms);
         }
-        // GM phis lie in (0, 1) whatever the preset; AR1 follows the preset.
-        let width = if ssm && !model.uses_gm() { 2.0 } else { 1.0 };
+        let width = if lo == f64::NEG_INFINITY {
+            1.0
+        } else {
+            1.0 - lo
+        };
         Ok(Self {
             single,
             ordered,
@@ -308,14 +159,6 @@ impl Parametrisation {
         }
     }
 
-    /// `1 - phi` of an ordered slot holding `v` (exact for GM: `-expm1(-beta / freq)`).
-    fn complement(slot: Slot, v: f64) -> f64 {
-        match slot {
-            Slot::Phi => 1.0 - v,
-            Slot::Beta(freq) => -(-v / freq).exp_m1(),
-        }
-    }
-
     /// docs/methods.md §5.3 (and the ordered chain of the module doc): `u` from `theta`.
     ///
     /// # Errors
@@ -352,29 +195,21 @@ impl Parametrisation {
         for s in (0..k).rev() {
             let (i, ci, slot) = self.ordered[s];
             let v = theta[i];
-            let mut c = Self::complement(slot, v);
+            let mut c = slot.complement(v);
             if restart && c.is_finite() && (0.0..=upper).contains(&c) {
                 c = c.clamp(upper * RESTART_EDGE, upper * (1.0 - RESTART_EDGE));
             }
-            let domain = match slot {
-                Slot::Phi if self.width > 1.0 => "phi in (-1, 1)",
-                Slot::Phi => "phi in (0, 1)",
-                Slot::Beta(_) => "beta > 0 with exp(-beta / freq) not rounding to 0 or 1",
-            };
+            let domain = slot.domain(self.width);
             if !(c.is_finite() && c > 0.0 && c < self.width) {
                 return Err(self.out_of_domain(i, v, domain));
             }
             if c >= upper {
                 let (j, cj, slot_j) = self.ordered[s + 1];
-                let phi = |slot: Slot, v: f64| match slot {
-                    Slot::Phi => v,
-                    Slot::Beta(freq) => (-v / freq).exp(),
-                };
                 return Err(FitError::PhiNotOrdered {
                     first: ci,
                     second: cj,
-                    phi_first: phi(slot, v),
-                    phi_second: phi(slot_j, theta[j]),
+                    phi_first: slot.phi(v),
+                    phi_second: slot_j.phi(theta[j]),
                 });
             }
             // c = upper * logistic(-u)  =>  u = ln((upper - c) / c)
@@ -439,10 +274,7 @@ impl Parametrisation {
         for s in (0..k).rev() {
             let (i, _, slot) = self.ordered[s];
             c *= logistic(-u[i]);
-            let (value, dvalue_dc) = match slot {
-                Slot::Phi => (1.0 - c, -1.0),
-                Slot::Beta(freq) => (-freq * (-c).ln_1p(), freq / (1.0 - c)),
-            };
+            let (value, dvalue_dc) = slot.value(c);
             theta[i] = value;
             if let Some(j) = jac.as_deref_mut() {
                 for &(r, _, _) in &self.ordered[s..] {
@@ -470,13 +302,14 @@ impl Parametrisation {
         let mut starts = Vec::new();
         let mut at = 0;
         for c in model.components() {
-            if matches!(c.kind, ProcessKind::Ar1 | ProcessKind::Gm) {
-                starts.push((at, c.kind == ProcessKind::Gm));
+            // the rate does not change the order: phi decreasing is beta increasing
+            if let Some(slot) = spec(c.kind).chain.map(|slot| slot(1.0)) {
+                starts.push((at, slot));
             }
             at += c.kind.n_params();
         }
-        // sort key: phi decreasing == (for GM) beta increasing; NaN keys keep their place last
-        let key = |&(i, gm): &(usize, bool)| if gm { -theta[i] } else { theta[i] };
+        // sort key: phi decreasing; NaN keys keep their place last
+        let key = |&(i, slot): &(usize, Slot)| slot.order_key(theta[i]);
         let mut sorted = starts.clone();
         sorted.sort_by(|a, b| key(b).total_cmp(&key(a)));
         let mut out = theta.to_vec();

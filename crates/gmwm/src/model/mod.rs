@@ -255,15 +255,14 @@ pub(crate) fn validate(components: &[Component]) -> Result<(), (usize, ModelErro
             ));
         }
     }
-    let gm = components
-        .iter()
-        .filter(|c| c.kind == ProcessKind::Gm)
-        .count();
-    let ar1 = components
-        .iter()
-        .filter(|c| c.kind == ProcessKind::Ar1)
-        .count();
-    if gm > 0 && ar1 > 0 {
+    // a kind and the kind it reparametrises (GM, AR1) are not mixed
+    let count = |kind: ProcessKind| components.iter().filter(|c| c.kind == kind).count();
+    let mixed = KINDS.iter().find_map(|&kind| {
+        let base = spec(kind).reparametrises?;
+        let (n, m) = (count(kind), count(base));
+        (n > 0 && m > 0).then_some((n, m))
+    });
+    if let Some((gm, ar1)) = mixed {
         // point at the first component of whichever kind came second
         let first_rep = components
             .iter()
@@ -407,16 +406,6 @@ impl Model {
     /// How many components have exactly this kind (`AR(2)` and `AR(3)` differ).
     pub fn count(&self, kind: ProcessKind) -> usize {
         self.components.iter().filter(|c| c.kind == kind).count()
-    }
-
-    /// Whether the model has a GM component (GM parametrisation, docs/methods.md §4.3).
-    pub fn uses_gm(&self) -> bool {
-        self.count(ProcessKind::Gm) > 0
-    }
-
-    /// Whether the model has an AR1 component.
-    pub fn uses_ar1(&self) -> bool {
-        self.count(ProcessKind::Ar1) > 0
     }
 
     /// The kinds in model order.

@@ -12,6 +12,11 @@
 //! is evaluated with `exp_m1` (its condition number there is below ~12). Derivatives are exact
 //! derivatives of this evaluation (forward-mode jets), so they inherit its accuracy.
 
+use super::draw::Draw;
+use super::{
+    negative_phi, ChainSlot, CovariancePart, Markov, MarkovForms, ParamTransform, Physical,
+    ProcessKind, Role, UnitShape, BASE,
+};
 use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +43,29 @@ pub(crate) const AR1_SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::Repeats,
     build: |_, v, _| Ok(Ar1::new(v[0], v[1])?.into()),
+    role: Role::Correlated,
+    transforms: |_, preset| vec![preset.unit_coefficient(), ParamTransform::Log],
+    chain: Some(|_| ChainSlot::Phi),
+    draw: |d, _, given, out| draw_markov(d, false, given, out),
+    unit_shapes: |levels, _| unit_shapes(levels, |phi| phi),
+    markov: Some(Markov {
+        ar1: |v, _| Ar1 {
+            phi: v[0],
+            sigma2: v[1],
+        },
+        from_ar1: |a, _| Some(vec![a.phi, a.sigma2]),
+        correlation_time_s: |v, freq_hz| {
+            let phi = v[0];
+            if phi > 0.0 {
+                -1.0 / (phi.ln() * freq_hz)
+            } else {
+                0.0
+            }
+        },
+        forms: ar1_forms,
+    }),
+    physical: |v, freq_hz, u| markov_physical(v, freq_hz, u, ar1_forms),
+    ..BASE
 };
 
 /// `GM(beta, sigma2_gm)` at the model's sampling rate: may repeat (`k*GM()`), not with AR1.
@@ -54,7 +82,127 @@ pub(crate) const GM_SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::Repeats,
     build: |_, v, freq_hz| Ok(Gm::new(v[0], v[1], freq_hz)?.into()),
+    role: Role::Correlated,
+    reparametrises: Some(ProcessKind::Ar1),
+    needs_rate: true,
+    transforms: |_, _| vec![ParamTransform::Log, ParamTransform::Log],
+    chain: Some(ChainSlot::Beta),
+    draw: |d, _, given, out| draw_markov(d, true, given, out),
+    unit_shapes: |levels, freq_hz| unit_shapes(levels, |phi| -phi.ln() * freq_hz),
+    markov: Some(Markov {
+        ar1: |v, freq_hz| {
+            Gm {
+                beta: v[0],
+                sigma2_gm: v[1],
+                freq_hz,
+            }
+            .to_ar1()
+        },
+        from_ar1: |a, freq_hz| {
+            let gm = a.to_gm(freq_hz).ok()?;
+            Some(vec![gm.beta, gm.sigma2_gm])
+        },
+        correlation_time_s: |v, _| 1.0 / v[0],
+        forms: gm_forms,
+    }),
+    physical: |v, freq_hz, u| markov_physical(v, freq_hz, u, gm_forms),
 };
+
+/// docs/methods.md §4.3: `(phi, sigma2, beta, sigma2_gm)` of an AR1 `[phi, sigma2]`.
+fn ar1_forms(v: &[f64], freq_hz: f64) -> (f64, f64, f64, f64) {
+    let dt = 1.0 / freq_hz;
+    let (a, b) = (v[0], v[1]);
+    (a, b, -a.ln() / dt, b / (1.0 - a * a))
+}
+
+/// docs/methods.md §4.3: `(phi, sigma2, beta, sigma2_gm)` of a GM `[beta, sigma2_gm]`.
+fn gm_forms(v: &[f64], freq_hz: f64) -> (f64, f64, f64, f64) {
+    let dt = 1.0 / freq_hz;
+    let (a, b) = (v[0], v[1]);
+    ((-a * dt).exp(), -b * (-2.0 * a * dt).exp_m1(), a, b)
+}
+
+/// The physical read-off of an AR1 or GM (docs/methods.md §14) from its two forms
+/// (`forms`): correlation time `1 / beta`, stationary standard deviation `sqrt(sigma2_gm)`
+/// and driving-noise density `sqrt(2 beta sigma2_gm)`; none without both values.
+fn markov_physical(v: &[f64], freq_hz: f64, u: &str, forms: MarkovForms) -> Vec<Physical> {
+    if v.len() < 2 {
+        return Vec::new();
+    }
+    let (_, _, beta, sigma2_gm) = forms(v, freq_hz);
+    vec![
+        ("correlation_time", 1.0 / beta, "s".to_string()),
+        ("gm_std", sigma2_gm.sqrt(), u.to_string()),
+        (
+            "driving_noise_density",
+            (2.0 * beta * sigma2_gm).sqrt(),
+            format!("{u}*sqrt(Hz)"),
+        ),
+    ]
+}
+
+/// The unit shapes of a correlated kind for `crate::fit::revive`: correlation lengths
+/// `2^((m - 2) / 2)` samples, 0.5 to `2^(J + 1)`, the first parameter from `phi` by `first`.
+fn unit_shapes(levels: usize, first: impl Fn(f64) -> f64) -> Vec<UnitShape> {
+    (0..=2 * levels + 4)
+        .map(|m| {
+            let length = 2f64.powf((m as f64 - 2.0) / 2.0);
+            let phi = (-1.0 / length).exp();
+            (vec![first(phi), 1.0], (|t| t) as fn(f64) -> f64)
+        })
+        .collect()
+}
+
+/// docs/methods.md §6.3 condition 1: `phi = (1 - sqrt(1 - 3U)) / 5` for `U` in `[0, 1/3]`
+/// (0 at `U = 0`, 0.2 at `U = 1/3`).
+pub(crate) fn condition1_phi(u: f64) -> f64 {
+    (1.0 - (1.0 - 3.0 * u).max(0.0).sqrt()) / 5.0
+}
+
+/// docs/methods.md §6.3 condition 3: `phi = last_phi + (0.999995 - last_phi) sqrt(1 - 3U)` for `U`
+/// in `[0, 1/3]`.
+pub(crate) fn condition3_phi(u: f64, last_phi: f64) -> f64 {
+    last_phi + (PHI_MAX - last_phi) * (1.0 - 3.0 * u).max(0.0).sqrt()
+}
+
+/// docs/methods.md §6.3 for an AR1 (`gm` false) or a GM: the `phi` of the component's
+/// condition (1: fast, 2: in (0.9, PHI_MAX), 3+: above the last), a variance share of the
+/// total (all of it for the first, up to 1% for the others); GM converted from the AR1 draw
+/// with the rate; given values kept.
+fn draw_markov(d: &mut Draw<'_>, gm: bool, g: &[Option<f64>], theta: &mut Vec<f64>) {
+    d.condition += 1;
+    let freq_hz = d.ctx.freq_hz;
+    let given_phi = g[0].map(|v| if gm { (-v / freq_hz).exp() } else { v });
+    let phi = given_phi.unwrap_or_else(|| match d.condition {
+        1 => condition1_phi(d.unif(0.0, 1.0 / 3.0)),
+        2 => {
+            let lo = d.last_phi.max(0.9);
+            d.unif(lo, PHI_MAX)
+        }
+        _ => {
+            let u = d.unif(0.0, 1.0 / 3.0);
+            condition3_phi(u, d.last_phi)
+        }
+    });
+    let v = 1.0 - phi * phi;
+    let st = d.ctx.sigma2_t;
+    let sigma2 = if d.condition == 1 {
+        d.unif(st * v / 2.0, st * v)
+    } else {
+        d.unif(0.0, 0.01 * st * v)
+    };
+    d.last_phi = phi;
+    if gm {
+        theta.push(g[0].unwrap_or(-phi.ln() * freq_hz));
+        theta.push(g[1].unwrap_or(sigma2 / v));
+    } else {
+        theta.push(phi);
+        theta.push(g[1].unwrap_or(sigma2));
+    }
+}
+
+/// Upper end of the AR1 phi draws (docs/methods.md §6.3).
+pub(crate) const PHI_MAX: f64 = 0.999995;
 
 /// Below this `x = m L = -m ln(phi)` the series of the module doc is used: there the closed form
 /// loses about `-2 log10(x)` digits, the series (terms bounded by `1.5^k/k!`) none.
@@ -489,6 +637,17 @@ impl Sampler for Ar1Sampler {
 }
 
 impl Simulate for Ar1 {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        if self.phi < 0.0 {
+            return Err(negative_phi(self.phi));
+        }
+        let r0 = self.sigma2 / ((1.0 - self.phi) * (1.0 + self.phi));
+        Ok(CovariancePart::Autoregressive {
+            phi: self.phi,
+            r0,
+            r1: self.phi * r0,
+        })
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.phi, self.sigma2).map(drop)
     }
@@ -507,6 +666,15 @@ impl Simulate for Ar1 {
 }
 
 impl Simulate for Gm {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        let a = self.to_ar1();
+        let r0 = a.sigma2 / ((1.0 - a.phi) * (1.0 + a.phi));
+        Ok(CovariancePart::Autoregressive {
+            phi: a.phi,
+            r0,
+            r1: a.phi * r0,
+        })
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.beta, self.sigma2_gm, self.freq_hz).map(drop)
     }
@@ -519,6 +687,21 @@ impl Simulate for Gm {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn condition_phi_ranges() {
+        assert_eq!(condition1_phi(0.0), 0.0);
+        assert!((condition1_phi(1.0 / 3.0) - 0.2).abs() < 1e-15);
+        for k in 0..=100 {
+            let u = k as f64 / 300.0;
+            let p1 = condition1_phi(u);
+            assert!((0.0..=0.2 + 1e-15).contains(&p1), "{p1}");
+            let p3 = condition3_phi(u, 0.9);
+            assert!((0.9..=PHI_MAX).contains(&p3), "{p3}");
+        }
+        assert!((condition3_phi(0.0, 0.9) - PHI_MAX).abs() < 1e-15);
+        assert!((condition3_phi(1.0 / 3.0, 0.9) - 0.9).abs() < 1e-15);
+    }
 
     /// The blocks of four give the recursion `x_t = phi x_{t-1} + w_t` on the same draws, to
     /// rounding (each value is a few operations off the one-step path: 1e-13 relative to the

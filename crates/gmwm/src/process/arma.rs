@@ -2,7 +2,11 @@
 //! empty) as special cases. R sign convention: AR polynomial `1 - sum ar_i B^i`, MA polynomial
 //! `1 + sum ma_i B^i`.
 
+use super::draw::{unif, Draw};
+use super::{CovariancePart, ParamTransform, Role, TransformPreset, BASE};
 use crate::process::sampler::SimRng;
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -30,6 +34,10 @@ pub(crate) const AR_SPEC: Spec = Spec {
     }),
     occurs: Occurs::ArmaFamily,
     build,
+    role: Role::Other,
+    transforms,
+    draw,
+    ..BASE
 };
 
 /// `MA(q)`, `q` from 1 to [`MAX_ORDER`](crate::model::MAX_ORDER): of the ARMA family.
@@ -48,6 +56,10 @@ pub(crate) const MA_SPEC: Spec = Spec {
     }),
     occurs: Occurs::ArmaFamily,
     build,
+    role: Role::Other,
+    transforms,
+    draw,
+    ..BASE
 };
 
 /// `ARMA(p,q)`, each order from 0 to [`MAX_ORDER`](crate::model::MAX_ORDER), `p + q >= 1`
@@ -67,7 +79,115 @@ pub(crate) const ARMA_SPEC: Spec = Spec {
     }),
     occurs: Occurs::ArmaFamily,
     build,
+    role: Role::Other,
+    transforms,
+    draw,
+    ..BASE
 };
+
+/// docs/methods.md §5.3: the coefficients pseudo-logit, under the SSM preset logit2 for a
+/// polynomial of order above 1; the innovation variance log.
+fn transforms(kind: ProcessKind, preset: TransformPreset) -> Vec<ParamTransform> {
+    use ParamTransform as T;
+    let (p, q) = kind.orders();
+    let coef = |order: usize| match preset {
+        TransformPreset::Ssm if order > 1 => T::Logit2,
+        _ => T::PseudoLogit,
+    };
+    let mut out = vec![coef(p); p];
+    out.extend(std::iter::repeat(coef(q)).take(q));
+    out.push(T::Log);
+    out
+}
+
+/// AR coefficient bounds of the §6.5 ARMA draws (the package's constants).
+const ARMA_LO: f64 = -0.99999999;
+const ARMA_HI: f64 = 0.999999999;
+/// Tries of the §6.5 stationarity rejection loop before falling back to zero AR
+/// coefficients (the package loops without bound; a high order can make acceptance rare).
+const ARMA_TRIES: usize = 1000;
+/// Number of psi weights in the §6.5 ARMA variance scaling.
+const PSI_TERMS: usize = 1000;
+
+/// Levinson step-down: the AR polynomial `1 - sum a_i z^i` has all roots outside the unit
+/// circle iff every partial autocorrelation has modulus < 1.
+pub(crate) fn ar_stationary(a: &[f64]) -> bool {
+    let mut cur = a.to_vec();
+    while let Some(&k) = cur.last() {
+        if k.is_nan() || k.abs() >= 1.0 {
+            return false;
+        }
+        let m = cur.len() - 1;
+        let d = 1.0 - k * k;
+        cur = (0..m).map(|i| (cur[i] + k * cur[m - 1 - i]) / d).collect();
+    }
+    true
+}
+
+/// The increasing nested draw of §6.5, randomly permuted.
+fn nested_draw(rng: &mut ChaCha8Rng, n: usize) -> Vec<f64> {
+    let mut v = Vec::with_capacity(n);
+    let mut lo = ARMA_LO;
+    for _ in 0..n {
+        let a = unif(rng, lo, ARMA_HI);
+        v.push(a);
+        lo = a;
+    }
+    // Fisher–Yates
+    for i in (1..v.len()).rev() {
+        let j = rng.random_range(0..=i);
+        v.swap(i, j);
+    }
+    v
+}
+
+/// `1 + sum_{k=1}^{1000} psi_k^2` of `x_t = sum a_i x_{t-i} + e_t + sum m_j e_{t-j}`.
+pub(crate) fn psi_norm(ar: &[f64], ma: &[f64]) -> f64 {
+    let mut psi = vec![1.0];
+    let mut total = 1.0;
+    for k in 1..=PSI_TERMS {
+        let mut v = if k <= ma.len() { ma[k - 1] } else { 0.0 };
+        for (i, a) in ar.iter().enumerate().take(k) {
+            v += a * psi[k - 1 - i];
+        }
+        psi.push(v);
+        total += v * v;
+        if !total.is_finite() {
+            break;
+        }
+    }
+    total
+}
+
+/// docs/methods.md §6.5 (port) for every ARMA-family kind: AR coefficients by the nested draw,
+/// redrawn until stationary (zeros after [`ARMA_TRIES`] tries), MA coefficients by the nested
+/// draw, the innovation variance `sigma2_T / (1 + sum psi_k^2)`; given values kept.
+pub(crate) fn draw(d: &mut Draw<'_>, kind: ProcessKind, g: &[Option<f64>], theta: &mut Vec<f64>) {
+    let (p, q) = kind.orders();
+    let rng = &mut *d.rng;
+    let mut ar = nested_draw(rng, p);
+    let mut tries = 1;
+    while !ar_stationary(&ar) {
+        if tries >= ARMA_TRIES {
+            ar = vec![0.0; p];
+            break;
+        }
+        ar = nested_draw(rng, p);
+        tries += 1;
+    }
+    let ma = nested_draw(rng, q);
+    for (k, a) in ar.iter_mut().enumerate() {
+        *a = g[k].unwrap_or(*a);
+    }
+    let mut ma = ma;
+    for (k, m) in ma.iter_mut().enumerate() {
+        *m = g[p + k].unwrap_or(*m);
+    }
+    let s = g[p + q].unwrap_or(d.ctx.sigma2_t / psi_norm(&ar, &ma));
+    theta.extend_from_slice(&ar);
+    theta.extend_from_slice(&ma);
+    theta.push(s);
+}
 
 /// The [`Arma`] of an order kind from `ar1..arp, ma1..maq, sigma2`.
 fn build(kind: ProcessKind, v: &[f64], _freq_hz: f64) -> Result<Process, ParamError> {
@@ -638,6 +758,13 @@ impl Step for ArmaState {
 }
 
 impl Simulate for Arma {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        Err(ParamError::new(
+            "model",
+            "a generic ARMA(p, q) term",
+            "only WN, QN, RW, DR, AR1, GM, MA1 and ARMA11 terms for the exact WV covariance (--covariance auto or bootstrap simulates V)",
+        ))
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.ar.clone(), self.ma.clone(), self.sigma2).map(drop)
     }
@@ -664,6 +791,21 @@ impl Simulate for Arma {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn stationarity_check() {
+        assert!(ar_stationary(&[0.5]));
+        assert!(!ar_stationary(&[1.2]));
+        assert!(ar_stationary(&[0.5, 0.3]));
+        assert!(!ar_stationary(&[0.6, 0.5]));
+    }
+
+    #[test]
+    fn psi_of_ar1() {
+        // AR1 with a = 0.5: sum psi_k^2 = 1 / (1 - 0.25)
+        assert!((psi_norm(&[0.5], &[]) - 4.0 / 3.0).abs() < 1e-12);
+        assert!((psi_norm(&[], &[0.5]) - 1.25).abs() < 1e-12);
+    }
 
     #[test]
     fn ar_is_stationary_matches_known_cases() {

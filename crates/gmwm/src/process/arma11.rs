@@ -8,6 +8,7 @@
 //! and the AR1 part uses the stable evaluation of [`super::ar1`]. This is used for
 //! `phi > 1/2`; below, the closed form is used as written.
 
+use super::{negative_phi, CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
@@ -36,6 +37,13 @@ pub(crate) const SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::ArmaFamily,
     build: |_, v, _| Ok(Arma11::new(v[0], v[1], v[2])?.into()),
+    role: Role::Other,
+    transforms: |_, _| {
+        use ParamTransform as T;
+        vec![T::PseudoLogit, T::PseudoLogit, T::Log]
+    },
+    draw: super::arma::draw,
+    ..BASE
 };
 
 /// From this `phi` on, the WN + AR1 decomposition of the module doc is used (it divides by
@@ -148,6 +156,18 @@ impl Step for Arma11Sampler {
 }
 
 impl Simulate for Arma11 {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        if self.phi < 0.0 {
+            return Err(negative_phi(self.phi));
+        }
+        let (phi, theta, s2) = (self.phi, self.theta, self.sigma2);
+        let den = (1.0 - phi) * (1.0 + phi);
+        Ok(CovariancePart::Autoregressive {
+            phi,
+            r0: s2 * (1.0 + 2.0 * phi * theta + theta * theta) / den,
+            r1: s2 * (1.0 + phi * theta) * (phi + theta) / den,
+        })
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.phi, self.theta, self.sigma2).map(drop)
     }

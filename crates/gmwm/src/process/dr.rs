@@ -1,5 +1,6 @@
 //! Deterministic drift (docs/methods.md §0.2, §4.2, §10.1).
 
+use super::{CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
@@ -17,6 +18,16 @@ pub(crate) const SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::Once,
     build: |_, v, _| Ok(Dr::new(v[0])?.into()),
+    role: Role::Drift,
+    transforms: |_, _| vec![ParamTransform::LogAbs],
+    draw: |d, _, given, out| {
+        let r = d.ctx.range;
+        // docs/methods.md §6.3: U(R / 100, R / 2)
+        out.push(given[0].unwrap_or_else(|| d.unif(r / 100.0, r / 2.0)));
+    },
+    unit_shapes: |_, _| vec![(vec![1.0], f64::sqrt)],
+    physical: |v, f, u| vec![("drift_rate", v[0] * f, format!("{u}/s"))],
+    ..BASE
 };
 
 /// Deterministic drift: the ramp `x_t = omega (t + 1)`.
@@ -95,6 +106,9 @@ impl Step for DrSampler {
 }
 
 impl Simulate for Dr {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        Ok(CovariancePart::Drift(self.omega))
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.omega).map(drop)
     }

@@ -2,7 +2,8 @@
 //! parameters: what the model language names, facts read from the one table of processes
 //! ([`table`](super::table)).
 
-use super::table::{spec, Occurs, Params};
+use super::facts::{Occurs, Params};
+use super::{spec, ProcessKind};
 use crate::error::ModelError;
 use std::fmt;
 
@@ -12,35 +13,6 @@ use std::fmt;
 /// orders of 1 to 3, and the implied WV of docs/methods.md §4.4 becomes numerically meaningless
 /// long before 100 lags.
 pub const MAX_ORDER: usize = 100;
-
-/// The kind of one latent process (docs/methods.md §0.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum ProcessKind {
-    /// White noise, parameter `sigma2`.
-    Wn,
-    /// Quantisation noise, parameter `q2` (Q^2).
-    Qn,
-    /// Random walk, parameter `gamma2` (increment variance).
-    Rw,
-    /// Deterministic drift, parameter `omega` (slope per sample).
-    Dr,
-    /// First-order autoregression, parameters `phi`, `sigma2`.
-    Ar1,
-    /// Gauss–Markov process (AR1 reparametrised with the sampling rate, docs/methods.md §4.3),
-    /// parameters `beta`, `sigma2_gm`.
-    Gm,
-    /// First-order moving average, parameters `theta`, `sigma2`.
-    Ma1,
-    /// ARMA(1,1), parameters `phi`, `theta`, `sigma2`.
-    Arma11,
-    /// Autoregression of order p, parameters `ar1..arp`, `sigma2`.
-    Ar(usize),
-    /// Moving average of order q, parameters `ma1..maq`, `sigma2`.
-    Ma(usize),
-    /// ARMA(p, q) (package name `SARIMA` without seasonal part), parameters `ar1..arp`,
-    /// `ma1..maq`, `sigma2`; R sign convention (docs/methods.md §0.2).
-    Arma(usize, usize),
-}
 
 /// The basic domain of one parameter value, checked whenever a value is given (docs/methods.md §5.3
 /// lists the transforms the optimiser applies on these domains).

@@ -1,5 +1,6 @@
 //! First-order moving average (docs/methods.md §0.2, §4.2, §4.5, §4.6, §10.1).
 
+use super::{CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
@@ -26,6 +27,15 @@ pub(crate) const SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::ArmaFamily,
     build: |_, v, _| Ok(Ma1::new(v[0], v[1])?.into()),
+    role: Role::Other,
+    transforms: |_, preset| vec![preset.unit_coefficient(), ParamTransform::Log],
+    draw: |d, _, given, out| {
+        // §6.5 port rule: theta ~ U(0, 1), sigma2 = sigma2_T / (1 + theta^2)
+        let t = given[0].unwrap_or_else(|| d.unif(0.0, 1.0));
+        out.push(t);
+        out.push(given[1].unwrap_or(d.ctx.sigma2_t / (1.0 + t * t)));
+    },
+    ..BASE
 };
 
 /// First-order moving average `x_t = w_t + theta w_{t-1}`, `Var w_t = sigma2`.
@@ -110,6 +120,13 @@ impl Step for Ma1Sampler {
 }
 
 impl Simulate for Ma1 {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        Ok(CovariancePart::Autoregressive {
+            phi: 0.0,
+            r0: self.sigma2 * (1.0 + self.theta * self.theta),
+            r1: self.sigma2 * self.theta,
+        })
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.theta, self.sigma2).map(drop)
     }

@@ -7,9 +7,11 @@
 //!
 //! Each process's module holds all of its facts: its name and parameters in the model language
 //! (with their domains), its validating constructor, its implied WV and derivatives, its
-//! spectral density, and how it is simulated (docs/methods.md §10.1). One table maps a
-//! [`ProcessKind`] to those facts; the model language, the model's
-//! validation and the simulator ([`crate::sim`]) read it.
+//! spectral density, how it is simulated (docs/methods.md §10.1), its part of the exact WV
+//! covariance, its parameter transforms, starting values, role and physical read-off (the
+//! `Spec` of `facts.rs`). One table, the `processes!` rows below, declares [`ProcessKind`] and
+//! [`Process`] and maps each kind to those facts; no code outside this module matches on a
+//! kind. A new process is its file, its `mod` line and one row of the table.
 //!
 //! Derivatives of the closed forms are exact (forward-mode automatic differentiation of the
 //! numerically stable evaluation, see [`ar1`]), so they stay accurate where the textbook quotient
@@ -22,13 +24,15 @@ pub mod ar1;
 pub mod arma;
 pub mod arma11;
 pub mod dr;
+pub(crate) mod draw;
+mod facts;
 mod kind;
 pub mod ma1;
+mod param;
 pub mod qn;
 pub mod rw;
 pub(crate) mod sampler;
 pub mod spectral;
-mod table;
 pub mod wn;
 
 pub use ar1::{Ar1, Gm};
@@ -40,9 +44,14 @@ pub use qn::Qn;
 pub use rw::Rw;
 pub use wn::Wn;
 
-pub use kind::{ParamDomain, ProcessKind, MAX_ORDER};
+pub use draw::Dominance;
+pub(crate) use facts::{
+    kind_of, Markov, MarkovForms, Occurs, Orders, Params, Physical, Role, Spec, UnitShape, BASE,
+};
+pub use kind::{ParamDomain, MAX_ORDER};
+pub(crate) use param::ChainSlot;
+pub use param::{logistic, ParamTransform, TransformPreset, RESTART_EDGE};
 pub use sampler::StartMode;
-pub(crate) use table::{spec, Occurs, Orders, Params, Spec, KINDS};
 
 use crate::error::ParamError;
 use sampler::{Sampler, SimRng};
@@ -87,59 +96,151 @@ pub(crate) trait Simulate: LatentProcess {
     /// # Errors
     /// [`ParamError`] only for a generic ARMA whose burn-in would be too long.
     fn sampler(&self, rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError>;
+    /// What the exact covariance of the WV (docs/methods.md §1.10,
+    /// `crate::variance::implied_cov`) needs of the process.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming what the exact covariance does not cover (the default: a
+    /// process without a part).
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        Err(ParamError::new(
+            "model",
+            format!("a {} term", self.name()),
+            "only WN, QN, RW, DR, AR1, GM, MA1 and ARMA11 terms for the exact WV covariance (--covariance auto or bootstrap simulates V)",
+        ))
+    }
 }
 
-/// Declares [`Process`] over the process structs (one line each), with its dispatch and the
-/// `From` conversions.
+/// A process as the exact covariance of the WV sees it (docs/methods.md §1.10): its
+/// autocovariance in closed form, as one of the shapes that covariance sums.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum CovariancePart {
+    /// White noise of this variance.
+    White(f64),
+    /// A random walk of this increment variance.
+    RandomWalk(f64),
+    /// Quantisation noise of this `q2`.
+    Quantization(f64),
+    /// A drift of this slope.
+    Drift(f64),
+    /// An autocovariance `gamma(0) = r0`, `gamma(h) = r1 phi^(h - 1)` for `h >= 1` (AR1, GM,
+    /// MA1 with `phi = 0`, ARMA11), `phi >= 0`.
+    Autoregressive {
+        /// The decay per lag.
+        phi: f64,
+        /// `gamma(0)`.
+        r0: f64,
+        /// `gamma(1)`.
+        r1: f64,
+    },
+}
+
+/// The refusal of a negative `phi` by the exact covariance.
+pub(crate) fn negative_phi(phi: f64) -> ParamError {
+    ParamError::new(
+        "phi",
+        phi,
+        "phi >= 0 for the exact WV covariance (a negative autoregression alternates in sign; --covariance auto or bootstrap simulates V)",
+    )
+}
+
+/// Declares the one table of processes: each row a [`ProcessKind`] (with its orders, and an
+/// example kind for lists), the [`Spec`] of its facts in the kind's own module, and for the
+/// row that owns a struct, the [`Process`] variant over it. It defines [`ProcessKind`],
+/// [`Process`] with its dispatch and `From` conversions, `spec` (the only map from a kind to
+/// its facts) and `KINDS` (every kind once, in table order: the order of lists in messages).
 macro_rules! processes {
-    ($($(#[doc = $doc:literal])* $v:ident,)*) => {
-        /// One latent process of a model (docs/methods.md §0.2).
+    ($(
+        $(#[doc = $doc:literal])*
+        $kind:ident $(($($order:ty),+) = $example:expr)? => $spec:path
+        $(, process $(#[doc = $pdoc:literal])* $variant:ident($ty:ty))?;
+    )*) => {
+        /// The kind of one latent process (docs/methods.md §0.2).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum ProcessKind {
+            $($(#[doc = $doc])* $kind $(($($order),+))?,)*
+        }
+
+        /// One latent process of a model, with its values (docs/methods.md §0.2).
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
         pub enum Process {
-            $($(#[doc = $doc])* $v($v),)*
+            $($($(#[doc = $pdoc])* $variant($ty),)?)*
         }
 
         impl Process {
             fn inner(&self) -> &dyn Simulate {
                 match self {
-                    $(Process::$v(p) => p,)*
+                    $($(Process::$variant(p) => p,)?)*
                 }
             }
         }
 
-        $(impl From<$v> for Process {
-            fn from(p: $v) -> Self {
-                Process::$v(p)
+        $($(impl From<$ty> for Process {
+            fn from(p: $ty) -> Self {
+                Process::$variant(p)
             }
-        })*
+        })?)*
+
+        /// The facts of `kind`.
+        pub(crate) fn spec(kind: ProcessKind) -> &'static Spec {
+            match kind {
+                $(ProcessKind::$kind { .. } => &$spec,)*
+            }
+        }
+
+        /// Every kind once, in table order (the order of lists in messages); order kinds with
+        /// example orders.
+        pub(crate) const KINDS: &[ProcessKind] = &[$(processes!(@example $kind $(, $example)?),)*];
     };
+    (@example $kind:ident) => { ProcessKind::$kind };
+    (@example $kind:ident, $example:expr) => { $example };
 }
 
 processes! {
-    /// White noise.
-    Wn,
-    /// Quantisation noise.
-    Qn,
-    /// Random walk.
-    Rw,
-    /// Deterministic drift.
-    Dr,
-    /// First-order autoregression.
-    Ar1,
-    /// Gauss–Markov (AR1 at a sampling rate).
-    Gm,
-    /// First-order moving average.
-    Ma1,
-    /// ARMA(1,1).
-    Arma11,
-    /// General ARMA(p, q).
-    Arma,
+    /// White noise, parameter `sigma2`.
+    Wn => wn::SPEC, process /// White noise.
+        Wn(Wn);
+    /// Quantisation noise, parameter `q2` (Q^2).
+    Qn => qn::SPEC, process /// Quantisation noise.
+        Qn(Qn);
+    /// Random walk, parameter `gamma2` (increment variance).
+    Rw => rw::SPEC, process /// Random walk.
+        Rw(Rw);
+    /// Deterministic drift, parameter `omega` (slope per sample).
+    Dr => dr::SPEC, process /// Deterministic drift.
+        Dr(Dr);
+    /// First-order autoregression, parameters `phi`, `sigma2`.
+    Ar1 => ar1::AR1_SPEC, process /// First-order autoregression.
+        Ar1(Ar1);
+    /// Gauss–Markov process (AR1 reparametrised with the sampling rate, docs/methods.md §4.3),
+    /// parameters `beta`, `sigma2_gm`.
+    Gm => ar1::GM_SPEC, process /// Gauss–Markov (AR1 at a sampling rate).
+        Gm(Gm);
+    /// First-order moving average, parameters `theta`, `sigma2`.
+    Ma1 => ma1::SPEC, process /// First-order moving average.
+        Ma1(Ma1);
+    /// ARMA(1,1), parameters `phi`, `theta`, `sigma2`.
+    Arma11 => arma11::SPEC, process /// ARMA(1,1).
+        Arma11(Arma11);
+    /// Autoregression of order p, parameters `ar1..arp`, `sigma2`.
+    Ar(usize) = ProcessKind::Ar(1) => arma::AR_SPEC;
+    /// Moving average of order q, parameters `ma1..maq`, `sigma2`.
+    Ma(usize) = ProcessKind::Ma(1) => arma::MA_SPEC;
+    /// ARMA(p, q) (package name `SARIMA` without seasonal part), parameters `ar1..arp`,
+    /// `ma1..maq`, `sigma2`; R sign convention (docs/methods.md §0.2).
+    Arma(usize, usize) = ProcessKind::Arma(1, 1) => arma::ARMA_SPEC, process /// General ARMA(p, q).
+        Arma(Arma);
 }
 
 impl Process {
     /// [`Simulate::check`].
     pub(crate) fn check(&self) -> Result<(), ParamError> {
         self.inner().check()
+    }
+
+    /// [`Simulate::covariance_part`].
+    pub(crate) fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        self.inner().covariance_part()
     }
 
     /// [`Simulate::sampler`].

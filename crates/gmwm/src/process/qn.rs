@@ -1,5 +1,7 @@
 //! Quantisation noise (docs/methods.md §0.2, §4.2, §10.1).
 
+use super::draw::{Dominance, Draw};
+use super::{CovariancePart, ParamTransform, ProcessKind, Role, BASE};
 use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
@@ -19,7 +21,32 @@ pub(crate) const SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::Once,
     build: |_, v, _| Ok(Qn::new(v[0])?.into()),
+    role: Role::Quantization,
+    transforms: |_, _| vec![ParamTransform::Log],
+    draw,
+    unit_shapes: |_, _| vec![(vec![1.0], |t| t)],
+    physical: |v, f, u| {
+        vec![(
+            "quantization_coefficient",
+            v[0].sqrt() / f,
+            format!("{u}*s"),
+        )]
+    },
+    ..BASE
 };
+
+/// docs/methods.md §6.3: `U(sigma2_T / 8, sigma2_T / 3)` where quantisation noise dominates the
+/// first scales (or is the only term), else `U(5e-6 sigma2_T, sigma2_T / 100)`.
+fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
+    let (st, dominant) = (d.ctx.sigma2_t, d.ctx.only_qn || d.ctx.dom == Dominance::Qn);
+    out.push(given[0].unwrap_or_else(|| {
+        if dominant {
+            d.unif(st / 8.0, st / 3.0)
+        } else {
+            d.unif(5e-6 * st, st / 100.0)
+        }
+    }));
+}
 
 /// `sqrt(12)`: scales `U(0, 1)` to variance 1 for quantisation noise (docs/methods.md §10.1).
 const SQRT_12: f64 = 3.464_101_615_137_754_6;
@@ -102,6 +129,9 @@ impl Step for QnSampler {
 }
 
 impl Simulate for Qn {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        Ok(CovariancePart::Quantization(self.q2))
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.q2).map(drop)
     }

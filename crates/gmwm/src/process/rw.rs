@@ -1,5 +1,6 @@
 //! Random walk (docs/methods.md §0.2, §4.2, §10.1).
 
+use super::{CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
@@ -20,6 +21,22 @@ pub(crate) const SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::Once,
     build: |_, v, _| Ok(Rw::new(v[0])?.into()),
+    role: Role::RandomWalk,
+    transforms: |_, _| vec![ParamTransform::Log],
+    draw: |d, _, given, out| {
+        let (st, n) = (d.ctx.sigma2_t, d.ctx.n);
+        // docs/methods.md §6.3: U(1e-5 sigma2_T / N, sigma2_T / N)
+        out.push(given[0].unwrap_or_else(|| d.unif(1e-5 * st / n, st / n)));
+    },
+    unit_shapes: |_, _| vec![(vec![1.0], |t| t)],
+    physical: |v, f, u| {
+        vec![(
+            "rate_random_walk_density",
+            (v[0] * f).sqrt(),
+            format!("{u}*sqrt(Hz)"),
+        )]
+    },
+    ..BASE
 };
 
 /// Random walk: cumulative sum of white noise with increment variance `gamma2`.
@@ -77,6 +94,9 @@ impl LatentProcess for Rw {
 }
 
 impl Simulate for Rw {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        Ok(CovariancePart::RandomWalk(self.gamma2))
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.gamma2).map(drop)
     }

@@ -3,8 +3,10 @@
 use crate::process::sampler::SimRng;
 use serde::{Deserialize, Serialize};
 
+use super::draw::{Dominance, Draw};
 use super::{
-    add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Simulate, Spec,
+    add_scaled, check_positive, half_widths, CovariancePart, LatentProcess, Occurs, ParamTransform,
+    Params, ProcessKind, Role, Simulate, Spec, BASE,
 };
 use crate::error::ParamError;
 use crate::process::sampler::{normal, Sampler, Step};
@@ -19,7 +21,32 @@ pub(crate) const SPEC: Spec = Spec {
     orders: None,
     occurs: Occurs::Once,
     build: |_, v, _| Ok(Wn::new(v[0])?.into()),
+    role: Role::WhiteNoise,
+    transforms: |_, _| vec![ParamTransform::Log],
+    draw,
+    unit_shapes: |_, _| vec![(vec![1.0], |t| t)],
+    physical: |v, f, u| {
+        vec![(
+            "white_noise_density",
+            (v[0] / f).sqrt(),
+            format!("{u}/sqrt(Hz)"),
+        )]
+    },
+    ..BASE
 };
+
+/// docs/methods.md §6.3: `U(sigma2_T / 2, sigma2_T)` where white noise dominates the first
+/// scales (or is the only term), else `U(1e-5 sigma2_T, 0.1 sigma2_T)`.
+fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
+    let (st, dominant) = (d.ctx.sigma2_t, d.ctx.only_wn || d.ctx.dom == Dominance::Wn);
+    out.push(given[0].unwrap_or_else(|| {
+        if dominant {
+            d.unif(st / 2.0, st)
+        } else {
+            d.unif(1e-5 * st, 0.1 * st)
+        }
+    }));
+}
 
 /// White noise: independent samples of variance `sigma2`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -90,6 +117,9 @@ impl Step for WnSampler {
 }
 
 impl Simulate for Wn {
+    fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
+        Ok(CovariancePart::White(self.sigma2))
+    }
     fn check(&self) -> Result<(), ParamError> {
         Self::new(self.sigma2).map(drop)
     }

@@ -9,6 +9,7 @@
 
 use super::SelectionError;
 use crate::model::{Component, Model, ProcessKind};
+use crate::process::{spec, Occurs, KINDS};
 use std::collections::BTreeSet;
 
 /// Largest number of terms of a full model for [`nested_candidates`]: `2^20 - 1` subsets are
@@ -32,23 +33,36 @@ pub(crate) fn check_candidate(model: &Model) -> Result<(), SelectionError> {
     if let Some(kind) = model.kinds().into_iter().find(|k| k.is_arma_family()) {
         return Err(SelectionError::ArmaNotSupported { candidate, kind });
     }
-    for kind in [
-        ProcessKind::Wn,
-        ProcessKind::Qn,
-        ProcessKind::Rw,
-        ProcessKind::Dr,
-    ] {
+    for kind in once_kinds() {
         if model.count(kind) > 1 {
             return Err(SelectionError::Repeated { candidate, kind });
         }
     }
-    if model.uses_gm() && model.uses_ar1() {
+    if mixed_pair(std::slice::from_ref(model)).is_some() {
         return Err(SelectionError::GmAr1Mixed {
             gm: candidate.clone(),
             ar1: candidate,
         });
     }
     Ok(())
+}
+
+/// The kinds that appear at most once in a model (WN, QN, RW, DR), in table order.
+fn once_kinds() -> impl Iterator<Item = ProcessKind> {
+    KINDS
+        .iter()
+        .copied()
+        .filter(|&k| spec(k).occurs == Occurs::Once)
+}
+
+/// A candidate using a kind and one using the kind it reparametrises (GM, AR1), if any.
+fn mixed_pair(models: &[Model]) -> Option<(&Model, &Model)> {
+    KINDS.iter().find_map(|&kind| {
+        let base = spec(kind).reparametrises?;
+        let a = models.iter().find(|m| m.count(kind) > 0)?;
+        let b = models.iter().find(|m| m.count(base) > 0)?;
+        Some((a, b))
+    })
 }
 
 fn model_of(kinds: &[ProcessKind]) -> Model {
@@ -108,27 +122,20 @@ pub fn common_denominator(models: &[Model]) -> Result<Model, SelectionError> {
     for m in models {
         check_candidate(m)?;
     }
-    let gm = models.iter().find(|m| m.uses_gm());
-    let ar1 = models.iter().find(|m| m.uses_ar1());
-    if let (Some(gm), Some(ar1)) = (gm, ar1) {
+    if let Some((gm, ar1)) = mixed_pair(models) {
         return Err(SelectionError::GmAr1Mixed {
             gm: gm.without_values().to_string(),
             ar1: ar1.without_values().to_string(),
         });
     }
-    let repeat = if gm.is_some() {
-        ProcessKind::Gm
-    } else {
-        ProcessKind::Ar1
-    };
-    let k = models.iter().map(|m| m.count(repeat)).max().unwrap_or(0);
-    let mut kinds = vec![repeat; k];
-    for kind in [
-        ProcessKind::Wn,
-        ProcessKind::Qn,
-        ProcessKind::Rw,
-        ProcessKind::Dr,
-    ] {
+    // each repeating kind as often as the candidate with most of it, then the kinds that
+    // appear once when any candidate has them, in table order
+    let mut kinds = Vec::new();
+    for kind in KINDS.iter().copied().filter(|&k| k.may_repeat()) {
+        let k = models.iter().map(|m| m.count(kind)).max().unwrap_or(0);
+        kinds.extend(std::iter::repeat(kind).take(k));
+    }
+    for kind in once_kinds() {
         if models.iter().any(|m| m.count(kind) > 0) {
             kinds.push(kind);
         }

@@ -11,7 +11,8 @@ use crate::fit::canonical::wv_separation;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit, StartInputs, Weights, SEPARATION_LIMIT};
 use crate::inference::gof::{hartlap_factor, j_test};
 use crate::inference::{NoProgress, Progress};
-use crate::model::{Model, ProcessKind};
+use crate::model::Model;
+use crate::process::{spec, Role};
 use crate::sim::bootstrap::map_replicates;
 use crate::sim::covariance::{pooled_wv_covariance, wv_covariance, CovarianceMethod, VSource};
 use crate::sim::replicate_seed;
@@ -728,7 +729,8 @@ fn tie_representative(i: usize, ties: &[(&Model, f64, usize)]) -> usize {
 /// How many of the two terms every navigation filter carries (white noise, random walk) a
 /// model has.
 fn navigation_terms(m: &Model) -> usize {
-    usize::from(m.count(ProcessKind::Wn) > 0) + usize::from(m.count(ProcessKind::Rw) > 0)
+    let has = |role| m.kinds().iter().any(|&k| spec(k).role == role);
+    usize::from(has(Role::WhiteNoise)) + usize::from(has(Role::RandomWalk))
 }
 
 /// One candidate's fit, score and canonical reading.

@@ -45,7 +45,7 @@
 //! shared-process fit accepts with QN in one place only.
 
 use crate::error::{InputError, ParamError};
-use crate::process::Process;
+use crate::process::{LatentProcess, Process};
 use crate::variance::implied_cov::exact_covariance_of;
 use crate::variance::wv::{wavelet_variance, WvOptions};
 use nalgebra::DMatrix;
@@ -126,7 +126,7 @@ pub fn stacked_moment_covariance(
         .collect();
     if comps
         .iter()
-        .any(|c| c.iter().any(|q| matches!(q, Process::Dr(_))))
+        .any(|c| c.iter().any(|q| q.spectral_density(0.0).is_none()))
     {
         return Err(ParamError::new(
             "model",

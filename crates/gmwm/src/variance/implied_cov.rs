@@ -61,7 +61,7 @@
 
 use crate::error::{InputError, ParamError};
 use crate::model::Model;
-use crate::process::Process;
+use crate::process::{CovariancePart, Process};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
@@ -197,59 +197,14 @@ struct Parts {
 impl Parts {
     fn of(processes: &[Process]) -> Result<Self, ParamError> {
         let mut parts = Parts::default();
-        let negative = |phi: f64| {
-            ParamError::new(
-                "phi",
-                phi,
-                "phi >= 0 for the exact WV covariance (a negative autoregression alternates in sign; --covariance auto or bootstrap simulates V)",
-            )
-        };
         for p in processes {
-            match p {
-                Process::Wn(w) => parts.wn += w.sigma2,
-                Process::Rw(r) => parts.rw += r.gamma2,
-                Process::Qn(q) => parts.qn += q.q2,
-                Process::Dr(d) => parts.dr += d.omega,
-                Process::Ar1(a) => {
-                    if a.phi < 0.0 {
-                        return Err(negative(a.phi));
-                    }
-                    let r0 = a.sigma2 / ((1.0 - a.phi) * (1.0 + a.phi));
-                    parts
-                        .autoregressive
-                        .push(Autoregressive::new(a.phi, r0, a.phi * r0));
-                }
-                Process::Gm(g) => {
-                    let a = g.to_ar1();
-                    let r0 = a.sigma2 / ((1.0 - a.phi) * (1.0 + a.phi));
-                    parts
-                        .autoregressive
-                        .push(Autoregressive::new(a.phi, r0, a.phi * r0));
-                }
-                Process::Ma1(m) => {
-                    let r0 = m.sigma2 * (1.0 + m.theta * m.theta);
-                    parts
-                        .autoregressive
-                        .push(Autoregressive::new(0.0, r0, m.sigma2 * m.theta));
-                }
-                Process::Arma11(m) => {
-                    if m.phi < 0.0 {
-                        return Err(negative(m.phi));
-                    }
-                    let (phi, theta, s2) = (m.phi, m.theta, m.sigma2);
-                    let den = (1.0 - phi) * (1.0 + phi);
-                    let r0 = s2 * (1.0 + 2.0 * phi * theta + theta * theta) / den;
-                    let r1 = s2 * (1.0 + phi * theta) * (phi + theta) / den;
-                    parts
-                        .autoregressive
-                        .push(Autoregressive::new(phi, r0, r1));
-                }
-                Process::Arma(_) => {
-                    return Err(ParamError::new(
-                        "model",
-                        "a generic ARMA(p, q) term",
-                        "only WN, QN, RW, DR, AR1, GM, MA1 and ARMA11 terms for the exact WV covariance (--covariance auto or bootstrap simulates V)",
-                    ))
+            match p.covariance_part()? {
+                CovariancePart::White(sigma2) => parts.wn += sigma2,
+                CovariancePart::RandomWalk(gamma2) => parts.rw += gamma2,
+                CovariancePart::Quantization(q2) => parts.qn += q2,
+                CovariancePart::Drift(omega) => parts.dr += omega,
+                CovariancePart::Autoregressive { phi, r0, r1 } => {
+                    parts.autoregressive.push(Autoregressive::new(phi, r0, r1))
                 }
             }
         }
