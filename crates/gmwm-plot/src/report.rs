@@ -490,7 +490,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
                 &format!(
                     "{}: classical and robust (efficiency {}) WV with their intervals.",
                     a.column,
-                    c.robust.robust().map_or(0.6, |r| r.eff)
+                    c.robust.robust().map_or(0.6, |r| r.eff())
                 ),
             )?);
         }

@@ -387,7 +387,7 @@ pub fn monitor_against(
             c_low.push(nu[j] * chi_square_quantile(alpha_level / 2.0, e)? / e);
             c_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, e)? / e);
         }
-        let r = widened(opts.robust.eff * eta[j], centre_var_r[j]);
+        let r = widened(opts.robust.eff() * eta[j], centre_var_r[j]);
         if !(r.is_finite() && r > 0.0) {
             return Err(Error::Param(ParamError::new(
                 "model",
@@ -488,7 +488,7 @@ pub fn monitor_against(
         step,
         alpha: opts.alpha,
         alpha_level,
-        eff: opts.robust.eff,
+        eff: opts.robust.eff(),
         tau_s: implied.tau_s.clone(),
         model_wv,
         eta,

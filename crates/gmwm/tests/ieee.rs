@@ -236,12 +236,8 @@ fn ieee_simulated_white_noise_and_random_walk() {
     // at most one of the five may.
     let (n, k) = (1e-3, 1e-4);
     let gens = [
-        Process::Wn(Wn {
-            sigma2: n * n * FREQ_HZ,
-        }),
-        Process::Rw(Rw {
-            gamma2: k * k / FREQ_HZ,
-        }),
+        Process::Wn(Wn::new(n * n * FREQ_HZ).unwrap()),
+        Process::Rw(Rw::new(k * k / FREQ_HZ).unwrap()),
     ];
     let mut without_k = 0;
     for seed in SEED..SEED + 5 {

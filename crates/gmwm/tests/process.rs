@@ -99,8 +99,12 @@ fn process_arma_family_test_values() {
 #[test]
 fn gm_to_ar1_test_value() {
     let ar = Gm::new(1.0, 1.0, 100.0).unwrap().to_ar1();
-    assert!(rel_diff(ar.phi, 0.99004983) < PRINTED, "{}", ar.phi);
-    assert!(rel_diff(ar.sigma2, 0.01980133) < PRINTED, "{}", ar.sigma2);
+    assert!(rel_diff(ar.phi(), 0.99004983) < PRINTED, "{}", ar.phi());
+    assert!(
+        rel_diff(ar.sigma2(), 0.01980133) < PRINTED,
+        "{}",
+        ar.sigma2()
+    );
 }
 
 #[test]
@@ -381,17 +385,14 @@ fn with_param(p: &Process, k: usize, v: f64) -> Process {
         Process::Rw(_) => Rw::new(q[0]).unwrap().into(),
         Process::Dr(_) => Dr::new(q[0]).unwrap().into(),
         Process::Ar1(_) => Ar1::new(q[0], q[1]).unwrap().into(),
-        Process::Gm(g) => Gm::new(q[0], q[1], g.freq_hz).unwrap().into(),
+        Process::Gm(g) => Gm::new(q[0], q[1], g.freq_hz()).unwrap().into(),
         Process::Ma1(_) => Ma1::new(q[0], q[1]).unwrap().into(),
         Process::Arma11(_) => Arma11::new(q[0], q[1], q[2]).unwrap().into(),
         Process::Arma(a) => {
-            let (p_, q_) = (a.ar.len(), a.ma.len());
-            Arma {
-                ar: q[..p_].to_vec(),
-                ma: q[p_..p_ + q_].to_vec(),
-                sigma2: q[p_ + q_],
-            }
-            .into()
+            let (p_, q_) = (a.ar().len(), a.ma().len());
+            Arma::new(q[..p_].to_vec(), q[p_..p_ + q_].to_vec(), q[p_ + q_])
+                .unwrap()
+                .into()
         }
     }
 }
@@ -410,7 +411,7 @@ fn fd_step(p: &Process, k: usize, levels: usize) -> f64 {
         {
             h = h.min(0.02 * (1.0 - v.abs())).min(0.02 / m_max);
         }
-        Process::Gm(g) if k == 0 => h = h.min(0.02 * g.freq_hz / m_max),
+        Process::Gm(g) if k == 0 => h = h.min(0.02 * g.freq_hz() / m_max),
         _ => {}
     }
     h
@@ -513,8 +514,8 @@ fn gm_ar1_round_trip() {
     for (beta, s2, f) in [(1.0, 1.0, 100.0), (1e-3, 3e-6, 250.0), (40.0, 2.0, 10.0)] {
         let gm = Gm::new(beta, s2, f).unwrap();
         let back = gm.to_ar1().to_gm(f).unwrap();
-        assert!(rel_diff(back.beta, beta) < 1e-9, "{back:?}");
-        assert!(rel_diff(back.sigma2_gm, s2) < 1e-9, "{back:?}");
+        assert!(rel_diff(back.beta(), beta) < 1e-9, "{back:?}");
+        assert!(rel_diff(back.sigma2_gm(), s2) < 1e-9, "{back:?}");
         // the GM WV is the WV of its AR1
         check_close(&gm.wv(20), &gm.to_ar1().wv(20), 1e-8, "GM vs its AR1");
     }
@@ -595,9 +596,14 @@ fn process_names_and_enum_delegation() {
     for p in &all {
         assert_eq!(p.param_names().len(), p.params().len(), "{}", p.name());
         assert_eq!(p.jacobian(3)[0].len(), p.params().len());
+        // serialised with its values; read back only through a model's text (validated)
         let json = serde_json::to_string(p).unwrap();
-        let back: Process = serde_json::from_str(&json).unwrap();
-        assert_eq!(&back, p);
+        for v in p.params() {
+            assert!(
+                json.contains(&format!("{v}")) || json.contains(&format!("{v:e}")),
+                "{json}"
+            );
+        }
     }
     let a = Arma::new(vec![0.1, 0.2], vec![0.3], 1.0).unwrap();
     assert_eq!(a.param_names(), ["ar1", "ar2", "ma1", "sigma2"]);

@@ -161,7 +161,7 @@ fn robust_options_new_rejects_eff_0_1_nan() {
         assert!(RobustOptions::new(bad, RobustConvention::Exact).is_err());
     }
     let o = RobustOptions::new(0.8, RobustConvention::Package).unwrap();
-    assert!((o.tuning_constant().unwrap() - 5.649325).abs() < PACKAGE_C_TOL);
+    assert!((o.tuning_constant() - 5.649325).abs() < PACKAGE_C_TOL);
 }
 
 // ---- §2.4 / §2.5 scale ----

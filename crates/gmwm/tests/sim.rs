@@ -20,33 +20,19 @@ const HAND_TOL: f64 = 5e-8;
 /// Every kind of process but GM (an AR1 at a rate), with parameters far from degenerate.
 fn every_process() -> Vec<Process> {
     vec![
-        Process::Wn(Wn { sigma2: 2.0 }),
-        Process::Qn(Qn { q2: 0.5 }),
-        Process::Rw(Rw { gamma2: 0.1 }),
-        Process::Dr(Dr { omega: 0.01 }),
-        Process::Ar1(Ar1 {
-            phi: 0.9,
-            sigma2: 1.0,
-        }),
-        Process::Ma1(Ma1 {
-            theta: 0.5,
-            sigma2: 1.0,
-        }),
-        Process::Arma11(Arma11 {
-            phi: 0.8,
-            theta: -0.3,
-            sigma2: 1.0,
-        }),
+        Process::Wn(Wn::new(2.0).unwrap()),
+        Process::Qn(Qn::new(0.5).unwrap()),
+        Process::Rw(Rw::new(0.1).unwrap()),
+        Process::Dr(Dr::new(0.01).unwrap()),
+        Process::Ar1(Ar1::new(0.9, 1.0).unwrap()),
+        Process::Ma1(Ma1::new(0.5, 1.0).unwrap()),
+        Process::Arma11(Arma11::new(0.8, -0.3, 1.0).unwrap()),
         arma21(),
     ]
 }
 
 fn arma21() -> Process {
-    Process::Arma(Arma {
-        ar: vec![1.3, -0.4],
-        ma: vec![0.5],
-        sigma2: 1.0,
-    })
+    Process::Arma(Arma::new(vec![1.3, -0.4], vec![0.5], 1.0).unwrap())
 }
 
 /// Mean and standard error of replicate values.
@@ -95,10 +81,10 @@ fn bits(x: &[f64]) -> Vec<u64> {
 
 #[test]
 fn simulate_drift_matches_hand_values() {
-    let x = simulate(&[Process::Dr(Dr { omega: 2.0 })], 4, 1).unwrap();
+    let x = simulate(&[Process::Dr(Dr::new(2.0).unwrap())], 4, 1).unwrap();
     assert_eq!(x, vec![2.0, 4.0, 6.0, 8.0]);
     // The ramp continues across fill calls.
-    let mut sim = Simulator::new(vec![Process::Dr(Dr { omega: 2.0 })], 1).unwrap();
+    let mut sim = Simulator::new(vec![Process::Dr(Dr::new(2.0).unwrap())], 1).unwrap();
     let (mut a, mut b) = ([0.0; 3], [0.0; 2]);
     sim.fill(&mut a);
     sim.fill(&mut b);
@@ -122,7 +108,7 @@ fn quantisation_noise_stream_telescopes() {
     // sqrt(q2)(u_{t+1} - u_0), so it stays inside (-sqrt(12 q2), sqrt(12 q2)); independent
     // draws of the same variance would wander like a random walk far beyond it.
     let q2 = 2.0;
-    let x = simulate(&[Process::Qn(Qn { q2 })], 100_000, SEED).unwrap();
+    let x = simulate(&[Process::Qn(Qn::new(q2).unwrap())], 100_000, SEED).unwrap();
     // The range of the partial sums is sqrt(q2)(max u - min u), which nears sqrt(12 q2).
     let bound = (12.0 * q2).sqrt();
     let (mut s, mut lo, mut hi) = (0.0, 0.0f64, 0.0f64);
@@ -146,11 +132,9 @@ fn quantisation_noise_stream_telescopes() {
 fn simulator_fill_is_chunking_invariant() {
     let n = 10_000;
     let mut gens = every_process();
-    gens.push(Process::Arma(Arma {
-        ar: vec![0.5, -0.2, 0.1],
-        ma: vec![0.3, 0.2],
-        sigma2: 0.5,
-    }));
+    gens.push(Process::Arma(
+        Arma::new(vec![0.5, -0.2, 0.1], vec![0.3, 0.2], 0.5).unwrap(),
+    ));
     for mode in [StartMode::Stationary, StartMode::Zero] {
         // One component at a time, then the whole sum.
         let mut cases: Vec<Vec<Process>> = gens.iter().map(|g| vec![g.clone()]).collect();
@@ -197,7 +181,7 @@ fn replicate_seed_gives_distinct_streams() {
     assert_eq!(set.len(), seeds.len());
     assert_eq!(replicate_seed(SEED, 3), replicate_seed(SEED, 3));
     assert_ne!(replicate_seed(SEED, 0), SEED);
-    let g = [Process::Wn(Wn { sigma2: 1.0 })];
+    let g = [Process::Wn(Wn::new(1.0).unwrap())];
     assert_ne!(
         simulate(&g, 10, seeds[0]).unwrap(),
         simulate(&g, 10, seeds[1]).unwrap()
@@ -283,15 +267,15 @@ fn check_moments(g: &Process, mode: StartMode, gamma0: f64, gamma1: f64) {
 #[test]
 fn simulate_moments_match_autocovariances() {
     let st = StartMode::Stationary;
-    check_moments(&Process::Wn(Wn { sigma2: 2.0 }), st, 2.0, 0.0);
+    check_moments(&Process::Wn(Wn::new(2.0).unwrap()), st, 2.0, 0.0);
     // QN: Var = 2 q2, lag-1 covariance -q2 (docs/methods.md §10.1).
-    check_moments(&Process::Qn(Qn { q2: 0.5 }), st, 1.0, -0.5);
+    check_moments(&Process::Qn(Qn::new(0.5).unwrap()), st, 1.0, -0.5);
     let (phi, s2) = (0.95, 0.3);
     let g0 = s2 / (1.0 - phi * phi);
-    check_moments(&Process::Ar1(Ar1 { phi, sigma2: s2 }), st, g0, phi * g0);
+    check_moments(&Process::Ar1(Ar1::new(phi, s2).unwrap()), st, g0, phi * g0);
     let (theta, s2) = (-0.6, 1.5);
     check_moments(
-        &Process::Ma1(Ma1 { theta, sigma2: s2 }),
+        &Process::Ma1(Ma1::new(theta, s2).unwrap()),
         st,
         s2 * (1.0 + theta * theta),
         s2 * theta,
@@ -299,7 +283,7 @@ fn simulate_moments_match_autocovariances() {
     for mode in [StartMode::Stationary, StartMode::Zero] {
         // MA1 is stationary in both modes (one extra innovation, docs/methods.md §10.1).
         check_moments(
-            &Process::Ma1(Ma1 { theta, sigma2: s2 }),
+            &Process::Ma1(Ma1::new(theta, s2).unwrap()),
             mode,
             s2 * (1.0 + theta * theta),
             s2 * theta,
@@ -308,11 +292,7 @@ fn simulate_moments_match_autocovariances() {
     let (phi, theta, s2) = (0.9, 0.4, 0.7);
     let g = arma_autocov(&[phi], &[theta], s2, 1);
     check_moments(
-        &Process::Arma11(Arma11 {
-            phi,
-            theta,
-            sigma2: s2,
-        }),
+        &Process::Arma11(Arma11::new(phi, theta, s2).unwrap()),
         st,
         g[0],
         g[1],
@@ -322,11 +302,7 @@ fn simulate_moments_match_autocovariances() {
     // A generic ARMA(1, 0) must agree with AR1.
     let g0 = 0.3 / (1.0 - 0.95 * 0.95);
     check_moments(
-        &Process::Arma(Arma {
-            ar: vec![0.95],
-            ma: vec![],
-            sigma2: 0.3,
-        }),
+        &Process::Arma(Arma::new(vec![0.95], vec![], 0.3).unwrap()),
         st,
         g0,
         0.95 * g0,
@@ -350,7 +326,12 @@ fn simulate_random_walk_increments_have_variance_gamma2() {
     let (reps, n) = (200u64, 2000usize);
     let (mut d0, mut d1, mut first) = (Vec::new(), Vec::new(), Vec::new());
     for r in 0..reps {
-        let x = simulate(&[Process::Rw(Rw { gamma2 })], n, replicate_seed(SEED, r)).unwrap();
+        let x = simulate(
+            &[Process::Rw(Rw::new(gamma2).unwrap())],
+            n,
+            replicate_seed(SEED, r),
+        )
+        .unwrap();
         let d: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
         d0.push(d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64);
         d1.push(d.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (d.len() - 1) as f64);
@@ -381,7 +362,7 @@ fn simulate_stationary_start_has_stationary_variance() {
     let reps = 4000;
     let (phi, s2) = (0.99, 1.0);
     let g0 = s2 / (1.0 - phi * phi);
-    let ar1 = Process::Ar1(Ar1 { phi, sigma2: s2 });
+    let ar1 = Process::Ar1(Ar1::new(phi, s2).unwrap());
     assert_mc(
         &first_sample_second_moment(&ar1, StartMode::Stationary, reps),
         g0,
@@ -395,11 +376,7 @@ fn simulate_stationary_start_has_stationary_variance() {
 
     let (phi, theta) = (0.98, 0.5);
     let g = arma_autocov(&[phi], &[theta], s2, 0);
-    let arma11 = Process::Arma11(Arma11 {
-        phi,
-        theta,
-        sigma2: s2,
-    });
+    let arma11 = Process::Arma11(Arma11::new(phi, theta, s2).unwrap());
     assert_mc(
         &first_sample_second_moment(&arma11, StartMode::Stationary, reps),
         g[0],
@@ -415,7 +392,7 @@ fn simulate_stationary_start_has_stationary_variance() {
     // Generic ARMA with a slow root: the burn-in reaches the stationary law.
     let (ar, ma) = (vec![1.5, -0.56], vec![0.4]); // inverse roots 0.8 and 0.7
     let g = arma_autocov(&ar, &ma, s2, 0);
-    let arma = Process::Arma(Arma { ar, ma, sigma2: s2 });
+    let arma = Process::Arma(Arma::new(ar, ma, s2).unwrap());
     assert_mc(
         &first_sample_second_moment(&arma, StartMode::Stationary, reps),
         g[0],
@@ -433,26 +410,29 @@ fn k_term(phi: f64, tau: f64) -> f64 {
 
 /// The closed forms of docs/methods.md §4.2, typed here as the independent truth.
 fn closed_form_wv(g: &Process, tau: f64) -> f64 {
-    match *g {
-        Process::Wn(Wn { sigma2 }) => sigma2 / tau,
-        Process::Qn(Qn { q2 }) => 6.0 * q2 / (tau * tau),
-        Process::Rw(Rw { gamma2 }) => gamma2 * (tau * tau + 2.0) / (12.0 * tau),
-        Process::Dr(Dr { omega }) => omega * omega * tau * tau / 16.0,
-        Process::Ar1(Ar1 { phi, sigma2 }) => {
+    match g {
+        Process::Wn(w) => w.sigma2() / tau,
+        Process::Qn(q) => 6.0 * q.q2() / (tau * tau),
+        Process::Rw(r) => r.gamma2() * (tau * tau + 2.0) / (12.0 * tau),
+        Process::Dr(d) => d.omega() * d.omega() * tau * tau / 16.0,
+        Process::Ar1(a) => {
+            let (phi, sigma2) = (a.phi(), a.sigma2());
             sigma2 * (tau * (1.0 - phi * phi) - 2.0 * phi * k_term(phi, tau))
                 / (tau * tau * (1.0 - phi).powi(3) * (1.0 + phi))
         }
-        Process::Ma1(Ma1 { theta, sigma2 }) => {
+        Process::Ma1(m) => {
+            let (theta, sigma2) = (m.theta(), m.sigma2());
             sigma2 * ((1.0 + theta).powi(2) * tau - 6.0 * theta) / (tau * tau)
         }
-        Process::Arma11(Arma11 { phi, theta, sigma2 }) => {
+        Process::Arma11(m) => {
+            let (phi, theta, sigma2) = (m.phi(), m.theta(), m.sigma2());
             sigma2
                 * ((1.0 + theta).powi(2) * (1.0 - phi * phi) * tau
                     - 2.0 * (theta + phi) * (1.0 + theta * phi) * k_term(phi, tau))
                 / (tau * tau * (1.0 - phi).powi(3) * (1.0 + phi))
         }
         // GM is an AR1 at a rate, checked through models below
-        Process::Arma(Arma { .. }) | Process::Gm(_) => unreachable!("no closed form in §4.2"),
+        Process::Arma(_) | Process::Gm(_) => unreachable!("no closed form in §4.2"),
     }
 }
 
@@ -464,22 +444,12 @@ fn simulate_wv_matches_closed_forms() {
         ..WvOptions::default()
     };
     let gens = [
-        Process::Wn(Wn { sigma2: 2.0 }),
-        Process::Qn(Qn { q2: 0.5 }),
-        Process::Rw(Rw { gamma2: 0.1 }),
-        Process::Ar1(Ar1 {
-            phi: 0.9,
-            sigma2: 1.0,
-        }),
-        Process::Ma1(Ma1 {
-            theta: 0.5,
-            sigma2: 1.0,
-        }),
-        Process::Arma11(Arma11 {
-            phi: 0.8,
-            theta: -0.3,
-            sigma2: 1.0,
-        }),
+        Process::Wn(Wn::new(2.0).unwrap()),
+        Process::Qn(Qn::new(0.5).unwrap()),
+        Process::Rw(Rw::new(0.1).unwrap()),
+        Process::Ar1(Ar1::new(0.9, 1.0).unwrap()),
+        Process::Ma1(Ma1::new(0.5, 1.0).unwrap()),
+        Process::Arma11(Arma11::new(0.8, -0.3, 1.0).unwrap()),
     ];
     for g in &gens {
         let mut per_level = vec![Vec::new(); levels];
@@ -501,7 +471,7 @@ fn simulate_wv_matches_closed_forms() {
     }
     // A sum: WV of independent components add (docs/methods.md §4.1), DR included.
     let mut sum = gens[..4].to_vec();
-    sum.push(Process::Dr(Dr { omega: 0.01 }));
+    sum.push(Process::Dr(Dr::new(0.01).unwrap()));
     let mut per_level = vec![Vec::new(); levels];
     for r in 0..reps {
         let x = simulate(&sum, n, replicate_seed(SEED, r)).unwrap();
@@ -521,7 +491,7 @@ fn simulate_wv_matches_closed_forms() {
 fn simulate_drift_wv_is_exact() {
     // DR is deterministic: its empirical Haar WV equals omega^2 tau^2 / 16 (docs/methods.md §4.2,
     // §10.3) in every replicate.
-    let g = Process::Dr(Dr { omega: 0.01 });
+    let g = Process::Dr(Dr::new(0.01).unwrap());
     let x = simulate(std::slice::from_ref(&g), 4096, SEED).unwrap();
     let wv = wavelet_variance(
         &x,
@@ -548,73 +518,36 @@ fn simulate_drift_wv_is_exact() {
 
 #[test]
 fn simulator_rejects_bad_parameters() {
-    let bad = [
-        Process::Ar1(Ar1 {
-            phi: 1.0,
-            sigma2: 1.0,
-        }),
-        Process::Ar1(Ar1 {
-            phi: -1.5,
-            sigma2: 1.0,
-        }),
-        Process::Ar1(Ar1 {
-            phi: f64::NAN,
-            sigma2: 1.0,
-        }),
-        Process::Ar1(Ar1 {
-            phi: 0.5,
-            sigma2: -1.0,
-        }),
-        Process::Arma11(Arma11 {
-            phi: 1.0,
-            theta: 0.0,
-            sigma2: 1.0,
-        }),
-        Process::Arma11(Arma11 {
-            phi: 0.5,
-            theta: f64::INFINITY,
-            sigma2: 1.0,
-        }),
-        Process::Ma1(Ma1 {
-            theta: f64::NAN,
-            sigma2: 1.0,
-        }),
-        Process::Wn(Wn { sigma2: -1.0 }),
-        Process::Wn(Wn { sigma2: f64::NAN }),
-        Process::Qn(Qn { q2: -0.1 }),
-        Process::Rw(Rw {
-            gamma2: f64::INFINITY,
-        }),
-        Process::Dr(Dr { omega: f64::NAN }),
-        Process::Arma(Arma {
-            ar: vec![0.5, 0.6],
-            ma: vec![],
-            sigma2: 1.0,
-        }),
-        Process::Arma(Arma {
-            ar: vec![2.0, -1.0],
-            ma: vec![0.1],
-            sigma2: 1.0,
-        }),
-        Process::Arma(Arma {
-            ar: vec![0.5],
-            ma: vec![f64::NAN],
-            sigma2: 1.0,
-        }),
-        Process::Arma(Arma {
-            ar: vec![0.5],
-            ma: vec![],
-            sigma2: -2.0,
-        }),
-        // stationary in exact arithmetic but too close to a unit root for a burn-in
-        Process::Arma(Arma {
-            ar: vec![1.0 - 1e-12],
-            ma: vec![],
-            sigma2: 1.0,
-        }),
+    // a process with a bad value cannot be made: its constructor refuses it, so the
+    // simulator never sees one
+    let refused = [
+        Ar1::new(1.0, 1.0).map(Process::from),
+        Ar1::new(-1.5, 1.0).map(Process::from),
+        Ar1::new(f64::NAN, 1.0).map(Process::from),
+        Ar1::new(0.5, -1.0).map(Process::from),
+        Arma11::new(1.0, 0.0, 1.0).map(Process::from),
+        Arma11::new(0.5, f64::INFINITY, 1.0).map(Process::from),
+        Ma1::new(f64::NAN, 1.0).map(Process::from),
+        Wn::new(-1.0).map(Process::from),
+        Wn::new(f64::NAN).map(Process::from),
+        Qn::new(-0.1).map(Process::from),
+        Rw::new(f64::INFINITY).map(Process::from),
+        Dr::new(f64::NAN).map(Process::from),
+        Arma::new(vec![0.5, 0.6], vec![], 1.0).map(Process::from),
+        Arma::new(vec![2.0, -1.0], vec![0.1], 1.0).map(Process::from),
+        Arma::new(vec![0.5], vec![f64::NAN], 1.0).map(Process::from),
+        Arma::new(vec![0.5], vec![], -2.0).map(Process::from),
     ];
+    for r in refused {
+        assert!(r.is_err(), "{r:?} accepted");
+    }
+    // stationary in exact arithmetic but too close to a unit root for a burn-in: made, then
+    // refused by the simulator
+    let bad = [Process::Arma(
+        Arma::new(vec![1.0 - 1e-12], vec![], 1.0).unwrap(),
+    )];
     for g in bad {
-        let good = Process::Wn(Wn { sigma2: 1.0 });
+        let good = Process::Wn(Wn::new(1.0).unwrap());
         assert!(
             Simulator::new(vec![good, g.clone()], 1).is_err(),
             "{g:?} accepted"
@@ -625,50 +558,20 @@ fn simulator_rejects_bad_parameters() {
         );
     }
     assert!(Simulator::new(vec![], 1).is_err());
-    assert!(simulate(&[Process::Wn(Wn { sigma2: 1.0 })], 0, 1).is_err());
-    let e = Simulator::new(
-        vec![Process::Arma(Arma {
-            ar: vec![0.5, 0.6],
-            ma: vec![],
-            sigma2: 1.0,
-        })],
-        1,
-    )
-    .unwrap_err();
-    assert_eq!(e.name, "ar");
-    // a variance of 0 is refused as the process itself refuses it (issue 13: one domain for
-    // the simulator and the model), naming the parameter
-    let e = Simulator::new(vec![Process::Wn(Wn { sigma2: 0.0 })], 1).unwrap_err();
-    assert_eq!(e.name, "sigma2");
-    assert!(gmwm::process::Wn::new(0.0).is_err());
-    // one validation: the simulator refuses what the process constructors refuse, with their
-    // errors (a process built without its constructor is checked through it)
-    let e = Simulator::new(
-        vec![Process::Ar1(Ar1 {
-            phi: 1.0,
-            sigma2: 1.0,
-        })],
-        1,
-    )
-    .unwrap_err();
-    assert_eq!(e, Ar1::new(1.0, 1.0).unwrap_err());
+    assert!(simulate(&[Process::Wn(Wn::new(1.0).unwrap())], 0, 1).is_err());
+    // the constructors' errors name the parameter (issue 13: one domain for the simulator and
+    // the model)
+    assert_eq!(
+        Arma::new(vec![0.5, 0.6], vec![], 1.0).unwrap_err().name,
+        "ar"
+    );
+    assert_eq!(Wn::new(0.0).unwrap_err().name, "sigma2");
     // Boundary values that are valid.
     for g in [
-        Process::Wn(Wn { sigma2: 1e-300 }),
-        Process::Ar1(Ar1 {
-            phi: -0.999999,
-            sigma2: 1.0,
-        }),
-        Process::Arma(Arma {
-            ar: vec![],
-            ma: vec![],
-            sigma2: 1.0,
-        }),
-        Process::Arma(Arma {
-            ar: vec![0.0, 0.0],
-            ma: vec![2.0],
-            sigma2: 1.0,
-        }),
+        Process::Wn(Wn::new(1e-300).unwrap()),
+        Process::Ar1(Ar1::new(-0.999999, 1.0).unwrap()),
+        Process::Arma(Arma::new(vec![], vec![], 1.0).unwrap()),
+        Process::Arma(Arma::new(vec![0.0, 0.0], vec![2.0], 1.0).unwrap()),
     ] {
         assert!(
             simulate(std::slice::from_ref(&g), 10, 1).is_ok(),

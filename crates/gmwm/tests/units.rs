@@ -124,12 +124,12 @@ fn units_accelerometer_hand_values() {
 fn units_gauss_markov_hand_values() {
     // docs/methods.md §14.5: AR1 phi = 0.999, sigma2 = 1e-8 at 100 Hz
     let gm = Ar1::new(0.999, 1e-8).unwrap().to_gm(100.0).unwrap();
-    assert!(rel_diff(gm.beta, 0.1000500) < TOL_7, "{}", gm.beta);
-    assert!(rel_diff(1.0 / gm.beta, 9.994999) < TOL_7);
+    assert!(rel_diff(gm.beta(), 0.1000500) < TOL_7, "{}", gm.beta());
+    assert!(rel_diff(1.0 / gm.beta(), 9.994999) < TOL_7);
     assert!(
-        rel_diff(gm.sigma2_gm, 5.002501e-6) < TOL_7,
+        rel_diff(gm.sigma2_gm(), 5.002501e-6) < TOL_7,
         "{}",
-        gm.sigma2_gm
+        gm.sigma2_gm()
     );
     // the fit's physical forms agree with §14.5
     let nav = navigation("AR1(phi=0.999, sigma2=1e-8)", 100.0);

@@ -383,7 +383,7 @@ fn check_robust_matches_direct_route(x: &[f64], what: &str) {
         ..WvOptions::default()
     };
     let fast = wavelet_variance(x, 1.0, &opts).unwrap();
-    let c = RobustOptions::default().tuning_constant().unwrap();
+    let c = RobustOptions::default().tuning_constant();
     let coefs = Modwt::new(WaveletFilter::Haar, fast.levels())
         .unwrap()
         .transform(x)

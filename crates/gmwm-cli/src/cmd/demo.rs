@@ -115,7 +115,7 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
     writeln!(out, "  {} Hz, N = {}, seed {}", r.freq_hz, r.n, r.seed)?;
     writeln!(out)?;
     let kind = match wv.robust() {
-        Some(ro) => format!("robust (eff {}) WV", ro.eff),
+        Some(ro) => format!("robust (eff {}) WV", ro.eff()),
         None => "WV".to_string(),
     };
     writeln!(

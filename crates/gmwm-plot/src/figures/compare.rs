@@ -9,7 +9,7 @@ pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]
         .iter()
         .map(|c| {
             let (classical, robust) = c.data;
-            let eff = robust.robust().map_or(0.6, |r| r.eff);
+            let eff = robust.robust().map_or(0.6, |r| r.eff());
             let level = 100.0 * (1.0 - classical.alpha());
             let [cb, cp] = estimate_series(
                 classical.tau_s(),

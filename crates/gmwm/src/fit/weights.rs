@@ -86,7 +86,7 @@ impl Weights {
     pub fn diag(x: &[f64], wv: &WaveletVariance) -> Result<Self, FitError> {
         let mut v = wv_diag_covariance(x, wv.filter, wv.levels(), DiagDivisor::Level)?;
         if let Some(r) = wv.robust {
-            v.iter_mut().for_each(|x| *x /= r.eff);
+            v.iter_mut().for_each(|x| *x /= r.eff());
         }
         Self::from_v(v, "diag variance")
     }

@@ -18,7 +18,7 @@ use super::{
     ProcessKind, Role, UnitShape, BASE,
 };
 use crate::process::sampler::SimRng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, one_minus, Jet,
@@ -213,24 +213,50 @@ const G_TERMS: usize = 40;
 const E_TERMS: usize = 20;
 
 /// First-order autoregression `x_t = phi x_{t-1} + w_t`, `Var w_t = sigma2`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Ar1 {
     /// Autoregressive coefficient, `|phi| < 1`.
-    pub phi: f64,
+    pub(crate) phi: f64,
     /// Innovation variance per sample.
-    pub sigma2: f64,
+    pub(crate) sigma2: f64,
+}
+
+impl Ar1 {
+    /// Autoregressive coefficient, `|phi| < 1`.
+    pub fn phi(&self) -> f64 {
+        self.phi
+    }
+    /// Innovation variance per sample.
+    pub fn sigma2(&self) -> f64 {
+        self.sigma2
+    }
 }
 
 /// Gauss–Markov process: an AR1 parametrised by its inverse correlation time `beta` (1/s) and
 /// stationary variance `sigma2_gm` at sampling rate `freq_hz` (docs/methods.md §4.3).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Gm {
     /// Inverse correlation time in 1/s, `> 0`.
-    pub beta: f64,
+    pub(crate) beta: f64,
     /// Stationary variance, `> 0`.
-    pub sigma2_gm: f64,
+    pub(crate) sigma2_gm: f64,
     /// Sampling rate in Hz, `> 0`.
-    pub freq_hz: f64,
+    pub(crate) freq_hz: f64,
+}
+
+impl Gm {
+    /// Inverse correlation time in 1/s, `> 0`.
+    pub fn beta(&self) -> f64 {
+        self.beta
+    }
+    /// Stationary variance, `> 0`.
+    pub fn sigma2_gm(&self) -> f64 {
+        self.sigma2_gm
+    }
+    /// Sampling rate in Hz, `> 0`.
+    pub fn freq_hz(&self) -> f64 {
+        self.freq_hz
+    }
 }
 
 impl Ar1 {
@@ -648,9 +674,6 @@ impl Simulate for Ar1 {
             r1: self.phi * r0,
         })
     }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.phi, self.sigma2).map(drop)
-    }
     /// [`StartMode::Stationary`]: `x_{-1} ~ N(0, sigma2 / (1 - phi^2))` is drawn first, so
     /// every kept value is stationary; [`StartMode::Zero`]: `x_{-1} = 0` (the package's
     /// `x_0 = 0`, dropped).
@@ -674,9 +697,6 @@ impl Simulate for Gm {
             r0,
             r1: a.phi * r0,
         })
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.beta, self.sigma2_gm, self.freq_hz).map(drop)
     }
     /// Simulated as its exact per-sample AR1 ([`Gm::to_ar1`], docs/methods.md §4.3).
     fn sampler(&self, rng: SimRng, start: StartMode) -> Result<Box<dyn Sampler>, ParamError> {

@@ -7,7 +7,7 @@ use super::{CovariancePart, ParamTransform, Role, TransformPreset, BASE};
 use crate::process::sampler::SimRng;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::{
     autocovariance_wv, check_positive, LatentProcess, Occurs, Orders, Params, Process, Simulate,
@@ -196,14 +196,29 @@ fn build(kind: ProcessKind, v: &[f64], _freq_hz: f64) -> Result<Process, ParamEr
 }
 
 /// General ARMA(p, q): `x_t = sum ar_i x_{t-i} + w_t + sum ma_i w_{t-i}`, `Var w_t = sigma2`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Arma {
     /// Autoregressive coefficients `ar_1..ar_p`.
-    pub ar: Vec<f64>,
+    pub(crate) ar: Vec<f64>,
     /// Moving-average coefficients `ma_1..ma_q`.
-    pub ma: Vec<f64>,
+    pub(crate) ma: Vec<f64>,
     /// Innovation variance per sample.
-    pub sigma2: f64,
+    pub(crate) sigma2: f64,
+}
+
+impl Arma {
+    /// AR coefficients `a_1..a_p` (R sign convention).
+    pub fn ar(&self) -> &[f64] {
+        &self.ar
+    }
+    /// MA coefficients `m_1..m_q` (R sign convention).
+    pub fn ma(&self) -> &[f64] {
+        &self.ma
+    }
+    /// Innovation variance per sample.
+    pub fn sigma2(&self) -> f64 {
+        self.sigma2
+    }
 }
 
 /// Durand–Kerner iterations for the polynomial roots (quadratic convergence once close; the
@@ -764,9 +779,6 @@ impl Simulate for Arma {
             "a generic ARMA(p, q) term",
             "only WN, QN, RW, DR, AR1, GM, MA1 and ARMA11 terms for the exact WV covariance (--covariance auto or bootstrap simulates V)",
         ))
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.ar.clone(), self.ma.clone(), self.sigma2).map(drop)
     }
     /// Runs the burn-in of [`arma_burn_in`] first, from zeros with the first `q` MA outputs
     /// set to 0 (R's `arima.sim`), in both start modes; only its length depends on the mode.

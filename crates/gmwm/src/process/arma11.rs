@@ -10,7 +10,7 @@
 
 use super::{negative_phi, CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::ar1::ar1_wv_jet;
 use super::{
@@ -51,14 +51,29 @@ pub(crate) const SPEC: Spec = Spec {
 const DECOMPOSE_FROM_PHI: f64 = 0.5;
 
 /// ARMA(1,1) `x_t = phi x_{t-1} + w_t + theta w_{t-1}`, `Var w_t = sigma2`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Arma11 {
     /// Autoregressive coefficient, `|phi| < 1`.
-    pub phi: f64,
+    pub(crate) phi: f64,
     /// Moving-average coefficient, `|theta| < 1`.
-    pub theta: f64,
+    pub(crate) theta: f64,
     /// Innovation variance per sample.
-    pub sigma2: f64,
+    pub(crate) sigma2: f64,
+}
+
+impl Arma11 {
+    /// AR coefficient.
+    pub fn phi(&self) -> f64 {
+        self.phi
+    }
+    /// MA coefficient.
+    pub fn theta(&self) -> f64 {
+        self.theta
+    }
+    /// Innovation variance per sample.
+    pub fn sigma2(&self) -> f64 {
+        self.sigma2
+    }
 }
 
 impl Arma11 {
@@ -167,9 +182,6 @@ impl Simulate for Arma11 {
             r0: s2 * (1.0 + 2.0 * phi * theta + theta * theta) / den,
             r1: s2 * (1.0 + phi * theta) * (phi + theta) / den,
         })
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.phi, self.theta, self.sigma2).map(drop)
     }
     /// Draws `w_{-1}`, then in [`StartMode::Stationary`] `x_{-1}` from the stationary joint law
     /// (`Cov(x, w) = sigma2`, `Var x = gamma_0`: `x_{-1} = w_{-1} + N(0, gamma_0 - sigma2)`,

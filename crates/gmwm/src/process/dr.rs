@@ -2,7 +2,7 @@
 
 use super::{CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::{add_scaled, half_widths, LatentProcess, Occurs, Params, Simulate, Spec};
 use crate::error::ParamError;
@@ -31,10 +31,17 @@ pub(crate) const SPEC: Spec = Spec {
 };
 
 /// Deterministic drift: the ramp `x_t = omega (t + 1)`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Dr {
     /// Slope per sample (any sign).
-    pub omega: f64,
+    pub(crate) omega: f64,
+}
+
+impl Dr {
+    /// Slope per sample.
+    pub fn omega(&self) -> f64 {
+        self.omega
+    }
 }
 
 impl Dr {
@@ -108,9 +115,6 @@ impl Step for DrSampler {
 impl Simulate for Dr {
     fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
         Ok(CovariancePart::Drift(self.omega))
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.omega).map(drop)
     }
     fn sampler(&self, _: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         Ok(Box::new(DrSampler {

@@ -2,7 +2,7 @@
 
 use super::{CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::{
     check_positive, check_unit, jet_levels, jets_hessian, jets_jacobian, Jet, LatentProcess,
@@ -39,12 +39,23 @@ pub(crate) const SPEC: Spec = Spec {
 };
 
 /// First-order moving average `x_t = w_t + theta w_{t-1}`, `Var w_t = sigma2`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Ma1 {
     /// Moving-average coefficient, `|theta| < 1` (invertible, hence identifiable).
-    pub theta: f64,
+    pub(crate) theta: f64,
     /// Innovation variance per sample.
-    pub sigma2: f64,
+    pub(crate) sigma2: f64,
+}
+
+impl Ma1 {
+    /// MA coefficient.
+    pub fn theta(&self) -> f64 {
+        self.theta
+    }
+    /// Innovation variance per sample.
+    pub fn sigma2(&self) -> f64 {
+        self.sigma2
+    }
 }
 
 impl Ma1 {
@@ -126,9 +137,6 @@ impl Simulate for Ma1 {
             r0: self.sigma2 * (1.0 + self.theta * self.theta),
             r1: self.sigma2 * self.theta,
         })
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.theta, self.sigma2).map(drop)
     }
     fn sampler(&self, mut rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         let sd = self.sigma2.sqrt();

@@ -18,7 +18,7 @@
 //! of §4.5 cancels (AR1/GM with `phi` near 1). The generic [`Arma`] is differentiated numerically
 //! (§4.7). [`spectral`] holds the slow quadrature oracle of §1.9.
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 pub mod ar1;
 pub mod arma;
@@ -87,9 +87,6 @@ pub trait LatentProcess {
 /// What the engine needs of a process beyond [`LatentProcess`]: its validation, again, and its
 /// simulation (docs/methods.md §10.1). Implemented by every process next to its implied WV.
 pub(crate) trait Simulate: LatentProcess {
-    /// Checks the values through the process's own constructor (the fields are public, so a
-    /// value may have been built without it).
-    fn check(&self) -> Result<(), ParamError>;
     /// The simulation state on `rng`, the component's own stream; initial draws come first in
     /// it, per `start` for the autoregressive processes.
     ///
@@ -162,7 +159,7 @@ macro_rules! processes {
         }
 
         /// One latent process of a model, with its values (docs/methods.md §0.2).
-        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[derive(Debug, Clone, PartialEq, Serialize)]
         pub enum Process {
             $($($(#[doc = $pdoc])* $variant($ty),)?)*
         }
@@ -233,11 +230,6 @@ processes! {
 }
 
 impl Process {
-    /// [`Simulate::check`].
-    pub(crate) fn check(&self) -> Result<(), ParamError> {
-        self.inner().check()
-    }
-
     /// [`Simulate::covariance_part`].
     pub(crate) fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
         self.inner().covariance_part()

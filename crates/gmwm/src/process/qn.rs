@@ -3,7 +3,7 @@
 use super::draw::{Dominance, Draw};
 use super::{CovariancePart, ParamTransform, ProcessKind, Role, BASE};
 use crate::process::sampler::SimRng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::{
     add_scaled, check_positive, half_widths, LatentProcess, Occurs, Params, Simulate, Spec,
@@ -52,10 +52,17 @@ fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f
 const SQRT_12: f64 = 3.464_101_615_137_754_6;
 
 /// Quantisation noise: first difference of white noise of variance `q2`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Qn {
     /// Quantisation parameter Q^2.
-    pub q2: f64,
+    pub(crate) q2: f64,
+}
+
+impl Qn {
+    /// Quantisation variance parameter Q^2.
+    pub fn q2(&self) -> f64 {
+        self.q2
+    }
 }
 
 impl Qn {
@@ -131,9 +138,6 @@ impl Step for QnSampler {
 impl Simulate for Qn {
     fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
         Ok(CovariancePart::Quantization(self.q2))
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.q2).map(drop)
     }
     fn sampler(&self, mut rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         let u = SQRT_12 * uniform(&mut rng);

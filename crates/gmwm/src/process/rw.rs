@@ -2,7 +2,7 @@
 
 use super::{CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::ar1::Ar1Sampler;
 use super::{
@@ -40,10 +40,17 @@ pub(crate) const SPEC: Spec = Spec {
 };
 
 /// Random walk: cumulative sum of white noise with increment variance `gamma2`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Rw {
     /// Increment variance.
-    pub gamma2: f64,
+    pub(crate) gamma2: f64,
+}
+
+impl Rw {
+    /// Increment variance per sample.
+    pub fn gamma2(&self) -> f64 {
+        self.gamma2
+    }
 }
 
 impl Rw {
@@ -96,9 +103,6 @@ impl LatentProcess for Rw {
 impl Simulate for Rw {
     fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
         Ok(CovariancePart::RandomWalk(self.gamma2))
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.gamma2).map(drop)
     }
     fn sampler(&self, rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         // docs/methods.md §10.1: `x_t = sum_{i=0}^{t} w_i`, `w ~ N(0, gamma2)` (the first value is

@@ -1,7 +1,7 @@
 //! White noise (docs/methods.md §0.2, §4.2, §10.1).
 
 use crate::process::sampler::SimRng;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::draw::{Dominance, Draw};
 use super::{
@@ -49,10 +49,17 @@ fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f
 }
 
 /// White noise: independent samples of variance `sigma2`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Wn {
     /// Variance per sample.
-    pub sigma2: f64,
+    pub(crate) sigma2: f64,
+}
+
+impl Wn {
+    /// Variance per sample.
+    pub fn sigma2(&self) -> f64 {
+        self.sigma2
+    }
 }
 
 impl Wn {
@@ -119,9 +126,6 @@ impl Step for WnSampler {
 impl Simulate for Wn {
     fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
         Ok(CovariancePart::White(self.sigma2))
-    }
-    fn check(&self) -> Result<(), ParamError> {
-        Self::new(self.sigma2).map(drop)
     }
     fn sampler(&self, rng: SimRng, _: StartMode) -> Result<Box<dyn Sampler>, ParamError> {
         Ok(Box::new(WnSampler {

@@ -137,7 +137,7 @@ pub fn wv_covariance(
         match (exact, method) {
             (Ok(v), _) => {
                 let v = match wv_opts.robust {
-                    Some(r) => v / r.eff,
+                    Some(r) => v / r.eff(),
                     None => v,
                 };
                 return Ok(WvCovariance {

@@ -13,7 +13,7 @@ impl Simulator {
     /// # Errors
     /// A model that is not fully specified or has invalid values ([`Model::processes`]).
     pub fn for_model(model: &Model, freq_hz: f64, seed: u64) -> Result<Self, InputError> {
-        Ok(Simulator::checked(model.processes(freq_hz)?, seed)?)
+        Ok(Simulator::new(model.processes(freq_hz)?, seed)?)
     }
 }
 

@@ -33,26 +33,16 @@ pub struct Simulator {
 }
 
 impl Simulator {
-    /// Checks the processes (through their constructors: the fields are public) and prepares
-    /// one stream per component, in [`StartMode::Stationary`].
+    /// Prepares one stream per component, in [`StartMode::Stationary`]. The processes are
+    /// valid: their constructors checked them and their fields are private.
     ///
     /// Cost: O(p^3) root finding per generic ARMA plus its burn-in (O(n0 (p + q))); O(1)
     /// otherwise.
     ///
     /// # Errors
-    /// [`ParamError`] for an empty list, a value its process's constructor refuses (e.g. a
-    /// variance that is not > 0, `|phi| >= 1`, an AR polynomial with a root of modulus
-    /// `<= 1`), or a generic ARMA whose burn-in would exceed 10^8 samples (AR root too close
-    /// to the unit circle).
+    /// [`ParamError`] for an empty list, or a generic ARMA whose burn-in would exceed 10^8
+    /// samples (AR root too close to the unit circle).
     pub fn new(processes: Vec<Process>, seed: u64) -> Result<Self, ParamError> {
-        for p in &processes {
-            p.check()?;
-        }
-        Self::checked(processes, seed)
-    }
-
-    /// [`Simulator::new`] for processes known to be valid (built by their constructors).
-    pub(crate) fn checked(processes: Vec<Process>, seed: u64) -> Result<Self, ParamError> {
         if processes.is_empty() {
             return Err(ParamError::new(
                 "processes",

@@ -130,7 +130,7 @@ impl PooledWv {
             let (lo, hi) = match first.robust {
                 // §2.5 scales the classical interval's relative half-widths by 1 / sqrt(eff)
                 Some(r) => {
-                    let (lo, hi) = robust_ci(value[j], value[j], lo, hi, r.eff, lowest);
+                    let (lo, hi) = robust_ci(value[j], value[j], lo, hi, r.eff(), lowest);
                     if lo.is_finite() {
                         lowest = Some(lowest.map_or(lo, |l| l.min(lo)));
                     }

@@ -71,15 +71,21 @@ pub const DEFAULT_EFF: f64 = 0.6;
 /// the estimator stops being robust.
 pub const MAX_EFF: f64 = 0.99;
 
-/// Options of the robust estimator (docs/methods.md §2). Read from JSON (a saved WV, a
-/// calibration), they are checked as [`RobustOptions::new`] checks them.
+/// Options of the robust estimator (docs/methods.md §2), with their tuning constant solved once
+/// (§2.3). Made by [`RobustOptions::new`] (or read from JSON, a saved WV or a calibration, and
+/// checked the same way): a value that exists is valid.
+///
+/// Wire format: `eff`, `convention`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "RobustOptionsDoc")]
 pub struct RobustOptions {
     /// Requested Gaussian efficiency in (0, 0.99] (docs/methods.md §2.3).
-    pub eff: f64,
+    eff: f64,
     /// Convention (docs/methods.md §2.3–§2.4).
-    pub convention: RobustConvention,
+    convention: RobustConvention,
+    /// The tuning constant `c` of `eff` under `convention` (§2.3).
+    #[serde(skip)]
+    c: f64,
 }
 
 /// [`RobustOptions`] as JSON holds them, before the check.
@@ -101,10 +107,7 @@ impl Default for RobustOptions {
     /// `eff = 0.6` (the package default, docs/methods.md §2.3) with the [`RobustConvention::Exact`]
     /// convention (correct formulas, docs/methods.md §2.4 "Port").
     fn default() -> Self {
-        Self {
-            eff: DEFAULT_EFF,
-            convention: RobustConvention::Exact,
-        }
+        Self::new(DEFAULT_EFF, RobustConvention::Exact).expect("the default efficiency is valid")
     }
 }
 
@@ -115,16 +118,24 @@ impl RobustOptions {
     /// [`ParamError`] (name `eff`) unless `eff` is finite and in `(0, 0.99]`; values above 0.99
     /// are refused as the package does (§2.5).
     pub fn new(eff: f64, convention: RobustConvention) -> Result<Self, ParamError> {
-        check_eff(eff)?;
-        Ok(Self { eff, convention })
+        let c = tuning_constant(eff, convention)?;
+        Ok(Self { eff, convention, c })
     }
 
-    /// The tuning constant `c` of these options (docs/methods.md §2.3); see [`tuning_constant`].
-    ///
-    /// # Errors
-    /// As [`tuning_constant`].
-    pub fn tuning_constant(&self) -> Result<f64, ParamError> {
-        tuning_constant(self.eff, self.convention)
+    /// The requested Gaussian efficiency (docs/methods.md §2.3).
+    pub fn eff(&self) -> f64 {
+        self.eff
+    }
+
+    /// The convention (docs/methods.md §2.3–§2.4).
+    pub fn convention(&self) -> RobustConvention {
+        self.convention
+    }
+
+    /// The tuning constant `c` of these options (docs/methods.md §2.3, [`tuning_constant`]),
+    /// solved once when the options were made.
+    pub fn tuning_constant(&self) -> f64 {
+        self.c
     }
 }
 

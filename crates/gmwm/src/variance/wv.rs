@@ -11,9 +11,7 @@ use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, eta3, interval_unchecked};
 use crate::variance::haar::haar_square_sums;
 use crate::variance::haar_robust::haar_robust_levels;
-use crate::variance::robust::{
-    robust_ci, robust_scale, tuning_constant, RobustConvention, RobustOptions,
-};
+use crate::variance::robust::{robust_ci, robust_scale, RobustConvention, RobustOptions};
 use crate::wavelet::{
     dwt_boundary, modwt_boundary, Dwt, Modwt, Transform, WaveletFilter, MAX_LEVELS,
 };
@@ -247,7 +245,7 @@ impl WaveletVariance {
     /// assert!((v[0] * wv.eta()[0] / 2.0 - 1.0).abs() < 1e-3);
     /// ```
     pub fn log_variance(&self) -> Vec<f64> {
-        let widen = self.robust.map_or(1.0, |r| 1.0 / r.eff);
+        let widen = self.robust.map_or(1.0, |r| 1.0 / r.eff());
         self.eta
             .iter()
             .map(|&e| trigamma(e / 2.0) * widen)
@@ -288,7 +286,7 @@ impl WaveletVariance {
             let (lo_c, hi_c) = interval_unchecked(nu_c, e, opts.alpha);
             match (robust, opts.robust) {
                 (Some(r), Some(ro)) => {
-                    let (lo, hi) = robust_ci(r[i], nu_c, lo_c, hi_c, ro.eff, lowest);
+                    let (lo, hi) = robust_ci(r[i], nu_c, lo_c, hi_c, ro.eff(), lowest);
                     if lo.is_finite() {
                         lowest = Some(lowest.map_or(lo, |l| l.min(lo)));
                     }
@@ -325,7 +323,7 @@ impl WaveletVariance {
 impl fmt::Display for WaveletVariance {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let kind = match self.robust {
-            Some(r) => format!("robust (eff {}, {})", r.eff, r.convention),
+            Some(r) => format!("robust (eff {}, {})", r.eff(), r.convention()),
             None => "classical".to_string(),
         };
         writeln!(
@@ -473,9 +471,6 @@ pub fn wavelet_variance(
             .levels
             .unwrap_or_else(|| default_levels(n, opts.transform, opts.filter).max(1));
         check_levels(n, levels, opts)?;
-        if let Some(r) = opts.robust {
-            RobustOptions::new(r.eff, r.convention)?;
-        }
         Ok(levels)
     })();
     let levels = match params {
@@ -499,7 +494,7 @@ pub fn wavelet_variance(
     if let (Some(r), Transform::Modwt, WaveletFilter::Haar) =
         (opts.robust, opts.transform, opts.filter)
     {
-        if r.convention == RobustConvention::Exact {
+        if r.convention() == RobustConvention::Exact {
             return haar_robust_in_memory(x, levels, freq_hz, opts);
         }
     }
@@ -508,10 +503,7 @@ pub fn wavelet_variance(
         Transform::Modwt => Modwt::new(opts.filter, levels)?.transform(x)?,
         Transform::Dwt => Dwt::new(opts.filter, levels)?.transform(x)?,
     };
-    let c = opts
-        .robust
-        .map(|r| tuning_constant(r.eff, r.convention))
-        .transpose()?;
+    let c = opts.robust.map(|r| r.tuning_constant());
     // Levels are independent once the transform is done: the robust solves (the expensive
     // part, O(n) per fixed-point step) run in parallel across levels.
     use rayon::prelude::*;
@@ -524,7 +516,7 @@ pub fn wavelet_variance(
                 Transform::Dwt => (j as f64).exp2(),
             };
             let robust = match (c, opts.robust) {
-                (Some(c), Some(r)) => match robust_scale(kept, c, r.convention) {
+                (Some(c), Some(r)) => match robust_scale(kept, c, r.convention()) {
                     Ok(s2) => Some(s2 / scale),
                     Err(InputError::Series(SeriesError::NoRobustScale { .. })) => Some(f64::NAN),
                     Err(e) => return Err(e),
@@ -582,7 +574,7 @@ fn haar_robust_in_memory(
 ) -> Result<WaveletVariance, InputError> {
     let n = x.len();
     let r = opts.robust.expect("robust options");
-    let c = tuning_constant(r.eff, r.convention)?;
+    let c = r.tuning_constant();
     let head = &x[..n.min(crate::variance::haar::BLOCK)];
     let offset = head.iter().sum::<f64>() / head.len() as f64;
     let per_level = haar_robust_levels(x, levels, offset, c)
