@@ -759,8 +759,8 @@ pub enum BatchJob {
     },
     /// `gmwm wv`: `json` prints the batch summary as JSON (`--json`).
     Wv {
-        /// The estimator.
-        config: WvConfig,
+        /// The estimator (boxed: the variants differ in size).
+        config: Box<WvConfig>,
         /// `--json`: the summary as JSON.
         json: bool,
     },
@@ -875,7 +875,7 @@ fn wv_or_batch(a: &WvCommand) -> Result<Config> {
         force: batch.force,
         job: BatchJob::Wv {
             json: config.output == Style::Json,
-            config,
+            config: Box::new(config),
         },
     }))
 }
