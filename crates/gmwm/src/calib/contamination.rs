@@ -37,7 +37,7 @@ pub struct Contamination {
     pub max_ratio: f64,
     /// Whether the classical estimate, and so a classical fit, is affected: more scales outside
     /// than `alpha` of them allows by chance, or one outside by more than
-    /// [`CHANCE_MISS_REL`].
+    /// `CHANCE_MISS_REL`.
     pub matters: bool,
     /// One sentence for the report.
     pub summary: String,
@@ -56,7 +56,7 @@ pub enum FitUses {
 /// Compares `classical` with `robust` (docs/methods.md §2, paper Fig. 2) at confidence level
 /// `1 - alpha`: a level counts as outside when the classical estimate is beyond the robust
 /// interval; the verdict is the fit verdict's rule (more than `ceil(alpha J)` levels outside, or
-/// one outside by more than [`CHANCE_MISS_REL`] relative).
+/// one outside by more than `CHANCE_MISS_REL` relative).
 pub fn compare_classical_robust(
     classical: WaveletVariance,
     robust: WaveletVariance,

@@ -1,9 +1,9 @@
 //! Calibration: from a recording to navigation-filter parameters.
-pub mod contamination;
+pub(crate) mod contamination;
 pub mod export;
 pub mod ieee;
-pub mod nav;
-pub mod pipeline;
+pub(crate) mod nav;
+pub(crate) mod pipeline;
 pub mod pooled;
 pub mod streamed;
 

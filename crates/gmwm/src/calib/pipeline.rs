@@ -37,12 +37,12 @@ const DELTA_STEP: f64 = 1e-5;
 /// Largest relative miss of the band that the verdict still puts down to chance when no more
 /// than `alpha` of the scales are outside (10%: beyond it one scale misses by more than the
 /// WV's own precision at the scales a filter integrates over).
-pub const CHANCE_MISS_REL: f64 = 0.1;
+pub(crate) const CHANCE_MISS_REL: f64 = 0.1;
 
 /// Relative standard error above which a read-off is reported without an interval, as not
 /// determined by the data: beyond it the log-scale interval spans more than a factor e^(2 z)
 /// (50 at 95%), which says nothing a filter could use, and `--conservative` would export noise.
-pub const UNDETERMINED_SE_REL: f64 = 1.0;
+pub(crate) const UNDETERMINED_SE_REL: f64 = 1.0;
 
 /// Relative agreement below which a canonical term is a function of the fitted estimates
 /// (terms computed by a refit are not, and get no interval from the fit's covariance).
@@ -169,7 +169,7 @@ pub enum EstimateStatus {
     /// An estimate (with its interval when the fit's covariance gives one).
     Estimated,
     /// An estimate the data do not determine: no interval
-    /// ([`UNDETERMINED_SE_REL`]).
+    /// (`UNDETERMINED_SE_REL`).
     Undetermined,
     /// The term was not detected; `value` (= `ci_high`) is an upper bound.
     UpperBound,
@@ -333,7 +333,7 @@ pub struct CalibrationReport {
 /// Longest scale, in seconds, below which a recording is reported as too short to show the
 /// bias instability and the random walk: those of MEMS and tactical IMUs show between 10 s and
 /// 1000 s, and the WV's longest scale is about a quarter of the recording.
-pub const SHORT_RECORDING_SCALE_S: f64 = 1000.0;
+pub(crate) const SHORT_RECORDING_SCALE_S: f64 = 1000.0;
 
 /// The calibration pipeline (module doc).
 ///

@@ -9,17 +9,17 @@
 //! and [`Gmwm::fit`] runs the two-stage pipeline from generated starting values ([`start`], §6). Non-convergence is reported in
 //! [`Convergence`], never hidden.
 
-pub mod active;
-pub mod auto;
+pub(crate) mod active;
+pub(crate) mod auto;
 pub mod canonical;
-pub mod gmwm;
-pub mod objective;
+pub(crate) mod gmwm;
+pub(crate) mod objective;
 pub(crate) mod optimize;
 pub mod pooled;
 pub mod report;
 pub(crate) mod revive;
 pub mod start;
-pub mod transform;
+pub(crate) mod transform;
 pub mod weights;
 
 #[cfg(test)]

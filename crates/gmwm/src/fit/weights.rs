@@ -76,13 +76,13 @@ impl Weights {
         Self::from_v(v, "squared CI width")
     }
 
-    /// docs/methods.md §5.2 "diag": `V_jj` from [`wv_diag_covariance`] of the series `x` at the
+    /// docs/methods.md §5.2 "diag": `V_jj` from `wv_diag_covariance` of the series `x` at the
     /// levels and filter of `wv` (per-level divisor), divided by `eff` when `wv` is robust.
     ///
     /// Cost: one MODWT of `x` and one FFT per level.
     ///
     /// # Errors
-    /// [`FitError::Input`] wrapping the error of [`wv_diag_covariance`]; [`FitError::BadWeight`] for a zero or non-finite `V_jj`.
+    /// [`FitError::Input`] wrapping the error of `wv_diag_covariance`; [`FitError::BadWeight`] for a zero or non-finite `V_jj`.
     pub fn diag(x: &[f64], wv: &WaveletVariance) -> Result<Self, FitError> {
         let mut v = wv_diag_covariance(x, wv.filter, wv.levels(), DiagDivisor::Level)?;
         if let Some(r) = wv.robust {

@@ -648,13 +648,18 @@ fn sd(x: &[f64]) -> f64 {
 }
 
 /// Resamples of the bootstrap GoF p-value (docs/methods.md §7.4, as the package).
-pub const GOF_RESAMPLES: usize = 1000;
+pub(crate) const GOF_RESAMPLES: usize = 1000;
 
 /// docs/methods.md §7.4: bootstrap GoF p-value (share of `objectives` strictly above `observed`)
 /// and its interval: [`GOF_RESAMPLES`] resamples with replacement of the objectives, each giving a
 /// p-value, and their `alpha/2`, `1 - alpha/2` empirical quantiles (lower order statistic
 /// `sorted[floor(q (R - 1))]`, no interpolation). Seeded by `seed`.
-pub fn bootstrap_gof(observed: f64, objectives: &[f64], alpha: f64, seed: u64) -> BootstrapGof {
+pub(crate) fn bootstrap_gof(
+    observed: f64,
+    objectives: &[f64],
+    alpha: f64,
+    seed: u64,
+) -> BootstrapGof {
     let b = objectives.len();
     let share =
         |it: &mut dyn Iterator<Item = f64>| it.filter(|&o| o > observed).count() as f64 / b as f64;

@@ -14,26 +14,26 @@
 //! kind. A new process is its file, its `mod` line and one row of the table.
 //!
 //! Derivatives of the closed forms are exact (forward-mode automatic differentiation of the
-//! numerically stable evaluation, see [`ar1`]), so they stay accurate where the textbook quotient
+//! numerically stable evaluation, see `ar1`), so they stay accurate where the textbook quotient
 //! of §4.5 cancels (AR1/GM with `phi` near 1). The generic [`Arma`] is differentiated numerically
 //! (§4.7). [`spectral`] holds the slow quadrature oracle of §1.9.
 
 use serde::Serialize;
 
-pub mod ar1;
-pub mod arma;
-pub mod arma11;
-pub mod dr;
+pub(crate) mod ar1;
+pub(crate) mod arma;
+pub(crate) mod arma11;
+pub(crate) mod dr;
 pub(crate) mod draw;
 mod facts;
 mod kind;
-pub mod ma1;
+pub(crate) mod ma1;
 mod param;
-pub mod qn;
-pub mod rw;
+pub(crate) mod qn;
+pub(crate) mod rw;
 pub(crate) mod sampler;
 pub mod spectral;
-pub mod wn;
+pub(crate) mod wn;
 
 pub use ar1::{Ar1, Gm};
 pub use arma::Arma;
@@ -364,7 +364,7 @@ pub(crate) struct Jet<const N: usize> {
 
 impl<const N: usize> Jet<N> {
     /// A constant.
-    pub fn c(v: f64) -> Self {
+    pub(crate) fn c(v: f64) -> Self {
         Self {
             v,
             g: [0.0; N],
@@ -372,7 +372,7 @@ impl<const N: usize> Jet<N> {
         }
     }
     /// The `k`-th independent variable at value `v`.
-    pub fn var(v: f64, k: usize) -> Self {
+    pub(crate) fn var(v: f64, k: usize) -> Self {
         let mut s = Self::c(v);
         if k < N {
             s.g[k] = 1.0;
@@ -380,7 +380,7 @@ impl<const N: usize> Jet<N> {
         s
     }
     /// `f(self)` given `f`, `f'`, `f''` at `self.v`.
-    pub fn chain(self, f0: f64, f1: f64, f2: f64) -> Self {
+    pub(crate) fn chain(self, f0: f64, f1: f64, f2: f64) -> Self {
         let mut out = Self::c(f0);
         for a in 0..N {
             out.g[a] = f1 * self.g[a];
@@ -391,22 +391,22 @@ impl<const N: usize> Jet<N> {
         out
     }
     /// `exp`.
-    pub fn exp(self) -> Self {
+    pub(crate) fn exp(self) -> Self {
         let e = self.v.exp();
         self.chain(e, e, e)
     }
     /// `exp(x) - 1`, accurate near 0.
-    pub fn exp_m1(self) -> Self {
+    pub(crate) fn exp_m1(self) -> Self {
         let e = self.v.exp();
         self.chain(self.v.exp_m1(), e, e)
     }
     /// Natural logarithm.
-    pub fn ln(self) -> Self {
+    pub(crate) fn ln(self) -> Self {
         let v = self.v;
         self.chain(v.ln(), 1.0 / v, -1.0 / (v * v))
     }
     /// Integer power.
-    pub fn powi(self, n: i32) -> Self {
+    pub(crate) fn powi(self, n: i32) -> Self {
         let v = self.v;
         let nf = f64::from(n);
         let d1 = if n == 0 { 0.0 } else { nf * v.powi(n - 1) };
@@ -418,12 +418,12 @@ impl<const N: usize> Jet<N> {
         self.chain(v.powi(n), d1, d2)
     }
     /// `1 / x`.
-    pub fn recip(self) -> Self {
+    pub(crate) fn recip(self) -> Self {
         let v = self.v;
         self.chain(1.0 / v, -1.0 / (v * v), 2.0 / (v * v * v))
     }
     /// Multiplies by a constant.
-    pub fn scale(self, s: f64) -> Self {
+    pub(crate) fn scale(self, s: f64) -> Self {
         let mut out = self;
         out.v *= s;
         for a in 0..N {

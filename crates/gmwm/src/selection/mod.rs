@@ -1,12 +1,12 @@
 //! Model selection by the Wavelet Information Criterion (docs/methods.md §8, paper eq. 5).
 //!
 //! `WIC = Q(theta_hat) + optimism`: the apparent loss of a candidate (its GMWM objective against
-//! the data's WV, §5.1) plus an estimate of how much that loss flatters it ([`optimism`]).
+//! the data's WV, §5.1) plus an estimate of how much that loss flatters it (`optimism`).
 //! Smaller is better.
 //!
-//! - [`candidates`]: the nested candidates of a full model (§8.4) and the common denominator
+//! - `candidates`: the nested candidates of a full model (§8.4) and the common denominator
 //!   of a user's list (§8.5), with the refusals of §8.5;
-//! - [`optimism`]: the asymptotic optimism (§8.2, corrected derivative and trace order by
+//! - `optimism`: the asymptotic optimism (§8.2, corrected derivative and trace order by
 //!   default, the package's variant on request) and the bootstrap one (§8.3);
 //! - [`wic`]: the selection procedure (§8.6), [`Wic`] and its result [`ModelSelection`];
 //! - [`imu`]: every axis of an [`Imu`](crate::imu::Imu) in parallel (`auto.imu`).
@@ -84,9 +84,9 @@
 //! assert!(s.rows().iter().all(|r| r.score.wic >= s.rows()[0].score.wic * (1.0 - 1e-6)));
 //! ```
 
-pub mod candidates;
+pub(crate) mod candidates;
 pub mod imu;
-pub mod optimism;
+pub(crate) mod optimism;
 pub mod pooled;
 pub mod wic;
 

@@ -4,10 +4,10 @@
 //! docs/methods.md §10.1 (each process simulates itself, next to its implied WV);
 //! [`simulate_model`] and [`Simulator::for_model`] simulate a [`Model`](crate::model::Model);
 //! [`DemoSensor`] is the known truth behind `gmwm demo`.
-//! [`bootstrap`] simulates parametric-bootstrap replicates and their wavelet variances
+//! `bootstrap` simulates parametric-bootstrap replicates and their wavelet variances
 //! (docs/methods.md §7.4).
 
-pub mod bootstrap;
+pub(crate) mod bootstrap;
 pub mod covariance;
 pub mod demo;
 mod model;

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 /// Which count divides `A_j` (docs/methods.md §1.10, §13.4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum DiagDivisor {
+pub(crate) enum DiagDivisor {
     /// `V_jj = 2 A_j / n_j` with `n_j` the kept count of level j (correct; default).
     #[default]
     Level,
@@ -23,7 +23,7 @@ pub enum DiagDivisor {
 /// Computed with one zero-padded FFT and Parseval: with padding `L >= 2n - 1` the circular
 /// autocovariance equals the linear one, so `sum_{|k| < n} s_k^2 = (1/L) sum_f |X_f|^4 / n^2`
 /// and `A` is half of that. O(n log n); short inputs use the direct O(n^2) sum.
-pub fn half_sum_squared_autocovariance(w: &[f64]) -> f64 {
+pub(crate) fn half_sum_squared_autocovariance(w: &[f64]) -> f64 {
     let n = w.len();
     if n == 0 {
         return f64::NAN;
@@ -48,7 +48,7 @@ pub fn half_sum_squared_autocovariance(w: &[f64]) -> f64 {
 ///
 /// # Errors
 /// Bad series or levels, as [`Modwt::transform`].
-pub fn wv_diag_covariance(
+pub(crate) fn wv_diag_covariance(
     x: &[f64],
     filter: WaveletFilter,
     levels: usize,

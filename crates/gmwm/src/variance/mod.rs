@@ -3,7 +3,7 @@
 
 pub mod allan;
 pub mod ci;
-pub mod cov;
+pub(crate) mod cov;
 pub mod cross;
 mod file;
 pub(crate) mod haar;

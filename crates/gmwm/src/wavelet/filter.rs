@@ -229,7 +229,7 @@ pub(crate) struct Taps {
 impl Taps {
     /// Taps of `filter` times `scale` (1 for the DWT, `1/sqrt2` for the MODWT, docs/methods.md
     /// §1.1).
-    pub fn new(filter: WaveletFilter, scale: f64) -> Self {
+    pub(crate) fn new(filter: WaveletFilter, scale: f64) -> Self {
         let g = filter.scaling();
         let mut taps = Taps {
             h: [0.0; MAX_FILTER_LEN],
@@ -245,12 +245,12 @@ impl Taps {
     }
 
     /// Wavelet taps `h_0..h_{L-1}`.
-    pub fn h(&self) -> &[f64] {
+    pub(crate) fn h(&self) -> &[f64] {
         &self.h[..self.len]
     }
 
     /// Scaling taps `g_0..g_{L-1}`.
-    pub fn g(&self) -> &[f64] {
+    pub(crate) fn g(&self) -> &[f64] {
         &self.g[..self.len]
     }
 }
