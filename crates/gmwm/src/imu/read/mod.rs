@@ -122,6 +122,20 @@ impl FromStr for InputFormat {
     }
 }
 
+crate::names::named_values!(InputFormat, "format", {
+    Auto => "auto",
+    Csv => "csv",
+    Tsv => "tsv",
+    ImuRecord(ImuRecordType::Imar) => "imar",
+    ImuRecord(ImuRecordType::Ln200) => "ln200",
+    ImuRecord(ImuRecordType::Ln200Ig) => "ln200ig",
+    ImuRecord(ImuRecordType::Ixsea) => "ixsea",
+    ImuRecord(ImuRecordType::NavchipInt) => "navchip-int",
+    ImuRecord(ImuRecordType::NavchipFlt) => "navchip-flt",
+    F64 => "f64",
+    F32 => "f32",
+});
+
 impl fmt::Display for InputFormat {
     /// The name [`InputFormat::from_str`] reads back (`f64`, `ln200`, `navchip-int`, ...).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -246,6 +260,12 @@ pub enum HeaderMode {
     /// There is no header; columns are named `col1`, `col2`, ...
     Absent,
 }
+
+crate::names::named_values!(HeaderMode, "header", {
+    Auto => "auto",
+    Present => "yes",
+    Absent => "no",
+}, derive(FromStr, Display));
 
 /// Options of [`read_table`]. The default reads every column of any supported file.
 #[derive(Debug, Clone, PartialEq, Default)]
