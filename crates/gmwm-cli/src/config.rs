@@ -7,24 +7,21 @@
 //! decided here from the flags ([`SavedWvCheck`]) and raised there once FILE is known to be one.
 
 use crate::args::{
-    AvarArgs, AxisPolicyArg, BatchArgs, CalibrateArgs, CalibrateCommand, Command, ConventionArg,
-    DemoArgs, FigureArgs, FitArgs, FormatArg, HeaderArg, ImpliedArgs, InputArgs, KindArg,
-    OptimismArg, OptimismConventionArg, OutputArgs, PlotArgs, PlotCommand, ReportArgs,
-    RobustConventionArg, RuleArg, SelectArgs, SimulateArgs, TimeUnitArg, TopicsArgs, TransformArg,
-    WeightsArg, WvArgs, WvCommand, WvEstimatorArgs,
+    AvarArgs, BatchArgs, CalibrateArgs, CalibrateCommand, Command, DemoArgs, FigureArgs, FitArgs,
+    ImpliedArgs, InputArgs, OutputArgs, PlotArgs, PlotCommand, ReportArgs, SelectArgs,
+    SimulateArgs, TopicsArgs, WvArgs, WvCommand, WvEstimatorArgs,
 };
 use crate::render::Style;
 use crate::UsageError;
 use anyhow::Result;
 use gmwm::calib::export::ExportFormat;
 use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, DEFAULT_FULL_MODEL};
-use gmwm::imu::{ColumnSelector, HeaderMode, ImuRecordType, InputFormat, ReadOptions, TimeUnit};
+use gmwm::imu::{ColumnSelector, ReadOptions};
 use gmwm::inference::InferenceOptions;
 use gmwm::model::Model;
-use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
 use gmwm::{
-    AllanKind, AllanOptions, AvConvention, Gmwm, RobustConvention, RobustOptions, Transform,
-    WaveletFilter, Weighting, Wic, WvOptions,
+    AllanKind, AllanOptions, AvConvention, Gmwm, RobustOptions, Transform, WaveletFilter,
+    Weighting, Wic, WvOptions,
 };
 use gmwm_plot::{ImageFormat, Layout};
 use std::path::{Path, PathBuf};
@@ -117,23 +114,6 @@ fn selector(text: &str) -> ColumnSelector {
     }
 }
 
-/// The engine format of `--format`.
-fn input_format(arg: FormatArg) -> InputFormat {
-    match arg {
-        FormatArg::Auto => InputFormat::Auto,
-        FormatArg::Csv => InputFormat::Csv,
-        FormatArg::Tsv => InputFormat::Tsv,
-        FormatArg::Imar => InputFormat::ImuRecord(ImuRecordType::Imar),
-        FormatArg::Ln200 => InputFormat::ImuRecord(ImuRecordType::Ln200),
-        FormatArg::Ln200ig => InputFormat::ImuRecord(ImuRecordType::Ln200Ig),
-        FormatArg::Ixsea => InputFormat::ImuRecord(ImuRecordType::Ixsea),
-        FormatArg::NavchipInt => InputFormat::ImuRecord(ImuRecordType::NavchipInt),
-        FormatArg::NavchipFlt => InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
-        FormatArg::F64 => InputFormat::F64,
-        FormatArg::F32 => InputFormat::F32,
-    }
-}
-
 impl TryFrom<&InputArgs> for InputConfig {
     type Error = anyhow::Error;
 
@@ -153,19 +133,10 @@ impl TryFrom<&InputArgs> for InputConfig {
             );
         }
         let read = ReadOptions {
-            format: input_format(a.format),
-            header: match a.header {
-                HeaderArg::Auto => HeaderMode::Auto,
-                HeaderArg::Yes => HeaderMode::Present,
-                HeaderArg::No => HeaderMode::Absent,
-            },
+            format: a.format,
+            header: a.header,
             time_column: a.time_column.as_deref().map(selector),
-            time_unit: a.time_unit.map(|u| match u {
-                TimeUnitArg::S => TimeUnit::Seconds,
-                TimeUnitArg::Ms => TimeUnit::Milliseconds,
-                TimeUnitArg::Us => TimeUnit::Microseconds,
-                TimeUnitArg::Ns => TimeUnit::Nanoseconds,
-            }),
+            time_unit: a.time_unit,
             columns: a.columns.iter().map(|c| selector(c)).collect(),
             ncols: a.ncols,
             freq_hz: a.freq,
@@ -222,14 +193,6 @@ impl SavedWvCheck {
     }
 }
 
-/// The engine convention of `--robust-convention`.
-fn robust_convention(arg: RobustConventionArg) -> RobustConvention {
-    match arg {
-        RobustConventionArg::Exact => RobustConvention::Exact,
-        RobustConventionArg::Package => RobustConvention::Package,
-    }
-}
-
 /// The engine's estimator options of the wavelet-variance flags (`--robust`, `--eff`,
 /// `--robust-convention`, `--filter`, `--transform`, `--levels`, `--alpha`).
 fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
@@ -240,10 +203,7 @@ fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
     };
     gmwm::variance::ci::check_alpha(a.alpha)?;
     Ok(WvOptions {
-        transform: match a.transform {
-            TransformArg::Modwt => Transform::Modwt,
-            TransformArg::Dwt => Transform::Dwt,
-        },
+        transform: a.transform,
         filter: a.filter.parse::<WaveletFilter>()?,
         levels: a.levels,
         alpha: a.alpha,
@@ -254,10 +214,7 @@ fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
 /// The robust estimator at `--eff` and `--robust-convention`, whether or not `--robust` is
 /// given (the contamination check of calibrate, the robust series of plot compare).
 fn robust_at_eff(a: &WvEstimatorArgs) -> Result<RobustOptions> {
-    Ok(RobustOptions::new(
-        a.eff,
-        robust_convention(a.robust_convention),
-    )?)
+    Ok(RobustOptions::new(a.eff, a.robust_convention)?)
 }
 
 /// Refuses a non-Haar `--filter` for the estimation commands (fit, select, calibrate): every
@@ -287,21 +244,12 @@ fn estimator_saved_wv_check(a: &WvEstimatorArgs) -> SavedWvCheck {
             })
         })
         .or_else(|| {
-            (a.filter != "haar" || a.transform != TransformArg::Modwt).then(|| {
+            (a.filter != "haar" || a.transform != Transform::Modwt).then(|| {
                 "--filter/--transform apply to a recording; a wavelet-variance file is used as \
                  it is"
                     .to_string()
             })
         })
-}
-
-/// The engine rule of `--rule`.
-fn selection_rule(arg: RuleArg) -> SelectionRule {
-    match arg {
-        RuleArg::Navigation => SelectionRule::Navigation,
-        RuleArg::Parsimonious => SelectionRule::Parsimonious,
-        RuleArg::WicMinimum => SelectionRule::WicMinimum,
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -386,18 +334,9 @@ impl TryFrom<&AvarArgs> for AvarConfig {
     fn try_from(a: &AvarArgs) -> Result<Self> {
         gmwm::variance::ci::check_alpha(a.alpha)?;
         let allan = AllanOptions {
-            kind: match a.kind {
-                KindArg::Overlapping => AllanKind::Overlapping,
-                KindArg::NonOverlapping => AllanKind::NonOverlapping,
-                KindArg::Modified => AllanKind::Modified,
-                KindArg::Hadamard => AllanKind::Hadamard,
-                KindArg::HadamardNonOverlapping => AllanKind::HadamardNonOverlapping,
-            },
+            kind: a.kind,
             alpha: a.alpha,
-            convention: match a.convention {
-                ConventionArg::Textbook => AvConvention::Textbook,
-                ConventionArg::Package => AvConvention::Package,
-            },
+            convention: a.convention,
         };
         // docs/methods.md §3.4, AV(m) = 2 WV(2m), holds for the overlapping textbook estimator only
         let saved_wv = SavedWvCheck::default().or_else(|| {
@@ -515,13 +454,7 @@ impl TryFrom<&FitArgs> for FitConfig {
         let model: Model = a.model.parse()?;
         let wv = wv_options(&a.estimator)?;
         check_haar(&a.estimator, &wv)?;
-        let mut gmwm = Gmwm::new(model)
-            .with_weighting(match a.weights {
-                WeightsArg::Fast => Weighting::Fast,
-                WeightsArg::Diag => Weighting::Diag,
-                WeightsArg::Bootstrap => Weighting::Bootstrap,
-            })
-            .with_seed(a.seed);
+        let mut gmwm = Gmwm::new(model).with_weighting(a.weights).with_seed(a.seed);
         if let Some(g) = a.draws {
             anyhow::ensure!(g >= 1, "invalid --G 0: at least one starting-value draw");
             gmwm = gmwm.with_draws(g);
@@ -534,14 +467,14 @@ impl TryFrom<&FitArgs> for FitConfig {
             Some(InferenceOptions {
                 alpha: a.estimator.alpha,
                 bootstrap: a.bootstrap,
-                v_method: a.covariance.into(),
+                v_method: a.covariance,
                 ..InferenceOptions::default()
             })
         } else {
             None
         };
         let saved_wv = estimator_saved_wv_check(&a.estimator).or_else(|| {
-            (a.weights == WeightsArg::Diag).then(|| {
+            (a.weights == Weighting::Diag).then(|| {
                 "--weights diag needs the series; use fast or bootstrap with a wavelet-variance \
                  file"
                     .to_string()
@@ -610,17 +543,11 @@ impl TryFrom<&SelectArgs> for SelectConfig {
         check_haar(&a.estimator, &wv)?;
         let mut wic = wic
             .with_bootstrap(a.bootstrap)
-            .with_covariance(a.covariance.into())
+            .with_covariance(a.covariance)
             .with_seed(a.seed)
-            .with_optimism(match a.optimism {
-                OptimismArg::Asymptotic => OptimismMethod::Asymptotic,
-                OptimismArg::Bootstrap => OptimismMethod::Bootstrap,
-            })
-            .with_convention(match a.convention {
-                OptimismConventionArg::Corrected => OptimismConvention::Corrected,
-                OptimismConventionArg::Package => OptimismConvention::Package,
-            })
-            .with_rule(selection_rule(a.rule))
+            .with_optimism(a.optimism)
+            .with_convention(a.convention)
+            .with_rule(a.rule)
             .with_wv_options(wv);
         if let Some(g) = a.draws {
             wic = wic.with_draws(g);
@@ -693,11 +620,11 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             stream_from: input.stream_from,
             full_model,
             wv,
-            covariance: a.covariance.into(),
+            covariance: a.covariance,
             bootstrap: a.bootstrap,
             draws: a.draws,
             seed: a.seed,
-            rule: selection_rule(a.rule),
+            rule: a.rule,
             gyro_unit: a.gyro_unit,
             accel_unit: a.accel_unit,
             // the contamination check compares with the robust WV at --eff
@@ -714,11 +641,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             options,
             exports,
             adjustment,
-            policy: match a.axis_policy {
-                AxisPolicyArg::Worst => AxisPolicy::Worst,
-                AxisPolicyArg::Mean => AxisPolicy::Mean,
-                AxisPolicyArg::PerAxis => AxisPolicy::PerAxis,
-            },
+            policy: a.axis_policy,
             json: a.json.clone(),
             rostopic: a.rostopic.clone(),
             report: a.report.clone(),
@@ -1028,7 +951,7 @@ fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
         }
         PlotCommand::Avar { args, figure } => (&args.output, figure),
         PlotCommand::Ieee { args, figure } => {
-            if args.kind != KindArg::Overlapping {
+            if args.kind != AllanKind::Overlapping {
                 return Err(UsageError(
                     "gmwm plot ieee reads the overlapping Allan variance (IEEE Std 952): drop --kind"
                         .into(),
@@ -1145,6 +1068,9 @@ mod tests {
     use super::*;
     use crate::args::Cli;
     use clap::Parser;
+    use gmwm::imu::{HeaderMode, ImuRecordType, InputFormat, TimeUnit};
+    use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
+    use gmwm::RobustConvention;
 
     /// The arguments clap parses from `gmwm ARGV`.
     fn parse(argv: &[&str]) -> Command {
@@ -1278,9 +1204,9 @@ mod tests {
             file: "x.csv".into(),
             columns: Vec::new(),
             freq: Some(-5.0),
-            format: FormatArg::Auto,
+            format: InputFormat::Auto,
             ncols: None,
-            header: HeaderArg::Auto,
+            header: HeaderMode::Auto,
             time_column: None,
             time_unit: None,
             topic: None,
@@ -1296,7 +1222,7 @@ mod tests {
             InputConfig::try_from(&args).unwrap_err().to_string(),
             "invalid --ncols 0: a binary file has at least one column"
         );
-        args.format = FormatArg::Ln200ig;
+        args.format = InputFormat::ImuRecord(ImuRecordType::Ln200Ig);
         args.ncols = None;
         assert_eq!(
             InputConfig::try_from(&args).unwrap().read.format,

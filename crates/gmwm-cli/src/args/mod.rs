@@ -2,8 +2,19 @@
 //! value parsers that refuse a value outside its domain with a usage error). `config.rs` turns
 //! them into one validated configuration per subcommand, in `main`, before any file is read.
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+mod values;
+
+use clap::{Args, Parser, Subcommand};
+use gmwm::calib::AxisPolicy;
+use gmwm::imu::{HeaderMode, InputFormat, TimeUnit};
+use gmwm::inference::CovarianceMethod;
+use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
+use gmwm::{AllanKind, AvConvention, RobustConvention, Transform, Weighting};
 use std::path::PathBuf;
+use values::{
+    alpha, at_least_1, at_least_2, choice, efficiency, inflation, positive_hz, seed, signal_unit,
+    whole,
+};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -217,8 +228,8 @@ pub struct CalibrateArgs {
     pub model: Option<String>,
     /// How the selected model is chosen among the canonical models within one standard error
     /// of the WIC minimum.
-    #[arg(long, value_enum, default_value_t = RuleArg::Navigation)]
-    pub rule: RuleArg,
+    #[arg(long, value_parser = choice::<SelectionRule>(), default_value_t = SelectionRule::Navigation)]
+    pub rule: SelectionRule,
     /// Wavelet-variance settings.
     #[command(flatten)]
     pub estimator: WvEstimatorArgs,
@@ -228,8 +239,8 @@ pub struct CalibrateArgs {
     /// How V, the covariance of the WV behind the WIC and every interval, is obtained: exact
     /// from the model (no simulation, any length) when it has only WN, QN, RW, DR, AR1/GM,
     /// MA1 or ARMA11 terms, else simulated (auto); always exact; or simulated as the R package.
-    #[arg(long, value_enum, default_value_t = CovarianceArg::Auto)]
-    pub covariance: CovarianceArg,
+    #[arg(long, value_parser = choice::<CovarianceMethod>(), default_value_t = CovarianceMethod::Auto)]
+    pub covariance: CovarianceMethod,
     /// Number of starting-value draws of every fit [default: 20000 for N <= 1e4, else 100000,
     /// with early stop].
     #[arg(long = "G", value_name = "N", value_parser = at_least_1)]
@@ -247,8 +258,8 @@ pub struct CalibrateArgs {
     #[arg(long, num_args = 2, value_names = ["STACK", "FILE"], action = clap::ArgAction::Append)]
     pub export: Vec<String>,
     /// Which axis speaks for a sensor triad in the exported files.
-    #[arg(long, value_enum, default_value_t = AxisPolicyArg::Worst)]
-    pub axis_policy: AxisPolicyArg,
+    #[arg(long, value_parser = choice::<AxisPolicy>(), default_value_t = AxisPolicy::Worst)]
+    pub axis_policy: AxisPolicy,
     /// Multiply the exported noise densities and random walks by K (stated in the file).
     #[arg(long, value_name = "K", value_parser = inflation, conflicts_with = "conservative")]
     pub inflate: Option<f64>,
@@ -391,32 +402,6 @@ pub struct FigureArgs {
     pub height: Option<usize>,
 }
 
-/// `--axis-policy`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum AxisPolicyArg {
-    /// The largest value over the axes, per key.
-    Worst,
-    /// The root mean square over the axes.
-    Mean,
-    /// One file per axis letter (FILE.x.yaml, ...).
-    PerAxis,
-}
-
-/// `--gyro-unit`, `--accel-unit`.
-pub fn signal_unit(s: &str) -> Result<gmwm::units::SignalUnit, String> {
-    s.parse::<gmwm::units::SignalUnit>().map_err(|_| {
-        "must be rad/s, deg/s, deg/h (gyroscope) or m/s^2, g, mg (accelerometer)".into()
-    })
-}
-
-/// `--inflate`: a factor of at least 1.
-pub fn inflation(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v >= 1.0 => Ok(v),
-        _ => Err("must be a factor >= 1, e.g. 2".into()),
-    }
-}
-
 const SELECT_EXAMPLES: &str = "\
 Each candidate's fit is read as its canonical model (an AR1 below the sampling interval is white
 noise, one rising over every observed scale a random walk, two the WV cannot separate are one, a
@@ -458,19 +443,19 @@ pub struct SelectArgs {
     /// How V, the covariance of the WV behind the WIC and every interval, is obtained: exact
     /// from the model (no simulation, any length) when it has only WN, QN, RW, DR, AR1/GM,
     /// MA1 or ARMA11 terms, else simulated (auto); always exact; or simulated as the R package.
-    #[arg(long, value_enum, default_value_t = CovarianceArg::Auto)]
-    pub covariance: CovarianceArg,
+    #[arg(long, value_parser = choice::<CovarianceMethod>(), default_value_t = CovarianceMethod::Auto)]
+    pub covariance: CovarianceMethod,
     /// Optimism estimator (docs/methods.md §8.2, §8.3).
-    #[arg(long, value_enum, default_value_t = OptimismArg::Asymptotic)]
-    pub optimism: OptimismArg,
+    #[arg(long, value_parser = choice::<OptimismMethod>(), default_value_t = OptimismMethod::Asymptotic)]
+    pub optimism: OptimismMethod,
     /// Asymptotic optimism formula: the corrected derivative and trace order, or the R
     /// package's (docs/methods.md §13.15).
-    #[arg(long, value_enum, default_value_t = OptimismConventionArg::Corrected)]
-    pub convention: OptimismConventionArg,
+    #[arg(long, value_parser = choice::<OptimismConvention>(), default_value_t = OptimismConvention::Corrected)]
+    pub convention: OptimismConvention,
     /// How the selected model is chosen among the canonical models whose WIC is within one
     /// standard error of the minimum.
-    #[arg(long, value_enum, default_value_t = RuleArg::Navigation)]
-    pub rule: RuleArg,
+    #[arg(long, value_parser = choice::<SelectionRule>(), default_value_t = SelectionRule::Navigation)]
+    pub rule: SelectionRule,
     /// Wavelet-variance settings of the estimate.
     #[command(flatten)]
     pub estimator: WvEstimatorArgs,
@@ -497,36 +482,6 @@ pub struct SelectArgs {
     pub output: OutputArgs,
 }
 
-/// `--rule` of `gmwm select`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum RuleArg {
-    /// The most of white noise and random walk (the terms a navigation filter carries), then
-    /// the fewest parameters.
-    Navigation,
-    /// The fewest parameters (the one-standard-error rule).
-    Parsimonious,
-    /// The smallest WIC (the package's rule, on canonical models).
-    WicMinimum,
-}
-
-/// `--optimism`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum OptimismArg {
-    /// Closed form with the full model's V, exact or simulated as --covariance says (the package default).
-    Asymptotic,
-    /// Parametric bootstrap per candidate (about K times slower for K candidates).
-    Bootstrap,
-}
-
-/// `--convention` of `gmwm select`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum OptimismConventionArg {
-    /// (B + D)^+ A' Omega and tr(Omega A dTheta V).
-    Corrected,
-    /// The R package's formula.
-    Package,
-}
-
 /// `gmwm fit`.
 #[derive(Debug, Args)]
 pub struct FitArgs {
@@ -543,8 +498,8 @@ pub struct FitArgs {
     /// Weighting matrix Omega (docs/methods.md §5.2): CI-width ("fast", the IMU default), the
     /// Percival asymptotic diagonal, or a parametric bootstrap of the WV variances at the
     /// first fit (100 replicates of the series length, then a refit).
-    #[arg(long, value_enum, default_value_t = WeightsArg::Fast)]
-    pub weights: WeightsArg,
+    #[arg(long, value_parser = choice::<Weighting>(), default_value_t = Weighting::Fast)]
+    pub weights: Weighting,
     /// Number of starting-value draws [default: 20000 for N <= 1e4, else 100000, with early stop].
     #[arg(long = "G", value_name = "N", value_parser = at_least_1)]
     pub draws: Option<usize>,
@@ -558,8 +513,8 @@ pub struct FitArgs {
     /// With --inference: how V is obtained: exact from the fitted model when it has only WN,
     /// QN, RW, DR, AR1/GM, MA1 or ARMA11 terms, else simulated (auto); always exact; or
     /// simulated from it, 100 replicates, as the R package.
-    #[arg(long, value_enum, default_value_t = CovarianceArg::Auto, requires = "inference")]
-    pub covariance: CovarianceArg,
+    #[arg(long, value_parser = choice::<CovarianceMethod>(), default_value_t = CovarianceMethod::Auto, requires = "inference")]
+    pub covariance: CovarianceMethod,
     /// With --inference: parametric-bootstrap inference with B replicates instead of the
     /// sandwich (bootstrap SE/CI and the bootstrap goodness-of-fit p-value).
     #[arg(long, value_name = "B", requires = "inference", value_parser = at_least_2)]
@@ -574,38 +529,6 @@ pub struct FitArgs {
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,
-}
-
-/// `--covariance`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum CovarianceArg {
-    /// Exact when the model is covered, else simulated.
-    Auto,
-    /// Exact (an error for a model it does not cover).
-    Exact,
-    /// Parametric bootstrap, as the R package.
-    Bootstrap,
-}
-
-impl From<CovarianceArg> for gmwm::inference::CovarianceMethod {
-    fn from(a: CovarianceArg) -> Self {
-        match a {
-            CovarianceArg::Auto => Self::Auto,
-            CovarianceArg::Exact => Self::Exact,
-            CovarianceArg::Bootstrap => Self::Bootstrap,
-        }
-    }
-}
-
-/// `--weights`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum WeightsArg {
-    /// Inverse squared CI widths (package "fast").
-    Fast,
-    /// Inverse of the Percival asymptotic diagonal covariance (docs/methods.md §1.10).
-    Diag,
-    /// Inverse of the parametric-bootstrap WV variances at the fast fit, then refit (§5.2).
-    Bootstrap,
 }
 
 /// `gmwm simulate`.
@@ -705,21 +628,21 @@ pub struct InputArgs {
     #[arg(long, value_name = "HZ", value_parser = positive_hz)]
     pub freq: Option<f64>,
     /// Input format (auto: from the name, the sidecar and the content).
-    #[arg(long, value_enum, default_value_t = FormatArg::Auto)]
-    pub format: FormatArg,
+    #[arg(long, value_parser = choice::<InputFormat>(), default_value_t = InputFormat::Auto)]
+    pub format: InputFormat,
     /// Number of interleaved columns of a raw binary file [default: the sidecar's, else 1].
     #[arg(long, value_name = "K", value_parser = at_least_1)]
     pub ncols: Option<usize>,
     /// Whether the first row of a text file is a header.
-    #[arg(long, value_enum, default_value_t = HeaderArg::Auto)]
-    pub header: HeaderArg,
+    #[arg(long, value_parser = choice::<HeaderMode>(), default_value_t = HeaderMode::Auto)]
+    pub header: HeaderMode,
     /// Column holding time stamps (name or 1-based index); excluded from analysis
     /// [default: a column named like time, timestamp, t, %time, #timestamp [ns], ...].
     #[arg(long, value_name = "COL")]
     pub time_column: Option<String>,
     /// Unit of the time column [default: stated by its name, else inferred from the values].
-    #[arg(long, value_enum, value_name = "UNIT")]
-    pub time_unit: Option<TimeUnitArg>,
+    #[arg(long, value_parser = choice::<TimeUnit>(), value_name = "UNIT")]
+    pub time_unit: Option<TimeUnit>,
     /// The sensor_msgs/Imu topic of a ROS recording (ROS1 .bag, MCAP, rosbag2 .db3 or folder)
     /// [default: its only IMU topic; `gmwm topics FILE` lists them].
     #[arg(long, value_name = "TOPIC")]
@@ -730,19 +653,6 @@ pub struct InputArgs {
     /// [default: 16777216 = 2^24].
     #[arg(long, value_name = "ROWS", value_parser = clap::value_parser!(u64).range(1..))]
     pub stream_from: Option<u64>,
-}
-
-/// `--time-unit`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum TimeUnitArg {
-    /// Seconds.
-    S,
-    /// Milliseconds.
-    Ms,
-    /// Microseconds.
-    Us,
-    /// Nanoseconds.
-    Ns,
 }
 
 /// Output format shared by the analysis commands.
@@ -767,15 +677,15 @@ pub struct WvEstimatorArgs {
     #[arg(long, value_name = "E", default_value_t = 0.6, value_parser = efficiency)]
     pub eff: f64,
     /// Robust tuning constant and solver: the correct formula, or the R package's.
-    #[arg(long, value_enum, default_value_t = RobustConventionArg::Exact)]
-    pub robust_convention: RobustConventionArg,
+    #[arg(long, value_parser = choice::<RobustConvention>(), default_value_t = RobustConvention::Exact)]
+    pub robust_convention: RobustConvention,
     /// Wavelet filter (docs/methods.md §1.8): haar, d4, d6, d8, d16, fk4, fk8, fk14, fk22, bl14,
     /// bl20, la8, la16, la20, mb4, mb8, mb16, mb24.
     #[arg(long, value_name = "NAME", default_value = "haar")]
     pub filter: String,
     /// Wavelet transform.
-    #[arg(long, value_enum, default_value_t = TransformArg::Modwt)]
-    pub transform: TransformArg,
+    #[arg(long, value_parser = choice::<Transform>(), default_value_t = Transform::Modwt)]
+    pub transform: Transform,
     /// Number of levels J [default: floor(log2 N), one fewer if the last would keep < 2 coefficients].
     #[arg(long, value_name = "J", value_parser = at_least_1)]
     pub levels: Option<usize>,
@@ -823,12 +733,12 @@ pub struct AvarArgs {
     #[command(flatten)]
     pub input: InputArgs,
     /// Which variance.
-    #[arg(long, value_enum, default_value_t = KindArg::Overlapping)]
-    pub kind: KindArg,
+    #[arg(long, value_parser = choice::<AllanKind>(), default_value_t = AllanKind::Overlapping)]
+    pub kind: AllanKind,
     /// Textbook estimators, or the R package's (with its off-by-one terms, docs/methods.md
     /// §13.8–13.10).
-    #[arg(long, value_enum, default_value_t = ConventionArg::Textbook)]
-    pub convention: ConventionArg,
+    #[arg(long, value_parser = choice::<AvConvention>(), default_value_t = AvConvention::Textbook)]
+    pub convention: AvConvention,
     /// Significance level A: the intervals cover 1 - A (0.05 gives 95% intervals; a value
     /// above 0.5, such as 0.95, is refused as a likely confidence level).
     #[arg(long, value_name = "A", default_value_t = 0.05, value_parser = alpha)]
@@ -836,152 +746,6 @@ pub struct AvarArgs {
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,
-}
-
-/// `--format`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum FormatArg {
-    /// From the name, the JSON sidecar and the first bytes (.csv, .tsv, .txt, .gz, .f64, .f32).
-    Auto,
-    /// Comma-separated text.
-    Csv,
-    /// Tab-separated text.
-    Tsv,
-    /// iMAR binary IMU records (docs/methods.md §9.2-9.3: f64 time + 6 int32 increments).
-    Imar,
-    /// Northrop Grumman LN-200 records (int32 increments, gyro 2^-21 rad).
-    Ln200,
-    /// LN-200 IG records (int32 increments, gyro 2^-19 rad).
-    Ln200ig,
-    /// iXblue (IXSEA) records (f64 increments, gyro 1 arcsec).
-    Ixsea,
-    /// NavChip integer records (int32 increments).
-    NavchipInt,
-    /// NavChip float records (f64 increments).
-    NavchipFlt,
-    /// Raw little-endian 64-bit floats.
-    F64,
-    /// Raw little-endian 32-bit floats.
-    F32,
-}
-
-/// `--header`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum HeaderArg {
-    /// A header iff the first row has a non-numeric field.
-    Auto,
-    /// The first row is a header.
-    Yes,
-    /// There is no header.
-    No,
-}
-
-/// `--transform`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum TransformArg {
-    /// Maximal-overlap DWT.
-    Modwt,
-    /// Decimated DWT.
-    Dwt,
-}
-
-/// `--robust-convention`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum RobustConventionArg {
-    /// Correct tuning constant, root-finder from a robust start.
-    Exact,
-    /// The R package's constant and solver (for comparisons).
-    Package,
-}
-
-/// `--kind`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum KindArg {
-    /// Maximal-overlap Allan variance.
-    Overlapping,
-    /// Non-overlapping Allan variance.
-    NonOverlapping,
-    /// Modified Allan variance.
-    Modified,
-    /// Overlapping Hadamard variance.
-    Hadamard,
-    /// Non-overlapping Hadamard variance.
-    HadamardNonOverlapping,
-}
-
-/// `--convention`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ConventionArg {
-    /// Textbook estimators.
-    Textbook,
-    /// The R package's estimators.
-    Package,
-}
-
-/// `--freq`: a positive finite number of hertz.
-pub fn positive_hz(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err("must be a positive number of hertz, e.g. 100".into()),
-    }
-}
-
-/// `--eff`: a Gaussian efficiency in (0, 0.99].
-pub fn efficiency(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v > 0.0 && v <= 0.99 => Ok(v),
-        _ => Err("must be a Gaussian efficiency in (0, 0.99], e.g. 0.6".into()),
-    }
-}
-
-/// `--alpha`: a significance level in (0, 0.5]
-/// ([`gmwm::variance::ci::significance_level_problem`]).
-pub fn alpha(s: &str) -> Result<f64, String> {
-    let v = s
-        .trim()
-        .parse::<f64>()
-        .map_err(|_| "must be a significance level in (0, 0.5]: 0.05 gives 95% intervals")?;
-    match gmwm::variance::ci::significance_level_problem(v) {
-        None => Ok(v),
-        Some(why) => Err(why),
-    }
-}
-
-/// A count of at least `min`: digits, or a whole number in exponent notation (`1e6`).
-fn count_at_least(s: &str, min: usize) -> Result<usize, String> {
-    let t = s.trim();
-    let v = t.parse::<usize>().ok().or_else(|| {
-        t.parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite() && *x >= 0.0 && x.fract() == 0.0 && *x < 9.0e15)
-            .map(|x| x as usize)
-    });
-    match v {
-        Some(v) if v >= min => Ok(v),
-        _ => Err(format!("must be a whole number >= {min}")),
-    }
-}
-
-/// A whole number >= 1 (`--G`, `--levels`, `--ncols`, `--n`).
-pub fn at_least_1(s: &str) -> Result<usize, String> {
-    count_at_least(s, 1)
-}
-
-/// A whole number >= 2 (`--bootstrap`: a covariance needs two replicates).
-pub fn at_least_2(s: &str) -> Result<usize, String> {
-    count_at_least(s, 2).map_err(|e| format!("{e} (a covariance needs two replicates)"))
-}
-
-/// A whole number >= 0 (`--top`).
-pub fn whole(s: &str) -> Result<usize, String> {
-    count_at_least(s, 0)
-}
-
-/// A seed: a whole number from 0 to 2^64 - 1.
-pub fn seed(s: &str) -> Result<u64, String> {
-    s.trim()
-        .parse::<u64>()
-        .map_err(|_| "must be a whole number from 0 to 18446744073709551615".into())
 }
 
 const TOPICS_EXAMPLES: &str = "\

@@ -4,7 +4,7 @@
 //! `gmwm::inference::same_model`); this module reads the files, checks that they can be pooled
 //! (one rate, one unit per sensor, the same columns) and renders.
 
-use crate::args::{FitArgs, FormatArg, HeaderArg, InputArgs, SelectArgs};
+use crate::args::{FitArgs, InputArgs, SelectArgs};
 use crate::config::{FitConfig, InputConfig, SelectConfig};
 use crate::input::{load, Loaded};
 use anyhow::{bail, Context, Result};
@@ -532,9 +532,9 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
         file: args.files[0].clone(),
         columns: args.columns.clone(),
         freq: args.freq,
-        format: FormatArg::Auto,
+        format: gmwm::imu::InputFormat::Auto,
         ncols: None,
-        header: HeaderArg::Auto,
+        header: gmwm::imu::HeaderMode::Auto,
         time_column: None,
         time_unit: None,
         topic: None,
