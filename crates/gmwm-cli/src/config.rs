@@ -11,8 +11,10 @@ use crate::args::{
     ImpliedArgs, InputArgs, OutputArgs, PlotArgs, PlotCommand, ReportArgs, SelectArgs,
     SimulateArgs, TopicsArgs, WvArgs, WvCommand, WvEstimatorArgs,
 };
+use crate::error::UsageError;
+use crate::input::InputConfig;
+use crate::recordings::{is_glob, is_rosbag2_folder};
 use crate::render::Style;
-use crate::UsageError;
 use anyhow::Result;
 use gmwm::calib::export::ExportFormat;
 use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, DEFAULT_FULL_MODEL};
@@ -89,22 +91,6 @@ impl TryFrom<&Command> for Config {
 
 // ---------------------------------------------------------------------------------------------
 // Shared parts
-
-/// Where the data come from and how to read them: FILE and the engine's read options
-/// (`--columns`, `--freq`, `--format`, `--ncols`, `--header`, `--time-column`, `--time-unit`),
-/// and the ROS topic (`--topic`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct InputConfig {
-    /// The data file (or rosbag2 folder).
-    pub file: PathBuf,
-    /// The engine's read options; `read.freq_hz` is `--freq`, `read.columns` is `--columns`.
-    pub read: ReadOptions,
-    /// `--topic`: the IMU topic of a ROS recording.
-    pub topic: Option<String>,
-    /// `--stream-from`: rows from which a text or IMU-record recording is streamed
-    /// ([`gmwm::calib::STREAM_FROM`] by default).
-    pub stream_from: u64,
-}
 
 /// `--columns` entries: all digits → a 1-based index, anything else a name.
 fn selector(text: &str) -> ColumnSelector {
@@ -654,7 +640,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
 // Batch mode
 
 /// `gmwm calibrate` or `gmwm wv` over many recordings: the inputs as given (files, folders,
-/// globs; expanded by [`crate::batch`]), where the outputs go, and the job run on each.
+/// globs; expanded by [`crate::cmd::batch`]), where the outputs go, and the job run on each.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BatchConfig {
     /// FILE arguments as given.
@@ -686,17 +672,6 @@ pub enum BatchJob {
         /// `--json`: the summary as JSON.
         json: bool,
     },
-}
-
-/// A FILE argument that gmwm expands itself: it does not exist as written and holds a glob
-/// metacharacter (`*`, `?`, `[`).
-pub fn is_glob(path: &Path) -> bool {
-    !path.exists() && path.to_str().is_some_and(|s| s.contains(['*', '?', '[']))
-}
-
-/// A folder that is one ROS recording: a rosbag2 folder (it holds metadata.yaml).
-pub fn is_rosbag2_folder(path: &Path) -> bool {
-    path.is_dir() && path.join("metadata.yaml").is_file()
 }
 
 /// Batch mode: more than one FILE, a folder that is not a rosbag2 recording, a glob, or a

@@ -1,13 +1,28 @@
 //! Reading the input an [`InputConfig`] names into loaded columns, and printing what the
 //! reader found (time column, skipped columns, warnings) once per file on stderr.
 
-use crate::config::InputConfig;
 use anyhow::{Context, Result};
 use gmwm::imu::{
     is_wv_json, quote, read_table, read_wv_json, select_series, InputFormat, ReadWarning, Table,
 };
 use gmwm::WaveletVariance;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Where the data come from and how to read them: FILE and the engine's read options
+/// (`--columns`, `--freq`, `--format`, `--ncols`, `--header`, `--time-column`, `--time-unit`),
+/// and the ROS topic (`--topic`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputConfig {
+    /// The data file (or rosbag2 folder).
+    pub file: PathBuf,
+    /// The engine's read options; `read.freq_hz` is `--freq`, `read.columns` is `--columns`.
+    pub read: gmwm::imu::ReadOptions,
+    /// `--topic`: the IMU topic of a ROS recording.
+    pub topic: Option<String>,
+    /// `--stream-from`: rows from which a text or IMU-record recording is streamed
+    /// ([`gmwm::calib::STREAM_FROM`] by default).
+    pub stream_from: u64,
+}
 
 /// A path as the user named it (`<stdin>` for the copy of standard input, [`crate::spool`]).
 pub fn shown_path(path: &Path) -> std::path::PathBuf {
@@ -120,7 +135,7 @@ pub fn load(input: &InputConfig) -> Result<Loaded> {
         return load_ros(input);
     }
     if let Some(topic) = &input.topic {
-        return Err(crate::UsageError(format!(
+        return Err(crate::error::UsageError(format!(
             "invalid --topic {topic}: {} is not a ROS recording (ROS1 bag, MCAP, rosbag2 sqlite3)",
             input.file.display()
         ))
@@ -131,7 +146,7 @@ pub fn load(input: &InputConfig) -> Result<Loaded> {
     let freq_hz = match input.read.freq_hz.or(table.freq_hz) {
         Some(f) => f,
         None if crate::spool::is_stdin(&input.file) => {
-            return Err(crate::UsageError(format!(
+            return Err(crate::error::UsageError(format!(
                 "{}: no sampling rate: standard input has no JSON sidecar and no time column \
                  was found; give --freq",
                 crate::spool::STDIN

@@ -5,19 +5,22 @@
 //! Exit codes: 0 success, 1 input or computation error (one line on stderr), 2 usage error.
 
 mod args;
-mod batch;
 mod cmd;
 mod config;
+mod error;
 mod input;
 mod output;
 mod panic;
 mod progress;
+mod recordings;
 mod render;
 mod spool;
 
 use args::Cli;
 use clap::Parser;
-use config::{Config, InputConfig, PlotKind};
+use config::{Config, PlotKind};
+use error::{one_line, UsageError};
+use input::InputConfig;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 use std::process::ExitCode;
@@ -175,7 +178,7 @@ fn execute(config: &Config) -> anyhow::Result<()> {
         Config::Topics(c) => cmd::topics::run(c, &mut out)?,
         Config::Plot(c) => cmd::plot::run(c, &mut out)?,
         Config::Report(c) => cmd::report::run(c, &mut out)?,
-        Config::Batch(c) => batch::run(c, &mut out)?,
+        Config::Batch(c) => cmd::batch::run(c, &mut out)?,
         Config::Shared(c) => cmd::shared::run(c, &mut out)?,
         Config::Monitor(c) => cmd::monitor::run(c, &mut out)?,
     }
@@ -267,7 +270,7 @@ fn prepare_input(config: &mut Config) -> anyhow::Result<Option<spool::Spool>> {
             .into());
         }
     }
-    if input.file.is_dir() && !config::is_rosbag2_folder(&input.file) {
+    if input.file.is_dir() && !recordings::is_rosbag2_folder(&input.file) {
         anyhow::bail!(
             "{}: is a folder, not a recording (a rosbag2 folder holds metadata.yaml; gmwm wv \
              and gmwm calibrate also take a folder of recordings)",
@@ -311,35 +314,6 @@ pub(crate) fn warn_implausible(input: &InputConfig) {
             eprintln!("gmwm: warning: {}", spool::shown(&bad.to_string()));
         }
     }
-}
-
-/// A flag combination the command refuses (e.g. `gmwm fit --filter la8`): reported in one line
-/// like every error, with the usage-error exit code 2.
-#[derive(Debug)]
-pub struct UsageError(pub String);
-
-impl std::fmt::Display for UsageError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for UsageError {}
-
-/// The error and its causes in one line, `: `-separated, leaving out a cause whose text the
-/// message before it already holds (an engine error that names its I/O cause, say).
-fn one_line(e: &anyhow::Error) -> String {
-    let mut out = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if !out.contains(&text) {
-            if !out.is_empty() {
-                out.push_str(": ");
-            }
-            out.push_str(&text);
-        }
-    }
-    out
 }
 
 fn is_broken_pipe(e: &anyhow::Error) -> bool {

@@ -2,8 +2,8 @@
 //! the files a navigation filter reads.
 
 use crate::config::CalibrateConfig;
+use crate::error::UsageError;
 use crate::progress::{bar, Ticks};
-use crate::UsageError;
 use anyhow::{Context, Result};
 use gmwm::calib::export::{render, ExportFormat};
 use gmwm::calib::{
@@ -228,7 +228,7 @@ fn calibrate_pooled(
     report_path: Option<&Path>,
     mode: Mode,
 ) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
-    let files = crate::batch::recordings(&config.pool, config.input.read.format)?;
+    let files = crate::recordings::recordings(&config.pool, config.input.read.format)?;
     if files.len() < 2 {
         return Err(UsageError(format!(
             "--pool calibrates several recordings as one sensor: {} found in {}; give two or more",
@@ -245,7 +245,7 @@ fn calibrate_pooled(
     let mut loaded = Vec::with_capacity(files.len());
     for f in &files {
         let one = CalibrateConfig {
-            input: crate::config::InputConfig {
+            input: crate::input::InputConfig {
                 file: f.clone(),
                 ..config.input.clone()
             },

@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod avar;
+pub mod batch;
 pub mod calibrate;
 pub mod demo;
 pub mod fit;

@@ -1,8 +1,9 @@
 //! `gmwm plot`: one figure of the matching command's results (gmwm-plot renders; the numbers
 //! are those `gmwm wv|avar|fit|select --json` gives).
 
-use crate::config::{FigureConfig, InputConfig, PlotConfig, PlotKind};
+use crate::config::{FigureConfig, PlotConfig, PlotKind};
 use crate::input::is_wv;
+use crate::input::InputConfig;
 use anyhow::{Context, Result};
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{Sensor, SensorInfo};

@@ -5,7 +5,8 @@
 //! (one rate, one unit per sensor, the same columns) and renders.
 
 use crate::args::{FitArgs, InputArgs, SelectArgs};
-use crate::config::{FitConfig, InputConfig, SelectConfig};
+use crate::config::{FitConfig, SelectConfig};
+use crate::input::InputConfig;
 use crate::input::{load, Loaded};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -366,7 +367,7 @@ pub fn run_pooled_fit(args: &FitArgs, out: &mut impl Write) -> Result<()> {
 pub fn run_pooled_select(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
     let config = SelectConfig::try_from(args)?;
     let Some(text) = &args.model else {
-        return Err(crate::UsageError(
+        return Err(crate::error::UsageError(
             "--pool selects among the sub-models of --model; --candidates is not supported with \
              --pool"
                 .into(),
@@ -509,7 +510,7 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
     }
     if let Some(b) = args.bootstrap {
         if b < 1 {
-            return Err(crate::UsageError(format!(
+            return Err(crate::error::UsageError(format!(
                 "invalid --bootstrap {b}: at least 1 replicate"
             ))
             .into());
@@ -517,7 +518,7 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
     }
     if let Some(f) = args.freq {
         if !(f.is_finite() && f > 0.0) {
-            return Err(crate::UsageError(format!(
+            return Err(crate::error::UsageError(format!(
                 "invalid --freq {f}: must be a positive number of hertz"
             ))
             .into());

@@ -3,8 +3,9 @@
 //! cross-covariances, with intervals and the test of "no shared process".
 
 use crate::args::{InputArgs, OutputArgs};
-use crate::config::{InputConfig, OutputConfig};
+use crate::config::OutputConfig;
 use crate::input::load;
+use crate::input::InputConfig;
 use crate::render::Style;
 use anyhow::{Context, Result};
 use clap::Args;

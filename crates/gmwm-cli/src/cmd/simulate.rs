@@ -110,7 +110,7 @@ fn size_check(config: &SimulateConfig, ncols: usize, free: Option<u64>) -> Resul
         if ncols == 1 { "" } else { "s" }
     );
     if config.n > CONFIRM_SAMPLES {
-        return Err(crate::UsageError(format!(
+        return Err(crate::error::UsageError(format!(
             "--n {}: gmwm simulate would write {what} to {target}, more than {CONFIRM_SAMPLES} \
              samples; give --yes to write it",
             config.n
@@ -120,7 +120,7 @@ fn size_check(config: &SimulateConfig, ncols: usize, free: Option<u64>) -> Resul
     if let Some(p) = &config.output {
         if let Some(free) = free {
             if size > free && !gz {
-                return Err(crate::UsageError(format!(
+                return Err(crate::error::UsageError(format!(
                     "{}: gmwm simulate would write {what}, and its file system has {} free; \
                      give --yes to write it anyway",
                     p.display(),

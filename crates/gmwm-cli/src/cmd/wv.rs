@@ -1,6 +1,7 @@
 //! `gmwm wv`: wavelet variance of each selected column.
 
-use crate::config::{InputConfig, WvConfig};
+use crate::config::WvConfig;
+use crate::input::InputConfig;
 use crate::input::{analyse_columns, is_wv, load, load_wv, named, note};
 use crate::render;
 use anyhow::Result;
@@ -76,7 +77,7 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
     Ok(match sidecar.and_then(|s| s.sampling_frequency_hz) {
         Some(f) => f,
         None if crate::spool::is_stdin(path) => {
-            return Err(crate::UsageError(format!(
+            return Err(crate::error::UsageError(format!(
                 "{}: no sampling rate: raw binary on standard input has no JSON sidecar; give \
                  --freq",
                 crate::spool::STDIN
