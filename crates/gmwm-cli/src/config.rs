@@ -6,21 +6,26 @@
 //! with the data, in the commands and `input.rs`; what a saved wavelet variance cannot honour is
 //! decided here from the flags ([`SavedWvCheck`]) and raised there once FILE is known to be one.
 
+pub use crate::args::Against;
 use crate::args::{
     AvarArgs, BatchArgs, CalibrateArgs, CalibrateCommand, Command, DemoArgs, FigureArgs, FitArgs,
-    ImpliedArgs, InputArgs, OutputArgs, PlotArgs, PlotCommand, ReportArgs, SelectArgs,
-    SimulateArgs, TopicsArgs, WvArgs, WvCommand, WvEstimatorArgs,
+    ImpliedArgs, InputArgs, MonitorArgs, OutputArgs, PlotArgs, PlotCommand, ReportArgs,
+    SameModelArgs, SelectArgs, SharedArgs, SimulateArgs, TopicsArgs, WvArgs, WvCommand,
+    WvEstimatorArgs,
 };
 use crate::error::UsageError;
 use crate::input::InputConfig;
 use crate::recordings::{is_glob, is_rosbag2_folder};
 use crate::render::Style;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use gmwm::calib::export::ExportFormat;
 use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, DEFAULT_FULL_MODEL};
 use gmwm::imu::{ColumnSelector, ReadOptions};
+use gmwm::inference::same_model::SameModelOptions;
 use gmwm::inference::InferenceOptions;
 use gmwm::model::Model;
+use gmwm::monitor::MonitorOptions;
+use gmwm::shared::SharedOptions;
 use gmwm::{
     AllanKind, AllanOptions, AvConvention, Gmwm, RobustOptions, Transform, WaveletFilter,
     Weighting, Wic, WvOptions,
@@ -56,9 +61,15 @@ pub enum Config {
     /// `gmwm calibrate` or `gmwm wv` over many recordings.
     Batch(BatchConfig),
     /// `gmwm shared`.
-    Shared(crate::cmd::shared::SharedConfig),
+    Shared(SharedConfig),
     /// `gmwm monitor`.
-    Monitor(crate::cmd::monitor::MonitorConfig),
+    Monitor(MonitorConfig),
+    /// `gmwm same-model`.
+    SameModel(SameModelConfig),
+    /// `gmwm fit FILE... --pool`.
+    PooledFit(PooledFitConfig),
+    /// `gmwm select FILE... --pool`.
+    PooledSelect(PooledSelectConfig),
 }
 
 impl TryFrom<&Command> for Config {
@@ -75,12 +86,9 @@ impl TryFrom<&Command> for Config {
             Command::Topics(a) => Self::Topics(a.into()),
             Command::Plot(a) => Self::Plot(a.try_into()?),
             Command::Report(a) => Self::Report(a.try_into()?),
-            // run by cmd::same_model before this conversion (main::run)
-            Command::SameModel(_)
-            | Command::Fit(FitArgs { pool: true, .. })
-            | Command::Select(SelectArgs { pool: true, .. }) => {
-                anyhow::bail!("internal: several recordings are not one configuration")
-            }
+            Command::SameModel(a) => Self::SameModel(a.try_into()?),
+            Command::Fit(a) if a.pool => Self::PooledFit(a.try_into()?),
+            Command::Select(a) if a.pool => Self::PooledSelect(a.try_into()?),
             Command::Fit(a) => Self::Fit(a.try_into()?),
             Command::Select(a) => Self::Select(a.try_into()?),
             Command::Shared(a) => Self::Shared(a.try_into()?),
@@ -1038,6 +1046,307 @@ impl TryFrom<&PlotArgs> for PlotConfig {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Several recordings (one model for all, or are they one model?)
+
+/// `gmwm fit FILE... --pool`: the fit's configuration (its `input` names the first recording
+/// and how every recording is read) and every recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PooledFitConfig {
+    /// The fit, as `gmwm fit` (`--inference` and `--bootstrap` included).
+    pub fit: FitConfig,
+    /// `--seed`: of the search and the inference.
+    pub seed: u64,
+    /// FILE and the more FILEs, in order.
+    pub files: Vec<PathBuf>,
+}
+
+impl TryFrom<&FitArgs> for PooledFitConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &FitArgs) -> Result<Self> {
+        let fit = FitConfig::try_from(a)?;
+        let files = std::iter::once(fit.input.file.clone())
+            .chain(a.more.iter().cloned())
+            .collect();
+        Ok(Self {
+            fit,
+            seed: a.seed,
+            files,
+        })
+    }
+}
+
+/// `gmwm select FILE... --pool`: the sub-models of `--model` ranked by the pooled WIC.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PooledSelectConfig {
+    /// The selection's flags, as `gmwm select` (`input`, `wv`, `top`, `output` are used).
+    pub select: SelectConfig,
+    /// The full model's estimator (values dropped), seed and draws.
+    pub gmwm: Gmwm,
+    /// `--seed`: of the searches.
+    pub seed: u64,
+    /// FILE and the more FILEs, in order.
+    pub files: Vec<PathBuf>,
+}
+
+impl TryFrom<&SelectArgs> for PooledSelectConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SelectArgs) -> Result<Self> {
+        let select = SelectConfig::try_from(a)?;
+        let Some(text) = &a.model else {
+            return Err(UsageError(
+                "--pool selects among the sub-models of --model; --candidates is not supported \
+                 with --pool"
+                    .into(),
+            )
+            .into());
+        };
+        let model: Model = text.parse()?;
+        let mut gmwm = Gmwm::new(model.without_values()).with_seed(a.seed);
+        if let Some(g) = a.draws {
+            gmwm = gmwm.with_draws(g.max(1));
+        }
+        let files = std::iter::once(select.input.file.clone())
+            .chain(a.more.iter().cloned())
+            .collect();
+        Ok(Self {
+            select,
+            gmwm,
+            seed: a.seed,
+            files,
+        })
+    }
+}
+
+/// `gmwm same-model FILE...`: the recordings, how each is read, the model and the test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SameModelConfig {
+    /// The recordings (at least two).
+    pub files: Vec<PathBuf>,
+    /// How every recording is read (`--columns`, `--freq`; `file` is the first).
+    pub input: InputConfig,
+    /// The model's estimator, seed and draws.
+    pub gmwm: Gmwm,
+    /// `--levels`: the WV of every recording (Haar MODWT).
+    pub wv: WvOptions,
+    /// `--bootstrap`, `--seed`.
+    pub test: SameModelOptions,
+    /// `--plot FILE`.
+    pub plot: Option<PathBuf>,
+    /// `--json` instead of a table.
+    pub json: bool,
+}
+
+impl TryFrom<&SameModelArgs> for SameModelConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SameModelArgs) -> Result<Self> {
+        if a.files.len() < 2 {
+            anyhow::bail!(
+                "{}: the same-model test needs at least two recordings (FILEs); got one",
+                a.files[0].display()
+            );
+        }
+        if let Some(b) = a.bootstrap {
+            if b < 1 {
+                return Err(
+                    UsageError(format!("invalid --bootstrap {b}: at least 1 replicate")).into(),
+                );
+            }
+        }
+        if let Some(f) = a.freq {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(UsageError(format!(
+                    "invalid --freq {f}: must be a positive number of hertz"
+                ))
+                .into());
+            }
+        }
+        let model: Model = a.model.parse()?;
+        let mut gmwm = Gmwm::new(model).with_seed(a.seed);
+        if let Some(g) = a.draws {
+            gmwm = gmwm.with_draws(g.max(1));
+        }
+        let input = InputConfig {
+            file: a.files[0].clone(),
+            read: ReadOptions {
+                columns: a.columns.iter().map(|c| selector(c)).collect(),
+                freq_hz: a.freq,
+                ..ReadOptions::default()
+            },
+            topic: None,
+            stream_from: gmwm::calib::STREAM_FROM,
+        };
+        Ok(Self {
+            files: a.files.clone(),
+            input,
+            gmwm,
+            wv: WvOptions {
+                levels: a.levels,
+                ..WvOptions::default()
+            },
+            test: SameModelOptions {
+                bootstrap: a.bootstrap,
+                seed: a.seed,
+            },
+            plot: a.plot.clone(),
+            json: a.json,
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Several axes of one recording
+
+/// Validated `gmwm shared`.
+#[derive(Debug, Clone)]
+pub struct SharedConfig {
+    /// The recording.
+    pub input: InputConfig,
+    /// `--shared`.
+    pub shared: Model,
+    /// `--model`.
+    pub specific: Model,
+    /// Estimator settings.
+    pub options: SharedOptions,
+    /// `--plot`.
+    pub plot: Option<std::path::PathBuf>,
+    /// Table, JSON or CSV.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&SharedArgs> for SharedConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SharedArgs) -> Result<Self> {
+        let model = |flag: &str, text: &str| -> Result<Model> {
+            text.parse::<Model>()
+                .with_context(|| format!("invalid {flag} {text:?}"))
+        };
+        if let Some(why) = gmwm::variance::ci::significance_level_problem(a.alpha) {
+            anyhow::bail!("invalid --alpha {}: {why}", a.alpha);
+        }
+        anyhow::ensure!(a.draws >= 1, "invalid --G 0: at least one draw");
+        if a.levels == Some(0) {
+            anyhow::bail!("invalid --levels 0: at least one level");
+        }
+        Ok(Self {
+            input: InputConfig::try_from(&a.input)?,
+            shared: model("--shared", &a.shared)?,
+            specific: model("--model", &a.model)?,
+            options: SharedOptions {
+                levels: a.levels,
+                alpha: a.alpha,
+                seed: a.seed,
+                draws: a.draws,
+                ..SharedOptions::default()
+            },
+            plot: a.plot.clone(),
+            output: OutputConfig::from(&a.output),
+        })
+    }
+}
+
+/// A length given as samples or as a duration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Span {
+    /// Samples.
+    Samples(usize),
+    /// Seconds.
+    Seconds(f64),
+}
+
+impl Span {
+    fn parse(flag: &str, text: &str) -> Result<Self> {
+        let t = text.trim();
+        if let Ok(n) = t.parse::<usize>() {
+            anyhow::ensure!(n >= 1, "invalid {flag} {text}: at least 1 sample");
+            return Ok(Span::Samples(n));
+        }
+        let (num, unit) = t
+            .find(|c: char| c.is_ascii_alphabetic())
+            .map(|i| t.split_at(i))
+            .unwrap_or((t, ""));
+        let factor = match unit {
+            "s" => 1.0,
+            "min" => 60.0,
+            "h" => 3600.0,
+            _ => anyhow::bail!(
+                "invalid {flag} {text}: give samples (65536) or a duration in s, min or h (600s)"
+            ),
+        };
+        let v: f64 = num
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite() && *v > 0.0)
+            .with_context(|| format!("invalid {flag} {text}: not a positive duration"))?;
+        Ok(Span::Seconds(v * factor))
+    }
+
+    /// The samples at `freq_hz`.
+    pub fn samples(self, freq_hz: f64) -> usize {
+        match self {
+            Span::Samples(n) => n,
+            Span::Seconds(s) => (s * freq_hz).round() as usize,
+        }
+    }
+}
+
+/// Validated `gmwm monitor`.
+#[derive(Debug, Clone)]
+pub struct MonitorConfig {
+    /// The recording.
+    pub input: InputConfig,
+    /// `--model-from`.
+    pub calibration: PathBuf,
+    /// `--window`.
+    pub window: Span,
+    /// `--step`.
+    pub step: Option<Span>,
+    /// Engine settings (window and step filled in once the rate is known).
+    pub options: MonitorOptions,
+    /// `--against`.
+    pub against: Against,
+    /// Table or JSON.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&MonitorArgs> for MonitorConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &MonitorArgs) -> Result<Self> {
+        if let Some(why) = gmwm::variance::ci::significance_level_problem(a.alpha) {
+            anyhow::bail!("invalid --alpha {}: {why}", a.alpha);
+        }
+        let robust = gmwm::RobustOptions::new(a.eff, gmwm::RobustConvention::Exact)
+            .map_err(|e| anyhow::anyhow!("invalid --eff {}: {e}", a.eff))?;
+        if a.levels == Some(0) {
+            anyhow::bail!("invalid --levels 0: at least one level");
+        }
+        Ok(Self {
+            input: InputConfig::try_from(&a.input)?,
+            calibration: a.model_from.clone(),
+            window: Span::parse("--window", &a.window)?,
+            step: a
+                .step
+                .as_deref()
+                .map(|s| Span::parse("--step", s))
+                .transpose()?,
+            options: MonitorOptions {
+                alpha: a.alpha,
+                robust,
+                levels: a.levels,
+                ..MonitorOptions::default()
+            },
+            against: a.against,
+            output: OutputConfig::from(&a.output),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1666,6 +1975,111 @@ mod tests {
             SimulateConfig::try_from(&args).unwrap_err().to_string(),
             "invalid --n 0: simulate at least one sample"
         );
+    }
+
+    #[test]
+    fn several_recordings_are_one_configuration() {
+        let Config::PooledFit(c) = config(&[
+            "fit", "a.csv", "b.csv", "--pool", "--model", "WN()", "--seed", "4",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.files, [PathBuf::from("a.csv"), PathBuf::from("b.csv")]);
+        assert_eq!(
+            (c.seed, c.fit.input.file.as_path()),
+            (4, Path::new("a.csv"))
+        );
+        let Config::PooledSelect(c) = config(&[
+            "select",
+            "a.csv",
+            "b.csv",
+            "--pool",
+            "--model",
+            "AR1(phi=0.5, sigma2=1)",
+            "--G",
+            "5",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.gmwm.model(), &"AR1()".parse::<Model>().unwrap());
+        assert_eq!(c.files.len(), 2);
+        let (msg, usage) = refusal(&[
+            "select",
+            "a.csv",
+            "b.csv",
+            "--pool",
+            "--candidates",
+            "WN();RW()",
+        ]);
+        assert!(
+            msg.starts_with("--pool selects among the sub-models") && usage,
+            "{msg}"
+        );
+        let Config::SameModel(c) = config(&[
+            "same-model",
+            "a.csv",
+            "b.csv",
+            "--model",
+            "WN()",
+            "--columns",
+            "gyro_x,2",
+            "--freq",
+            "100",
+            "--levels",
+            "5",
+            "--bootstrap",
+            "20",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.input.file, PathBuf::from("a.csv"));
+        assert_eq!(
+            c.input.read,
+            ReadOptions {
+                columns: vec![
+                    ColumnSelector::Name("gyro_x".into()),
+                    ColumnSelector::Index(2)
+                ],
+                freq_hz: Some(100.0),
+                ..ReadOptions::default()
+            }
+        );
+        assert_eq!((c.wv.levels, c.test.bootstrap), (Some(5), Some(20)));
+        for (argv, text, usage) in [
+            (
+                &["same-model", "a.csv", "--model", "WN()"][..],
+                "a.csv: the same-model test needs at least two recordings (FILEs); got one",
+                false,
+            ),
+            (
+                &[
+                    "same-model",
+                    "a.csv",
+                    "b.csv",
+                    "--model",
+                    "WN()",
+                    "--bootstrap",
+                    "0",
+                ],
+                "invalid --bootstrap 0: at least 1 replicate",
+                true,
+            ),
+            (
+                &[
+                    "same-model",
+                    "a.csv",
+                    "b.csv",
+                    "--model",
+                    "WN()",
+                    "--freq",
+                    "0",
+                ],
+                "invalid --freq 0: must be a positive number of hertz",
+                true,
+            ),
+        ] {
+            assert_eq!(refusal(argv), (text.to_string(), usage), "{argv:?}");
+        }
     }
 
     #[test]

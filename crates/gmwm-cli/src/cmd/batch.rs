@@ -10,10 +10,13 @@
 //! message a single run prints, after all the others completed; the exit code is then 1.
 
 use super::calibrate::{execute_in, per_axis_path, Calibrated, Mode};
+use super::Command;
 use crate::config::{BatchConfig, BatchJob, CalibrateConfig, WvConfig};
 use crate::error::UsageError;
+use crate::prepare::{warn_implausible, Inputs};
 use crate::recordings::{expand, key, sidecar_of, Found};
 use crate::render::Style;
+use crate::style::OutputStyle;
 use anyhow::{Context, Result};
 use std::collections::HashMap;
 use std::io::Write;
@@ -212,6 +215,7 @@ fn calibrate_one(
     config: &CalibrateConfig,
     p: &Planned,
     force: bool,
+    style: OutputStyle,
 ) -> Result<(Status, Vec<PathBuf>, Detail)> {
     let json = p.output("calibration.json");
     let report = config
@@ -258,12 +262,12 @@ fn calibrate_one(
     let mut one = config.clone();
     one.input.file = p.recording.clone();
     // the single-file command's warning on raw floats no sensor gives, per recording
-    crate::warn_implausible(&one.input);
+    warn_implausible(&one.input);
     one.exports = exports;
     one.json = Some(json);
     let mode = Mode {
         print_summary: false,
-        batch: true,
+        style,
     };
     let Calibrated {
         axes,
@@ -290,7 +294,12 @@ fn wv_detail(doc: &serde_json::Value) -> Option<Detail> {
 }
 
 /// The wavelet variance of one recording of the batch, or `Ok` of an up-to-date one.
-fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<PathBuf>, Detail)> {
+fn wv_one(
+    config: &WvConfig,
+    p: &Planned,
+    force: bool,
+    style: OutputStyle,
+) -> Result<(Status, Vec<PathBuf>, Detail)> {
     let out = p.output("wv.json");
     let outputs = vec![out.clone()];
     if !force && all_newer(&outputs, input_time(&p.recording)) {
@@ -300,9 +309,9 @@ fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<Pa
     }
     let mut one = config.clone();
     one.input.file = p.recording.clone();
-    crate::warn_implausible(&one.input);
+    warn_implausible(&one.input);
     one.output = Style::Json;
-    let items = crate::cmd::wv::compute(&one)?;
+    let items = super::wv::compute(&one, style)?;
     let mut doc = Vec::new();
     crate::render::series(&mut doc, &crate::input::named(&items), Style::Json)?;
     crate::output::write(&out, &doc)?;
@@ -314,10 +323,11 @@ fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<Pa
 }
 
 /// Runs one recording; a failure (or a panic) becomes its outcome, never the batch's.
-fn run_one(config: &BatchConfig, p: &Planned) -> Outcome {
+/// `style` has no progress bar: the batch's is the one.
+fn run_one(config: &BatchConfig, p: &Planned, style: OutputStyle) -> Outcome {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match &config.job {
-        BatchJob::Calibrate { config: c, .. } => calibrate_one(c, p, config.force),
-        BatchJob::Wv { config: c, .. } => wv_one(c, p, config.force),
+        BatchJob::Calibrate { config: c, .. } => calibrate_one(c, p, config.force, style),
+        BatchJob::Wv { config: c, .. } => wv_one(c, p, config.force, style),
     }))
     .unwrap_or_else(|payload| {
         Err(anyhow::anyhow!(
@@ -368,10 +378,34 @@ fn words(job: &BatchJob) -> Words {
     }
 }
 
+impl Command for BatchConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Files {
+            paths: &self.inputs,
+            refusal: "batch mode (several FILEs, a folder, --out-dir, --force) reads files; \
+                      give standard input or a pipe alone, without --out-dir/--force",
+        }
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        // each recording's, planned once the inputs are expanded (see `plan`)
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        // each recording's error is its row of the summary
+        None
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        run(self, style, &mut out)
+    }
+}
+
 /// Runs the batch: expands the inputs, runs every recording in parallel (workers pull the
 /// next recording; each one's own computation is parallel on the shared rayon pool), prints
 /// the summary; an error naming the failed recordings when any failed.
-pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
+fn run(config: &BatchConfig, style: OutputStyle, out: &mut impl Write) -> Result<()> {
     let format = match &config.job {
         BatchJob::Calibrate { config, .. } => config.input.read.format,
         BatchJob::Wv { config, .. } => config.input.read.format,
@@ -382,7 +416,7 @@ pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
             .with_context(|| format!("cannot create --out-dir {}", dir.display()))?;
     }
     let w = words(&config.job);
-    let progress = crate::progress::bar(planned.len() as u64, w.verb, "recordings");
+    let progress = style.bar(planned.len() as u64, w.verb, "recordings");
     let outcomes: Vec<Mutex<Option<Outcome>>> = planned.iter().map(|_| Mutex::new(None)).collect();
     let next = AtomicUsize::new(0);
     // workers that are not rayon threads: a rayon worker waiting inside a calibration would
@@ -395,7 +429,7 @@ pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
                 let Some(p) = planned.get(i) else {
                     break;
                 };
-                let outcome = run_one(config, p);
+                let outcome = run_one(config, p, style.without_progress());
                 if let Some(e) = &outcome.error {
                     let file = p.recording.display().to_string();
                     progress.suspend(|| {

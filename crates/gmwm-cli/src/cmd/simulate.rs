@@ -1,7 +1,10 @@
 //! `gmwm simulate`: seeded simulation of a fully specified model, streamed to CSV on stdout or
 //! to a file in the format of its name (CSV, TSV, gzip, raw f64/f32) with a sidecar.
 
+use super::Command;
 use crate::config::SimulateConfig;
+use crate::prepare::Inputs;
+use crate::style::OutputStyle;
 use anyhow::{Context, Result};
 use gmwm::imu::write::{write_csv_header, write_csv_rows, write_sidecar};
 use gmwm::imu::{OutputFormat, SeriesWriter, Sidecar, SidecarColumn};
@@ -216,6 +219,25 @@ fn csv_quote(s: &str) -> String {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
+    }
+}
+
+impl Command for SimulateConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::None
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        // -o: refused by the writer when it cannot be created, naming it (as before)
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        None
+    }
+
+    fn run(&self, _: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        run(self, &mut out)
     }
 }
 
