@@ -57,7 +57,7 @@ pub trait Named: Copy + PartialEq + 'static {
 /// exhaustive: every value has a name) and, when listed in `derive(...)`, `FromStr`
 /// ([`Named::from_name`]) and `Display` (the name).
 ///
-/// ```ignore
+/// ```text
 /// named_values!(Weighting, "weights", { Fast => "fast", Diag => "diag" }, derive(FromStr, Display));
 /// named_values!(InputFormat, "format", { Auto => "auto", ImuRecord(ImuRecordType::Imar) => "imar", ... });
 /// ```
@@ -126,10 +126,11 @@ mod tests {
 
     #[test]
     fn every_option_set_reads_back_its_names() {
-        fn check<T: Named + std::fmt::Debug + std::str::FromStr>() {
+        fn check<T: Named + std::fmt::Debug + std::fmt::Display + std::str::FromStr>() {
             for v in T::VALUES {
                 assert_eq!(T::from_name(v.name()).ok(), Some(*v), "{}", T::WHAT);
                 assert_eq!(v.name().parse::<T>().ok(), Some(*v), "{}", T::WHAT);
+                assert_eq!(v.to_string(), v.name(), "{}", T::WHAT);
             }
         }
         check::<crate::calib::AxisPolicy>();

@@ -134,21 +134,7 @@ crate::names::named_values!(InputFormat, "format", {
     ImuRecord(ImuRecordType::NavchipFlt) => "navchip-flt",
     F64 => "f64",
     F32 => "f32",
-});
-
-impl fmt::Display for InputFormat {
-    /// The name [`InputFormat::from_str`] reads back (`f64`, `ln200`, `navchip-int`, ...).
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Auto => f.write_str("auto"),
-            Self::Csv => f.write_str("csv"),
-            Self::Tsv => f.write_str("tsv"),
-            Self::F64 => f.write_str("f64"),
-            Self::F32 => f.write_str("f32"),
-            Self::ImuRecord(t) => f.write_str(&t.name().to_ascii_lowercase().replace('_', "-")),
-        }
-    }
-}
+}, derive(Display));
 
 impl InputFormat {
     /// Bytes per value of a raw binary format, `None` for text formats and IMU records.
