@@ -6,25 +6,29 @@
 //! with the data, in the commands and `input.rs`; what a saved wavelet variance cannot honour is
 //! decided here from the flags ([`SavedWvCheck`]) and raised there once FILE is known to be one.
 
+pub use crate::args::Against;
 use crate::args::{
-    AvarArgs, AxisPolicyArg, BatchArgs, CalibrateArgs, CalibrateCommand, Command, ConventionArg,
-    DemoArgs, FigureArgs, FitArgs, FormatArg, HeaderArg, ImpliedArgs, InputArgs, KindArg,
-    OptimismArg, OptimismConventionArg, OutputArgs, PlotArgs, PlotCommand, ReportArgs,
-    RobustConventionArg, RuleArg, SelectArgs, SimulateArgs, TimeUnitArg, TopicsArgs, TransformArg,
-    WeightsArg, WvArgs, WvCommand, WvEstimatorArgs,
+    AvarArgs, BatchArgs, CalibrateArgs, CalibrateCommand, Command, DemoArgs, FigureArgs, FitArgs,
+    ImpliedArgs, InputArgs, MonitorArgs, OutputArgs, PlotArgs, PlotCommand, ReportArgs,
+    SameModelArgs, SelectArgs, SharedArgs, SimulateArgs, TopicsArgs, WvArgs, WvCommand,
+    WvEstimatorArgs,
 };
+use crate::error::UsageError;
+use crate::input::InputConfig;
+use crate::recordings::{is_glob, is_rosbag2_folder};
 use crate::render::Style;
-use crate::UsageError;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use gmwm::calib::export::ExportFormat;
 use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, DEFAULT_FULL_MODEL};
-use gmwm::imu::{ColumnSelector, HeaderMode, ImuRecordType, InputFormat, ReadOptions, TimeUnit};
+use gmwm::imu::{ColumnSelector, ReadOptions};
+use gmwm::inference::same_model::SameModelOptions;
 use gmwm::inference::InferenceOptions;
 use gmwm::model::Model;
-use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
+use gmwm::monitor::MonitorOptions;
+use gmwm::shared::SharedOptions;
 use gmwm::{
-    AllanKind, AllanOptions, AvConvention, Gmwm, RobustConvention, RobustOptions, Transform,
-    WaveletFilter, Weighting, Wic, WvOptions,
+    AllanKind, AllanOptions, AvConvention, Gmwm, RobustOptions, Transform, WaveletFilter,
+    Weighting, Wic, WvOptions,
 };
 use gmwm_plot::{ImageFormat, Layout};
 use std::path::{Path, PathBuf};
@@ -57,9 +61,15 @@ pub enum Config {
     /// `gmwm calibrate` or `gmwm wv` over many recordings.
     Batch(BatchConfig),
     /// `gmwm shared`.
-    Shared(crate::cmd::shared::SharedConfig),
+    Shared(SharedConfig),
     /// `gmwm monitor`.
-    Monitor(crate::cmd::monitor::MonitorConfig),
+    Monitor(MonitorConfig),
+    /// `gmwm same-model`.
+    SameModel(SameModelConfig),
+    /// `gmwm fit FILE... --pool`.
+    PooledFit(PooledFitConfig),
+    /// `gmwm select FILE... --pool`.
+    PooledSelect(PooledSelectConfig),
 }
 
 impl TryFrom<&Command> for Config {
@@ -76,12 +86,9 @@ impl TryFrom<&Command> for Config {
             Command::Topics(a) => Self::Topics(a.into()),
             Command::Plot(a) => Self::Plot(a.try_into()?),
             Command::Report(a) => Self::Report(a.try_into()?),
-            // run by cmd::same_model before this conversion (main::run)
-            Command::SameModel(_)
-            | Command::Fit(FitArgs { pool: true, .. })
-            | Command::Select(SelectArgs { pool: true, .. }) => {
-                anyhow::bail!("internal: several recordings are not one configuration")
-            }
+            Command::SameModel(a) => Self::SameModel(a.try_into()?),
+            Command::Fit(a) if a.pool => Self::PooledFit(a.try_into()?),
+            Command::Select(a) if a.pool => Self::PooledSelect(a.try_into()?),
             Command::Fit(a) => Self::Fit(a.try_into()?),
             Command::Select(a) => Self::Select(a.try_into()?),
             Command::Shared(a) => Self::Shared(a.try_into()?),
@@ -93,44 +100,11 @@ impl TryFrom<&Command> for Config {
 // ---------------------------------------------------------------------------------------------
 // Shared parts
 
-/// Where the data come from and how to read them: FILE and the engine's read options
-/// (`--columns`, `--freq`, `--format`, `--ncols`, `--header`, `--time-column`, `--time-unit`),
-/// and the ROS topic (`--topic`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct InputConfig {
-    /// The data file (or rosbag2 folder).
-    pub file: PathBuf,
-    /// The engine's read options; `read.freq_hz` is `--freq`, `read.columns` is `--columns`.
-    pub read: ReadOptions,
-    /// `--topic`: the IMU topic of a ROS recording.
-    pub topic: Option<String>,
-    /// `--stream-from`: rows from which a text or IMU-record recording is streamed
-    /// ([`gmwm::calib::STREAM_FROM`] by default).
-    pub stream_from: u64,
-}
-
 /// `--columns` entries: all digits → a 1-based index, anything else a name.
 fn selector(text: &str) -> ColumnSelector {
     match text.trim().parse::<usize>() {
         Ok(i) => ColumnSelector::Index(i),
         Err(_) => ColumnSelector::Name(text.trim().to_string()),
-    }
-}
-
-/// The engine format of `--format`.
-fn input_format(arg: FormatArg) -> InputFormat {
-    match arg {
-        FormatArg::Auto => InputFormat::Auto,
-        FormatArg::Csv => InputFormat::Csv,
-        FormatArg::Tsv => InputFormat::Tsv,
-        FormatArg::Imar => InputFormat::ImuRecord(ImuRecordType::Imar),
-        FormatArg::Ln200 => InputFormat::ImuRecord(ImuRecordType::Ln200),
-        FormatArg::Ln200ig => InputFormat::ImuRecord(ImuRecordType::Ln200Ig),
-        FormatArg::Ixsea => InputFormat::ImuRecord(ImuRecordType::Ixsea),
-        FormatArg::NavchipInt => InputFormat::ImuRecord(ImuRecordType::NavchipInt),
-        FormatArg::NavchipFlt => InputFormat::ImuRecord(ImuRecordType::NavchipFlt),
-        FormatArg::F64 => InputFormat::F64,
-        FormatArg::F32 => InputFormat::F32,
     }
 }
 
@@ -153,19 +127,10 @@ impl TryFrom<&InputArgs> for InputConfig {
             );
         }
         let read = ReadOptions {
-            format: input_format(a.format),
-            header: match a.header {
-                HeaderArg::Auto => HeaderMode::Auto,
-                HeaderArg::Yes => HeaderMode::Present,
-                HeaderArg::No => HeaderMode::Absent,
-            },
+            format: a.format,
+            header: a.header,
             time_column: a.time_column.as_deref().map(selector),
-            time_unit: a.time_unit.map(|u| match u {
-                TimeUnitArg::S => TimeUnit::Seconds,
-                TimeUnitArg::Ms => TimeUnit::Milliseconds,
-                TimeUnitArg::Us => TimeUnit::Microseconds,
-                TimeUnitArg::Ns => TimeUnit::Nanoseconds,
-            }),
+            time_unit: a.time_unit,
             columns: a.columns.iter().map(|c| selector(c)).collect(),
             ncols: a.ncols,
             freq_hz: a.freq,
@@ -222,14 +187,6 @@ impl SavedWvCheck {
     }
 }
 
-/// The engine convention of `--robust-convention`.
-fn robust_convention(arg: RobustConventionArg) -> RobustConvention {
-    match arg {
-        RobustConventionArg::Exact => RobustConvention::Exact,
-        RobustConventionArg::Package => RobustConvention::Package,
-    }
-}
-
 /// The engine's estimator options of the wavelet-variance flags (`--robust`, `--eff`,
 /// `--robust-convention`, `--filter`, `--transform`, `--levels`, `--alpha`).
 fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
@@ -240,10 +197,7 @@ fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
     };
     gmwm::variance::ci::check_alpha(a.alpha)?;
     Ok(WvOptions {
-        transform: match a.transform {
-            TransformArg::Modwt => Transform::Modwt,
-            TransformArg::Dwt => Transform::Dwt,
-        },
+        transform: a.transform,
         filter: a.filter.parse::<WaveletFilter>()?,
         levels: a.levels,
         alpha: a.alpha,
@@ -254,10 +208,7 @@ fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
 /// The robust estimator at `--eff` and `--robust-convention`, whether or not `--robust` is
 /// given (the contamination check of calibrate, the robust series of plot compare).
 fn robust_at_eff(a: &WvEstimatorArgs) -> Result<RobustOptions> {
-    Ok(RobustOptions::new(
-        a.eff,
-        robust_convention(a.robust_convention),
-    )?)
+    Ok(RobustOptions::new(a.eff, a.robust_convention)?)
 }
 
 /// Refuses a non-Haar `--filter` for the estimation commands (fit, select, calibrate): every
@@ -287,21 +238,12 @@ fn estimator_saved_wv_check(a: &WvEstimatorArgs) -> SavedWvCheck {
             })
         })
         .or_else(|| {
-            (a.filter != "haar" || a.transform != TransformArg::Modwt).then(|| {
+            (a.filter != "haar" || a.transform != Transform::Modwt).then(|| {
                 "--filter/--transform apply to a recording; a wavelet-variance file is used as \
                  it is"
                     .to_string()
             })
         })
-}
-
-/// The engine rule of `--rule`.
-fn selection_rule(arg: RuleArg) -> SelectionRule {
-    match arg {
-        RuleArg::Navigation => SelectionRule::Navigation,
-        RuleArg::Parsimonious => SelectionRule::Parsimonious,
-        RuleArg::WicMinimum => SelectionRule::WicMinimum,
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -386,18 +328,9 @@ impl TryFrom<&AvarArgs> for AvarConfig {
     fn try_from(a: &AvarArgs) -> Result<Self> {
         gmwm::variance::ci::check_alpha(a.alpha)?;
         let allan = AllanOptions {
-            kind: match a.kind {
-                KindArg::Overlapping => AllanKind::Overlapping,
-                KindArg::NonOverlapping => AllanKind::NonOverlapping,
-                KindArg::Modified => AllanKind::Modified,
-                KindArg::Hadamard => AllanKind::Hadamard,
-                KindArg::HadamardNonOverlapping => AllanKind::HadamardNonOverlapping,
-            },
+            kind: a.kind,
             alpha: a.alpha,
-            convention: match a.convention {
-                ConventionArg::Textbook => AvConvention::Textbook,
-                ConventionArg::Package => AvConvention::Package,
-            },
+            convention: a.convention,
         };
         // docs/methods.md §3.4, AV(m) = 2 WV(2m), holds for the overlapping textbook estimator only
         let saved_wv = SavedWvCheck::default().or_else(|| {
@@ -515,13 +448,7 @@ impl TryFrom<&FitArgs> for FitConfig {
         let model: Model = a.model.parse()?;
         let wv = wv_options(&a.estimator)?;
         check_haar(&a.estimator, &wv)?;
-        let mut gmwm = Gmwm::new(model)
-            .with_weighting(match a.weights {
-                WeightsArg::Fast => Weighting::Fast,
-                WeightsArg::Diag => Weighting::Diag,
-                WeightsArg::Bootstrap => Weighting::Bootstrap,
-            })
-            .with_seed(a.seed);
+        let mut gmwm = Gmwm::new(model).with_weighting(a.weights).with_seed(a.seed);
         if let Some(g) = a.draws {
             anyhow::ensure!(g >= 1, "invalid --G 0: at least one starting-value draw");
             gmwm = gmwm.with_draws(g);
@@ -534,14 +461,14 @@ impl TryFrom<&FitArgs> for FitConfig {
             Some(InferenceOptions {
                 alpha: a.estimator.alpha,
                 bootstrap: a.bootstrap,
-                v_method: a.covariance.into(),
+                v_method: a.covariance,
                 ..InferenceOptions::default()
             })
         } else {
             None
         };
         let saved_wv = estimator_saved_wv_check(&a.estimator).or_else(|| {
-            (a.weights == WeightsArg::Diag).then(|| {
+            (a.weights == Weighting::Diag).then(|| {
                 "--weights diag needs the series; use fast or bootstrap with a wavelet-variance \
                  file"
                     .to_string()
@@ -610,17 +537,11 @@ impl TryFrom<&SelectArgs> for SelectConfig {
         check_haar(&a.estimator, &wv)?;
         let mut wic = wic
             .with_bootstrap(a.bootstrap)
-            .with_covariance(a.covariance.into())
+            .with_covariance(a.covariance)
             .with_seed(a.seed)
-            .with_optimism(match a.optimism {
-                OptimismArg::Asymptotic => OptimismMethod::Asymptotic,
-                OptimismArg::Bootstrap => OptimismMethod::Bootstrap,
-            })
-            .with_convention(match a.convention {
-                OptimismConventionArg::Corrected => OptimismConvention::Corrected,
-                OptimismConventionArg::Package => OptimismConvention::Package,
-            })
-            .with_rule(selection_rule(a.rule))
+            .with_optimism(a.optimism)
+            .with_convention(a.convention)
+            .with_rule(a.rule)
             .with_wv_options(wv);
         if let Some(g) = a.draws {
             wic = wic.with_draws(g);
@@ -694,11 +615,11 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             stream_from: input.stream_from,
             full_model,
             wv,
-            covariance: a.covariance.into(),
+            covariance: a.covariance,
             bootstrap: a.bootstrap,
             draws: a.draws,
             seed: a.seed,
-            rule: selection_rule(a.rule),
+            rule: a.rule,
             gyro_unit: a.gyro_unit,
             accel_unit: a.accel_unit,
             // the contamination check compares with the robust WV at --eff
@@ -715,11 +636,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             options,
             exports,
             adjustment,
-            policy: match a.axis_policy {
-                AxisPolicyArg::Worst => AxisPolicy::Worst,
-                AxisPolicyArg::Mean => AxisPolicy::Mean,
-                AxisPolicyArg::PerAxis => AxisPolicy::PerAxis,
-            },
+            policy: a.axis_policy,
             json: a.json.clone(),
             rostopic: a.rostopic.clone(),
             report: a.report.clone(),
@@ -732,7 +649,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
 // Batch mode
 
 /// `gmwm calibrate` or `gmwm wv` over many recordings: the inputs as given (files, folders,
-/// globs; expanded by [`crate::batch`]), where the outputs go, and the job run on each.
+/// globs; expanded by [`crate::cmd::batch`]), where the outputs go, and the job run on each.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BatchConfig {
     /// FILE arguments as given.
@@ -764,17 +681,6 @@ pub enum BatchJob {
         /// `--json`: the summary as JSON.
         json: bool,
     },
-}
-
-/// A FILE argument that gmwm expands itself: it does not exist as written and holds a glob
-/// metacharacter (`*`, `?`, `[`).
-pub fn is_glob(path: &Path) -> bool {
-    !path.exists() && path.to_str().is_some_and(|s| s.contains(['*', '?', '[']))
-}
-
-/// A folder that is one ROS recording: a rosbag2 folder (it holds metadata.yaml).
-pub fn is_rosbag2_folder(path: &Path) -> bool {
-    path.is_dir() && path.join("metadata.yaml").is_file()
 }
 
 /// Batch mode: more than one FILE, a folder that is not a rosbag2 recording, a glob, or a
@@ -1029,7 +935,7 @@ fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
         }
         PlotCommand::Avar { args, figure } => (&args.output, figure),
         PlotCommand::Ieee { args, figure } => {
-            if args.kind != KindArg::Overlapping {
+            if args.kind != AllanKind::Overlapping {
                 return Err(UsageError(
                     "gmwm plot ieee reads the overlapping Allan variance (IEEE Std 952): drop --kind"
                         .into(),
@@ -1141,11 +1047,315 @@ impl TryFrom<&PlotArgs> for PlotConfig {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Several recordings (one model for all, or are they one model?)
+
+/// `gmwm fit FILE... --pool`: the fit's configuration (its `input` names the first recording
+/// and how every recording is read) and every recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PooledFitConfig {
+    /// The fit, as `gmwm fit` (`--inference` and `--bootstrap` included).
+    pub fit: FitConfig,
+    /// `--seed`: of the search and the inference.
+    pub seed: u64,
+    /// FILE and the more FILEs, in order.
+    pub files: Vec<PathBuf>,
+}
+
+impl TryFrom<&FitArgs> for PooledFitConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &FitArgs) -> Result<Self> {
+        let fit = FitConfig::try_from(a)?;
+        let files = std::iter::once(fit.input.file.clone())
+            .chain(a.more.iter().cloned())
+            .collect();
+        Ok(Self {
+            fit,
+            seed: a.seed,
+            files,
+        })
+    }
+}
+
+/// `gmwm select FILE... --pool`: the sub-models of `--model` ranked by the pooled WIC.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PooledSelectConfig {
+    /// The selection's flags, as `gmwm select` (`input`, `wv`, `top`, `output` are used).
+    pub select: SelectConfig,
+    /// The full model's estimator (values dropped), seed and draws.
+    pub gmwm: Gmwm,
+    /// `--seed`: of the searches.
+    pub seed: u64,
+    /// FILE and the more FILEs, in order.
+    pub files: Vec<PathBuf>,
+}
+
+impl TryFrom<&SelectArgs> for PooledSelectConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SelectArgs) -> Result<Self> {
+        let select = SelectConfig::try_from(a)?;
+        let Some(text) = &a.model else {
+            return Err(UsageError(
+                "--pool selects among the sub-models of --model; --candidates is not supported \
+                 with --pool"
+                    .into(),
+            )
+            .into());
+        };
+        let model: Model = text.parse()?;
+        let mut gmwm = Gmwm::new(model.without_values()).with_seed(a.seed);
+        if let Some(g) = a.draws {
+            gmwm = gmwm.with_draws(g.max(1));
+        }
+        let files = std::iter::once(select.input.file.clone())
+            .chain(a.more.iter().cloned())
+            .collect();
+        Ok(Self {
+            select,
+            gmwm,
+            seed: a.seed,
+            files,
+        })
+    }
+}
+
+/// `gmwm same-model FILE...`: the recordings, how each is read, the model and the test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SameModelConfig {
+    /// The recordings (at least two).
+    pub files: Vec<PathBuf>,
+    /// How every recording is read (`--columns`, `--freq`; `file` is the first).
+    pub input: InputConfig,
+    /// The model's estimator, seed and draws.
+    pub gmwm: Gmwm,
+    /// `--levels`: the WV of every recording (Haar MODWT).
+    pub wv: WvOptions,
+    /// `--bootstrap`, `--seed`.
+    pub test: SameModelOptions,
+    /// `--plot FILE`.
+    pub plot: Option<PathBuf>,
+    /// `--json` instead of a table.
+    pub json: bool,
+}
+
+impl TryFrom<&SameModelArgs> for SameModelConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SameModelArgs) -> Result<Self> {
+        if a.files.len() < 2 {
+            anyhow::bail!(
+                "{}: the same-model test needs at least two recordings (FILEs); got one",
+                a.files[0].display()
+            );
+        }
+        if let Some(b) = a.bootstrap {
+            if b < 1 {
+                return Err(
+                    UsageError(format!("invalid --bootstrap {b}: at least 1 replicate")).into(),
+                );
+            }
+        }
+        if let Some(f) = a.freq {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(UsageError(format!(
+                    "invalid --freq {f}: must be a positive number of hertz"
+                ))
+                .into());
+            }
+        }
+        let model: Model = a.model.parse()?;
+        let mut gmwm = Gmwm::new(model).with_seed(a.seed);
+        if let Some(g) = a.draws {
+            gmwm = gmwm.with_draws(g.max(1));
+        }
+        let input = InputConfig {
+            file: a.files[0].clone(),
+            read: ReadOptions {
+                columns: a.columns.iter().map(|c| selector(c)).collect(),
+                freq_hz: a.freq,
+                ..ReadOptions::default()
+            },
+            topic: None,
+            stream_from: gmwm::calib::STREAM_FROM,
+        };
+        Ok(Self {
+            files: a.files.clone(),
+            input,
+            gmwm,
+            wv: WvOptions {
+                levels: a.levels,
+                ..WvOptions::default()
+            },
+            test: SameModelOptions {
+                bootstrap: a.bootstrap,
+                seed: a.seed,
+            },
+            plot: a.plot.clone(),
+            json: a.json,
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Several axes of one recording
+
+/// Validated `gmwm shared`.
+#[derive(Debug, Clone)]
+pub struct SharedConfig {
+    /// The recording.
+    pub input: InputConfig,
+    /// `--shared`.
+    pub shared: Model,
+    /// `--model`.
+    pub specific: Model,
+    /// Estimator settings.
+    pub options: SharedOptions,
+    /// `--plot`.
+    pub plot: Option<std::path::PathBuf>,
+    /// Table, JSON or CSV.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&SharedArgs> for SharedConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SharedArgs) -> Result<Self> {
+        let model = |flag: &str, text: &str| -> Result<Model> {
+            text.parse::<Model>()
+                .with_context(|| format!("invalid {flag} {text:?}"))
+        };
+        if let Some(why) = gmwm::variance::ci::significance_level_problem(a.alpha) {
+            anyhow::bail!("invalid --alpha {}: {why}", a.alpha);
+        }
+        anyhow::ensure!(a.draws >= 1, "invalid --G 0: at least one draw");
+        if a.levels == Some(0) {
+            anyhow::bail!("invalid --levels 0: at least one level");
+        }
+        Ok(Self {
+            input: InputConfig::try_from(&a.input)?,
+            shared: model("--shared", &a.shared)?,
+            specific: model("--model", &a.model)?,
+            options: SharedOptions {
+                levels: a.levels,
+                alpha: a.alpha,
+                seed: a.seed,
+                draws: a.draws,
+                ..SharedOptions::default()
+            },
+            plot: a.plot.clone(),
+            output: OutputConfig::from(&a.output),
+        })
+    }
+}
+
+/// A length given as samples or as a duration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Span {
+    /// Samples.
+    Samples(usize),
+    /// Seconds.
+    Seconds(f64),
+}
+
+impl Span {
+    fn parse(flag: &str, text: &str) -> Result<Self> {
+        let t = text.trim();
+        if let Ok(n) = t.parse::<usize>() {
+            anyhow::ensure!(n >= 1, "invalid {flag} {text}: at least 1 sample");
+            return Ok(Span::Samples(n));
+        }
+        let (num, unit) = t
+            .find(|c: char| c.is_ascii_alphabetic())
+            .map(|i| t.split_at(i))
+            .unwrap_or((t, ""));
+        let factor = match unit {
+            "s" => 1.0,
+            "min" => 60.0,
+            "h" => 3600.0,
+            _ => anyhow::bail!(
+                "invalid {flag} {text}: give samples (65536) or a duration in s, min or h (600s)"
+            ),
+        };
+        let v: f64 = num
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite() && *v > 0.0)
+            .with_context(|| format!("invalid {flag} {text}: not a positive duration"))?;
+        Ok(Span::Seconds(v * factor))
+    }
+
+    /// The samples at `freq_hz`.
+    pub fn samples(self, freq_hz: f64) -> usize {
+        match self {
+            Span::Samples(n) => n,
+            Span::Seconds(s) => (s * freq_hz).round() as usize,
+        }
+    }
+}
+
+/// Validated `gmwm monitor`.
+#[derive(Debug, Clone)]
+pub struct MonitorConfig {
+    /// The recording.
+    pub input: InputConfig,
+    /// `--model-from`.
+    pub calibration: PathBuf,
+    /// `--window`.
+    pub window: Span,
+    /// `--step`.
+    pub step: Option<Span>,
+    /// Engine settings (window and step filled in once the rate is known).
+    pub options: MonitorOptions,
+    /// `--against`.
+    pub against: Against,
+    /// Table or JSON.
+    pub output: OutputConfig,
+}
+
+impl TryFrom<&MonitorArgs> for MonitorConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &MonitorArgs) -> Result<Self> {
+        if let Some(why) = gmwm::variance::ci::significance_level_problem(a.alpha) {
+            anyhow::bail!("invalid --alpha {}: {why}", a.alpha);
+        }
+        let robust = gmwm::RobustOptions::new(a.eff, gmwm::RobustConvention::Exact)
+            .map_err(|e| anyhow::anyhow!("invalid --eff {}: {e}", a.eff))?;
+        if a.levels == Some(0) {
+            anyhow::bail!("invalid --levels 0: at least one level");
+        }
+        Ok(Self {
+            input: InputConfig::try_from(&a.input)?,
+            calibration: a.model_from.clone(),
+            window: Span::parse("--window", &a.window)?,
+            step: a
+                .step
+                .as_deref()
+                .map(|s| Span::parse("--step", s))
+                .transpose()?,
+            options: MonitorOptions {
+                alpha: a.alpha,
+                robust,
+                levels: a.levels,
+                ..MonitorOptions::default()
+            },
+            against: a.against,
+            output: OutputConfig::from(&a.output),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::args::Cli;
     use clap::Parser;
+    use gmwm::imu::{HeaderMode, ImuRecordType, InputFormat, TimeUnit};
+    use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
+    use gmwm::RobustConvention;
 
     /// The arguments clap parses from `gmwm ARGV`.
     fn parse(argv: &[&str]) -> Command {
@@ -1279,9 +1489,9 @@ mod tests {
             file: "x.csv".into(),
             columns: Vec::new(),
             freq: Some(-5.0),
-            format: FormatArg::Auto,
+            format: InputFormat::Auto,
             ncols: None,
-            header: HeaderArg::Auto,
+            header: HeaderMode::Auto,
             time_column: None,
             time_unit: None,
             topic: None,
@@ -1297,7 +1507,7 @@ mod tests {
             InputConfig::try_from(&args).unwrap_err().to_string(),
             "invalid --ncols 0: a binary file has at least one column"
         );
-        args.format = FormatArg::Ln200ig;
+        args.format = InputFormat::ImuRecord(ImuRecordType::Ln200Ig);
         args.ncols = None;
         assert_eq!(
             InputConfig::try_from(&args).unwrap().read.format,
@@ -1766,6 +1976,111 @@ mod tests {
             SimulateConfig::try_from(&args).unwrap_err().to_string(),
             "invalid --n 0: simulate at least one sample"
         );
+    }
+
+    #[test]
+    fn several_recordings_are_one_configuration() {
+        let Config::PooledFit(c) = config(&[
+            "fit", "a.csv", "b.csv", "--pool", "--model", "WN()", "--seed", "4",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.files, [PathBuf::from("a.csv"), PathBuf::from("b.csv")]);
+        assert_eq!(
+            (c.seed, c.fit.input.file.as_path()),
+            (4, Path::new("a.csv"))
+        );
+        let Config::PooledSelect(c) = config(&[
+            "select",
+            "a.csv",
+            "b.csv",
+            "--pool",
+            "--model",
+            "AR1(phi=0.5, sigma2=1)",
+            "--G",
+            "5",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.gmwm.model(), &"AR1()".parse::<Model>().unwrap());
+        assert_eq!(c.files.len(), 2);
+        let (msg, usage) = refusal(&[
+            "select",
+            "a.csv",
+            "b.csv",
+            "--pool",
+            "--candidates",
+            "WN();RW()",
+        ]);
+        assert!(
+            msg.starts_with("--pool selects among the sub-models") && usage,
+            "{msg}"
+        );
+        let Config::SameModel(c) = config(&[
+            "same-model",
+            "a.csv",
+            "b.csv",
+            "--model",
+            "WN()",
+            "--columns",
+            "gyro_x,2",
+            "--freq",
+            "100",
+            "--levels",
+            "5",
+            "--bootstrap",
+            "20",
+        ]) else {
+            panic!()
+        };
+        assert_eq!(c.input.file, PathBuf::from("a.csv"));
+        assert_eq!(
+            c.input.read,
+            ReadOptions {
+                columns: vec![
+                    ColumnSelector::Name("gyro_x".into()),
+                    ColumnSelector::Index(2)
+                ],
+                freq_hz: Some(100.0),
+                ..ReadOptions::default()
+            }
+        );
+        assert_eq!((c.wv.levels, c.test.bootstrap), (Some(5), Some(20)));
+        for (argv, text, usage) in [
+            (
+                &["same-model", "a.csv", "--model", "WN()"][..],
+                "a.csv: the same-model test needs at least two recordings (FILEs); got one",
+                false,
+            ),
+            (
+                &[
+                    "same-model",
+                    "a.csv",
+                    "b.csv",
+                    "--model",
+                    "WN()",
+                    "--bootstrap",
+                    "0",
+                ],
+                "invalid --bootstrap 0: at least 1 replicate",
+                true,
+            ),
+            (
+                &[
+                    "same-model",
+                    "a.csv",
+                    "b.csv",
+                    "--model",
+                    "WN()",
+                    "--freq",
+                    "0",
+                ],
+                "invalid --freq 0: must be a positive number of hertz",
+                true,
+            ),
+        ] {
+            assert_eq!(refusal(argv), (text.to_string(), usage), "{argv:?}");
+        }
     }
 
     #[test]

@@ -1,12 +1,28 @@
-//! Reading the input an [`InputConfig`] names into loaded columns, and printing what the
-//! reader found (time column, skipped columns, warnings) once per file on stderr.
+//! What to read ([`InputConfig`]) and reading it into loaded columns, printing what the reader
+//! found (time column, skipped columns, warnings) once per file on stderr.
 
-use crate::config::InputConfig;
+use crate::style::OutputStyle;
 use anyhow::{Context, Result};
 use gmwm::imu::{quote, read_table, InputFormat, ReadWarning, Table};
 use gmwm::variance::{is_wv_json, read_wv_json, select_series};
 use gmwm::WaveletVariance;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Where the data come from and how to read them: FILE and the engine's read options
+/// (`--columns`, `--freq`, `--format`, `--ncols`, `--header`, `--time-column`, `--time-unit`),
+/// and the ROS topic (`--topic`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputConfig {
+    /// The data file (or rosbag2 folder).
+    pub file: PathBuf,
+    /// The engine's read options; `read.freq_hz` is `--freq`, `read.columns` is `--columns`.
+    pub read: gmwm::imu::ReadOptions,
+    /// `--topic`: the IMU topic of a ROS recording.
+    pub topic: Option<String>,
+    /// `--stream-from`: rows from which a text or IMU-record recording is streamed
+    /// ([`gmwm::calib::STREAM_FROM`] by default).
+    pub stream_from: u64,
+}
 
 /// A path as the user named it (`<stdin>` for the copy of standard input, [`crate::spool`]).
 pub fn shown_path(path: &Path) -> std::path::PathBuf {
@@ -41,19 +57,11 @@ fn hz(x: f64) -> String {
     }
 }
 
-/// Prints a note on stderr.
-pub fn note(file: &Path, text: &str) {
-    eprintln!(
-        "gmwm: note: {}",
-        crate::spool::shown(&format!("{}: {text}", file.display()))
-    );
-}
-
-/// Prints the columns a reader left out (none: nothing).
-pub fn note_not_analysed(file: &Path, skipped: &[String]) {
+/// Notes the columns a reader left out (none: nothing).
+pub fn note_not_analysed(style: OutputStyle, file: &Path, skipped: &[String]) {
     if !skipped.is_empty() {
         let names: Vec<String> = skipped.iter().map(|n| quote(n)).collect();
-        note(
+        style.note(
             file,
             &format!(
                 "not analysed: {} (not a gyroscope or accelerometer axis, or another time \
@@ -66,8 +74,9 @@ pub fn note_not_analysed(file: &Path, skipped: &[String]) {
 
 /// Prints what the reader found: the time column and its rate, the columns left out, then
 /// every warning, each once.
-fn report(table: &Table) {
+fn report(style: OutputStyle, table: &Table) {
     report_parts(
+        style,
         &table.path,
         table.timing.as_ref(),
         &table.skipped,
@@ -78,6 +87,7 @@ fn report(table: &Table) {
 
 /// [`report`] of a table's parts (a streamed table's too).
 pub(crate) fn report_parts(
+    style: OutputStyle,
     file: &std::path::Path,
     timing: Option<&gmwm::imu::TimingReport>,
     skipped: &[String],
@@ -85,10 +95,10 @@ pub(crate) fn report_parts(
     warnings: &[ReadWarning],
 ) {
     if let Some(t) = timing {
-        note(file, &t.to_string());
+        style.note(file, &t.to_string());
     }
-    note_not_analysed(file, skipped);
-    note(file, &samples.to_string());
+    note_not_analysed(style, file, skipped);
+    style.note(file, &samples.to_string());
     for w in warnings {
         match w {
             ReadWarning::FreqDisagrees {
@@ -112,25 +122,25 @@ pub(crate) fn report_parts(
 
 /// Reads the file named by `input`; the rate comes from `--freq`, else the file (time column
 /// or sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in
-/// samples). The reader's notes and warnings are printed on stderr.
-pub fn load(input: &InputConfig) -> Result<Loaded> {
+/// samples). The reader's notes (as `style` says) and warnings are printed on stderr.
+pub fn load(input: &InputConfig, style: OutputStyle) -> Result<Loaded> {
     if input.read.format == InputFormat::Auto && gmwm::imu::ros::container_of(&input.file).is_some()
     {
-        return load_ros(input);
+        return load_ros(input, style);
     }
     if let Some(topic) = &input.topic {
-        return Err(crate::UsageError(format!(
+        return Err(crate::error::UsageError(format!(
             "invalid --topic {topic}: {} is not a ROS recording (ROS1 bag, MCAP, rosbag2 sqlite3)",
             input.file.display()
         ))
         .into());
     }
     let table = read_table(&input.file, &input.read)?;
-    report(&table);
+    report(style, &table);
     let freq_hz = match input.read.freq_hz.or(table.freq_hz) {
         Some(f) => f,
         None if crate::spool::is_stdin(&input.file) => {
-            return Err(crate::UsageError(format!(
+            return Err(crate::error::UsageError(format!(
                 "{}: no sampling rate: standard input has no JSON sidecar and no time column \
                  was found; give --freq",
                 crate::spool::STDIN
@@ -351,7 +361,7 @@ pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> L
 }
 
 /// A ROS recording read as a table: the IMU topic's six axes at the header stamps' rate.
-fn load_ros(input: &InputConfig) -> Result<Loaded> {
+fn load_ros(input: &InputConfig, style: OutputStyle) -> Result<Loaded> {
     let rec = gmwm::imu::Recording::open(
         &input.file,
         &gmwm::imu::RecordingOptions {
@@ -360,7 +370,7 @@ fn load_ros(input: &InputConfig) -> Result<Loaded> {
         },
     )?;
     for n in &rec.notes {
-        note(&input.file, n);
+        style.note(&input.file, n);
     }
     let freq_hz = rec.imu.freq_hz();
     let table = Table {

@@ -1,77 +1,53 @@
 //! `gmwm`: command-line front end of the gmwm engine. Parses flags, validates them once into
-//! the subcommand's configuration (`config.rs`), runs the subcommand, renders its result; no
-//! numerics of its own.
+//! the subcommand's configuration (`config.rs`), decides the output style once (`style.rs`),
+//! then runs every subcommand through the same steps ([`cmd::Command`]): prepare what it reads,
+//! check that its output files can be written, run it; no numerics of its own.
 //!
 //! Exit codes: 0 success, 1 input or computation error (one line on stderr), 2 usage error.
 
 mod args;
-mod batch;
 mod cmd;
 mod config;
+mod error;
 mod input;
 mod output;
 mod panic;
-mod progress;
+mod prepare;
+mod recordings;
 mod render;
 mod spool;
+mod style;
 
 use args::Cli;
-use clap::Parser;
-use config::{Config, InputConfig, PlotKind};
+use clap::{CommandFactory, FromArgMatches};
+use config::Config;
+use error::{one_line, UsageError};
 use std::io::{BufWriter, Write};
 use std::path::Path;
 use std::process::ExitCode;
+use style::OutputStyle;
 
-/// Validates the flags into the subcommand's configuration, before any file is read, then
-/// runs it.
-fn run(cli: &Cli) -> anyhow::Result<()> {
-    // several recordings at once (issue 16): their own path, cmd::same_model
-    match &cli.command {
-        args::Command::SameModel(a) => return stdout_run(|out| cmd::same_model::run(a, out)),
-        args::Command::Fit(a) if a.pool => {
-            return stdout_run(|out| cmd::same_model::run_pooled_fit(a, out))
-        }
-        args::Command::Select(a) if a.pool => {
-            return stdout_run(|out| cmd::same_model::run_pooled_select(a, out))
-        }
-        _ => {}
-    }
+/// Validates the flags into the subcommand's configuration, before any file is read, prepares
+/// its inputs, checks its outputs' folders, then runs it.
+fn run(cli: &Cli, style: OutputStyle) -> anyhow::Result<()> {
     let mut config = Config::try_from(&cli.command)?;
-    let _spool = prepare_input(&mut config)?;
-    check_outputs(&config)?;
-    let levels = levels_of(&config);
-    execute(&config).map_err(|e| match levels {
+    let command = cmd::of(&mut config);
+    let _spool = prepare::prepare(command.inputs())?;
+    check_outputs(&command.outputs())?;
+    let levels = command.levels();
+    let mut out = BufWriter::new(Stdout(std::io::stdout().lock()));
+    let ran = command.run(style, &mut out).and_then(|()| Ok(out.flush()?));
+    ran.map_err(|e| match levels {
         // a series too short for the levels asked: the flag is the thing to change
         Some(j) if too_short(&e) => e.context(format!("--levels {j}")),
         _ => e,
     })
 }
 
-/// The files a command will write (`-` for standard output left out).
-fn outputs(config: &Config) -> Vec<&Path> {
-    let mut out: Vec<&Path> = Vec::new();
-    match config {
-        Config::Calibrate(c) => {
-            out.extend(c.exports.iter().map(|(_, p)| p.as_path()));
-            out.extend(c.json.as_deref());
-            out.extend(c.report.as_deref());
-        }
-        Config::Report(r) => {
-            out.extend(r.calibrate.exports.iter().map(|(_, p)| p.as_path()));
-            out.extend(r.calibrate.json.as_deref());
-            out.push(&r.output);
-        }
-        Config::Plot(p) => out.push(&p.figure.output),
-        _ => {}
-    }
-    out.retain(|p| p.as_os_str() != "-");
-    out
-}
-
-/// Before any work: every file the command writes must have a folder to go in (STYLE §9: a bad
-/// path fails in milliseconds, not after the calibration).
-fn check_outputs(config: &Config) -> anyhow::Result<()> {
-    for path in outputs(config) {
+/// Before any work: every file the command writes (`-`, standard output, aside) must have a
+/// folder to go in (STYLE §9: a bad path fails in milliseconds, not after the calibration).
+fn check_outputs(outputs: &[&Path]) -> anyhow::Result<()> {
+    for path in outputs.iter().filter(|p| p.as_os_str() != "-") {
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
@@ -90,24 +66,6 @@ fn check_outputs(config: &Config) -> anyhow::Result<()> {
         }
     }
     Ok(())
-}
-
-/// `--levels J` when the command was given one.
-fn levels_of(config: &Config) -> Option<usize> {
-    match config {
-        Config::Wv(c) => c.wv.levels,
-        Config::Fit(c) => c.wv.levels,
-        Config::Select(c) => c.wv.levels,
-        Config::Calibrate(c) => c.options.wv.levels,
-        Config::Report(c) => c.calibrate.options.wv.levels,
-        Config::Plot(c) => match &c.kind {
-            PlotKind::Wv(c) => c.wv.levels,
-            PlotKind::Fit(c) => c.wv.levels,
-            PlotKind::Select(c) => c.wv.levels,
-            _ => None,
-        },
-        _ => None,
-    }
 }
 
 /// Whether a series was too short for the computation (the engine's
@@ -150,198 +108,6 @@ fn named_stdout(e: std::io::Error) -> std::io::Error {
     std::io::Error::new(e.kind(), format!("standard output: {e}"))
 }
 
-/// Runs `f` on buffered standard output and flushes it.
-fn stdout_run(
-    f: impl FnOnce(&mut BufWriter<Stdout<std::io::StdoutLock<'static>>>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let mut out = BufWriter::new(Stdout(std::io::stdout().lock()));
-    f(&mut out)?;
-    out.flush()?;
-    Ok(())
-}
-
-fn execute(config: &Config) -> anyhow::Result<()> {
-    let stdout = std::io::stdout();
-    let mut out = BufWriter::new(Stdout(stdout.lock()));
-    match config {
-        Config::Demo(c) => cmd::demo::run(c, &mut out)?,
-        Config::Wv(c) => cmd::wv::run(c, &mut out)?,
-        Config::Avar(c) => cmd::avar::run(c, &mut out)?,
-        Config::Simulate(c) => cmd::simulate::run(c, &mut out)?,
-        Config::Implied(c) => cmd::implied::run(c, &mut out)?,
-        Config::Fit(c) => cmd::fit::run(c, &mut out)?,
-        Config::Select(c) => cmd::select::run(c, &mut out)?,
-        Config::Calibrate(c) => cmd::calibrate::run(c, &mut out)?,
-        Config::Topics(c) => cmd::topics::run(c, &mut out)?,
-        Config::Plot(c) => cmd::plot::run(c, &mut out)?,
-        Config::Report(c) => cmd::report::run(c, &mut out)?,
-        Config::Batch(c) => batch::run(c, &mut out)?,
-        Config::Shared(c) => cmd::shared::run(c, &mut out)?,
-        Config::Monitor(c) => cmd::monitor::run(c, &mut out)?,
-    }
-    out.flush()?;
-    Ok(())
-}
-
-/// The recording of a one-recording command.
-fn input_mut(config: &mut Config) -> Option<&mut InputConfig> {
-    Some(match config {
-        Config::Wv(c) => &mut c.input,
-        Config::Avar(c) => &mut c.input,
-        Config::Fit(c) => &mut c.input,
-        Config::Select(c) => &mut c.input,
-        Config::Calibrate(c) => &mut c.input,
-        Config::Report(c) => &mut c.calibrate.input,
-        Config::Shared(c) => &mut c.input,
-        Config::Monitor(c) => &mut c.input,
-        Config::Plot(c) => match &mut c.kind {
-            PlotKind::Wv(c) => &mut c.input,
-            PlotKind::Avar(c) | PlotKind::Ieee(c) => &mut c.input,
-            PlotKind::Compare(c) => &mut c.input,
-            PlotKind::Fit(c) => &mut c.input,
-            PlotKind::Select(c) => &mut c.input,
-        },
-        _ => return None,
-    })
-}
-
-/// Before anything is read: standard input (`-`) or a pipe as FILE is copied to a temporary
-/// file ([`spool`]; the guard removes it), and raw floats that are no sensor's samples (f64
-/// read as f32, ...) are warned about, naming the other format.
-fn prepare_input(config: &mut Config) -> anyhow::Result<Option<spool::Spool>> {
-    if let Config::Batch(b) = config {
-        if let Some(p) = b.inputs.iter().find(|p| spool::is_stream(p)) {
-            return Err(UsageError(format!(
-                "{}: batch mode (several FILEs, a folder, --out-dir, --force) reads files; \
-                 give standard input or a pipe alone, without --out-dir/--force",
-                if p.as_os_str() == "-" {
-                    spool::STDIN.to_string()
-                } else {
-                    p.display().to_string()
-                }
-            ))
-            .into());
-        }
-        return Ok(None);
-    }
-    if let Config::Calibrate(c) = config {
-        if let Some(p) = c.pool.iter().find(|p| spool::is_stream(p)) {
-            return Err(UsageError(format!(
-                "{}: --pool reads several recordings from files; give standard input or a \
-                 pipe to a one-recording command",
-                if p.as_os_str() == "-" {
-                    spool::STDIN.to_string()
-                } else {
-                    p.display().to_string()
-                }
-            ))
-            .into());
-        }
-        if !c.pool.is_empty() {
-            return Ok(None);
-        }
-    }
-    let mut guard = None;
-    if let Config::Topics(t) = config {
-        if spool::is_stream(&t.file) {
-            let (copy, g) = spool::spool(&t.file)?;
-            t.file = copy;
-            guard = Some(g);
-        }
-        return Ok(guard);
-    }
-    let Some(input) = input_mut(config) else {
-        return Ok(None);
-    };
-    if let Some(topic) = &input.topic {
-        if !spool::is_stream(&input.file)
-            && gmwm::imu::ros::container_of(&input.file).is_none()
-            && input.read.format == gmwm::imu::InputFormat::Auto
-            && input.file.exists()
-        {
-            return Err(UsageError(format!(
-                "invalid --topic {topic}: {} is not a ROS recording (ROS1 bag, MCAP, rosbag2 \
-                 sqlite3)",
-                input.file.display()
-            ))
-            .into());
-        }
-    }
-    if input.file.is_dir() && !config::is_rosbag2_folder(&input.file) {
-        anyhow::bail!(
-            "{}: is a folder, not a recording (a rosbag2 folder holds metadata.yaml; gmwm wv \
-             and gmwm calibrate also take a folder of recordings)",
-            input.file.display()
-        );
-    }
-    if spool::is_stream(&input.file) {
-        let (copy, g) = spool::spool(&input.file)?;
-        input.file = copy;
-        guard = Some(g);
-    }
-    warn_implausible(input);
-    Ok(guard)
-}
-
-/// A warning when FILE is raw f64/f32 whose first values no sensor gives
-/// ([`gmwm::imu::plausible::raw_floats`]); silent when it is not raw floats or cannot be read
-/// (the reader then says why).
-pub(crate) fn warn_implausible(input: &InputConfig) {
-    if input.read.format == gmwm::imu::InputFormat::Auto
-        && (gmwm::imu::ros::container_of(&input.file).is_some() || input::is_wv(input))
-    {
-        return;
-    }
-    let layout = match gmwm::imu::binary_layout(&input.file, &input.read) {
-        Ok(layout) => layout,
-        // a size that is no whole number of rows (the reader says so next): the values are
-        // still looked at when the format was given, as text read as f64 often has that size
-        Err(_) => matches!(
-            input.read.format,
-            gmwm::imu::InputFormat::F64 | gmwm::imu::InputFormat::F32
-        )
-        .then(|| gmwm::imu::BinaryLayout {
-            format: input.read.format,
-            ncols: 1,
-            names: Vec::new(),
-        }),
-    };
-    if let Some(layout) = layout {
-        if let Ok(Some(bad)) = gmwm::imu::plausible::raw_floats(&input.file, &layout) {
-            eprintln!("gmwm: warning: {}", spool::shown(&bad.to_string()));
-        }
-    }
-}
-
-/// A flag combination the command refuses (e.g. `gmwm fit --filter la8`): reported in one line
-/// like every error, with the usage-error exit code 2.
-#[derive(Debug)]
-pub struct UsageError(pub String);
-
-impl std::fmt::Display for UsageError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for UsageError {}
-
-/// The error and its causes in one line, `: `-separated, leaving out a cause whose text the
-/// message before it already holds (an engine error that names its I/O cause, say).
-fn one_line(e: &anyhow::Error) -> String {
-    let mut out = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if !out.contains(&text) {
-            if !out.is_empty() {
-                out.push_str(": ");
-            }
-            out.push_str(&text);
-        }
-    }
-    out
-}
-
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| {
         c.downcast_ref::<std::io::Error>()
@@ -349,11 +115,20 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
-/// A flag value outside its domain (`--freq -5`, `--G 0`, `--rule foo`): one line naming the
-/// flag and what would be valid, exit code 2; other usage errors keep clap's message with the
-/// usage.
+/// The flags, parsed with colour as [`style::colour`] allows. A flag value outside its domain
+/// (`--freq -5`, `--G 0`, `--rule foo`): one line naming the flag and what would be valid, exit
+/// code 2; other usage errors keep clap's message with the usage.
 fn parse() -> Result<Cli, ExitCode> {
-    match Cli::try_parse() {
+    let colour = match style::colour() {
+        true => clap::ColorChoice::Auto,
+        false => clap::ColorChoice::Never,
+    };
+    let mut command = Cli::command().color(colour);
+    let parsed = command
+        .try_get_matches_from_mut(std::env::args_os())
+        .and_then(|mut m| Cli::from_arg_matches_mut(&mut m))
+        .map_err(|e| e.format(&mut command));
+    match parsed {
         Ok(cli) => Ok(cli),
         Err(e)
             if matches!(
@@ -382,7 +157,7 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(code) => return code,
     };
-    match run(&cli) {
+    match run(&cli, OutputStyle::detect(cli.quiet)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {

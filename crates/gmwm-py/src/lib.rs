@@ -10,6 +10,7 @@ use gmwm::imu::{
 };
 use gmwm::inference::{infer_with_progress, CovarianceMethod, InferenceOptions, Progress};
 use gmwm::model::Model;
+use gmwm::names::Named;
 use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
 use gmwm::{
     allan_variance, wavelet_variance, AllanKind, AllanOptions, AvConvention, Gmwm,
@@ -21,6 +22,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::borrow::Cow;
 use std::path::PathBuf;
+use std::str::FromStr;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 create_exception!(
@@ -101,6 +103,19 @@ fn check_columns(arrays: &Borrowed<'_>, names: &[String]) -> PyResult<()> {
     Ok(())
 }
 
+/// The engine value a keyword names, read by the engine's `FromStr`; an unknown name is refused
+/// with the valid ones (`invalid rule "best": "navigation", "parsimonious" or "wic-minimum"`).
+fn choice<T: Named + FromStr>(keyword: &str, text: &str) -> PyResult<T> {
+    text.parse::<T>().map_err(|_| {
+        let names: Vec<String> = T::names().iter().map(|n| format!("{n:?}")).collect();
+        let listed = match names.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+            _ => names.join(", "),
+        };
+        err(format!("invalid {keyword} {text:?}: {listed}"))
+    })
+}
+
 fn check_freq(freq: f64) -> PyResult<()> {
     if freq.is_finite() && freq > 0.0 {
         Ok(())
@@ -122,15 +137,7 @@ fn wv_options(
     levels: Option<usize>,
     alpha: f64,
 ) -> PyResult<WvOptions> {
-    let convention = match robust_convention {
-        "exact" => RobustConvention::Exact,
-        "package" => RobustConvention::Package,
-        other => {
-            return Err(err(format!(
-                "invalid robust_convention {other:?}: \"exact\" or \"package\""
-            )))
-        }
-    };
+    let convention: RobustConvention = choice("robust_convention", robust_convention)?;
     let robust = if robust {
         Some(RobustOptions::new(eff, convention).map_err(engine)?)
     } else {
@@ -143,15 +150,7 @@ fn wv_options(
         return Err(err("invalid levels 0: at least one level"));
     }
     Ok(WvOptions {
-        transform: match transform {
-            "modwt" => Transform::Modwt,
-            "dwt" => Transform::Dwt,
-            other => {
-                return Err(err(format!(
-                    "invalid transform {other:?}: \"modwt\" or \"dwt\""
-                )))
-            }
-        },
+        transform: choice::<Transform>("transform", transform)?,
         filter: filter.parse::<WaveletFilter>().map_err(engine)?,
         levels,
         alpha,
@@ -217,19 +216,8 @@ fn avar(
         return Err(err(format!("invalid alpha {alpha}: {why}")));
     }
     let opts = AllanOptions {
-        kind: match kind {
-            "overlapping" => AllanKind::Overlapping,
-            "non-overlapping" => AllanKind::NonOverlapping,
-            "modified" => AllanKind::Modified,
-            "hadamard" => AllanKind::Hadamard,
-            "hadamard-non-overlapping" => AllanKind::HadamardNonOverlapping,
-            other => return Err(err(format!("invalid kind {other:?}: \"overlapping\", \"non-overlapping\", \"modified\", \"hadamard\" or \"hadamard-non-overlapping\""))),
-        },
-        convention: match convention {
-            "textbook" => AvConvention::Textbook,
-            "package" => AvConvention::Package,
-            other => return Err(err(format!("invalid convention {other:?}: \"textbook\" or \"package\""))),
-        },
+        kind: choice::<AllanKind>("kind", kind)?,
+        convention: choice::<AvConvention>("convention", convention)?,
         alpha,
     };
     let cols = columns_of(&arrays);
@@ -371,16 +359,7 @@ fn fit(
     let model: Model = model.parse().map_err(engine)?;
     let mut gmwm = Gmwm::new(model)
         .with_seed(seed)
-        .with_weighting(match weights {
-            "fast" => Weighting::Fast,
-            "diag" => Weighting::Diag,
-            "bootstrap" => Weighting::Bootstrap,
-            other => {
-                return Err(err(format!(
-                    "invalid weights {other:?}: \"fast\", \"diag\" or \"bootstrap\""
-                )))
-            }
-        });
+        .with_weighting(choice::<Weighting>("weights", weights)?);
     if let Some(g) = draws {
         if g == 0 {
             return Err(err("invalid draws 0: at least one starting-value draw"));
@@ -390,7 +369,7 @@ fn fit(
     if bootstrap.is_some_and(|b| b < 2) {
         return Err(err("invalid bootstrap: at least 2 replicates"));
     }
-    let v_method = covariance_of(covariance)?;
+    let v_method = choice::<CovarianceMethod>("covariance", covariance)?;
     let cols = columns_of(&arrays);
     let reporter = PyProgress {
         callback: progress,
@@ -493,28 +472,12 @@ fn select(
     };
     wic = wic
         .with_bootstrap(bootstrap)
-        .with_covariance(covariance_of(covariance)?)
+        .with_covariance(choice::<CovarianceMethod>("covariance", covariance)?)
         .with_seed(seed)
         .with_wv_options(wv_opts)
-        .with_optimism(match optimism {
-            "asymptotic" => OptimismMethod::Asymptotic,
-            "bootstrap" => OptimismMethod::Bootstrap,
-            other => {
-                return Err(err(format!(
-                    "invalid optimism {other:?}: \"asymptotic\" or \"bootstrap\""
-                )))
-            }
-        })
-        .with_convention(match convention {
-            "corrected" => OptimismConvention::Corrected,
-            "package" => OptimismConvention::Package,
-            other => {
-                return Err(err(format!(
-                    "invalid convention {other:?}: \"corrected\" or \"package\""
-                )))
-            }
-        })
-        .with_rule(rule_of(rule)?);
+        .with_optimism(choice::<OptimismMethod>("optimism", optimism)?)
+        .with_convention(choice::<OptimismConvention>("convention", convention)?)
+        .with_rule(choice::<SelectionRule>("rule", rule)?);
     if let Some(g) = draws {
         if g == 0 {
             return Err(err("invalid draws 0: at least one starting-value draw"));
@@ -553,33 +516,6 @@ impl Progress for Ticks<'_> {
     }
 }
 
-/// `covariance`: how V, the covariance of the WV, is obtained.
-fn covariance_of(text: &str) -> PyResult<CovarianceMethod> {
-    Ok(match text {
-        "auto" => CovarianceMethod::Auto,
-        "exact" => CovarianceMethod::Exact,
-        "bootstrap" => CovarianceMethod::Bootstrap,
-        other => {
-            return Err(err(format!(
-                "invalid covariance {other:?}: \"auto\", \"exact\" or \"bootstrap\""
-            )))
-        }
-    })
-}
-
-fn rule_of(rule: &str) -> PyResult<SelectionRule> {
-    Ok(match rule {
-        "navigation" => SelectionRule::Navigation,
-        "parsimonious" => SelectionRule::Parsimonious,
-        "wic-minimum" => SelectionRule::WicMinimum,
-        other => {
-            return Err(err(format!(
-                "invalid rule {other:?}: \"navigation\", \"parsimonious\" or \"wic-minimum\""
-            )))
-        }
-    })
-}
-
 /// The read options of the keywords (the input flags of the CLI).
 #[allow(clippy::too_many_arguments)]
 fn read_options(
@@ -599,28 +535,17 @@ fn read_options(
         Err(_) => ColumnSelector::Name(t.trim().to_string()),
     };
     Ok(ReadOptions {
-        format: match format {
-            "auto" => InputFormat::Auto,
-            other => other.parse::<InputFormat>().map_err(|_| {
-                err(format!("invalid format {other:?}: auto, csv, tsv, f64, f32, imar, ln200, ln200ig, ixsea, navchip-int or navchip-flt"))
-            })?,
-        },
-        header: match header {
-            "auto" => HeaderMode::Auto,
-            "yes" => HeaderMode::Present,
-            "no" => HeaderMode::Absent,
-            other => return Err(err(format!("invalid header {other:?}: \"auto\", \"yes\" or \"no\""))),
-        },
+        format: choice::<InputFormat>("format", format)?,
+        header: choice::<HeaderMode>("header", header)?,
         time_column: time_column.as_deref().map(selector),
-        time_unit: match time_unit {
-            None => None,
-            Some("s") => Some(TimeUnit::Seconds),
-            Some("ms") => Some(TimeUnit::Milliseconds),
-            Some("us") => Some(TimeUnit::Microseconds),
-            Some("ns") => Some(TimeUnit::Nanoseconds),
-            Some(other) => return Err(err(format!("invalid time_unit {other:?}: s, ms, us or ns"))),
-        },
-        columns: columns.unwrap_or_default().iter().map(|c| selector(c)).collect(),
+        time_unit: time_unit
+            .map(|u| choice::<TimeUnit>("time_unit", u))
+            .transpose()?,
+        columns: columns
+            .unwrap_or_default()
+            .iter()
+            .map(|c| selector(c))
+            .collect(),
         ncols,
         freq_hz: freq,
     })
@@ -755,15 +680,7 @@ fn calibrate(
         })
         .transpose()
     };
-    let convention = match robust_convention {
-        "exact" => RobustConvention::Exact,
-        "package" => RobustConvention::Package,
-        other => {
-            return Err(err(format!(
-                "invalid robust_convention {other:?}: \"exact\" or \"package\""
-            )))
-        }
-    };
+    let convention: RobustConvention = choice("robust_convention", robust_convention)?;
     let wv = wv_options(robust, eff, robust_convention, "haar", "modwt", None, alpha)?;
     let options = CalibrationOptions {
         full_model: model
@@ -771,26 +688,17 @@ fn calibrate(
             .parse()
             .map_err(engine)?,
         wv,
-        covariance: covariance_of(covariance)?,
+        covariance: choice::<CovarianceMethod>("covariance", covariance)?,
         bootstrap,
         draws,
         seed,
-        rule: rule_of(rule)?,
+        rule: choice::<SelectionRule>("rule", rule)?,
         gyro_unit: unit(gyro_unit, "gyro_unit")?,
         accel_unit: unit(accel_unit, "accel_unit")?,
         robust_check: Some(RobustOptions::new(eff, convention).map_err(engine)?),
         ..CalibrationOptions::default()
     };
-    let policy = match axis_policy {
-        "worst" => AxisPolicy::Worst,
-        "mean" => AxisPolicy::Mean,
-        "per-axis" => AxisPolicy::PerAxis,
-        other => {
-            return Err(err(format!(
-                "invalid axis_policy {other:?}: \"worst\", \"mean\" or \"per-axis\""
-            )))
-        }
-    };
+    let policy: AxisPolicy = choice("axis_policy", axis_policy)?;
     let adjustment = match (inflate, conservative) {
         (Some(_), true) => return Err(err("give inflate or conservative, not both")),
         (Some(k), false) => Adjustment::inflate(k).map_err(engine)?,

@@ -36,6 +36,7 @@ pub mod inference;
 pub(crate) mod math;
 pub mod model;
 pub mod monitor;
+pub mod names;
 pub mod process;
 pub mod progress;
 pub mod selection;

@@ -1,17 +1,21 @@
 //! `gmwm avar`: Allan, modified Allan or Hadamard variance of each selected column.
 
+use super::Command;
 use crate::config::AvarConfig;
-use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named, note};
+use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named};
+use crate::prepare::Inputs;
 use crate::render;
+use crate::style::OutputStyle;
 use anyhow::Result;
 use gmwm::variance::allan_from_wv;
 use gmwm::{allan_variance, AllanVariance};
 use std::io::Write;
+use std::path::Path;
 
 /// A saved wavelet variance: the overlapping Allan variance by docs/methods.md §3.4,
 /// `AV(m) = 2 WV(2m)`, exact for the classical Haar MODWT WV and the textbook estimator; other
 /// kinds and conventions need the recording.
-fn run_saved(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
+fn run_saved(config: &AvarConfig, style: OutputStyle) -> Result<Vec<(String, AllanVariance)>> {
     let (file, opts) = (&config.input.file, &config.allan);
     config.saved_wv.check(file)?;
     let series = load_wv(&config.input, None)?;
@@ -29,7 +33,7 @@ fn run_saved(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
         let av = allan_from_wv(wv).map_err(gmwm::Error::from);
         items.push((name.clone(), column_context(av, file, name)?));
     }
-    note(
+    style.note(
         file,
         "Allan variance from the saved Haar wavelet variance, AV(m) = 2 WV(2m) \
          (docs/methods.md §3.4), intervals the WV's times 2; not recomputed from a recording",
@@ -37,18 +41,31 @@ fn run_saved(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
     Ok(items)
 }
 
-/// Runs the subcommand.
-pub fn run(config: &AvarConfig, out: &mut impl Write) -> Result<()> {
-    let items = compute(config)?;
-    render::series(out, &named(&items), config.output)
+impl Command for AvarConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Recording(&mut self.input)
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        None
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        let items = compute(self, style)?;
+        render::series(&mut out, &named(&items), self.output)
+    }
 }
 
 /// The Allan-type variance of every selected column (from a saved WV: the overlapping one).
-pub fn compute(config: &AvarConfig) -> Result<Vec<(String, AllanVariance)>> {
+pub fn compute(config: &AvarConfig, style: OutputStyle) -> Result<Vec<(String, AllanVariance)>> {
     if is_wv(&config.input) {
-        return run_saved(config);
+        return run_saved(config, style);
     }
-    let loaded = load(&config.input)?;
+    let loaded = load(&config.input, style)?;
     analyse_columns(&loaded, &config.input.file, |x| {
         Ok(allan_variance(x, loaded.freq_hz, &config.allan)?)
     })

@@ -1,9 +1,11 @@
 //! `gmwm calibrate`: the engine's calibration pipeline on a recording, a readable summary, and
 //! the files a navigation filter reads.
 
+use super::Command;
 use crate::config::CalibrateConfig;
-use crate::progress::{bar, Ticks};
-use crate::UsageError;
+use crate::error::UsageError;
+use crate::prepare::Inputs;
+use crate::style::{OutputStyle, Ticks};
 use anyhow::{Context, Result};
 use gmwm::calib::export::{render, ExportFormat};
 use gmwm::calib::{
@@ -13,24 +15,36 @@ use gmwm::selection::SelectionRule;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// Runs the subcommand.
-pub fn run(config: &CalibrateConfig, out: &mut impl Write) -> Result<()> {
-    execute(config, config.report.as_deref(), true, out)
-}
+impl Command for CalibrateConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        if self.pool.is_empty() {
+            return Inputs::Recording(&mut self.input);
+        }
+        Inputs::Files {
+            paths: &self.pool,
+            refusal: "--pool reads several recordings from files; give standard input or a \
+                      pipe to a one-recording command",
+        }
+    }
 
-/// The calibration, its files, and the HTML report when `report` names one; the summary is
-/// printed when `print_summary`, else only what was written.
-pub fn execute(
-    config: &CalibrateConfig,
-    report_path: Option<&Path>,
-    print_summary: bool,
-    out: &mut impl Write,
-) -> Result<()> {
-    let mode = Mode {
-        print_summary,
-        batch: false,
-    };
-    execute_in(config, report_path, mode, out).map(|_| ())
+    fn outputs(&self) -> Vec<&Path> {
+        let mut out: Vec<&Path> = self.exports.iter().map(|(_, p)| p.as_path()).collect();
+        out.extend(self.json.as_deref());
+        out.extend(self.report.as_deref());
+        out
+    }
+
+    fn levels(&self) -> Option<usize> {
+        self.options.wv.levels
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        let mode = Mode {
+            print_summary: true,
+            style,
+        };
+        execute_in(self, self.report.as_deref(), mode, &mut out).map(|_| ())
+    }
 }
 
 /// How [`execute_in`] runs.
@@ -38,10 +52,8 @@ pub fn execute(
 pub struct Mode {
     /// Print the summary (else only what was written).
     pub print_summary: bool,
-    /// One recording of a batch: no progress bar of its own, and every file written
-    /// atomically (a temporary file renamed), so that an interrupted batch never leaves a
-    /// partial file that a later run would take as up to date.
-    pub batch: bool,
+    /// Progress and notes (one recording of a batch: no progress bar of its own).
+    pub style: OutputStyle,
 }
 
 /// What a calibration gave.
@@ -201,11 +213,9 @@ fn calibrate_one(
     }
     let per_axis = calibration.candidates_per_axis()?;
     let axes = recording.columns.len();
-    let progress = if mode.batch {
-        indicatif::ProgressBar::hidden()
-    } else {
-        bar((axes * per_axis) as u64, "calibrating", "candidate fits")
-    };
+    let progress = mode
+        .style
+        .bar((axes * per_axis) as u64, "calibrating", "candidate fits");
     let report = match &recording.imu {
         Some(imu) => calibration.run_with_progress(imu, &Ticks(&progress)),
         None => match &table {
@@ -226,7 +236,7 @@ fn calibrate_pooled(
     report_path: Option<&Path>,
     mode: Mode,
 ) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
-    let files = crate::batch::recordings(&config.pool, config.input.read.format)?;
+    let files = crate::recordings::recordings(&config.pool, config.input.read.format)?;
     if files.len() < 2 {
         return Err(UsageError(format!(
             "--pool calibrates several recordings as one sensor: {} found in {}; give two or more",
@@ -243,7 +253,7 @@ fn calibrate_pooled(
     let mut loaded = Vec::with_capacity(files.len());
     for f in &files {
         let one = CalibrateConfig {
-            input: crate::config::InputConfig {
+            input: crate::input::InputConfig {
                 file: f.clone(),
                 ..config.input.clone()
             },
@@ -268,11 +278,9 @@ fn calibrate_pooled(
         .collect();
     let per_axis = calibration.candidates_per_axis()?;
     let axes = loaded[0].columns.len();
-    let progress = if mode.batch {
-        indicatif::ProgressBar::hidden()
-    } else {
-        bar((axes * per_axis) as u64, "calibrating", "candidate fits")
-    };
+    let progress = mode
+        .style
+        .bar((axes * per_axis) as u64, "calibrating", "candidate fits");
     let report = calibration
         .run_pooled_with_progress(&named, &Ticks(&progress))
         .map_err(gmwm::Error::from)?;

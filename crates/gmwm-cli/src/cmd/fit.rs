@@ -1,17 +1,20 @@
 //! `gmwm fit`: GMWM estimation of a latent error model on each selected column (docs/methods.md
 //! §5).
 
-use crate::cmd::wv::{stream_columns, streamable};
+use super::wv::{stream_columns, streamable};
+use super::Command;
 use crate::config::FitConfig;
 use crate::input::{analyse_columns, column_context, is_wv, load, load_wv};
-use crate::progress::bar;
+use crate::prepare::Inputs;
 use crate::render::Style;
+use crate::style::OutputStyle;
 use anyhow::Result;
 use gmwm::fit::{CanonicalModel, StartInputs};
 use gmwm::inference::{infer_with_progress, Inference, InferenceOptions};
 use gmwm::{GmwmFit, WaveletVariance, Weighting};
 use rayon::prelude::*;
 use std::io::Write;
+use std::path::Path;
 
 /// Fits every series of a WV JSON file (`gmwm wv --json`) selected by `--columns` (names or
 /// 1-based indices).
@@ -41,7 +44,7 @@ fn fit_wv_file(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
 /// `R = (max - min) / N`, as [`StartInputs::from_series`] gives them) come from one streamed
 /// pass instead of loading the file. Only for the columns the loader would take too: the
 /// file's single column, or `--columns`. `None` when the file is not such a case.
-fn fit_streamed(config: &FitConfig) -> Result<Option<Vec<(String, GmwmFit)>>> {
+fn fit_streamed(config: &FitConfig, style: OutputStyle) -> Result<Option<Vec<(String, GmwmFit)>>> {
     let input = &config.input;
     if config.gmwm.weighting() == Weighting::Diag {
         return Ok(None);
@@ -52,7 +55,7 @@ fn fit_streamed(config: &FitConfig) -> Result<Option<Vec<(String, GmwmFit)>>> {
     if layout.ncols > 1 && input.read.columns.is_empty() {
         return Ok(None);
     }
-    let columns = stream_columns(input, &layout, &config.wv)?;
+    let columns = stream_columns(input, &layout, &config.wv, style)?;
     let fits: Vec<_> = columns
         .par_iter()
         .map(|(_, c)| {
@@ -77,9 +80,10 @@ fn fit_streamed(config: &FitConfig) -> Result<Option<Vec<(String, GmwmFit)>>> {
 }
 
 /// docs/methods.md §7 on one column's fit, at the series length and WV settings the fit carries,
-/// with a progress bar on a terminal.
+/// with a progress bar as `style` says.
 fn inference(
     config: &FitConfig,
+    style: OutputStyle,
     opts: &InferenceOptions,
     column: &str,
     fit: &GmwmFit,
@@ -88,7 +92,7 @@ fn inference(
         .empirical()
         .ok_or_else(|| anyhow::anyhow!("the fit carries no wavelet variance"))?;
     let total = opts.bootstrap.unwrap_or(opts.v_replicates) as u64;
-    let bar = bar(total, &format!("inference on {column}"), "replicates");
+    let bar = style.bar(total, &format!("inference on {column}"), "replicates");
     let progress = |done: usize| bar.set_position(done as u64);
     let result = infer_with_progress(&config.gmwm, fit, wv.n(), &wv.options(), opts, &progress);
     bar.finish_and_clear();
@@ -99,22 +103,35 @@ fn inference(
     )
 }
 
-/// Runs the subcommand.
-pub fn run(config: &FitConfig, out: &mut impl Write) -> Result<()> {
-    let fits = compute(config)?;
-    render_fits(config, &fits, out)
+impl Command for FitConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Recording(&mut self.input)
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        self.wv.levels
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        let fits = compute(self, style)?;
+        render_fits(self, style, &fits, &mut out)
+    }
 }
 
 /// The fit of the configured estimator on every selected column (convergence warnings
 /// printed).
-pub fn compute(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
+pub fn compute(config: &FitConfig, style: OutputStyle) -> Result<Vec<(String, GmwmFit)>> {
     let file = &config.input.file;
     let fits = if is_wv(&config.input) {
         fit_wv_file(config)?
-    } else if let Some(fits) = fit_streamed(config)? {
+    } else if let Some(fits) = fit_streamed(config, style)? {
         fits
     } else {
-        let loaded = load(&config.input)?;
+        let loaded = load(&config.input, style)?;
         analyse_columns(&loaded, file, |x| {
             config
                 .gmwm
@@ -134,7 +151,12 @@ pub fn compute(config: &FitConfig) -> Result<Vec<(String, GmwmFit)>> {
     Ok(fits)
 }
 
-fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Write) -> Result<()> {
+fn render_fits(
+    config: &FitConfig,
+    style: OutputStyle,
+    fits: &[(String, GmwmFit)],
+    out: &mut impl Write,
+) -> Result<()> {
     let canonicals: Vec<CanonicalModel> = fits
         .par_iter()
         .map(|(column, fit)| {
@@ -148,7 +170,7 @@ fn render_fits(config: &FitConfig, fits: &[(String, GmwmFit)], out: &mut impl Wr
     let inferences: Vec<Option<Inference>> = match &config.inference {
         Some(opts) => fits
             .iter()
-            .map(|(column, fit)| inference(config, opts, column, fit).map(Some))
+            .map(|(column, fit)| inference(config, style, opts, column, fit).map(Some))
             .collect::<Result<_>>()?,
         None => fits.iter().map(|_| None).collect(),
     };

@@ -1,8 +1,12 @@
 //! `gmwm implied`: the implied wavelet variance of a fully specified model.
 
+use super::Command;
 use crate::config::ImpliedConfig;
+use crate::prepare::Inputs;
+use crate::style::OutputStyle;
 use anyhow::Result;
 use std::io::Write;
+use std::path::Path;
 
 /// Runs the subcommand.
 pub fn run(config: &ImpliedConfig, out: &mut impl Write) -> Result<()> {
@@ -14,4 +18,23 @@ pub fn run(config: &ImpliedConfig, out: &mut impl Write) -> Result<()> {
         write!(out, "{implied}")?;
     }
     Ok(())
+}
+
+impl Command for ImpliedConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::None
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        // the levels of a model, not of a series
+        None
+    }
+
+    fn run(&self, _: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        run(self, &mut out)
+    }
 }

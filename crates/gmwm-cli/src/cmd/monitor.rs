@@ -2,174 +2,20 @@
 //! recording against the models of a calibration (`gmwm calibrate FILE --out-dir DIR` writes
 //! `DIR/NAME.calibration.json`).
 
-use crate::args::{InputArgs, OutputArgs};
-use crate::config::{InputConfig, OutputConfig};
+use super::Command;
+use crate::config::Against;
+use crate::config::MonitorConfig;
 use crate::input::load;
+use crate::prepare::Inputs;
 use crate::render::Style;
+use crate::style::OutputStyle;
 use anyhow::{Context, Result};
-use clap::Args;
 use gmwm::model::Model;
-use gmwm::monitor::{monitor_against, MonitorOptions, MonitorReport, Reference};
+use gmwm::monitor::{monitor_against, MonitorReport, Reference};
 use gmwm::units::SignalUnit;
 use serde::Serialize;
 use std::io::Write;
-use std::path::PathBuf;
-
-/// `gmwm monitor --help` examples.
-pub const EXAMPLES: &str = "Each window's robust WV (docs/methods.md §2) is compared with the band the calibrated \
-model predicts for a window of that length (chi-square with the model's equivalent degrees of \
-freedom, Bonferroni over the levels); a window outside at some level is flagged. About --alpha \
-of the windows of a recording that follows the model are flagged by chance. Where the \
-calibration's verdict says the model misfits its WV, the windows are compared with that \
-empirical WV and its uncertainty instead (--against auto, the default; docs/methods/multi-axis.md \
-§16.6): a misfit of a few percent would otherwise flag nearly every long window.\n\n\
-Examples:\n  gmwm calibrate imu.csv.gz --out-dir cal && gmwm monitor imu.csv.gz --model-from cal/imu.calibration.json\n  \
-gmwm monitor long.csv.gz --model-from cal/imu.calibration.json --columns gyro_x --window 600s --step 60s\n  \
-gmwm monitor long.csv.gz --model-from cal/imu.calibration.json --window 65536 --json";
-
-/// `gmwm monitor` flags.
-#[derive(Debug, Args)]
-pub struct MonitorArgs {
-    /// Input.
-    #[command(flatten)]
-    pub input: InputArgs,
-    /// The calibration JSON (`gmwm calibrate FILE --out-dir DIR` writes DIR/NAME.calibration.json):
-    /// per axis the model and its estimates.
-    #[arg(long = "model-from", value_name = "CALIB_JSON")]
-    pub model_from: PathBuf,
-    /// Window length: samples (65536) or a duration with a unit (600s, 10min, 2h).
-    #[arg(long, default_value = "65536")]
-    pub window: String,
-    /// Step between windows: samples or a duration [default: half a window].
-    #[arg(long)]
-    pub step: Option<String>,
-    /// Probability that a window of a recording following the model is flagged, in (0, 0.5].
-    #[arg(long, default_value_t = 0.01)]
-    pub alpha: f64,
-    /// Efficiency of the robust WV, in (0, 0.99].
-    #[arg(long, default_value_t = 0.6)]
-    pub eff: f64,
-    /// Largest level tested [default: every level with M_j / 2^j >= 8].
-    #[arg(long, value_name = "J")]
-    pub levels: Option<usize>,
-    /// What each window is compared with: the calibrated model's WV (model), the calibration's
-    /// empirical WV with its uncertainty (wv), or the model where the calibration's verdict says it
-    /// explains the WV and the empirical WV where it misfits (auto; docs/methods/multi-axis.md
-    /// §16.6).
-    #[arg(long, value_enum, default_value_t = Against::Auto)]
-    pub against: Against,
-    /// Output format.
-    #[command(flatten)]
-    pub output: OutputArgs,
-}
-
-/// `--against`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Against {
-    /// The model where it explains the calibration's WV, else that WV.
-    Auto,
-    /// The calibrated model's implied WV.
-    Model,
-    /// The calibration's empirical WV.
-    Wv,
-}
-
-/// A length given as samples or as a duration.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Span {
-    /// Samples.
-    Samples(usize),
-    /// Seconds.
-    Seconds(f64),
-}
-
-impl Span {
-    fn parse(flag: &str, text: &str) -> Result<Self> {
-        let t = text.trim();
-        if let Ok(n) = t.parse::<usize>() {
-            anyhow::ensure!(n >= 1, "invalid {flag} {text}: at least 1 sample");
-            return Ok(Span::Samples(n));
-        }
-        let (num, unit) = t
-            .find(|c: char| c.is_ascii_alphabetic())
-            .map(|i| t.split_at(i))
-            .unwrap_or((t, ""));
-        let factor = match unit {
-            "s" => 1.0,
-            "min" => 60.0,
-            "h" => 3600.0,
-            _ => anyhow::bail!(
-                "invalid {flag} {text}: give samples (65536) or a duration in s, min or h (600s)"
-            ),
-        };
-        let v: f64 = num
-            .trim()
-            .parse()
-            .ok()
-            .filter(|v: &f64| v.is_finite() && *v > 0.0)
-            .with_context(|| format!("invalid {flag} {text}: not a positive duration"))?;
-        Ok(Span::Seconds(v * factor))
-    }
-
-    fn samples(self, freq_hz: f64) -> usize {
-        match self {
-            Span::Samples(n) => n,
-            Span::Seconds(s) => (s * freq_hz).round() as usize,
-        }
-    }
-}
-
-/// Validated `gmwm monitor`.
-#[derive(Debug, Clone)]
-pub struct MonitorConfig {
-    /// The recording.
-    pub input: InputConfig,
-    /// `--model-from`.
-    pub calibration: PathBuf,
-    /// `--window`.
-    pub window: Span,
-    /// `--step`.
-    pub step: Option<Span>,
-    /// Engine settings (window and step filled in once the rate is known).
-    pub options: MonitorOptions,
-    /// `--against`.
-    pub against: Against,
-    /// Table or JSON.
-    pub output: OutputConfig,
-}
-
-impl TryFrom<&MonitorArgs> for MonitorConfig {
-    type Error = anyhow::Error;
-
-    fn try_from(a: &MonitorArgs) -> Result<Self> {
-        if let Some(why) = gmwm::variance::ci::significance_level_problem(a.alpha) {
-            anyhow::bail!("invalid --alpha {}: {why}", a.alpha);
-        }
-        let robust = gmwm::RobustOptions::new(a.eff, gmwm::RobustConvention::Exact)
-            .map_err(|e| anyhow::anyhow!("invalid --eff {}: {e}", a.eff))?;
-        if a.levels == Some(0) {
-            anyhow::bail!("invalid --levels 0: at least one level");
-        }
-        Ok(Self {
-            input: InputConfig::try_from(&a.input)?,
-            calibration: a.model_from.clone(),
-            window: Span::parse("--window", &a.window)?,
-            step: a
-                .step
-                .as_deref()
-                .map(|s| Span::parse("--step", s))
-                .transpose()?,
-            options: MonitorOptions {
-                alpha: a.alpha,
-                robust,
-                levels: a.levels,
-                ..MonitorOptions::default()
-            },
-            against: a.against,
-            output: OutputConfig::from(&a.output),
-        })
-    }
-}
+use std::path::Path;
 
 /// One axis of a calibration JSON.
 struct CalibratedAxis {
@@ -248,18 +94,32 @@ pub struct AxisMonitor {
     pub event_stamps: Option<Vec<(f64, f64)>>,
 }
 
-/// Runs the subcommand.
-pub fn run(config: &MonitorConfig, out: &mut impl Write) -> Result<()> {
-    let axes = compute(config)?;
-    render(&axes, config.output, out)
+impl Command for MonitorConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Recording(&mut self.input)
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        // --levels: the largest level tested, not the WV's J
+        None
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        let axes = compute(self, style)?;
+        render(&axes, self.output, &mut out)
+    }
 }
 
 /// Checks the recording against the calibration (columns, rate, units) and monitors each axis.
-pub fn compute(config: &MonitorConfig) -> Result<Vec<AxisMonitor>> {
+pub fn compute(config: &MonitorConfig, style: OutputStyle) -> Result<Vec<AxisMonitor>> {
     let file = config.input.file.display().to_string();
     let cal_shown = config.calibration.display().to_string();
     let (cal_freq, cal_axes) = read_calibration(&config.calibration)?;
-    let loaded = load(&config.input)?;
+    let loaded = load(&config.input, style)?;
     let freq = loaded.freq_hz;
     anyhow::ensure!(
         ((freq - cal_freq) / cal_freq).abs() <= 1e-6,

@@ -1,14 +1,18 @@
 //! `gmwm plot`: one figure of the matching command's results (gmwm-plot renders; the numbers
 //! are those `gmwm wv|avar|fit|select --json` gives).
 
-use crate::config::{FigureConfig, InputConfig, PlotConfig, PlotKind};
-use crate::input::is_wv;
+use super::Command;
+use crate::config::{FigureConfig, PlotConfig, PlotKind};
+use crate::input::{is_wv, InputConfig};
+use crate::prepare::Inputs;
+use crate::style::OutputStyle;
 use anyhow::{Context, Result};
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{Sensor, SensorInfo};
 use gmwm::units::SignalUnit;
 use gmwm_plot::{Column, Figure};
 use std::io::Write;
+use std::path::Path;
 
 /// The unit of each column for axis labels and legends: the one its name or the sidecar
 /// states (SI for ROS recordings and binary IMU records), as its symbol; `u` when unknown.
@@ -94,13 +98,43 @@ fn draw<T>(
     save(build(&columns(items, &units)), figure, out)
 }
 
-/// Runs the subcommand.
-pub fn run(config: &PlotConfig, out: &mut impl Write) -> Result<()> {
+impl Command for PlotConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Recording(match &mut self.kind {
+            PlotKind::Wv(c) => &mut c.input,
+            PlotKind::Avar(c) | PlotKind::Ieee(c) => &mut c.input,
+            PlotKind::Compare(c) => &mut c.input,
+            PlotKind::Fit(c) => &mut c.input,
+            PlotKind::Select(c) => &mut c.input,
+        })
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        vec![&self.figure.output]
+    }
+
+    fn levels(&self) -> Option<usize> {
+        match &self.kind {
+            PlotKind::Wv(c) => c.wv.levels,
+            PlotKind::Fit(c) => c.wv.levels,
+            PlotKind::Select(c) => c.wv.levels,
+            // compare's --levels: the engine's error without the flag, as before
+            PlotKind::Avar(_) | PlotKind::Ieee(_) | PlotKind::Compare(_) => None,
+        }
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        run(self, style, &mut out)
+    }
+}
+
+/// Computes the figure's data and draws it.
+fn run(config: &PlotConfig, style: OutputStyle, out: &mut impl Write) -> Result<()> {
     let figure = &config.figure;
     let layout = figure.layout;
     match &config.kind {
         PlotKind::Wv(c) => {
-            let items = crate::cmd::wv::compute(c)?;
+            let items = super::wv::compute(c, style)?;
             draw(
                 &c.input,
                 &items,
@@ -110,7 +144,7 @@ pub fn run(config: &PlotConfig, out: &mut impl Write) -> Result<()> {
             )
         }
         PlotKind::Avar(c) => {
-            let items = crate::cmd::avar::compute(c)?;
+            let items = super::avar::compute(c, style)?;
             draw(
                 &c.input,
                 &items,
@@ -126,7 +160,7 @@ pub fn run(config: &PlotConfig, out: &mut impl Write) -> Result<()> {
                 "{}: classical against robust needs the samples, not a saved wavelet variance",
                 input.file.display()
             );
-            let loaded = crate::input::load(input)?;
+            let loaded = crate::input::load(input, style)?;
             let items = crate::input::analyse_columns(&loaded, &input.file, |x| {
                 Ok((
                     gmwm::wavelet_variance(x, loaded.freq_hz, &c.classical)?,
@@ -136,17 +170,17 @@ pub fn run(config: &PlotConfig, out: &mut impl Write) -> Result<()> {
             draw(input, &items, gmwm_plot::compare_figure, figure, out)
         }
         PlotKind::Fit(c) => {
-            let fits = crate::cmd::fit::compute(c)?;
+            let fits = super::fit::compute(c, style)?;
             draw(&c.input, &fits, gmwm_plot::fit_figure, figure, out)
         }
         PlotKind::Select(c) => {
-            let selections = crate::cmd::select::compute(c)?;
+            let selections = super::select::compute(c, style)?;
             let top = c.top;
             let build = |cols: &[Column<'_, _>]| gmwm_plot::selection_figure(cols, top);
             draw(&c.input, &selections, build, figure, out)
         }
         PlotKind::Ieee(c) => {
-            let items = crate::cmd::avar::compute(c)?;
+            let items = super::avar::compute(c, style)?;
             let mut pairs = Vec::with_capacity(items.len());
             for (name, av) in items {
                 let readoff = ieee_readoff(&av)

@@ -4,70 +4,50 @@
 //! `gmwm::inference::same_model`); this module reads the files, checks that they can be pooled
 //! (one rate, one unit per sensor, the same columns) and renders.
 
-use crate::args::{FitArgs, FormatArg, HeaderArg, InputArgs, SelectArgs};
-use crate::config::{FitConfig, InputConfig, SelectConfig};
+use super::Command;
+use crate::config::{PooledFitConfig, PooledSelectConfig, SameModelConfig};
+use crate::input::InputConfig;
 use crate::input::{load, Loaded};
+use crate::prepare::Inputs;
+use crate::render::Style;
+use crate::style::OutputStyle;
 use anyhow::{bail, Context, Result};
-use clap::Args;
 use gmwm::fit::{FitError, Gmwm, PooledFit, Recording};
 use gmwm::inference::same_model::{compare_wvs, same_model_test_of, SameModelOptions};
 use gmwm::inference::ParameterInference;
-use gmwm::model::Model;
 use gmwm::{Weighting, WvOptions};
 use serde::Serialize;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-/// Examples of `gmwm same-model --help`.
-pub const EXAMPLES: &str = "\
-The recordings must share one sampling rate (within 1%), the units their sidecars state and
-the columns tested. The statistic T compares the pooled fit (one model for all) with the
-separate fits (one per recording), both with efficient weights; p_value is its chi-square
-tail with df = (K - 1) p, p_value_bootstrap the rank of T among B replicates simulated from
-the pooled fit (every recording at its own length). per_scale shows where they differ: the
-contributions sum to T; wv_max_abs_z is the largest model-free difference of two recordings'
-WVs at that scale over its standard error (flagged above the normal quantile).
+/// The pooled commands read their recordings themselves ([`read_pool`] refuses a stream as it
+/// comes to it), write no file before their results, and take no `--levels` context (as
+/// before).
+macro_rules! pooled_command {
+    ($config:ty, $run:ident) => {
+        impl Command for $config {
+            fn inputs(&mut self) -> Inputs<'_> {
+                Inputs::Pool
+            }
 
-Examples:
-  gmwm same-model a.csv b.csv c.csv --model \"AR1()+WN()+RW()\"
-  gmwm same-model imu1.csv.gz imu2.csv.gz --model \"2*GM()+WN()+RW()\" --columns gyro_x,accel_x --bootstrap 200 --json
-  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference      the pooled fit";
+            fn outputs(&self) -> Vec<&Path> {
+                Vec::new()
+            }
 
-/// `gmwm same-model`.
-#[derive(Debug, Args)]
-pub struct SameModelArgs {
-    /// Recordings (at least two), read as by `gmwm fit`.
-    #[arg(value_name = "FILE", required = true, num_args = 1..)]
-    pub files: Vec<PathBuf>,
-    /// The model of every recording (guess mode, or with starting values).
-    #[arg(long, value_name = "MODEL")]
-    pub model: String,
-    /// Columns to test, comma-separated names or 1-based indices [default: the sensor axes].
-    #[arg(long, value_name = "LIST", value_delimiter = ',')]
-    pub columns: Vec<String>,
-    /// Sampling rate in Hz of every file [default: from a time column or the JSON sidecar].
-    #[arg(long, value_name = "HZ")]
-    pub freq: Option<f64>,
-    /// Parametric-bootstrap replicates B of the p-value (none: the chi-square p-value only).
-    #[arg(long, value_name = "B")]
-    pub bootstrap: Option<usize>,
-    /// Number of wavelet-variance levels J of every recording [default: per recording].
-    #[arg(long, value_name = "J")]
-    pub levels: Option<usize>,
-    /// Number of starting-value draws of the separate fits.
-    #[arg(long = "G", value_name = "N")]
-    pub draws: Option<usize>,
-    /// Seed of the searches and of the bootstrap.
-    #[arg(long, value_name = "S", default_value_t = 1337)]
-    pub seed: u64,
-    /// Also draw every recording's WV with the pooled model's implied WV, one panel per
-    /// column, to FILE (.svg or .png).
-    #[arg(long, value_name = "FILE")]
-    pub plot: Option<PathBuf>,
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
+            fn levels(&self) -> Option<usize> {
+                None
+            }
+
+            fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+                $run(self, style, &mut out)
+            }
+        }
+    };
 }
+
+pooled_command!(PooledFitConfig, run_pooled_fit);
+pooled_command!(PooledSelectConfig, run_pooled_select);
+pooled_command!(SameModelConfig, run);
 
 /// One input of a pooled computation, as reported (`recordings[]`).
 #[derive(Debug, Clone, Serialize)]
@@ -100,6 +80,7 @@ fn read_pool(
     base: &InputConfig,
     wv: &WvOptions,
     weighting: Weighting,
+    style: OutputStyle,
 ) -> Result<Pool> {
     let mut loaded: Vec<Loaded> = Vec::with_capacity(files.len());
     for f in files {
@@ -114,7 +95,7 @@ fn read_pool(
             file: f.clone(),
             ..base.clone()
         };
-        loaded.push(load(&input)?);
+        loaded.push(load(&input, style)?);
     }
     let first = &loaded[0];
     let names: Vec<&str> = first
@@ -228,62 +209,45 @@ fn named(e: FitError, files: &[PathBuf], column: &str) -> anyhow::Error {
     }
 }
 
+/// A column's pooled fit with its inference and how it was made (`asymptotic`, `bootstrap`).
+type ColumnFit<'a> = (
+    &'a str,
+    PooledFit,
+    Option<(Vec<ParameterInference>, &'static str)>,
+);
+
 /// `gmwm fit FILE... --pool`: the pooled fit per column.
-pub fn run_pooled_fit(args: &FitArgs, out: &mut impl Write) -> Result<()> {
-    let config = FitConfig::try_from(args)?;
-    let mut files = vec![config.input.file.clone()];
-    files.extend(args.more.iter().cloned());
-    let pool = read_pool(&files, &config.input, &config.wv, config.gmwm.weighting())?;
-    #[derive(Serialize)]
-    struct Item<'a> {
-        column: &'a str,
-        #[serde(flatten)]
-        fit: &'a PooledFit,
-        inference: Option<Vec<ParameterInference>>,
-        inference_method: Option<&'static str>,
-    }
-    let mut items = Vec::new();
-    for (column, recs) in &pool.columns {
-        let fit = config
-            .gmwm
-            .fit_pooled(recs)
-            .map_err(|e| named(e, &pool.files, column))?;
-        if !fit.convergence().converged {
-            eprintln!(
-                "gmwm: warning: column {column}: the pooled fit did not converge ({})",
-                fit.convergence()
-            );
+fn run_pooled_fit(
+    pooled: &PooledFitConfig,
+    style: OutputStyle,
+    out: &mut impl Write,
+) -> Result<()> {
+    let config = &pooled.fit;
+    let pool = read_pool(
+        &pooled.files,
+        &config.input,
+        &config.wv,
+        config.gmwm.weighting(),
+        style,
+    )?;
+    let fits = pooled_fits(pooled, &pool)?;
+    if config.output == Style::Json {
+        #[derive(Serialize)]
+        struct Item<'a> {
+            column: &'a str,
+            #[serde(flatten)]
+            fit: &'a PooledFit,
+            inference: Option<Vec<ParameterInference>>,
+            inference_method: Option<&'static str>,
         }
-        items.push((column.as_str(), fit));
-    }
-    let mut infs = Vec::new();
-    for (column, fit) in &items {
-        let inf = match (&config.inference, args.bootstrap) {
-            (None, _) => None,
-            (Some(o), None) => Some((
-                fit.sandwich(o.alpha, args.seed)
-                    .map_err(|e| named(e, &pool.files, column))?
-                    .0,
-                "asymptotic",
-            )),
-            (Some(o), Some(b)) => Some((
-                fit.bootstrap_inference(&config.gmwm, b, args.seed, o.alpha)
-                    .map_err(|e| named(e, &pool.files, column))?,
-                "bootstrap",
-            )),
-        };
-        infs.push(inf);
-    }
-    if args.output.json {
         #[derive(Serialize)]
         struct Doc<'a> {
             recordings: &'a [RecordingInfo],
             fits: Vec<Item<'a>>,
         }
-        let fits = items
+        let fits = fits
             .iter()
-            .zip(&infs)
-            .map(|((column, fit), inf)| Item {
+            .map(|(column, fit, inf)| Item {
                 column,
                 fit,
                 inference: inf.as_ref().map(|i| i.0.clone()),
@@ -301,93 +265,141 @@ pub fn run_pooled_fit(args: &FitArgs, out: &mut impl Write) -> Result<()> {
         return Ok(());
     }
     write_recordings(&pool.info, out)?;
-    for ((column, fit), inf) in items.iter().zip(&infs) {
-        writeln!(out)?;
-        writeln!(
-            out,
-            "{column}: pooled fit of {} recordings: {}",
-            pool.info.len(),
-            fit.model()
-        )?;
-        writeln!(
-            out,
-            "  Q_pool = {:.6e} ({})",
-            fit.objective(),
-            fit.convergence()
-        )?;
-        writeln!(
-            out,
-            "  {:<20} {:>14} {:>12} {:>14} {:>14}",
-            "parameter", "estimate", "SE", "CI low", "CI high"
-        )?;
-        for (k, name) in fit.param_names().iter().enumerate() {
-            let q = inf.as_ref().map(|i| &i.0[k]);
-            let cell = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.6e}"));
-            writeln!(
-                out,
-                "  {:<20} {:>14.6e} {:>12} {:>14} {:>14}",
-                name,
-                fit.theta()[k],
-                cell(q.and_then(|q| q.se)),
-                cell(q.and_then(|q| q.ci_low)),
-                cell(q.and_then(|q| q.ci_high))
-            )?;
+    for fit in &fits {
+        write_pooled_fit(fit, &pool.info, out)?;
+    }
+    Ok(())
+}
+
+/// Every column's pooled fit (a convergence warning printed) and its inference, when asked.
+fn pooled_fits<'a>(pooled: &PooledFitConfig, pool: &'a Pool) -> Result<Vec<ColumnFit<'a>>> {
+    let (config, seed) = (&pooled.fit, pooled.seed);
+    let mut items = Vec::new();
+    for (column, recs) in &pool.columns {
+        let fit = config
+            .gmwm
+            .fit_pooled(recs)
+            .map_err(|e| named(e, &pool.files, column))?;
+        if !fit.convergence().converged {
+            eprintln!(
+                "gmwm: warning: column {column}: the pooled fit did not converge ({})",
+                fit.convergence()
+            );
         }
+        items.push((column.as_str(), fit));
+    }
+    let mut infs = Vec::new();
+    for (column, fit) in &items {
+        let inf = match config.inference.as_ref().map(|o| (o, o.bootstrap)) {
+            None => None,
+            Some((o, None)) => Some((
+                fit.sandwich(o.alpha, seed)
+                    .map_err(|e| named(e, &pool.files, column))?
+                    .0,
+                "asymptotic",
+            )),
+            Some((o, Some(b))) => Some((
+                fit.bootstrap_inference(&config.gmwm, b, seed, o.alpha)
+                    .map_err(|e| named(e, &pool.files, column))?,
+                "bootstrap",
+            )),
+        };
+        infs.push(inf);
+    }
+    Ok(items
+        .into_iter()
+        .zip(infs)
+        .map(|((column, fit), inf)| (column, fit, inf))
+        .collect())
+}
+
+/// One column's pooled fit as a table: the estimates with their intervals, then each
+/// recording's objective at the pooled estimate and its own fit.
+fn write_pooled_fit(
+    (column, fit, inf): &ColumnFit<'_>,
+    info: &[RecordingInfo],
+    out: &mut impl Write,
+) -> Result<()> {
+    writeln!(out)?;
+    writeln!(
+        out,
+        "{column}: pooled fit of {} recordings: {}",
+        info.len(),
+        fit.model()
+    )?;
+    writeln!(
+        out,
+        "  Q_pool = {:.6e} ({})",
+        fit.objective(),
+        fit.convergence()
+    )?;
+    writeln!(
+        out,
+        "  {:<20} {:>14} {:>12} {:>14} {:>14}",
+        "parameter", "estimate", "SE", "CI low", "CI high"
+    )?;
+    for (k, name) in fit.param_names().iter().enumerate() {
+        let q = inf.as_ref().map(|i| &i.0[k]);
+        let cell = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.6e}"));
         writeln!(
             out,
-            "  per recording: Q_k at the pooled estimate ({} weights), its own fast fit's Q_k and \
-             estimates",
-            if fit.reweighted() {
-                "model-variance"
-            } else {
-                "fast"
-            }
+            "  {:<20} {:>14.6e} {:>12} {:>14} {:>14}",
+            name,
+            fit.theta()[k],
+            cell(q.and_then(|q| q.se)),
+            cell(q.and_then(|q| q.ci_low)),
+            cell(q.and_then(|q| q.ci_high))
         )?;
-        for (r, info) in fit.recordings().iter().zip(&pool.info) {
-            let own: Vec<String> = r
-                .separate_theta
-                .iter()
-                .map(|v| format!("{v:.4e}"))
-                .collect();
-            writeln!(
-                out,
-                "  {:<40} {:>12.4e} {:>12.4e}  [{}]",
-                info.path,
-                r.objective,
-                r.separate_objective,
-                own.join(", ")
-            )?;
+    }
+    writeln!(
+        out,
+        "  per recording: Q_k at the pooled estimate ({} weights), its own fast fit's Q_k and \
+         estimates",
+        if fit.reweighted() {
+            "model-variance"
+        } else {
+            "fast"
         }
+    )?;
+    for (r, info) in fit.recordings().iter().zip(info) {
+        let own: Vec<String> = r
+            .separate_theta
+            .iter()
+            .map(|v| format!("{v:.4e}"))
+            .collect();
+        writeln!(
+            out,
+            "  {:<40} {:>12.4e} {:>12.4e}  [{}]",
+            info.path,
+            r.objective,
+            r.separate_objective,
+            own.join(", ")
+        )?;
     }
     Ok(())
 }
 
 /// `gmwm select FILE... --pool`: the nested candidates of --model ranked by the pooled WIC.
-pub fn run_pooled_select(args: &SelectArgs, out: &mut impl Write) -> Result<()> {
-    let config = SelectConfig::try_from(args)?;
-    let Some(text) = &args.model else {
-        return Err(crate::UsageError(
-            "--pool selects among the sub-models of --model; --candidates is not supported with \
-             --pool"
-                .into(),
-        )
-        .into());
-    };
-    let model: Model = text.parse()?;
-    let mut gmwm = Gmwm::new(model.without_values()).with_seed(args.seed);
-    if let Some(g) = args.draws {
-        gmwm = gmwm.with_draws(g.max(1));
-    }
-    let mut files = vec![config.input.file.clone()];
-    files.extend(args.more.iter().cloned());
-    let pool = read_pool(&files, &config.input, &config.wv, Weighting::Fast)?;
+fn run_pooled_select(
+    pooled: &PooledSelectConfig,
+    style: OutputStyle,
+    out: &mut impl Write,
+) -> Result<()> {
+    let config = &pooled.select;
+    let pool = read_pool(
+        &pooled.files,
+        &config.input,
+        &config.wv,
+        Weighting::Fast,
+        style,
+    )?;
     let mut rows = Vec::new();
     for (column, recs) in &pool.columns {
-        let s = gmwm::selection::select_pooled(&gmwm, recs, args.seed)
+        let s = gmwm::selection::select_pooled(&pooled.gmwm, recs, pooled.seed)
             .map_err(|e| named(e, &pool.files, column))?;
         rows.push((column.clone(), s));
     }
-    if args.output.json {
+    if config.output == Style::Json {
         #[derive(Serialize)]
         struct Sel<'a> {
             column: &'a str,
@@ -434,7 +446,11 @@ pub fn run_pooled_select(args: &SelectArgs, out: &mut impl Write) -> Result<()> 
             "#", "candidate", "Q_pool", "optimism", "WIC", "dWIC"
         )?;
         let best = s.candidates[0].wic;
-        let top = if args.top == 0 { usize::MAX } else { args.top };
+        let top = if config.top == 0 {
+            usize::MAX
+        } else {
+            config.top
+        };
         for (i, c) in s.candidates.iter().take(top).enumerate() {
             writeln!(
                 out,
@@ -500,129 +516,27 @@ struct TestRow {
 }
 
 /// `gmwm same-model`.
-pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
-    if args.files.len() < 2 {
-        bail!(
-            "{}: the same-model test needs at least two recordings (FILEs); got one",
-            args.files[0].display()
-        );
-    }
-    if let Some(b) = args.bootstrap {
-        if b < 1 {
-            return Err(crate::UsageError(format!(
-                "invalid --bootstrap {b}: at least 1 replicate"
-            ))
-            .into());
-        }
-    }
-    if let Some(f) = args.freq {
-        if !(f.is_finite() && f > 0.0) {
-            return Err(crate::UsageError(format!(
-                "invalid --freq {f}: must be a positive number of hertz"
-            ))
-            .into());
-        }
-    }
-    let model: Model = args.model.parse()?;
-    let mut gmwm = Gmwm::new(model).with_seed(args.seed);
-    if let Some(g) = args.draws {
-        gmwm = gmwm.with_draws(g.max(1));
-    }
-    let input_args = InputArgs {
-        file: args.files[0].clone(),
-        columns: args.columns.clone(),
-        freq: args.freq,
-        format: FormatArg::Auto,
-        ncols: None,
-        header: HeaderArg::Auto,
-        time_column: None,
-        time_unit: None,
-        topic: None,
-        stream_from: None,
-    };
-    let base = InputConfig::try_from(&input_args)?;
-    let wv = WvOptions {
-        levels: args.levels,
-        ..WvOptions::default()
-    };
-    let pool = read_pool(&args.files, &base, &wv, Weighting::Fast)?;
-    let opts = SameModelOptions {
-        bootstrap: args.bootstrap,
-        seed: args.seed,
-    };
+fn run(config: &SameModelConfig, style: OutputStyle, out: &mut impl Write) -> Result<()> {
+    let (gmwm, opts) = (&config.gmwm, &config.test);
+    let pool = read_pool(
+        &config.files,
+        &config.input,
+        &config.wv,
+        Weighting::Fast,
+        style,
+    )?;
     let mut tests = Vec::new();
     let mut fits = Vec::new();
     for (column, recs) in &pool.columns {
-        let pooled = gmwm
-            .fit_pooled(recs)
-            .map_err(|e| named(e, &pool.files, column))?;
-        let t =
-            same_model_test_of(&gmwm, &pooled, &opts).map_err(|e| named(e, &pool.files, column))?;
-        let mut cmp = Vec::new();
-        for a in 0..recs.len() {
-            for b in a + 1..recs.len() {
-                cmp.push(compare_wvs(recs[a].wv(), recs[b].wv())?);
-            }
-        }
-        let per_scale = t
-            .per_scale
-            .iter()
-            .map(|s| {
-                let at: Vec<&gmwm::inference::WvComparison> = cmp
-                    .iter()
-                    .filter_map(|c| c.get(s.level - 1))
-                    .filter(|c| c.z.is_finite())
-                    .collect();
-                ScaleRow {
-                    level: s.level,
-                    tau_s: s.tau_s,
-                    contribution: s.contribution,
-                    recordings: s.recordings,
-                    wv_max_abs_z: at.iter().map(|c| c.z.abs()).reduce(f64::max),
-                    wv_pairs_differing: at.iter().filter(|c| c.differs).count(),
-                }
-            })
-            .collect();
-        tests.push(TestRow {
-            column: column.clone(),
-            statistic: t.statistic,
-            df: t.df,
-            p_value: t.p_value,
-            p_value_bootstrap: t.p_value_bootstrap,
-            bootstrap_replicates: t.bootstrap_replicates,
-            restricted: t.restricted,
-            unrestricted: t.unrestricted,
-            per_scale,
-            per_recording: t.per_recording.clone(),
-            pooled_model: gmwm.model().with_values(&t.theta_restricted)?.to_string(),
-            pooled_theta: t.theta_restricted.clone(),
-            param_names: pooled.param_names().to_vec(),
-        });
+        let (test, pooled) = test_column(gmwm, opts, &pool.files, column, recs)?;
+        tests.push(test);
         fits.push((column.clone(), pooled));
     }
-    if let Some(path) = &args.plot {
-        let labels: Vec<String> = pool
-            .files
-            .iter()
-            .map(|f| {
-                f.file_name()
-                    .map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into())
-            })
-            .collect();
-        let columns: Vec<gmwm_plot::Column<'_, PooledFit>> = fits
-            .iter()
-            .map(|(name, fit)| {
-                let k = pool.columns.iter().position(|(c, _)| c == name);
-                let unit = k
-                    .and_then(|k| pool.units.get(k))
-                    .map_or("u", String::as_str);
-                gmwm_plot::Column::new(name, unit, fit)
-            })
-            .collect();
-        crate::render::save_figure(&gmwm_plot::pooled_figure(&columns, &labels), path)?;
-        eprintln!("gmwm: wrote {}", path.display());
+    if let Some(path) = &config.plot {
+        plot_pooled(&pool, &fits, path)?;
+        style.wrote(path);
     }
-    if args.json {
+    if config.json {
         #[derive(Serialize)]
         struct Doc<'a> {
             model: String,
@@ -642,40 +556,122 @@ pub fn run(args: &SameModelArgs, out: &mut impl Write) -> Result<()> {
     }
     write_recordings(&pool.info, out)?;
     for t in &tests {
-        writeln!(out)?;
-        let boot = t
-            .p_value_bootstrap
-            .map(|p| {
-                format!(
-                    ", bootstrap p = {p:.4} (B = {})",
-                    t.bootstrap_replicates.unwrap_or(0)
-                )
-            })
-            .unwrap_or_default();
-        writeln!(
-            out,
-            "{}: same model? T = {:.4}, df = {}, p = {:.4e}{boot}",
-            t.column, t.statistic, t.df, t.p_value
-        )?;
-        writeln!(out, "  pooled (efficient weights): {}", t.pooled_model)?;
-        writeln!(
-            out,
-            "  {:>5} {:>12} {:>14} {:>10} {:>8}",
-            "level", "tau (s)", "contribution", "max |z|", "pairs"
-        )?;
-        for s in &t.per_scale {
-            writeln!(
-                out,
-                "  {:>5} {:>12.4e} {:>14.4} {:>10} {:>8}",
-                s.level,
-                s.tau_s,
-                s.contribution,
-                s.wv_max_abs_z.map_or("-".into(), |z| format!("{z:.2}")),
-                s.wv_pairs_differing
-            )?;
-        }
-        let per: Vec<String> = t.per_recording.iter().map(|c| format!("{c:.3}")).collect();
-        writeln!(out, "  per recording: {}", per.join(", "))?;
+        write_test(t, out)?;
     }
+    Ok(())
+}
+
+/// One column's test: the pooled fit, the statistic and where the recordings differ.
+fn test_column(
+    gmwm: &Gmwm,
+    opts: &SameModelOptions,
+    files: &[PathBuf],
+    column: &str,
+    recs: &[Recording],
+) -> Result<(TestRow, PooledFit)> {
+    let pooled = gmwm.fit_pooled(recs).map_err(|e| named(e, files, column))?;
+    let t = same_model_test_of(gmwm, &pooled, opts).map_err(|e| named(e, files, column))?;
+    let mut cmp = Vec::new();
+    for a in 0..recs.len() {
+        for b in a + 1..recs.len() {
+            cmp.push(compare_wvs(recs[a].wv(), recs[b].wv())?);
+        }
+    }
+    let per_scale = t
+        .per_scale
+        .iter()
+        .map(|s| {
+            let at: Vec<&gmwm::inference::WvComparison> = cmp
+                .iter()
+                .filter_map(|c| c.get(s.level - 1))
+                .filter(|c| c.z.is_finite())
+                .collect();
+            ScaleRow {
+                level: s.level,
+                tau_s: s.tau_s,
+                contribution: s.contribution,
+                recordings: s.recordings,
+                wv_max_abs_z: at.iter().map(|c| c.z.abs()).reduce(f64::max),
+                wv_pairs_differing: at.iter().filter(|c| c.differs).count(),
+            }
+        })
+        .collect();
+    let test = TestRow {
+        column: column.to_string(),
+        statistic: t.statistic,
+        df: t.df,
+        p_value: t.p_value,
+        p_value_bootstrap: t.p_value_bootstrap,
+        bootstrap_replicates: t.bootstrap_replicates,
+        restricted: t.restricted,
+        unrestricted: t.unrestricted,
+        per_scale,
+        per_recording: t.per_recording.clone(),
+        pooled_model: gmwm.model().with_values(&t.theta_restricted)?.to_string(),
+        pooled_theta: t.theta_restricted.clone(),
+        param_names: pooled.param_names().to_vec(),
+    };
+    Ok((test, pooled))
+}
+
+/// Every recording's WV with the pooled model's implied WV, one panel per column, to `path`.
+fn plot_pooled(pool: &Pool, fits: &[(String, PooledFit)], path: &Path) -> Result<()> {
+    let labels: Vec<String> = pool
+        .files
+        .iter()
+        .map(|f| {
+            f.file_name()
+                .map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into())
+        })
+        .collect();
+    let columns: Vec<gmwm_plot::Column<'_, PooledFit>> = fits
+        .iter()
+        .map(|(name, fit)| {
+            let k = pool.columns.iter().position(|(c, _)| c == name);
+            let unit = k
+                .and_then(|k| pool.units.get(k))
+                .map_or("u", String::as_str);
+            gmwm_plot::Column::new(name, unit, fit)
+        })
+        .collect();
+    crate::render::save_figure(&gmwm_plot::pooled_figure(&columns, &labels), path)
+}
+
+/// One column's test as a table.
+fn write_test(t: &TestRow, out: &mut impl Write) -> Result<()> {
+    writeln!(out)?;
+    let boot = t
+        .p_value_bootstrap
+        .map(|p| {
+            format!(
+                ", bootstrap p = {p:.4} (B = {})",
+                t.bootstrap_replicates.unwrap_or(0)
+            )
+        })
+        .unwrap_or_default();
+    writeln!(
+        out,
+        "{}: same model? T = {:.4}, df = {}, p = {:.4e}{boot}",
+        t.column, t.statistic, t.df, t.p_value
+    )?;
+    writeln!(out, "  pooled (efficient weights): {}", t.pooled_model)?;
+    writeln!(
+        out,
+        "  {:>5} {:>12} {:>14} {:>10} {:>8}",
+        "level", "tau (s)", "contribution", "max |z|", "pairs"
+    )?;
+    for s in &t.per_scale {
+        writeln!(
+            out,
+            "  {:>5} {:>12.4e} {:>14.4} {:>10} {:>8}",
+            s.level,
+            s.tau_s,
+            s.contribution,
+            s.wv_max_abs_z.map_or("-".into(), |z| format!("{z:.2}")),
+            s.wv_pairs_differing
+        )?;
+    }
+    let per: Vec<String> = t.per_recording.iter().map(|c| format!("{c:.3}")).collect();
+    writeln!(out, "  per recording: {}", per.join(", "))?;
     Ok(())
 }

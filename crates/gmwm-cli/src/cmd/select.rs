@@ -1,15 +1,18 @@
 //! `gmwm select`: model selection by the Wavelet Information Criterion on each selected column
 //! (docs/methods.md §8), the candidates folded by canonical model.
 
+use super::Command;
 use crate::config::SelectConfig;
 use crate::input::{analyse_columns, column_context, is_wv, load, load_wv};
-use crate::progress::{bar, Ticks};
+use crate::prepare::Inputs;
 use crate::render::Style;
+use crate::style::{OutputStyle, Ticks};
 use anyhow::Result;
 use gmwm::model::Model;
 use gmwm::selection::RowStatus;
 use gmwm::ModelSelection;
 use std::io::Write;
+use std::path::Path;
 
 /// CSV: one line per row of each column's table.
 const CSV_HEADER: &str = "column,rank,canonical_model,candidate,members,objective,optimism,wic,\
@@ -46,21 +49,34 @@ fn write_csv(results: &[(String, ModelSelection)], out: &mut impl Write) -> Resu
     Ok(())
 }
 
-/// Runs the subcommand.
-pub fn run(config: &SelectConfig, out: &mut impl Write) -> Result<()> {
-    let results = compute(config)?;
-    render_selections(config, &results, out)
+impl Command for SelectConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Recording(&mut self.input)
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        self.wv.levels
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        let results = compute(self, style)?;
+        render_selections(self, &results, &mut out)
+    }
 }
 
 /// The WIC selection on every selected column (convergence warnings printed).
-pub fn compute(config: &SelectConfig) -> Result<Vec<(String, ModelSelection)>> {
+pub fn compute(config: &SelectConfig, style: OutputStyle) -> Result<Vec<(String, ModelSelection)>> {
     let wic = &config.wic;
     let file = &config.input.file;
     let results: Result<Vec<(String, ModelSelection)>> = if is_wv(&config.input) {
         // a saved wavelet variance: selected as it is, the bootstrap V simulated at its n
         config.saved_wv.check(file)?;
         let series = load_wv(&config.input, config.wv.levels)?;
-        let progress = bar(
+        let progress = style.bar(
             (series.len() * wic.candidates().len()) as u64,
             "WIC selection",
             "candidates",
@@ -78,9 +94,9 @@ pub fn compute(config: &SelectConfig) -> Result<Vec<(String, ModelSelection)>> {
         progress.finish_and_clear();
         results
     } else {
-        let loaded = load(&config.input)?;
+        let loaded = load(&config.input, style)?;
         let columns = loaded.table.columns.len();
-        let progress = bar(
+        let progress = style.bar(
             (columns * wic.candidates().len()) as u64,
             "WIC selection",
             "candidates",

@@ -1,7 +1,10 @@
 //! `gmwm simulate`: seeded simulation of a fully specified model, streamed to CSV on stdout or
 //! to a file in the format of its name (CSV, TSV, gzip, raw f64/f32) with a sidecar.
 
+use super::Command;
 use crate::config::SimulateConfig;
+use crate::prepare::Inputs;
+use crate::style::OutputStyle;
 use anyhow::{Context, Result};
 use gmwm::imu::write::{write_csv_header, write_csv_rows, write_sidecar};
 use gmwm::imu::{OutputFormat, SeriesWriter, Sidecar, SidecarColumn};
@@ -110,7 +113,7 @@ fn size_check(config: &SimulateConfig, ncols: usize, free: Option<u64>) -> Resul
         if ncols == 1 { "" } else { "s" }
     );
     if config.n > CONFIRM_SAMPLES {
-        return Err(crate::UsageError(format!(
+        return Err(crate::error::UsageError(format!(
             "--n {}: gmwm simulate would write {what} to {target}, more than {CONFIRM_SAMPLES} \
              samples; give --yes to write it",
             config.n
@@ -120,7 +123,7 @@ fn size_check(config: &SimulateConfig, ncols: usize, free: Option<u64>) -> Resul
     if let Some(p) = &config.output {
         if let Some(free) = free {
             if size > free && !gz {
-                return Err(crate::UsageError(format!(
+                return Err(crate::error::UsageError(format!(
                     "{}: gmwm simulate would write {what}, and its file system has {} free; \
                      give --yes to write it anyway",
                     p.display(),
@@ -216,6 +219,25 @@ fn csv_quote(s: &str) -> String {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
+    }
+}
+
+impl Command for SimulateConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::None
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        // -o: refused by the writer when it cannot be created, naming it (as before)
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        None
+    }
+
+    fn run(&self, _: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        run(self, &mut out)
     }
 }
 

@@ -1,6 +1,9 @@
 //! `gmwm topics`: the topics of a ROS recording, with the IMU topics marked.
 
+use super::Command;
 use crate::config::TopicsConfig;
+use crate::prepare::Inputs;
+use crate::style::OutputStyle;
 use anyhow::Result;
 use gmwm::imu::ros::{choose_topic, list_topics, RosContainer, TopicInfo};
 use serde::Serialize;
@@ -105,4 +108,22 @@ fn table(
         writeln!(out, "note: {reason}")?;
     }
     Ok(())
+}
+
+impl Command for TopicsConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::RosFile(&mut self.file)
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        None
+    }
+
+    fn run(&self, _: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        run(self, &mut out)
+    }
 }

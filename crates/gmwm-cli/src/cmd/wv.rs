@@ -1,13 +1,18 @@
 //! `gmwm wv`: wavelet variance of each selected column.
 
-use crate::config::{InputConfig, WvConfig};
-use crate::input::{analyse_columns, is_wv, load, load_wv, named, note};
+use super::Command;
+use crate::config::WvConfig;
+use crate::input::InputConfig;
+use crate::input::{analyse_columns, is_wv, load, load_wv, named};
+use crate::prepare::Inputs;
 use crate::render;
+use crate::style::OutputStyle;
 use anyhow::Result;
 use gmwm::imu::{binary_layout, BinaryLayout};
 use gmwm::variance::{binary_columns_wv, StreamedColumn};
 use gmwm::{wavelet_variance, Transform, WaveletFilter, WaveletVariance, WvOptions};
 use std::io::Write;
+use std::path::Path;
 
 /// Raw binary input (from `--format`, the name or the sidecar) with the classical Haar MODWT
 /// estimator and no time column streams ([`gmwm::variance::binary_wavelet_variance`]): the
@@ -34,8 +39,9 @@ fn run_streaming(
     input: &InputConfig,
     layout: &BinaryLayout,
     opts: &WvOptions,
+    style: OutputStyle,
 ) -> Result<Vec<(String, WaveletVariance)>> {
-    let columns = stream_columns(input, layout, opts)?;
+    let columns = stream_columns(input, layout, opts, style)?;
     Ok(columns.into_iter().map(|(name, c)| (name, c.wv)).collect())
 }
 
@@ -45,10 +51,11 @@ pub(crate) fn stream_columns(
     input: &InputConfig,
     layout: &BinaryLayout,
     opts: &WvOptions,
+    style: OutputStyle,
 ) -> Result<Vec<(String, StreamedColumn)>> {
     let sidecar = gmwm::imu::find_sidecar(&input.file)?;
     let (columns, skipped) = layout.selection(&input.file, &input.read, sidecar.as_ref())?;
-    crate::input::note_not_analysed(&input.file, &skipped);
+    crate::input::note_not_analysed(style, &input.file, &skipped);
     let freq_hz = match input.read.freq_hz {
         Some(f) => f,
         None => stream_freq(&input.file)?,
@@ -66,7 +73,7 @@ pub(crate) fn stream_columns(
             "row",
             first.wv.n() as u64,
         );
-        note(&input.file, &account.to_string());
+        style.note(&input.file, &account.to_string());
     }
     Ok(named)
 }
@@ -76,7 +83,7 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
     Ok(match sidecar.and_then(|s| s.sampling_frequency_hz) {
         Some(f) => f,
         None if crate::spool::is_stdin(path) => {
-            return Err(crate::UsageError(format!(
+            return Err(crate::error::UsageError(format!(
                 "{}: no sampling rate: raw binary on standard input has no JSON sidecar; give \
                  --freq",
                 crate::spool::STDIN
@@ -117,6 +124,7 @@ pub(crate) fn streams_text(input: &InputConfig, opts: &WvOptions) -> Result<bool
 fn run_streamed_table(
     input: &InputConfig,
     opts: &WvOptions,
+    style: OutputStyle,
 ) -> Result<Vec<(String, WaveletVariance)>> {
     let table = gmwm::imu::read::stream::StreamedTable::open_recording(
         &input.file,
@@ -128,6 +136,7 @@ fn run_streamed_table(
     if table.topic.is_none() {
         // a ROS topic's notes say all of it, as the in-memory path prints them
         crate::input::report_parts(
+            style,
             &table.path,
             table.timing.as_ref(),
             &table.skipped,
@@ -136,7 +145,7 @@ fn run_streamed_table(
         );
     }
     for n in &table.notes {
-        note(&input.file, n);
+        style.note(&input.file, n);
     }
     let freq_hz = match table.freq_hz {
         Some(f) => f,
@@ -153,7 +162,7 @@ fn run_streamed_table(
 }
 
 /// A saved wavelet variance as it is (no recomputation).
-fn run_saved(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
+fn run_saved(config: &WvConfig, style: OutputStyle) -> Result<Vec<(String, WaveletVariance)>> {
     let file = &config.input.file;
     config.saved_wv.check(file)?;
     let alpha = config.wv.alpha;
@@ -171,33 +180,46 @@ fn run_saved(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
             wv.alpha()
         );
     }
-    note(
+    style.note(
         file,
         "a wavelet variance saved by gmwm wv --json: shown as read, not recomputed",
     );
     Ok(series)
 }
 
-/// Runs the subcommand.
-pub fn run(config: &WvConfig, out: &mut impl Write) -> Result<()> {
-    let items = compute(config)?;
-    render::series(out, &named(&items), config.output)
+impl Command for WvConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Recording(&mut self.input)
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        self.wv.levels
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        let items = compute(self, style)?;
+        render::series(&mut out, &named(&items), self.output)
+    }
 }
 
 /// The wavelet variance of every selected column: read from a saved WV, streamed from raw
 /// binary, or computed from the loaded columns (warnings printed).
-pub fn compute(config: &WvConfig) -> Result<Vec<(String, WaveletVariance)>> {
+pub fn compute(config: &WvConfig, style: OutputStyle) -> Result<Vec<(String, WaveletVariance)>> {
     let (input, opts) = (&config.input, &config.wv);
     if is_wv(input) {
-        return run_saved(config);
+        return run_saved(config, style);
     }
     if let Some(layout) = streamable(input, opts)? {
-        return run_streaming(input, &layout, opts);
+        return run_streaming(input, &layout, opts, style);
     }
     if streams_text(input, opts)? {
-        return run_streamed_table(input, opts);
+        return run_streamed_table(input, opts, style);
     }
-    let loaded = load(input)?;
+    let loaded = load(input, style)?;
     let items = analyse_columns(&loaded, &input.file, |x| {
         Ok(wavelet_variance(x, loaded.freq_hz, opts)?)
     })?;

@@ -22,6 +22,12 @@ pub enum AxisPolicy {
     PerAxis,
 }
 
+crate::names::named_values!(AxisPolicy, "axis policy", {
+    Worst => "worst",
+    Mean => "mean",
+    PerAxis => "per-axis",
+}, derive(Display));
+
 impl FromStr for AxisPolicy {
     type Err = ParamError;
 

@@ -30,6 +30,12 @@ pub enum Weighting {
     Bootstrap,
 }
 
+crate::names::named_values!(Weighting, "weights", {
+    Fast => "fast",
+    Diag => "diag",
+    Bootstrap => "bootstrap",
+}, derive(FromStr, Display));
+
 /// Diagonal weights `omega_j = 1 / V_jj` (docs/methods.md §5.2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Weights {

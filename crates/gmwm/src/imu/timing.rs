@@ -125,6 +125,16 @@ impl FromStr for TimeUnit {
     }
 }
 
+impl crate::names::Named for TimeUnit {
+    const WHAT: &'static str = "time unit";
+    const VALUES: &'static [Self] = &TimeUnit::ALL;
+
+    /// The symbol (`s`, `ms`, `us`, `ns`); [`FromStr`] also reads the longer words.
+    fn name(self) -> &'static str {
+        self.symbol()
+    }
+}
+
 /// Where the unit of a time column came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]

@@ -33,7 +33,6 @@
 use crate::fit::FitError;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
-use std::fmt;
 
 /// How the optimism is estimated (docs/methods.md §8.2, §8.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -47,14 +46,10 @@ pub enum OptimismMethod {
     Bootstrap,
 }
 
-impl fmt::Display for OptimismMethod {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::Asymptotic => "asymptotic",
-            Self::Bootstrap => "bootstrap",
-        })
-    }
-}
+crate::names::named_values!(OptimismMethod, "optimism", {
+    Asymptotic => "asymptotic",
+    Bootstrap => "bootstrap",
+}, derive(FromStr, Display));
 
 /// Which asymptotic formula (docs/methods.md §8.2, §13.15).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -67,6 +62,11 @@ pub enum OptimismConvention {
     /// The package's `-((D - B)'(D - B))^+ (D - B)' A' Omega` and `tr(A dTheta Omega V)`.
     Package,
 }
+
+crate::names::named_values!(OptimismConvention, "convention", {
+    Corrected => "corrected",
+    Package => "package",
+}, derive(FromStr, Display));
 
 /// docs/methods.md §8.2, §4.6: `D_kl = sum_j H_jkl [Omega (nu2(theta_hat) - nu2_hat)]_j`, from the
 /// model Hessian `hessian[level][k][l]` ([`Model::hessian`](crate::model::Model::hessian)), the

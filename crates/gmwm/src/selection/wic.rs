@@ -78,15 +78,11 @@ pub enum SelectionRule {
     Navigation,
 }
 
-impl fmt::Display for SelectionRule {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            SelectionRule::WicMinimum => "wic-minimum",
-            SelectionRule::Parsimonious => "parsimonious",
-            SelectionRule::Navigation => "navigation",
-        })
-    }
-}
+crate::names::named_values!(SelectionRule, "rule", {
+    Navigation => "navigation",
+    Parsimonious => "parsimonious",
+    WicMinimum => "wic-minimum",
+}, derive(FromStr, Display));
 
 impl Wic {
     fn with_candidates(full: Model, candidates: Vec<Model>) -> Self {

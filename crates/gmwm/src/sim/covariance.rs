@@ -36,14 +36,16 @@ pub enum CovarianceMethod {
     Bootstrap,
 }
 
+crate::names::named_values!(CovarianceMethod, "covariance", {
+    Auto => "auto",
+    Exact => "exact",
+    Bootstrap => "bootstrap",
+}, derive(FromStr, Display));
+
 impl CovarianceMethod {
     /// Lower-case name, as on the command line and in JSON.
     pub fn name(&self) -> &'static str {
-        match self {
-            CovarianceMethod::Auto => "auto",
-            CovarianceMethod::Exact => "exact",
-            CovarianceMethod::Bootstrap => "bootstrap",
-        }
+        crate::names::Named::name(*self)
     }
 }
 

@@ -106,6 +106,15 @@ impl AllanKind {
     }
 }
 
+impl crate::names::Named for AllanKind {
+    const WHAT: &'static str = "kind";
+    const VALUES: &'static [Self] = &AllanKind::ALL;
+
+    fn name(self) -> &'static str {
+        AllanKind::name(self)
+    }
+}
+
 impl fmt::Display for AllanKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -150,6 +159,15 @@ impl AvConvention {
             AvConvention::Textbook => "textbook",
             AvConvention::Package => "package",
         }
+    }
+}
+
+impl crate::names::Named for AvConvention {
+    const WHAT: &'static str = "convention";
+    const VALUES: &'static [Self] = &[AvConvention::Textbook, AvConvention::Package];
+
+    fn name(self) -> &'static str {
+        AvConvention::name(self)
     }
 }
 

@@ -19,7 +19,6 @@ use crate::error::{InputError, ParamError, SeriesError};
 use crate::math::brent::{find_root, minimize, OPTIMIZE_TOL};
 use crate::math::sum::NeumaierSum;
 use serde::{Deserialize, Serialize};
-use std::fmt;
 use std::str::FromStr;
 
 /// Which tuning constant and solver to use (docs/methods.md §2.3–§2.4).
@@ -33,15 +32,11 @@ pub enum RobustConvention {
     Package,
 }
 
-impl fmt::Display for RobustConvention {
-    /// `exact` or `package` (docs/methods.md §2.3–§2.4), the spelling [`FromStr`] accepts.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            RobustConvention::Exact => "exact",
-            RobustConvention::Package => "package",
-        })
-    }
-}
+// `exact` or `package` (docs/methods.md §2.3–§2.4), the spelling `FromStr` accepts
+crate::names::named_values!(RobustConvention, "robust-convention", {
+    Exact => "exact",
+    Package => "package",
+}, derive(Display));
 
 impl FromStr for RobustConvention {
     type Err = ParamError;

@@ -60,6 +60,15 @@ impl Transform {
     }
 }
 
+impl crate::names::Named for Transform {
+    const WHAT: &'static str = "transform";
+    const VALUES: &'static [Self] = &[Transform::Modwt, Transform::Dwt];
+
+    fn name(self) -> &'static str {
+        Transform::name(&self)
+    }
+}
+
 impl fmt::Display for Transform {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.pad(self.name())

@@ -122,19 +122,19 @@ impl FromStr for InputFormat {
     }
 }
 
-impl fmt::Display for InputFormat {
-    /// The name [`InputFormat::from_str`] reads back (`f64`, `ln200`, `navchip-int`, ...).
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Auto => f.write_str("auto"),
-            Self::Csv => f.write_str("csv"),
-            Self::Tsv => f.write_str("tsv"),
-            Self::F64 => f.write_str("f64"),
-            Self::F32 => f.write_str("f32"),
-            Self::ImuRecord(t) => f.write_str(&t.name().to_ascii_lowercase().replace('_', "-")),
-        }
-    }
-}
+crate::names::named_values!(InputFormat, "format", {
+    Auto => "auto",
+    Csv => "csv",
+    Tsv => "tsv",
+    ImuRecord(ImuRecordType::Imar) => "imar",
+    ImuRecord(ImuRecordType::Ln200) => "ln200",
+    ImuRecord(ImuRecordType::Ln200Ig) => "ln200ig",
+    ImuRecord(ImuRecordType::Ixsea) => "ixsea",
+    ImuRecord(ImuRecordType::NavchipInt) => "navchip-int",
+    ImuRecord(ImuRecordType::NavchipFlt) => "navchip-flt",
+    F64 => "f64",
+    F32 => "f32",
+}, derive(Display));
 
 impl InputFormat {
     /// Bytes per value of a raw binary format, `None` for text formats and IMU records.
@@ -246,6 +246,12 @@ pub enum HeaderMode {
     /// There is no header; columns are named `col1`, `col2`, ...
     Absent,
 }
+
+crate::names::named_values!(HeaderMode, "header", {
+    Auto => "auto",
+    Present => "yes",
+    Absent => "no",
+}, derive(FromStr, Display));
 
 /// Options of [`read_table`]. The default reads every column of any supported file.
 #[derive(Debug, Clone, PartialEq, Default)]

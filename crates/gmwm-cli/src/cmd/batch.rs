@@ -9,12 +9,15 @@
 //! a later run would take as up to date. A failure is reported by name with the one-line
 //! message a single run prints, after all the others completed; the exit code is then 1.
 
-use crate::cmd::calibrate::{execute_in, per_axis_path, Calibrated, Mode};
-use crate::config::{is_glob, is_rosbag2_folder, BatchConfig, BatchJob, CalibrateConfig, WvConfig};
+use super::calibrate::{execute_in, per_axis_path, Calibrated, Mode};
+use super::Command;
+use crate::config::{BatchConfig, BatchJob, CalibrateConfig, WvConfig};
+use crate::error::UsageError;
+use crate::prepare::{warn_implausible, Inputs};
+use crate::recordings::{expand, key, sidecar_of, Found};
 use crate::render::Style;
-use crate::UsageError;
+use crate::style::OutputStyle;
 use anyhow::{Context, Result};
-use gmwm::imu::InputFormat;
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -27,14 +30,6 @@ const DATA_EXTENSIONS: &[&str] = &[
     "gz", "csv", "tsv", "txt", "dat", "bin", "raw", "f64", "f32", "f64le", "f32le", "bag", "mcap",
     "db3",
 ];
-
-/// Extensions of files a folder or glob contributes as recordings, whatever else they hold.
-const RECORDING_EXTENSIONS: &[&str] = &[
-    "csv", "tsv", "txt", "bag", "mcap", "db3", "f64", "f32", "f64le", "f32le",
-];
-
-/// Raw binary extensions: a recording when a JSON sidecar (or `--format`) says how to read it.
-const RAW_EXTENSIONS: &[&str] = &["bin", "dat", "raw"];
 
 /// The stem of a recording: its file (or rosbag2 folder) name without its data extensions,
 /// stripped from the right (`imu1.csv.gz` → `imu1`, `log.f64le.bin` → `log`, `run` → `run`).
@@ -51,129 +46,6 @@ pub fn stem(path: &Path) -> String {
         stem = head;
     }
     stem.to_string()
-}
-
-/// Whether a folder entry (or glob match) is a recording gmwm reads: by its name (see
-/// [`RECORDING_EXTENSIONS`], also `.gz` text; raw `.bin`/`.dat`/`.raw` with a sidecar or an
-/// explicit `--format`), or a rosbag2 folder. Hidden files, sidecars and other JSON (gmwm's own
-/// `.calibration.json` and `.wv.json` among them) are not.
-fn is_recording(path: &Path, format: InputFormat) -> bool {
-    let Some(name) = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_ascii_lowercase())
-    else {
-        return false;
-    };
-    if name.starts_with('.') {
-        return false;
-    }
-    if path.is_dir() {
-        return is_rosbag2_folder(path);
-    }
-    let ext = |n: &str| n.rsplit_once('.').map(|(_, e)| e.to_string());
-    if let Some(text) = name.strip_suffix(".gz") {
-        return ext(text).is_some_and(|e| ["csv", "tsv", "txt"].contains(&e.as_str()));
-    }
-    match ext(&name) {
-        Some(e) if RECORDING_EXTENSIONS.contains(&e.as_str()) => true,
-        Some(e) if RAW_EXTENSIONS.contains(&e.as_str()) => {
-            format != InputFormat::Auto || sidecar_of(path).is_some()
-        }
-        _ => false,
-    }
-}
-
-/// The JSON sidecar a reader would use for `path`, if one exists.
-fn sidecar_of(path: &Path) -> Option<PathBuf> {
-    gmwm::imu::sidecar::sidecar_candidates(path)
-        .into_iter()
-        .find(|p| p.is_file())
-}
-
-/// A recording to run, and whether it was named on the command line (else a folder or a glob
-/// found it).
-#[derive(Debug, Clone)]
-struct Found {
-    path: PathBuf,
-    named: bool,
-}
-
-/// The recordings of a folder (not recursing), sorted by name.
-fn scan_folder(dir: &Path, format: InputFormat) -> Result<Vec<PathBuf>> {
-    let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
-        .with_context(|| format!("cannot read folder {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| is_recording(p, format))
-        .collect();
-    found.sort();
-    anyhow::ensure!(
-        !found.is_empty(),
-        "{}: no recording in this folder (.csv, .tsv, .txt, .gz, .bag, .mcap, .db3, .f64, .f32, \
-         raw binary with a sidecar, rosbag2 folders)",
-        dir.display()
-    );
-    Ok(found)
-}
-
-/// The recordings among a glob's matches, sorted.
-fn expand_glob(pattern: &Path, format: InputFormat) -> Result<Vec<PathBuf>> {
-    let text = pattern.to_string_lossy();
-    let paths = glob::glob(&text)
-        .map_err(|e| UsageError(format!("invalid glob {text:?}: {e}")))?
-        .filter_map(|p| p.ok())
-        .filter(|p| is_recording(p, format));
-    let mut found: Vec<PathBuf> = paths.collect();
-    found.sort();
-    anyhow::ensure!(!found.is_empty(), "no recording matches {text:?}");
-    Ok(found)
-}
-
-/// A path to compare outputs and inputs by: the canonical folder and the file name.
-fn key(path: &Path) -> PathBuf {
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let folder = parent
-        .canonicalize()
-        .or_else(|_| std::path::absolute(parent))
-        .unwrap_or_else(|_| parent.to_path_buf());
-    match path.file_name() {
-        Some(name) => folder.join(name),
-        None => folder,
-    }
-}
-
-/// Every FILE argument expanded: a named file (or rosbag2 folder) as it is, a folder into its
-/// recordings, a glob into the recordings among its matches; the same recording once.
-fn expand(inputs: &[PathBuf], format: InputFormat) -> Result<Vec<Found>> {
-    let mut out: Vec<Found> = Vec::new();
-    let mut seen = std::collections::HashSet::new();
-    for input in inputs {
-        let (paths, named) = if is_glob(input) {
-            (expand_glob(input, format)?, false)
-        } else if input.is_dir() && !is_rosbag2_folder(input) {
-            (scan_folder(input, format)?, false)
-        } else {
-            (vec![input.clone()], true)
-        };
-        for path in paths {
-            // by folder and name: two links to one file are two recordings with two stems
-            if seen.insert(key(&path)) {
-                out.push(Found { path, named });
-            }
-        }
-    }
-    Ok(out)
-}
-
-/// The recordings that the FILE arguments `inputs` name, expanded as in batch mode (folders,
-/// globs), in order, each once: the inputs of `calibrate --pool`.
-pub fn recordings(inputs: &[PathBuf], format: InputFormat) -> Result<Vec<PathBuf>> {
-    Ok(expand(inputs, format)?
-        .into_iter()
-        .map(|f| f.path)
-        .collect())
 }
 
 /// One recording of the batch and where its outputs go.
@@ -343,6 +215,7 @@ fn calibrate_one(
     config: &CalibrateConfig,
     p: &Planned,
     force: bool,
+    style: OutputStyle,
 ) -> Result<(Status, Vec<PathBuf>, Detail)> {
     let json = p.output("calibration.json");
     let report = config
@@ -389,12 +262,12 @@ fn calibrate_one(
     let mut one = config.clone();
     one.input.file = p.recording.clone();
     // the single-file command's warning on raw floats no sensor gives, per recording
-    crate::warn_implausible(&one.input);
+    warn_implausible(&one.input);
     one.exports = exports;
     one.json = Some(json);
     let mode = Mode {
         print_summary: false,
-        batch: true,
+        style,
     };
     let Calibrated {
         axes,
@@ -421,7 +294,12 @@ fn wv_detail(doc: &serde_json::Value) -> Option<Detail> {
 }
 
 /// The wavelet variance of one recording of the batch, or `Ok` of an up-to-date one.
-fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<PathBuf>, Detail)> {
+fn wv_one(
+    config: &WvConfig,
+    p: &Planned,
+    force: bool,
+    style: OutputStyle,
+) -> Result<(Status, Vec<PathBuf>, Detail)> {
     let out = p.output("wv.json");
     let outputs = vec![out.clone()];
     if !force && all_newer(&outputs, input_time(&p.recording)) {
@@ -431,9 +309,9 @@ fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<Pa
     }
     let mut one = config.clone();
     one.input.file = p.recording.clone();
-    crate::warn_implausible(&one.input);
+    warn_implausible(&one.input);
     one.output = Style::Json;
-    let items = crate::cmd::wv::compute(&one)?;
+    let items = super::wv::compute(&one, style)?;
     let mut doc = Vec::new();
     crate::render::series(&mut doc, &crate::input::named(&items), Style::Json)?;
     crate::output::write(&out, &doc)?;
@@ -445,10 +323,11 @@ fn wv_one(config: &WvConfig, p: &Planned, force: bool) -> Result<(Status, Vec<Pa
 }
 
 /// Runs one recording; a failure (or a panic) becomes its outcome, never the batch's.
-fn run_one(config: &BatchConfig, p: &Planned) -> Outcome {
+/// `style` has no progress bar: the batch's is the one.
+fn run_one(config: &BatchConfig, p: &Planned, style: OutputStyle) -> Outcome {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match &config.job {
-        BatchJob::Calibrate { config: c, .. } => calibrate_one(c, p, config.force),
-        BatchJob::Wv { config: c, .. } => wv_one(c, p, config.force),
+        BatchJob::Calibrate { config: c, .. } => calibrate_one(c, p, config.force, style),
+        BatchJob::Wv { config: c, .. } => wv_one(c, p, config.force, style),
     }))
     .unwrap_or_else(|payload| {
         Err(anyhow::anyhow!(
@@ -468,7 +347,7 @@ fn run_one(config: &BatchConfig, p: &Planned) -> Outcome {
             file: p.recording.clone(),
             status: Status::Failed,
             outputs: Vec::new(),
-            error: Some(crate::one_line(&e)),
+            error: Some(crate::error::one_line(&e)),
             detail: Detail::default(),
         },
     }
@@ -499,10 +378,34 @@ fn words(job: &BatchJob) -> Words {
     }
 }
 
+impl Command for BatchConfig {
+    fn inputs(&mut self) -> Inputs<'_> {
+        Inputs::Files {
+            paths: &self.inputs,
+            refusal: "batch mode (several FILEs, a folder, --out-dir, --force) reads files; \
+                      give standard input or a pipe alone, without --out-dir/--force",
+        }
+    }
+
+    fn outputs(&self) -> Vec<&Path> {
+        // each recording's, planned once the inputs are expanded (see `plan`)
+        Vec::new()
+    }
+
+    fn levels(&self) -> Option<usize> {
+        // each recording's error is its row of the summary
+        None
+    }
+
+    fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        run(self, style, &mut out)
+    }
+}
+
 /// Runs the batch: expands the inputs, runs every recording in parallel (workers pull the
 /// next recording; each one's own computation is parallel on the shared rayon pool), prints
 /// the summary; an error naming the failed recordings when any failed.
-pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
+fn run(config: &BatchConfig, style: OutputStyle, out: &mut impl Write) -> Result<()> {
     let format = match &config.job {
         BatchJob::Calibrate { config, .. } => config.input.read.format,
         BatchJob::Wv { config, .. } => config.input.read.format,
@@ -513,7 +416,7 @@ pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
             .with_context(|| format!("cannot create --out-dir {}", dir.display()))?;
     }
     let w = words(&config.job);
-    let progress = crate::progress::bar(planned.len() as u64, w.verb, "recordings");
+    let progress = style.bar(planned.len() as u64, w.verb, "recordings");
     let outcomes: Vec<Mutex<Option<Outcome>>> = planned.iter().map(|_| Mutex::new(None)).collect();
     let next = AtomicUsize::new(0);
     // workers that are not rayon threads: a rayon worker waiting inside a calibration would
@@ -526,7 +429,7 @@ pub fn run(config: &BatchConfig, out: &mut impl Write) -> Result<()> {
                 let Some(p) = planned.get(i) else {
                     break;
                 };
-                let outcome = run_one(config, p);
+                let outcome = run_one(config, p, style.without_progress());
                 if let Some(e) = &outcome.error {
                     let file = p.recording.display().to_string();
                     progress.suspend(|| {
@@ -718,41 +621,5 @@ mod tests {
         ] {
             assert_eq!(stem(Path::new(name)), s, "{name}");
         }
-    }
-
-    #[test]
-    fn recordings_are_chosen_by_name() {
-        let dir = tempfile::tempdir().unwrap();
-        let touch = |n: &str| {
-            let p = dir.path().join(n);
-            std::fs::write(&p, b"").unwrap();
-            p
-        };
-        for (name, yes) in [
-            ("a.csv", true),
-            ("a.csv.gz", true),
-            ("a.txt", true),
-            ("a.bag", true),
-            ("a.f64", true),
-            ("a.json", false),
-            ("a.csv.json", false),
-            ("a.calibration.json", false),
-            ("a.report.html", false),
-            ("a.yaml", false),
-            ("a.gz", false),
-            (".a.csv", false),
-            ("raw.bin", false),
-        ] {
-            assert_eq!(is_recording(&touch(name), InputFormat::Auto), yes, "{name}");
-        }
-        let raw = dir.path().join("raw.bin");
-        assert!(is_recording(&raw, InputFormat::F64));
-        touch("raw.bin.json");
-        assert!(is_recording(&raw, InputFormat::Auto));
-        let bag = dir.path().join("bag2");
-        std::fs::create_dir(&bag).unwrap();
-        assert!(!is_recording(&bag, InputFormat::Auto));
-        std::fs::write(bag.join("metadata.yaml"), b"").unwrap();
-        assert!(is_recording(&bag, InputFormat::Auto));
     }
 }
