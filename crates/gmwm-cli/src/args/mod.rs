@@ -264,8 +264,14 @@ pub struct CalibrateArgs {
     /// Write a Kalibr imu.yaml (noise densities and random walks, continuous-time SI).
     #[arg(long, value_name = "FILE")]
     pub kalibr: Option<PathBuf>,
-    /// Write a navigation stack's file: openvins, vins, orbslam3, px4 (or kalibr); repeatable.
-    #[arg(long, num_args = 2, value_names = ["STACK", "FILE"], action = clap::ArgAction::Append)]
+    /// Write a navigation stack's file (the stacks of `ExportFormat::ALL`); repeatable.
+    #[arg(
+        long,
+        num_args = 2,
+        value_names = ["STACK", "FILE"],
+        action = clap::ArgAction::Append,
+        help = export_help()
+    )]
     pub export: Vec<String>,
     /// Which axis speaks for a sensor triad in the exported files.
     #[arg(long, value_parser = choice::<AxisPolicy>(), default_value_t = AxisPolicy::Worst)]
@@ -790,4 +796,20 @@ mod tests {
     fn cli_definition_is_consistent() {
         Cli::command().debug_assert();
     }
+}
+
+/// The help of `--export`: the stacks' names from the engine's one list, Kalibr (which
+/// `--kalibr` also writes) last.
+fn export_help() -> String {
+    use gmwm::calib::export::ExportFormat;
+    let others: Vec<&str> = ExportFormat::ALL
+        .iter()
+        .filter(|f| **f != ExportFormat::KALIBR)
+        .map(|f| f.name())
+        .collect();
+    format!(
+        "Write a navigation stack's file: {} (or {}); repeatable",
+        others.join(", "),
+        ExportFormat::KALIBR.name()
+    )
 }
