@@ -140,6 +140,7 @@ impl TryFrom<&InputArgs> for InputConfig {
             read,
             topic: a.topic.clone(),
             stream_from: a.stream_from.unwrap_or(gmwm::calib::STREAM_FROM),
+            probe: Default::default(),
         })
     }
 }
@@ -1179,6 +1180,7 @@ impl TryFrom<&SameModelArgs> for SameModelConfig {
             },
             topic: None,
             stream_from: gmwm::calib::STREAM_FROM,
+            probe: Default::default(),
         };
         Ok(Self {
             files: a.files.clone(),

@@ -22,6 +22,33 @@ pub struct InputConfig {
     /// `--stream-from`: rows from which a text or IMU-record recording is streamed
     /// ([`gmwm::calib::STREAM_FROM`] by default).
     pub stream_from: u64,
+    /// What FILE is, probed once ([`InputConfig::probe`]).
+    pub probe: std::sync::OnceLock<gmwm::imu::Probe>,
+}
+
+impl InputConfig {
+    /// What FILE is ([`gmwm::imu::Probe`]: a ROS container, a folder, a file), probed the
+    /// first time it is asked and kept: every reader and the calibration's choice between
+    /// memory and streaming take it from here.
+    pub fn probe(&self) -> &gmwm::imu::Probe {
+        self.probe
+            .get_or_init(|| gmwm::imu::Probe::of(&self.file, &self.read))
+    }
+
+    /// The same reading of another FILE (its own probe).
+    pub fn with_file(&self, file: &Path) -> InputConfig {
+        InputConfig {
+            file: file.to_path_buf(),
+            probe: std::sync::OnceLock::new(),
+            ..self.clone()
+        }
+    }
+
+    /// Puts `file` in place of FILE (a stream's copy), to be probed afresh.
+    pub fn set_file(&mut self, file: PathBuf) {
+        self.file = file;
+        self.probe = std::sync::OnceLock::new();
+    }
 }
 
 /// A path as the user named it (`<stdin>` for the copy of standard input, [`crate::spool`]).
@@ -124,8 +151,7 @@ pub(crate) fn report_parts(
 /// or sidecar), else 1 Hz with a warning on stderr (scales in seconds are then scales in
 /// samples). The reader's notes (as `style` says) and warnings are printed on stderr.
 pub fn load(input: &InputConfig, style: OutputStyle) -> Result<Loaded> {
-    if input.read.format == InputFormat::Auto && gmwm::imu::ros::container_of(&input.file).is_some()
-    {
+    if input.probe().is_ros() {
         return load_ros(input, style);
     }
     if let Some(topic) = &input.topic {
@@ -256,8 +282,15 @@ pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
         read: input.read.clone(),
         topic: input.topic.clone(),
     };
-    let rec = gmwm::imu::Recording::open(&input.file, &opts)?;
-    Ok(LoadedRecording {
+    let rec = gmwm::imu::Recording::open_probed(input.probe(), &opts)?;
+    let mut loaded = memory_recording(&rec);
+    loaded.imu = Some(rec.imu);
+    Ok(loaded)
+}
+
+/// What a recording read into memory is, as shown (its samples stay with `rec`).
+pub fn memory_recording(rec: &gmwm::imu::Recording) -> LoadedRecording {
+    LoadedRecording {
         path: shown_path(&rec.path),
         columns: rec
             .imu
@@ -265,13 +298,13 @@ pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
             .iter()
             .map(|a| (a.column.name.clone(), a.info.clone()))
             .collect(),
-        imu: Some(rec.imu),
-        topic: rec.topic,
-        source: rec.source,
-        timing: rec.timing,
-        samples: rec.samples,
-        notes: rec.notes,
-    })
+        imu: None,
+        topic: rec.topic.clone(),
+        source: rec.source.clone(),
+        timing: rec.timing.clone(),
+        samples: rec.samples.clone(),
+        notes: rec.notes.clone(),
+    }
 }
 
 /// A raw binary recording the calibration streams ([`gmwm::calib::Calibration::streams`]):

@@ -51,7 +51,11 @@ pub fn prepare(inputs: Inputs<'_>) -> Result<Option<Spool>> {
         Inputs::RosFile(file) => spooled(file),
         Inputs::Recording(input) => {
             check_recording(input)?;
-            let guard = spooled(&mut input.file)?;
+            let mut file = input.file.clone();
+            let guard = spooled(&mut file)?;
+            if guard.is_some() {
+                input.set_file(file);
+            }
             warn_implausible(input);
             Ok(guard)
         }
@@ -82,7 +86,7 @@ fn spooled(file: &mut PathBuf) -> Result<Option<Spool>> {
 fn check_recording(input: &InputConfig) -> Result<()> {
     if let Some(topic) = &input.topic {
         if !spool::is_stream(&input.file)
-            && gmwm::imu::ros::container_of(&input.file).is_none()
+            && input.probe().container().is_none()
             && input.read.format == InputFormat::Auto
             && input.file.exists()
         {
@@ -109,7 +113,7 @@ fn check_recording(input: &InputConfig) -> Result<()> {
 /// (the reader then says why).
 pub fn warn_implausible(input: &InputConfig) {
     if input.read.format == InputFormat::Auto
-        && (gmwm::imu::ros::container_of(&input.file).is_some() || crate::input::is_wv(input))
+        && (input.probe().container().is_some() || crate::input::is_wv(input))
     {
         return;
     }

@@ -575,11 +575,11 @@ fn read<'py>(
     Vec<String>,
 )> {
     let opts = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
-    let ros = opts.format == InputFormat::Auto && gmwm::imu::ros::container_of(&path).is_some();
+    let probe = gmwm::imu::Probe::of(&path, &opts);
     let read = py.detach(|| -> Result<_, gmwm::Error> {
-        if ros {
-            let rec = Recording::open(
-                &path,
+        if probe.is_ros() {
+            let rec = Recording::open_probed(
+                &probe,
                 &RecordingOptions {
                     read: opts,
                     topic: topic.clone(),

@@ -759,7 +759,8 @@ fn ros_streamed_equals_in_memory_noting(
 ) {
     use gmwm::imu::read::stream::StreamedTable;
     let rec = gmwm::imu::Recording::open(path, opts).unwrap();
-    let s = StreamedTable::open_recording(path, opts).unwrap();
+    let probe = gmwm::imu::Probe::of(path, &opts.read);
+    let s = StreamedTable::open_recording(&probe, opts).unwrap();
     let names: Vec<String> = rec
         .imu
         .axes()
@@ -864,7 +865,8 @@ fn ros_streamed_errors_are_the_in_memory_ones() {
     ];
     for (path, opts) in cases {
         let m = gmwm::imu::Recording::open(path, &opts).unwrap_err();
-        let s = StreamedTable::open_recording(path, &opts).unwrap_err();
+        let probe = gmwm::imu::Probe::of(path, &opts.read);
+        let s = StreamedTable::open_recording(&probe, &opts).unwrap_err();
         assert_eq!(s.to_string(), m.to_string(), "{}", path.display());
     }
 }

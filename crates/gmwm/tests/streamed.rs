@@ -53,14 +53,15 @@ fn streamed_calibration_matches_in_memory() {
         stream_from: 1,
         ..CalibrationOptions::default()
     });
-    assert!(streaming.streams(&path, &read).unwrap());
+    let probe = gmwm::imu::Probe::of(&path, &read);
+    assert!(streaming.streams(&probe, &read).unwrap());
     let streamed = streaming.run_file(&path, &read, &NoProgress).unwrap();
     let imu = Imu::from_table(read_table(&path, &read).unwrap()).unwrap();
     let in_memory = Calibration::new(CalibrationOptions::default())
         .run(&imu)
         .unwrap();
     assert!(!Calibration::new(CalibrationOptions::default())
-        .streams(&path, &read)
+        .streams(&probe, &read)
         .unwrap());
     assert_eq!(streamed.axes.len(), 2);
     assert!(streamed.checks.iter().any(|c| c.starts_with("streamed")));

@@ -787,17 +787,6 @@ pub struct TopicsArgs {
     pub json: bool,
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use clap::CommandFactory;
-
-    #[test]
-    fn cli_definition_is_consistent() {
-        Cli::command().debug_assert();
-    }
-}
-
 /// The help of `--export`: the stacks' names from the engine's one list, Kalibr (which
 /// `--kalibr` also writes) last.
 fn export_help() -> String {
@@ -812,4 +801,15 @@ fn export_help() -> String {
         others.join(", "),
         ExportFormat::KALIBR.name()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
 }

@@ -9,7 +9,8 @@ use crate::style::{OutputStyle, Ticks};
 use anyhow::{Context, Result};
 use gmwm::calib::export::{render, ExportFormat};
 use gmwm::calib::{
-    AxisCalibration, Calibration, CalibrationReport, Estimate, EstimateStatus, NavSet,
+    AxisCalibration, Calibration, CalibrationReport, CalibrationSource, Estimate, EstimateStatus,
+    NavSet,
 };
 use gmwm::selection::SelectionRule;
 use std::io::Write;
@@ -182,31 +183,19 @@ fn calibrate_one(
 ) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
     let exports = &config.exports;
     let calibration = Calibration::new(config.options.clone());
-    // a long raw binary recording is calibrated while streamed from the file (bounded memory)
-    // (a topic is for ROS recordings: with another file, the in-memory reader refuses it)
-    let ros = config.input.read.format == gmwm::imu::InputFormat::Auto
-        && gmwm::imu::ros::container_of(&config.input.file).is_some();
-    let streamed = (config.input.topic.is_none() || ros)
-        && calibration.streams(&config.input.file, &config.input.read)?;
-    // text, IMU records and ROS recordings are read once, into a spool the calibration
-    // streams from
-    let table = if streamed
-        && gmwm::imu::read::stream::streamed_size(&config.input.file, &config.input.read)?.is_some()
-    {
-        Some(gmwm::imu::read::stream::StreamedTable::open_recording(
-            &config.input.file,
-            &gmwm::imu::RecordingOptions {
-                read: config.input.read.clone(),
-                topic: config.input.topic.clone(),
-            },
-        )?)
-    } else {
-        None
-    };
-    let recording = match &table {
-        Some(t) => crate::input::streamed_table_recording(t),
-        None if streamed => crate::input::streamed_recording(&config.input)?,
-        None => crate::input::load_recording(&config.input)?,
+    // the engine reads the recording the way its kind and length ask (memory, one spooled
+    // pass, or a raw binary file streamed), from the probe the configuration carries
+    let source = calibration.open(
+        config.input.probe(),
+        &gmwm::imu::RecordingOptions {
+            read: config.input.read.clone(),
+            topic: config.input.topic.clone(),
+        },
+    )?;
+    let recording = match &source {
+        CalibrationSource::Memory(r) => crate::input::memory_recording(r),
+        CalibrationSource::Spooled(t) => crate::input::streamed_table_recording(t),
+        CalibrationSource::Raw { .. } => crate::input::streamed_recording(&config.input)?,
     };
     if !exports.is_empty() {
         check_units_known(config, &recording)?;
@@ -216,14 +205,9 @@ fn calibrate_one(
     let progress = mode
         .style
         .bar((axes * per_axis) as u64, "calibrating", "candidate fits");
-    let report = match &recording.imu {
-        Some(imu) => calibration.run_with_progress(imu, &Ticks(&progress)),
-        None => match &table {
-            Some(t) => calibration.run_table(t, &Ticks(&progress)),
-            None => calibration.run_file(&config.input.file, &config.input.read, &Ticks(&progress)),
-        },
-    }
-    .with_context(|| recording.path.display().to_string())?;
+    let report = calibration
+        .run_source(&source, &Ticks(&progress))
+        .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();
     Ok((recording, report))
 }
@@ -253,10 +237,7 @@ fn calibrate_pooled(
     let mut loaded = Vec::with_capacity(files.len());
     for f in &files {
         let one = CalibrateConfig {
-            input: crate::input::InputConfig {
-                file: f.clone(),
-                ..config.input.clone()
-            },
+            input: config.input.with_file(f),
             ..config.clone()
         };
         check_outputs(&one, report_path)?;

@@ -17,7 +17,7 @@ use std::path::Path;
 /// The unit of each column for axis labels and legends: the one its name or the sidecar
 /// states (SI for ROS recordings and binary IMU records), as its symbol; `u` when unknown.
 fn column_units(input: &InputConfig, names: &[String]) -> Vec<String> {
-    let ros = gmwm::imu::ros::container_of(&input.file).is_some();
+    let ros = input.probe().container().is_some();
     let sidecar = if ros || is_wv(input) {
         None
     } else {

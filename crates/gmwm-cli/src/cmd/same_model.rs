@@ -91,10 +91,7 @@ fn read_pool(
                 f.display()
             );
         }
-        let input = InputConfig {
-            file: f.clone(),
-            ..base.clone()
-        };
+        let input = base.with_file(f);
         loaded.push(load(&input, style)?);
     }
     let first = &loaded[0];

@@ -19,7 +19,7 @@ use std::path::Path;
 /// columns are never loaded, and memory does not grow with the file.
 pub(crate) fn streamable(input: &InputConfig, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
     if input.read.time_column.is_some()
-        || gmwm::imu::ros::container_of(&input.file).is_some()
+        || input.probe().container().is_some()
         || opts.robust.is_some()
         || opts.transform != Transform::Modwt
         || opts.filter != WaveletFilter::Haar
@@ -113,7 +113,7 @@ pub(crate) fn streams_text(input: &InputConfig, opts: &WvOptions) -> Result<bool
         return Ok(false);
     }
     Ok(gmwm::imu::read::stream::streams_from(
-        &input.file,
+        input.probe(),
         &input.read,
         input.stream_from,
     )?)
@@ -127,7 +127,7 @@ fn run_streamed_table(
     style: OutputStyle,
 ) -> Result<Vec<(String, WaveletVariance)>> {
     let table = gmwm::imu::read::stream::StreamedTable::open_recording(
-        &input.file,
+        input.probe(),
         &gmwm::imu::RecordingOptions {
             read: input.read.clone(),
             topic: input.topic.clone(),

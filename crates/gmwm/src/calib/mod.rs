@@ -14,4 +14,4 @@ pub use pipeline::{
     EstimateStatus, FitVerdict, GaussMarkovBias, DEFAULT_FULL_MODEL,
 };
 pub use pooled::PooledInput;
-pub use streamed::{ROBUST_BLOCK, ROBUST_LEVELS, STREAM_FROM};
+pub use streamed::{CalibrationSource, ROBUST_BLOCK, ROBUST_LEVELS, STREAM_FROM};

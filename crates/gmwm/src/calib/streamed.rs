@@ -34,9 +34,10 @@
 use super::pipeline::{AxisData, Calibration, CalibrationReport, InputAxis};
 use crate::calib::CalibError as Error;
 use crate::error::ParamError;
-use crate::imu::read::stream::{streams_from, StreamedTable};
+use crate::imu::read::stream::{streamed_size, streams_from, StreamedTable};
 use crate::imu::{
-    binary_layout, find_sidecar, BinaryChunks, BinaryLayout, ReadError, ReadOptions, SensorInfo,
+    binary_layout, find_sidecar, BinaryChunks, BinaryLayout, Probe, ReadError, ReadOptions,
+    Recording, RecordingOptions, SensorInfo,
 };
 use crate::inference::Progress;
 use crate::variance::binary_wavelet_variance;
@@ -67,8 +68,8 @@ impl Calibration {
     ///
     /// # Errors
     /// As [`binary_layout`] and [`BinaryChunks::open`].
-    pub fn streams(&self, path: &Path, read: &ReadOptions) -> Result<bool, Error> {
-        Ok(self.stream_layout(path, read)?.is_some() || self.streams_table(path, read)?)
+    pub fn streams(&self, probe: &Probe, read: &ReadOptions) -> Result<bool, Error> {
+        Ok(self.stream_layout(probe, read)?.is_some() || self.streams_table(probe, read)?)
     }
 
     /// Whether the options calibrate with the classical Haar MODWT WV, the one that streams.
@@ -77,19 +78,17 @@ impl Calibration {
         wv.robust.is_none() && wv.transform == Transform::Modwt && wv.filter == WaveletFilter::Haar
     }
 
-    fn streams_table(&self, path: &Path, read: &ReadOptions) -> Result<bool, Error> {
-        Ok(self.classical_haar() && streams_from(path, read, self.options().stream_from)?)
+    fn streams_table(&self, probe: &Probe, read: &ReadOptions) -> Result<bool, Error> {
+        Ok(self.classical_haar() && streams_from(probe, read, self.options().stream_from)?)
     }
 
     fn stream_layout(
         &self,
-        path: &Path,
+        probe: &Probe,
         read: &ReadOptions,
     ) -> Result<Option<(BinaryLayout, u64)>, Error> {
-        if crate::imu::ros::container_of(path).is_some()
-            || read.time_column.is_some()
-            || !self.classical_haar()
-        {
+        let path = probe.path();
+        if probe.container().is_some() || read.time_column.is_some() || !self.classical_haar() {
             return Ok(None);
         }
         let Some(layout) = binary_layout(path, read)? else {
@@ -121,11 +120,22 @@ impl Calibration {
         read: &ReadOptions,
         progress: &dyn Progress,
     ) -> Result<CalibrationReport, Error> {
-        if self.stream_layout(path, read)?.is_none() && self.streams_table(path, read)? {
+        self.run_probed(&Probe::of(path, read), read, progress)
+    }
+
+    /// [`Calibration::run_file`] of a path probed before.
+    fn run_probed(
+        &self,
+        probe: &Probe,
+        read: &ReadOptions,
+        progress: &dyn Progress,
+    ) -> Result<CalibrationReport, Error> {
+        let path = probe.path();
+        if self.stream_layout(probe, read)?.is_none() && self.streams_table(probe, read)? {
             let table = StreamedTable::open(path, read)?;
             return self.run_table(&table, progress);
         }
-        let Some((layout, rows)) = self.stream_layout(path, read)? else {
+        let Some((layout, rows)) = self.stream_layout(probe, read)? else {
             return Err(ParamError::new(
                 "input",
                 path.display().to_string(),
@@ -308,6 +318,69 @@ impl Calibration {
             }
         ));
         self.run_axes(name, freq_hz, n, axes, checks, progress)
+    }
+}
+
+/// A recording opened for a calibration, read the way its kind and length ask, as
+/// [`Calibration::open`] settled once from the recording's [`Probe`].
+#[derive(Debug)]
+pub enum CalibrationSource {
+    /// Read into memory.
+    Memory(Recording),
+    /// Text, binary IMU records or a ROS topic, read in one pass and spooled
+    /// ([`StreamedTable`]).
+    Spooled(StreamedTable),
+    /// A raw binary f64/f32 file, streamed from the file as it is.
+    Raw {
+        /// The file, probed.
+        probe: Probe,
+        /// How it is read.
+        read: ReadOptions,
+    },
+}
+
+impl Calibration {
+    /// Opens the recording probed as `probe` for [`Calibration::run_source`]: a long
+    /// recording that the options calibrate with the classical Haar WV is streamed (a raw
+    /// binary file from the file, text, IMU records and ROS topics through one spooled pass,
+    /// [`Calibration::streams`]); any other is read into memory ([`Recording::open`]). A topic
+    /// is for ROS recordings: with another file the in-memory reader refuses it.
+    ///
+    /// # Errors
+    /// The readers' errors naming the file ([`CalibError::Read`]).
+    pub fn open(&self, probe: &Probe, opts: &RecordingOptions) -> Result<CalibrationSource, Error> {
+        let streamed =
+            (opts.topic.is_none() || probe.is_ros()) && self.streams(probe, &opts.read)?;
+        Ok(if streamed && streamed_size(probe, &opts.read)?.is_some() {
+            CalibrationSource::Spooled(StreamedTable::open_recording(probe, opts)?)
+        } else if streamed {
+            CalibrationSource::Raw {
+                probe: probe.clone(),
+                read: opts.read.clone(),
+            }
+        } else {
+            CalibrationSource::Memory(Recording::open_probed(probe, opts)?)
+        })
+    }
+
+    /// Calibrates a recording opened by [`Calibration::open`]: [`Calibration::run`] on one in
+    /// memory, [`Calibration::run_table`] on a spooled one, [`Calibration::run_file`] on a raw
+    /// binary file streamed.
+    ///
+    /// # Errors
+    /// As those.
+    pub fn run_source(
+        &self,
+        source: &CalibrationSource,
+        progress: &dyn Progress,
+    ) -> Result<CalibrationReport, Error> {
+        match source {
+            CalibrationSource::Memory(recording) => {
+                self.run_with_progress(&recording.imu, progress)
+            }
+            CalibrationSource::Spooled(table) => self.run_table(table, progress),
+            CalibrationSource::Raw { probe, read } => self.run_probed(probe, read, progress),
+        }
     }
 }
 

@@ -29,6 +29,7 @@
 
 mod error;
 pub mod plausible;
+mod probe;
 pub mod read;
 pub mod recording;
 pub mod ros;
@@ -40,6 +41,7 @@ pub mod write;
 
 pub(crate) use error::escape_name;
 pub use error::{quote, ReadError, QUOTE_MAX};
+pub use probe::Probe;
 pub use read::{
     binary_layout, for_each_chunk, read_imu_record_file, read_table, resolve_format, sniff,
     BinaryChunks, BinaryLayout, Column, ColumnSelector, Content, HeaderMode, ImuRecordType,

@@ -2,8 +2,8 @@
 //! records, a ROS bag), an [`Imu`] with its rate, where it came from and what the reader
 //! noticed.
 
-use super::read::{read_table, Column, InputFormat, ReadOptions, ReadWarning, RATE_TOLERANCE};
-use super::ros::{container_of, read_imu_messages, ImuMessages, RosContainer};
+use super::read::{read_table, Column, ReadOptions, ReadWarning, RATE_TOLERANCE};
+use super::ros::{read_imu_messages, ImuMessages, RosContainer};
 use super::timing::{check_times, TimeUnit, TimingReport, UnitSource};
 use super::{Imu, ReadError, SampleAccount, Sensor, SensorInfo};
 use crate::imu::ReadError as Error;
@@ -69,7 +69,16 @@ impl Recording {
     /// Any read error of the container, or [`crate::imu::ReadError::FreqNotDerivable`] when no
     /// rate can be found.
     pub fn open(path: &Path, opts: &RecordingOptions) -> Result<Self, Error> {
-        if opts.read.format == InputFormat::Auto && container_of(path).is_some() {
+        Self::open_probed(&super::Probe::of(path, &opts.read), opts)
+    }
+
+    /// [`Recording::open`] of a path probed before ([`Probe`](super::Probe)).
+    ///
+    /// # Errors
+    /// As [`Recording::open`].
+    pub fn open_probed(probe: &super::Probe, opts: &RecordingOptions) -> Result<Self, Error> {
+        let path = probe.path();
+        if probe.is_ros() {
             return Self::open_ros(path, opts);
         }
         if let Some(topic) = &opts.topic {

@@ -49,7 +49,7 @@ use super::{
 use crate::error::ParamError;
 use crate::imu::sidecar::{find_sidecar, Sidecar};
 use crate::imu::timing::{check_times, infer_unit, StepStats, TimeUnit, TimingReport, UnitSource};
-use crate::imu::{ImuRecordType, ReadError, SampleAccount};
+use crate::imu::{ImuRecordType, Probe, ReadError, SampleAccount};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -107,11 +107,12 @@ pub struct StreamedTable {
 ///
 /// # Errors
 /// As [`resolve_format`].
-pub fn streamed_size(path: &Path, opts: &ReadOptions) -> Result<Option<u64>, ReadError> {
-    if is_ros(path, opts) {
+pub fn streamed_size(probe: &Probe, opts: &ReadOptions) -> Result<Option<u64>, ReadError> {
+    let path = probe.path();
+    if probe.is_ros() {
         return Ok(Some(std::fs::metadata(path).map_or(0, |m| m.len())));
     }
-    if crate::imu::ros::container_of(path).is_some() || path.is_dir() {
+    if probe.is_container_or_folder() {
         return Ok(None);
     }
     let sidecar = find_sidecar(path)?;
@@ -139,12 +140,17 @@ pub fn streamed_size(path: &Path, opts: &ReadOptions) -> Result<Option<u64>, Rea
 /// # Errors
 /// As [`streamed_size`]; for a ROS recording, as
 /// [`list_topics`](crate::imu::ros::list_topics).
-pub fn streams_from(path: &Path, opts: &ReadOptions, stream_from: u64) -> Result<bool, ReadError> {
-    if is_ros(path, opts) {
+pub fn streams_from(
+    probe: &Probe,
+    opts: &ReadOptions,
+    stream_from: u64,
+) -> Result<bool, ReadError> {
+    let path = probe.path();
+    if probe.is_ros() {
         let rows = crate::imu::ros::imu_messages_count(path)?;
         return Ok(rows > 0 && rows >= stream_from.max(1));
     }
-    let Some(size) = streamed_size(path, opts)? else {
+    let Some(size) = streamed_size(probe, opts)? else {
         return Ok(false);
     };
     let sidecar = find_sidecar(path)?;
@@ -153,12 +159,6 @@ pub fn streams_from(path: &Path, opts: &ReadOptions, stream_from: u64) -> Result
         _ => size / 8,
     };
     Ok(rows >= stream_from.max(1))
-}
-
-/// Whether `path` is read as a ROS recording ([`Recording::open`](crate::imu::Recording)'s
-/// rule: format `auto` and a ROS container).
-fn is_ros(path: &Path, opts: &ReadOptions) -> bool {
-    opts.format == InputFormat::Auto && crate::imu::ros::container_of(path).is_some()
 }
 
 impl StreamedTable {
@@ -172,10 +172,11 @@ impl StreamedTable {
     /// for the spool; [`ParamError`] `topic` for a topic given with a file that is not a ROS
     /// recording.
     pub fn open_recording(
-        path: &Path,
+        probe: &Probe,
         opts: &crate::imu::RecordingOptions,
     ) -> Result<Self, ReadError> {
-        if is_ros(path, &opts.read) {
+        let path = probe.path();
+        if probe.is_ros() {
             return super::ros_stream::open(path, opts);
         }
         if let Some(topic) = &opts.topic {
