@@ -64,6 +64,7 @@ use crate::fit::{
     TransformPreset,
 };
 use crate::inference::asymptotic::{sandwich, wald_interval, z_value, IntervalScale, ZConvention};
+use crate::inference::ParameterInference;
 use crate::model::{Component, Model};
 use crate::process::{spec, Process, Role};
 use crate::variance::cross::{axis_pairs, stacked_moment_covariance, wavelet_cross_covariance};
@@ -101,22 +102,19 @@ impl Default for SharedOptions {
     }
 }
 
-/// One estimated parameter of a shared-process fit.
+/// One estimated parameter of a shared-process fit: the inference on it (standard error from
+/// the sandwich of §15.5; `None` for a component collapsed to its boundary, no influence on the
+/// moments, or when the exact covariance is not available) and the block it belongs to.
+///
+/// Wire format: `block`, then the fields of [`ParameterInference`] (`name`, `estimate`, `se`,
+/// `ci_low`, `ci_high`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SharedParameter {
     /// `shared` or the axis name.
     pub block: String,
-    /// Parameter label, e.g. `GM[0].beta`.
-    pub name: String,
-    /// Estimate (GM as `beta` 1/s, `sigma2_gm`).
-    pub estimate: f64,
-    /// Standard error (sandwich, §15.5); `None` for a component collapsed to its boundary
-    /// (no influence on the moments) or when the exact covariance is not available.
-    pub se: Option<f64>,
-    /// Lower end of the `1 - alpha` interval.
-    pub ci_low: Option<f64>,
-    /// Upper end of the `1 - alpha` interval.
-    pub ci_high: Option<f64>,
+    /// The parameter (label e.g. `GM[0].beta`; GM as `beta` 1/s, `sigma2_gm`).
+    #[serde(flatten)]
+    pub parameter: ParameterInference,
 }
 
 /// The test of "no shared process" (module docs, docs/methods.md §15.6).
@@ -531,11 +529,13 @@ pub fn fit_shared(
                 };
                 parameters.push(SharedParameter {
                     block: label.to_string(),
-                    name: format!("{}.{name}", c.kind.base_name()),
-                    estimate: theta[at],
-                    se,
-                    ci_low: lo,
-                    ci_high: hi,
+                    parameter: ParameterInference {
+                        name: format!("{}.{name}", c.kind.base_name()),
+                        estimate: theta[at],
+                        se,
+                        ci_low: lo,
+                        ci_high: hi,
+                    },
                 });
                 at += 1;
             }
@@ -733,11 +733,11 @@ impl fmt::Display for SharedFit {
                 f,
                 "{:<10} {:<16} {:>13.5e} {} {} {}",
                 p.block,
-                p.name,
-                p.estimate,
-                opt(p.se, 11),
-                opt(p.ci_low, 13),
-                opt(p.ci_high, 13)
+                p.parameter.name,
+                p.parameter.estimate,
+                opt(p.parameter.se, 11),
+                opt(p.parameter.ci_low, 13),
+                opt(p.parameter.ci_high, 13)
             )?;
         }
         writeln!(

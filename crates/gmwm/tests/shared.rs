@@ -66,10 +66,11 @@ fn study(n: usize, reps: u64, seed: u64, with_shared: bool) -> (u64, u64, u64, u
         .map(|r| {
             let fit = replicate(n, replicate_seed(seed, r), with_shared);
             let sp: Vec<_> = fit.shared_parameters().collect();
-            let inside = |k: usize, truth: f64| match (sp[k].ci_low, sp[k].ci_high) {
-                (Some(lo), Some(hi)) => lo <= truth && truth <= hi,
-                _ => false,
-            };
+            let inside =
+                |k: usize, truth: f64| match (sp[k].parameter.ci_low, sp[k].parameter.ci_high) {
+                    (Some(lo), Some(hi)) => lo <= truth && truth <= hi,
+                    _ => false,
+                };
             (inside(0, 0.5), inside(1, 0.05), fit.test.p_value < 0.05)
         })
         .collect();

@@ -121,11 +121,11 @@ pub fn render(fit: &SharedFit, style: Style, out: &mut impl Write) -> Result<()>
                     out,
                     "{},{},{:e},{},{},{}",
                     p.block,
-                    p.name,
-                    p.estimate,
-                    opt(p.se),
-                    opt(p.ci_low),
-                    opt(p.ci_high)
+                    p.parameter.name,
+                    p.parameter.estimate,
+                    opt(p.parameter.se),
+                    opt(p.parameter.ci_low),
+                    opt(p.parameter.ci_high)
                 )?;
             }
         }
