@@ -347,7 +347,7 @@ impl Calibration {
     /// is for ROS recordings: with another file the in-memory reader refuses it.
     ///
     /// # Errors
-    /// The readers' errors naming the file ([`CalibError::Read`]).
+    /// The readers' errors naming the file ([`CalibError::Read`](crate::calib::CalibError::Read)).
     pub fn open(&self, probe: &Probe, opts: &RecordingOptions) -> Result<CalibrationSource, Error> {
         let streamed =
             (opts.topic.is_none() || probe.is_ros()) && self.streams(probe, &opts.read)?;

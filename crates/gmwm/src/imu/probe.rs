@@ -8,7 +8,10 @@ use super::read::{InputFormat, ReadOptions};
 use super::ros::{container_of, RosContainer};
 use std::path::{Path, PathBuf};
 
-/// The probe of one recording's path ([module docs](self)).
+/// What a recording's path is, found once before it is read: a ROS container (read as one when
+/// the format is `auto`), a folder, or a file for the table and binary readers. It travels with
+/// the read options to every reader and to the calibration's choice between memory and
+/// streaming, so that the file is sniffed once per command.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Probe {
     path: PathBuf,
