@@ -23,7 +23,7 @@ use crate::error::ParamError;
 use crate::imu::{Imu, Sensor, SensorInfo};
 use crate::inference::same_model::{compare_wvs, WvComparison};
 use crate::inference::{NoProgress, Progress};
-use crate::units::SignalKind;
+use crate::units::{SignalKind, SignalUnit};
 use crate::variance::pooled::PooledWv;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use rayon::prelude::*;
@@ -76,37 +76,69 @@ impl Calibration {
         recordings: &[(&str, &Imu)],
         progress: &dyn Progress,
     ) -> Result<CalibrationReport, CalibError> {
-        let pool_error = |recording: &str, reason: String| CalibError::Pool {
-            recording: recording.to_string(),
-            reason,
-        };
-        let [(first_name, first), ..] = recordings else {
-            return Err(pool_error(
-                "(none)",
-                "no recording given: a pooled calibration needs at least two".to_string(),
-            ));
-        };
-        if recordings.len() < 2 {
-            return Err(pool_error(
-                first_name,
-                "the only recording: a pooled calibration needs at least two (calibrate one recording without --pool)".to_string(),
-            ));
-        }
-        let freq_hz = first.freq_hz();
-        for (name, imu) in &recordings[1..] {
-            if (imu.freq_hz() - freq_hz).abs() > crate::imu::read::RATE_TOLERANCE * freq_hz {
-                return Err(pool_error(
-                    name,
-                    format!(
-                        "sampled at {} Hz, {first_name} at {freq_hz} Hz: the recordings of one model need one rate (its parameters are per sample)",
-                        imu.freq_hz()
-                    ),
-                ));
-            }
-        }
+        let freq_hz = check_pool(recordings)?;
         let names: Vec<String> = recordings.iter().map(|(n, _)| n.to_string()).collect();
         let mut checks = Vec::new();
-        // per inertial axis of the first recording: the axis of every recording, in SI
+        let columns = self.pooled_columns(recordings, &mut checks)?;
+        let (classical_opts, robust_opts) = self.pooled_wv_options();
+        let mut wvs = recording_wvs(
+            &columns,
+            recordings.len(),
+            freq_hz,
+            &classical_opts,
+            robust_opts,
+        )
+        .into_iter();
+        let mut data = Vec::with_capacity(columns.len());
+        let mut agreement = Vec::with_capacity(columns.len());
+        for column in &columns {
+            let (pooled, agreed) =
+                self.pool_column(column.name, recordings, &mut wvs, robust_opts, &names)?;
+            data.push(pooled);
+            agreement.push(agreed);
+        }
+        // the pooled WVs are in SI already; the first recording's unit names the data's
+        let infos: Vec<SensorInfo> = columns
+            .iter()
+            .map(|c| SensorInfo {
+                unit: c.units[0].map(|u| u.symbol().to_string()),
+                ..c.axis.info.clone()
+            })
+            .collect();
+        let axes: Vec<InputAxis<'_>> = columns
+            .iter()
+            .zip(&infos)
+            .zip(data)
+            .map(|((c, info), (classical, robust))| InputAxis {
+                column: c.name,
+                info,
+                data: AxisData::Pooled { classical, robust },
+            })
+            .collect();
+        let samples: usize = recordings.iter().map(|(_, imu)| imu.len()).sum();
+        let label = format!("{} recordings pooled", names.len());
+        let mut report = self.run_axes(Some(&label), freq_hz, samples, axes, checks, progress)?;
+        report.recordings = recordings
+            .iter()
+            .map(|(name, imu)| PooledInput {
+                name: name.to_string(),
+                samples: imu.len(),
+                duration_s: imu.len() as f64 / freq_hz,
+            })
+            .collect();
+        annotate_agreement(&mut report, &columns, agreement, names.len());
+        Ok(report)
+    }
+
+    /// Per inertial axis of the first recording: the axis of every recording and its unit
+    /// (docs/methods.md §5.12: the recordings are converted to SI before pooling, with a check
+    /// line when their units differ).
+    fn pooled_columns<'a>(
+        &self,
+        recordings: &[(&str, &'a Imu)],
+        checks: &mut Vec<String>,
+    ) -> Result<Vec<PoolColumn<'a>>, CalibError> {
+        let (first_name, first) = recordings[0];
         let mut columns = Vec::new();
         for axis in first.axes() {
             let column = axis.column.name.as_str();
@@ -151,149 +183,202 @@ impl Calibration {
                     distinct.join(", ")
                 ));
             }
-            columns.push((column, axis, series, units));
+            columns.push(PoolColumn {
+                name: column,
+                axis,
+                series,
+                units,
+            });
         }
-        // every recording's WVs, in parallel over axes and recordings
-        let classical_opts = WvOptions {
-            robust: None,
-            ..self.options().wv
-        };
-        let robust_opts = self
-            .options()
-            .wv
+        Ok(columns)
+    }
+
+    /// The options of the recordings' classical WVs and of their robust ones (the fit's when
+    /// the options ask for a robust WV, else the contamination check's; `None`: neither).
+    fn pooled_wv_options(&self) -> (WvOptions, Option<WvOptions>) {
+        let wv = self.options().wv;
+        let classical = WvOptions { robust: None, ..wv };
+        let robust = wv
             .robust
             .or(self.options().robust_check)
             .map(|r| WvOptions {
                 robust: Some(r),
-                ..self.options().wv
+                ..wv
             });
-        let jobs: Vec<(usize, usize)> = (0..columns.len())
-            .flat_map(|c| (0..recordings.len()).map(move |k| (c, k)))
-            .collect();
-        type Wvs = (
-            Result<WaveletVariance, crate::InputError>,
-            Option<Result<WaveletVariance, crate::InputError>>,
+        (classical, robust)
+    }
+
+    /// One column's pooled WVs (classical, and robust when asked) from the recordings' own
+    /// (`wvs`, in recording order), and each recording against the others, without a model:
+    /// its lines, how many differ, and the WVs the fit uses.
+    fn pool_column(
+        &self,
+        column: &str,
+        recordings: &[(&str, &Imu)],
+        wvs: &mut impl Iterator<Item = RecordingWvs>,
+        robust_opts: Option<WvOptions>,
+        names: &[String],
+    ) -> Result<(PooledPair, Agreement), CalibError> {
+        let engine = |e: crate::ParamError| CalibError::Engine {
+            column: column.to_string(),
+            source: e.into(),
+        };
+        let mut classical = Vec::with_capacity(recordings.len());
+        let mut robust: Option<Result<Vec<_>, String>> = robust_opts.map(|_| Ok(Vec::new()));
+        for (name, _) in recordings {
+            let (c, r) = wvs.next().expect("one job per column and recording");
+            classical.push(c.map_err(|e| pool_error(name, format!("column {column}: {e}")))?);
+            if let (Some(Ok(list)), Some(r)) = (&mut robust, r) {
+                match r {
+                    Ok(w) => list.push(w),
+                    Err(e) => robust = Some(Err(format!("{name}: {e}"))),
+                }
+            }
+        }
+        let classical = Box::new(PooledWv::new(classical).map_err(engine)?);
+        let robust = match robust {
+            Some(Ok(parts)) => Some(
+                PooledWv::new(parts)
+                    .map(Box::new)
+                    .map_err(|e| engine(e).to_string()),
+            ),
+            Some(Err(e)) => Some(Err(e)),
+            None => None,
+        };
+        // the WV the fit uses: each recording against the others, without a model
+        let fitted = match (self.options().wv.robust, &robust) {
+            (Some(_), Some(Ok(r))) => r.parts(),
+            _ => classical.parts(),
+        };
+        let agreement = (
+            recording_agreement(fitted, names).map_err(engine)?,
+            fitted.to_vec(),
         );
-        let wvs: Vec<Wvs> = jobs
-            .par_iter()
-            .map(|&(c, k)| {
-                let (_, _, series, units) = &columns[c];
-                let to_si = units[k].map_or(1.0, |u| u.to_si());
-                let si: Vec<f64>;
-                let x: &[f64] = if to_si == 1.0 {
-                    series[k]
-                } else {
-                    si = series[k].iter().map(|v| v * to_si).collect();
-                    &si
-                };
-                let classical = wavelet_variance(x, freq_hz, &classical_opts);
-                let robust = robust_opts.as_ref().map(|o| {
-                    let levels = classical.as_ref().ok().map(|w| w.levels());
-                    wavelet_variance(
-                        x,
-                        freq_hz,
-                        &WvOptions {
-                            levels: o.levels.or(levels),
-                            ..*o
-                        },
-                    )
-                });
-                (classical, robust)
-            })
-            .collect();
-        let mut data = Vec::with_capacity(columns.len());
-        // per column: the recordings' lines and how many differ, and their WVs
-        type Agreement = ((Vec<String>, usize), Vec<WaveletVariance>);
-        let mut agreement: Vec<Agreement> = Vec::with_capacity(columns.len());
-        let mut wvs = wvs.into_iter();
-        for (column, _, _, _) in &columns {
-            let mut classical = Vec::with_capacity(recordings.len());
-            let mut robust: Option<Result<Vec<_>, String>> = robust_opts.map(|_| Ok(Vec::new()));
-            for (name, _) in recordings {
-                let (c, r) = wvs.next().expect("one job per column and recording");
-                classical.push(c.map_err(|e| pool_error(name, format!("column {column}: {e}")))?);
-                if let (Some(Ok(list)), Some(r)) = (&mut robust, r) {
-                    match r {
-                        Ok(w) => list.push(w),
-                        Err(e) => robust = Some(Err(format!("{name}: {e}"))),
-                    }
-                }
-            }
-            let pooled = |parts| {
-                PooledWv::new(parts).map_err(|e| CalibError::Engine {
-                    column: column.to_string(),
-                    source: e.into(),
-                })
-            };
-            let classical = Box::new(pooled(classical)?);
-            let robust = match robust {
-                Some(Ok(parts)) => Some(pooled(parts).map(Box::new).map_err(|e| e.to_string())),
-                Some(Err(e)) => Some(Err(e)),
-                None => None,
-            };
-            // the WV the fit uses: each recording against the others, without a model
-            let fitted = match (self.options().wv.robust, &robust) {
-                (Some(_), Some(Ok(r))) => r.parts(),
-                _ => classical.parts(),
-            };
-            agreement.push((
-                recording_agreement(fitted, &names).map_err(|e| CalibError::Engine {
-                    column: column.to_string(),
-                    source: e.into(),
-                })?,
-                fitted.to_vec(),
-            ));
-            data.push((classical, robust));
-        }
-        // the pooled WVs are in SI already; the first recording's unit names the data's
-        let infos: Vec<SensorInfo> = columns
-            .iter()
-            .map(|(_, axis, _, units)| SensorInfo {
-                unit: units[0].map(|u| u.symbol().to_string()),
-                ..axis.info.clone()
-            })
-            .collect();
-        let axes: Vec<InputAxis<'_>> = columns
-            .iter()
-            .zip(&infos)
-            .zip(data)
-            .map(
-                |(((column, _, _, _), info), (classical, robust))| InputAxis {
-                    column,
-                    info,
-                    data: AxisData::Pooled { classical, robust },
-                },
-            )
-            .collect();
-        let samples: usize = recordings.iter().map(|(_, imu)| imu.len()).sum();
-        let label = format!("{} recordings pooled", names.len());
-        let mut report = self.run_axes(Some(&label), freq_hz, samples, axes, checks, progress)?;
-        report.recordings = recordings
-            .iter()
-            .map(|(name, imu)| PooledInput {
-                name: name.to_string(),
-                samples: imu.len(),
-                duration_s: imu.len() as f64 / freq_hz,
-            })
-            .collect();
-        // the per-recording lines, on the axes calibrated (an axis may be left out)
-        let mut disagreeing = Vec::new();
-        for ((column, _, _, _), ((lines, differing), wvs)) in columns.iter().zip(agreement) {
-            if let Some(a) = report.axes.iter_mut().find(|a| a.column == *column) {
-                a.notes.extend(lines);
-                a.recording_wvs = wvs;
-                if differing > 0 {
-                    disagreeing.push(format!("{column} ({differing} of {})", names.len()));
-                }
-            }
-        }
-        if !disagreeing.is_empty() {
-            report.checks.push(format!(
-                "some recordings' WVs differ from the others' at more scales than chance: {}; those recordings may not share one model, and the pooled one is their average (test it: gmwm same-model FILE... --model MODEL)",
-                disagreeing.join(", ")
+        Ok(((classical, robust), agreement))
+    }
+}
+
+/// One inertial axis of a pooled calibration: the column, the first recording's axis, every
+/// recording's samples and unit.
+struct PoolColumn<'a> {
+    name: &'a str,
+    axis: &'a crate::imu::Axis,
+    series: Vec<&'a [f64]>,
+    units: Vec<Option<SignalUnit>>,
+}
+
+/// A recording's classical WV of one column, and its robust one when asked.
+type RecordingWvs = (
+    Result<WaveletVariance, crate::InputError>,
+    Option<Result<WaveletVariance, crate::InputError>>,
+);
+
+/// A column's pooled classical WV and its robust one (or why not).
+type PooledPair = (Box<PooledWv>, Option<Result<Box<PooledWv>, String>>);
+
+/// A column's recordings against the others: their lines and how many differ, and their WVs.
+type Agreement = ((Vec<String>, usize), Vec<WaveletVariance>);
+
+/// A pooling error naming the recording.
+fn pool_error(recording: &str, reason: String) -> CalibError {
+    CalibError::Pool {
+        recording: recording.to_string(),
+        reason,
+    }
+}
+
+/// At least two recordings, all at the first one's rate (1%): that rate.
+fn check_pool(recordings: &[(&str, &Imu)]) -> Result<f64, CalibError> {
+    let [(first_name, first), ..] = recordings else {
+        return Err(pool_error(
+            "(none)",
+            "no recording given: a pooled calibration needs at least two".to_string(),
+        ));
+    };
+    if recordings.len() < 2 {
+        return Err(pool_error(
+            first_name,
+            "the only recording: a pooled calibration needs at least two (calibrate one recording without --pool)".to_string(),
+        ));
+    }
+    let freq_hz = first.freq_hz();
+    for (name, imu) in &recordings[1..] {
+        if (imu.freq_hz() - freq_hz).abs() > crate::imu::read::RATE_TOLERANCE * freq_hz {
+            return Err(pool_error(
+                name,
+                format!(
+                    "sampled at {} Hz, {first_name} at {freq_hz} Hz: the recordings of one model need one rate (its parameters are per sample)",
+                    imu.freq_hz()
+                ),
             ));
         }
-        Ok(report)
+    }
+    Ok(freq_hz)
+}
+
+/// Every recording's WVs of every column, in SI, in parallel over columns and recordings
+/// (column-major: the recordings of the first column first).
+fn recording_wvs(
+    columns: &[PoolColumn<'_>],
+    recordings: usize,
+    freq_hz: f64,
+    classical_opts: &WvOptions,
+    robust_opts: Option<WvOptions>,
+) -> Vec<RecordingWvs> {
+    let jobs: Vec<(usize, usize)> = (0..columns.len())
+        .flat_map(|c| (0..recordings).map(move |k| (c, k)))
+        .collect();
+    jobs.par_iter()
+        .map(|&(c, k)| {
+            let column = &columns[c];
+            let to_si = column.units[k].map_or(1.0, |u| u.to_si());
+            let si: Vec<f64>;
+            let x: &[f64] = if to_si == 1.0 {
+                column.series[k]
+            } else {
+                si = column.series[k].iter().map(|v| v * to_si).collect();
+                &si
+            };
+            let classical = wavelet_variance(x, freq_hz, classical_opts);
+            let robust = robust_opts.as_ref().map(|o| {
+                let levels = classical.as_ref().ok().map(|w| w.levels());
+                wavelet_variance(
+                    x,
+                    freq_hz,
+                    &WvOptions {
+                        levels: o.levels.or(levels),
+                        ..*o
+                    },
+                )
+            });
+            (classical, robust)
+        })
+        .collect()
+}
+
+/// The per-recording lines on the axes calibrated (an axis may be left out), and a check line
+/// naming the columns where some recordings differ from the others.
+fn annotate_agreement(
+    report: &mut CalibrationReport,
+    columns: &[PoolColumn<'_>],
+    agreement: Vec<Agreement>,
+    recordings: usize,
+) {
+    let mut disagreeing = Vec::new();
+    for (column, ((lines, differing), wvs)) in columns.iter().zip(agreement) {
+        if let Some(a) = report.axes.iter_mut().find(|a| a.column == column.name) {
+            a.notes.extend(lines);
+            a.recording_wvs = wvs;
+            if differing > 0 {
+                disagreeing.push(format!("{} ({differing} of {recordings})", column.name));
+            }
+        }
+    }
+    if !disagreeing.is_empty() {
+        report.checks.push(format!(
+            "some recordings' WVs differ from the others' at more scales than chance: {}; those recordings may not share one model, and the pooled one is their average (test it: gmwm same-model FILE... --model MODEL)",
+            disagreeing.join(", ")
+        ));
     }
 }
 
