@@ -101,15 +101,15 @@ fn check_table(table: &Table) {
             "the time column does not strictly increase"
         );
         assert!(
-            table.timing.is_some(),
+            table.facts.timing.is_some(),
             "a time column without a timing report"
         );
     }
-    if let Some(f) = table.freq_hz {
+    if let Some(f) = table.facts.freq_hz {
         assert!(f.is_finite() && f > 0.0, "freq_hz = {f}");
     }
     // errors of every kind render as one line naming the file
-    for w in &table.warnings {
+    for w in &table.facts.warnings {
         assert!(!w.to_string().contains('\n'), "multi-line warning: {w}");
     }
 }
@@ -252,8 +252,8 @@ pub fn imu_record(data: &[u8]) {
         assert_eq!(table.columns.len(), 6);
         assert_eq!(table.len(), content.len() / t.record_size());
         assert_eq!(content.len() % t.record_size(), 0);
-        assert_eq!(table.record_type, Some(t));
-        let f = table.freq_hz.expect("IMU records have a rate");
+        assert_eq!(table.facts.record_type, Some(t));
+        let f = table.facts.freq_hz.expect("IMU records have a rate");
         assert_eq!(f, f.round(), "an IMU record rate is a whole number");
         assert!(table.time.is_some(), "IMU records carry their time");
     }

@@ -104,11 +104,11 @@ pub fn note_not_analysed(style: OutputStyle, file: &Path, skipped: &[String]) {
 fn report(style: OutputStyle, table: &Table) {
     report_parts(
         style,
-        &table.path,
-        table.timing.as_ref(),
-        &table.skipped,
-        &table.samples,
-        &table.warnings,
+        &table.facts.path,
+        table.facts.timing.as_ref(),
+        &table.facts.skipped,
+        &table.facts.samples,
+        &table.facts.warnings,
     );
 }
 
@@ -163,7 +163,7 @@ pub fn load(input: &InputConfig, style: OutputStyle) -> Result<Loaded> {
     }
     let table = read_table(&input.file, &input.read)?;
     report(style, &table);
-    let freq_hz = match input.read.freq_hz.or(table.freq_hz) {
+    let freq_hz = match input.read.freq_hz.or(table.facts.freq_hz) {
         Some(f) => f,
         None if crate::spool::is_stdin(&input.file) => {
             return Err(crate::error::UsageError(format!(
@@ -364,20 +364,20 @@ pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> L
     let mut notes = match t.topic {
         Some(_) => Vec::new(),
         None => gmwm::imu::recording::table_notes(
-            t.record_type,
-            t.timing.as_ref(),
-            &t.skipped,
-            &t.samples,
-            &t.warnings,
+            t.facts.record_type,
+            t.facts.timing.as_ref(),
+            &t.facts.skipped,
+            &t.facts.samples,
+            &t.facts.warnings,
         ),
     };
     notes.extend(t.notes.iter().cloned());
     LoadedRecording {
-        path: shown_path(&t.path),
+        path: shown_path(&t.facts.path),
         columns: t.names.iter().cloned().zip(t.sensor_infos()).collect(),
         imu: None,
         topic: t.topic.clone(),
-        source: match (t.record_type, &t.topic, t.container) {
+        source: match (t.facts.record_type, &t.topic, t.container) {
             (_, Some(topic), Some(container)) => gmwm::imu::RecordingSource::Ros {
                 container: container.to_string(),
                 topic: topic.clone(),
@@ -387,8 +387,8 @@ pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> L
             },
             _ => gmwm::imu::RecordingSource::Table,
         },
-        timing: t.timing.clone(),
-        samples: t.samples.clone(),
+        timing: t.facts.timing.clone(),
+        samples: t.facts.samples.clone(),
         notes,
     }
 }
@@ -407,16 +407,18 @@ fn load_ros(input: &InputConfig, style: OutputStyle) -> Result<Loaded> {
     }
     let freq_hz = rec.imu.freq_hz();
     let table = Table {
-        path: rec.path,
+        facts: gmwm::imu::TableFacts {
+            path: rec.path,
+            freq_hz: Some(freq_hz),
+            sidecar: None,
+            timing: rec.timing,
+            warnings: Vec::new(),
+            skipped: Vec::new(),
+            record_type: None,
+            samples: rec.samples,
+        },
         columns: rec.imu.into_axes().into_iter().map(|a| a.column).collect(),
-        freq_hz: Some(freq_hz),
-        sidecar: None,
         time: None,
-        timing: rec.timing,
-        warnings: Vec::new(),
-        skipped: Vec::new(),
-        record_type: None,
-        samples: rec.samples,
     };
     Ok(Loaded { table, freq_hz })
 }

@@ -23,7 +23,7 @@ fn data(name: &str) -> PathBuf {
 /// Columns of a recording (`limit` samples each) and its rate.
 fn recording(name: &str, limit: usize) -> (Vec<(String, Vec<f64>)>, f64) {
     let table = read_table(&data(name), &ReadOptions::default()).unwrap();
-    let freq = table.freq_hz.unwrap();
+    let freq = table.facts.freq_hz.unwrap();
     let cols = table
         .columns
         .into_iter()

@@ -608,13 +608,13 @@ fn read<'py>(
             .map(|i| i.unit)
             .collect();
         let mut notes = Vec::new();
-        if let Some(t) = &table.timing {
+        if let Some(t) = &table.facts.timing {
             notes.push(t.to_string());
         }
-        notes.extend(gmwm::imu::recording::left_out_note(&table.skipped));
-        notes.push(table.samples.to_string());
-        notes.extend(table.warnings.iter().map(ToString::to_string));
-        Ok((table.columns, table.freq_hz, units, notes))
+        notes.extend(gmwm::imu::recording::left_out_note(&table.facts.skipped));
+        notes.push(table.facts.samples.to_string());
+        notes.extend(table.facts.warnings.iter().map(ToString::to_string));
+        Ok((table.columns, table.facts.freq_hz, units, notes))
     });
     let (cols, freq, units, notes) = read.map_err(engine)?;
     let names = cols.iter().map(|c| c.name.clone()).collect();

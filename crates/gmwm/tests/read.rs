@@ -58,9 +58,9 @@ fn read_csv_with_header() {
     assert_eq!(t.columns[0].name, "gyro_x");
     assert_eq!(t.columns[0].values, [1.0, -0.03]);
     assert_eq!(t.columns[1].values, [2.5, 4.0]);
-    assert_eq!(t.freq_hz, None);
+    assert_eq!(t.facts.freq_hz, None);
     assert_eq!(t.len(), 2);
-    assert_eq!(t.path, p);
+    assert_eq!(t.facts.path, p);
 }
 
 #[test]
@@ -148,14 +148,14 @@ fn read_time_column_gives_unrounded_freq() {
     let t = read_table(&p, &o).unwrap();
     assert_eq!(t.columns.len(), 1);
     assert_eq!(t.columns[0].name, "x");
-    assert_eq!(t.freq_hz, Some(62.5));
+    assert_eq!(t.facts.freq_hz, Some(62.5));
     assert_eq!(t.time.as_ref().unwrap().values, [0.0, 0.016, 0.032]);
     // an explicit rate wins over the time column
     let o = ReadOptions {
         freq_hz: Some(60.0),
         ..o
     };
-    assert_eq!(read_table(&p, &o).unwrap().freq_hz, Some(60.0));
+    assert_eq!(read_table(&p, &o).unwrap().facts.freq_hz, Some(60.0));
 }
 
 #[test]
@@ -186,13 +186,16 @@ fn read_sidecar_freq_and_precedence() {
         br#"{"name": "rec", "sampling_frequency_hz": 250, "unknown": {"a": 1}}"#,
     );
     let t = read(&p).unwrap();
-    assert_eq!(t.freq_hz, Some(250.0));
-    assert_eq!(t.sidecar.as_ref().unwrap().name.as_deref(), Some("rec"));
+    assert_eq!(t.facts.freq_hz, Some(250.0));
+    assert_eq!(
+        t.facts.sidecar.as_ref().unwrap().name.as_deref(),
+        Some("rec")
+    );
     let o = ReadOptions {
         freq_hz: Some(10.0),
         ..ReadOptions::default()
     };
-    assert_eq!(read_table(&p, &o).unwrap().freq_hz, Some(10.0));
+    assert_eq!(read_table(&p, &o).unwrap().facts.freq_hz, Some(10.0));
 }
 
 #[test]
@@ -456,7 +459,7 @@ fn binary_time_column() {
         ..ReadOptions::default()
     };
     let t = read_table(&p, &o).unwrap();
-    assert_eq!(t.freq_hz, Some(2.0));
+    assert_eq!(t.facts.freq_hz, Some(2.0));
     assert_eq!(t.columns[0].values, [1.0, 2.0, 3.0]);
 }
 
@@ -729,10 +732,10 @@ fn data_adis_16405_imu1_reads_whole() {
     let t = read(&p).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(t.columns.len(), 6);
     assert_eq!(t.len(), 1_000_000);
-    assert_eq!(t.freq_hz, Some(100.0));
+    assert_eq!(t.facts.freq_hz, Some(100.0));
     let first: Vec<f64> = t.columns.iter().map(|c| c.values[0]).collect();
     assert_eq!(first, [-0.05, -0.3, 0.7, -0.00666, 0.0, -1.01565]);
-    let sidecar = t.sidecar.as_ref().unwrap();
+    let sidecar = t.facts.sidecar.as_ref().unwrap();
     for c in &t.columns {
         let want = sidecar.summary[&c.name].mean.unwrap();
         let got = mean(&c.values);
@@ -849,8 +852,8 @@ fn issue_time_column_in_ns_is_not_read_as_seconds() {
         timed_csv("stamp", 0.0, 5e6, 100, usize::MAX, 0.0).as_bytes(),
     );
     let t = read(&p).unwrap();
-    assert_eq!(t.freq_hz, Some(200.0));
-    let timing = t.timing.as_ref().unwrap();
+    assert_eq!(t.facts.freq_hz, Some(200.0));
+    let timing = t.facts.timing.as_ref().unwrap();
     assert_eq!(timing.unit, TimeUnit::Nanoseconds);
     assert_eq!(timing.unit_source, UnitSource::Inferred);
     assert_eq!(
@@ -873,8 +876,12 @@ fn issue_time_column_in_ns_is_not_read_as_seconds() {
         ..ReadOptions::default()
     };
     let t = read_table(&p, &o).unwrap();
-    assert!((t.freq_hz.unwrap() - 200.0).abs() < 1e-6, "{:?}", t.freq_hz);
-    assert_eq!(t.timing.as_ref().unwrap().unit, TimeUnit::Nanoseconds);
+    assert!(
+        (t.facts.freq_hz.unwrap() - 200.0).abs() < 1e-6,
+        "{:?}",
+        t.facts.freq_hz
+    );
+    assert_eq!(t.facts.timing.as_ref().unwrap().unit, TimeUnit::Nanoseconds);
     // the name states the unit; a given unit wins and is reported as given
     let p = write(
         &d,
@@ -882,15 +889,21 @@ fn issue_time_column_in_ns_is_not_read_as_seconds() {
         timed_csv("%time", 0.0, 5e6, 100, usize::MAX, 0.0).as_bytes(),
     );
     let t = read(&p).unwrap();
-    assert_eq!(t.timing.as_ref().unwrap().unit_source, UnitSource::Stated);
-    assert_eq!(t.freq_hz, Some(200.0));
+    assert_eq!(
+        t.facts.timing.as_ref().unwrap().unit_source,
+        UnitSource::Stated
+    );
+    assert_eq!(t.facts.freq_hz, Some(200.0));
     let o = ReadOptions {
         time_unit: Some(TimeUnit::Microseconds),
         ..ReadOptions::default()
     };
     let t = read_table(&p, &o).unwrap();
-    assert_eq!(t.timing.as_ref().unwrap().unit_source, UnitSource::Flag);
-    assert!((t.freq_hz.unwrap() - 0.2).abs() < 1e-12);
+    assert_eq!(
+        t.facts.timing.as_ref().unwrap().unit_source,
+        UnitSource::Flag
+    );
+    assert!((t.facts.freq_hz.unwrap() - 0.2).abs() < 1e-12);
 }
 
 /// A 0.5 s gap in a 200 Hz log was averaged into the rate silently.
@@ -903,16 +916,20 @@ fn issue_gap_is_not_averaged_into_the_rate() {
         timed_csv("time", 0.0, 0.005, 2000, 1000, 0.5).as_bytes(),
     );
     let t = read(&p).unwrap();
-    assert!((t.freq_hz.unwrap() - 200.0).abs() < 1e-9, "{:?}", t.freq_hz);
-    let timing = t.timing.as_ref().unwrap();
+    assert!(
+        (t.facts.freq_hz.unwrap() - 200.0).abs() < 1e-9,
+        "{:?}",
+        t.facts.freq_hz
+    );
+    let timing = t.facts.timing.as_ref().unwrap();
     assert!((timing.mean_rate_hz - 1999.0 / 10.495).abs() < 1e-9);
     assert_eq!(timing.gaps.len(), 1);
     let g = &timing.gaps[0];
     assert_eq!((g.row, g.line, g.missing), (1000, Some(1002), 100));
     assert!((g.duration_s - 0.5).abs() < 1e-9);
-    assert_eq!(t.warnings.len(), 1);
+    assert_eq!(t.facts.warnings.len(), 1);
     assert_eq!(
-        t.warnings[0].to_string(),
+        t.facts.warnings[0].to_string(),
         format!(
             "{}: time column \"time\": 1 gap (100 samples missing), largest 0.50 s at line 1002 \
              (5.00 s after the start); the rows are analysed as if evenly spaced at 200 Hz",
@@ -920,7 +937,7 @@ fn issue_gap_is_not_averaged_into_the_rate() {
         )
     );
     assert!(matches!(
-        &t.warnings[0],
+        &t.facts.warnings[0],
         ReadWarning::Timing {
             warning: TimingWarning::Gaps { count: 1, .. },
             ..
@@ -942,10 +959,10 @@ fn issue_freq_disagreeing_with_the_time_column_is_warned() {
         ..ReadOptions::default()
     };
     let t = read_table(&p, &o).unwrap();
-    assert_eq!(t.freq_hz, Some(100.0), "the given rate still wins");
-    assert_eq!(t.warnings.len(), 1);
+    assert_eq!(t.facts.freq_hz, Some(100.0), "the given rate still wins");
+    assert_eq!(t.facts.warnings.len(), 1);
     assert_eq!(
-        t.warnings[0].to_string(),
+        t.facts.warnings[0].to_string(),
         format!(
             "{}: the rate given (100 Hz) differs by 50% from time column \"t\" (200 Hz); the \
              given rate is used",
@@ -957,13 +974,13 @@ fn issue_freq_disagreeing_with_the_time_column_is_warned() {
         freq_hz: Some(200.5),
         ..ReadOptions::default()
     };
-    assert!(read_table(&p, &o).unwrap().warnings.is_empty());
+    assert!(read_table(&p, &o).unwrap().facts.warnings.is_empty());
     // a sidecar rate that disagrees is reported, the time column's is used
     write(&d, "t.csv.json", br#"{"sampling_frequency_hz": 100}"#);
     let t = read(&p).unwrap();
-    assert!((t.freq_hz.unwrap() - 200.0).abs() < 1e-9);
+    assert!((t.facts.freq_hz.unwrap() - 200.0).abs() < 1e-9);
     assert!(matches!(
-        t.warnings[..],
+        t.facts.warnings[..],
         [ReadWarning::SidecarFreqDisagrees { .. }]
     ));
 }
@@ -980,9 +997,9 @@ fn issue_time_columns_are_not_analysed() {
     let t = read(&p).unwrap();
     let names: Vec<&str> = t.columns.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["x"]);
-    assert_eq!(t.timing.as_ref().unwrap().column, "timestamp");
-    assert_eq!(t.skipped, ["time"]);
-    assert!((t.freq_hz.unwrap() - 100.0).abs() < 1e-9);
+    assert_eq!(t.facts.timing.as_ref().unwrap().column, "timestamp");
+    assert_eq!(t.facts.skipped, ["time"]);
+    assert!((t.facts.freq_hz.unwrap() - 100.0).abs() < 1e-9);
     // selecting the time column explicitly analyses it (and it is then not the time)
     let o = ReadOptions {
         columns: names_of(&["timestamp", "x"]),
@@ -990,7 +1007,7 @@ fn issue_time_columns_are_not_analysed() {
     };
     let t = read_table(&p, &o).unwrap();
     assert_eq!(t.columns.len(), 2);
-    assert_eq!(t.timing.as_ref().unwrap().column, "time");
+    assert_eq!(t.facts.timing.as_ref().unwrap().column, "time");
     // time stamps that go backwards stay an error naming the line
     let p = write(&d, "back.csv", b"time,x\n0,1\n0.01,2\n0.005,3\n");
     assert_eq!(
@@ -1059,10 +1076,13 @@ fn rostopic_layout_reads_the_sensor_columns() {
     }
     let p = write(&d, "imu.csv", s.as_bytes());
     let t = read(&p).unwrap();
-    assert_eq!(t.timing.as_ref().unwrap().column, "field.header.stamp");
-    assert!((t.freq_hz.unwrap() - 100.0).abs() < 1e-6);
     assert_eq!(
-        t.skipped,
+        t.facts.timing.as_ref().unwrap().column,
+        "field.header.stamp"
+    );
+    assert!((t.facts.freq_hz.unwrap() - 100.0).abs() < 1e-6);
+    assert_eq!(
+        t.facts.skipped,
         [
             "%time",
             "field.header.seq",
@@ -1087,7 +1107,7 @@ fn short_headers_time_ax_gx() {
     }
     let p = write(&d, "log.txt", s.as_bytes());
     let t = read(&p).unwrap();
-    assert_eq!(t.skipped, ["temp"]);
+    assert_eq!(t.facts.skipped, ["temp"]);
     let imu = Imu::from_table(t).unwrap();
     assert_eq!(imu.num_sensor(), (3, 3));
     assert!((imu.freq_hz() - 100.0).abs() < 1e-9);
@@ -1206,7 +1226,7 @@ fn issue_series_files_follow_their_extension_and_sidecars_do_not_collide() {
         assert_eq!(side, d.path().join(format!("{name}.json")));
         // read back without options
         let t = read(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(t.freq_hz, Some(50.0));
+        assert_eq!(t.facts.freq_hz, Some(50.0));
         assert_eq!(t.columns[0].name, "a", "{name}");
         if format == "f32" {
             let a32: Vec<f64> = a.iter().map(|&v| f64::from(v as f32)).collect();
@@ -1301,7 +1321,7 @@ fn imu_records_every_type_rates_and_errors() {
             ..ReadOptions::default()
         };
         let table = read_table(&p, &o).unwrap();
-        assert_eq!(table.freq_hz, Some(400.0));
+        assert_eq!(table.facts.freq_hz, Some(400.0));
         assert_eq!(table.columns[0].name, "accel_z");
         assert_eq!(
             table.columns[0].values,
@@ -1311,7 +1331,7 @@ fn imu_records_every_type_rates_and_errors() {
             table.columns[1].values,
             imu.axis("gyro_y").unwrap().values()
         );
-        assert_eq!(table.record_type, Some(t));
+        assert_eq!(table.facts.record_type, Some(t));
         // truncated
         let mut cut = b[..2 * t.record_size()].to_vec();
         cut.extend_from_slice(&[0; 5]);
@@ -1455,7 +1475,7 @@ fn read_accounts_for_every_row() {
         ..ReadOptions::default()
     };
     let t = read_table(&p, &opts).unwrap();
-    let s = &t.samples;
+    let s = &t.facts.samples;
     assert_eq!(s.columns, ["gx", "gy"]);
     assert_eq!((s.unit, s.read, s.used, s.missing), ("row", 7, 7, 3));
     let parts: Vec<(u64, &str)> = s
@@ -1472,10 +1492,13 @@ fn read_accounts_for_every_row() {
     );
     // gzip: the same account
     let gz = write(&d, "gaps.csv.gz", &gzip(text.as_bytes()));
-    assert_eq!(read_table(&gz, &opts).unwrap().samples, t.samples);
+    assert_eq!(
+        read_table(&gz, &opts).unwrap().facts.samples,
+        t.facts.samples
+    );
     // no header, no blank line, no time column
     let p = write(&d, "plain.csv", b"1,2\n3,4\n5,6\n");
-    let s = read(&p).unwrap().samples;
+    let s = read(&p).unwrap().facts.samples;
     assert_eq!((s.read, s.used, s.missing), (3, 3, 0));
     assert!(s.without_samples.is_empty());
     assert!(
@@ -1492,6 +1515,7 @@ fn read_accounts_for_every_row() {
         },
     )
     .unwrap()
+    .facts
     .samples;
     assert_eq!((s.unit, s.read, s.used), ("row", 3, 3));
     assert_eq!(s.columns, ["col1", "col2"]);
@@ -1509,6 +1533,7 @@ fn read_accounts_for_every_row() {
         },
     )
     .unwrap()
+    .facts
     .samples;
     assert_eq!(
         (s.unit, s.read, s.used, s.columns.len()),

@@ -771,11 +771,11 @@ fn ros_streamed_equals_in_memory_noting(
     assert_eq!(s.names, names, "{shown}");
     assert_eq!(s.rows as usize, rec.imu.len(), "{shown}");
     assert_eq!(
-        s.freq_hz.map(f64::to_bits),
+        s.facts.freq_hz.map(f64::to_bits),
         Some(rec.imu.freq_hz().to_bits())
     );
-    assert_eq!(s.timing, rec.timing, "{shown}");
-    assert_eq!(s.samples, rec.samples, "{shown}");
+    assert_eq!(s.facts.timing, rec.timing, "{shown}");
+    assert_eq!(s.facts.samples, rec.samples, "{shown}");
     let notes: Vec<String> = rec
         .notes
         .iter()

@@ -207,14 +207,19 @@ fn same_as_in_memory(path: &Path, read: &ReadOptions) -> (Table, StreamedTable) 
     assert_eq!(streamed.names, names, "{}", path.display());
     assert_eq!(streamed.rows as usize, table.len());
     assert_eq!(
-        streamed.freq_hz.map(f64::to_bits),
-        table.freq_hz.map(f64::to_bits)
+        streamed.facts.freq_hz.map(f64::to_bits),
+        table.facts.freq_hz.map(f64::to_bits)
     );
-    assert_eq!(streamed.timing, table.timing, "{}", path.display());
-    assert_eq!(streamed.warnings, table.warnings);
-    assert_eq!(streamed.skipped, table.skipped);
-    assert_eq!(streamed.record_type, table.record_type);
-    let freq = table.freq_hz.unwrap_or(1.0);
+    assert_eq!(
+        streamed.facts.timing,
+        table.facts.timing,
+        "{}",
+        path.display()
+    );
+    assert_eq!(streamed.facts.warnings, table.facts.warnings);
+    assert_eq!(streamed.facts.skipped, table.facts.skipped);
+    assert_eq!(streamed.facts.record_type, table.facts.record_type);
+    let freq = table.facts.freq_hz.unwrap_or(1.0);
     let wvs = streamed
         .wavelet_variance(freq, &WvOptions::default())
         .unwrap();
@@ -282,7 +287,7 @@ fn streamed_records_equal_in_memory_for_every_type() {
             ..ReadOptions::default()
         };
         let (table, streamed) = same_as_in_memory(&path, &read);
-        assert_eq!(table.timing.unwrap().gaps.len(), 1, "{t}");
+        assert_eq!(table.facts.timing.unwrap().gaps.len(), 1, "{t}");
         assert!(streamed.notes.is_empty(), "{:?}", streamed.notes);
         // a column subset too
         let read = ReadOptions {
@@ -334,10 +339,10 @@ fn streamed_text_with_time_column_equals_in_memory() {
         path
     };
     let (table, streamed) = same_as_in_memory(&write("ns.csv", &ns), &ReadOptions::default());
-    let timing = table.timing.unwrap();
+    let timing = table.facts.timing.unwrap();
     assert!(!timing.gaps.is_empty() && timing.gaps[0].line.is_some());
     assert!(timing.jitter > 0.0);
-    assert_eq!(table.skipped, ["temp"]);
+    assert_eq!(table.facts.skipped, ["temp"]);
     assert!(streamed.notes.is_empty(), "{:?}", streamed.notes);
     let (_, streamed) = same_as_in_memory(&write("ms.csv", &ms), &ReadOptions::default());
     assert!(

@@ -194,6 +194,7 @@ pub fn compute(config: &MonitorConfig, style: OutputStyle) -> Result<Vec<AxisMon
         let event_stamps = loaded.table.time.as_ref().map(|t| {
             let start = loaded
                 .table
+                .facts
                 .timing
                 .as_ref()
                 .map_or(0.0, |timing| timing.start_s);

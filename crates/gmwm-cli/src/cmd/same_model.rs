@@ -122,7 +122,7 @@ fn read_pool(
                 names.join(",")
             );
         }
-        let units = |l: &Loaded| l.table.sidecar.as_ref().and_then(|s| s.units.clone());
+        let units = |l: &Loaded| l.table.facts.sidecar.as_ref().and_then(|s| s.units.clone());
         if let (Some(a), Some(b)) = (units(first), units(l)) {
             for (what, ua, ub) in [
                 ("gyroscope", unit_of(&a.gyro), unit_of(&b.gyro)),

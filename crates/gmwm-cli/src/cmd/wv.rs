@@ -137,17 +137,17 @@ fn run_streamed_table(
         // a ROS topic's notes say all of it, as the in-memory path prints them
         crate::input::report_parts(
             style,
-            &table.path,
-            table.timing.as_ref(),
-            &table.skipped,
-            &table.samples,
-            &table.warnings,
+            &table.facts.path,
+            table.facts.timing.as_ref(),
+            &table.facts.skipped,
+            &table.facts.samples,
+            &table.facts.warnings,
         );
     }
     for n in &table.notes {
         style.note(&input.file, n);
     }
-    let freq_hz = match table.freq_hz {
+    let freq_hz = match table.facts.freq_hz {
         Some(f) => f,
         None => {
             eprintln!(

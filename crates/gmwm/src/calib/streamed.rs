@@ -182,16 +182,21 @@ impl Calibration {
         let (spool, layout) = table.spooled();
         let columns: Vec<usize> = (1..=table.names.len()).collect();
         let infos: Vec<SensorInfo> = table.sensor_infos();
-        let freq_hz = table.freq_hz.ok_or_else(|| ReadError::FreqNotDerivable {
-            path: table.path.clone(),
-            reason: "no freq_hz given, no time column, no sampling_frequency_hz in a sidecar",
-        })?;
+        let freq_hz = table
+            .facts
+            .freq_hz
+            .ok_or_else(|| ReadError::FreqNotDerivable {
+                path: table.facts.path.clone(),
+                reason: "no freq_hz given, no time column, no sampling_frequency_hz in a sidecar",
+            })?;
         let name = table
+            .facts
             .sidecar
             .as_ref()
             .and_then(|s| s.name.clone())
             .or_else(|| {
                 table
+                    .facts
                     .path
                     .file_name()
                     .map(|f| f.to_string_lossy().into_owned())

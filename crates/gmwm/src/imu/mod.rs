@@ -45,7 +45,7 @@ pub use probe::Probe;
 pub use read::{
     binary_layout, for_each_chunk, read_imu_record_file, read_table, resolve_format, sniff,
     BinaryChunks, BinaryLayout, Column, ColumnSelector, Content, HeaderMode, ImuRecordType,
-    InputFormat, ReadOptions, ReadWarning, Table,
+    InputFormat, ReadOptions, ReadWarning, Table, TableFacts,
 };
 pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use samples::{SampleAccount, Tally};

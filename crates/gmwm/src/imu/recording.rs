@@ -94,20 +94,20 @@ impl Recording {
         }
         let table = read_table(path, &opts.read)?;
         let notes = table_notes(
-            table.record_type,
-            table.timing.as_ref(),
-            &table.skipped,
-            &table.samples,
-            &table.warnings,
+            table.facts.record_type,
+            table.facts.timing.as_ref(),
+            &table.facts.skipped,
+            &table.facts.samples,
+            &table.facts.warnings,
         );
-        let source = match table.record_type {
+        let source = match table.facts.record_type {
             Some(t) => RecordingSource::Records {
                 record_type: t.name().to_string(),
             },
             None => RecordingSource::Table,
         };
-        let timing = table.timing.clone();
-        let samples = table.samples.clone();
+        let timing = table.facts.timing.clone();
+        let samples = table.facts.samples.clone();
         let imu = Imu::from_table(table)?;
         Ok(Self {
             path: path.to_path_buf(),

@@ -110,8 +110,8 @@ impl SensorInfo {
     /// states, else the sidecar's, else rad/s and m/s^2 for binary IMU records (docs/methods.md
     /// §9.3).
     pub fn of_table(table: &Table) -> Vec<SensorInfo> {
-        let sidecar = table.sidecar.as_ref();
-        let record = table.record_type.is_some();
+        let sidecar = table.facts.sidecar.as_ref();
+        let record = table.facts.record_type.is_some();
         table
             .columns
             .iter()
@@ -322,25 +322,26 @@ impl Imu {
     /// [`ReadError::FreqNotDerivable`] if `table.freq_hz` is `None`; [`ParamError`] as
     /// [`Imu::new`] (e.g. two `gyro_x` columns).
     pub fn from_table(table: Table) -> Result<Self, Error> {
-        let Some(freq_hz) = table.freq_hz else {
+        let Some(freq_hz) = table.facts.freq_hz else {
             return Err(ReadError::FreqNotDerivable {
-                path: table.path,
+                path: table.facts.path,
                 reason: "no freq_hz given, no time column, no sampling_frequency_hz in a sidecar",
             });
         };
         let info = SensorInfo::of_table(&table);
-        let sidecar = table.sidecar.as_ref();
+        let sidecar = table.facts.sidecar.as_ref();
         let name = sidecar.and_then(|s| s.name.clone()).or_else(|| {
             table
+                .facts
                 .path
                 .file_name()
                 .map(|f| f.to_string_lossy().into_owned())
         });
         let mut imu = Self::new(table.columns, info, freq_hz)?;
         imu.name = name;
-        imu.record_type = table.record_type;
-        imu.timing = table.timing;
-        imu.warnings = table.warnings;
+        imu.record_type = table.facts.record_type;
+        imu.timing = table.facts.timing;
+        imu.warnings = table.facts.warnings;
         Ok(imu)
     }
 
@@ -415,7 +416,7 @@ impl Imu {
         self.timing.as_ref()
     }
 
-    /// Soft problems found while reading the file ([`Table::warnings`]).
+    /// Soft problems found while reading the file ([`TableFacts::warnings`](crate::imu::TableFacts::warnings)).
     pub fn warnings(&self) -> &[ReadWarning] {
         &self.warnings
     }

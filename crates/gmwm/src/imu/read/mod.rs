@@ -285,21 +285,18 @@ pub struct Column {
     pub values: Vec<f64>,
 }
 
-/// A table read from a file.
+/// What a reader found out about a recording besides its samples: where it came from, its
+/// rate, sidecar, time column, soft problems, the columns it left out, its record type and its
+/// row accounting. Shared by the in-memory [`Table`] and the streamed
+/// [`StreamedTable`](stream::StreamedTable).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Table {
+pub struct TableFacts {
     /// File, as given by the caller.
     pub path: PathBuf,
-    /// Selected columns, in the requested order, all of the same length (≥ 1).
-    pub columns: Vec<Column>,
     /// Sampling rate in Hz, resolved as documented on [`read_table`].
     pub freq_hz: Option<f64>,
     /// The JSON sidecar beside the file, if any.
     pub sidecar: Option<Sidecar>,
-    /// The time column, if one was given or found: seconds after its first stamp (which is
-    /// [`TimingReport::start_s`]), finite and strictly increasing; relative so that epoch
-    /// stamps keep their precision (whole-number stamps are subtracted exactly).
-    pub time: Option<Column>,
     /// What the time column says about the sampling (unit, rate, gaps, ...), if there is one.
     pub timing: Option<TimingReport>,
     /// Soft problems found while reading (gaps, a rate that disagrees with the time column).
@@ -312,6 +309,19 @@ pub struct Table {
     pub record_type: Option<ImuRecordType>,
     /// How many samples were read and used per column, and what held none (row accounting).
     pub samples: SampleAccount,
+}
+
+/// A table read from a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// What the reader found out besides the samples.
+    pub facts: TableFacts,
+    /// Selected columns, in the requested order, all of the same length (≥ 1).
+    pub columns: Vec<Column>,
+    /// The time column, if one was given or found: seconds after its first stamp (which is
+    /// [`TimingReport::start_s`]), finite and strictly increasing; relative so that epoch
+    /// stamps keep their precision (whole-number stamps are subtracted exactly).
+    pub time: Option<Column>,
 }
 
 impl Table {
@@ -574,12 +584,12 @@ pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<Strin
 /// order) unless `opts.columns` selects that column explicitly. Its unit: `opts.time_unit`,
 /// else the one its name states, else [`infer_time_unit`](super::timing::infer_time_unit)
 /// (seconds if nothing can be inferred). The stamps are converted to seconds and checked
-/// ([`check_times`], [`Table::timing`]); in a text or raw binary file
+/// ([`check_times`], [`TableFacts::timing`]); in a text or raw binary file
 /// they must strictly increase ([`ReadError::TimeNotIncreasing`] names the line).
 ///
 /// Columns: `opts.columns` in that order; by default every column but the time columns, and
 /// if some columns are gyroscope or accelerometer axes ([`SensorInfo::infer`] on the name or
-/// the sidecar's meaning) only those; the others are listed in [`Table::skipped`].
+/// the sidecar's meaning) only those; the others are listed in [`TableFacts::skipped`].
 ///
 /// Sampling frequency, first match wins: `opts.freq_hz`; the time column's rate,
 /// [`TimingReport::rate_hz`] (1 / the nominal step: the mean of the steps within 1.5 median
@@ -713,19 +723,21 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         .without(raw.blank_lines, "blank line")
     };
     Ok(Table {
-        samples,
-        path: path.to_path_buf(),
-        columns: raw.columns,
-        freq_hz,
-        sidecar,
-        time,
-        timing,
-        warnings,
-        skipped: raw.skipped,
-        record_type: match format {
-            InputFormat::ImuRecord(t) => Some(t),
-            _ => None,
+        facts: TableFacts {
+            samples,
+            path: path.to_path_buf(),
+            freq_hz,
+            sidecar,
+            timing,
+            warnings,
+            skipped: raw.skipped,
+            record_type: match format {
+                InputFormat::ImuRecord(t) => Some(t),
+                _ => None,
+            },
         },
+        columns: raw.columns,
+        time,
     })
 }
 

@@ -44,7 +44,7 @@ use super::binary::{
 use super::text::for_each_text_row;
 use super::{
     resolve_format, resolve_rate, timing_warnings, BinaryLayout, InputFormat, ReadOptions,
-    ReadWarning,
+    TableFacts,
 };
 use crate::error::ParamError;
 use crate::imu::sidecar::{find_sidecar, Sidecar};
@@ -61,33 +61,19 @@ use std::path::{Path, PathBuf};
 /// ```no_run
 /// use gmwm::imu::read::stream::StreamedTable;
 /// let table = StreamedTable::open("imu.csv.gz".as_ref(), &Default::default())?;
-/// let wvs = table.wavelet_variance(table.freq_hz.unwrap_or(1.0), &Default::default())?;
+/// let wvs = table.wavelet_variance(table.facts.freq_hz.unwrap_or(1.0), &Default::default())?;
 /// println!("{} rows, {:?}", table.rows, wvs[0].wv());
 /// # Ok::<(), gmwm::imu::ReadError>(())
 /// ```
 #[derive(Debug)]
 pub struct StreamedTable {
-    /// File, as given.
-    pub path: PathBuf,
+    /// What the reader found out besides the samples, as [`read_table`](super::read_table)
+    /// finds it.
+    pub facts: TableFacts,
     /// Names of the selected columns, in order (as [`Table::columns`](super::Table)).
     pub names: Vec<String>,
     /// Rows (samples per column).
     pub rows: u64,
-    /// Sampling rate, resolved as [`read_table`](super::read_table) resolves it.
-    pub freq_hz: Option<f64>,
-    /// The JSON sidecar beside the file, if any.
-    pub sidecar: Option<Sidecar>,
-    /// What the time column says, if there is one.
-    pub timing: Option<TimingReport>,
-    /// Soft problems, as [`Table::warnings`](super::Table).
-    pub warnings: Vec<ReadWarning>,
-    /// Columns left out of the default selection.
-    pub skipped: Vec<String>,
-    /// The binary IMU record type, if the file holds records.
-    pub record_type: Option<ImuRecordType>,
-    /// How many samples were read and used per column, and what held none (as
-    /// [`Table::samples`](super::Table)).
-    pub samples: SampleAccount,
     /// What the streamed reader did that the in-memory one does not (the stamps checked in
     /// memory beyond the bounds of the streamed check), one line each. For a ROS recording,
     /// every note of [`Recording::notes`](crate::imu::Recording) (the topic, the timing, the
@@ -247,16 +233,18 @@ impl StreamedTable {
         spool: Spool,
     ) -> Self {
         Self {
-            path: path.to_path_buf(),
+            facts: TableFacts {
+                path: path.to_path_buf(),
+                freq_hz: Some(freq_hz),
+                sidecar: None,
+                timing: Some(timing),
+                warnings: Vec::new(),
+                skipped: Vec::new(),
+                record_type: None,
+                samples,
+            },
             names,
             rows,
-            freq_hz: Some(freq_hz),
-            sidecar: None,
-            timing: Some(timing),
-            warnings: Vec::new(),
-            skipped: Vec::new(),
-            record_type: None,
-            samples,
             notes,
             topic: Some(topic),
             container: Some(container),
@@ -267,10 +255,10 @@ impl StreamedTable {
     /// What each selected column measures: by its name, the sidecar, and for binary IMU
     /// records and ROS topics their units (rad/s, m/s^2).
     pub fn sensor_infos(&self) -> Vec<crate::imu::SensorInfo> {
-        let known = self.record_type.is_some() || self.topic.is_some();
+        let known = self.facts.record_type.is_some() || self.topic.is_some();
         self.names
             .iter()
-            .map(|n| crate::imu::SensorInfo::of_column(n, self.sidecar.as_ref(), known))
+            .map(|n| crate::imu::SensorInfo::of_column(n, self.facts.sidecar.as_ref(), known))
             .collect()
     }
 
@@ -294,7 +282,7 @@ impl StreamedTable {
     pub(crate) fn rename(&self, e: ReadError) -> ReadError {
         match e {
             ReadError::Series { column, source, .. } => ReadError::Series {
-                path: self.path.clone(),
+                path: self.facts.path.clone(),
                 column,
                 source,
             },
@@ -518,7 +506,8 @@ fn open_text_stream(
         notes,
         spool,
     )?;
-    table.samples = table
+    table.facts.samples = table
+        .facts
         .samples
         .without(pass.header_lines, "header line")
         .without(pass.blank_lines, "blank line");
@@ -617,16 +606,18 @@ fn finish(
         ..SampleAccount::all_used(names.clone(), "row", rows)
     };
     Ok(StreamedTable {
-        samples,
-        path: path.to_path_buf(),
+        facts: TableFacts {
+            samples,
+            path: path.to_path_buf(),
+            freq_hz,
+            sidecar,
+            timing,
+            warnings,
+            skipped,
+            record_type: None,
+        },
         names,
         rows,
-        freq_hz,
-        sidecar,
-        timing,
-        warnings,
-        skipped,
-        record_type: None,
         notes,
         topic: None,
         container: None,
@@ -804,7 +795,7 @@ fn open_records_stream(
         notes,
         spool,
     )?;
-    table.record_type = Some(record_type);
-    table.samples.unit = "record";
+    table.facts.record_type = Some(record_type);
+    table.facts.samples.unit = "record";
     Ok(table)
 }
