@@ -55,7 +55,7 @@ fn streamed_calibration_matches_in_memory() {
     });
     let probe = gmwm::imu::Probe::of(&path, &read);
     assert!(streaming.streams(&probe, &read).unwrap());
-    let streamed = streaming.run_file(&path, &read, &NoProgress).unwrap();
+    let streamed = streamed_calibration(&streaming, &path, &read);
     let imu = Imu::from_table(read_table(&path, &read).unwrap()).unwrap();
     let in_memory = Calibration::new(CalibrationOptions::default())
         .run(&imu)
@@ -122,9 +122,8 @@ fn streamed_robust_matches_whole_series() {
     let streamed = Calibration::new(CalibrationOptions {
         stream_from: 1,
         ..CalibrationOptions::default()
-    })
-    .run_file(&path, &ReadOptions::default(), &NoProgress)
-    .unwrap();
+    });
+    let streamed = streamed_calibration(&streamed, &path, &ReadOptions::default());
     let c = streamed.axes[0].contamination.as_ref().unwrap();
     assert!(c.matters, "{}", c.summary);
     let whole = wavelet_variance(
@@ -177,9 +176,8 @@ fn streamed_calibration_names_a_dead_column() {
     let report = Calibration::new(CalibrationOptions {
         stream_from: 1,
         ..CalibrationOptions::default()
-    })
-    .run_file(&path, &ReadOptions::default(), &NoProgress)
-    .unwrap();
+    });
+    let report = streamed_calibration(&report, &path, &ReadOptions::default());
     assert_eq!(report.axes.len(), 1);
     assert_eq!(report.axes[0].column, "gyro_x");
     assert!(
@@ -367,4 +365,28 @@ fn streamed_text_with_time_column_equals_in_memory() {
             .unwrap_err()
             .to_string()
     );
+}
+
+/// The calibration of `path` as `gmwm calibrate` runs it ([`Calibration::open`] from its probe,
+/// then [`Calibration::run_source`]), which must have chosen to stream it.
+fn streamed_calibration(
+    calibration: &Calibration,
+    path: &std::path::Path,
+    read: &ReadOptions,
+) -> gmwm::calib::CalibrationReport {
+    let source = calibration
+        .open(
+            &gmwm::imu::Probe::of(path, read),
+            &gmwm::imu::RecordingOptions {
+                read: read.clone(),
+                topic: None,
+            },
+        )
+        .unwrap();
+    assert!(
+        !matches!(source, gmwm::calib::CalibrationSource::Memory(_)),
+        "{} read into memory, not streamed",
+        path.display()
+    );
+    calibration.run_source(&source, &NoProgress).unwrap()
 }

@@ -75,7 +75,7 @@ pub struct CalibrationOptions {
     /// The robust estimator the classical WV is compared with to tell whether contamination
     /// matters (paper Fig. 2; default `eff = 0.6`, the package's; `None` skips the check).
     pub robust_check: Option<RobustOptions>,
-    /// Samples per column from which [`Calibration::run_file`] streams a raw binary recording
+    /// Samples per column from which [`Calibration::run_source`] streams a raw binary recording
     /// instead of reading it into memory (default [`crate::calib::STREAM_FROM`], 2^24).
     pub stream_from: u64,
 }

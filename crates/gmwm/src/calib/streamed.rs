@@ -2,7 +2,7 @@
 //! (a day at 1 kHz is 8.6·10^7 samples an axis): a raw binary recording as it is, text and
 //! binary IMU records through the raw f64 spool that
 //! [`StreamedTable`] writes in its one pass over the
-//! file ([`Calibration::run_table`]).
+//! file (`Calibration::run_table`).
 //!
 //! The pipeline of [`Calibration::run`] needs the samples only for four things, and each has a
 //! streamed form:
@@ -48,7 +48,7 @@ use crate::wavelet::{Transform, WaveletFilter};
 use rayon::prelude::*;
 use std::path::Path;
 
-/// Default samples per axis from which [`Calibration::run_file`] streams a raw binary
+/// Default samples per axis from which [`Calibration::run_source`] streams a raw binary
 /// recording instead of reading it (2^24, 128 MiB an axis in f64;
 /// [`CalibrationOptions::stream_from`](super::CalibrationOptions::stream_from)).
 pub const STREAM_FROM: u64 = 1 << 24;
@@ -59,7 +59,7 @@ pub const ROBUST_BLOCK: usize = 1 << 21;
 pub const ROBUST_LEVELS: usize = 15;
 
 impl Calibration {
-    /// Whether [`Calibration::run_file`] streams `path`, calibrated with the classical Haar
+    /// Whether [`Calibration::run_source`] streams `path`, calibrated with the classical Haar
     /// MODWT WV: a raw binary f64/f32 file (by `read.format`, its name or its sidecar) of at
     /// least `stream_from` rows whose columns have no time column; or text or binary IMU
     /// records of at least `stream_from` rows
@@ -105,25 +105,15 @@ impl Calibration {
         Ok((rows >= self.options().stream_from.max(1)).then_some((layout, rows)))
     }
 
-    /// Calibrates the recording `path` streamed from the file (module docs; text and IMU
-    /// records through [`Calibration::run_table`]): the same report as [`Calibration::run`] on
-    /// the recording read into memory, up to the contamination check (on blocks, at the fine
-    /// scales) and the starting values (from the WV), in memory bounded whatever the length.
+    /// Calibrates the recording `probe` streamed from the file (module docs; text and IMU
+    /// records through `run_table`): the same report as [`Calibration::run`] on the recording
+    /// read into memory, up to the contamination check (on blocks, at the fine scales) and the
+    /// starting values (from the WV), in memory bounded whatever the length.
     ///
     /// # Errors
-    /// [`ParamError`] (as [`Error`]) when `path` is not streamed ([`Calibration::streams`]);
-    /// read errors naming the file (a non-finite value with its sample index or line, a
-    /// truncated file); no rate known; the errors of [`Calibration::run`].
-    pub fn run_file(
-        &self,
-        path: &Path,
-        read: &ReadOptions,
-        progress: &dyn Progress,
-    ) -> Result<CalibrationReport, Error> {
-        self.run_probed(&Probe::of(path, read), read, progress)
-    }
-
-    /// [`Calibration::run_file`] of a path probed before.
+    /// [`ParamError`] when the recording is not streamed ([`Calibration::streams`]); read
+    /// errors naming the file (a non-finite value with its sample index or line, a truncated
+    /// file); no rate known; the errors of [`Calibration::run`].
     fn run_probed(
         &self,
         probe: &Probe,
@@ -170,11 +160,11 @@ impl Calibration {
     }
 
     /// Calibrates a text or IMU-record recording read by [`StreamedTable::open`], streamed
-    /// from its spool: as [`Calibration::run_file`].
+    /// from its spool: as [`Calibration::run_source`].
     ///
     /// # Errors
     /// No rate known ([`ReadError::FreqNotDerivable`]); the errors of [`Calibration::run`].
-    pub fn run_table(
+    pub(crate) fn run_table(
         &self,
         table: &StreamedTable,
         progress: &dyn Progress,
@@ -369,8 +359,9 @@ impl Calibration {
     }
 
     /// Calibrates a recording opened by [`Calibration::open`]: [`Calibration::run`] on one in
-    /// memory, [`Calibration::run_table`] on a spooled one, [`Calibration::run_file`] on a raw
-    /// binary file streamed.
+    /// memory; streamed from its spool (text, IMU records, ROS) or from the file (raw binary)
+    /// otherwise, with the same report up to the contamination check and the starting values
+    /// (module docs).
     ///
     /// # Errors
     /// As those.
