@@ -216,4 +216,58 @@ mod tests {
             }
         }
     }
+
+    /// Every kind declares one transform per parameter under both presets, its starting-value
+    /// draw gives one value per parameter, and its physical read-off and Markov form exist
+    /// exactly for the kinds whose role says so: a new process that forgets a fact fails here,
+    /// not in a fit.
+    #[test]
+    fn every_kind_declares_its_facts() {
+        use super::super::draw::{Dominance, Draw, DrawContext};
+        use super::super::param::TransformPreset;
+        use rand::SeedableRng;
+        let ctx = DrawContext {
+            sigma2_t: 1.0,
+            n: 1000.0,
+            range: 0.01,
+            freq_hz: 100.0,
+            dom: Dominance::Wn,
+            only_wn: false,
+            only_qn: false,
+        };
+        for &kind in KINDS.iter().chain(&[ProcessKind::Arma(2, 1)]) {
+            let s = spec(kind);
+            let n = kind.n_params();
+            for preset in [TransformPreset::Imu, TransformPreset::Ssm] {
+                assert_eq!((s.transforms)(kind, preset).len(), n, "{kind} transforms");
+            }
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+            let mut draw = Draw {
+                ctx: &ctx,
+                rng: &mut rng,
+                condition: 1,
+                last_phi: 0.0,
+            };
+            let mut theta = Vec::new();
+            (s.draw)(&mut draw, kind, &vec![None; n], &mut theta);
+            assert_eq!(theta.len(), n, "{kind} draw");
+            assert!(theta.iter().all(|v| v.is_finite()), "{kind} draw {theta:?}");
+            assert_eq!(
+                s.markov.is_some(),
+                s.role == Role::Correlated,
+                "{kind} Markov form"
+            );
+            assert_eq!(
+                s.chain.is_some(),
+                s.role == Role::Correlated,
+                "{kind} chain slot"
+            );
+            let physical = (s.physical)(&theta, 100.0, "u");
+            assert_eq!(
+                physical.is_empty(),
+                s.role == Role::Other,
+                "{kind} physical read-off"
+            );
+        }
+    }
 }
