@@ -23,7 +23,7 @@
 //! The recordings are independent, so with `D_k` the `J_bar x J_k` matrix holding `w_kj` at
 //! `(j, j)`, `Cov(nu2_bar) = sum_k D_k V_k D_k'`, `V_k` the covariance of recording k's WV
 //! (exact at `N_k`, docs/methods.md §1.10, or simulated at `N_k`):
-//! `inference::covariance::pooled_wv_covariance`.
+//! `sim::covariance::pooled_wv_covariance`.
 //!
 //! # Relation to the pooled GMWM (§5.11)
 //! With diagonal weights `omega_kj`, `sum_k omega_kj (nu2_hat_kj - nu2_j)^2 = Omega_j
