@@ -1,6 +1,6 @@
 //! Bodies of the fuzz targets of the gmwm readers, one function per target, shared by the
 //! cargo-fuzz binaries (`fuzz/fuzz_targets/<target>.rs`, nightly, libFuzzer) and by the stable
-//! property tests of the engine (`crates/gmwm/tests/fuzz_props.rs` includes this file), so the
+//! property tests of the engine (`crates/gmwm/src/tests/fuzz_props.rs` includes this file), so the
 //! two never drift apart.
 //!
 //! Each body takes arbitrary bytes, hands them to a reader through the engine's public API and

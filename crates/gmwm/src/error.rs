@@ -247,7 +247,7 @@ impl ParamError {
 
 /// Samples whose range is below this have squared differences below 1e-300, near the end of
 /// double precision (normal numbers stop at 2.2e-308).
-pub const UNDERFLOW_RANGE: f64 = 1e-150;
+pub(crate) const UNDERFLOW_RANGE: f64 = 1e-150;
 
 /// Checks that a series is non-empty, finite and not constant (docs/methods.md §0.1 preconditions),
 /// nor so flat that its squared differences underflow ([`UNDERFLOW_RANGE`]).
@@ -259,7 +259,7 @@ pub const UNDERFLOW_RANGE: f64 = 1e-150;
 /// [`SeriesError::Empty`], [`SeriesError::TooShort`] (one sample),
 /// [`SeriesError::NonFinite`] (first offending index), [`SeriesError::Constant`] or
 /// [`SeriesError::Underflow`].
-pub fn check_series(x: &[f64]) -> Result<(), SeriesError> {
+pub(crate) fn check_series(x: &[f64]) -> Result<(), SeriesError> {
     let first = *x.first().ok_or(SeriesError::Empty)?;
     if x.len() == 1 {
         // one sample is no series: say so rather than call it constant
@@ -302,7 +302,7 @@ pub fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
 ///
 /// # Errors
 /// [`SeriesError::NonFinite`] with the first offending index.
-pub fn check_finite(x: &[f64]) -> Result<(), SeriesError> {
+pub(crate) fn check_finite(x: &[f64]) -> Result<(), SeriesError> {
     // v * 0 is 0 for finite v and NaN for NaN or +-inf; the sum is NaN iff one of them is.
     let mut acc = [0.0f64; 4];
     let mut quads = x.chunks_exact(4);

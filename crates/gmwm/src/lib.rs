@@ -46,12 +46,20 @@ pub mod units;
 pub mod variance;
 pub mod wavelet;
 
+// The engine's tests against reference data, properties and Monte Carlo; they reach the
+// crate-internal kernels, so they live inside the crate (the public API has its own test,
+// `tests/public_api.rs`).
+#[cfg(test)]
+mod tests;
+
 pub use error::{InputError, ParamError, SeriesError};
 pub use fit::{FitError, Gmwm, GmwmFit, Weighting, Weights};
 pub use selection::{auto_imu, ModelSelection, SelectionError, Wic};
 pub use variance::allan::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
 pub use variance::robust::{RobustConvention, RobustOptions};
-pub use variance::wv::{wavelet_variance, HaarWvAccumulator, WaveletVariance, WvOptions};
+#[cfg(test)]
+pub(crate) use variance::wv::HaarWvAccumulator;
+pub use variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 pub use wavelet::{Transform, WaveletFilter};
 
 /// Any error the engine can return.

@@ -65,7 +65,7 @@ use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use serde::Serialize;
 
 /// Smallest equivalent degrees of freedom `M_j / 2^j` (§1.7) of a level the monitor tests.
-pub const MIN_ETA: f64 = 8.0;
+pub(crate) const MIN_ETA: f64 = 8.0;
 
 /// Settings of [`monitor`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -125,7 +125,7 @@ pub struct MonitorWindow {
     /// The window's robust WV at the tested levels.
     pub wv: Vec<f64>,
     /// The window's classical WV at the tested levels.
-    pub classical_wv: Vec<f64>,
+    pub(crate) classical_wv: Vec<f64>,
     /// Whether it leaves the band at some level.
     pub flagged: bool,
     /// The levels out of the band.
@@ -187,9 +187,9 @@ pub struct MonitorReport {
     pub reference: &'static str,
     /// The centre of the classical WV's bands at the tested levels: the model's WV or the
     /// calibration's.
-    pub reference_wv: Vec<f64>,
+    pub(crate) reference_wv: Vec<f64>,
     /// The centre of the robust WV's bands: the model's WV or the calibration's robust WV.
-    pub robust_reference_wv: Vec<f64>,
+    pub(crate) robust_reference_wv: Vec<f64>,
     /// Sampling rate (Hz).
     pub freq_hz: f64,
     /// Window length (samples).
@@ -205,20 +205,20 @@ pub struct MonitorReport {
     /// Scales `2^j / f` of the tested levels (s).
     pub tau_s: Vec<f64>,
     /// The model's WV at those levels.
-    pub model_wv: Vec<f64>,
+    pub(crate) model_wv: Vec<f64>,
     /// Equivalent degrees of freedom of a window's classical WV (§16.3), before the
     /// reference's own uncertainty (§16.6).
     pub eta: Vec<f64>,
     /// Band of the robust WV, lower ends.
-    pub band_low: Vec<f64>,
+    pub(crate) band_low: Vec<f64>,
     /// Band of the robust WV, upper ends.
-    pub band_high: Vec<f64>,
+    pub(crate) band_high: Vec<f64>,
     /// Band of the classical WV, lower ends.
-    pub classical_band_low: Vec<f64>,
+    pub(crate) classical_band_low: Vec<f64>,
     /// Band of the classical WV, upper ends.
-    pub classical_band_high: Vec<f64>,
+    pub(crate) classical_band_high: Vec<f64>,
     /// Whether `eta` comes from the exact covariance (`false`: §1.7's `M_j / 2^j`).
-    pub exact_eta: bool,
+    pub(crate) exact_eta: bool,
     /// Every window.
     pub windows: Vec<MonitorWindow>,
     /// Merged runs of flagged windows.

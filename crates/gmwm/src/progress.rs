@@ -16,7 +16,7 @@ pub trait Progress: Sync {
 
 /// No progress reporting.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct NoProgress;
+pub(crate) struct NoProgress;
 
 impl Progress for NoProgress {}
 

@@ -53,7 +53,7 @@
 //! uses the levels with `eta_j >= 10` only ([`SharedOptions::test_min_eta`]): `c_hat_ik(j)` is a
 //! mean of about `eta_j` independent products of two normals (excess kurtosis 6), so its law is
 //! near-normal only when `eta_j` is not small. Its size is checked by Monte Carlo
-//! (`crates/gmwm/tests/shared.rs`).
+//! (`crates/gmwm/src/tests/shared.rs`).
 
 use crate::error::{InputError, ParamError};
 use crate::fit::objective::Stack;
@@ -129,7 +129,7 @@ pub struct NoSharedTest {
     /// Levels `j` used (those with `eta_j >= test_min_eta`).
     pub levels: Vec<usize>,
     /// The model fitted to each axis alone under H0.
-    pub null_models: Vec<String>,
+    pub(crate) null_models: Vec<String>,
 }
 
 /// The cross-covariance of one pair of axes with its standard errors.
@@ -163,7 +163,7 @@ pub struct SharedFit {
     /// The shared model with its estimates.
     pub shared_model: String,
     /// Each axis's specific model with its estimates.
-    pub specific_models: Vec<String>,
+    pub(crate) specific_models: Vec<String>,
     /// Every parameter: the shared ones first, then axis by axis.
     pub parameters: Vec<SharedParameter>,
     /// Each axis's WV.
@@ -188,7 +188,8 @@ pub struct SharedFit {
 
 impl SharedFit {
     /// The shared process's parameters.
-    pub fn shared_parameters(&self) -> impl Iterator<Item = &SharedParameter> {
+    #[cfg(test)]
+    pub(crate) fn shared_parameters(&self) -> impl Iterator<Item = &SharedParameter> {
         self.parameters.iter().filter(|p| p.block == "shared")
     }
 }

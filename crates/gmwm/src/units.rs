@@ -47,7 +47,7 @@ use std::fmt;
 use std::str::FromStr;
 
 /// Standard gravity `g_n` in m/s² (3rd CGPM 1901, exact): the `g` of accelerometer units.
-pub const STANDARD_GRAVITY: f64 = 9.80665;
+pub(crate) const STANDARD_GRAVITY: f64 = 9.80665;
 
 /// Seconds per hour: datasheet units are per hour or per root hour.
 const SECONDS_PER_HOUR: f64 = 3600.0;
@@ -129,7 +129,7 @@ impl SignalUnit {
     }
 
     /// The SI unit of a kind: rad/s or m/s².
-    pub fn si(kind: SignalKind) -> SignalUnit {
+    pub(crate) fn si(kind: SignalKind) -> SignalUnit {
         match kind {
             SignalKind::Gyroscope => SignalUnit::RadPerSecond,
             SignalKind::Accelerometer => SignalUnit::MeterPerSecond2,
@@ -296,7 +296,7 @@ impl fmt::Display for Quantity {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct UnitForms {
     /// Continuous-time form, in SI (known sensor kind) or in the data unit.
-    pub si: Quantity,
+    pub(crate) si: Quantity,
     /// Discrete form at the sampling rate, where one exists (docs/methods.md §14.2).
     pub discrete: Option<Quantity>,
     /// Datasheet form, where the sensor kind is known and one exists (module doc).
@@ -384,7 +384,8 @@ fn datasheet(term: NoiseTerm, kind: SignalKind) -> Option<Datasheet> {
 
 /// docs/methods.md §14.2: the datasheet form of a continuous SI value (units of the module doc);
 /// `None` where the term has no datasheet unit (Q; the accelerometer R).
-pub fn to_datasheet(term: NoiseTerm, kind: SignalKind, si_value: f64) -> Option<Quantity> {
+#[cfg(test)]
+pub(crate) fn to_datasheet(term: NoiseTerm, kind: SignalKind, si_value: f64) -> Option<Quantity> {
     datasheet(term, kind).map(|d| Quantity {
         value: si_value * d.factor,
         unit: d.unit.to_string(),
@@ -393,7 +394,8 @@ pub fn to_datasheet(term: NoiseTerm, kind: SignalKind, si_value: f64) -> Option<
 
 /// docs/methods.md §14.2: the continuous SI value of a datasheet figure (the inverse of
 /// [`to_datasheet`]); `None` where the term has no datasheet unit.
-pub fn from_datasheet(term: NoiseTerm, kind: SignalKind, value: f64) -> Option<f64> {
+#[cfg(test)]
+pub(crate) fn from_datasheet(term: NoiseTerm, kind: SignalKind, value: f64) -> Option<f64> {
     datasheet(term, kind).map(|d| value / d.factor)
 }
 

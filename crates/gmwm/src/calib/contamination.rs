@@ -27,14 +27,14 @@ pub struct Contamination {
     /// Number of scales where both estimates are defined.
     pub levels: usize,
     /// 1-based levels whose robust WV is undefined (no root of the scale equation).
-    pub undefined_levels: Vec<usize>,
+    pub(crate) undefined_levels: Vec<usize>,
     /// 1-based levels where the classical WV lies above the robust interval.
-    pub levels_above: Vec<usize>,
+    pub(crate) levels_above: Vec<usize>,
     /// 1-based levels where the classical WV lies below the robust interval.
-    pub levels_below: Vec<usize>,
+    pub(crate) levels_below: Vec<usize>,
     /// Largest factor between the classical and the robust WV over the levels outside (1 when
     /// none is).
-    pub max_ratio: f64,
+    pub(crate) max_ratio: f64,
     /// Whether the classical estimate, and so a classical fit, is affected: more scales outside
     /// than `alpha` of them allows by chance, or one outside by more than
     /// `CHANCE_MISS_REL`.
@@ -57,7 +57,7 @@ pub enum FitUses {
 /// `1 - alpha`: a level counts as outside when the classical estimate is beyond the robust
 /// interval; the verdict is the fit verdict's rule (more than `ceil(alpha J)` levels outside, or
 /// one outside by more than `CHANCE_MISS_REL` relative).
-pub fn compare_classical_robust(
+pub(crate) fn compare_classical_robust(
     classical: WaveletVariance,
     robust: WaveletVariance,
     fit_uses: FitUses,

@@ -50,7 +50,7 @@ pub const FLICKER_FACTOR: f64 = 0.664;
 /// Share of the fitted AV a term must carry at a scale for the scale to join its region.
 /// 0.9 bounds the contamination of a read-off by the other terms to 5.4% (module doc) while
 /// leaving regions of several octaves on real sensors, whose terms cross within a decade.
-pub const DOMINANCE: f64 = 0.9;
+pub(crate) const DOMINANCE: f64 = 0.9;
 
 /// Cap on the edf weight of a scale in the model fit: the five-term model is an idealisation
 /// (real sensors add Gauss–Markov bumps), so once a scale's AV is known to about 14%
@@ -298,7 +298,7 @@ fn line(s: &Scales, j: usize, idx: &[usize], values: &[f64]) -> Option<f64> {
 /// the white-noise line, do not pull the N read at 1 s (ADIS16405 gyro X: 6.06e-4 through
 /// 0.01–2.56 s, 7.0e-4 through 0.16–2.56 s, where the deviation's local slope is −1/2 within
 /// 0.02).
-pub const READ_OFF_WINDOW: f64 = 8.0;
+pub(crate) const READ_OFF_WINDOW: f64 = 8.0;
 
 /// The scales of `idx` within [`READ_OFF_WINDOW`] of `at_tau_s` when there are two or more,
 /// else `idx`.

@@ -7,11 +7,16 @@ pub(crate) mod pipeline;
 pub mod pooled;
 pub mod streamed;
 
-pub use contamination::{compare_classical_robust, Contamination, FitUses};
+pub use contamination::{Contamination, FitUses};
+
+#[cfg(test)]
+pub(crate) use contamination::compare_classical_robust;
 pub use nav::{Adjustment, AxisPolicy, NavSet};
 pub use pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,
     EstimateStatus, FitVerdict, GaussMarkovBias, DEFAULT_FULL_MODEL,
 };
 pub use pooled::PooledInput;
-pub use streamed::{CalibrationSource, ROBUST_BLOCK, ROBUST_LEVELS, STREAM_FROM};
+#[cfg(test)]
+pub(crate) use streamed::ROBUST_LEVELS;
+pub use streamed::{CalibrationSource, STREAM_FROM};

@@ -219,13 +219,13 @@ pub struct GaussMarkovBias {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitVerdict {
     /// p-value of the J-test (docs/methods.md §7.3).
-    pub j_test_p_value: Option<f64>,
+    pub(crate) j_test_p_value: Option<f64>,
     /// Number of scales.
     pub levels: usize,
     /// Scales where the implied WV lies outside the empirical WV's `1 - alpha` interval.
-    pub levels_outside_band: usize,
+    pub(crate) levels_outside_band: usize,
     /// Largest `|implied / empirical - 1|` over the scales outside the band (0 when none is).
-    pub max_relative_deviation: f64,
+    pub(crate) max_relative_deviation: f64,
     /// `levels_outside_band` is at most the count expected by chance (`alpha` of the levels,
     /// rounded up).
     pub explains_wv: bool,

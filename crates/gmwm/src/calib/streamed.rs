@@ -53,10 +53,10 @@ use std::path::Path;
 /// [`CalibrationOptions::stream_from`](super::CalibrationOptions::stream_from)).
 pub const STREAM_FROM: u64 = 1 << 24;
 /// Samples per block of the streamed robust check (2^21).
-pub const ROBUST_BLOCK: usize = 1 << 21;
+pub(crate) const ROBUST_BLOCK: usize = 1 << 21;
 /// Levels of the streamed robust check: scales up to `2^15` samples, at least 64 windows a
 /// block.
-pub const ROBUST_LEVELS: usize = 15;
+pub(crate) const ROBUST_LEVELS: usize = 15;
 
 impl Calibration {
     /// Whether [`Calibration::run_source`] streams `path`, calibrated with the classical Haar

@@ -15,7 +15,7 @@ use crate::model::{Component, ImpliedWv, Model};
 /// A component whose implied WV is below this share of the model's at every level counts as
 /// fitted to nothing; its effect on the objective is of the order of this share, far below
 /// what separates candidate models or moves an estimate.
-pub const NEGLIGIBLE_WV_SHARE: f64 = 1e-6;
+pub(crate) const NEGLIGIBLE_WV_SHARE: f64 = 1e-6;
 
 /// Per component of `implied`, whether it contributes: its implied WV exceeds
 /// [`NEGLIGIBLE_WV_SHARE`] of the model's at some level.
@@ -33,7 +33,7 @@ pub(crate) fn active_components(implied: &ImpliedWv) -> Vec<bool> {
 
 /// The active components of a fit as a guess-mode model (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
-pub struct SubModel {
+pub(crate) struct SubModel {
     /// The active components, in model order, without values.
     pub model: Model,
     /// Indices into the full theta of the sub-model's parameters.
@@ -58,7 +58,7 @@ impl GmwmFit {
     /// Indices (into theta) of the parameters of the components that contribute to the fit:
     /// all but those whose implied WV is below [`NEGLIGIBLE_WV_SHARE`] of the model's at every
     /// level (see the module docs).
-    pub fn active_parameters(&self) -> Vec<usize> {
+    pub(crate) fn active_parameters(&self) -> Vec<usize> {
         let mut keep = Vec::with_capacity(self.theta.len());
         let mut at = 0;
         let active = active_components(&self.implied_wv);
@@ -78,7 +78,7 @@ impl GmwmFit {
     ///
     /// # Errors
     /// As [`GmwmFit::active_sub_model`].
-    pub fn active_model(&self) -> Result<Model, FitError> {
+    pub(crate) fn active_model(&self) -> Result<Model, FitError> {
         match self.active_sub_model()? {
             Some(sub) => Ok(sub.model.with_values(&sub.start)?),
             None => Ok(self.model.clone()),
@@ -91,7 +91,7 @@ impl GmwmFit {
     /// # Errors
     /// [`FitError::Input`] if the sub-model cannot be built (it always can: its components
     /// are a subset of a valid model's).
-    pub fn active_sub_model(&self) -> Result<Option<SubModel>, FitError> {
+    pub(crate) fn active_sub_model(&self) -> Result<Option<SubModel>, FitError> {
         let keep = self.active_parameters();
         if keep.len() == self.theta.len() || keep.is_empty() {
             return Ok(None);

@@ -111,7 +111,7 @@ pub const SEPARATION_LIMIT: f64 = 2.0;
 /// standard error of the WV, summed over the levels) is fitted to nothing, whether or not the
 /// optimiser reached the boundary ([`NEGLIGIBLE_WV_SHARE`](super::NEGLIGIBLE_WV_SHARE) is that
 /// numerical test).
-pub const NEGLIGIBLE_SEPARATION: f64 = 0.01;
+pub(crate) const NEGLIGIBLE_SEPARATION: f64 = 0.01;
 
 /// Per component of `implied`, whether it contributes: it passes the numerical test of
 /// `crate::fit::active` and removing it moves the implied WV by more than
@@ -195,7 +195,7 @@ pub struct CanonicalTerm {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 #[non_exhaustive]
-pub enum Reading {
+pub(crate) enum Reading {
     /// Rule 1: fitted to nothing (at the boundary or negligible), dropped.
     AtBoundary {
         /// Component.
@@ -278,7 +278,7 @@ pub enum Reading {
 
 impl Reading {
     /// Whether the reading is a note only (the term is reported as fitted).
-    pub fn is_note(&self) -> bool {
+    pub(crate) fn is_note(&self) -> bool {
         matches!(self, Reading::CorrelationBeyondRecording { .. })
     }
 
@@ -412,7 +412,7 @@ pub struct CanonicalModel {
     /// Its terms in canonical order.
     pub terms: Vec<CanonicalTerm>,
     /// What was read differently from the fit, and why.
-    pub readings: Vec<Reading>,
+    pub(crate) readings: Vec<Reading>,
     /// The reduced model (rules 1 and 2, guess mode): the smallest model whose fit the data
     /// cannot tell from the fitted model's; fit it for identified estimates and intervals.
     pub reduced: Model,
@@ -427,7 +427,7 @@ pub struct CanonicalModel {
 
 impl CanonicalModel {
     /// Whether the canonical model is the fitted model, term for term (notes aside).
-    pub fn is_as_fitted(&self) -> bool {
+    pub(crate) fn is_as_fitted(&self) -> bool {
         self.readings.iter().all(Reading::is_note)
     }
 
@@ -478,7 +478,8 @@ impl CanonicalModel {
     }
 
     /// Number of correlated-noise terms (AR1/GM).
-    pub fn correlated_terms(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn correlated_terms(&self) -> usize {
         self.terms
             .iter()
             .filter(|t| spec(t.kind).role == Role::Correlated)
@@ -625,7 +626,7 @@ impl GmwmFit {
     /// number >= 0, or for a fit without an empirical WV (a bare [`Gmwm::fit_weighted`]: the
     /// separation is measured in the noise of that WV); errors of the refits' set-up. A refit
     /// that fails to converge only makes its reduction fail the test.
-    pub fn canonical_with(&self, limit: f64) -> Result<CanonicalModel, FitError> {
+    pub(crate) fn canonical_with(&self, limit: f64) -> Result<CanonicalModel, FitError> {
         if !(limit.is_finite() && limit >= 0.0) {
             return Err(crate::ParamError::new(
                 "separation limit",

@@ -15,7 +15,7 @@ use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use serde::Serialize;
 
 /// Default number of bootstrap replicates H behind [`Weighting::Bootstrap`] (docs/methods.md §5.7).
-pub const DEFAULT_BOOTSTRAP_REPLICATES: usize = 100;
+pub(crate) const DEFAULT_BOOTSTRAP_REPLICATES: usize = 100;
 
 /// GMWM estimator settings (docs/methods.md §5): the model and how to fit it. Build with
 /// [`Gmwm::new`] and the `with_*` setters, then call [`Gmwm::fit_wv`] or [`Gmwm::fit_series`].
@@ -108,20 +108,14 @@ impl Gmwm {
     }
 
     /// Sets the transform preset (docs/methods.md §5.3); default [`TransformPreset::Imu`].
-    pub fn with_preset(mut self, preset: TransformPreset) -> Self {
+    pub(crate) fn with_preset(mut self, preset: TransformPreset) -> Self {
         self.preset = preset;
         self
     }
 
     /// Sets how several AR1/GM components are parametrised; default [`PhiOrder::Ordered`].
-    pub fn with_phi_order(mut self, phi_order: PhiOrder) -> Self {
+    pub(crate) fn with_phi_order(mut self, phi_order: PhiOrder) -> Self {
         self.phi_order = phi_order;
-        self
-    }
-
-    /// Sets the optimiser options; default [`LmOptions::default`].
-    pub fn with_options(mut self, options: LmOptions) -> Self {
-        self.options = options;
         self
     }
 
@@ -299,7 +293,7 @@ impl Gmwm {
     ///
     /// # Errors
     /// As [`Gmwm::fit_wv`].
-    pub fn fit_weighted(
+    pub(crate) fn fit_weighted(
         &self,
         nu_hat: &[f64],
         weights: Weights,
@@ -489,16 +483,6 @@ impl GmwmFit {
         self.freq_hz
     }
 
-    /// Transform preset used.
-    pub fn preset(&self) -> TransformPreset {
-        self.preset
-    }
-
-    /// AR1/GM parametrisation used.
-    pub fn phi_order(&self) -> PhiOrder {
-        self.phi_order
-    }
-
     /// Which weighting produced `weights` (docs/methods.md §5.2).
     pub fn weighting(&self) -> Weighting {
         self.weighting
@@ -506,7 +490,8 @@ impl GmwmFit {
 
     /// The fast V of the first fit when the bootstrap weighting replaced it (the package's
     /// `orgV`); `None` otherwise (then `weights.v` is `orgV`).
-    pub fn org_v(&self) -> Option<&[f64]> {
+    #[cfg(test)]
+    pub(crate) fn org_v(&self) -> Option<&[f64]> {
         self.org_v.as_deref()
     }
 

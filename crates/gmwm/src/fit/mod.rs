@@ -25,17 +25,24 @@ pub mod weights;
 #[cfg(test)]
 mod tests_groundwork;
 
-pub use active::{SubModel, NEGLIGIBLE_WV_SHARE};
-pub use canonical::{CanonicalModel, CanonicalTerm, Reading, SEPARATION_LIMIT};
-pub use gmwm::{Gmwm, GmwmFit, DEFAULT_BOOTSTRAP_REPLICATES};
-pub use objective::Objective;
+pub(crate) use canonical::Reading;
+pub use canonical::{CanonicalModel, CanonicalTerm, SEPARATION_LIMIT};
+pub use gmwm::{Gmwm, GmwmFit};
+pub(crate) use objective::Objective;
 pub(crate) use optimize::minimize;
-pub use optimize::{Convergence, LmOptions, StopReason};
+pub(crate) use optimize::LmOptions;
+pub use optimize::{Convergence, StopReason};
 pub use pooled::{PooledFit, PooledRecording, Recording};
-pub use report::{Ar1GmForms, NavParameter, ParameterEstimate};
-pub use start::{starting_values, Dominance, StartInputs, StartOptions, StartValues};
+pub(crate) use report::Ar1GmForms;
+pub use report::{NavParameter, ParameterEstimate};
+#[cfg(test)]
+pub(crate) use start::starting_values;
+pub use start::StartInputs;
+pub(crate) use start::StartOptions;
 
-pub use transform::{ParamTransform, Parametrisation, PhiOrder, TransformPreset};
+pub use transform::{Parametrisation, PhiOrder, TransformPreset};
+
+pub(crate) use transform::ParamTransform;
 pub use weights::{Weighting, Weights};
 
 use crate::wavelet::WaveletFilter;

@@ -17,7 +17,7 @@ use crate::process::LatentProcess;
 
 /// The objective of one fit: a model template, the target WV, the weights and the transforms.
 #[derive(Debug, Clone)]
-pub struct Objective {
+pub(crate) struct Objective {
     model: Model,
     param: Parametrisation,
     nu_hat: Vec<f64>,
@@ -74,13 +74,13 @@ pub(crate) struct Eval {
     /// theta(u).
     pub theta: Vec<f64>,
     /// d theta / d u, row-major p x p.
-    pub dtheta: Vec<f64>,
+    pub(crate) dtheta: Vec<f64>,
     /// Whitened residuals, J.
     pub r: Vec<f64>,
     /// d r / d u, row-major J x p.
     pub jac: Vec<f64>,
     /// Implied WV nu2(theta), J.
-    pub nu: Vec<f64>,
+    pub(crate) nu: Vec<f64>,
 }
 
 impl Objective {
@@ -176,7 +176,7 @@ impl Objective {
     ///
     /// # Errors
     /// As [`Objective::new`].
-    pub fn with_full_weights(
+    pub(crate) fn with_full_weights(
         model: &Model,
         param: Parametrisation,
         nu_hat: &[f64],
@@ -323,18 +323,13 @@ impl Objective {
     }
 
     /// The transforms.
-    pub fn parametrisation(&self) -> &Parametrisation {
+    pub(crate) fn parametrisation(&self) -> &Parametrisation {
         &self.param
     }
 
     /// The model template (no values).
     pub fn model(&self) -> &Model {
         &self.model
-    }
-
-    /// The target WV `nu2_hat`.
-    pub fn nu_hat(&self) -> &[f64] {
-        &self.nu_hat
     }
 
     /// `sum_j omega_j nu2_hat_j^2`, the objective at a zero implied WV: the scale of `Q`.
@@ -362,11 +357,6 @@ impl Objective {
             }
             None => out.copy_from_slice(e),
         }
-    }
-
-    /// Sampling rate in Hz.
-    pub fn freq_hz(&self) -> f64 {
-        self.freq_hz
     }
 
     /// Implied WV `nu2(theta)` and, if asked, its Jacobian `A` (row-major J x p, docs/methods.md
@@ -526,6 +516,7 @@ impl Objective {
         Ok(())
     }
 
+    #[cfg(test)]
     fn check_u(&self, u: &[f64]) -> Result<(), FitError> {
         if u.len() == self.n_params() {
             Ok(())
@@ -544,7 +535,8 @@ impl Objective {
     ///
     /// # Errors
     /// [`FitError::Length`]; [`FitError::Input`] when theta is not a valid model.
-    pub fn value_at_theta(&self, theta: &[f64]) -> Result<f64, FitError> {
+    #[cfg(test)]
+    pub(crate) fn value_at_theta(&self, theta: &[f64]) -> Result<f64, FitError> {
         self.value_at_theta_in(theta, &mut Vec::new())
     }
 
@@ -588,6 +580,7 @@ impl Objective {
     /// # Errors
     /// [`FitError::Length`]; [`FitError::Input`] when theta(u) is not a valid model (e.g. a
     /// transformed variance that underflowed to 0).
+    #[cfg(test)]
     pub fn value(&self, u: &[f64]) -> Result<f64, FitError> {
         self.check_u(u)?;
         let mut ev = self.buffer();
@@ -600,7 +593,8 @@ impl Objective {
     ///
     /// # Errors
     /// As [`Objective::value`].
-    pub fn gradient(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
+    #[cfg(test)]
+    pub(crate) fn gradient(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
         self.check_u(u)?;
         let p = self.n_params();
         let mut ev = self.buffer();

@@ -39,7 +39,7 @@ pub enum StopReason {
 
 impl StopReason {
     /// Whether this reason means convergence.
-    pub fn is_converged(self) -> bool {
+    pub(crate) fn is_converged(self) -> bool {
         !matches!(
             self,
             StopReason::MaxIterations | StopReason::MaxEvaluations | StopReason::Stalled
@@ -65,9 +65,9 @@ impl fmt::Display for StopReason {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Convergence {
     /// Accepted steps.
-    pub iterations: usize,
+    pub(crate) iterations: usize,
     /// Evaluations of the implied WV (each with its Jacobian).
-    pub evaluations: usize,
+    pub(crate) evaluations: usize,
     /// Why it stopped.
     pub reason: StopReason,
     /// `reason.is_converged()`.
@@ -86,22 +86,22 @@ impl fmt::Display for Convergence {
 
 /// Options of the Levenberg–Marquardt optimiser ([`crate::Gmwm::with_options`]); the defaults suit the GMWM problem (a few to ~20 parameters).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LmOptions {
+pub(crate) struct LmOptions {
     /// Maximum accepted steps; default 2000 (LM typically needs 10–200 here, more when a
     /// component slowly fades to zero; the package's CG
     /// stops at 100).
-    pub max_iterations: usize,
+    pub(crate) max_iterations: usize,
     /// Maximum evaluations; default 20000 (ten trials per step leave the damping exhausted).
-    pub max_evaluations: usize,
+    pub(crate) max_evaluations: usize,
     /// Gradient cosine tolerance; default 1e-10 (MINPACK's `gtol` measure, scale-free).
-    pub gradient_tolerance: f64,
+    pub(crate) gradient_tolerance: f64,
     /// Relative step tolerance in `u`; default 1e-12 (theta then moves by ~1e-12 relative).
-    pub step_tolerance: f64,
+    pub(crate) step_tolerance: f64,
     /// Relative reduction tolerance of `Q`; default 1e-15 (a few ulps of `Q`).
-    pub function_tolerance: f64,
+    pub(crate) function_tolerance: f64,
     /// Relative residual size treated as exact zero; default 1e-28 (residuals ~1e-14 of the
     /// whitened WV, i.e. rounding).
-    pub zero_tolerance: f64,
+    pub(crate) zero_tolerance: f64,
 }
 
 impl Default for LmOptions {

@@ -70,7 +70,7 @@ use serde::Serialize;
 
 /// Replicates of the bootstrap V used when the exact WV covariance does not cover the model
 /// (as the single-recording inference, docs/methods.md §7.4).
-pub const POOLED_V_REPLICATES: usize = 100;
+pub(crate) const POOLED_V_REPLICATES: usize = 100;
 
 /// One recording of a pooled fit: its WV, its weights and the search inputs (N, range).
 #[derive(Debug, Clone, PartialEq)]

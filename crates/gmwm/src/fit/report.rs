@@ -40,7 +40,7 @@ pub struct ParameterEstimate {
 
 /// An AR1 or GM component in both forms (docs/methods.md §4.3, `dt = 1 / freq_hz`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Ar1GmForms {
+pub(crate) struct Ar1GmForms {
     /// Process as written in the model (`AR1` or `GM`).
     pub process: String,
     /// 0-based position of the component in the model.
@@ -54,7 +54,7 @@ pub struct Ar1GmForms {
     /// Stationary variance (data unit squared).
     pub sigma2_gm: f64,
     /// Correlation time `1 / beta`, seconds.
-    pub correlation_time_s: f64,
+    pub(crate) correlation_time_s: f64,
 }
 
 /// A parameter in physical units (see the module table).
@@ -93,7 +93,7 @@ impl GmwmFit {
     }
 
     /// Every AR1/GM component in both the per-sample AR1 and the rate-aware GM form.
-    pub fn ar1_gm_forms(&self) -> Vec<Ar1GmForms> {
+    pub(crate) fn ar1_gm_forms(&self) -> Vec<Ar1GmForms> {
         let mut out = Vec::new();
         let mut k = 0;
         for (index, c) in self.model.components().iter().enumerate() {

@@ -20,7 +20,7 @@
 use super::{FitError, Objective, Parametrisation, PhiOrder, TransformPreset, Weights};
 use crate::model::Model;
 use crate::process::draw::{Draw, DrawContext};
-pub use crate::process::Dominance;
+pub(crate) use crate::process::Dominance;
 use crate::process::{spec, Role};
 use crate::sim::replicate_seed;
 use crate::variance::wv::WaveletVariance;
@@ -32,7 +32,7 @@ use rayon::prelude::*;
 pub(crate) const BATCH_DRAWS: usize = 1000;
 /// The early stop is not considered before this many draws (five batches), so that a
 /// lucky or unlucky first batch cannot end the search.
-pub const MIN_DRAWS: usize = 5000;
+pub(crate) const MIN_DRAWS: usize = 5000;
 /// A batch that improves the best `F` by at most this fraction counts as no improvement
 /// (F is a sum of squared relative errors; 1e-6 of it is far below what stage 1 resolves).
 pub(crate) const EARLY_STOP_REL: f64 = 1e-6;
@@ -157,7 +157,7 @@ fn draw_into(
 
 /// Settings of the search.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct StartOptions {
+pub(crate) struct StartOptions {
     /// RNG seed (the package's default is 1337).
     pub seed: u64,
     /// Number of draws G; `None` for [`default_draws`].
@@ -174,7 +174,7 @@ impl Default for StartOptions {
 }
 
 /// Default G: 20000 for `N <= 1e4`, else 100000 (see the module docs).
-pub fn default_draws(n: usize) -> usize {
+pub(crate) fn default_draws(n: usize) -> usize {
     if n <= 10_000 {
         20_000
     } else {
@@ -184,15 +184,15 @@ pub fn default_draws(n: usize) -> usize {
 
 /// The result of the search.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct StartValues {
+pub(crate) struct StartValues {
     /// The best draw, model order, original parametrisation (GM as `beta`, `sigma2_gm`).
     pub theta: Vec<f64>,
     /// Its flattening objective `F`.
-    pub flattening: f64,
+    pub(crate) flattening: f64,
     /// Draws made (fewer than G after an early stop).
     pub draws: usize,
     /// The dominance found (§6.2).
-    pub dominance: Dominance,
+    pub(crate) dominance: Dominance,
 }
 
 /// docs/methods.md §6: the best of up to G random draws for `model` (values it carries are kept)
@@ -202,7 +202,7 @@ pub struct StartValues {
 /// [`FitError::BadWv`]/[`FitError::BadWeight`] for an unusable WV; [`FitError::TooFewLevels`];
 /// [`FitError::NonFiniteStart`] when no draw has a finite `F`; errors of
 /// [`Parametrisation::new`].
-pub fn starting_values(
+pub(crate) fn starting_values(
     model: &Model,
     wv: &WaveletVariance,
     inputs: &StartInputs,

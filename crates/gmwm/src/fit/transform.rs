@@ -13,7 +13,8 @@
 
 use super::FitError;
 use crate::model::Model;
-pub use crate::process::{logistic, ParamTransform, TransformPreset, RESTART_EDGE};
+pub use crate::process::TransformPreset;
+pub(crate) use crate::process::{logistic, ParamTransform, RESTART_EDGE};
 use crate::process::{spec, ChainSlot as Slot};
 use serde::{Deserialize, Serialize};
 
@@ -138,12 +139,12 @@ impl Parametrisation {
     }
 
     /// The scalar transform of each parameter; `None` for a `phi`/`beta` of the ordered chain.
-    pub fn transforms(&self) -> &[Option<ParamTransform>] {
+    pub(crate) fn transforms(&self) -> &[Option<ParamTransform>] {
         &self.single
     }
 
     /// Whether the AR1/GM components are parametrised by the ordered chain.
-    pub fn is_ordered(&self) -> bool {
+    pub(crate) fn is_ordered(&self) -> bool {
         !self.ordered.is_empty()
     }
 
@@ -164,7 +165,8 @@ impl Parametrisation {
     /// # Errors
     /// [`FitError::Length`]; [`FitError::OutOfDomain`] naming the parameter; with the ordered
     /// chain, [`FitError::PhiNotOrdered`] unless the phis strictly decrease in model order.
-    pub fn to_u(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+    #[cfg(test)]
+    pub(crate) fn to_u(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
         self.to_u_with(theta, false)
     }
 
@@ -175,7 +177,7 @@ impl Parametrisation {
     ///
     /// # Errors
     /// As [`Parametrisation::to_u`].
-    pub fn to_u_restart(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+    pub(crate) fn to_u_restart(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
         self.to_u_with(theta, true)
     }
 
@@ -232,7 +234,8 @@ impl Parametrisation {
     ///
     /// # Errors
     /// [`FitError::Length`].
-    pub fn from_u(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
+    #[cfg(test)]
+    pub(crate) fn to_theta(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
         self.check_len("u", u.len())?;
         let mut theta = vec![0.0; u.len()];
         self.eval(u, &mut theta, None);
@@ -262,7 +265,7 @@ impl Parametrisation {
         }
         for (i, t) in self.single.iter().enumerate() {
             if let Some(t) = t {
-                theta[i] = t.from_u(u[i]);
+                theta[i] = t.to_theta(u[i]);
                 if let Some(j) = jac.as_deref_mut() {
                     j[i * p + i] = t.dtheta_du(u[i]);
                 }
@@ -372,13 +375,13 @@ mod tests {
     fn param_transform_round_trips_and_differentiates() {
         for t in ALL {
             for u in [-7.0, -1.3, 0.0, 0.4, 2.5, 9.0] {
-                let theta = t.from_u(u);
+                let theta = t.to_theta(u);
                 let back = t.to_u(theta).unwrap();
                 assert!(
                     (back - u).abs() < 1e-9 * (1.0 + u.abs()),
                     "{t:?} {u} {back}"
                 );
-                let fd = (t.from_u(u + FD_STEP) - t.from_u(u - FD_STEP)) / (2.0 * FD_STEP);
+                let fd = (t.to_theta(u + FD_STEP) - t.to_theta(u - FD_STEP)) / (2.0 * FD_STEP);
                 let d = t.dtheta_du(u);
                 assert!(
                     (fd - d).abs() < FD_TOL * (1.0 + d.abs()),
@@ -387,7 +390,7 @@ mod tests {
             }
         }
         assert_eq!(
-            ParamTransform::LogAbs.from_u(ParamTransform::LogAbs.to_u(-0.5).unwrap()),
+            ParamTransform::LogAbs.to_theta(ParamTransform::LogAbs.to_u(-0.5).unwrap()),
             0.5
         );
     }
@@ -405,7 +408,7 @@ mod tests {
             let h = FD_STEP;
             up[k] += h;
             dn[k] -= h;
-            let (tp, td) = (p.from_u(&up).unwrap(), p.from_u(&dn).unwrap());
+            let (tp, td) = (p.to_theta(&up).unwrap(), p.to_theta(&dn).unwrap());
             for i in 0..u.len() {
                 let fd = (tp[i] - td[i]) / (2.0 * h);
                 let scale = jac[i][k].abs().max(jac[i][i].abs()).max(1e-300);
@@ -429,7 +432,7 @@ mod tests {
             6.28e-3, 1.28e-8, 0.25, 7.08e-9, 8.48, 6.48e-9, 6.94e-7, 2.29e-6, 3.9e-14, 1e-6,
         ];
         let u = p.to_u(&theta).unwrap();
-        let back = p.from_u(&u).unwrap();
+        let back = p.to_theta(&u).unwrap();
         for (a, b) in theta.iter().zip(&back) {
             assert!((a / b - 1.0).abs() < 1e-12, "{a} {b}");
         }
@@ -472,7 +475,7 @@ mod tests {
             let p = Parametrisation::new(&m, preset, PhiOrder::Ordered, 1.0).unwrap();
             let theta = [phis[0], 1e-3, phis[1], 2.0, phis[2], 0.5, 1.0];
             let u = p.to_u(&theta).unwrap();
-            let back = p.from_u(&u).unwrap();
+            let back = p.to_theta(&u).unwrap();
             for (a, b) in theta.iter().zip(&back) {
                 assert!(
                     (a - b).abs() < 1e-12 * a.abs().max(1.0),
@@ -486,7 +489,7 @@ mod tests {
         let e = p.to_u(&[0.9, 1.0, 0.5, 1.0, -0.1, 1.0, 1.0]).unwrap_err();
         assert!(matches!(e, FitError::OutOfDomain { index: 4, .. }), "{e}");
         // any u maps to ordered phis
-        let theta = p.from_u(&[-30.0, 0.0, 30.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        let theta = p.to_theta(&[-30.0, 0.0, 30.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
         assert!(theta[0] >= theta[2] && theta[2] >= theta[4]);
     }
 
@@ -536,7 +539,7 @@ mod tests {
         ] {
             assert!(p.to_u(&theta).is_err(), "{theta:?}");
             let u = p.to_u_restart(&theta).unwrap();
-            let back = p.from_u(&u).unwrap();
+            let back = p.to_theta(&u).unwrap();
             for (a, b) in back.iter().zip(&theta) {
                 assert!((a - b).abs() < 1e-8, "{theta:?} -> {back:?}");
             }

@@ -102,7 +102,7 @@ impl Weights {
     ///
     /// # Errors
     /// [`FitError::BadWeight`] for a zero or non-finite `nu2_hat_j`.
-    pub fn flattening(nu_hat: &[f64]) -> Result<Self, FitError> {
+    pub(crate) fn flattening(nu_hat: &[f64]) -> Result<Self, FitError> {
         Self::from_v(
             nu_hat.iter().map(|v| v * v).collect(),
             "squared wavelet variance",
@@ -121,7 +121,8 @@ impl Weights {
     ///
     /// # Errors
     /// [`FitError::BadWeight`] for a zero or non-finite value.
-    pub fn from_variances(v: Vec<f64>) -> Result<Self, FitError> {
+    #[cfg(test)]
+    pub(crate) fn from_variances(v: Vec<f64>) -> Result<Self, FitError> {
         Self::from_v(v, "variance")
     }
 
@@ -162,7 +163,7 @@ impl Weights {
 /// factorisation runs on the correlation matrix `C = D^{-1} V D^{-1}`, `D = diag(sqrt V_jj)`:
 /// `W = L_C^{-1} D^{-1}`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FullWeights {
+pub(crate) struct FullWeights {
     v: DMatrix<f64>,
     whitening: DMatrix<f64>,
 }
@@ -176,7 +177,7 @@ impl FullWeights {
     /// [`FitError::Length`] when `V` is not square; [`FitError::BadWeight`] for a zero or
     /// non-finite variance `V_jj`, a non-finite entry, or a non-positive Cholesky pivot of the
     /// correlation matrix (`V` not numerically positive definite), naming the level.
-    pub fn from_covariance(v: &DMatrix<f64>) -> Result<Self, FitError> {
+    pub(crate) fn from_covariance(v: &DMatrix<f64>) -> Result<Self, FitError> {
         let n = v.nrows();
         if v.ncols() != n {
             return Err(FitError::Length {
@@ -245,17 +246,13 @@ impl FullWeights {
         })
     }
 
-    /// The covariance `V`.
-    pub fn v(&self) -> &DMatrix<f64> {
-        &self.v
-    }
-
     /// The lower-triangular whitening matrix `W`, `W' W = V^{-1}`.
-    pub fn whitening(&self) -> &DMatrix<f64> {
+    pub(crate) fn whitening(&self) -> &DMatrix<f64> {
         &self.whitening
     }
 
     /// `Omega = V^{-1} = W' W`.
+    #[cfg(test)]
     pub fn omega(&self) -> DMatrix<f64> {
         self.whitening.transpose() * &self.whitening
     }

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use thiserror::Error;
 
 /// Longest text from a file quoted in a message, in characters (a cell, a header name).
-pub const QUOTE_MAX: usize = 40;
+pub(crate) const QUOTE_MAX: usize = 40;
 
 /// Text from a file made safe for a one-line message: control and other non-printable
 /// characters escaped (`\n`, `\u{0}`), cut to [`QUOTE_MAX`] characters with `...` appended.

@@ -40,19 +40,21 @@ pub mod timing;
 pub mod write;
 
 pub(crate) use error::escape_name;
-pub use error::{quote, ReadError, QUOTE_MAX};
+pub use error::{quote, ReadError};
 pub use probe::Probe;
+#[cfg(test)]
+pub(crate) use read::sniff;
 pub use read::{
-    binary_layout, for_each_chunk, read_imu_record_file, read_table, resolve_format, sniff,
-    BinaryChunks, BinaryLayout, Column, ColumnSelector, Content, HeaderMode, ImuRecordType,
-    InputFormat, ReadOptions, ReadWarning, Table, TableFacts,
+    binary_layout, read_table, BinaryChunks, BinaryLayout, Column, ColumnSelector, Content,
+    HeaderMode, ImuRecordType, InputFormat, ReadOptions, ReadWarning, Table, TableFacts,
 };
+#[cfg(test)]
+pub(crate) use read::{for_each_chunk, read_imu_record_file};
 pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use samples::{SampleAccount, Tally};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
 pub use sidecar::{find_sidecar, ColumnSummary, Sidecar, SidecarColumn, SidecarUnits};
-pub use timing::{
-    check_times, infer_time_unit, time_column_unit, Gap, TimeUnit, TimingReport, TimingWarning,
-    UnitSource,
-};
+#[cfg(test)]
+pub(crate) use timing::{check_times, UnitSource};
+pub use timing::{time_column_unit, Gap, TimeUnit, TimingReport, TimingWarning};
 pub use write::{OutputFormat, SeriesWriter};

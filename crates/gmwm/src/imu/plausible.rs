@@ -13,10 +13,10 @@ use std::path::{Path, PathBuf};
 const SAMPLE: usize = 1 << 16;
 
 /// A magnitude no inertial sensor reports, in any unit.
-pub const HUGE: f64 = 1e20;
+pub(crate) const HUGE: f64 = 1e20;
 
 /// A nonzero magnitude no inertial sensor reports (a subnormal f32 is below 1.2e-38).
-pub const TINY: f64 = 1e-30;
+pub(crate) const TINY: f64 = 1e-30;
 
 /// Raw floats that do not look like sensor samples ([`raw_floats`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -26,13 +26,13 @@ pub struct ImplausibleFloats {
     /// The format it was read with: [`InputFormat::F64`] or [`InputFormat::F32`].
     pub format: InputFormat,
     /// Values looked at (the first of the file).
-    pub looked_at: usize,
+    pub(crate) looked_at: usize,
     /// Of those, finite with |x| > [`HUGE`].
-    pub huge: usize,
+    pub(crate) huge: usize,
     /// Of those, nonzero with |x| < [`TINY`] (subnormals among them).
-    pub tiny: usize,
+    pub(crate) tiny: usize,
     /// Of those, NaN or infinite.
-    pub non_finite: usize,
+    pub(crate) non_finite: usize,
     /// The largest finite magnitude seen.
     pub largest: f64,
     /// The bytes looked at are printable ASCII text: the file is text, not raw floats.
@@ -41,7 +41,7 @@ pub struct ImplausibleFloats {
 
 impl ImplausibleFloats {
     /// The other raw format, the likely right one.
-    pub fn other_format(&self) -> InputFormat {
+    pub(crate) fn other_format(&self) -> InputFormat {
         match self.format {
             InputFormat::F32 => InputFormat::F64,
             _ => InputFormat::F32,

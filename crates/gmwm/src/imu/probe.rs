@@ -50,7 +50,7 @@ impl Probe {
 
     /// Whether the path holds no file for the table and binary readers: a ROS container (of
     /// any format asked) or a folder.
-    pub fn is_container_or_folder(&self) -> bool {
+    pub(crate) fn is_container_or_folder(&self) -> bool {
         self.container.is_some() || self.dir
     }
 }

@@ -121,7 +121,7 @@ impl SensorInfo {
 
     /// What the column `name` measures: [`SensorInfo::infer`] on its name, else on the
     /// sidecar's meaning of it, with [`SensorInfo::column_unit`] (`record`: binary IMU records).
-    pub fn of_column(name: &str, sidecar: Option<&Sidecar>, record: bool) -> SensorInfo {
+    pub(crate) fn of_column(name: &str, sidecar: Option<&Sidecar>, record: bool) -> SensorInfo {
         let inferred = SensorInfo::infer(name).or_else(|| {
             sidecar
                 .and_then(|s| s.meaning(name))
@@ -154,7 +154,7 @@ impl SensorInfo {
 
     /// The unit a column name states in a trailing `[..]` or `(..)`, as text:
     /// `w_RS_S_x [rad s^-1]` → `rad s^-1`, `acc_x (m/s^2)` → `m/s^2`; `None` without one.
-    pub fn unit_from_name(name: &str) -> Option<String> {
+    pub(crate) fn unit_from_name(name: &str) -> Option<String> {
         let stripped = strip_unit(name);
         let rest = name.trim()[stripped.len()..].trim();
         let inner = rest.get(1..rest.len().saturating_sub(1))?.trim();
@@ -346,14 +346,8 @@ impl Imu {
     }
 
     /// Sets the name.
-    pub fn with_name(mut self, name: impl Into<String>) -> Self {
+    pub(crate) fn with_name(mut self, name: impl Into<String>) -> Self {
         self.name = Some(name.into());
-        self
-    }
-
-    /// Records the binary record type the data came from (docs/methods.md §9.1 `stype`).
-    pub fn with_record_type(mut self, record_type: ImuRecordType) -> Self {
-        self.record_type = Some(record_type);
         self
     }
 
@@ -392,7 +386,8 @@ impl Imu {
     }
 
     /// `(number of gyroscopes, number of accelerometers)` (docs/methods.md §9.1 `num.sensor`).
-    pub fn num_sensor(&self) -> (usize, usize) {
+    #[cfg(test)]
+    pub(crate) fn num_sensor(&self) -> (usize, usize) {
         (self.gyroscopes().count(), self.accelerometers().count())
     }
 

@@ -31,21 +31,21 @@ const MAD_TO_SD: f64 = 1.4826;
 
 /// A step longer than this many nominal steps is a gap (1.5: one missing sample at a perfectly
 /// regular rate makes a step of 2, a jittery but complete log stays well below 1.5).
-pub const GAP_FACTOR: f64 = 1.5;
+pub(crate) const GAP_FACTOR: f64 = 1.5;
 
 /// Relative jitter (robust spread of the steps over the nominal step) above which the stamps
 /// are reported as irregular: 10%, far above the quantisation of stamps in ns or µs at IMU
 /// rates and below the spread of host-side receive times.
-pub const JITTER_WARN: f64 = 0.1;
+pub(crate) const JITTER_WARN: f64 = 0.1;
 
 /// Plausible IMU rates used to infer the unit of unlabelled stamps from their step:
 /// `[10 Hz, 10 kHz)`. The four units are a factor 1000 apart and this band spans exactly a
 /// factor 1000, so every median step selects exactly one unit.
-pub const PLAUSIBLE_RATE_HZ: (f64, f64) = (10.0, 10_000.0);
+pub(crate) const PLAUSIBLE_RATE_HZ: (f64, f64) = (10.0, 10_000.0);
 
 /// Unix-epoch seconds of plausible recording dates: 2001-09-09 (1e9 s) to 2103 (4.2e9 s).
 /// A first stamp of that size in s, ms, µs or ns (x 1, 1e3, 1e6, 1e9) names the unit.
-pub const EPOCH_S: (f64, f64) = (1.0e9, 4.2e9);
+pub(crate) const EPOCH_S: (f64, f64) = (1.0e9, 4.2e9);
 
 /// Unit of a time column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -71,7 +71,7 @@ impl TimeUnit {
     ];
 
     /// Seconds per unit: 1, 1e-3, 1e-6, 1e-9.
-    pub fn to_seconds(self) -> f64 {
+    pub(crate) fn to_seconds(self) -> f64 {
         match self {
             Self::Seconds => 1.0,
             Self::Milliseconds => 1e-3,
@@ -138,7 +138,7 @@ impl crate::names::Named for TimeUnit {
 /// Where the unit of a time column came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
-pub enum UnitSource {
+pub(crate) enum UnitSource {
     /// Stated by the column name (`[ns]`, `_ms`, `(s)`, ...) or by the convention of the tool
     /// that names columns so (`%time` and `field.header.stamp` of `rostopic echo -p` are ns).
     Stated,
@@ -222,7 +222,8 @@ fn split_unit(name: &str) -> (&str, Option<TimeUnit>) {
 ///
 /// `None` when neither rule applies (fewer than two stamps and no epoch-sized first stamp, or
 /// no positive step).
-pub fn infer_time_unit(raw: &[f64]) -> Option<TimeUnit> {
+#[cfg(test)]
+pub(crate) fn infer_time_unit(raw: &[f64]) -> Option<TimeUnit> {
     infer_unit(0.0, raw)
 }
 
@@ -282,28 +283,28 @@ pub struct TimingReport {
     /// Its unit.
     pub unit: TimeUnit,
     /// Where the unit came from.
-    pub unit_source: UnitSource,
+    pub(crate) unit_source: UnitSource,
     /// Number of stamps.
     pub samples: usize,
     /// The first stamp, in seconds (e.g. Unix time; an f64, so to about 0.2 µs at 1.7e9 s).
     pub start_s: f64,
     /// Latest minus earliest stamp, in seconds.
-    pub span_s: f64,
+    pub(crate) span_s: f64,
     /// Rate in Hz: `1 / nominal step`, the mean of the regular steps (module docs; equal to
     /// `1 / median step` on evenly stamped data), to 12 significant digits; NaN when no step is
     /// positive.
-    pub rate_hz: f64,
+    pub(crate) rate_hz: f64,
     /// `(samples - 1) / span_s`: what the rate would be without gaps (NaN for a zero span).
-    pub mean_rate_hz: f64,
+    pub(crate) mean_rate_hz: f64,
     /// Steps longer than [`GAP_FACTOR`] nominal steps, in order.
     pub gaps: Vec<Gap>,
     /// Steps of exactly zero (a stamp repeated).
-    pub duplicates: usize,
+    pub(crate) duplicates: usize,
     /// Negative steps (a stamp earlier than its predecessor).
     pub reordered: usize,
     /// Robust relative spread of the regular steps: `1.4826 · MAD / nominal step` (0 for evenly
     /// spaced stamps; NaN when no step is positive).
-    pub jitter: f64,
+    pub(crate) jitter: f64,
 }
 
 /// Median of a non-empty slice (sorted in place); `None` when empty.
@@ -419,7 +420,7 @@ fn gap(row: usize, time_s: f64, d: f64, nominal: f64) -> Gap {
 /// [`TimingReport`] and the module. Gaps carry no line numbers (`Gap::line` is `None`).
 ///
 /// Cost: O(n log n) (two sorts), one buffer of n values.
-pub fn check_times(
+pub(crate) fn check_times(
     column: &str,
     times_s: &[f64],
     unit: TimeUnit,
@@ -476,12 +477,12 @@ pub fn check_times(
 /// are quantised, so their steps take few values (a 200 Hz log stamped in ns: a handful; the
 /// relative stamps of a text file in seconds: a few a binade); beyond this many the check
 /// cannot be exact in bounded memory, and the readers check the column in memory instead.
-pub const STREAM_DISTINCT_STEPS: usize = 1 << 16;
+pub(crate) const STREAM_DISTINCT_STEPS: usize = 1 << 16;
 
 /// Largest steps a streamed check holds with their place, to find the gaps among them once the
 /// nominal step is known: 2^16 (more gaps than this: checked in memory, as
 /// [`STREAM_DISTINCT_STEPS`]).
-pub const STREAM_LARGEST_STEPS: usize = 1 << 16;
+pub(crate) const STREAM_LARGEST_STEPS: usize = 1 << 16;
 
 /// A step with its place, for the gaps of [`StepStats`].
 #[derive(Debug, Clone, Copy)]
@@ -679,7 +680,7 @@ impl StepStats {
 impl TimingReport {
     /// Samples missing over all gaps at the nominal rate (saturating: a gap of absurd length,
     /// a corrupt stamp, counts `usize::MAX`).
-    pub fn missing_samples(&self) -> usize {
+    pub(crate) fn missing_samples(&self) -> usize {
         self.gaps
             .iter()
             .fold(0usize, |sum, g| sum.saturating_add(g.missing))

@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 const BUF_CAPACITY: usize = 1 << 20;
 
 /// The file names [`OutputFormat::from_path`] accepts, for messages.
-pub const OUTPUT_EXTENSIONS: &str = ".csv, .txt, .tsv (each optionally .gz), .f64, .f64le, \
+pub(crate) const OUTPUT_EXTENSIONS: &str = ".csv, .txt, .tsv (each optionally .gz), .f64, .f64le, \
                                      .f64.bin, .f64le.bin, .f32, .f32le, .f32.bin, .f32le.bin";
 
 /// Format of a series file, from its name ([`OutputFormat::from_path`]).
@@ -405,7 +405,7 @@ pub fn write_csv_header(out: &mut dyn Write, names: &[&str]) -> io::Result<()> {
 /// The sidecar path of a data file: its whole name with `.json` appended (`x.f64.json`,
 /// `x.csv.gz.json`), the first name the readers look for, so that `x.txt` and `x.f64` never
 /// share a sidecar.
-pub fn sidecar_path(data: &Path) -> PathBuf {
+pub(crate) fn sidecar_path(data: &Path) -> PathBuf {
     let mut name = data.file_name().unwrap_or_default().to_os_string();
     name.push(".json");
     data.with_file_name(name)

@@ -55,7 +55,7 @@ pub enum IntervalScale {
 ///
 /// # Errors
 /// [`ParamError`] unless `0 < alpha < 1`.
-pub fn z_value(alpha: f64, convention: ZConvention) -> Result<f64, ParamError> {
+pub(crate) fn z_value(alpha: f64, convention: ZConvention) -> Result<f64, ParamError> {
     check_alpha(alpha)?;
     let tail = match convention {
         ZConvention::TwoSided => alpha / 2.0,
@@ -80,7 +80,7 @@ pub struct Sandwich {
 /// Relative singular-value cut-off of the pseudo-inverse: singular values of the
 /// column-equilibrated `A' Omega A` below `1e-12` times the largest count as zero (about 1e4
 /// times the rounding level of its entries).
-pub const PINV_RCOND: f64 = 1e-12;
+pub(crate) const PINV_RCOND: f64 = 1e-12;
 
 /// docs/methods.md §7.1: `H = (A' Omega A)^+ A' Omega`, `Psi = H V H'` with `A` (J x p), `Omega`
 /// (J x J) and `V` (J x J).

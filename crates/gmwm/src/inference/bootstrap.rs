@@ -10,7 +10,9 @@
 use crate::error::ParamError;
 use crate::fit::{FitError, Gmwm, GmwmFit, StartInputs, Weighting, Weights};
 use crate::progress::Progress;
-pub use crate::sim::bootstrap::{map_replicates, wv_bootstrap, WvBootstrap};
+pub(crate) use crate::sim::bootstrap::map_replicates;
+#[cfg(test)]
+pub(crate) use crate::sim::bootstrap::wv_bootstrap;
 use crate::sim::replicate_seed;
 use crate::variance::wv::WvOptions;
 use nalgebra::{DMatrix, DVector};
@@ -23,7 +25,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// Wire format: `replicates`, `theta_hat`, `estimates` (B x p, replicate order), `mean`, `sd`,
 /// `v` (J x J), `cross_cov` (J x J), `objectives` (B values or null), `not_converged`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FitBootstrap {
+pub(crate) struct FitBootstrap {
     /// Number of replicates B.
     pub replicates: usize,
     /// The estimate the replicates were simulated from (model order).
@@ -39,12 +41,12 @@ pub struct FitBootstrap {
     /// `C = Cov(nu2_hat*, nu2(theta*))` (J x J, divisor B - 1; row index the empirical WV
     /// level, column the implied one), the input of the WIC bootstrap optimism `2 tr(C Omega)`
     /// (docs/methods.md §8.3).
-    pub cross_cov: DMatrix<f64>,
+    pub(crate) cross_cov: DMatrix<f64>,
     /// Final objective of a fresh two-stage fit per replicate (the bootstrap GoF input), when
     /// asked.
-    pub objectives: Option<Vec<f64>>,
+    pub(crate) objectives: Option<Vec<f64>>,
     /// Replicate refits whose optimiser did not report convergence (kept in the summaries).
-    pub not_converged: usize,
+    pub(crate) not_converged: usize,
 }
 
 /// One replicate's kept numbers.
@@ -69,7 +71,7 @@ pub(crate) fn replicate_weighting(gmwm: &Gmwm) -> Weighting {
 
 /// Settings of [`fit_bootstrap`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct FitBootstrapOptions {
+pub(crate) struct FitBootstrapOptions {
     /// Replicates B (at least 2).
     pub replicates: usize,
     /// Master seed of the replicates.
@@ -96,7 +98,7 @@ pub struct FitBootstrapOptions {
 /// # Errors
 /// [`FitError::Input`] with a [`ParamError`] for fewer than 2 replicates or `n == 0`; errors of
 /// the simulation, the WV, the weights and the replicate fits (the first one met).
-pub fn fit_bootstrap(
+pub(crate) fn fit_bootstrap(
     gmwm: &Gmwm,
     fit: &GmwmFit,
     n: usize,

@@ -42,7 +42,7 @@ impl fmt::Display for JTest {
 /// far into the tail (regularised upper incomplete gamma `Q(df/2, t/2)`); 1 for `t <= 0`, NaN for a
 /// NaN `t`. With `df = 0` the distribution is the point mass at 0, whose upper tail at `t > 0`
 /// is 0.
-pub fn chi_square_upper_tail(t: f64, df: usize) -> f64 {
+pub(crate) fn chi_square_upper_tail(t: f64, df: usize) -> f64 {
     if t <= 0.0 {
         1.0
     } else if t.is_infinite() || df == 0 {
@@ -56,7 +56,7 @@ pub fn chi_square_upper_tail(t: f64, df: usize) -> f64 {
 /// if `S` is the sample covariance of `H` Gaussian `J`-vectors, `E[S^{-1}] = V^{-1} (H - 1) /
 /// (H - J - 2)`, so `factor x S^{-1}` is unbiased for `V^{-1}`. Scaling `S` by `1 / factor`
 /// before [`j_test`] applies it. `None` unless `H > J + 2`.
-pub fn hartlap_factor(replicates: usize, levels: usize) -> Option<f64> {
+pub(crate) fn hartlap_factor(replicates: usize, levels: usize) -> Option<f64> {
     (replicates > levels + 2).then(|| (replicates - levels - 2) as f64 / (replicates - 1) as f64)
 }
 
@@ -76,7 +76,7 @@ pub fn hartlap_factor(replicates: usize, levels: usize) -> Option<f64> {
 /// positive definite ([`FullWeights::from_covariance`]); [`FitError::Input`] with a
 /// [`ParamError`] when `J <= p` (no degrees of freedom); errors of the fit's parametrisation
 /// and optimiser.
-pub fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, FitError> {
+pub(crate) fn j_test(gmwm: &Gmwm, fit: &GmwmFit, v: &DMatrix<f64>) -> Result<JTest, FitError> {
     let levels = fit.nu_hat.len();
     // components at the boundary stay there: test the active sub-model (crate::fit::active)
     let sub = fit.active_sub_model()?;

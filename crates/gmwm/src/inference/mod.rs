@@ -12,18 +12,23 @@ mod pooled;
 pub mod same_model;
 pub(crate) mod summary;
 
-pub use crate::progress::{NoProgress, Progress};
-pub use crate::sim::covariance::{wv_covariance, CovarianceMethod, VSource, WvCovariance};
-pub use asymptotic::{sandwich, wald_interval, z_value, IntervalScale, Sandwich, ZConvention};
-pub use bootstrap::{
-    fit_bootstrap, map_replicates, wv_bootstrap, FitBootstrap, FitBootstrapOptions, WvBootstrap,
-};
-pub use gof::{j_test, JTest};
+pub use crate::progress::Progress;
+
+pub(crate) use crate::progress::NoProgress;
+pub use crate::sim::covariance::CovarianceMethod;
+pub(crate) use crate::sim::covariance::VSource;
+#[cfg(test)]
+pub(crate) use asymptotic::z_value;
+pub use asymptotic::{sandwich, wald_interval, IntervalScale, Sandwich, ZConvention};
+#[cfg(test)]
+pub(crate) use bootstrap::wv_bootstrap;
+pub use gof::JTest;
 pub use same_model::{
     compare_wvs, same_model_test, same_model_test_of, SameModelOptions, SameModelTest,
     ScaleContribution, WvComparison,
 };
+pub(crate) use summary::infer_with_covariance;
 pub use summary::{
-    infer, infer_with_covariance, infer_with_progress, BootstrapGof, Inference, InferenceMethod,
-    InferenceOptions, InferenceWarning, ParameterInference, VShape,
+    infer, infer_with_progress, BootstrapGof, Inference, InferenceMethod, InferenceOptions,
+    InferenceWarning, ParameterInference, VShape,
 };

@@ -107,7 +107,7 @@ pub struct SameModelTest {
     /// Contribution of each recording (sum = T), input order.
     pub per_recording: Vec<f64>,
     /// The replicates' statistics `T*`, replicate order (empty without bootstrap).
-    pub bootstrap_statistics: Vec<f64>,
+    pub(crate) bootstrap_statistics: Vec<f64>,
 }
 
 /// One scale's share of the statistic.
@@ -345,7 +345,7 @@ pub struct WvComparison {
     /// Scale in seconds.
     pub tau_s: f64,
     /// `ln nu2_hat_a - ln nu2_hat_b`.
-    pub log_ratio: f64,
+    pub(crate) log_ratio: f64,
     /// Its standard error from the two intervals.
     pub se: f64,
     /// `log_ratio / se`.

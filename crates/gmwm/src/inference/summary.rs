@@ -288,11 +288,6 @@ impl Inference {
         self.z
     }
 
-    /// Its convention.
-    pub fn z_convention(&self) -> ZConvention {
-        self.z_convention
-    }
-
     /// Interval scale.
     pub fn scale(&self) -> IntervalScale {
         self.scale
@@ -391,7 +386,7 @@ pub fn infer_with_progress(
 ///
 /// # Errors
 /// As [`infer`]; [`FitError::Input`] if `v` is not `J x J` for the fit's `J` levels.
-pub fn infer_with_covariance(
+pub(crate) fn infer_with_covariance(
     gmwm: &Gmwm,
     fit: &GmwmFit,
     v: &DMatrix<f64>,

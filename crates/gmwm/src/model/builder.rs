@@ -52,11 +52,6 @@ pub fn ma1() -> Component {
     Component::guess(ProcessKind::Ma1)
 }
 
-/// ARMA(1,1) in guess mode, `ARMA11()`.
-pub fn arma11() -> Component {
-    Component::guess(ProcessKind::Arma11)
-}
-
 /// AR(p) in guess mode, `AR(p)`; the order is checked by [`ModelSpec::build`] / [`Model::new`].
 pub fn ar(p: usize) -> Component {
     Component::guess(ProcessKind::Ar(p))
@@ -69,7 +64,8 @@ pub fn ma(q: usize) -> Component {
 
 /// ARMA(p,q) in guess mode, `ARMA(p,q)`; the orders are checked by [`ModelSpec::build`] /
 /// [`Model::new`].
-pub fn arma(p: usize, q: usize) -> Component {
+#[cfg(test)]
+pub(crate) fn arma(p: usize, q: usize) -> Component {
     Component::guess(ProcessKind::Arma(p, q))
 }
 
@@ -88,27 +84,12 @@ pub fn wn_with(sigma2: f64) -> Result<Component, ModelError> {
     given(ProcessKind::Wn, [sigma2])
 }
 
-/// `QN(q2)`.
-///
-/// # Errors
-/// [`ModelError::BadParameter`] unless `q2` is a finite variance > 0.
-pub fn qn_with(q2: f64) -> Result<Component, ModelError> {
-    given(ProcessKind::Qn, [q2])
-}
-
-/// `RW(gamma2)`.
-///
-/// # Errors
-/// [`ModelError::BadParameter`] unless `gamma2` is a finite variance > 0.
-pub fn rw_with(gamma2: f64) -> Result<Component, ModelError> {
-    given(ProcessKind::Rw, [gamma2])
-}
-
 /// `DR(omega)`.
 ///
 /// # Errors
 /// [`ModelError::BadParameter`] unless `omega` is finite.
-pub fn dr_with(omega: f64) -> Result<Component, ModelError> {
+#[cfg(test)]
+pub(crate) fn dr_with(omega: f64) -> Result<Component, ModelError> {
     given(ProcessKind::Dr, [omega])
 }
 
@@ -124,23 +105,17 @@ pub fn ar1_with(phi: f64, sigma2: f64) -> Result<Component, ModelError> {
 ///
 /// # Errors
 /// [`ModelError::BadParameter`] unless `beta` > 0 and `sigma2_gm` > 0 are finite.
-pub fn gm_with(beta: f64, sigma2_gm: f64) -> Result<Component, ModelError> {
+#[cfg(test)]
+pub(crate) fn gm_with(beta: f64, sigma2_gm: f64) -> Result<Component, ModelError> {
     given(ProcessKind::Gm, [beta, sigma2_gm])
-}
-
-/// `MA1(theta, sigma2)`.
-///
-/// # Errors
-/// [`ModelError::BadParameter`] unless `theta` is in (-1, 1) and `sigma2` > 0 is finite.
-pub fn ma1_with(theta: f64, sigma2: f64) -> Result<Component, ModelError> {
-    given(ProcessKind::Ma1, [theta, sigma2])
 }
 
 /// `ARMA11(phi, theta, sigma2)`.
 ///
 /// # Errors
 /// [`ModelError::BadParameter`] unless `phi`, `theta` are in (-1, 1) and `sigma2` > 0 is finite.
-pub fn arma11_with(phi: f64, theta: f64, sigma2: f64) -> Result<Component, ModelError> {
+#[cfg(test)]
+pub(crate) fn arma11_with(phi: f64, theta: f64, sigma2: f64) -> Result<Component, ModelError> {
     given(ProcessKind::Arma11, [phi, theta, sigma2])
 }
 
@@ -149,21 +124,11 @@ pub fn arma11_with(phi: f64, theta: f64, sigma2: f64) -> Result<Component, Model
 /// # Errors
 /// [`ModelError::BadOrder`] for an empty or too long `ar`; [`ModelError::BadParameter`] for a
 /// non-finite coefficient or a bad `sigma2`.
-pub fn ar_with(ar: &[f64], sigma2: f64) -> Result<Component, ModelError> {
+#[cfg(test)]
+pub(crate) fn ar_with(ar: &[f64], sigma2: f64) -> Result<Component, ModelError> {
     given(
         ProcessKind::Ar(ar.len()),
         ar.iter().copied().chain([sigma2]),
-    )
-}
-
-/// `MA(q)` with coefficients `ma` (q = `ma.len()`) and innovation variance `sigma2`.
-///
-/// # Errors
-/// As [`ar_with`].
-pub fn ma_with(ma: &[f64], sigma2: f64) -> Result<Component, ModelError> {
-    given(
-        ProcessKind::Ma(ma.len()),
-        ma.iter().copied().chain([sigma2]),
     )
 }
 
@@ -171,7 +136,8 @@ pub fn ma_with(ma: &[f64], sigma2: f64) -> Result<Component, ModelError> {
 ///
 /// # Errors
 /// As [`ar_with`]; `ARMA(0,0)` is rejected.
-pub fn arma_with(ar: &[f64], ma: &[f64], sigma2: f64) -> Result<Component, ModelError> {
+#[cfg(test)]
+pub(crate) fn arma_with(ar: &[f64], ma: &[f64], sigma2: f64) -> Result<Component, ModelError> {
     given(
         ProcessKind::Arma(ar.len(), ma.len()),
         ar.iter().chain(ma).copied().chain([sigma2]),

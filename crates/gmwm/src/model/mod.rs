@@ -43,15 +43,16 @@ mod builder;
 pub mod parse;
 mod realize;
 
-pub use builder::{
-    ar, ar1, ar1_with, ar_with, arma, arma11, arma11_with, arma_with, dr, dr_with, gm, gm_with, ma,
-    ma1, ma1_with, ma_with, qn, qn_with, rw, rw_with, wn, wn_with, ModelSpec,
-};
+pub use builder::{ar, ar1, ar1_with, dr, gm, ma, ma1, qn, rw, wn, wn_with, ModelSpec};
+
+#[cfg(test)]
+pub(crate) use builder::{ar_with, arma, arma11_with, arma_with, dr_with, gm_with};
 pub use parse::{ModelParseError, ParseErrorKind};
 pub use realize::{ComponentWv, ImpliedWv};
 
 pub use crate::error::ModelError;
-pub use crate::process::{ParamDomain, ProcessKind, MAX_ORDER};
+pub(crate) use crate::process::MAX_ORDER;
+pub use crate::process::{ParamDomain, ProcessKind};
 
 use crate::process::{spec, Occurs, KINDS};
 use std::fmt;
@@ -124,7 +125,7 @@ impl Component {
     }
 
     /// Whether no value is given (guess mode, docs/methods.md §0.3).
-    pub fn is_guess(&self) -> bool {
+    pub(crate) fn is_guess(&self) -> bool {
         self.values.iter().all(Option::is_none)
     }
 

@@ -139,7 +139,11 @@ impl Model {
     ///
     /// # Errors
     /// As [`Model::implied_wv`].
-    pub fn hessian(&self, levels: usize, freq_hz: f64) -> Result<Vec<Vec<Vec<f64>>>, InputError> {
+    pub(crate) fn hessian(
+        &self,
+        levels: usize,
+        freq_hz: f64,
+    ) -> Result<Vec<Vec<Vec<f64>>>, InputError> {
         check_levels(levels)?;
         let p = self.n_params();
         let mut out = vec![vec![vec![0.0; p]; p]; levels];

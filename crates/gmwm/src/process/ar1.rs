@@ -277,7 +277,7 @@ impl Ar1 {
     /// # Errors
     /// [`ParamError`] naming `phi` unless `0 < phi < 1` (a GM has positive correlation), or
     /// `freq_hz` unless finite and `> 0`.
-    pub fn to_gm(&self, freq_hz: f64) -> Result<Gm, ParamError> {
+    pub(crate) fn to_gm(self, freq_hz: f64) -> Result<Gm, ParamError> {
         check_positive("freq_hz", freq_hz)?;
         if !(self.phi > 0.0 && self.phi < 1.0) {
             return Err(ParamError::new(
@@ -310,7 +310,7 @@ impl Gm {
 
     /// docs/methods.md §4.3: the equivalent per-sample AR1: `phi = exp(-beta dt)`,
     /// `sigma2 = sigma2_gm (1 - exp(-2 beta dt))`, `dt = 1/freq_hz`.
-    pub fn to_ar1(&self) -> Ar1 {
+    pub(crate) fn to_ar1(self) -> Ar1 {
         let l = self.beta / self.freq_hz;
         Ar1 {
             phi: (-l).exp(),

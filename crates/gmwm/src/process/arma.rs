@@ -256,21 +256,18 @@ impl Arma {
     }
 
     /// Whether every root of the MA polynomial `1 + sum ma_i z^i` lies outside the unit circle.
-    pub fn is_invertible(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn is_invertible(&self) -> bool {
         let m = min_root_modulus(&self.ma, 1.0);
         m > 1.0
-    }
-
-    /// MA(inf) weights `psi_0 = 1, psi_1, ...` (docs/methods.md §4.4).
-    pub fn psi_weights(&self, n: usize) -> Vec<f64> {
-        psi(&self.ar, &self.ma, n)
     }
 
     /// docs/methods.md §4.4: autocovariances `gamma_0..gamma_{max_lag}` from the exact
     /// `(r+1) x (r+1)` linear system (`r = max(p, q+1)`), then the AR recursion; `gamma_0` is
     /// exact, not the package's 1000-term MA(inf) truncation (§13.12). Values are NaN only if
     /// the system were singular, which stationarity (checked by [`Arma::new`]) excludes.
-    pub fn autocovariance(&self, max_lag: usize) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn autocovariance(&self, max_lag: usize) -> Vec<f64> {
         autocovariance(&self.ar, &self.ma, self.sigma2, max_lag)
     }
 }

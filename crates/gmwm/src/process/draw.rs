@@ -8,7 +8,7 @@ use rand_chacha::ChaCha8Rng;
 
 /// Which process dominates the first scales (docs/methods.md §6.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum Dominance {
+pub(crate) enum Dominance {
     /// Quantisation noise (slope below -1/2 for both CI bounds).
     Qn,
     /// White noise (the CI straddles slope -1/2).

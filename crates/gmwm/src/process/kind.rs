@@ -12,7 +12,7 @@ use std::fmt;
 /// A guard against absurd allocations from typos such as `AR(20000000)`; IMU error models use
 /// orders of 1 to 3, and the implied WV of docs/methods.md §4.4 becomes numerically meaningless
 /// long before 100 lags.
-pub const MAX_ORDER: usize = 100;
+pub(crate) const MAX_ORDER: usize = 100;
 
 /// The basic domain of one parameter value, checked whenever a value is given (docs/methods.md §5.3
 /// lists the transforms the optimiser applies on these domains).
@@ -68,7 +68,7 @@ impl ProcessKind {
     }
 
     /// The name without orders: `"AR"` for `AR(2)`, `"WN"` for `WN`.
-    pub fn base_name(&self) -> &'static str {
+    pub(crate) fn base_name(&self) -> &'static str {
         spec(*self).name
     }
 
@@ -102,14 +102,14 @@ impl ProcessKind {
     }
 
     /// The index of a parameter by name (ASCII case-insensitive), if the kind has it.
-    pub fn param_index(&self, name: &str) -> Option<usize> {
+    pub(crate) fn param_index(&self, name: &str) -> Option<usize> {
         self.param_names()
             .iter()
             .position(|n| n.eq_ignore_ascii_case(name))
     }
 
     /// The basic domain of parameter `index` (see [`ParamDomain`]); `None` past the end.
-    pub fn param_domain(&self, index: usize) -> Option<ParamDomain> {
+    pub(crate) fn param_domain(&self, index: usize) -> Option<ParamDomain> {
         match spec(*self).params {
             Params::Fixed(list, _) => list.get(index).map(|(_, d)| *d),
             // coefficients are any finite number, the innovation variance comes last
@@ -123,7 +123,7 @@ impl ProcessKind {
 
     /// The AR and MA orders `(p, q)` of the ARMA-family kinds; `(0, 0)` for the others except
     /// AR1 `(1, 0)`, MA1 `(0, 1)`, ARMA11 `(1, 1)`.
-    pub fn orders(&self) -> (usize, usize) {
+    pub(crate) fn orders(&self) -> (usize, usize) {
         match *self {
             ProcessKind::Ar(p) => (p, 0),
             ProcessKind::Ma(q) => (0, q),
@@ -136,13 +136,13 @@ impl ProcessKind {
     }
 
     /// Whether the kind may repeat in a model (`k*GM()`, `k*AR1()`; docs/methods.md §0.2).
-    pub fn may_repeat(&self) -> bool {
+    pub(crate) fn may_repeat(&self) -> bool {
         spec(*self).occurs == Occurs::Repeats
     }
 
     /// Whether the kind belongs to the ARMA family (MA1, ARMA11, AR(p), MA(q), ARMA(p,q)), of
     /// which a model holds at most one term.
-    pub fn is_arma_family(&self) -> bool {
+    pub(crate) fn is_arma_family(&self) -> bool {
         spec(*self).occurs == Occurs::ArmaFamily
     }
 
@@ -150,7 +150,7 @@ impl ProcessKind {
     ///
     /// # Errors
     /// [`ModelError::BadOrder`].
-    pub fn check_orders(&self) -> Result<(), ModelError> {
+    pub(crate) fn check_orders(&self) -> Result<(), ModelError> {
         let Some(o) = &spec(*self).orders else {
             return Ok(());
         };

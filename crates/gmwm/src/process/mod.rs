@@ -32,7 +32,8 @@ mod param;
 pub(crate) mod qn;
 pub(crate) mod rw;
 pub(crate) mod sampler;
-pub mod spectral;
+#[cfg(test)]
+pub(crate) mod spectral;
 pub(crate) mod wn;
 
 pub use ar1::{Ar1, Gm};
@@ -44,13 +45,15 @@ pub use qn::Qn;
 pub use rw::Rw;
 pub use wn::Wn;
 
-pub use draw::Dominance;
+pub(crate) use draw::Dominance;
 pub(crate) use facts::{
     kind_of, Markov, MarkovForms, Occurs, Orders, Params, Physical, Role, Spec, UnitShape, BASE,
 };
-pub use kind::{ParamDomain, MAX_ORDER};
+pub use kind::ParamDomain;
+pub(crate) use kind::MAX_ORDER;
 pub(crate) use param::ChainSlot;
-pub use param::{logistic, ParamTransform, TransformPreset, RESTART_EDGE};
+pub use param::TransformPreset;
+pub(crate) use param::{logistic, ParamTransform, RESTART_EDGE};
 pub use sampler::StartMode;
 
 use crate::error::ParamError;
@@ -279,7 +282,7 @@ impl LatentProcess for Process {
 /// all given are left out, so the result may be shorter than `levels`.
 ///
 /// Cost: `O(2^levels)`.
-pub fn autocovariance_wv(gamma: &[f64], levels: usize) -> Vec<f64> {
+pub(crate) fn autocovariance_wv(gamma: &[f64], levels: usize) -> Vec<f64> {
     let mut out = Vec::with_capacity(levels);
     for j in 1..=levels.min(62) {
         let m = 1usize << (j - 1);

@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Logistic function `1 / (1 + e^{-u})`, evaluated without overflow for either sign of `u`.
-pub fn logistic(u: f64) -> f64 {
+pub(crate) fn logistic(u: f64) -> f64 {
     if u >= 0.0 {
         1.0 / (1.0 + (-u).exp())
     } else {
@@ -18,7 +18,7 @@ pub fn logistic(u: f64) -> f64 {
 /// One scalar transform `theta = g(u)` (docs/methods.md §5.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
-pub enum ParamTransform {
+pub(crate) enum ParamTransform {
     /// `u = theta`.
     Identity,
     /// `u = ln theta`, theta in (0, inf): variances, GM beta.
@@ -48,7 +48,7 @@ impl ParamTransform {
     }
 
     /// docs/methods.md §5.3: `u = g^{-1}(theta)`; `None` when theta is outside the open domain.
-    pub fn to_u(self, theta: f64) -> Option<f64> {
+    pub(crate) fn to_u(self, theta: f64) -> Option<f64> {
         if !theta.is_finite() {
             return None;
         }
@@ -80,7 +80,7 @@ impl ParamTransform {
     }
 
     /// docs/methods.md §5.3: `theta = g(u)`.
-    pub fn from_u(self, u: f64) -> f64 {
+    pub(crate) fn to_theta(self, u: f64) -> f64 {
         match self {
             ParamTransform::Identity => u,
             ParamTransform::Log | ParamTransform::LogAbs => u.exp(),
@@ -92,7 +92,7 @@ impl ParamTransform {
     }
 
     /// `d theta / d u` at `u`.
-    pub fn dtheta_du(self, u: f64) -> f64 {
+    pub(crate) fn dtheta_du(self, u: f64) -> f64 {
         let s = || logistic(u) * logistic(-u);
         match self {
             ParamTransform::Identity => 1.0,
@@ -106,7 +106,7 @@ impl ParamTransform {
 
 /// Relative distance from the edge of its domain at which an estimate on the edge restarts
 /// (`Parametrisation::to_u_restart` (`crate::fit::transform`)): a phi of 0 restarts at 1e-9, of 1 at 1 - 1e-9.
-pub const RESTART_EDGE: f64 = 1e-9;
+pub(crate) const RESTART_EDGE: f64 = 1e-9;
 
 /// Which table of docs/methods.md §5.3 to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

@@ -94,7 +94,7 @@ impl Rule {
 
 /// docs/methods.md §1.9: `nu2_j` of a spectral density `density(f)` on `[-1/2, 1/2]` (even in `f`)
 /// by quadrature; slow oracle (see the module doc). `j >= 1`; `j = 0` gives NaN.
-pub fn spectral_wv_level(density: &dyn Fn(f64) -> f64, j: usize) -> f64 {
+pub(crate) fn spectral_wv_level(density: &dyn Fn(f64) -> f64, j: usize) -> f64 {
     if j == 0 || j > 40 {
         return f64::NAN;
     }
@@ -143,7 +143,7 @@ pub fn spectral_wv_level(density: &dyn Fn(f64) -> f64, j: usize) -> f64 {
 
 /// docs/methods.md §1.9: the implied WV of a process at levels `1..=levels` by quadrature of its
 /// spectral density; `None` for a process without one (DR). Slow oracle.
-pub fn spectral_wv(process: &dyn LatentProcess, levels: usize) -> Option<Vec<f64>> {
+pub(crate) fn spectral_wv(process: &dyn LatentProcess, levels: usize) -> Option<Vec<f64>> {
     process.spectral_density(0.25)?;
     let density = |f: f64| process.spectral_density(f).unwrap_or(f64::NAN);
     Some(

@@ -14,7 +14,7 @@ use std::collections::BTreeSet;
 
 /// Largest number of terms of a full model for [`nested_candidates`]: `2^20 - 1` subsets are
 /// enumerated (well under a second); a real full model has fewer than ten terms.
-pub const MAX_NESTED_TERMS: usize = 20;
+pub(crate) const MAX_NESTED_TERMS: usize = 20;
 
 /// The term list of a model, space-joined as the package names its rows (`"AR1 AR1 WN"`).
 pub fn terms(model: &Model) -> String {
@@ -81,7 +81,7 @@ fn model_of(kinds: &[ProcessKind]) -> Model {
 /// # Errors
 /// [`SelectionError::ArmaNotSupported`] (and the other refusals of §8.5);
 /// [`SelectionError::TooManyTerms`] above [`MAX_NESTED_TERMS`] terms.
-pub fn nested_candidates(full: &Model) -> Result<Vec<Model>, SelectionError> {
+pub(crate) fn nested_candidates(full: &Model) -> Result<Vec<Model>, SelectionError> {
     check_candidate(full)?;
     let kinds = full.kinds();
     let n = kinds.len();
@@ -115,7 +115,7 @@ pub fn nested_candidates(full: &Model) -> Result<Vec<Model>, SelectionError> {
 /// [`SelectionError::NoCandidates`] for an empty list; the refusals of §8.5 naming the
 /// candidate: [`SelectionError::ArmaNotSupported`], [`SelectionError::Repeated`],
 /// [`SelectionError::GmAr1Mixed`] (GM in one candidate, AR1 in another).
-pub fn common_denominator(models: &[Model]) -> Result<Model, SelectionError> {
+pub(crate) fn common_denominator(models: &[Model]) -> Result<Model, SelectionError> {
     if models.is_empty() {
         return Err(SelectionError::NoCandidates);
     }

@@ -90,11 +90,14 @@ pub(crate) mod optimism;
 pub mod pooled;
 pub mod wic;
 
-pub use candidates::{common_denominator, nested_candidates, terms, MAX_NESTED_TERMS};
+pub use candidates::terms;
+
+#[cfg(test)]
+pub(crate) use candidates::{common_denominator, nested_candidates};
 pub use imu::{auto_imu, AxisSelection, ImuSelection};
-pub use optimism::{
-    asymptotic_optimism, bootstrap_optimism, d_matrix, OptimismConvention, OptimismMethod,
-};
+#[cfg(test)]
+pub(crate) use optimism::d_matrix;
+pub use optimism::{asymptotic_optimism, OptimismConvention, OptimismMethod};
 pub use pooled::{select_pooled, PooledCandidate, PooledSelection};
 pub use wic::{
     CandidateScore, ModelSelection, RowStatus, SelectionRow, SelectionRule, SelectionTable, Wic,

@@ -74,7 +74,7 @@ crate::names::named_values!(OptimismConvention, "convention", {
 ///
 /// # Errors
 /// [`FitError::Length`] when the sizes disagree.
-pub fn d_matrix(
+pub(crate) fn d_matrix(
     hessian: &[Vec<Vec<f64>>],
     omega: &DMatrix<f64>,
     implied: &[f64],
@@ -188,7 +188,7 @@ pub fn asymptotic_optimism(
 ///
 /// # Errors
 /// [`FitError::Length`] for fewer than 2 replicates or vectors of different lengths.
-pub fn bootstrap_optimism(
+pub(crate) fn bootstrap_optimism(
     nu_hat_star: &[Vec<f64>],
     nu_theta_star: &[Vec<f64>],
     omega: &DMatrix<f64>,

@@ -25,12 +25,12 @@ use std::fmt;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Default number of bootstrap replicates B (the package's `B = 50`).
-pub const DEFAULT_BOOTSTRAP: usize = 50;
+pub(crate) const DEFAULT_BOOTSTRAP: usize = 50;
 /// Default seed (the package's 1337).
-pub const DEFAULT_SEED: u64 = 1337;
+pub(crate) const DEFAULT_SEED: u64 = 1337;
 /// Starting-value draws of the fresh fits behind the bootstrap GoF p-value (docs/methods.md §7.4:
 /// "a fresh guess with G = 10000 draws").
-pub const DEFAULT_BOOTSTRAP_DRAWS: usize = 10_000;
+pub(crate) const DEFAULT_BOOTSTRAP_DRAWS: usize = 10_000;
 /// The bootstrap replicates are seeded from `seed + 5`, as the package's `summary` (§7.5), so
 /// that their random streams differ from those of the starting-value search seeded by `seed`.
 const BOOTSTRAP_SEED_OFFSET: u64 = 5;
@@ -201,7 +201,8 @@ impl Wic {
 
     /// Sets the draws of the fresh fits behind the bootstrap GoF p-value; default
     /// [`DEFAULT_BOOTSTRAP_DRAWS`].
-    pub fn with_bootstrap_draws(mut self, draws: usize) -> Self {
+    #[cfg(test)]
+    pub(crate) fn with_bootstrap_draws(mut self, draws: usize) -> Self {
         self.bootstrap_draws = draws;
         self
     }
@@ -217,13 +218,6 @@ impl Wic {
     /// [`SelectionRule::Navigation`]).
     pub fn with_rule(mut self, rule: SelectionRule) -> Self {
         self.rule = rule;
-        self
-    }
-
-    /// Sets the separation below which a candidate's fit and its canonical reduction are not
-    /// told apart ([`crate::fit::canonical`]; default [`SEPARATION_LIMIT`]).
-    pub fn with_separation_limit(mut self, limit: f64) -> Self {
-        self.separation_limit = limit;
         self
     }
 
@@ -350,7 +344,8 @@ impl Wic {
     ///
     /// # Errors
     /// As [`Wic::select`] (a non-Haar WV is refused).
-    pub fn select_wv(&self, wv: &WaveletVariance) -> Result<ModelSelection, SelectionError> {
+    #[cfg(test)]
+    pub(crate) fn select_wv(&self, wv: &WaveletVariance) -> Result<ModelSelection, SelectionError> {
         self.select_wv_with_progress(wv, &NoProgress)
     }
 
@@ -378,7 +373,7 @@ impl Wic {
     /// # Errors
     /// As [`Wic::select_wv`]; [`SelectionError::Setting`] for the bootstrap optimism, which
     /// simulates one series where the pooled WV comes from several.
-    pub fn select_pooled_wv_with_progress(
+    pub(crate) fn select_pooled_wv_with_progress(
         &self,
         pooled: &PooledWv,
         progress: &dyn Progress,
@@ -741,11 +736,11 @@ struct Scored {
 /// and optimism up to the optimiser's tolerance (agreement to about 1e-7 relative seen on
 /// gyro_x of adis_16405_imu1); the tie then goes to the sub-model. Differences this small are
 /// far below the bootstrap noise of the optimism (about 10% with B = 50).
-pub const WIC_TIE_REL: f64 = 1e-6;
+pub(crate) const WIC_TIE_REL: f64 = 1e-6;
 
 /// Rows whose WIC exceeds the minimum by at most this many standard errors of the difference
 /// are equivalent (the one-standard-error rule).
-pub const WIC_EQUIVALENCE_SE: f64 = 1.0;
+pub(crate) const WIC_EQUIVALENCE_SE: f64 = 1.0;
 
 /// Standard error of the difference of two candidates' WICs under the sampling noise of the
 /// empirical WV (Vuong 1989, for fitted criteria): a first-order term, from the derivative of
@@ -765,7 +760,7 @@ pub const WIC_EQUIVALENCE_SE: f64 = 1.0;
 /// the term is small, their optimisms being close, and `k = 1` is used. Not included: the
 /// optimisms' own estimation noise (about 10% of each with B = 50 replicates behind V), which
 /// for nearly coinciding fits is of the order of this standard error.
-pub fn wic_difference_se(
+pub(crate) fn wic_difference_se(
     a: (&[f64], f64, usize),
     b: (&[f64], f64, usize),
     omega: &[f64],
@@ -1096,11 +1091,6 @@ impl ModelSelection {
         self.rule
     }
 
-    /// Separation below which a fit and its canonical reduction are not told apart.
-    pub fn separation_limit(&self) -> f64 {
-        self.separation_limit
-    }
-
     /// One row per canonical model, sorted by WIC.
     pub fn rows(&self) -> &[SelectionRow] {
         &self.rows
@@ -1126,19 +1116,6 @@ impl ModelSelection {
         &self.fit
     }
 
-    /// Every candidate's fit, in the order of `candidates` (not serialised).
-    pub fn candidate_fits(&self) -> &[GmwmFit] {
-        &self.candidate_fits
-    }
-
-    /// The covariance V of the WV at the full model's fit, which nests every candidate (exact,
-    /// or over `bootstrap` replicates simulated from it), for inference on the selected fit
-    /// without computing it again ([`crate::inference::infer_with_covariance`]); not
-    /// serialised.
-    pub fn wv_covariance(&self) -> &DMatrix<f64> {
-        &self.wv_covariance
-    }
-
     /// How V was obtained: `"exact"` or `"bootstrap"`.
     pub fn v_method(&self) -> &'static str {
         self.v_source.method()
@@ -1152,7 +1129,7 @@ impl ModelSelection {
 
 impl ModelSelection {
     /// The fit of the candidate `model` (guess mode, as listed in `candidates`).
-    pub fn candidate_fit(&self, model: &Model) -> Option<&GmwmFit> {
+    pub(crate) fn candidate_fit(&self, model: &Model) -> Option<&GmwmFit> {
         self.candidates
             .iter()
             .position(|c| &c.model == model)

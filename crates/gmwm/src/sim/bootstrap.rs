@@ -25,7 +25,7 @@ use serde::Serialize;
 /// # Errors
 /// [`ParamError`] for `replicates == 0` or `n == 0`; errors of [`Simulator::for_model`] (a
 /// model with unset or invalid values) and of [`wavelet_variance`]; the first error of `f`.
-pub fn map_replicates<T, E, F>(
+pub(crate) fn map_replicates<T, E, F>(
     model: &Model,
     n: usize,
     freq_hz: f64,
@@ -77,13 +77,13 @@ where
 
 /// The bootstrap distribution summary of the WV vector (the package's `cov_bootstrapper`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct WvBootstrap {
+pub(crate) struct WvBootstrap {
     /// Number of replicates H.
     pub replicates: usize,
     /// Replicate mean of the WV, per level.
     pub mean: Vec<f64>,
     /// Full J x J covariance of the replicate WV vectors (divisor H - 1).
-    pub cov: DMatrix<f64>,
+    pub(crate) cov: DMatrix<f64>,
 }
 
 impl WvBootstrap {
@@ -91,7 +91,7 @@ impl WvBootstrap {
     ///
     /// # Errors
     /// [`ParamError`] when fewer than two vectors are given or their lengths differ.
-    pub fn from_samples(samples: &[Vec<f64>]) -> Result<Self, InputError> {
+    pub(crate) fn from_samples(samples: &[Vec<f64>]) -> Result<Self, InputError> {
         let h = samples.len();
         if h < 2 {
             return Err(
@@ -137,7 +137,7 @@ impl WvBootstrap {
 ///
 /// # Errors
 /// As [`map_replicates`]; [`ParamError`] for fewer than 2 replicates.
-pub fn wv_bootstrap(
+pub(crate) fn wv_bootstrap(
     model: &Model,
     n: usize,
     freq_hz: f64,

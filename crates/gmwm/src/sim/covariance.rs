@@ -51,26 +51,21 @@ impl CovarianceMethod {
 
 /// A covariance `V` of the WV vector and how it was obtained.
 #[derive(Debug, Clone, PartialEq)]
-pub struct WvCovariance {
+pub(crate) struct WvCovariance {
     /// `J x J`.
     pub v: DMatrix<f64>,
     /// Replicates behind a bootstrap `V`; `None` for the exact one.
     pub replicates: Option<usize>,
 }
 
-impl WvCovariance {
-    /// How it was obtained.
-    pub fn source(&self) -> VSource {
-        VSource(self.replicates)
-    }
-}
+impl WvCovariance {}
 
 /// How a V was obtained: the bootstrap's replicates, or `None` for the exact V.
 ///
 /// Wire format (flattened into the result that carries it): `v_method` (`"exact"` or
 /// `"bootstrap"`) and `v_replicates` (null when exact).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct VSource(pub(crate) Option<usize>);
+pub(crate) struct VSource(pub(crate) Option<usize>);
 
 impl VSource {
     /// `"exact"` or `"bootstrap"`.
@@ -109,7 +104,7 @@ impl Serialize for VSource {
 // the bootstrap's own settings (replicates, seed, progress) sit beside the model's; a struct
 // for them would be used by this function alone
 #[allow(clippy::too_many_arguments)]
-pub fn wv_covariance(
+pub(crate) fn wv_covariance(
     model: &Model,
     n: usize,
     freq_hz: f64,

@@ -8,11 +8,12 @@ use serde::Serialize;
 /// The NavChip Y-axis gyroscope of paper Table I (docs/methods.md §5.10), classical column, at 250
 /// Hz: `3*GM() + WN() + QN() + RW()` with beta = (0.250, 6.28e-3, 8.48) 1/s,
 /// sigma2_gm = (7.08e-9, 1.28e-8, 6.48e-9), WN 6.94e-7, QN 2.29e-6, RW 3.90e-14.
-pub const DEMO_MODEL: &str = "GM(beta=0.25, sigma2_gm=7.08e-9)+GM(beta=6.28e-3, sigma2_gm=1.28e-8)\
+pub(crate) const DEMO_MODEL: &str =
+    "GM(beta=0.25, sigma2_gm=7.08e-9)+GM(beta=6.28e-3, sigma2_gm=1.28e-8)\
 +GM(beta=8.48, sigma2_gm=6.48e-9)+WN(sigma2=6.94e-7)+QN(q2=2.29e-6)+RW(gamma2=3.9e-14)";
 
 /// Sampling rate of the demo sensor (NavChip, paper Sec. III).
-pub const DEMO_FREQ_HZ: f64 = 250.0;
+pub(crate) const DEMO_FREQ_HZ: f64 = 250.0;
 
 /// A simulated sensor with known truth.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -13,6 +13,10 @@ pub mod demo;
 mod model;
 mod simulator;
 
-pub use demo::{DemoSensor, DEMO_FREQ_HZ, DEMO_MODEL};
+pub use demo::DemoSensor;
+
+#[cfg(test)]
+pub(crate) use demo::{DEMO_FREQ_HZ, DEMO_MODEL};
 pub use model::simulate_model;
-pub use simulator::{quantisation_noise, replicate_seed, simulate, Simulator, StartMode};
+pub(crate) use simulator::replicate_seed;
+pub use simulator::{quantisation_noise, simulate, Simulator, StartMode};

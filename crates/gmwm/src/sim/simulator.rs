@@ -156,7 +156,7 @@ pub fn simulate(processes: &[Process], n: usize, seed: u64) -> Result<Vec<f64>, 
 ///
 /// # Formula
 /// SplitMix64 finaliser of `splitmix64(seed) XOR (replicate * 0x9E3779B97F4A7C15)`.
-pub fn replicate_seed(seed: u64, replicate: u64) -> u64 {
+pub(crate) fn replicate_seed(seed: u64, replicate: u64) -> u64 {
     splitmix64(splitmix64(seed) ^ replicate.wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
 

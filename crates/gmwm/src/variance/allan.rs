@@ -98,7 +98,8 @@ impl AllanKind {
     }
 
     /// Whether the kind is a Hadamard variance (cluster lengths `3^i`, docs/methods.md §3.5).
-    pub fn is_hadamard(self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn is_hadamard(self) -> bool {
         matches!(
             self,
             AllanKind::Hadamard | AllanKind::HadamardNonOverlapping
@@ -308,7 +309,8 @@ impl AllanVariance {
     }
 
     /// Equivalent degrees of freedom of the chi-square interval (see [`allan_variance`]).
-    pub fn edf(&self) -> &[f64] {
+    #[cfg(test)]
+    pub(crate) fn edf(&self) -> &[f64] {
         &self.edf
     }
 
@@ -328,7 +330,8 @@ impl AllanVariance {
 impl AllanVariance {
     /// The package's deviation-scale band `(adev (1 - e), adev (1 + e))` per cluster length
     /// (docs/methods.md §3.3; the `lci`/`uci` columns of `gmwm::avar`).
-    pub fn package_band(&self) -> (Vec<f64>, Vec<f64>) {
+    #[cfg(test)]
+    pub(crate) fn package_band(&self) -> (Vec<f64>, Vec<f64>) {
         let lo = self
             .adev
             .iter()
@@ -495,7 +498,7 @@ pub fn allan_variance(
 }
 
 /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))`, docs/methods.md §3.3.
-pub fn package_error(n: usize, m: usize) -> f64 {
+pub(crate) fn package_error(n: usize, m: usize) -> f64 {
     1.0 / (2.0 * (n as f64 / m as f64 - 1.0)).sqrt()
 }
 

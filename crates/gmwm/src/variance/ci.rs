@@ -22,7 +22,7 @@ pub fn check_alpha(alpha: f64) -> Result<(), ParamError> {
 
 /// Equivalent degrees of freedom of the level-j WV, docs/methods.md §1.7, paper eq. (1) CI:
 /// `eta_j = max(M_j / 2^j, 1)` with `M_j` the number of kept coefficients.
-pub fn eta3(kept: usize, j: usize) -> f64 {
+pub(crate) fn eta3(kept: usize, j: usize) -> f64 {
     (kept as f64 / (j as f64).exp2()).max(1.0)
 }
 
@@ -73,7 +73,12 @@ fn check_df(name: &'static str, df: f64) -> Result<(), ParamError> {
 /// # Errors
 /// [`ParamError`] naming `alpha` when it is outside (0, 1) ([`check_alpha`]), `eta` when it is
 /// not finite and positive, or `estimate` when it is negative or not finite.
-pub fn chi_square_interval(estimate: f64, eta: f64, alpha: f64) -> Result<(f64, f64), ParamError> {
+#[cfg(test)]
+pub(crate) fn chi_square_interval(
+    estimate: f64,
+    eta: f64,
+    alpha: f64,
+) -> Result<(f64, f64), ParamError> {
     check_alpha(alpha)?;
     check_df("eta", eta)?;
     if !(estimate.is_finite() && estimate >= 0.0) {
@@ -106,7 +111,7 @@ pub(crate) fn interval_unchecked(estimate: f64, eta: f64, alpha: f64) -> (f64, f
 /// # Errors
 /// [`ParamError`] naming `p` when it is outside (0, 1) or `df` when it is not finite and
 /// positive.
-pub fn chi_square_quantile(p: f64, df: f64) -> Result<f64, ParamError> {
+pub(crate) fn chi_square_quantile(p: f64, df: f64) -> Result<f64, ParamError> {
     if !(p > 0.0 && p < 1.0) {
         return Err(ParamError::new("p", p, "must be a probability in (0, 1)"));
     }

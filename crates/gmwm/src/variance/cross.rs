@@ -100,7 +100,7 @@ pub fn wavelet_cross_covariance(
 }
 
 /// The pairs `(a, b)`, `a < b`, of `axes` axes in the order of the stacked moments.
-pub fn axis_pairs(axes: usize) -> Vec<(usize, usize)> {
+pub(crate) fn axis_pairs(axes: usize) -> Vec<(usize, usize)> {
     (0..axes)
         .flat_map(|a| (a + 1..axes).map(move |b| (a, b)))
         .collect()
@@ -114,7 +114,7 @@ pub fn axis_pairs(axes: usize) -> Vec<(usize, usize)> {
 /// # Errors
 /// [`ParamError`] for a drift or a process the exact WV covariance does not cover (generic
 /// ARMA, a negative autoregressive coefficient), or more levels than `n` holds.
-pub fn stacked_moment_covariance(
+pub(crate) fn stacked_moment_covariance(
     shared: &[Process],
     specific: &[Vec<Process>],
     n: usize,

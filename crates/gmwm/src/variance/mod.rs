@@ -17,7 +17,7 @@ pub mod wv;
 
 pub use file::{allan_from_wv, is_wv_json, read_wv_json, select_series};
 pub use stream::{binary_columns_wv, binary_wavelet_variance, StreamedColumn};
-pub use wv::{default_levels, kept_count};
+pub use wv::default_levels;
 
 use rayon::prelude::*;
 

@@ -167,14 +167,6 @@ impl PooledWv {
         let p = &self.parts[k];
         (0..p.levels()).map(|j| p.eta[j] / self.wv.eta[j]).collect()
     }
-
-    /// Every WV times `factor` (a unit conversion: `factor` is the square of the samples').
-    pub fn scaled(&self, factor: f64) -> Self {
-        Self {
-            wv: self.wv.scaled(factor),
-            parts: self.parts.iter().map(|p| p.scaled(factor)).collect(),
-        }
-    }
 }
 
 #[cfg(test)]

@@ -59,12 +59,12 @@ impl FromStr for RobustConvention {
 
 /// Default requested Gaussian efficiency, the package's `eff = 0.6` (docs/methods.md §2.3; paper
 /// Sec. III: near 0.5 is highly robust).
-pub const DEFAULT_EFF: f64 = 0.6;
+pub(crate) const DEFAULT_EFF: f64 = 0.6;
 
 /// Largest efficiency accepted; the package refuses `eff > 0.99` for robust estimation
 /// (docs/methods.md §2.5 R-level guard): the tuning constant grows without bound as eff -> 1 and
 /// the estimator stops being robust.
-pub const MAX_EFF: f64 = 0.99;
+pub(crate) const MAX_EFF: f64 = 0.99;
 
 /// Options of the robust estimator (docs/methods.md §2), with their tuning constant solved once
 /// (§2.3). Made by [`RobustOptions::new`] (or read from JSON, a saved WV or a calibration, and
@@ -185,7 +185,7 @@ const INV_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
 /// The recursion cancels badly for small `c` (below about 1.5 the higher moments lose all
 /// digits); the tuning constants of §2.3 are above 2.39, where it is accurate to a few ulps
 /// relative. For non-finite or non-positive `c` the result is NaN/garbage: callers validate.
-pub fn truncated_normal_moments(c: f64) -> [f64; 11] {
+pub(crate) fn truncated_normal_moments(c: f64) -> [f64; 11] {
     let mut mu = [0.0; 11];
     let two_phi = 2.0 * INV_SQRT_2PI * (-0.5 * c * c).exp();
     mu[0] = central_normal_mass(c, two_phi);
@@ -291,7 +291,7 @@ pub fn efficiency(c: f64) -> f64 {
 ///
 /// # Formula
 /// As [`efficiency`] with `Q` coefficients `1, -8, 28, -56, 70, -56, 28, +8, 1`.
-pub fn package_efficiency(c: f64) -> f64 {
+pub(crate) fn package_efficiency(c: f64) -> f64 {
     let (m, q) = m_and_q(c, &BINOM8_PACKAGE);
     m * m / (2.0 * q)
 }
@@ -346,7 +346,8 @@ pub fn tuning_constant(eff: f64, convention: RobustConvention) -> Result<f64, Pa
 
 /// Tukey's biweight `psi_c(r) = r (1 - r^2/c^2)^2` for `|r| <= c`, 0 otherwise (docs/methods.md
 /// §2.1).
-pub fn psi_biweight(r: f64, c: f64) -> f64 {
+#[cfg(test)]
+pub(crate) fn psi_biweight(r: f64, c: f64) -> f64 {
     if r.abs() <= c {
         let t = 1.0 - (r / c) * (r / c);
         r * t * t

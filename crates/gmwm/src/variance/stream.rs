@@ -961,7 +961,7 @@ impl StreamedTable {
     ///
     /// # Errors
     /// As [`binary_columns_wv`], naming the recording (not the spool).
-    pub fn columns_wv(
+    pub(crate) fn columns_wv(
         &self,
         columns: &[usize],
         freq_hz: f64,

@@ -141,7 +141,7 @@ impl WaveletVariance {
     }
 
     /// Number of boundary-free coefficients `M_j` behind each estimate.
-    pub fn n_coefficients(&self) -> &[usize] {
+    pub(crate) fn n_coefficients(&self) -> &[usize] {
         &self.n_coefficients
     }
 
@@ -371,7 +371,7 @@ pub fn default_levels(n: usize, transform: Transform, filter: WaveletFilter) -> 
 
 /// Kept (boundary-free) coefficient count of level `j` (docs/methods.md §1.3, §1.4), `None` when
 /// the level does not exist for this length.
-pub fn kept_count(
+pub(crate) fn kept_count(
     n: usize,
     j: usize,
     transform: Transform,
@@ -661,7 +661,7 @@ pub(crate) fn sum_squares(x: &[f64]) -> f64 {
 /// `V_{j,t} = (V_{j-1,t} + V_{j-1,t-m}) / 2`, `W_{j,t} = (V_{j-1,t} - V_{j-1,t-m}) / 2`,
 /// `m = 2^{j-1}`; coefficients with `t < 2^j - 1` (boundary) are skipped.
 #[derive(Debug, Clone)]
-pub struct HaarWvAccumulator {
+pub(crate) struct HaarWvAccumulator {
     levels: usize,
     /// First level run through the pyramid: 1, except for the upper half of a level split
     /// ([`upper_part`](Self::upper_part)), fed with the scaling coefficients of the level below.
@@ -733,6 +733,7 @@ impl HaarWvAccumulator {
     ///
     /// # Errors
     /// [`ParamError`] when `levels` is 0 or above [`MAX_LEVELS`].
+    #[cfg(test)]
     pub fn new(levels: usize) -> Result<Self, ParamError> {
         if levels == 0 || levels > MAX_LEVELS {
             return Err(ParamError::new(
@@ -767,7 +768,8 @@ impl HaarWvAccumulator {
     ///
     /// # Errors
     /// As [`new`](Self::new); also when `offset` is not finite.
-    pub fn with_offset(levels: usize, offset: f64) -> Result<Self, ParamError> {
+    #[cfg(test)]
+    pub(crate) fn with_offset(levels: usize, offset: f64) -> Result<Self, ParamError> {
         if !offset.is_finite() {
             return Err(ParamError::new("offset", offset, "must be finite"));
         }
@@ -984,16 +986,6 @@ impl HaarWvAccumulator {
         self.flush()?;
         self.priming = Vec::new();
         Ok(std::mem::take(&mut self.rings))
-    }
-
-    /// Number of samples pushed so far.
-    pub fn n(&self) -> u64 {
-        self.n + self.pending.len() as u64
-    }
-
-    /// Number of levels.
-    pub fn levels(&self) -> usize {
-        self.levels
     }
 
     /// Feeds the next chunk of the series.

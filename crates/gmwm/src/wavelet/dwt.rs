@@ -48,7 +48,8 @@ impl Dwt {
 
     /// Largest `J <= 60` a DWT of `n` samples with `filter` accepts: `2^J` divides `n` and every
     /// level keeps at least one boundary-free coefficient (docs/methods.md §1.4). 0 if none fits.
-    pub fn max_levels(filter: WaveletFilter, n: usize) -> usize {
+    #[cfg(test)]
+    pub(crate) fn max_levels(filter: WaveletFilter, n: usize) -> usize {
         (1..=super::MAX_LEVELS)
             .take_while(|&j| {
                 let p = pow2(j);
@@ -65,7 +66,7 @@ impl Dwt {
     /// [`ParamError`] named `levels` if `2^J` does not divide `n` (the message gives the largest
     /// valid `J` and the nearest valid lengths); [`SeriesError::TooShort`] naming the first level
     /// without a boundary-free coefficient.
-    pub fn check_len(&self, n: usize) -> Result<(), InputError> {
+    pub(crate) fn check_len(&self, n: usize) -> Result<(), InputError> {
         if n == 0 {
             return Err(SeriesError::Empty.into());
         }
@@ -113,7 +114,7 @@ impl Dwt {
     ///
     /// # Errors
     /// As [`check_len`](Self::check_len); `out` and `scratch` are then left unspecified.
-    pub fn transform_with_scratch(
+    pub(crate) fn transform_with_scratch(
         &self,
         x: &[f64],
         out: &mut WaveletCoefficients,

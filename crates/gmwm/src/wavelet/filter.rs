@@ -117,7 +117,7 @@ impl WaveletFilter {
     ///
     /// Unscaled (DWT) normalisation: `sum g = sqrt2`, `sum g^2 = 1`, up to
     /// [`orthonormality_tolerance`](Self::orthonormality_tolerance).
-    pub fn scaling(&self) -> &'static [f64] {
+    pub(crate) fn scaling(&self) -> &'static [f64] {
         match self {
             WaveletFilter::Haar => &HAAR,
             WaveletFilter::D4 => &D4,
@@ -170,7 +170,8 @@ impl WaveletFilter {
     /// The wavelet filter's sum `sum h` (its gain at frequency 0) then vanishes only to about the
     /// square root of this tolerance: `fk22` has `sum h = 9.7e-6`, so its MODWT of a constant
     /// series is about `7e-6` times the constant, not zero.
-    pub fn orthonormality_tolerance(&self) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn orthonormality_tolerance(&self) -> f64 {
         match self {
             WaveletFilter::Haar | WaveletFilter::D4 | WaveletFilter::D6 | WaveletFilter::Fk4 => {
                 1e-14
@@ -190,7 +191,8 @@ impl WaveletFilter {
     }
 
     /// MODWT scaling filter `g~ = g / sqrt2` (docs/methods.md §1.1, §1.2).
-    pub fn modwt_scaling(&self) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn modwt_scaling(&self) -> Vec<f64> {
         self.scaling()
             .iter()
             .map(|g| g * std::f64::consts::FRAC_1_SQRT_2)
@@ -198,7 +200,8 @@ impl WaveletFilter {
     }
 
     /// MODWT wavelet filter `h~ = h / sqrt2` (docs/methods.md §1.1, §1.2).
-    pub fn modwt_wavelet(&self) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn modwt_wavelet(&self) -> Vec<f64> {
         self.wavelet()
             .iter()
             .map(|h| h * std::f64::consts::FRAC_1_SQRT_2)
@@ -256,7 +259,7 @@ impl Taps {
 }
 
 /// Quadrature mirror of a scaling filter, `h_l = (-1)^l g_{L-1-l}` (docs/methods.md §1.1).
-pub fn quadrature_mirror(g: &[f64]) -> Vec<f64> {
+pub(crate) fn quadrature_mirror(g: &[f64]) -> Vec<f64> {
     g.iter()
         .rev()
         .enumerate()

@@ -30,12 +30,14 @@ pub(crate) mod naive;
 mod tests_oracle;
 
 pub use dwt::Dwt;
-pub use filter::{quadrature_mirror, WaveletFilter};
+#[cfg(test)]
+pub(crate) use filter::quadrature_mirror;
+pub use filter::WaveletFilter;
 pub use modwt::Modwt;
 
 /// Largest number of levels a [`Modwt`] or [`Dwt`] plan accepts (`2^60` samples would be
 /// needed; the bound keeps every `2^j` representable in a 64-bit `usize`).
-pub const MAX_LEVELS: usize = 60;
+pub(crate) const MAX_LEVELS: usize = 60;
 
 /// Decimated or maximal-overlap wavelet transform (docs/methods.md §1.2, §1.4).
 ///
@@ -167,7 +169,7 @@ impl WaveletCoefficients {
 /// [`Dwt::transform_with_scratch`]; after a run it holds the final scaling coefficients `V_J`
 /// (docs/methods.md §1.2, §1.4).
 #[derive(Debug, Clone, Default)]
-pub struct WaveletScratch {
+pub(crate) struct WaveletScratch {
     /// Current scaling coefficients `V_j`.
     v: Vec<f64>,
     /// Next scaling coefficients `V_{j+1}` while a level is computed.
@@ -183,7 +185,8 @@ impl WaveletScratch {
     /// Scaling coefficients `V_J` of the last level of the last successful transform
     /// (docs/methods.md §1.2, §1.4): length N for the MODWT, `N / 2^J` for the DWT; empty before
     /// the first run.
-    pub fn scaling(&self) -> &[f64] {
+    #[cfg(test)]
+    pub(crate) fn scaling(&self) -> &[f64] {
         &self.v
     }
 }

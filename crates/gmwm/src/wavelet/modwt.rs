@@ -51,7 +51,8 @@ impl Modwt {
     /// Largest `J <= 60` a MODWT of `n` samples with `filter` accepts: `2^J <= n` and at least
     /// one boundary-free coefficient at every level, `n >= L_J = (2^J - 1)(L - 1) + 1`
     /// (docs/methods.md §1.2, §1.3). 0 if not even one level fits.
-    pub fn max_levels(filter: WaveletFilter, n: usize) -> usize {
+    #[cfg(test)]
+    pub(crate) fn max_levels(filter: WaveletFilter, n: usize) -> usize {
         (1..=super::MAX_LEVELS)
             .take_while(|&j| pow2(j) <= n && modwt_boundary(filter.len(), j) < n)
             .last()
@@ -63,7 +64,7 @@ impl Modwt {
     /// # Errors
     /// [`SeriesError::Empty`] for `n = 0`; [`SeriesError::TooShort`] if `2^J > n`, or naming the
     /// first level `j` without a boundary-free coefficient (`n < L_j`).
-    pub fn check_len(&self, n: usize) -> Result<(), SeriesError> {
+    pub(crate) fn check_len(&self, n: usize) -> Result<(), SeriesError> {
         if n == 0 {
             return Err(SeriesError::Empty);
         }
@@ -101,7 +102,7 @@ impl Modwt {
     ///
     /// # Errors
     /// As [`check_len`](Self::check_len); `out` and `scratch` are then left unspecified.
-    pub fn transform_with_scratch(
+    pub(crate) fn transform_with_scratch(
         &self,
         x: &[f64],
         out: &mut WaveletCoefficients,

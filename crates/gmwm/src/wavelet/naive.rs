@@ -12,21 +12,21 @@ use super::{quadrature_mirror, WaveletFilter};
 /// Level-j equivalent filters (docs/methods.md §1.2, §1.3): a single convolution of the series with
 /// these gives `W_j` and `V_j` directly.
 #[derive(Debug, Clone, PartialEq)]
-pub struct EquivalentFilters {
+pub(crate) struct EquivalentFilters {
     /// Equivalent wavelet filter, width `L_j = (2^j - 1)(L - 1) + 1`.
     pub wavelet: Vec<f64>,
     /// Equivalent scaling filter, width `L_j`.
-    pub scaling: Vec<f64>,
+    pub(crate) scaling: Vec<f64>,
 }
 
 /// Output of the oracle transforms: every wavelet coefficient of every level and the final
 /// scaling coefficients `V_J` (docs/methods.md §1.2, §1.4).
 #[derive(Debug, Clone, PartialEq)]
-pub struct NaiveTransform {
+pub(crate) struct NaiveTransform {
     /// `w[j-1]` = level-j wavelet coefficients (no boundary removal).
     pub w: Vec<Vec<f64>>,
     /// Scaling coefficients `V_J`.
-    pub scaling: Vec<f64>,
+    pub(crate) scaling: Vec<f64>,
 }
 
 /// `c_m = sum_l f_l prev_{m - step l}`: `prev` convolved with `f` upsampled by `step`.
@@ -44,7 +44,7 @@ fn upsampled_convolution(f: &[f64], step: usize, prev: &[f64]) -> Vec<f64> {
 /// `g_k = (g upsampled by 2^{k-1}) * g_{k-1}`, `h_j = (h upsampled by 2^{j-1}) * g_{j-1}`.
 ///
 /// Pass `h~`, `g~` for the MODWT and the unscaled `h`, `g` for the DWT.
-pub fn equivalent_filters(h: &[f64], g: &[f64], j: usize) -> EquivalentFilters {
+pub(crate) fn equivalent_filters(h: &[f64], g: &[f64], j: usize) -> EquivalentFilters {
     let mut scaling = vec![1.0];
     let mut wavelet = vec![1.0];
     for k in 1..=j {
@@ -56,7 +56,7 @@ pub fn equivalent_filters(h: &[f64], g: &[f64], j: usize) -> EquivalentFilters {
 }
 
 /// MODWT level-`j` equivalent filters `h~_j`, `g~_j` of `filter` (docs/methods.md §1.2).
-pub fn modwt_equivalent_filters(filter: WaveletFilter, j: usize) -> EquivalentFilters {
+pub(crate) fn modwt_equivalent_filters(filter: WaveletFilter, j: usize) -> EquivalentFilters {
     let g: Vec<f64> = filter.scaling().iter().map(|c| c * FRAC_1_SQRT_2).collect();
     let h = quadrature_mirror(&g);
     equivalent_filters(&h, &g, j)

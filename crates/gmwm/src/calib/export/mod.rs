@@ -45,19 +45,19 @@ pub struct SensorNoise {
     /// Random-walk density K (or a GM driving density): rad/s²/√Hz or m/s³/√Hz.
     pub random_walk: Option<f64>,
     /// Gauss–Markov bias correlation time, s.
-    pub bias_correlation_time_s: Option<f64>,
+    pub(crate) bias_correlation_time_s: Option<f64>,
     /// Gauss–Markov bias standard deviation: rad/s or m/s².
-    pub bias_sigma: Option<f64>,
+    pub(crate) bias_sigma: Option<f64>,
     /// Density of the noise driving the Gauss–Markov bias, `sqrt(2 sigma^2 / T)` (rad/s²/√Hz
     /// or m/s³/√Hz): the random walk of a bias that is a Gauss–Markov process (PX4).
-    pub bias_driving_density: Option<f64>,
+    pub(crate) bias_driving_density: Option<f64>,
 }
 
 /// What a navigation filter needs, with provenance (docs/methods.md §14.4).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NavNoise {
     /// IMU rate, Hz.
-    pub update_rate_hz: f64,
+    pub(crate) update_rate_hz: f64,
     /// ROS topic of the IMU (Kalibr, OpenVINS, VINS-Fusion; PX4's `imuTopic`), if known;
     /// a placeholder marked as such is written otherwise.
     pub rostopic: Option<String>,
@@ -93,9 +93,9 @@ impl ExportFormat {
     /// OpenVINS `kalibr_imu_chain.yaml`.
     pub const OPENVINS: ExportFormat = ExportFormat(&openvins::OpenVins);
     /// VINS-Fusion config (IMU block).
-    pub const VINS: ExportFormat = ExportFormat(&vins::Vins);
+    pub(crate) const VINS: ExportFormat = ExportFormat(&vins::Vins);
     /// ORB-SLAM3 settings (IMU block).
-    pub const ORBSLAM3: ExportFormat = ExportFormat(&orbslam3::OrbSlam3);
+    pub(crate) const ORBSLAM3: ExportFormat = ExportFormat(&orbslam3::OrbSlam3);
     /// PX4 SITL / Gazebo IMU plugin SDF fragment.
     pub const PX4: ExportFormat = ExportFormat(&px4::Px4);
 

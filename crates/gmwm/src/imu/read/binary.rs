@@ -9,8 +9,11 @@ use super::positioned::read_at;
 use super::{binary_names, resolve_selection, Column, InputFormat, RawTable, ReadOptions};
 use crate::error::ParamError;
 use crate::imu::timing::{check_times, TimeUnit, UnitSource};
+#[cfg(test)]
+use crate::imu::Imu;
+#[cfg(test)]
 use crate::imu::ReadError as Error;
-use crate::imu::{Imu, ReadError, Sidecar};
+use crate::imu::{ReadError, Sidecar};
 use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, Read};
@@ -379,7 +382,7 @@ impl BinaryChunks {
     /// # Errors
     /// [`ReadError::ColumnOutOfRange`] for a column outside `1..=ncols`; as
     /// [`next_chunk`](Self::next_chunk), with the first non-finite value in file order.
-    pub fn next_chunk_of(
+    pub(crate) fn next_chunk_of(
         &mut self,
         columns: &[usize],
         out: &mut [Vec<f64>],
@@ -566,7 +569,8 @@ impl RawRows {
 ///
 /// # Errors
 /// As [`BinaryChunks::open`] and [`BinaryChunks::next_chunk`], or the first error of `f`.
-pub fn for_each_chunk(
+#[cfg(test)]
+pub(crate) fn for_each_chunk(
     path: &Path,
     format: InputFormat,
     ncols: usize,
@@ -625,7 +629,7 @@ impl ImuRecordType {
     }
 
     /// Whether the six values are 8-byte doubles (else 32-bit signed integers).
-    pub fn is_double(self) -> bool {
+    pub(crate) fn is_double(self) -> bool {
         matches!(self, Self::Ixsea | Self::NavchipFlt)
     }
 
@@ -856,7 +860,8 @@ pub(crate) fn read_record_table(
 /// time), [`ReadError::RecordTimeNotIncreasing`] (with the 0-based record and both times),
 /// [`ReadError::FreqNotDerivable`] (fewer than 2 epochs or a degenerate time span),
 /// [`ReadError::RecordRateOverflow`] (an increment times the rate is not finite).
-pub fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<Imu, Error> {
+#[cfg(test)]
+pub(crate) fn read_imu_record_file(path: &Path, record_type: ImuRecordType) -> Result<Imu, Error> {
     let opts = ReadOptions {
         format: InputFormat::ImuRecord(record_type),
         ..ReadOptions::default()

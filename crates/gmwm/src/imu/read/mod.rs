@@ -10,7 +10,10 @@ mod ros_stream;
 pub mod stream;
 pub(crate) mod text;
 
-pub use binary::{for_each_chunk, read_imu_record_file, BinaryChunks, ImuRecordType};
+pub use binary::{BinaryChunks, ImuRecordType};
+
+#[cfg(test)]
+pub(crate) use binary::{for_each_chunk, read_imu_record_file};
 
 use super::error::quote;
 use super::samples::SampleAccount;
@@ -148,7 +151,7 @@ impl InputFormat {
 
     /// Resolves [`InputFormat::Auto`] from the file name only (see the variant's doc; the
     /// sidecar and the content are looked at by [`read_table`]).
-    pub fn resolve(self, path: &Path) -> Self {
+    pub(crate) fn resolve(self, path: &Path) -> Self {
         if self != Self::Auto {
             return self;
         }
@@ -182,7 +185,7 @@ pub enum Content {
 }
 
 /// Bytes looked at by [`sniff`]: 4 KiB.
-pub const SNIFF_BYTES: usize = 4096;
+pub(crate) const SNIFF_BYTES: usize = 4096;
 
 /// Looks at the first [`SNIFF_BYTES`] bytes of a file (decompressed if it starts with the gzip
 /// magic bytes) and says whether it is text, gzip text, JSON or binary data. Text is UTF-8
@@ -191,7 +194,7 @@ pub const SNIFF_BYTES: usize = 4096;
 /// # Errors
 /// [`ReadError::Io`] if the file cannot be read; [`ReadError::Gzip`] if the gzip stream is
 /// corrupt at its start.
-pub fn sniff(path: &Path) -> Result<Content, ReadError> {
+pub(crate) fn sniff(path: &Path) -> Result<Content, ReadError> {
     use std::io::Read;
     let io = |source| ReadError::Io {
         path: path.to_path_buf(),
@@ -428,7 +431,7 @@ impl fmt::Display for ReadWarning {
 /// # Errors
 /// [`ReadError::LooksBinary`], [`ReadError::NotATable`], [`ReadError::Io`],
 /// [`ReadError::Gzip`].
-pub fn resolve_format(
+pub(crate) fn resolve_format(
     path: &Path,
     format: InputFormat,
     sidecar: Option<&Sidecar>,

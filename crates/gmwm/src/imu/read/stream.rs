@@ -23,7 +23,7 @@
 //!
 //! The values, the selection, the errors (with file and line), the time report and the rate
 //! are those of [`read_table`](super::read_table) on the same file (tests:
-//! `crates/gmwm/tests/streamed.rs`); the WVs equal the in-memory ones within 1e-12 (the same
+//! `crates/gmwm/src/tests/streamed.rs`); the WVs equal the in-memory ones within 1e-12 (the same
 //! values, the squares summed in another grouping).
 //!
 //! Cost (measured on a busy 2-core machine, indicative, `gmwm wv FILE --json` on a CSV of a
@@ -93,7 +93,7 @@ pub struct StreamedTable {
 ///
 /// # Errors
 /// As [`resolve_format`].
-pub fn streamed_size(probe: &Probe, opts: &ReadOptions) -> Result<Option<u64>, ReadError> {
+pub(crate) fn streamed_size(probe: &Probe, opts: &ReadOptions) -> Result<Option<u64>, ReadError> {
     let path = probe.path();
     if probe.is_ros() {
         return Ok(Some(std::fs::metadata(path).map_or(0, |m| m.len())));

@@ -12,7 +12,7 @@ use super::error::MessageError;
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ImuFields<'a> {
     /// `header.stamp` in ns since the epoch.
-    pub stamp_ns: i64,
+    pub(crate) stamp_ns: i64,
     /// `header.frame_id` bytes (without a terminating NUL).
     pub frame_id: &'a [u8],
     /// rad/s.

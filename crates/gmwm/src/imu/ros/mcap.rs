@@ -32,7 +32,7 @@ pub(crate) struct Channel {
 
 /// The channels of a file, and its summary when it has one.
 pub(crate) struct Catalog {
-    pub channels: Vec<Channel>,
+    pub(crate) channels: Vec<Channel>,
     summary: Option<mcap::Summary>,
 }
 

@@ -131,7 +131,7 @@ pub struct ImuMessages {
     /// `linear_acceleration` x, y, z in m/s^2.
     pub linear_acceleration: [Vec<f64>; 3],
     /// Messages of the recording on other topics (not read).
-    pub other_messages: u64,
+    pub(crate) other_messages: u64,
 }
 
 impl ImuMessages {
@@ -514,7 +514,7 @@ fn folder(dir: &Path) -> Result<Source, ReadError> {
 /// The container format of `path` (a file or a rosbag2 folder), recognised by magic bytes:
 /// `#ROSBAG V2.0`, the MCAP magic `0x89 M C A P 0x30 \r \n`, or `SQLite format 3\0`; `None`
 /// if it is none of them (or cannot be read).
-pub fn container_of(path: &Path) -> Option<RosContainer> {
+pub(crate) fn container_of(path: &Path) -> Option<RosContainer> {
     source(path).ok().map(|s| s.container)
 }
 
@@ -837,7 +837,7 @@ pub(crate) fn read_topic<'s>(
 ///
 /// # Errors
 /// As [`list_topics`].
-pub fn imu_messages_count(path: &Path) -> Result<u64, ReadError> {
+pub(crate) fn imu_messages_count(path: &Path) -> Result<u64, ReadError> {
     let (_, topics) = list_topics(path)?;
     Ok(topics
         .iter()

@@ -39,7 +39,7 @@ pub(crate) struct Connection {
 /// The bag's connections and which chunks (file positions) hold which connections.
 #[derive(Debug)]
 pub(crate) struct Catalog {
-    pub connections: Vec<Connection>,
+    pub(crate) connections: Vec<Connection>,
     /// chunk position -> connections with messages in it; `None` for an unindexed bag.
     chunks: Option<Vec<(u64, Vec<u32>)>>,
 }

@@ -2,7 +2,7 @@
 //! quadrature oracle, §4.1 against the closed forms, derivatives against finite differences, GM <->
 //! AR1, constructor accept/reject tables.
 
-use crate::common::rel_diff;
+use crate::tests::common::rel_diff;
 use gmwm::process::spectral::{spectral_wv, spectral_wv_level};
 use gmwm::process::{
     autocovariance_wv, Ar1, Arma, Arma11, Dr, Gm, LatentProcess, Ma1, Process, Qn, Rw, Wn,

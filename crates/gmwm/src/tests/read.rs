@@ -2,7 +2,7 @@
 //! text/gzip/binary round trips, the chunked reader, IMU binary records (§9.2–9.3) and the shared
 //! recordings.
 
-use crate::common::data_dir;
+use crate::tests::common::data_dir;
 use flate2::write::GzEncoder;
 use flate2::Compression;
 use gmwm::imu::write::write_sidecar;
@@ -723,7 +723,7 @@ fn imu_record_errors() {
 // ---------------------------------------------------------------- shared recordings
 
 fn mean(x: &[f64]) -> f64 {
-    crate::common::neumaier_sum(x.iter().copied()) / x.len() as f64
+    crate::tests::common::neumaier_sum(x.iter().copied()) / x.len() as f64
 }
 
 #[test]
@@ -1446,7 +1446,7 @@ fn wv_json_series_by_name_or_index_and_allan_by_methods_3_4() {
 #[test]
 fn wic_select_wv_equals_select_on_the_series() {
     use gmwm::{wavelet_variance, Wic, WvOptions};
-    let x = crate::common::white_noise(2000, 1.0, 5);
+    let x = crate::tests::common::white_noise(2000, 1.0, 5);
     let wic = Wic::nested("AR1()+WN()".parse().unwrap())
         .unwrap()
         .with_bootstrap(10)

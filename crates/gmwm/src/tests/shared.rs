@@ -112,7 +112,7 @@ fn shared_gm_is_recovered_and_the_test_holds_its_size() {
 }
 
 /// The full study (figures in the closing note): 1000 triads of N = 2^16 with and without the
-/// shared GM. `cargo test --release -p gmwm --test integration shared_study -- --ignored
+/// shared GM. `cargo test --release -p gmwm --lib shared_study -- --ignored
 /// --nocapture`.
 #[test]
 #[ignore = "full study, ~27 min: N = 2^16, 1000 triads each way; figures in docs/methods/multi-axis.md §15"]

@@ -2,7 +2,7 @@
 //! known answer, the separation measure, and the real recordings named by issue 10 (KVH1750
 //! GM()+WN()+RW() with beta -> infinity, 3*GM() at one beta; ADIS16405 gyro_x 2*AR1()).
 
-use crate::common::{data_dir, read_column};
+use crate::tests::common::{data_dir, read_column};
 use gmwm::fit::canonical::wv_separation;
 use gmwm::fit::{CanonicalModel, Gmwm, GmwmFit, Reading, StartInputs};
 use gmwm::model::{Model, ProcessKind};
@@ -149,13 +149,13 @@ fn canonical_reads_a_slow_ar1_as_the_random_walk_it_stands_for() {
 /// the levels, counts and degrees of freedom of a real estimate, values and intervals scaled
 /// to the implied WV (the chi-square interval is proportional to the estimate).
 fn exact_wv(truth: &Model, n: usize, freq: f64) -> gmwm::WaveletVariance {
-    let dummy = crate::common::white_noise(n, 1.0, 99);
+    let dummy = crate::tests::common::white_noise(n, 1.0, 99);
     let wv = gmwm::wavelet_variance(&dummy, freq, &WvOptions::default()).unwrap();
     let implied = truth.implied_wv(wv.levels(), freq).unwrap().wv;
     let ratio: Vec<f64> = implied.iter().zip(wv.wv()).map(|(i, w)| i / w).collect();
     let scaled = |v: &[f64]| -> Vec<f64> { v.iter().zip(&ratio).map(|(v, r)| v * r).collect() };
     let (low, high) = (scaled(wv.ci_low()), scaled(wv.ci_high()));
-    crate::common::edited_wv(&wv, |doc| {
+    crate::tests::common::edited_wv(&wv, |doc| {
         doc["wv"] = serde_json::json!(implied);
         doc["ci_low"] = serde_json::json!(low);
         doc["ci_high"] = serde_json::json!(high);
@@ -184,7 +184,7 @@ fn canonical_rising_ar1s_are_random_walks_and_peaked_ones_stay() {
     // with a thousand times the degrees of freedom at every level (as no recording of this
     // length has), the bend would show: the AR1 stays, and the note says it rises everywhere
     let eta: Vec<f64> = wv.eta().iter().map(|e| e * 1000.0).collect();
-    let precise = crate::common::edited_wv(&wv, |doc| doc["eta"] = serde_json::json!(eta));
+    let precise = crate::tests::common::edited_wv(&wv, |doc| doc["eta"] = serde_json::json!(eta));
     let f = fit_wv("AR1()+WN()", &precise);
     let c = f.canonical().unwrap();
     assert_eq!(c.model.to_string(), "AR1()+WN()", "{f}\n{c}");

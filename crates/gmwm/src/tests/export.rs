@@ -1,7 +1,7 @@
 //! Navigation-stack noise files (docs/methods.md §14.4): each format renders, parses by hand, and
 //! holds the right numbers under the right keys; missing values are typed errors naming the key.
 
-use crate::common::rel_diff;
+use crate::tests::common::rel_diff;
 use gmwm::calib::export::{render, ExportError, ExportFormat, NavNoise, SensorNoise};
 use std::collections::BTreeMap;
 

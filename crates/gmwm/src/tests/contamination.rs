@@ -22,7 +22,7 @@ fn pair(x: &[f64]) -> (WaveletVariance, WaveletVariance) {
 }
 
 fn white_noise(n: usize, seed: u64) -> Vec<f64> {
-    crate::common::white_noise(n, 1e-4, seed)
+    crate::tests::common::white_noise(n, 1e-4, seed)
 }
 
 #[test]
@@ -66,7 +66,7 @@ fn contamination_outliers_inflate_the_first_scales() {
 fn contamination_undefined_robust_level_is_named_not_compared() {
     let x = white_noise(1 << 12, 3);
     let (c, r) = pair(&x);
-    let r = crate::common::edited_wv(&r, |doc| {
+    let r = crate::tests::common::edited_wv(&r, |doc| {
         for key in ["wv", "ci_low", "ci_high"] {
             doc[key][2] = serde_json::Value::Null;
         }
@@ -84,7 +84,7 @@ fn contamination_undefined_robust_level_is_named_not_compared() {
 
 #[test]
 fn contamination_real_contaminated_recording_is_flagged() {
-    let x = crate::common::read_column("cont_imu1", "gyro_x");
+    let x = crate::tests::common::read_column("cont_imu1", "gyro_x");
     let (c, r) = pair(&x);
     let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
     assert!(check.matters, "{}", check.summary);
@@ -93,7 +93,7 @@ fn contamination_real_contaminated_recording_is_flagged() {
 
 #[test]
 fn contamination_advice_follows_the_estimator_the_fit_used() {
-    let x = crate::common::read_column("cont_imu1", "gyro_x");
+    let x = crate::tests::common::read_column("cont_imu1", "gyro_x");
     let (c, r) = pair(&x);
     let check = compare_classical_robust(c, r, FitUses::Robust, 0.05);
     assert!(check.matters, "{}", check.summary);
@@ -110,7 +110,7 @@ fn contamination_nothing_to_compare_says_so() {
     let x = white_noise(1 << 10, 9);
     let (c, r) = pair(&x);
     let undefined = vec![serde_json::Value::Null; r.levels()];
-    let r = crate::common::edited_wv(&r, |doc| doc["wv"] = serde_json::json!(undefined));
+    let r = crate::tests::common::edited_wv(&r, |doc| doc["wv"] = serde_json::json!(undefined));
     let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
     assert_eq!(check.levels, 0);
     assert!(!check.matters);

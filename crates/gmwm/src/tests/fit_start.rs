@@ -1,7 +1,7 @@
 //! Starting values (docs/methods.md §6) and the two-stage fit (§5.4–§5.5): hand values,
 //! reproducible draws, recovery from guess mode, and the objective against the R package.
 
-use crate::common::{f64s, read_column, read_ref};
+use crate::tests::common::{f64s, read_column, read_ref};
 use gmwm::fit::{
     starting_values, Gmwm, Objective, Parametrisation, PhiOrder, StartInputs, StartOptions,
     TransformPreset, Weights,
@@ -244,7 +244,7 @@ fn reference_gm3_guess_mode_vs_r() {
         let run = &r["runs"][n];
         let x = if n == "N1000000" {
             // raw little-endian float64, no header (the reference's notes)
-            let path = crate::common::data_dir().join("sim/gm3_N1000000.f64le.bin");
+            let path = crate::tests::common::data_dir().join("sim/gm3_N1000000.f64le.bin");
             let bytes = std::fs::read(&path).unwrap();
             bytes
                 .chunks_exact(8)

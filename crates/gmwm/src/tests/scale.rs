@@ -145,7 +145,7 @@ fn scale_white_noise_and_random_walk_match_the_exact_integer_wv() {
 }
 
 /// The 10^9-sample study of issue 14 (minutes, 8 GB for the in-memory copy):
-/// `cargo test -p gmwm --release --test integration scale::scale_1e9 -- --ignored --nocapture`.
+/// `cargo test -p gmwm --release --lib scale::scale_1e9 -- --ignored --nocapture`.
 #[test]
 #[ignore = "10^9 samples: minutes and 8 GB; run by hand, figures in the issue note"]
 fn scale_1e9_white_noise_and_random_walk_match_the_exact_integer_wv() {

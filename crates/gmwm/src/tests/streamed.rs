@@ -273,7 +273,7 @@ fn streamed_records_equal_in_memory_for_every_type() {
             } else {
                 0.005 + 1e-6 * (i % 3) as f64
             };
-            bytes.extend(crate::read::record(
+            bytes.extend(crate::tests::read::record(
                 t,
                 time,
                 [c(0), c(1), c(2), 100 + c(3), c(4), -16000 + c(5)],

@@ -1,7 +1,7 @@
 //! Wavelet variance: reference parity with the R package on real data, properties, Monte Carlo
 //! coverage and robustness (issue 2).
 
-use crate::common::{f64s, read_column, read_dataset, read_ref, rel_diff, white_noise};
+use crate::tests::common::{f64s, read_column, read_dataset, read_ref, rel_diff, white_noise};
 use gmwm::{wavelet_variance, HaarWvAccumulator, RobustConvention, RobustOptions, WvOptions};
 use proptest::prelude::*;
 
@@ -366,7 +366,7 @@ fn streaming_wv_is_exact_to_1e_9_at_30_million_samples() {
 }
 
 #[test]
-#[ignore = "10^9 samples: ~3 min and 12 GB; run with `cargo test --release -p gmwm --test integration -- --ignored streaming_wv_is_exact_to_1e_9_at_a_billion`"]
+#[ignore = "10^9 samples: ~3 min and 12 GB; run with `cargo test --release -p gmwm --lib -- --ignored streaming_wv_is_exact_to_1e_9_at_a_billion`"]
 fn streaming_wv_is_exact_to_1e_9_at_a_billion_samples() {
     check_streaming_exact(1_000_000_001);
 }
@@ -479,7 +479,7 @@ fn in_memory_wv_is_exact_to_1e_9_on_a_biased_random_walk() {
 /// cuts its levels together, refusing a count outside 1..=J.
 #[test]
 fn wv_options_recompute_it_and_truncation_cuts_every_level() {
-    let x = crate::common::white_noise(4096, 2.0, 9);
+    let x = crate::tests::common::white_noise(4096, 2.0, 9);
     let opts = WvOptions {
         robust: Some(gmwm::RobustOptions::default()),
         alpha: 0.1,

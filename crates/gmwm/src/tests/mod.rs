@@ -1,4 +1,5 @@
-//! The engine's single integration-test binary (STYLE §1): reference data, properties, Monte Carlo.
+//! The engine's tests against reference data, properties and Monte Carlo (STYLE §1), inside the
+//! crate so that they reach the kernels the public API does not show.
 
 // Parallel per-level arrays are compared by index throughout; iterator zips would obscure that.
 #![allow(clippy::needless_range_loop)]

@@ -1,7 +1,7 @@
 //! Allan, modified Allan and Hadamard variances (docs/methods.md §3): hand values, slow oracles,
 //! the AV = 2 WV identity (§3.4), R package and allantools references, white-noise closed forms.
 
-use crate::common::{data_dir, f64s, read_ref, rel_diff};
+use crate::tests::common::{data_dir, f64s, read_ref, rel_diff};
 use gmwm::variance::allan::package_error;
 use gmwm::{
     allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention, InputError, SeriesError,
@@ -49,7 +49,7 @@ fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
 
 /// Neumaier-compensated sum.
 fn csum(values: impl IntoIterator<Item = f64>) -> f64 {
-    crate::common::neumaier_sum(values)
+    crate::tests::common::neumaier_sum(values)
 }
 
 /// `sum_i w_i * mean(x_{s_i} .. x_{s_i + m - 1})` for windows `(s_i, w_i)`, summed as one

@@ -1,7 +1,7 @@
 //! Issue 4 "must show": parity with the R package's `gmwm_imu` fits on real data, the bootstrap
 //! weighting, `update`, fits of a WV read from JSON, and the §5.7 refusals.
 
-use crate::common::{data_dir, read_column, read_ref};
+use crate::tests::common::{data_dir, read_column, read_ref};
 use gmwm::fit::{FitError, Gmwm, StartInputs, Weighting};
 use gmwm::model::Model;
 use gmwm::{wavelet_variance, RobustConvention, RobustOptions, WvOptions};
@@ -43,10 +43,10 @@ fn objective_never_above_the_r_package_on_adis_imu1() {
                 ours.objective()
             );
             // the same weights as the package (its omega_diag), to the WV parity (1e-9)
-            let omega = crate::common::f64s(&f["gm"]["omega_diag"]);
+            let omega = crate::tests::common::f64s(&f["gm"]["omega_diag"]);
             for (j, (a, b)) in ours.weights().omega.iter().zip(&omega).enumerate() {
                 assert!(
-                    crate::common::rel_diff(*a, *b) < 1e-8,
+                    crate::tests::common::rel_diff(*a, *b) < 1e-8,
                     "{column} {key}: omega level {}: {a} vs {b}",
                     j + 1
                 );

@@ -652,7 +652,7 @@ fn ros_choose_topic_is_what_read_takes() {
 
 #[test]
 #[ignore = "throughput on a large recording: GMWM_ROS_BENCH=PATH cargo test --release -p gmwm \
-            --test integration ros_read_throughput -- --ignored --nocapture"]
+            --lib ros_read_throughput -- --ignored --nocapture"]
 fn ros_read_throughput() {
     let path = PathBuf::from(std::env::var_os("GMWM_ROS_BENCH").expect("GMWM_ROS_BENCH=PATH"));
     let start = std::time::Instant::now();

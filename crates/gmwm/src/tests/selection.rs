@@ -1,7 +1,7 @@
 //! Model selection by WIC (docs/methods.md §8): the model Hessian (§4.6), the §8 test values,
 //! candidate enumeration, seeded Monte Carlo and the R package's auto_imu on real data.
 
-use crate::common::{data_dir, f64s, read_column, read_ref};
+use crate::tests::common::{data_dir, f64s, read_column, read_ref};
 use gmwm::imu::{read_table, Imu, ReadOptions};
 use gmwm::model::Model;
 use gmwm::selection::wic::WIC_TIE_REL;
@@ -743,7 +743,7 @@ fn wic_with_a_second_ar1_in_the_full_model_still_never_underfits() {
 }
 
 #[test]
-#[ignore = "about 90 s in release on 2 cores; run with cargo test --release -p gmwm --test integration wic_second_ar1_full_size -- --ignored --nocapture"]
+#[ignore = "about 90 s in release on 2 cores; run with cargo test --release -p gmwm --lib wic_second_ar1_full_size -- --ignored --nocapture"]
 fn wic_second_ar1_full_size() {
     // The figure quoted above for issue 5's example at its size: N = 1e5, 200 replicates,
     // full model 2*AR1+WN+RW+QN+DR, B = 50: 191/200 measured (138/200 with the WIC minimum
@@ -871,7 +871,7 @@ fn auto_imu_gyro_x_objectives_are_no_worse_than_the_r_package() {
 }
 
 #[test]
-#[ignore = "six axes of 1e6 samples, 63 candidates each: about 3 minutes in release on 2 cores; run with cargo test --release -p gmwm --test integration auto_imu_adis_six_axes -- --ignored --nocapture"]
+#[ignore = "six axes of 1e6 samples, 63 candidates each: about 3 minutes in release on 2 cores; run with cargo test --release -p gmwm --lib auto_imu_adis_six_axes -- --ignored --nocapture"]
 fn auto_imu_adis_six_axes() {
     let path = data_dir().join("adis_16405_imu1.csv.gz");
     let table = read_table(
@@ -1220,7 +1220,7 @@ fn issue_10_selection_reports_the_canonical_truth() {
 
 #[test]
 #[ignore = "the issue's full Monte Carlo: 200 replicates of N = 1e5 for both full models, about \
-            90 s on 2 cores; run with cargo test --release -p gmwm --test integration \
+            90 s on 2 cores; run with cargo test --release -p gmwm --lib \
             issue_10_selection_full_size -- --ignored --nocapture"]
 fn issue_10_selection_full_size() {
     for full in ["2*AR1()+WN()+RW()+QN()+DR()", "3*AR1()+WN()+RW()+QN()+DR()"] {

@@ -1,6 +1,6 @@
 //! Units, datasheet forms and discrete forms (docs/methods.md §14.2) against the §14.5 hand values.
 
-use crate::common::rel_diff;
+use crate::tests::common::rel_diff;
 use gmwm::fit::{Gmwm, NavParameter, Weights};
 use gmwm::model::Model;
 use gmwm::process::Ar1;

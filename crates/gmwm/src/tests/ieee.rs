@@ -1,7 +1,7 @@
 //! IEEE Std 952 read-offs (docs/methods.md §14.3): closed-form Allan variances (§14.2 derivation
 //! check), a simulated WN + RW series, and the ADIS16405 recording.
 
-use crate::common::{read_column, rel_diff};
+use crate::tests::common::{read_column, rel_diff};
 use gmwm::calib::ieee::{ieee_readoff, IeeeReadoff, DOMINANCE};
 use gmwm::process::{Process, Rw, Wn};
 use gmwm::sim::simulate;

@@ -4,7 +4,7 @@
 //! in a reader), and as property tests on mutated seeds and arbitrary bytes. The long libFuzzer
 //! runs are in `fuzz/README.md`.
 
-#[path = "../../../fuzz/src/lib.rs"]
+#[path = "../../../../fuzz/src/lib.rs"]
 mod bodies;
 
 use bodies::TARGETS;
