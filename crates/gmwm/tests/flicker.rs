@@ -174,8 +174,7 @@ fn recover(n: usize, r: u64, seed: u64) -> Vec<(f64, f64, f64)> {
 /// `sqrt(b2)`.
 #[test]
 fn flicker_recovers_bias_instability_beside_wn_and_rw() {
-    let reps = std::env::var("FN_REPS").map_or(4, |v| v.parse().unwrap());
-    let rows = recover(1 << 18, reps, 1810);
+    let rows = recover(1 << 18, 4, 1810);
     let r = rows.len() as f64;
     let b = rows.iter().map(|t| t.0).sum::<f64>() / r;
     let gamma2 = rows.iter().map(|t| t.1).sum::<f64>() / r;
