@@ -994,7 +994,7 @@ fn model_of(parts: &[Part]) -> Result<Model, crate::model::ModelError> {
 }
 
 /// Canonical term order: by role ([`Role`]: correlated terms by decreasing correlation time
-/// (phi decreasing), then WN, QN, RW, DR, then anything else), in the given order within a
+/// (phi decreasing), then WN, QN, FN, RW, DR, then anything else), in the given order within a
 /// role.
 fn canonical_order(mut parts: Vec<Part>, freq_hz: f64) -> Vec<Part> {
     let phi = |p: &Part| p.ar1(freq_hz).map_or(0.0, |a| a.phi);

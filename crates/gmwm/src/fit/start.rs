@@ -236,6 +236,7 @@ pub(crate) fn starting_values(
         dom,
         only_wn: only(Role::WhiteNoise),
         only_qn: only(Role::Quantization),
+        wv_min: nu.iter().copied().fold(f64::INFINITY, f64::min),
     };
     let given = model.values();
     let total = options

@@ -34,6 +34,8 @@ pub(crate) struct DrawContext {
     pub(crate) only_wn: bool,
     /// The model's only term (besides the ARMA family) is quantisation noise.
     pub(crate) only_qn: bool,
+    /// The smallest empirical WV over the levels (the floor a flicker term cannot exceed).
+    pub(crate) wv_min: f64,
 }
 
 /// One draw in progress, component by component in model order.

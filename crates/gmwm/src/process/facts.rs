@@ -66,8 +66,8 @@ pub(crate) struct Spec {
 }
 
 /// What a term is to a navigation filter, in the canonical model's order (docs/methods.md
-/// §14): a correlated (Gauss–Markov) term, white noise (N), quantisation (Q), a random walk
-/// (K), a drift (R), anything else.
+/// §14): a correlated (Gauss–Markov) term, white noise (N), quantisation (Q), flicker (B), a
+/// random walk (K), a drift (R), anything else.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum Role {
     /// A first-order Markov process: AR1, GM.
@@ -76,6 +76,8 @@ pub(crate) enum Role {
     WhiteNoise,
     /// Quantisation noise: Q.
     Quantization,
+    /// Flicker (1/f) noise: the bias instability B; contributes to neither N nor K.
+    Flicker,
     /// A random walk: K.
     RandomWalk,
     /// A deterministic drift: R.
@@ -234,6 +236,7 @@ mod tests {
             dom: Dominance::Wn,
             only_wn: false,
             only_qn: false,
+            wv_min: 1e-3,
         };
         for &kind in KINDS.iter().chain(&[ProcessKind::Arma(2, 1)]) {
             let s = spec(kind);

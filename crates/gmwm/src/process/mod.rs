@@ -26,6 +26,7 @@ pub(crate) mod arma11;
 pub(crate) mod dr;
 pub(crate) mod draw;
 mod facts;
+pub(crate) mod flicker;
 mod kind;
 pub(crate) mod ma1;
 mod param;
@@ -40,6 +41,7 @@ pub use ar1::{Ar1, Gm};
 pub use arma::Arma;
 pub use arma11::Arma11;
 pub use dr::Dr;
+pub use flicker::Flicker;
 pub use ma1::Ma1;
 pub use qn::Qn;
 pub use rw::Rw;
@@ -62,7 +64,7 @@ use sampler::{Sampler, SimRng};
 /// A latent process with an implied Haar wavelet variance (docs/methods.md §4). Object safe.
 pub trait LatentProcess {
     /// Component name as in docs/methods.md §0.2: "WN", "QN", "RW", "DR", "AR1", "GM", "MA1",
-    /// "ARMA11", "ARMA".
+    /// "ARMA11", "ARMA", and "FN" (flicker, `process/flicker.rs`).
     fn name(&self) -> &'static str;
     /// Parameter names in docs/methods.md §0.2 order.
     fn param_names(&self) -> Vec<&'static str>;
@@ -209,6 +211,10 @@ processes! {
     /// Deterministic drift, parameter `omega` (slope per sample).
     Dr => dr::SPEC, process /// Deterministic drift.
         Dr(Dr);
+    /// Flicker (1/f, bias-instability) noise, parameter `b2` (B^2: innovation variance of the
+    /// d = 1/2 fractional integration).
+    Fn => flicker::SPEC, process /// Flicker noise.
+        Flicker(Flicker);
     /// First-order autoregression, parameters `phi`, `sigma2`.
     Ar1 => ar1::AR1_SPEC, process /// First-order autoregression.
         Ar1(Ar1);

@@ -13,6 +13,7 @@ mod export;
 mod fit_mc;
 mod fit_ref;
 mod fit_start;
+mod flicker;
 mod fuzz_props;
 mod ieee;
 mod inference;

@@ -5,7 +5,7 @@
 use crate::tests::common::rel_diff;
 use gmwm::process::spectral::{spectral_wv, spectral_wv_level};
 use gmwm::process::{
-    autocovariance_wv, Ar1, Arma, Arma11, Dr, Gm, LatentProcess, Ma1, Process, Qn, Rw, Wn,
+    autocovariance_wv, Ar1, Arma, Arma11, Dr, Flicker, Gm, LatentProcess, Ma1, Process, Qn, Rw, Wn,
 };
 use proptest::prelude::*;
 
@@ -234,6 +234,8 @@ fn oracle_processes() -> Vec<Process> {
         Gm::new(1e-3, 2.0, 250.0).unwrap().into(),
         Gm::new(0.05, 1.0, 250.0).unwrap().into(),
         Gm::new(10.0, 1.0, 100.0).unwrap().into(),
+        Flicker::new(0.8).unwrap().into(),
+        Flicker::new(3e-9).unwrap().into(),
     ];
     for phi in [-0.9, 0.0, 0.5, 0.9, 0.99, 0.999, 0.9999, 0.99999] {
         v.push(Ar1::new(phi, 1.5).unwrap().into());
@@ -384,6 +386,7 @@ fn with_param(p: &Process, k: usize, v: f64) -> Process {
         Process::Qn(_) => Qn::new(q[0]).unwrap().into(),
         Process::Rw(_) => Rw::new(q[0]).unwrap().into(),
         Process::Dr(_) => Dr::new(q[0]).unwrap().into(),
+        Process::Flicker(_) => Flicker::new(q[0]).unwrap().into(),
         Process::Ar1(_) => Ar1::new(q[0], q[1]).unwrap().into(),
         Process::Gm(g) => Gm::new(q[0], q[1], g.freq_hz()).unwrap().into(),
         Process::Ma1(_) => Ma1::new(q[0], q[1]).unwrap().into(),
@@ -486,6 +489,7 @@ fn arb_process() -> impl Strategy<Value = Process> {
         (1e-3f64..10.0).prop_map(|v| Qn::new(v).unwrap().into()),
         (1e-3f64..10.0).prop_map(|v| Rw::new(v).unwrap().into()),
         (-5.0f64..5.0).prop_map(|v| Dr::new(v).unwrap().into()),
+        (1e-3f64..10.0).prop_map(|v| Flicker::new(v).unwrap().into()),
         (-0.95f64..0.9999, 1e-3f64..10.0).prop_map(|(a, b)| Ar1::new(a, b).unwrap().into()),
         (1e-3f64..50.0, 1e-3f64..10.0, 1.0f64..500.0)
             .prop_map(|(a, b, f)| Gm::new(a, b, f).unwrap().into()),

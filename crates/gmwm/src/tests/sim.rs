@@ -1,7 +1,7 @@
 //! Simulation (docs/methods.md §10): hand values, determinism and chunking invariance, Monte Carlo
 //! moments and wavelet variances against closed forms (§4.2), and rejected parameters.
 
-use gmwm::process::{Ar1, Arma, Arma11, Dr, Ma1, Process, Qn, Rw, Wn};
+use gmwm::process::{Ar1, Arma, Arma11, Dr, Flicker, Ma1, Process, Qn, Rw, Wn};
 use gmwm::sim::{quantisation_noise, replicate_seed, simulate, Simulator, StartMode};
 use gmwm::{wavelet_variance, WvOptions};
 
@@ -28,6 +28,7 @@ fn every_process() -> Vec<Process> {
         Process::Ma1(Ma1::new(0.5, 1.0).unwrap()),
         Process::Arma11(Arma11::new(0.8, -0.3, 1.0).unwrap()),
         arma21(),
+        Process::Flicker(Flicker::new(0.3).unwrap()),
     ]
 }
 
@@ -415,6 +416,14 @@ fn closed_form_wv(g: &Process, tau: f64) -> f64 {
         Process::Qn(q) => 6.0 * q.q2() / (tau * tau),
         Process::Rw(r) => r.gamma2() * (tau * tau + 2.0) / (12.0 * tau),
         Process::Dr(d) => d.omega() * d.omega() * tau * tau / 16.0,
+        // process/flicker.rs: b2 [(16 m^2 - 1) D(m) + 3 H(m)] / (8 pi m^2), summed directly
+        Process::Flicker(f) => {
+            let m = (tau / 2.0) as u64;
+            let odd = |a: u64, b: u64| (a..=b).map(|k| 1.0 / (2 * k - 1) as f64).sum::<f64>();
+            let mf = m as f64;
+            f.b2() * ((16.0 * mf * mf - 1.0) * odd(m + 1, 2 * m) + 3.0 * odd(1, m))
+                / (8.0 * std::f64::consts::PI * mf * mf)
+        }
         Process::Ar1(a) => {
             let (phi, sigma2) = (a.phi(), a.sigma2());
             sigma2 * (tau * (1.0 - phi * phi) - 2.0 * phi * k_term(phi, tau))
@@ -450,6 +459,7 @@ fn simulate_wv_matches_closed_forms() {
         Process::Ar1(Ar1::new(0.9, 1.0).unwrap()),
         Process::Ma1(Ma1::new(0.5, 1.0).unwrap()),
         Process::Arma11(Arma11::new(0.8, -0.3, 1.0).unwrap()),
+        Process::Flicker(Flicker::new(0.3).unwrap()),
     ];
     for g in &gens {
         let mut per_level = vec![Vec::new(); levels];
