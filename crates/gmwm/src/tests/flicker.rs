@@ -3,7 +3,7 @@
 //! bias instability `B = sqrt(b2)`, the Monte Carlo WV of the simulation, and recovery of `B`
 //! beside white noise and a random walk.
 
-use crate::common::rel_diff;
+use crate::tests::common::rel_diff;
 use gmwm::fit::Gmwm;
 use gmwm::model::Model;
 use gmwm::process::{autocovariance_wv, Flicker, LatentProcess, Process, ProcessKind};
