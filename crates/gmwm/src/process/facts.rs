@@ -67,7 +67,7 @@ pub(crate) struct Spec {
 
 /// What a term is to a navigation filter, in the canonical model's order (docs/methods.md
 /// §14): a correlated (Gauss–Markov) term, white noise (N), quantisation (Q), a random walk
-/// (K), a drift (R), anything else.
+/// (K), a drift (R), a periodic term, anything else.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum Role {
     /// A first-order Markov process: AR1, GM.
@@ -80,6 +80,9 @@ pub(crate) enum Role {
     RandomWalk,
     /// A deterministic drift: R.
     Drift,
+    /// A periodic term (a vibration line, SIN): no N, K or B, a physical read-off of its
+    /// frequency and amplitude.
+    Periodic,
     /// No navigation read-off (the ARMA family).
     Other,
 }

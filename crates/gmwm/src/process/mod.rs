@@ -32,6 +32,7 @@ mod param;
 pub(crate) mod qn;
 pub(crate) mod rw;
 pub(crate) mod sampler;
+pub(crate) mod sin;
 pub mod spectral;
 pub(crate) mod wn;
 
@@ -42,6 +43,7 @@ pub use dr::Dr;
 pub use ma1::Ma1;
 pub use qn::Qn;
 pub use rw::Rw;
+pub use sin::Sin;
 pub use wn::Wn;
 
 pub use draw::Dominance;
@@ -59,7 +61,7 @@ use sampler::{Sampler, SimRng};
 /// A latent process with an implied Haar wavelet variance (docs/methods.md §4). Object safe.
 pub trait LatentProcess {
     /// Component name as in docs/methods.md §0.2: "WN", "QN", "RW", "DR", "AR1", "GM", "MA1",
-    /// "ARMA11", "ARMA".
+    /// "ARMA11", "ARMA"; "SIN" (the vibration term of `sin.rs`).
     fn name(&self) -> &'static str;
     /// Parameter names in docs/methods.md §0.2 order.
     fn param_names(&self) -> Vec<&'static str>;
@@ -227,6 +229,10 @@ processes! {
     /// `ma1..maq`, `sigma2`; R sign convention (docs/methods.md §0.2).
     Arma(usize, usize) = ProcessKind::Arma(1, 1) => arma::ARMA_SPEC, process /// General ARMA(p, q).
         Arma(Arma);
+    /// Sinusoid with random phase (vibration), parameters `amplitude` (data unit), `omega`
+    /// (cycles per sample, in (0, 1/2)).
+    Sin => sin::SPEC, process /// Sinusoid with random phase (vibration).
+        Sin(Sin);
 }
 
 impl Process {
