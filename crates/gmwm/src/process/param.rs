@@ -63,9 +63,7 @@ impl ParamTransform {
             ParamTransform::PseudoLogit if theta.abs() < 1.0 => 2.0 * theta.atanh(),
             ParamTransform::Logit2 if theta.abs() < 2.0 => ((theta + 2.0) / (2.0 - theta)).ln(),
             ParamTransform::LogAbs if theta != 0.0 => theta.abs().ln(),
-            ParamTransform::LogitHalf if theta > 0.0 && theta < 0.5 => {
-                (theta / (0.5 - theta)).ln()
-            }
+            ParamTransform::LogitHalf if theta > 0.0 && theta < 0.5 => (theta / (0.5 - theta)).ln(),
             _ => return None,
         };
         u.is_finite().then_some(u)

@@ -83,9 +83,7 @@ const OMEGA_MAX: f64 = 0.49;
 fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
     let st = d.ctx.sigma2_t;
     let amplitude = given[0].unwrap_or_else(|| {
-        let share = d
-            .unif(POWER_SHARE_MIN.ln(), POWER_SHARE_MAX.ln())
-            .exp();
+        let share = d.unif(POWER_SHARE_MIN.ln(), POWER_SHARE_MAX.ln()).exp();
         (2.0 * share * st).sqrt()
     });
     let lo = (2.0 / d.ctx.n).min(0.25 * OMEGA_MAX);
