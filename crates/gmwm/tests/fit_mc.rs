@@ -234,7 +234,7 @@ fn recovers_a_sinusoid_over_wn_and_rw() {
 /// The larger study behind [`recovers_a_sinusoid_over_wn_and_rw`]: 32 replicates, relative bias
 /// and SE of each parameter printed.
 #[test]
-#[ignore = "a 32-replicate study (about a minute in release); run with --ignored --nocapture"]
+#[ignore = "a 32-replicate study that prints figures; run with --ignored --nocapture"]
 fn sin_recovery_study() {
     let rows = sin_replicates(32, 7301);
     for (k, name) in ["frequency", "amplitude", "WN sigma2", "RW gamma2"]

@@ -230,6 +230,7 @@ mod tests {
         use super::super::param::TransformPreset;
         use rand::SeedableRng;
         let ctx = DrawContext {
+            wv: vec![0.5, 0.3, 0.1, 0.06, 0.03],
             sigma2_t: 1.0,
             n: 1000.0,
             range: 0.01,

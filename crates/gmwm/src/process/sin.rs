@@ -73,23 +73,68 @@ const POWER_SHARE_MAX: f64 = 2.0;
 /// The highest `omega` a draw tries, just below Nyquist.
 const OMEGA_MAX: f64 = 0.49;
 
+/// The peak of `sin^4(x) / x^2` (module doc): the hump of a sinusoid lies at
+/// `tau = 2 HUMP_X / (pi omega)` samples.
+const HUMP_X: f64 = 1.165_561_185_207_2;
+/// The share of draws that start at the empirical WV's hump when it has one.
+const HUMP_SHARE: f64 = 0.9;
+/// Its height: the hump's WV is about `HUMP_HEIGHT amplitude^2 / 2`.
+const HUMP_HEIGHT: f64 = 0.525;
+
+/// The humps of the empirical WV: the levels among `2..=J - 3` (the last levels are too noisy
+/// to place a hump) where it exceeds the geometric mean of its neighbours (`ln nu2` locally
+/// concave), as `(tau_j, nu2_j - sqrt(nu2_{j-1} nu2_{j+1}))`, largest excess first.
+fn wv_humps(wv: &[f64]) -> Vec<(f64, f64)> {
+    let last = wv.len().saturating_sub(3);
+    let mut humps: Vec<(f64, f64)> = (1..last)
+        .map(|j| {
+            (
+                2f64.powi(j as i32 + 1),
+                wv[j] - (wv[j - 1] * wv[j + 1]).sqrt(),
+            )
+        })
+        .filter(|&(_, e)| e > 0.0 && e.is_finite())
+        .collect();
+    humps.sort_by(|a, b| b.1.total_cmp(&a.1));
+    humps
+}
+
 /// Starting values (the §6.3 search, paper Appendix C, extended): a sinusoid's signature is
-/// a hump at `tau = 0.742 / omega` samples (module doc), so every draw is a start at another
-/// frequency, `omega` log-uniform between two cycles over the series (`2 / N`) and
-/// [`OMEGA_MAX`], and `amplitude^2 / 2` a log-uniform share of `sigma2_T` between
-/// [`POWER_SHARE_MIN`] and [`POWER_SHARE_MAX`]. The search keeps the draw whose WV fits best,
-/// which is a multi-start over frequencies: the dyadic scales see a hump of the right height
-/// and place only where `omega` is near the truth. Given values are kept.
+/// a hump peaking at `tau = 0.742 / omega` samples of height about `0.525 amplitude^2 / 2`
+/// (module doc). [`HUMP_SHARE`] of the draws start at one of the two largest humps of the
+/// empirical WV ([`wv_humps`]), at random:
+/// `omega` log-uniform within a factor 2 of `0.742 / tau` (one level either side) and
+/// `amplitude^2 / 2` within a factor 3 of the excess over `0.525`. The others, and all
+/// draws when the WV has no hump, are broad: `omega` log-uniform between two cycles over the
+/// series (`2 / N`) and [`OMEGA_MAX`], `amplitude^2 / 2` a log-uniform share of `sigma2_T`
+/// between [`POWER_SHARE_MIN`] and [`POWER_SHARE_MAX`]. The search keeps the draw whose WV
+/// fits best, so this is a multi-start over frequencies. Given values are kept.
 fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
     let st = d.ctx.sigma2_t;
-    let amplitude = given[0].unwrap_or_else(|| {
-        let share = d.unif(POWER_SHARE_MIN.ln(), POWER_SHARE_MAX.ln()).exp();
-        (2.0 * share * st).sqrt()
-    });
-    let lo = (2.0 / d.ctx.n).min(0.25 * OMEGA_MAX);
-    let omega = given[1].unwrap_or_else(|| d.unif(lo.ln(), OMEGA_MAX.ln()).exp());
-    out.push(amplitude);
-    out.push(omega);
+    let humps = wv_humps(&d.ctx.wv);
+    let hump = if !humps.is_empty() && d.unif(0.0, 1.0) < HUMP_SHARE {
+        // one of the two largest humps, at random
+        let k = humps.len().min(2);
+        let i = (d.unif(0.0, k as f64) as usize).min(k - 1);
+        Some(humps[i])
+    } else {
+        None
+    };
+    let (power, omega) = match hump {
+        Some((tau, excess)) => {
+            let peak = 2.0 * HUMP_X / (PI * tau);
+            let omega = (peak * d.unif(-(2f64.ln()), 2f64.ln()).exp()).min(OMEGA_MAX);
+            let power = excess / HUMP_HEIGHT * d.unif(-(3f64.ln()), 3f64.ln()).exp();
+            (power, omega)
+        }
+        None => {
+            let share = d.unif(POWER_SHARE_MIN.ln(), POWER_SHARE_MAX.ln()).exp();
+            let lo = (2.0 / d.ctx.n).min(0.25 * OMEGA_MAX);
+            (share * st, d.unif(lo.ln(), OMEGA_MAX.ln()).exp())
+        }
+    };
+    out.push(given[0].unwrap_or((2.0 * power).sqrt()));
+    out.push(given[1].unwrap_or(omega));
 }
 
 /// The physical read-off (docs/methods.md §14): `frequency` in Hz at the rate `freq_hz` and the
@@ -270,10 +315,26 @@ mod tests {
     #[test]
     fn sin_wv_hump_location() {
         let f = |x: f64| x.sin().powi(4) / (x * x);
-        let x: f64 = 1.165_561_185_207_2;
+        let x = HUMP_X;
         assert!((x.tan() - 2.0 * x).abs() < 1e-9);
         assert!(f(x) > f(x - 1e-3) && f(x) > f(x + 1e-3));
-        assert!((f(x) - 0.525).abs() < 1e-3, "{}", f(x));
+        assert!((f(x) - HUMP_HEIGHT).abs() < 1e-3, "{}", f(x));
+    }
+
+    /// The hump of a sinusoid over white noise is found at its level.
+    #[test]
+    fn sin_wv_hump_is_found() {
+        let s = Sin::new(1.0, 0.0058).unwrap();
+        let wv: Vec<f64> = s
+            .wv(16)
+            .iter()
+            .zip(half_widths(16))
+            .map(|(v, m)| v + 1e-3 / (2.0 * m))
+            .collect();
+        let (tau, excess) = wv_humps(&wv)[0];
+        assert_eq!(tau, 128.0);
+        assert!(excess > 0.0);
+        assert!(wv_humps(&[1.0, 0.5, 0.25, 0.125, 0.0625, 0.03]).is_empty());
     }
 
     /// The f64 hot path and the jets agree; the §4.1 sum agrees at the first levels.
