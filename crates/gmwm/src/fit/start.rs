@@ -229,6 +229,7 @@ pub(crate) fn starting_values(
         .collect();
     let only = |role: Role| roles.contains(&role) && roles.iter().all(|&r| r == role);
     let ctx = DrawContext {
+        wv: nu.to_vec(),
         sigma2_t,
         n: inputs.n.max(1) as f64,
         range: inputs.range,

@@ -18,8 +18,11 @@ pub(crate) enum Dominance {
 }
 
 /// The summary of the WV the draws need (docs/methods.md §6.1–§6.2).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct DrawContext {
+    /// The empirical WV at levels `1..=J` (for a draw that reads its shape, such as SIN's
+    /// hump).
+    pub(crate) wv: Vec<f64>,
     /// `sigma2_T`, the sum of the empirical WV.
     pub(crate) sigma2_t: f64,
     /// Series length N.

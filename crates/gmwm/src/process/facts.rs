@@ -67,7 +67,7 @@ pub(crate) struct Spec {
 
 /// What a term is to a navigation filter, in the canonical model's order (docs/methods.md
 /// §14): a correlated (Gauss–Markov) term, white noise (N), quantisation (Q), flicker (B), a
-/// random walk (K), a drift (R), anything else.
+/// random walk (K), a drift (R), a periodic term, anything else.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum Role {
     /// A first-order Markov process: AR1, GM.
@@ -82,6 +82,9 @@ pub(crate) enum Role {
     RandomWalk,
     /// A deterministic drift: R.
     Drift,
+    /// A periodic term (a vibration line, SIN): no N, K or B, a physical read-off of its
+    /// frequency and amplitude.
+    Periodic,
     /// No navigation read-off (the ARMA family).
     Other,
 }
@@ -229,6 +232,7 @@ mod tests {
         use super::super::param::TransformPreset;
         use rand::SeedableRng;
         let ctx = DrawContext {
+            wv: vec![0.5, 0.3, 0.1, 0.06, 0.03],
             sigma2_t: 1.0,
             n: 1000.0,
             range: 0.01,

@@ -31,13 +31,22 @@ pub enum ParamDomain {
     /// (docs/methods.md §5.3 imposes no joint stationarity; the package's placeholders are -1
     /// and -2).
     Finite,
+    /// A positive number that is not a variance (the SIN `amplitude`, data unit): finite and
+    /// > 0 (log transform).
+    Positive,
+    /// A frequency in cycles per sample below Nyquist (the SIN `omega`): in the open interval
+    /// (0, 1/2) (logit transform on (0, 1/2)).
+    HalfCycle,
 }
 
 impl ParamDomain {
     /// Whether `value` lies in this domain.
     pub fn contains(self, value: f64) -> bool {
         match self {
-            ParamDomain::Variance | ParamDomain::Rate => value.is_finite() && value > 0.0,
+            ParamDomain::Variance | ParamDomain::Rate | ParamDomain::Positive => {
+                value.is_finite() && value > 0.0
+            }
+            ParamDomain::HalfCycle => value > 0.0 && value < 0.5,
             ParamDomain::UnitInterval => value > -1.0 && value < 1.0,
             ParamDomain::Finite => value.is_finite(),
         }
@@ -50,6 +59,8 @@ impl ParamDomain {
             ParamDomain::Rate => "a finite rate > 0",
             ParamDomain::UnitInterval => "a value in the open interval (-1, 1)",
             ParamDomain::Finite => "a finite number",
+            ParamDomain::Positive => "a finite number > 0",
+            ParamDomain::HalfCycle => "a frequency in the open interval (0, 1/2) cycles per sample",
         }
     }
 }
@@ -75,7 +86,7 @@ impl ProcessKind {
     /// Parameter names in `theta` order (docs/methods.md §0.2): WN `sigma2`; QN `q2`; RW `gamma2`;
     /// DR `omega`; AR1 `phi, sigma2`; GM `beta, sigma2_gm`; MA1 `theta, sigma2`; ARMA11
     /// `phi, theta, sigma2`; AR(p) `ar1..arp, sigma2`; MA(q) `ma1..maq, sigma2`; ARMA(p,q)
-    /// `ar1..arp, ma1..maq, sigma2`.
+    /// `ar1..arp, ma1..maq, sigma2`; SIN `amplitude, omega`.
     pub fn param_names(&self) -> Vec<String> {
         match spec(*self).params {
             Params::Fixed(list, _) => list.iter().map(|(n, _)| n.to_string()).collect(),

@@ -33,6 +33,7 @@ mod param;
 pub(crate) mod qn;
 pub(crate) mod rw;
 pub(crate) mod sampler;
+pub(crate) mod sin;
 #[cfg(test)]
 pub(crate) mod spectral;
 pub(crate) mod wn;
@@ -45,6 +46,7 @@ pub use flicker::Flicker;
 pub use ma1::Ma1;
 pub use qn::Qn;
 pub use rw::Rw;
+pub use sin::Sin;
 pub use wn::Wn;
 
 pub(crate) use draw::Dominance;
@@ -64,7 +66,7 @@ use sampler::{Sampler, SimRng};
 /// A latent process with an implied Haar wavelet variance (docs/methods.md §4). Object safe.
 pub trait LatentProcess {
     /// Component name as in docs/methods.md §0.2: "WN", "QN", "RW", "DR", "AR1", "GM", "MA1",
-    /// "ARMA11", "ARMA", and "FN" (flicker, `process/flicker.rs`).
+    /// "ARMA11", "ARMA"; "FN" (flicker, `flicker.rs`), "SIN" (vibration, `sin.rs`).
     fn name(&self) -> &'static str;
     /// Parameter names in docs/methods.md §0.2 order.
     fn param_names(&self) -> Vec<&'static str>;
@@ -236,6 +238,10 @@ processes! {
     /// `ma1..maq`, `sigma2`; R sign convention (docs/methods.md §0.2).
     Arma(usize, usize) = ProcessKind::Arma(1, 1) => arma::ARMA_SPEC, process /// General ARMA(p, q).
         Arma(Arma);
+    /// Sinusoid with random phase (vibration), parameters `amplitude` (data unit), `omega`
+    /// (cycles per sample, in (0, 1/2)).
+    Sin => sin::SPEC, process /// Sinusoid with random phase (vibration).
+        Sin(Sin);
 }
 
 impl Process {

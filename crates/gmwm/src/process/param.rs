@@ -32,6 +32,9 @@ pub(crate) enum ParamTransform {
     Logit2,
     /// `u = ln |theta|`, inverse `e^u`: the DR slope, whose sign is lost (the estimate is >= 0).
     LogAbs,
+    /// Logit on (0, 1/2): `u = ln(theta / (1/2 - theta))`, inverse `logistic(u) / 2`: a
+    /// frequency in cycles per sample below Nyquist (the SIN `omega`).
+    LogitHalf,
 }
 
 impl ParamTransform {
@@ -44,6 +47,7 @@ impl ParamTransform {
             ParamTransform::PseudoLogit => "a number in (-1, 1)",
             ParamTransform::Logit2 => "a number in (-2, 2)",
             ParamTransform::LogAbs => "a finite non-zero number",
+            ParamTransform::LogitHalf => "a number in (0, 1/2)",
         }
     }
 
@@ -59,6 +63,7 @@ impl ParamTransform {
             ParamTransform::PseudoLogit if theta.abs() < 1.0 => 2.0 * theta.atanh(),
             ParamTransform::Logit2 if theta.abs() < 2.0 => ((theta + 2.0) / (2.0 - theta)).ln(),
             ParamTransform::LogAbs if theta != 0.0 => theta.abs().ln(),
+            ParamTransform::LogitHalf if theta > 0.0 && theta < 0.5 => (theta / (0.5 - theta)).ln(),
             _ => return None,
         };
         u.is_finite().then_some(u)
@@ -75,6 +80,8 @@ impl ParamTransform {
             ParamTransform::Logit if theta == 1.0 => 1.0 - e,
             ParamTransform::PseudoLogit if theta.abs() == 1.0 => theta * (1.0 - e),
             ParamTransform::Logit2 if theta.abs() == 2.0 => theta * (1.0 - e),
+            ParamTransform::LogitHalf if theta == 0.0 => 0.5 * e,
+            ParamTransform::LogitHalf if theta == 0.5 => 0.5 * (1.0 - e),
             _ => theta,
         }
     }
@@ -88,6 +95,7 @@ impl ParamTransform {
             // 2 logistic(u) - 1 = tanh(u / 2), without the cancellation near u = 0
             ParamTransform::PseudoLogit => (0.5 * u).tanh(),
             ParamTransform::Logit2 => 2.0 * (0.5 * u).tanh(),
+            ParamTransform::LogitHalf => 0.5 * logistic(u),
         }
     }
 
@@ -100,6 +108,7 @@ impl ParamTransform {
             ParamTransform::Logit => s(),
             ParamTransform::PseudoLogit => 2.0 * s(),
             ParamTransform::Logit2 => 4.0 * s(),
+            ParamTransform::LogitHalf => 0.5 * s(),
         }
     }
 }

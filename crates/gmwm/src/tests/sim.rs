@@ -441,7 +441,9 @@ fn closed_form_wv(g: &Process, tau: f64) -> f64 {
                 / (tau * tau * (1.0 - phi).powi(3) * (1.0 + phi))
         }
         // GM is an AR1 at a rate, checked through models below
-        Process::Arma(_) | Process::Gm(_) => unreachable!("no closed form in §4.2"),
+        Process::Arma(_) | Process::Gm(_) | Process::Sin(_) => {
+            unreachable!("no closed form in §4.2")
+        }
     }
 }
 
@@ -602,7 +604,7 @@ fn simulated_models_match_their_implied_wv() {
     const R: usize = 200;
     const N: usize = 4096;
     const SEED: u64 = 3;
-    let cases: [(&str, f64); 11] = [
+    let cases: [(&str, f64); 13] = [
         ("WN(sigma2=2)", 1.0),
         ("QN(q2=0.5)", 1.0),
         ("RW(gamma2=0.01)", 1.0),
@@ -614,6 +616,13 @@ fn simulated_models_match_their_implied_wv() {
         ("AR(2)(ar1=0.5, ar2=-0.3, sigma2=1)", 1.0),
         ("ARMA(2,1)(ar1=0.6, ar2=0.2, ma1=0.5, sigma2=1)", 1.0),
         (gmwm::sim::DEMO_MODEL, gmwm::sim::DEMO_FREQ_HZ),
+        // a sinusoid's empirical WV hardly varies with its phase (SE ~ 1e-3 of the WV), so a
+        // wrong gain or level is many SE off
+        ("SIN(amplitude=1.5, omega=0.0731)", 100.0),
+        (
+            "SIN(amplitude=0.8, omega=0.013)+WN(sigma2=1)+RW(gamma2=1e-4)",
+            100.0,
+        ),
     ];
     for (text, freq) in cases {
         let model: Model = text.parse().unwrap();
