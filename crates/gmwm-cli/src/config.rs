@@ -625,6 +625,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             accel_unit: a.accel_unit,
             // the contamination check compares with the robust WV at --eff
             robust_check: Some(robust_at_eff(&a.estimator)?),
+            tolerance: a.tolerance,
         };
         let exports = exports(a)?;
         let adjustment = match (a.inflate, a.conservative) {

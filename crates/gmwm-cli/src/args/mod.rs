@@ -16,7 +16,7 @@ use gmwm::{AllanKind, AvConvention, RobustConvention, Transform, Weighting};
 use std::path::PathBuf;
 use values::{
     alpha, at_least_1, at_least_2, choice, efficiency, inflation, positive_hz, seed, signal_unit,
-    whole,
+    tolerance, whole,
 };
 
 const EXAMPLES: &str = "\
@@ -282,6 +282,10 @@ pub struct CalibrateArgs {
     /// Export the upper ends of the intervals instead of the estimates (stated in the file).
     #[arg(long)]
     pub conservative: bool,
+    /// The verdict's tolerance: a scale is explained when the model's WV is inside the band or
+    /// within this fraction of the empirical WV (0.1 = 10%).
+    #[arg(long, value_name = "FRACTION", default_value_t = gmwm::calib::DEFAULT_TOLERANCE, value_parser = tolerance)]
+    pub tolerance: f64,
     /// rostopic written to Kalibr/OpenVINS files [default: the ROS topic read, else /imu0].
     #[arg(long, value_name = "TOPIC")]
     pub rostopic: Option<String>,

@@ -207,6 +207,14 @@ pub fn inflation(s: &str) -> Result<f64, String> {
     }
 }
 
+/// `--tolerance`: a fraction in (0, 1].
+pub fn tolerance(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
+        _ => Err("must be a fraction in (0, 1], e.g. 0.1 for 10%".into()),
+    }
+}
+
 /// `--freq`: a positive finite number of hertz.
 pub fn positive_hz(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {

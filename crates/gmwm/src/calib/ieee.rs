@@ -382,13 +382,40 @@ fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
     }
 }
 
-/// docs/methods.md §14.3: bias instability, minimum deviation / [`FLICKER_FACTOR`] (module doc).
+/// The widest Allan-variance interval (`ci_high / ci_low`) a scale may have for the bias
+/// read-off to rest on it: 10, about nine clusters or more. The last points of a recording
+/// rest on a handful of clusters, their intervals span 40x and more, and one of them dipping
+/// would hide a floor the earlier scales show.
+const RELIABLE_SPAN: f64 = 10.0;
+
+/// docs/methods.md §14.3: bias instability, minimum deviation / [`FLICKER_FACTOR`] (module doc),
+/// over the scales whose interval spans at most [`RELIABLE_SPAN`] (all scales when fewer than
+/// three do). An interior minimum is a floor: B with its interval. A minimum at either end of
+/// those scales is no floor: B is then the bound `min ADEV / 0.664` there, given as the value
+/// without a lower end, and the note says which end and its cluster time.
 fn bias_readoff(s: &Scales) -> Readoff {
+    let reliable: Vec<usize> = (0..s.len())
+        .filter(|&i| s.ci_low[i] > 0.0 && s.ci_high[i] / s.ci_low[i] <= RELIABLE_SPAN)
+        .collect();
+    let scales: Vec<usize> = if reliable.len() >= 3 {
+        reliable
+    } else {
+        (0..s.len()).collect()
+    };
+    let dropped = s.len() - scales.len();
     // the minimum; an interior scale attaining it is preferred, so a flat floor counts
-    let min = s.avar.iter().copied().fold(f64::INFINITY, f64::min);
-    let at_min: Vec<usize> = (0..s.len()).filter(|&i| s.avar[i] == min).collect();
-    let interior = at_min.iter().copied().find(|&i| i > 0 && i + 1 < s.len());
-    let Some(i) = interior.or_else(|| at_min.first().copied()) else {
+    let min = scales
+        .iter()
+        .map(|&i| s.avar[i])
+        .fold(f64::INFINITY, f64::min);
+    let at_min: Vec<usize> = (0..scales.len())
+        .filter(|&k| s.avar[scales[k]] == min)
+        .collect();
+    let interior = at_min
+        .iter()
+        .copied()
+        .find(|&k| k > 0 && k + 1 < scales.len());
+    let Some(k) = interior.or_else(|| at_min.first().copied()) else {
         return Readoff {
             value: None,
             ci_low: None,
@@ -398,36 +425,45 @@ fn bias_readoff(s: &Scales) -> Readoff {
             note: Some("no usable scale: no value".to_string()),
         };
     };
+    let i = scales[k];
     let bound = |v: f64| {
         let b = v.sqrt() / FLICKER_FACTOR;
         (b.is_finite() && b > 0.0).then_some(b)
     };
     let b = bound(s.avar[i]);
     let tau = s.tau_s[i];
-    let (value, ci_low, ci_high, note) = if s.len() >= 3 && i > 0 && i + 1 < s.len() {
+    let skipped = if dropped > 0 {
+        format!(
+            " ({dropped} longest cluster time{} left out: interval wider than {RELIABLE_SPAN:.0}x)",
+            if dropped == 1 { "" } else { "s" }
+        )
+    } else {
+        String::new()
+    };
+    let (value, ci_low, ci_high, note) = if scales.len() >= 3 && k > 0 && k + 1 < scales.len() {
         (
             b,
             bound(s.ci_low[i]),
             bound(s.ci_high[i]),
             format!(
-                "min ADEV / 0.664 (flicker-floor factor applied), minimum at {} s",
+                "min ADEV / 0.664 (flicker-floor factor applied), minimum at {} s{skipped}",
                 seconds(tau)
             ),
         )
     } else {
-        let why = if s.len() < 3 {
-            "fewer than 3 scales: no floor can be seen".to_string()
-        } else if i == 0 {
-            "ADEV rising from the shortest cluster time: no floor reached".to_string()
+        let why = if scales.len() < 3 {
+            "fewer than 3 scales: no floor can be seen"
+        } else if k == 0 {
+            "ADEV rising from the shortest cluster time: no floor reached"
         } else {
-            "ADEV still falling at the longest cluster time: no floor reached".to_string()
+            "ADEV still falling at the longest reliable cluster time: no floor reached"
         };
         (
-            None,
+            b,
             None,
             b,
             format!(
-                "{why}; B ≤ ci_high = min ADEV / 0.664 at {} s: no value",
+                "{why}; B <= min ADEV / 0.664 at {} s, given as an upper bound{skipped}",
                 seconds(tau)
             ),
         )

@@ -6,6 +6,7 @@ pub(crate) mod nav;
 pub(crate) mod pipeline;
 pub mod pooled;
 pub mod streamed;
+pub(crate) mod verdict;
 
 pub use contamination::{Contamination, FitUses};
 
@@ -14,9 +15,10 @@ pub(crate) use contamination::compare_classical_robust;
 pub use nav::{Adjustment, AxisPolicy, NavSet};
 pub use pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,
-    EstimateStatus, FitVerdict, GaussMarkovBias, DEFAULT_FULL_MODEL,
+    EstimateStatus, GaussMarkovBias, DEFAULT_FULL_MODEL,
 };
 pub use pooled::PooledInput;
 #[cfg(test)]
 pub(crate) use streamed::ROBUST_LEVELS;
 pub use streamed::{CalibrationSource, STREAM_FROM};
+pub use verdict::{FitVerdict, ScaleFit, ScaleMiss, DEFAULT_TOLERANCE};

@@ -529,3 +529,78 @@ fn pooled_calibration_coverage_full() {
         "pooled calibration, R = 1000: coverage N {cn:.3}, K {ck:.3}; bias in Monte Carlo SEs of the mean N {zn:.2}, K {zk:.2}"
     );
 }
+
+fn gyro_axis(truth: &str, full: &str, tolerance: f64) -> gmwm::calib::AxisCalibration {
+    let x = simulate_model(&truth.parse().unwrap(), N, FREQ, 31).unwrap();
+    let imu = Imu::new(
+        vec![column("gyro_x", x)],
+        vec![info(Sensor::Gyroscope, Some("rad/s"))],
+        FREQ,
+    )
+    .unwrap();
+    Calibration::new(CalibrationOptions {
+        full_model: full.parse().unwrap(),
+        tolerance,
+        ..options()
+    })
+    .run(&imu)
+    .unwrap()
+    .axes
+    .remove(0)
+}
+
+/// The verdict (calib/verdict.rs): the true model explains its WV; a model without the
+/// sinusoid misses the hump, below the WV, by more than the tolerance, and says where; every
+/// scale is explained exactly when inside the band or within the tolerance.
+#[test]
+fn verdict_explains_the_true_model_and_names_a_missing_hump() {
+    let truth = "WN(sigma2=1e-4)+SIN(amplitude=0.02, omega=0.05)";
+    let explained = gyro_axis(truth, "WN()+SIN()", 0.1);
+    let v = &explained.verdict;
+    assert!(v.explains_wv, "{}", v.summary);
+    assert!(v.worst.is_none() && v.scales_missed == 0);
+    assert_eq!(v.scales.len(), v.levels);
+    assert!(v.summary.starts_with("explains the WV"), "{}", v.summary);
+    for tolerance in [0.1, 1.0] {
+        let missed = gyro_axis(truth, "WN()+RW()", tolerance);
+        let v = &missed.verdict;
+        for s in &v.scales {
+            assert_eq!(s.explained, s.inside_band || s.deviation.abs() <= tolerance);
+        }
+        assert_eq!(v.explains_wv, v.scales.iter().all(|s| s.explained));
+        if tolerance == 0.1 {
+            // the hump of the sinusoid peaks near tau = 0.742 / omega = 15 samples
+            assert!(!v.explains_wv, "{}", v.summary);
+            let w = v.worst.as_ref().unwrap();
+            assert!(w.deviation < -0.1, "{w:?}");
+            assert!((0.04..=0.64).contains(&w.tau_s), "{w:?}");
+            assert!(v.summary.starts_with("misfit at"), "{}", v.summary);
+        }
+    }
+}
+
+/// A Gauss–Markov term is not a random walk: without a random-walk term K is the Allan-band
+/// bound, marked as one, whatever the slowest correlated term's driving noise.
+#[test]
+fn a_gauss_markov_term_does_not_export_a_random_walk() {
+    let a = gyro_axis(
+        "WN(sigma2=1e-4)+AR1(phi=0.999, sigma2=1e-8)",
+        "AR1()+WN()",
+        0.1,
+    );
+    assert!(a.canonical_model.contains("AR1"), "{}", a.canonical_model);
+    let k = a.random_walk.as_ref().expect("a bound");
+    assert_eq!(k.status, gmwm::calib::EstimateStatus::UpperBound);
+    let tightest = a
+        .allan
+        .ci_high()
+        .iter()
+        .zip(a.allan.tau_s())
+        .map(|(h, t)| (3.0 * h / t).sqrt())
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        k.value <= tightest * (1.0 + 1e-12),
+        "{} > {tightest}",
+        k.value
+    );
+}
