@@ -10,7 +10,7 @@
 //!
 //! # Levels (docs/methods.md §16.2)
 //! The levels `j` whose boundary-free coefficient count `M_j = L - 2^j + 1` gives at least
-//! [`MIN_ETA`] equivalent degrees of freedom by §1.7 (`M_j / 2^j >= 8`): coarser levels are too
+//! `MIN_ETA` equivalent degrees of freedom by §1.7 (`M_j / 2^j >= 8`): coarser levels are too
 //! noisy in one window to show anything but gross faults (capped by `--levels`).
 //!
 //! # Band (docs/methods.md §16.3)

@@ -137,7 +137,7 @@ impl SignalUnit {
     }
 
     /// docs/methods.md §14.2: the factor to SI, `value_si = value * to_si()` (π/180 for deg/s,
-    /// π/180/3600 for deg/h, [`STANDARD_GRAVITY`] for g, 1e-3 of it for mg).
+    /// π/180/3600 for deg/h, `STANDARD_GRAVITY` for g, 1e-3 of it for mg).
     pub fn to_si(self) -> f64 {
         match self {
             SignalUnit::RadPerSecond | SignalUnit::MeterPerSecond2 => 1.0,

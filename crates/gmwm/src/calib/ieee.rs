@@ -11,12 +11,12 @@
 //! in relative terms (residual `AV_model / AV - 1`, weight `min(edf, EDF_CAP)`), exactly: every
 //! subset of the five columns is solved by unconstrained least squares and the best solution
 //! with no negative coefficient is kept (the NNLS optimum is such a solution). A scale belongs
-//! to the region of a term when that term carries at least [`DOMINANCE`] of the fitted AV
+//! to the region of a term when that term carries at least `DOMINANCE` of the fitted AV
 //! there. The fitted model is a posynomial in `tau`, so each region is an interval of scales
 //! (the longest contiguous run is taken all the same). Fitting all five terms, the flicker
 //! floor included, keeps a neighbouring term from being mistaken for the one read.
 //!
-//! On its region (narrowed to the scales within a factor [`READ_OFF_WINDOW`] of the read-off
+//! On its region (narrowed to the scales within a factor `READ_OFF_WINDOW` of the read-off
 //! time when two or more are there) the term's line of fixed slope (−1/2 for N, +1/2 for K, −1 for Q, +1 for R in
 //! the deviation) is fitted through the **data** (not the model): the per-scale coefficients
 //! `N_i = sigma_i sqrt(tau_i)`, `K_i = sigma_i sqrt(3 / tau_i)`, `Q_i = sigma_i tau_i / sqrt(3)`,

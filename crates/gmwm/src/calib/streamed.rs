@@ -10,15 +10,15 @@
 //!   ([`binary_wavelet_variance`]); identical to the in-memory estimate within 1e-12;
 //! - **the Allan variance**: `AV(m) = 2 nu2(2m)`, exact from that WV (docs/methods.md §3.4,
 //!   [`allan_from_wv`](crate::variance::allan_from_wv));
-//! - **the model selection and the fit**: they use the WV only ([`crate::Wic::select_wv`]);
+//! - **the model selection and the fit**: they use the WV only (`crate::Wic::select_wv`);
 //!   the starting values then come from the WV alone (no series range for drift draws), and
 //!   V is the exact covariance ([`crate::variance::implied_cov`]), which needs no series;
 //! - **the contamination check**: the robust WV is a root per level over all the level's
 //!   coefficients, which an exact streamed computation would need several passes and the
 //!   coefficients near the root for. Here it is estimated on consecutive blocks of
-//!   [`ROBUST_BLOCK`] samples, in memory one block at a time: per level, the blocks' robust
+//!   `ROBUST_BLOCK` samples, in memory one block at a time: per level, the blocks' robust
 //!   estimates averaged with weights their coefficient counts, at the levels up to
-//!   [`ROBUST_LEVELS`] (scales of at most `2^15` samples, where a block holds at least 64
+//!   `ROBUST_LEVELS` (scales of at most `2^15` samples, where a block holds at least 64
 //!   windows). The interval is the robust one (docs/methods.md §2.5) for the pooled count. The
 //!   error of this approximation against the robust WV of the whole series is measured in the
 //!   tests (`streamed_robust_matches_whole_series`); contamination (spikes, steps) shows at

@@ -18,7 +18,7 @@ impl Gmwm {
     ///
     /// # Errors
     /// As [`wavelet_variance`] (in [`FitError::Input`]), [`Weights::new`],
-    /// [`starting_values`] and [`Gmwm::fit_weighted`].
+    /// `starting_values` and `Gmwm::fit_weighted`.
     pub fn fit(&self, x: &[f64], freq_hz: f64, wv_opts: &WvOptions) -> Result<GmwmFit, FitError> {
         super::check_haar(wv_opts.filter)?;
         let wv = wavelet_variance(x, freq_hz, wv_opts)?;

@@ -34,7 +34,7 @@
 //!
 //! # The rules, in order
 //! 1. **Fitted to nothing**: a component at the boundary (`crate::fit::active`) or whose removal
-//!    moves the implied WV by at most [`NEGLIGIBLE_SEPARATION`] (a hundredth of a standard
+//!    moves the implied WV by at most `NEGLIGIBLE_SEPARATION` (a hundredth of a standard
 //!    error) is dropped.
 //! 2. **Tested reductions** (each refitted on the same WV and weights from the obvious start,
 //!    and accepted when the refit is not separable from the fitted model, `delta <= 2`; the
@@ -401,7 +401,7 @@ fn short(v: f64) -> String {
 /// The canonical model of a fit (module doc).
 ///
 /// Wire format: `model` (guess-mode text such as `AR1()+WN()+RW()`), `terms`
-/// ([`CanonicalTerm`]), `readings` ([`Reading`]), `reduced` (the reduced model, guess mode),
+/// ([`CanonicalTerm`]), `readings` (`Reading`), `reduced` (the reduced model, guess mode),
 /// `separation` (of the reduced model's refit from the fitted WV; 0 when nothing was
 /// refitted), `objective` (of that refit; the fit's own when nothing was refitted) and
 /// `implied_wv` (of that refit).
@@ -613,7 +613,7 @@ impl GmwmFit {
     /// AR1/GM, or a pair of adjacent AR1/GMs), a few milliseconds each.
     ///
     /// # Errors
-    /// As [`GmwmFit::canonical_with`].
+    /// As `GmwmFit::canonical_with`.
     pub fn canonical(&self) -> Result<CanonicalModel, FitError> {
         self.canonical_with(SEPARATION_LIMIT)
     }

@@ -125,7 +125,7 @@ impl Gmwm {
         self
     }
 
-    /// Sets the number of starting-value draws G (default [`super::start::default_draws`]).
+    /// Sets the number of starting-value draws G (default `super::start::default_draws`).
     pub fn with_draws(mut self, draws: usize) -> Self {
         self.start_options.draws = Some(draws);
         self
@@ -162,8 +162,8 @@ impl Gmwm {
     ///
     /// # Errors
     /// [`FitError::Length`] for a wrong-length start or [`Weighting::Diag`]; errors of
-    /// [`Weights::fast`], [`Parametrisation::to_u`] (a start outside its domain) and
-    /// [`Objective::new`] (more parameters than levels; a robust WV needs one level more,
+    /// [`Weights::fast`], `Parametrisation::to_u` (a start outside its domain) and
+    /// `Objective::new` (more parameters than levels; a robust WV needs one level more,
     /// §5.7, reported with `params` counting that extra one); [`FitError::BadStart`] when the
     /// start is not a valid model.
     pub fn fit_wv(
@@ -269,7 +269,7 @@ impl Gmwm {
     ///
     /// # Errors
     /// [`FitError::Length`] (what = "stored WV") when `fit` carries no empirical WV (a fit made
-    /// by [`Gmwm::fit_weighted`] alone); as [`Gmwm::fit_from_wv`].
+    /// by `Gmwm::fit_weighted` alone); as [`Gmwm::fit_from_wv`].
     pub fn update(&self, fit: &GmwmFit) -> Result<GmwmFit, FitError> {
         let (Some(wv), Some(inputs)) = (&fit.empirical, fit.inputs) else {
             return Err(FitError::Length {
@@ -500,7 +500,7 @@ impl GmwmFit {
         self.bootstrap_replicates
     }
 
-    /// The empirical WV fitted, with its CI (`None` only for a bare [`Gmwm::fit_weighted`]).
+    /// The empirical WV fitted, with its CI (`None` only for a bare `Gmwm::fit_weighted`).
     pub fn empirical(&self) -> Option<&WaveletVariance> {
         self.empirical.as_ref()
     }
@@ -512,8 +512,8 @@ impl GmwmFit {
     }
 
     /// Labels of the parameters of the components fitted to nothing (implied WV below
-    /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level,
-    /// [`GmwmFit::active_parameters`]): the fit is a boundary point and a smaller model fits as
+    /// `super::NEGLIGIBLE_WV_SHARE` of the model's at every level,
+    /// `GmwmFit::active_parameters`): the fit is a boundary point and a smaller model fits as
     /// well. Inference reports these parameters without a standard error.
     pub fn collapsed(&self) -> &[String] {
         &self.collapsed

@@ -3,8 +3,8 @@
 //!
 //! The optimiser works on unconstrained parameters `u`; [`Parametrisation`] maps them to the
 //! model's `theta` (original parametrisation, GM in `(beta, sigma2_gm)`), [`Weights`] holds the
-//! diagonal of Omega, [`Objective`] evaluates `Q(u)` and its whitened residuals, and
-//! a crate-internal Levenberg–Marquardt routine (options [`LmOptions`]) runs the optimiser from
+//! diagonal of Omega, `Objective` evaluates `Q(u)` and its whitened residuals, and
+//! a crate-internal Levenberg–Marquardt routine (options `LmOptions`) runs the optimiser from
 //! a given start; [`Gmwm`] ties them together,
 //! and [`Gmwm::fit`] runs the two-stage pipeline from generated starting values ([`start`], §6). Non-convergence is reported in
 //! [`Convergence`], never hidden.

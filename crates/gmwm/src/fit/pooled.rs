@@ -13,7 +13,7 @@
 //! The implied WV `nu2_j(theta)` does not depend on `N_k`, so recordings of different lengths
 //! share it level by level; a long recording has more levels and tighter weights and counts
 //! more, as it should. It is one least-squares problem on the concatenated whitened residuals
-//! ([`super::Objective`] in its stacked form), minimised by the crate's Levenberg–Marquardt.
+//! (`super::Objective` in its stacked form), minimised by the crate's Levenberg–Marquardt.
 //!
 //! **Rate.** The model's parameters are per sample (WN, RW, AR1 phi, ...), so the recordings
 //! must share one sampling rate: rates differing by more than

@@ -1,16 +1,16 @@
 //! Starting values by random search (docs/methods.md §6, the IMU algorithm of paper Appendix C).
 //!
-//! [`starting_values`] draws G candidate parameter vectors following the §6.3 table, scores
+//! `starting_values` draws G candidate parameter vectors following the §6.3 table, scores
 //! each by the flattening objective `F` (§5.4) at the untransformed draw and keeps the draw
 //! with the strictly smallest `F` (ties go to the lower draw index).
 //!
 //! Reproducibility: draw `g` uses its own `ChaCha8Rng` seeded with
-//! [`replicate_seed`]`(seed, g)`, and draws are evaluated in fixed batches of
+//! `replicate_seed``(seed, g)`, and draws are evaluated in fixed batches of
 //! 1000 draws, so the result does not depend on the number of rayon threads.
 //!
 //! Early stop (port, allowed by §6.4): after each batch the search stops when at least
-//! [`MIN_DRAWS`] draws were made and the batch lowered the best `F` by no more than
-//! 1e-6 (relative). The default G ([`default_draws`]) is 20000 for
+//! `MIN_DRAWS` draws were made and the batch lowered the best `F` by no more than
+//! 1e-6 (relative). The default G (`default_draws`) is 20000 for
 //! `N <= 1e4`, else 100000 (the package uses 1e6 for long series; the early stop and the
 //! stage-1/stage-2 optimisation make the larger count unnecessary).
 //!

@@ -289,7 +289,7 @@ impl Parametrisation {
 
     /// docs/methods.md §5.6 (port): theta with the AR1/GM blocks `(phi, sigma2)` / `(beta,
     /// sigma2_gm)` stably sorted by `phi` decreasing (GM: `beta` increasing), wherever they appear;
-    /// other parameters stay in place. Use it on a start before [`Parametrisation::to_u`] with the
+    /// other parameters stay in place. Use it on a start before `Parametrisation::to_u` with the
     /// ordered chain, and on a [`PhiOrder::Free`] result.
     ///
     /// # Errors

@@ -13,7 +13,7 @@ use thiserror::Error;
 pub(crate) const QUOTE_MAX: usize = 40;
 
 /// Text from a file made safe for a one-line message: control and other non-printable
-/// characters escaped (`\n`, `\u{0}`), cut to [`QUOTE_MAX`] characters with `...` appended.
+/// characters escaped (`\n`, `\u{0}`), cut to `QUOTE_MAX` characters with `...` appended.
 pub fn quote(text: &str) -> String {
     escaped(text, QUOTE_MAX)
 }
@@ -94,7 +94,7 @@ pub(crate) fn name_list(names: &[String]) -> String {
 ///
 /// Line numbers are 1-based physical lines of the (decompressed) file, the header being line 1;
 /// column indices are 1-based; sample indices in binary files are 0-based rows. Text taken
-/// from a file (cells, header names) is cut to [`QUOTE_MAX`] characters with non-printable
+/// from a file (cells, header names) is cut to `QUOTE_MAX` characters with non-printable
 /// characters escaped ([`quote`]), so no message can dump a file.
 #[derive(Debug, Error)]
 #[non_exhaustive]

@@ -3,10 +3,10 @@
 //! - [`read_table`]: CSV/TSV text (plain or gzip), raw little-endian f64/f32 binary and binary
 //!   IMU records into a [`Table`] of named columns, with the JSON [`Sidecar`], the time column
 //!   ([`TimingReport`]), soft problems ([`ReadWarning`]) and the sampling rate;
-//! - [`check_times`]: rate, gaps, duplicates and reordering of any time stamps (module
+//! - `check_times`: rate, gaps, duplicates and reordering of any time stamps (module
 //!   [`timing`]);
-//! - [`BinaryChunks`] / [`for_each_chunk`]: one column of a huge binary file in bounded memory;
-//! - [`read_imu_record_file`]: the binary IMU epoch records of docs/methods.md §9.2–9.3;
+//! - [`BinaryChunks`] / `for_each_chunk`: one column of a huge binary file in bounded memory;
+//! - `read_imu_record_file`: the binary IMU epoch records of docs/methods.md §9.2–9.3;
 //! - [`write::SeriesWriter`]: series to CSV, TSV, gzip or raw binary by file name;
 //! - [`plausible::raw_floats`]: whether raw floats look like samples (f64 read as f32, ...);
 //! - [`Imu`]: gyroscope/accelerometer axes with a common rate (docs/methods.md §9.1);

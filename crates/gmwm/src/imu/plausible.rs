@@ -81,8 +81,8 @@ impl fmt::Display for ImplausibleFloats {
 }
 
 /// Looks at the first values of a raw f64/f32 file (`layout`) and returns what is implausible
-/// when any value is beyond [`HUGE`], at least 1% are NaN or infinite, or at least 5% are
-/// nonzero below [`TINY`]; `None` when they look like samples (or the file is not raw floats).
+/// when any value is beyond `HUGE`, at least 1% are NaN or infinite, or at least 5% are
+/// nonzero below `TINY`; `None` when they look like samples (or the file is not raw floats).
 ///
 /// # Errors
 /// [`ReadError::Io`] when the file cannot be opened or read.

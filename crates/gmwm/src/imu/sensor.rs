@@ -314,7 +314,7 @@ impl Imu {
     /// Builds an IMU from a table, inferring sensor and axis of each column from its name, else
     /// from the sidecar's meaning ([`SensorInfo::infer`]); columns that match neither become
     /// [`Sensor::Other`] with the column name as label. Units: the one the column name states
-    /// ([`SensorInfo::unit_from_name`]), else the sidecar's, else rad/s and m/s^2 for binary
+    /// (`SensorInfo::unit_from_name`), else the sidecar's, else rad/s and m/s^2 for binary
     /// IMU records (docs/methods.md §9.3), as text. The name comes from the sidecar, else the file
     /// name. The table's timing report and warnings are kept ([`Imu::timing`], [`Imu::warnings`]).
     ///

@@ -4,14 +4,14 @@
 //! - [`time_column_unit`]: whether a header name is a time column (`time`, `timestamp`, `t`,
 //!   `stamp`, `%time`, `#timestamp [ns]`, `timestamp_ns`, `time_s`, `time [s]`,
 //!   `field.header.stamp`, ...) and the unit the name states, if any;
-//! - [`infer_time_unit`]: the unit of unlabelled stamps, from their magnitude (Unix epoch) or
+//! - `infer_time_unit`: the unit of unlabelled stamps, from their magnitude (Unix epoch) or
 //!   their step (a plausible IMU rate);
-//! - [`check_times`]: a [`TimingReport`] of any sequence of stamps in seconds, monotonic or not,
+//! - `check_times`: a [`TimingReport`] of any sequence of stamps in seconds, monotonic or not,
 //!   and its typed [`TimingWarning`]s.
 //!
 //! # Rate from time stamps
 //! The rate is `1 / nominal step`, the nominal step being the mean of the *regular* steps: the
-//! positive steps no longer than [`GAP_FACTOR`] times the median step (first the steps within
+//! positive steps no longer than `GAP_FACTOR` times the median step (first the steps within
 //! twice the median set a provisional nominal step, then the gap threshold is 1.5 times that).
 //! The median makes the rate robust to gaps (a 0.5 s hole in a 200 Hz log does not lower it);
 //! averaging the regular steps makes it robust to quantised stamps (300 Hz stamped in whole
@@ -254,7 +254,7 @@ pub(crate) fn infer_unit(origin: f64, raw: &[f64]) -> Option<TimeUnit> {
     Some(unit)
 }
 
-/// A gap: a step longer than [`GAP_FACTOR`] nominal steps.
+/// A gap: a step longer than `GAP_FACTOR` nominal steps.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Gap {
     /// 0-based index of the first sample after the gap.
@@ -270,7 +270,7 @@ pub struct Gap {
     pub missing: usize,
 }
 
-/// What a time column says about the sampling ([`check_times`]).
+/// What a time column says about the sampling (`check_times`).
 ///
 /// Wire format: `column`, `unit` (`seconds`, ...), `unit_source` (`stated`, `inferred`,
 /// `flag`), `samples`, `start_s`, `span_s`, `rate_hz`, `mean_rate_hz`, `gaps` ([`Gap`]: `row`, `line`,
@@ -296,7 +296,7 @@ pub struct TimingReport {
     pub(crate) rate_hz: f64,
     /// `(samples - 1) / span_s`: what the rate would be without gaps (NaN for a zero span).
     pub(crate) mean_rate_hz: f64,
-    /// Steps longer than [`GAP_FACTOR`] nominal steps, in order.
+    /// Steps longer than `GAP_FACTOR` nominal steps, in order.
     pub gaps: Vec<Gap>,
     /// Steps of exactly zero (a stamp repeated).
     pub(crate) duplicates: usize,
@@ -687,7 +687,7 @@ impl TimingReport {
     }
 
     /// The soft problems of the stamps, one per kind: gaps (count, largest, where), duplicates,
-    /// reordering, jitter above [`JITTER_WARN`].
+    /// reordering, jitter above `JITTER_WARN`.
     pub fn warnings(&self) -> Vec<TimingWarning> {
         let mut out = Vec::new();
         if let Some(largest) = self
@@ -784,7 +784,7 @@ fn trim_zeros(s: &str) -> String {
 #[serde(tag = "kind", rename_all = "kebab-case")]
 #[non_exhaustive]
 pub enum TimingWarning {
-    /// Steps longer than [`GAP_FACTOR`] nominal steps.
+    /// Steps longer than `GAP_FACTOR` nominal steps.
     Gaps {
         /// Time column.
         column: String,
@@ -815,7 +815,7 @@ pub enum TimingWarning {
     Jitter {
         /// Time column.
         column: String,
-        /// Robust relative spread of the steps ([`TimingReport::jitter`]).
+        /// Robust relative spread of the steps (`TimingReport::jitter`).
         jitter: f64,
     },
 }

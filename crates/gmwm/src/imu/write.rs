@@ -44,7 +44,7 @@ impl OutputFormat {
     /// raw f64; the same with `f32` → raw f32 (case-insensitive).
     ///
     /// # Errors
-    /// [`ParamError`] `output` for any other name, listing [`OUTPUT_EXTENSIONS`].
+    /// [`ParamError`] `output` for any other name, listing `OUTPUT_EXTENSIONS`.
     pub fn from_path(path: &Path) -> Result<Self, ParamError> {
         let name = path
             .file_name()
@@ -411,7 +411,7 @@ pub(crate) fn sidecar_path(data: &Path) -> PathBuf {
     data.with_file_name(name)
 }
 
-/// Writes the JSON sidecar of a data file at [`sidecar_path`] and returns that path.
+/// Writes the JSON sidecar of a data file at `sidecar_path` and returns that path.
 ///
 /// # Errors
 /// [`ReadError::Io`] when it cannot be written.

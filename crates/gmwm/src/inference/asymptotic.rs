@@ -87,7 +87,7 @@ pub(crate) const PINV_RCOND: f64 = 1e-12;
 ///
 /// The columns of `A` are first scaled to unit `Omega`-norm (parameters differ by many decades,
 /// e.g. a GM `beta` and `sigma2_gm`), the pseudo-inverse of the equilibrated `p x p` matrix uses
-/// the relative cut-off [`PINV_RCOND`] and the scaling is undone; for a full-rank matrix this is
+/// the relative cut-off `PINV_RCOND` and the scaling is undone; for a full-rank matrix this is
 /// exactly the inverse.
 ///
 /// # Errors
@@ -206,7 +206,7 @@ pub(crate) fn scales(model: &Model, scale: IntervalScale) -> Vec<Scale> {
 }
 
 /// docs/methods.md §7.2 with the scale of the module doc: the interval of `estimate` with standard
-/// error `se` (natural units) for a parameter of `domain`, `z` from [`z_value`].
+/// error `se` (natural units) for a parameter of `domain`, `z` from `z_value`.
 ///
 /// # Examples
 /// ```

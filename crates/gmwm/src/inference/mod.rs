@@ -1,6 +1,6 @@
 //! Inference on a GMWM fit (docs/methods.md §7): the parametric bootstrap of the wavelet variance
 //! and of the fit (`bootstrap`, §7.4), and the covariance V of the WV, exact or bootstrapped
-//! ([`wv_covariance`], in `sim`), on which the bootstrap weighting (§5.2), the bootstrap
+//! (`wv_covariance`, in `sim`), on which the bootstrap weighting (§5.2), the bootstrap
 //! covariance of the estimates and the WIC optimism (§8) rest; the sandwich covariance and
 //! intervals ([`asymptotic`], §7.1, §7.2, §7.6); the J-test ([`gof`], §7.3); and one entry
 //! point, [`infer`] (`summary`, §7.5).

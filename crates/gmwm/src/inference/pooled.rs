@@ -27,7 +27,7 @@ pub(crate) struct Stacked {
 impl PooledFit {
     /// docs/methods.md §5.11: the sandwich covariance `H V H'` on the stacked Jacobian, the
     /// block-diagonal weights and the block-diagonal exact covariance of the recordings' WVs at
-    /// the pooled estimate (a bootstrap V of [`POOLED_V_REPLICATES`] replicates seeded with
+    /// the pooled estimate (a bootstrap V of `POOLED_V_REPLICATES` replicates seeded with
     /// `seed` where the exact one does not cover the model), and the `1 - alpha` intervals of
     /// §7.2 on the transformed scale. Returns the parameters and the `p x p` covariance.
     ///

@@ -345,7 +345,7 @@ impl Inference {
 ///
 /// Asymptotic mode: V from `opts.v_replicates` series simulated from the fitted model, the
 /// sandwich with the fit's Omega and the analytic Jacobian, the J-test. Bootstrap mode:
-/// [`fit_bootstrap`] with B replicates. See the module doc for the choices.
+/// `fit_bootstrap` with B replicates. See the module doc for the choices.
 ///
 /// Cost: asymptotic, H x (simulation + WV) of length `n` plus one stage-2 fit; bootstrap, B x
 /// (simulation + WV + stage-2 fit [+ G draws and a two-stage fit]).

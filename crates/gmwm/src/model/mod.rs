@@ -25,8 +25,8 @@
 //! - **at most one ARMA-family term** (`MA1`, `ARMA11`, `AR(p)`, `MA(q)`, `ARMA(p,q)`): two such
 //!   terms are not identifiable from one another by the wavelet variance (a sum of ARMAs is an
 //!   ARMA). The R package has no such rule; it is gmwm's own;
-//! - orders: `AR(p)`, `MA(q)` need an order from 1 to [`MAX_ORDER`]; `ARMA(p,q)` needs
-//!   `p + q >= 1`, each at most [`MAX_ORDER`];
+//! - orders: `AR(p)`, `MA(q)` need an order from 1 to `MAX_ORDER`; `ARMA(p,q)` needs
+//!   `p + q >= 1`, each at most `MAX_ORDER`;
 //! - every given value is finite and in its basic domain ([`ParamDomain`]).
 //!
 //! ```
@@ -81,7 +81,7 @@ pub struct Component {
 impl Component {
     /// A component in guess mode: no value given (docs/methods.md §0.3).
     ///
-    /// The kind's orders are not checked here (see [`ProcessKind::check_orders`]); a bad order
+    /// The kind's orders are not checked here (see `ProcessKind::check_orders`); a bad order
     /// is reported when the component enters a [`Model`].
     pub fn guess(kind: ProcessKind) -> Component {
         let n = kind.n_params().min(2 * MAX_ORDER + 1);

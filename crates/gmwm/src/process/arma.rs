@@ -229,7 +229,7 @@ const ROOT_TOL: f64 = 1e-15;
 
 impl Arma {
     /// Builds an ARMA(p, q). Non-invertible MA parts are valid processes (accepted) but are not
-    /// identifiable from second moments; see [`Arma::is_invertible`].
+    /// identifiable from second moments; see `Arma::is_invertible`.
     ///
     /// # Errors
     /// [`ParamError`] naming `ar`/`ma` for a non-finite coefficient, `ar` when the AR polynomial

@@ -16,7 +16,7 @@
 //! Derivatives of the closed forms are exact (forward-mode automatic differentiation of the
 //! numerically stable evaluation, see `ar1`), so they stay accurate where the textbook quotient
 //! of §4.5 cancels (AR1/GM with `phi` near 1). The generic [`Arma`] is differentiated numerically
-//! (§4.7). [`spectral`] holds the slow quadrature oracle of §1.9.
+//! (§4.7). `spectral` holds the slow quadrature oracle of §1.9.
 
 use serde::Serialize;
 

@@ -31,7 +31,7 @@
 //! hidden behind it.
 //!
 //! The rows are ranked by WIC. Rows whose WIC exceeds the minimum by at most one standard
-//! error of the difference ([`wic::wic_difference_se`]: a first-order term from the two fits'
+//! error of the difference (`wic::wic_difference_se`: a first-order term from the two fits'
 //! WVs and the WV's covariance, and the chi-square spread of the objective drop that extra
 //! parameters buy on noise alone) are ones the criterion cannot tell apart from the minimum;
 //! the [`SelectionRule`] chooses among them: by default ([`SelectionRule::Navigation`]) the
@@ -164,7 +164,7 @@ pub enum SelectionError {
     TooManyTerms {
         /// Terms of the full model.
         terms: usize,
-        /// [`MAX_NESTED_TERMS`].
+        /// `MAX_NESTED_TERMS`.
         max: usize,
     },
     /// A setting out of range (e.g. fewer than 2 bootstrap replicates).

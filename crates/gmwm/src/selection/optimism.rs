@@ -101,7 +101,7 @@ pub(crate) fn d_matrix(
     Ok(d)
 }
 
-/// docs/methods.md §8.2: the asymptotic optimism from the Jacobian `a` (J x p), `d` ([`d_matrix`],
+/// docs/methods.md §8.2: the asymptotic optimism from the Jacobian `a` (J x p), `d` (`d_matrix`,
 /// p x p), the weighting matrix `omega` and the covariance `v` of the WV (both J x J).
 ///
 /// # Errors

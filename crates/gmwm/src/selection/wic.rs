@@ -57,7 +57,7 @@ pub struct Wic {
 /// How the selected row is chosen among the rows of canonical models (module docs of
 /// [`super`]): every rule ranks the rows by WIC; they differ in what they do with the rows
 /// whose WIC exceeds the minimum by at most one standard error of that difference
-/// ([`WIC_EQUIVALENCE_SE`], [`wic_difference_se`]): the criterion cannot tell those apart.
+/// (`WIC_EQUIVALENCE_SE`, `wic_difference_se`): the criterion cannot tell those apart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SelectionRule {
@@ -103,10 +103,10 @@ impl Wic {
     }
 
     /// Nested selection (docs/methods.md §8.4, `auto.imu`, `rank.models(nested = TRUE)`): every
-    /// sub-model of `full` ([`nested_candidates`]); values in `full` are ignored.
+    /// sub-model of `full` (`nested_candidates`); values in `full` are ignored.
     ///
     /// # Errors
-    /// As [`nested_candidates`].
+    /// As `nested_candidates`.
     pub fn nested(full: Model) -> Result<Self, SelectionError> {
         let candidates = nested_candidates(&full)?;
         Ok(Self::with_candidates(full.without_values(), candidates))
@@ -114,11 +114,11 @@ impl Wic {
 
     /// Selection among a user's list (docs/methods.md §8.5, `rank.models(nested = FALSE)`): the
     /// candidates in the order given (identical term lists merged, values ignored); the common
-    /// denominator ([`common_denominator`]) plays the full model and is appended as a candidate
+    /// denominator (`common_denominator`) plays the full model and is appended as a candidate
     /// unless a given one has the same terms (which then plays the full model).
     ///
     /// # Errors
-    /// As [`common_denominator`].
+    /// As `common_denominator`.
     pub fn list(models: &[Model]) -> Result<Self, SelectionError> {
         let denominator = common_denominator(models)?;
         let mut candidates: Vec<Model> = Vec::with_capacity(models.len() + 1);
@@ -171,7 +171,7 @@ impl Wic {
     }
 
     /// Sets the bootstrap replicates B (of a bootstrap V for the asymptotic optimism, per
-    /// candidate for the bootstrap one); default [`DEFAULT_BOOTSTRAP`]; at least 2.
+    /// candidate for the bootstrap one); default `DEFAULT_BOOTSTRAP`; at least 2.
     pub fn with_bootstrap(mut self, replicates: usize) -> Self {
         self.bootstrap = replicates;
         self
@@ -186,14 +186,14 @@ impl Wic {
     }
 
     /// Sets the seed (starting values of every candidate, bootstrap); default
-    /// [`DEFAULT_SEED`]. Every candidate's search restarts from it, as in the package.
+    /// `DEFAULT_SEED`. Every candidate's search restarts from it, as in the package.
     pub fn with_seed(mut self, seed: u64) -> Self {
         self.seed = seed;
         self
     }
 
     /// Sets the starting-value draws G of every fit; default as [`Gmwm`]
-    /// ([`default_draws`](crate::fit::start::default_draws)).
+    /// (`default_draws`).
     pub fn with_draws(mut self, draws: usize) -> Self {
         self.draws = Some(draws);
         self
@@ -283,7 +283,7 @@ impl Wic {
     /// 3. every candidate (in parallel; each search seeded with `seed`) fitted in guess mode
     ///    against the same WV and weights; objective, optimism, WIC, GoF p-value (the J-test of
     ///    §7.3 with `V`, or with the bootstrap optimism the bootstrap p-value of §7.4).
-    ///    Candidates with one canonical model and one objective (within [`WIC_TIE_REL`]) are
+    ///    Candidates with one canonical model and one objective (within `WIC_TIE_REL`) are
     ///    one fit up to terms fitted to nothing: they share the GoF p-value of their smallest
     ///    member, and with the bootstrap optimism its optimism too, bootstrapped once for the
     ///    group (the asymptotic optimisms of such members agree, their terms fitted to nothing
@@ -294,7 +294,7 @@ impl Wic {
     ///    canonical model are one row, scored by its smallest member (fewest parameters, then
     ///    smallest WIC), so a superset whose extra terms collapsed or stand in for others never
     ///    wins on the noise of its optimism;
-    /// 5. rows sorted by WIC (a NaN WIC last; ties within [`WIC_TIE_REL`] go to the model with
+    /// 5. rows sorted by WIC (a NaN WIC last; ties within `WIC_TIE_REL` go to the model with
     ///    fewer parameters); the selected row is chosen by the [`SelectionRule`] among the rows
     ///    whose fits the data cannot separate from the WIC minimum's.
     ///
@@ -349,11 +349,11 @@ impl Wic {
         self.select_wv_with_progress(wv, &NoProgress)
     }
 
-    /// [`Wic::select_wv`] reporting each scored candidate to `progress` (as
+    /// `Wic::select_wv` reporting each scored candidate to `progress` (as
     /// [`Wic::select_with_progress`]).
     ///
     /// # Errors
-    /// As [`Wic::select_wv`].
+    /// As `Wic::select_wv`.
     pub fn select_wv_with_progress(
         &self,
         wv: &WaveletVariance,
@@ -958,7 +958,7 @@ impl Context<'_> {
 /// estimate on the boundary of its transform domain), `gof_p_value_upper_bound` (true when
 /// the bootstrap p-value is a bound: no replicate exceeded the observed objective, so the
 /// p-value is below `1 / (B + 1)`, the value given), `converged` (of the candidate's
-/// optimiser). Candidates with one canonical model and one objective (within [`WIC_TIE_REL`])
+/// optimiser). Candidates with one canonical model and one objective (within `WIC_TIE_REL`)
 /// are one fit up to terms fitted to nothing, and report the p-value of the one with the
 /// fewest parameters.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -999,7 +999,7 @@ pub enum RowStatus {
 /// (fewest parameters, then smallest WIC: `model`, `canonical_model`, `objective`,
 /// `optimism`, `wic`, `gof_p_value`, `gof_p_value_upper_bound`, `converged`), `members` (every
 /// candidate with this canonical model), `delta_wic` (its WIC less the minimum's),
-/// `delta_wic_se` (the standard error of that difference, [`wic_difference_se`]), `status`
+/// `delta_wic_se` (the standard error of that difference, `wic_difference_se`), `status`
 /// (`selected`, `equivalent`, `separable`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SelectionRow {
@@ -1010,7 +1010,7 @@ pub struct SelectionRow {
     pub members: Vec<Model>,
     /// WIC less the minimum's.
     pub delta_wic: f64,
-    /// Standard error of `delta_wic` ([`wic_difference_se`]).
+    /// Standard error of `delta_wic` (`wic_difference_se`).
     pub delta_wic_se: f64,
     /// Selected, equivalent or separable.
     pub status: RowStatus,

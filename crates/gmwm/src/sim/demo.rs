@@ -25,7 +25,7 @@ pub struct DemoSensor {
 }
 
 impl Default for DemoSensor {
-    /// The NavChip truth of docs/methods.md §5.10 ([`DEMO_MODEL`] at [`DEMO_FREQ_HZ`]).
+    /// The NavChip truth of docs/methods.md §5.10 (`DEMO_MODEL` at `DEMO_FREQ_HZ`).
     fn default() -> Self {
         Self {
             model: DEMO_MODEL

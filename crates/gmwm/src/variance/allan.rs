@@ -320,7 +320,7 @@ impl AllanVariance {
     }
 
     /// The package's "error" column `e = 1 / sqrt(2 (N/m - 1))` (docs/methods.md §3.3), in both
-    /// conventions; its deviation band is [`AllanVariance::package_band`]. The package itself
+    /// conventions; its deviation band is `AllanVariance::package_band`. The package itself
     /// calls this band "known to be incorrect"; prefer `ci_low`/`ci_high`.
     pub fn error(&self) -> &[f64] {
         &self.error

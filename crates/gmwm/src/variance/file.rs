@@ -44,7 +44,7 @@ struct SeriesDoc {
 }
 
 /// True when `path` looks like a WV JSON: extension `.json`, or content that is a JSON object
-/// ([`sniff`]: first non-blank character `{`), whatever the name; the test the CLI uses to
+/// (`sniff`: first non-blank character `{`), whatever the name; the test the CLI uses to
 /// choose between a recording and a precomputed WV. A file that cannot be read is not one (the
 /// reader then reports why).
 pub fn is_wv_json(path: &Path) -> bool {

@@ -250,7 +250,7 @@ const BINOM8_PACKAGE: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, 8.0
 ///
 /// # Formula
 /// `a(c) = mu_2 - 4 mu_4 / c^2 + 6 mu_6 / c^4 - 4 mu_8 / c^6 + mu_10 / c^8`
-/// with `mu_{2k}` from [`truncated_normal_moments`].
+/// with `mu_{2k}` from `truncated_normal_moments`.
 ///
 /// # Examples
 /// ```

@@ -972,10 +972,10 @@ impl StreamedTable {
         binary_columns_wv(path, &layout, &one_based, freq_hz, opts).map_err(|e| self.rename(e))
     }
 
-    /// [`columns_wv`](Self::columns_wv) of every selected column, the WVs only.
+    /// `columns_wv` of every selected column, the WVs only.
     ///
     /// # Errors
-    /// As [`columns_wv`](Self::columns_wv).
+    /// As `columns_wv`.
     pub fn wavelet_variance(
         &self,
         freq_hz: f64,

@@ -2,7 +2,7 @@
 //! confidence intervals (§1.7), for the MODWT (default) and the DWT with any filter of §1.8.
 //!
 //! The Haar MODWT classical WV — the one every later step of the platform uses — is computed by
-//! [`HaarWvAccumulator`], a streaming O(N·J) pass that never stores the coefficients and can
+//! `HaarWvAccumulator`, a streaming O(N·J) pass that never stores the coefficients and can
 //! consume its input in chunks.
 
 use crate::error::{check_finite, check_freq, check_series, InputError, ParamError, SeriesError};
@@ -438,7 +438,7 @@ pub(crate) fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<
 /// Wavelet variance of `x` sampled at `freq_hz`, docs/methods.md §1.5 (classical) or §2 (robust),
 /// with chi-square intervals (§1.7; robust intervals §2.5).
 ///
-/// The classical Haar MODWT path is a streaming O(N·J) pass ([`HaarWvAccumulator`]); other
+/// The classical Haar MODWT path is a streaming O(N·J) pass (`HaarWvAccumulator`); other
 /// filters and the DWT go through the transform ([`Modwt`], [`Dwt`]) and keep O(N·J) memory.
 /// The DWT estimate is normalised to the MODWT scale (`mean(W^2) / 2^j`), unlike the package's
 /// raw mean which is `2^j` times larger (§13.3); its equivalent degrees of freedom are the

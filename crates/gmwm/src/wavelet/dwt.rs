@@ -97,7 +97,7 @@ impl Dwt {
     /// `O(N L)` time; memory: the output (`< N` values) plus two length-`N/2` buffers.
     ///
     /// # Errors
-    /// As [`check_len`](Self::check_len).
+    /// As `check_len`.
     pub fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, InputError> {
         let mut out = WaveletCoefficients::default();
         self.transform_with_scratch(x, &mut out, &mut WaveletScratch::new())?;

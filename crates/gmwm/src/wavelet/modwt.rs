@@ -85,7 +85,7 @@ impl Modwt {
     /// `O(N J L)` time; memory: the output (`J N` values) plus two length-N buffers.
     ///
     /// # Errors
-    /// As [`check_len`](Self::check_len).
+    /// As `check_len`.
     pub fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, InputError> {
         let mut out = WaveletCoefficients::default();
         self.transform_with_scratch(x, &mut out, &mut WaveletScratch::new())?;

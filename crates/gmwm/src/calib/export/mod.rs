@@ -20,7 +20,7 @@
 //! white noise of density `*RandomWalk` with correlation time `*BiasCorrelationTime` (its
 //! stationary sd is `RandomWalk × sqrt(T / 2)`), plus a constant turn-on bias of sd
 //! `*TurnOnBiasSigma` drawn once per run. So for PX4 the random walk should be the GM driving
-//! density (docs/methods.md §14.2) when a GM bias is exported; [`SensorNoise::bias_sigma`] is
+//! density (docs/methods.md §14.2) when a GM bias is exported; `SensorNoise::bias_sigma` is
 //! written as the turn-on sigma, and the stationary sd implied by the other two keys is stated in a
 //! comment so the two can be compared.
 

@@ -171,7 +171,7 @@ impl InputFormat {
     }
 }
 
-/// What the first bytes of a file are ([`sniff`]).
+/// What the first bytes of a file are (`sniff`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Content {
     /// Plain text.
@@ -180,7 +180,7 @@ pub enum Content {
     Gzip,
     /// A JSON object (first non-blank character `{`).
     Json,
-    /// Neither: NUL bytes or invalid UTF-8 in the first [`SNIFF_BYTES`].
+    /// Neither: NUL bytes or invalid UTF-8 in the first `SNIFF_BYTES`.
     Binary,
 }
 
@@ -268,7 +268,7 @@ pub struct ReadOptions {
     /// stamp), not among the columns.
     pub time_column: Option<ColumnSelector>,
     /// Unit of the time column (default `None`: stated by its name, else inferred, see
-    /// [`infer_time_unit`](crate::imu::infer_time_unit)).
+    /// `infer_time_unit`).
     pub time_unit: Option<TimeUnit>,
     /// Columns to read, in this order (default empty: see [`read_table`]).
     pub columns: Vec<ColumnSelector>,
@@ -545,7 +545,7 @@ impl BinaryLayout {
 /// ([`BinaryChunks`]).
 ///
 /// # Errors
-/// As [`resolve_format`] and [`find_sidecar`]; [`ReadError::Empty`] or
+/// As `resolve_format` and [`find_sidecar`]; [`ReadError::Empty`] or
 /// [`ReadError::BinarySize`] if the file does not hold a whole number of rows of `ncols`
 /// values; [`ParamError`] `ncols` for 0 columns.
 pub fn binary_layout(path: &Path, opts: &ReadOptions) -> Result<Option<BinaryLayout>, ReadError> {
@@ -579,15 +579,15 @@ pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<Strin
 
 /// Reads a text or binary file into a [`Table`].
 ///
-/// Format: [`resolve_format`] (name, sidecar, content).
+/// Format: `resolve_format` (name, sidecar, content).
 ///
 /// Time column: `opts.time_column`, else found by name ([`time_column_unit`]: `time`,
 /// `timestamp`, `t`, `stamp`, `%time`, `#timestamp [ns]`, `timestamp_ns`, `time_s`,
 /// `time [s]`, `field.header.stamp`, ...; a header stamp is preferred, else the first in file
 /// order) unless `opts.columns` selects that column explicitly. Its unit: `opts.time_unit`,
-/// else the one its name states, else [`infer_time_unit`](super::timing::infer_time_unit)
+/// else the one its name states, else `infer_time_unit`
 /// (seconds if nothing can be inferred). The stamps are converted to seconds and checked
-/// ([`check_times`], [`TableFacts::timing`]); in a text or raw binary file
+/// (`check_times`, [`TableFacts::timing`]); in a text or raw binary file
 /// they must strictly increase ([`ReadError::TimeNotIncreasing`] names the line).
 ///
 /// Columns: `opts.columns` in that order; by default every column but the time columns, and
@@ -595,7 +595,7 @@ pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<Strin
 /// the sidecar's meaning) only those; the others are listed in [`TableFacts::skipped`].
 ///
 /// Sampling frequency, first match wins: `opts.freq_hz`; the time column's rate,
-/// [`TimingReport::rate_hz`] (1 / the nominal step: the mean of the steps within 1.5 median
+/// `TimingReport::rate_hz` (1 / the nominal step: the mean of the steps within 1.5 median
 /// steps, so gaps do not lower it; not rounded, so 62.5 Hz survives) — for IMU records
 /// docs/methods.md §9.2's rounded rate; the sidecar's `sampling_frequency_hz`; otherwise `None` and
 /// the caller decides. A given rate or a sidecar rate that differs from the time column's by

@@ -13,9 +13,9 @@
 //! read back, its raw f64 copy can, by several threads at once. The spool takes
 //! `8 · columns · rows` bytes of disk in [`std::env::temp_dir`] (`TMPDIR`), none of memory.
 //!
-//! The time column: `timing::StepStats` gives the report of [`check_times`] bit for bit without
+//! The time column: `timing::StepStats` gives the report of `check_times` bit for bit without
 //! holding the stamps, from the distinct steps and the largest ones. When its bounds are
-//! passed (more than [`STREAM_DISTINCT_STEPS`](crate::imu::timing::STREAM_DISTINCT_STEPS)
+//! passed (more than `STREAM_DISTINCT_STEPS`
 //! distinct steps, or more gaps than it holds), or when the unit of the stamps must be
 //! inferred from their steps (not stated by the name, `--time-unit` or an epoch-sized first
 //! stamp), the stamps, spooled too, are read back and checked in memory (8 bytes a row), and
@@ -120,11 +120,11 @@ pub(crate) fn streamed_size(probe: &Probe, opts: &ReadOptions) -> Result<Option<
 /// once read, the file's size in bytes over 8 (a text row of numbers takes more than 8 bytes
 /// a column, so this is never below what the rule means for raw f64: a text file of
 /// `stream_from` rows streams); for a ROS recording, the messages of its largest IMU topic
-/// ([`imu_messages_count`](crate::imu::ros::imu_messages_count), from the index or the
+/// (`imu_messages_count`, from the index or the
 /// statistics).
 ///
 /// # Errors
-/// As [`streamed_size`]; for a ROS recording, as
+/// As `streamed_size`; for a ROS recording, as
 /// [`list_topics`](crate::imu::ros::list_topics).
 pub fn streams_from(
     probe: &Probe,
@@ -179,7 +179,7 @@ impl StreamedTable {
         Self::open(path, &opts.read)
     }
 
-    /// Reads `path` (text or binary IMU records, see [`streamed_size`]) in one pass, as
+    /// Reads `path` (text or binary IMU records, see `streamed_size`) in one pass, as
     /// [`read_table`](super::read_table) would with `opts`, spooling the selected columns.
     ///
     /// # Errors
