@@ -626,6 +626,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             // the contamination check compares with the robust WV at --eff
             robust_check: Some(robust_at_eff(&a.estimator)?),
             tolerance: a.tolerance,
+            force_units: a.force_units,
         };
         let exports = exports(a)?;
         let adjustment = match (a.inflate, a.conservative) {

@@ -298,3 +298,81 @@ fn calibrate_refuses_bad_flags() {
         &["gyro_x", "not a gyroscope"],
     );
 }
+
+/// Units checked (issue 28): a unit flag on a ROS recording (SI by definition) is refused
+/// unless forced; a flag that overrides the sidecar's unit is said in a note; an accelerometer
+/// whose mean magnitude is far from 1 g under the unit in force is a check naming the likely
+/// unit; `--tolerance` takes a fraction.
+#[test]
+fn calibrate_checks_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = write_bag(dir.path(), "si.bag", "ros1", 4096, &[]);
+    assert_one_line_error(
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--gyro-unit", "deg/s"]),
+        &["--gyro-unit deg/s", "ROS", "--force-units"],
+    );
+    let forced = run_json(
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--gyro-unit", "deg/s", "--force-units", "--G", "200"])
+            .args(["--model", "WN()+RW()", "--json", "-"]),
+    );
+    assert_eq!(forced["axes"].as_array().unwrap().len(), 6);
+
+    // a CSV whose sidecar says m/s^2 for an accelerometer that reads 1 in magnitude: in g
+    let csv = dir.path().join("acc.csv");
+    let mut text = String::from("gyro_x,accel_x,accel_y,accel_z\n");
+    for i in 0..4096u32 {
+        let e =
+            |k: u32| (((i.wrapping_mul(2654435761).wrapping_add(k)) % 1000) as f64 - 500.0) * 1e-6;
+        text.push_str(&format!(
+            "{},{},{},{}\n",
+            e(1),
+            0.01 + e(2),
+            -0.02 + e(3),
+            -1.0 + e(4)
+        ));
+    }
+    std::fs::write(&csv, text).unwrap();
+    std::fs::write(
+        dir.path().join("acc.json"),
+        r#"{"sampling_frequency_hz": 100, "units": {"gyro": "rad/s", "accel": "m/s^2"}}"#,
+    )
+    .unwrap();
+    let doc = run_json(
+        gmwm()
+            .arg("calibrate")
+            .arg(&csv)
+            .args(["--model", "WN()", "--G", "100", "--json", "-"]),
+    );
+    let checks = doc["checks"].to_string();
+    assert!(
+        checks.contains("1 g") && checks.contains("look like g"),
+        "{checks}"
+    );
+    let overridden = run_json(gmwm().arg("calibrate").arg(&csv).args([
+        "--accel-unit",
+        "g",
+        "--model",
+        "WN()",
+        "--G",
+        "100",
+        "--json",
+        "-",
+    ]));
+    assert!(
+        !overridden["checks"].to_string().contains("1 g"),
+        "{}",
+        overridden["checks"]
+    );
+    let notes = overridden["axes"][1]["notes"].to_string();
+    assert!(notes.contains("overrides the recording's unit"), "{notes}");
+    assert_usage_error(
+        gmwm().arg("calibrate").arg(&csv).args(["--tolerance", "2"]),
+        &["--tolerance", "(0, 1]"],
+    );
+}

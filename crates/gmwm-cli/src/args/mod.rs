@@ -286,6 +286,10 @@ pub struct CalibrateArgs {
     /// within this fraction of the empirical WV (0.1 = 10%).
     #[arg(long, value_name = "FRACTION", default_value_t = gmwm::calib::DEFAULT_TOLERANCE, value_parser = tolerance)]
     pub tolerance: f64,
+    /// Apply --gyro-unit/--accel-unit to a ROS recording too (sensor_msgs/Imu is SI by
+    /// definition, so they are refused there without this).
+    #[arg(long)]
+    pub force_units: bool,
     /// rostopic written to Kalibr/OpenVINS files [default: the ROS topic read, else /imu0].
     #[arg(long, value_name = "TOPIC")]
     pub rostopic: Option<String>,

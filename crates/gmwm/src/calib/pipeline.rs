@@ -82,6 +82,9 @@ pub struct CalibrationOptions {
     /// The verdict's practical tolerance, relative to the empirical WV (default
     /// [`DEFAULT_TOLERANCE`], 10%): a scale is explained inside the band or within it.
     pub tolerance: f64,
+    /// Apply `gyro_unit`/`accel_unit` to a ROS recording too (SI by definition, refused
+    /// otherwise: [`CalibError::UnitOnRos`]).
+    pub force_units: bool,
 }
 
 impl Default for CalibrationOptions {
@@ -101,6 +104,7 @@ impl Default for CalibrationOptions {
             robust_check: Some(RobustOptions::default()),
             stream_from: crate::calib::STREAM_FROM,
             tolerance: DEFAULT_TOLERANCE,
+            force_units: false,
         }
     }
 }
@@ -124,6 +128,15 @@ pub enum CalibError {
         unit: String,
         /// What the column measures.
         expected: &'static str,
+    },
+    /// A unit flag given for a ROS recording, whose `sensor_msgs/Imu` messages are SI by
+    /// definition (REP 103), without `force_units`.
+    #[error("{flag} {unit} on a ROS recording: sensor_msgs/Imu is in rad/s and m/s^2 by definition (REP 103), so the flag would rescale correct data; drop it, or add --force-units if the publisher broke the convention")]
+    UnitOnRos {
+        /// The flag (`--gyro-unit`, `--accel-unit`).
+        flag: &'static str,
+        /// The unit given.
+        unit: String,
     },
     /// Selecting or fitting one axis failed.
     #[error("column {column}: {source}")]
@@ -394,6 +407,54 @@ impl Calibration {
         )
     }
 
+    /// A static accelerometer measures gravity: the magnitude of its axes' means, under the
+    /// unit in force, should be near 1 g. Far from it (outside 0.5 g to 1.5 g with every axis of
+    /// the triad present) the unit is probably wrong; the check line names the unit under which
+    /// the magnitude would be 1 g. Only in-memory series are checked (a streamed recording
+    /// keeps no mean); the unit read or given is kept.
+    fn gravity_check(&self, axes: &[InputAxis<'_>]) -> Option<String> {
+        const G: f64 = 9.80665;
+        let mut sum_sq = 0.0;
+        let mut count = 0;
+        let mut chosen = None;
+        for a in axes
+            .iter()
+            .filter(|a| a.info.sensor == Sensor::Accelerometer)
+        {
+            let AxisData::Series(x) = &a.data else {
+                return None;
+            };
+            let unit = self
+                .options
+                .accel_unit
+                .or_else(|| a.info.unit.as_deref().and_then(|u| u.parse().ok()))?;
+            if chosen.is_some_and(|c| c != unit) {
+                return None;
+            }
+            chosen = Some(unit);
+            let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+            sum_sq += (mean * unit.to_si()).powi(2);
+            count += 1;
+        }
+        let unit: SignalUnit = chosen?;
+        let magnitude = sum_sq.sqrt();
+        if count < 3 || (0.5 * G..=1.5 * G).contains(&magnitude) {
+            return None;
+        }
+        let raw = magnitude / unit.to_si();
+        let likely = ["m/s^2", "g", "mg"]
+            .iter()
+            .filter_map(|u| u.parse::<SignalUnit>().ok())
+            .find(|u| (0.5 * G..=1.5 * G).contains(&(raw * u.to_si())));
+        Some(format!(
+            "the accelerometer's mean reads {} {} ({:.3} g) in magnitude, where a static sensor reads 1 g{}: check --accel-unit",
+            crate::fit::report::significant(raw, 4),
+            unit.symbol(),
+            magnitude / G,
+            likely.map_or_else(String::new, |u| format!("; the data look like {}", u.symbol()))
+        ))
+    }
+
     /// The pipeline on the inertial axes among `axes` of a recording of `samples` samples per
     /// axis at `freq_hz`; `checks` are recording-level lines of the caller.
     pub(crate) fn run_axes(
@@ -419,6 +480,7 @@ impl Calibration {
                 column: axes[0].column.to_string(),
                 source: Box::new(source),
             })?;
+        checks.extend(self.gravity_check(&axes));
         progress.start(axes.len() * per_axis);
         let done = AtomicUsize::new(0);
         let shared = |_: usize| progress.advance(done.fetch_add(1, Ordering::Relaxed) + 1);
@@ -503,7 +565,18 @@ impl Calibration {
             None => None,
         };
         let unit = match (given, recorded) {
-            (Some(u), _) => Some(u),
+            (Some(u), Some(text)) => {
+                if text.parse::<SignalUnit>().ok() != Some(u) {
+                    // the unit itself, without the sidecar's comment
+                    let recorded = text.split(" (").next().unwrap_or(text).trim();
+                    notes.push(format!(
+                        "the unit flag ({}) overrides the recording's unit ({recorded}): check which is right",
+                        u.symbol()
+                    ));
+                }
+                Some(u)
+            }
+            (Some(u), None) => Some(u),
             (None, Some(text)) => match text.parse::<SignalUnit>() {
                 Ok(u) => Some(u),
                 Err(_) => {

@@ -342,8 +342,22 @@ impl Calibration {
     /// is for ROS recordings: with another file the in-memory reader refuses it.
     ///
     /// # Errors
-    /// The readers' errors naming the file ([`CalibError::Read`](crate::calib::CalibError::Read)).
+    /// The readers' errors naming the file ([`CalibError::Read`](crate::calib::CalibError::Read));
+    /// [`CalibError::UnitOnRos`](crate::calib::CalibError::UnitOnRos) for a unit flag on a ROS
+    /// recording without `force_units`.
     pub fn open(&self, probe: &Probe, opts: &RecordingOptions) -> Result<CalibrationSource, Error> {
+        if probe.is_ros() && !self.options().force_units {
+            let given = [
+                ("--gyro-unit", self.options().gyro_unit),
+                ("--accel-unit", self.options().accel_unit),
+            ];
+            if let Some((flag, Some(u))) = given.into_iter().find(|(_, u)| u.is_some()) {
+                return Err(Error::UnitOnRos {
+                    flag,
+                    unit: u.symbol().to_string(),
+                });
+            }
+        }
         let streamed =
             (opts.topic.is_none() || probe.is_ros()) && self.streams(probe, &opts.read)?;
         Ok(if streamed && streamed_size(probe, &opts.read)?.is_some() {
