@@ -35,11 +35,6 @@ pub const DEFAULT_FULL_MODEL: &str = "3*AR1()+WN()+QN()+RW()+DR()";
 /// truncation error near `1e-10` and the rounding error near `1e-11` of the gradient.
 const DELTA_STEP: f64 = 1e-5;
 
-/// Largest relative miss of the band that the verdict still puts down to chance when no more
-/// than `alpha` of the scales are outside (10%: beyond it one scale misses by more than the
-/// WV's own precision at the scales a filter integrates over).
-pub(crate) const CHANCE_MISS_REL: f64 = 0.1;
-
 /// Relative standard error above which a read-off is reported without an interval, as not
 /// determined by the data: beyond it the log-scale interval spans more than a factor e^(2 z)
 /// (50 at 95%), which says nothing a filter could use, and `--conservative` would export noise.
@@ -795,11 +790,25 @@ impl Calibration {
                     None => FitUses::Classical,
                 };
                 let robust = robust.as_ref().map(|r| r.as_ref().map(|p| p.wv()));
-                return compared(classical.wv(), robust, uses, alpha, notes);
+                return compared(
+                    classical.wv(),
+                    robust,
+                    uses,
+                    alpha,
+                    self.options.tolerance,
+                    notes,
+                );
             }
             AxisData::Streamed { robust, .. } => {
                 let robust = robust.as_ref().map(|r| r.as_ref().map(|w| &**w));
-                return compared(wv, robust, FitUses::Classical, alpha, notes);
+                return compared(
+                    wv,
+                    robust,
+                    FitUses::Classical,
+                    alpha,
+                    self.options.tolerance,
+                    notes,
+                );
             }
         };
         let other = WvOptions {
@@ -812,8 +821,20 @@ impl Calibration {
         };
         match wavelet_variance(x, freq_hz, &other) {
             Ok(w) => Some(match wv.robust {
-                Some(_) => compare_classical_robust(w, wv.clone(), FitUses::Robust, alpha),
-                None => compare_classical_robust(wv.clone(), w, FitUses::Classical, alpha),
+                Some(_) => compare_classical_robust(
+                    w,
+                    wv.clone(),
+                    FitUses::Robust,
+                    alpha,
+                    self.options.tolerance,
+                ),
+                None => compare_classical_robust(
+                    wv.clone(),
+                    w,
+                    FitUses::Classical,
+                    alpha,
+                    self.options.tolerance,
+                ),
             }),
             Err(e) => {
                 notes.push(format!(
@@ -832,6 +853,7 @@ fn compared(
     robust: Option<Result<&WaveletVariance, &String>>,
     uses: FitUses,
     alpha: f64,
+    tolerance: f64,
     notes: &mut Vec<String>,
 ) -> Option<Contamination> {
     match robust? {
@@ -840,6 +862,7 @@ fn compared(
             r.clone(),
             uses,
             alpha,
+            tolerance,
         )),
         Err(e) => {
             notes.push(format!(

@@ -31,7 +31,7 @@ fn contamination_clean_gaussian_data_does_not_matter() {
     for seed in 1..=5 {
         let x = white_noise(1 << 16, seed);
         let (c, r) = pair(&x);
-        let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
+        let check = compare_classical_robust(c, r, FitUses::Classical, 0.05, 0.1);
         assert!(!check.matters, "seed {seed}: {}", check.summary);
         assert!(check.max_ratio < 1.1, "seed {seed}: {}", check.max_ratio);
         assert!(
@@ -50,7 +50,7 @@ fn contamination_outliers_inflate_the_first_scales() {
         x[k] += 0.3 * if k % 1000 == 0 { 1.0 } else { -1.0 };
     }
     let (c, r) = pair(&x);
-    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05, 0.1);
     assert!(check.matters, "{}", check.summary);
     assert!(check.levels_above.contains(&1), "{:?}", check.levels_above);
     // the spikes add 0.002 * 0.09 / 2 = 9e-5 to the level-1 WV of 5e-5: a factor near 2.8
@@ -72,7 +72,7 @@ fn contamination_undefined_robust_level_is_named_not_compared() {
         }
     });
     let levels = c.wv().len();
-    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05, 0.1);
     assert_eq!(check.undefined_levels, vec![3]);
     assert_eq!(check.levels, levels - 1);
     assert!(
@@ -86,7 +86,7 @@ fn contamination_undefined_robust_level_is_named_not_compared() {
 fn contamination_real_contaminated_recording_is_flagged() {
     let x = crate::tests::common::read_column("cont_imu1", "gyro_x");
     let (c, r) = pair(&x);
-    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05, 0.1);
     assert!(check.matters, "{}", check.summary);
     assert!(!check.levels_above.is_empty());
 }
@@ -95,7 +95,7 @@ fn contamination_real_contaminated_recording_is_flagged() {
 fn contamination_advice_follows_the_estimator_the_fit_used() {
     let x = crate::tests::common::read_column("cont_imu1", "gyro_x");
     let (c, r) = pair(&x);
-    let check = compare_classical_robust(c, r, FitUses::Robust, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Robust, 0.05, 0.1);
     assert!(check.matters, "{}", check.summary);
     assert!(
         check.summary.contains("the robust fit used here"),
@@ -111,7 +111,7 @@ fn contamination_nothing_to_compare_says_so() {
     let (c, r) = pair(&x);
     let undefined = vec![serde_json::Value::Null; r.levels()];
     let r = crate::tests::common::edited_wv(&r, |doc| doc["wv"] = serde_json::json!(undefined));
-    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05);
+    let check = compare_classical_robust(c, r, FitUses::Classical, 0.05, 0.1);
     assert_eq!(check.levels, 0);
     assert!(!check.matters);
     assert!(

@@ -121,9 +121,10 @@ fn ieee_pure_power_laws_come_back_exactly() {
                 assert!(r.note.as_ref().unwrap().contains("no value"));
             }
         }
-        // no floor: B is only bounded
-        assert!(ro.b.value.is_none(), "{ro}");
-        assert!(ro.b.ci_high.is_some());
+        // no floor: B is the bound min ADEV / 0.664, given as the value without a lower end
+        assert!(ro.b.value.is_some() && ro.b.value == ro.b.ci_high, "{ro}");
+        assert!(ro.b.ci_low.is_none(), "{ro}");
+        assert!(ro.b.note.as_ref().unwrap().contains("upper bound"), "{ro}");
     }
     let ro = ieee_readoff(&closed_form(wn(1e-4))).unwrap();
     assert_eq!(ro.n.at_tau_s, 1.0);
@@ -215,8 +216,13 @@ fn ieee_refuses_other_variances_and_survives_bad_values() {
         _ => [None, Some(0.0), Some(-1.0)][k % 3],
     });
     let ro = ieee_readoff(&av).unwrap();
-    for (_, _, r) in ro.rows() {
-        assert!(r.value.is_none(), "{ro}");
+    for (sym, _, r) in ro.rows() {
+        if sym == "B" {
+            // one scale: no floor can be seen, B is only the bound there
+            assert!(r.ci_low.is_none() && r.value == r.ci_high, "{ro}");
+        } else {
+            assert!(r.value.is_none(), "{ro}");
+        }
     }
     let text = ro.to_string();
     assert!(
