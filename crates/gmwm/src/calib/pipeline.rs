@@ -647,6 +647,28 @@ impl Calibration {
             })
         })?;
         let (fit, inference, canonical) = self.identify(&selection).map_err(|e| errors.fit(e))?;
+        let verdict = verdict(
+            &fit,
+            &wv,
+            &inference,
+            self.options.wv.alpha,
+            self.options.tolerance,
+        );
+        // at most two refinements: a term for the worst miss, then one for the next
+        let mut current = (
+            selection.selected.to_string(),
+            fit,
+            inference,
+            canonical,
+            verdict,
+        );
+        for _ in 0..2 {
+            match self.refine(&selection, &current.1, &wv, &current.4, freq_hz, &mut notes) {
+                Some(r) => current = r,
+                None => break,
+            }
+        }
+        let (model, fit, inference, canonical, verdict) = current;
         let allan =
             allan_of(&data, freq_hz, self.options.wv.alpha).map_err(|e| errors.engine(e))?;
         let ieee = ieee_readoff(&allan).map_err(|e| errors.engine(e.into()))?;
@@ -659,13 +681,6 @@ impl Calibration {
             freq_hz,
         );
         let read = readoff.read(&allan, &ieee, &mut notes);
-        let verdict = verdict(
-            &fit,
-            &wv,
-            &inference,
-            self.options.wv.alpha,
-            self.options.tolerance,
-        );
         notes.extend(readings(&selection, &canonical));
         let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
         Ok(AxisCalibration {
@@ -677,7 +692,7 @@ impl Calibration {
                 .or_else(|| recorded_unit.map(str::to_string)),
             unit: unit_label,
             samples,
-            model: selection.selected.to_string(),
+            model,
             canonical_model: canonical.model.to_string(),
             identified_model: fit.model.without_values().to_string(),
             noise_density: read.noise_density,
@@ -733,6 +748,81 @@ impl Calibration {
             },
         }
         .map_err(|source| errors.selection(source))
+    }
+
+    /// Guided by the WV's shape (issue 28): when the verdict misses, the term its likely cause
+    /// names is added to the identified model and fitted on the same WV, starting from the
+    /// miss: a hump at `tau` samples or a flat start is a sinusoid whose WV peaks there
+    /// (`SIN(omega = 0.742 / tau)`, `process/sin.rs`), a floor a flicker term (`FN()`), the
+    /// longest scales above the model a random walk (`RW()`, when the model may take one). The
+    /// refined model is kept when it explains more scales and lowers the objective; its
+    /// inference uses the selection's V (the WV's covariance, not the model's). Returns the
+    /// model text, fit, inference, canonical model and verdict; `None` to keep the selection's.
+    #[allow(clippy::type_complexity)]
+    fn refine(
+        &self,
+        selection: &ModelSelection,
+        base: &GmwmFit,
+        wv: &WaveletVariance,
+        verdict: &FitVerdict,
+        freq_hz: f64,
+        notes: &mut Vec<String>,
+    ) -> Option<(String, GmwmFit, Inference, CanonicalModel, FitVerdict)> {
+        let worst = verdict.worst.as_ref()?;
+        let tau_samples = worst.tau_s * freq_hz;
+        let term = match worst.cause {
+            "hump" | "sensor filter" => format!("SIN(omega={})", (0.742 / tau_samples).min(0.45)),
+            "floor" => "FN()".to_string(),
+            // the longest scales above the model: a random walk the model lacks
+            "long scales" if worst.deviation < 0.0 => "RW()".to_string(),
+            _ => return None,
+        };
+        let text = format!("{}+{term}", base.model.without_values());
+        let model: Model = text.parse().ok()?;
+        let mut g = Gmwm::new(model).with_seed(self.options.seed);
+        if let Some(d) = self.options.draws {
+            g = g.with_draws(d);
+        }
+        let base_objective = base.objective;
+        let fit = g.update(&selection.fit).ok()?;
+        let inference = infer_with_covariance(
+            &Gmwm::new(fit.model.clone()),
+            &fit,
+            &selection.wv_covariance,
+            selection.v_replicates(),
+            &self.options.wv,
+            &InferenceOptions {
+                alpha: self.options.wv.alpha,
+                seed: self.options.seed,
+                ..InferenceOptions::default()
+            },
+        )
+        .ok()?;
+        let canonical = fit.canonical_with(selection.separation_limit).ok()?;
+        let refined = super::verdict::verdict(
+            &fit,
+            wv,
+            &inference,
+            self.options.wv.alpha,
+            self.options.tolerance,
+        );
+        if refined.scales_missed >= verdict.scales_missed || fit.objective >= base_objective {
+            return None;
+        }
+        let sig = |x: f64| crate::fit::report::significant(x, 3);
+        notes.push(format!(
+            "guided by the WV's shape: the selected model missed {} of {} scales (worst {:.0}% at {} s, likely {}); with {term} added it misses {} (objective {} -> {}); the WIC table ranks the selection's candidates, not this refinement",
+            verdict.scales_missed,
+            verdict.levels,
+            100.0 * worst.deviation.abs(),
+            sig(worst.tau_s),
+            worst.cause,
+            refined.scales_missed,
+            sig(base_objective),
+            sig(fit.objective),
+        ));
+        let model = fit.model.without_values().to_string();
+        Some((model, fit, inference, canonical, refined))
     }
 
     /// The identified fit (the canonical model's reduced model, fitted: a candidate of the
