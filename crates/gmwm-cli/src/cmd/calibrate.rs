@@ -609,6 +609,21 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
     if let Some(r) = &a.rate_ramp {
         writeln!(out, "  {:<18}{}", "rate ramp", estimate_line(r))?;
     }
+    // a periodic (vibration) term: its frequency and amplitude, as the canonical model reads them
+    for t in &a.canonical.terms {
+        let value = |name: &str| t.physical.iter().find(|p| p.name == name).map(|p| p.value);
+        if let (Some(f), Some(amp)) = (value("frequency"), value("amplitude")) {
+            writeln!(
+                out,
+                "  {:<18}{} Hz, amplitude {} {} ({} term)",
+                "vibration",
+                num(f),
+                num(amp),
+                a.unit,
+                t.process.split('(').next().unwrap_or_default()
+            )?;
+        }
+    }
     let ieee: Vec<String> = a
         .ieee
         .rows()
