@@ -255,20 +255,20 @@ pub(super) fn component_label(fit: &GmwmFit, index: usize, unit: &str) -> String
         .into_iter()
         .filter(|p| p.index == index && p.name != "driving_noise_density")
         .filter_map(|p| {
-            let (symbol, term) = match p.name {
-                "white_noise_density" => ("N", NoiseTerm::NoiseDensity),
-                "quantization_coefficient" => ("Q", NoiseTerm::Quantization),
-                "rate_random_walk_density" => ("K", NoiseTerm::RandomWalk),
-                "drift_rate" => ("R", NoiseTerm::RateRamp),
-                "correlation_time" => ("T", NoiseTerm::GmCorrelationTime),
-                "gm_std" => ("σ", NoiseTerm::GmSigma),
+            let (symbol, unit) = match p.name {
+                "white_noise_density" => ("N", term_unit(NoiseTerm::NoiseDensity, unit)),
+                "quantization_coefficient" => ("Q", term_unit(NoiseTerm::Quantization, unit)),
+                "rate_random_walk_density" => ("K", term_unit(NoiseTerm::RandomWalk, unit)),
+                "drift_rate" => ("R", term_unit(NoiseTerm::RateRamp, unit)),
+                "correlation_time" => ("T", term_unit(NoiseTerm::GmCorrelationTime, unit)),
+                "gm_std" => ("σ", term_unit(NoiseTerm::GmSigma, unit)),
+                "bias_instability" => ("B", term_unit(NoiseTerm::BiasInstability, unit)),
+                // a periodic (vibration) term: its line and its amplitude
+                "frequency" => ("f", "Hz".to_string()),
+                "amplitude" => ("A", unit.to_string()),
                 _ => return None,
             };
-            Some(format!(
-                "{symbol} = {} {}",
-                number(p.value),
-                term_unit(term, unit)
-            ))
+            Some(format!("{symbol} = {} {unit}", number(p.value)))
         })
         .collect();
     if values.is_empty() {
