@@ -171,6 +171,16 @@ def test_calibrate_arrays_with_units(imu):
     assert cal.axis("gyro_x")["noise_density"]["unit"] == "rad/s/√Hz"
 
 
+def test_calibrate_tolerance_reaches_the_verdict(imu):
+    names = ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]
+    cal = gmwm.calibrate(imu, freq=100, names=names, model="WN()", bootstrap=10, G=200, tolerance=0.5)
+    verdict = cal.axis("gyro_x")["verdict"]
+    assert verdict["tolerance"] == 0.5
+    assert all(s["explained"] == (s["inside_band"] or abs(s["deviation"]) <= 0.5) for s in verdict["scales"])
+    with pytest.raises(ValueError, match="tolerance"):
+        gmwm.calibrate(imu, freq=100, names=names, model="WN()", tolerance=2.0)
+
+
 def test_progress_is_called_and_the_gil_is_released(imu):
     import threading
 

@@ -238,8 +238,9 @@ def calibrate(
     identified fit with intervals, N/B/K in SI and datasheet units, the IEEE 952 read-off, the
     verdict, the contamination check, the navigation sets): ``gyro_unit``, ``accel_unit``,
     ``model``, ``rule``, ``bootstrap``, ``covariance``, ``G``, ``seed``, ``eff``, ``robust``, ``alpha``,
-    ``axis_policy``, ``inflate``, ``conservative``, ``rostopic``; for a path also the read
-    options (``columns``, ``format``, ``topic``, ...)."""
+    ``axis_policy``, ``inflate``, ``conservative``, ``rostopic``, ``tolerance`` (the verdict's,
+    0.1), ``force_units`` (unit flags on a ROS recording); for a path also the read options
+    (``columns``, ``format``, ``topic``, ...)."""
     if _is_path(data):
         doc = _native.calibrate(path=os.fspath(data), freq=freq, draws=G, progress=progress, **options)
     else:
