@@ -779,26 +779,9 @@ impl Calibration {
         };
         let text = format!("{}+{term}", base.model.without_values());
         let model: Model = text.parse().ok()?;
-        let mut g = Gmwm::new(model).with_seed(self.options.seed);
-        if let Some(d) = self.options.draws {
-            g = g.with_draws(d);
-        }
         let base_objective = base.objective;
-        let fit = g.update(&selection.fit).ok()?;
-        let inference = infer_with_covariance(
-            &Gmwm::new(fit.model.clone()),
-            &fit,
-            &selection.wv_covariance,
-            selection.v_replicates(),
-            &self.options.wv,
-            &InferenceOptions {
-                alpha: self.options.wv.alpha,
-                seed: self.options.seed,
-                ..InferenceOptions::default()
-            },
-        )
-        .ok()?;
-        let canonical = fit.canonical_with(selection.separation_limit).ok()?;
+        let fit = self.refit(model, selection).ok()?;
+        let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
         let refined = super::verdict::verdict(
             &fit,
             wv,
@@ -835,18 +818,31 @@ impl Calibration {
         let reduced = &selection.selected_canonical.reduced;
         let fit = match selection.candidate_fit(reduced) {
             Some(f) => f.clone(),
-            None => {
-                let mut g = Gmwm::new(reduced.clone()).with_seed(self.options.seed);
-                if let Some(d) = self.options.draws {
-                    g = g.with_draws(d);
-                }
-                g.update(&selection.fit)?
-            }
+            None => self.refit(reduced.clone(), selection)?,
         };
-        let gmwm = Gmwm::new(fit.model.clone());
+        let (inference, canonical) = self.infer_on(selection, &fit)?;
+        Ok((fit, inference, canonical))
+    }
+
+    /// `model` fitted on the selection's WV, with the options' seed and draws.
+    fn refit(&self, model: Model, selection: &ModelSelection) -> Result<GmwmFit, FitError> {
+        let mut g = Gmwm::new(model).with_seed(self.options.seed);
+        if let Some(d) = self.options.draws {
+            g = g.with_draws(d);
+        }
+        g.update(&selection.fit)
+    }
+
+    /// The inference of `fit` on the selection's V (the WV's covariance, whatever the model)
+    /// and its canonical model.
+    fn infer_on(
+        &self,
+        selection: &ModelSelection,
+        fit: &GmwmFit,
+    ) -> Result<(Inference, CanonicalModel), FitError> {
         let inference = infer_with_covariance(
-            &gmwm,
-            &fit,
+            &Gmwm::new(fit.model.clone()),
+            fit,
             &selection.wv_covariance,
             selection.v_replicates(),
             &self.options.wv,
@@ -857,7 +853,7 @@ impl Calibration {
             },
         )?;
         let canonical = fit.canonical_with(selection.separation_limit)?;
-        Ok((fit, inference, canonical))
+        Ok((inference, canonical))
     }
 
     /// The classical WV of the axis against the robust one ([`compare_classical_robust`]);
