@@ -288,13 +288,7 @@ fn calibration_bounds_an_undetected_random_walk() {
     assert_eq!(k.ci_high, Some(k.value));
     assert_eq!(k.ci_low, None);
     // the bound is the tightest sqrt(3 AV_high(tau) / tau) of the axis's Allan variance
-    let tightest = a
-        .allan
-        .ci_high()
-        .iter()
-        .zip(a.allan.tau_s())
-        .map(|(h, t)| (3.0 * h / t).sqrt())
-        .fold(f64::INFINITY, f64::min);
+    let tightest = tightest_random_walk_bound(a);
     assert!((k.value / tightest - 1.0).abs() < 1e-12);
     assert!(a
         .notes
@@ -604,16 +598,21 @@ fn a_gauss_markov_term_does_not_export_a_random_walk() {
     assert!(a.canonical_model.contains("AR1"), "{}", a.canonical_model);
     let k = a.random_walk.as_ref().expect("a bound");
     assert_eq!(k.status, gmwm::calib::EstimateStatus::UpperBound);
-    let tightest = a
-        .allan
-        .ci_high()
-        .iter()
-        .zip(a.allan.tau_s())
-        .map(|(h, t)| (3.0 * h / t).sqrt())
-        .fold(f64::INFINITY, f64::min);
+    let tightest = tightest_random_walk_bound(&a);
     assert!(
         k.value <= tightest * (1.0 + 1e-12),
         "{} > {tightest}",
         k.value
     );
+}
+
+/// The tightest `sqrt(3 AV_high(tau) / tau)` of an axis's Allan variance: a random walk adds
+/// `K^2 tau / 3` to it (docs/methods.md §14.2).
+fn tightest_random_walk_bound(a: &gmwm::calib::AxisCalibration) -> f64 {
+    a.allan
+        .ci_high()
+        .iter()
+        .zip(a.allan.tau_s())
+        .map(|(h, t)| (3.0 * h / t).sqrt())
+        .fold(f64::INFINITY, f64::min)
 }
