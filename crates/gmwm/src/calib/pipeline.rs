@@ -769,29 +769,53 @@ impl Calibration {
         notes: &mut Vec<String>,
     ) -> Option<(String, GmwmFit, Inference, CanonicalModel, FitVerdict)> {
         let worst = verdict.worst.as_ref()?;
-        let tau_samples = worst.tau_s * freq_hz;
-        let term = match worst.cause {
-            "hump" | "sensor filter" => format!("SIN(omega={})", (0.742 / tau_samples).min(0.45)),
-            "floor" => "FN()".to_string(),
-            // the longest scales above the model: a random walk the model lacks
-            "long scales" if worst.deviation < 0.0 => "RW()".to_string(),
-            _ => return None,
-        };
-        let text = format!("{}+{term}", base.model.without_values());
-        let model: Model = text.parse().ok()?;
+        let terms = refinement_terms(base, verdict, freq_hz, self.options.tolerance);
         let base_objective = base.objective;
-        let fit = self.refit(model, selection).ok()?;
-        let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
-        let refined = super::verdict::verdict(
-            &fit,
-            wv,
-            &inference,
-            self.options.wv.alpha,
-            self.options.tolerance,
-        );
-        if refined.scales_missed >= verdict.scales_missed || fit.objective >= base_objective {
-            return None;
-        }
+        // each candidate term fitted on the same WV; the one that explains the most scales,
+        // then the lowest objective, if it explains more than the base and lowers the objective
+        let (term, fit, inference, canonical, refined) = terms
+            .into_iter()
+            .filter_map(|term| {
+                let text = format!("{}+{term}", base.model.without_values());
+                let model: Model = text.parse().ok()?;
+                let fit = self.refit(model, selection).ok()?;
+                let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
+                let refined = super::verdict::verdict(
+                    &fit,
+                    wv,
+                    &inference,
+                    self.options.wv.alpha,
+                    self.options.tolerance,
+                );
+                (refined.scales_missed < verdict.scales_missed && fit.objective < base_objective)
+                    .then_some((term, fit, inference, canonical, refined))
+            })
+            .min_by(|a, b| {
+                (a.4.scales_missed, a.1.objective)
+                    .partial_cmp(&(b.4.scales_missed, b.1.objective))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })?;
+        // the refined fit's canonical model fitted as such (as `identify` does for the
+        // selection), so that every reported term has estimates and intervals, when it
+        // explains as many scales
+        let reduced = &canonical.reduced;
+        let identified = (reduced.without_values().to_string()
+            != fit.model.without_values().to_string())
+        .then(|| {
+            let fit = self.refit(reduced.clone(), selection).ok()?;
+            let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
+            let v = super::verdict::verdict(
+                &fit,
+                wv,
+                &inference,
+                self.options.wv.alpha,
+                self.options.tolerance,
+            );
+            (v.scales_missed <= refined.scales_missed).then_some((fit, inference, canonical, v))
+        })
+        .flatten();
+        let (fit, inference, canonical, refined) =
+            identified.unwrap_or((fit, inference, canonical, refined));
         let sig = |x: f64| crate::fit::report::significant(x, 3);
         notes.push(format!(
             "guided by the WV's shape: the selected model missed {} of {} scales (worst {:.0}% at {} s, likely {}); with {term} added it misses {} (objective {} -> {}); the WIC table ranks the selection's candidates, not this refinement",
@@ -1564,4 +1588,47 @@ fn random_walk_upper_bound(av: &AllanVariance) -> Option<(f64, f64)> {
         .map(|(&hi, &tau)| ((3.0 * hi / tau).sqrt(), tau))
         .filter(|(k, _)| k.is_finite() && *k > 0.0)
         .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// The terms refinement tries for `base`'s missed scales (at most three, the most deviant
+/// miss first): a vibration line `SIN()` at a hump, at the first scales or at the dip beside an
+/// overshoot (its WV peaks at `tau ~ 0.742 / omega` samples), a flicker `FN()` for a floor, a
+/// `RW()` for the longest scales above the model. A kind the model already has once is
+/// refused by the model's parser, so its candidate drops out.
+fn refinement_terms(
+    base: &GmwmFit,
+    verdict: &FitVerdict,
+    freq_hz: f64,
+    tolerance: f64,
+) -> Vec<String> {
+    let scales = &verdict.scales;
+    let sin_at = |tau_s: f64| format!("SIN(omega={})", (0.742 / (tau_s * freq_hz)).min(0.45));
+    let mut terms: Vec<String> = Vec::new();
+    for miss in super::verdict::misses(base, verdict) {
+        let term = match miss.cause {
+            "hump" | "sensor filter" => Some(sin_at(miss.tau_s)),
+            "floor" => Some("FN()".to_string()),
+            "long scales" if miss.deviation < 0.0 => Some("RW()".to_string()),
+            "overshoot" => {
+                // a sharper hump than the model's correlated term: the dip within two octaves
+                let j = scales.iter().position(|s| s.tau_s == miss.tau_s);
+                j.and_then(|j| {
+                    (j.saturating_sub(2)..(j + 3).min(scales.len().saturating_sub(2)))
+                        .filter(|&k| scales[k].deviation < -0.5 * tolerance)
+                        .min_by(|&a, &b| scales[a].deviation.total_cmp(&scales[b].deviation))
+                        .map(|k| sin_at(scales[k].tau_s))
+                })
+            }
+            _ => None,
+        };
+        if let Some(t) = term {
+            if !terms.contains(&t) {
+                terms.push(t);
+            }
+        }
+        if terms.len() == 3 {
+            break;
+        }
+    }
+    terms
 }

@@ -146,6 +146,25 @@ pub(crate) fn verdict(
     }
 }
 
+/// Every missed scale of `verdict` with its dominant term and likely cause, the most deviant
+/// first: what refinement may add a term for.
+pub(crate) fn misses(fit: &GmwmFit, verdict: &FitVerdict) -> Vec<ScaleMiss> {
+    let scales = &verdict.scales;
+    let mut missed: Vec<usize> = (0..scales.len())
+        .filter(|&j| !scales[j].explained)
+        .collect();
+    missed.sort_by(|&a, &b| {
+        scales[b]
+            .deviation
+            .abs()
+            .total_cmp(&scales[a].deviation.abs())
+    });
+    missed
+        .into_iter()
+        .map(|j| miss_at(fit, scales, j))
+        .collect()
+}
+
 /// The missed scale `j`: the dominant term and the likely cause, read from where the scale
 /// lies and the shape of the empirical WV around it.
 fn miss_at(fit: &GmwmFit, scales: &[ScaleFit], j: usize) -> ScaleMiss {
