@@ -776,7 +776,13 @@ impl Calibration {
         let (term, fit, inference, canonical, refined) = terms
             .into_iter()
             .filter_map(|term| {
-                let text = format!("{}+{term}", base.model.without_values());
+                let base_text = base.model.without_values().to_string();
+                // the filter takes the white noise's place (both are white beyond the filter)
+                let kept: Vec<&str> = base_text
+                    .split('+')
+                    .filter(|c| !(term.starts_with("MAF") && *c == "WN()"))
+                    .collect();
+                let text = format!("{}+{term}", kept.join("+"));
                 let model: Model = text.parse().ok()?;
                 let fit = self.refit(model, selection).ok()?;
                 let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
@@ -1590,10 +1596,12 @@ fn random_walk_upper_bound(av: &AllanVariance) -> Option<(f64, f64)> {
         .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
-/// The terms refinement tries for `base`'s missed scales (at most three, the most deviant
-/// miss first): a vibration line `SIN()` at a hump, at the first scales or at the dip beside an
-/// overshoot (its WV peaks at `tau ~ 0.742 / omega` samples), a flicker `FN()` for a floor, a
-/// `RW()` for the longest scales above the model. A kind the model already has once is
+/// The terms refinement tries for `base`'s missed scales (at most three for the most deviant
+/// misses, then the filter): a vibration line `SIN()` at a hump, at the first scales or at the
+/// dip beside an overshoot (its WV peaks at `tau ~ 0.742 / omega` samples), a flicker `FN()`
+/// for a floor, a `RW()` for the longest scales above the model; and the sensor's
+/// moving-average filter `MAF(2)`, `MAF(4)` when the first scales fall slower than white
+/// noise's. A kind the model already has once is
 /// refused by the model's parser, so its candidate drops out.
 fn refinement_terms(
     base: &GmwmFit,
@@ -1606,7 +1614,9 @@ fn refinement_terms(
     let mut terms: Vec<String> = Vec::new();
     for miss in super::verdict::misses(base, verdict) {
         let term = match miss.cause {
-            "hump" | "sensor filter" => Some(sin_at(miss.tau_s)),
+            "hump" => Some(sin_at(miss.tau_s)),
+            // a vibration line near the Nyquist end (the filter is tried below)
+            "sensor filter" => Some(sin_at(miss.tau_s)),
             "floor" => Some("FN()".to_string()),
             "long scales" if miss.deviation < 0.0 => Some("RW()".to_string()),
             "overshoot" => {
@@ -1630,5 +1640,14 @@ fn refinement_terms(
             break;
         }
     }
+    // first scales below white noise's halving (nu2_1 / nu2_2 = 2): the sensor's own filter
+    // may shape them, whatever the worst miss
+    if scales.len() >= 2 && scales[0].empirical < FILTERED_FIRST_RATIO * scales[1].empirical {
+        terms.extend(["MAF(2)".to_string(), "MAF(4)".to_string()]);
+    }
     terms
 }
+
+/// `nu2_1 / nu2_2` below which the first scales look filtered (white noise gives 2; a
+/// 2-sample moving average 0.8).
+const FILTERED_FIRST_RATIO: f64 = 1.9;

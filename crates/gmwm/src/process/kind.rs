@@ -138,6 +138,8 @@ impl ProcessKind {
         match *self {
             ProcessKind::Ar(p) => (p, 0),
             ProcessKind::Ma(q) => (0, q),
+            // the filter length, written as an MA order (a boxcar of L samples is an MA(L - 1))
+            ProcessKind::Maf(l) => (0, l),
             ProcessKind::Arma(p, q) => (p, q),
             other => match spec(other).params {
                 Params::Fixed(_, orders) => orders,

@@ -29,6 +29,7 @@ mod facts;
 pub(crate) mod flicker;
 mod kind;
 pub(crate) mod ma1;
+pub(crate) mod maf;
 mod param;
 pub(crate) mod qn;
 pub(crate) mod rw;
@@ -44,6 +45,7 @@ pub use arma11::Arma11;
 pub use dr::Dr;
 pub use flicker::Flicker;
 pub use ma1::Ma1;
+pub use maf::Maf;
 pub use qn::Qn;
 pub use rw::Rw;
 pub use sin::Sin;
@@ -66,7 +68,8 @@ use sampler::{Sampler, SimRng};
 /// A latent process with an implied Haar wavelet variance (docs/methods.md §4). Object safe.
 pub trait LatentProcess {
     /// Component name as in docs/methods.md §0.2: "WN", "QN", "RW", "DR", "AR1", "GM", "MA1",
-    /// "ARMA11", "ARMA"; "FN" (flicker, `flicker.rs`), "SIN" (vibration, `sin.rs`).
+    /// "ARMA11", "ARMA"; "FN" (flicker, `flicker.rs`), "SIN" (vibration, `sin.rs`), "MAF"
+    /// (the sensor's filter, `maf.rs`).
     fn name(&self) -> &'static str;
     /// Parameter names in docs/methods.md §0.2 order.
     fn param_names(&self) -> Vec<&'static str>;
@@ -217,6 +220,10 @@ processes! {
     /// d = 1/2 fractional integration).
     Fn => flicker::SPEC, process /// Flicker noise.
         Flicker(Flicker);
+    /// White noise through the sensor's `L`-sample moving-average filter, parameter `sigma2`
+    /// (its long-run variance: the white noise it is beyond the filter).
+    Maf(usize) = ProcessKind::Maf(4) => maf::SPEC, process /// The sensor's moving-average filter.
+        Maf(Maf);
     /// First-order autoregression, parameters `phi`, `sigma2`.
     Ar1 => ar1::AR1_SPEC, process /// First-order autoregression.
         Ar1(Ar1);
