@@ -17,6 +17,7 @@ mod flicker;
 mod fuzz_props;
 mod ieee;
 mod inference;
+mod maf;
 mod methods_reference;
 mod model;
 mod monitor;

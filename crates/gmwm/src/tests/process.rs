@@ -5,8 +5,8 @@
 use crate::tests::common::rel_diff;
 use gmwm::process::spectral::{spectral_wv, spectral_wv_level};
 use gmwm::process::{
-    autocovariance_wv, Ar1, Arma, Arma11, Dr, Flicker, Gm, LatentProcess, Ma1, Process, Qn, Rw,
-    Sin, Wn,
+    autocovariance_wv, Ar1, Arma, Arma11, Dr, Flicker, Gm, LatentProcess, Ma1, Maf, Process, Qn,
+    Rw, Sin, Wn,
 };
 use proptest::prelude::*;
 
@@ -469,6 +469,7 @@ fn with_param(p: &Process, k: usize, v: f64) -> Process {
         Process::Ma1(_) => Ma1::new(q[0], q[1]).unwrap().into(),
         Process::Arma11(_) => Arma11::new(q[0], q[1], q[2]).unwrap().into(),
         Process::Sin(_) => Sin::new(q[0], q[1]).unwrap().into(),
+        Process::Maf(m) => Maf::new(m.length(), q[0]).unwrap().into(),
         Process::Arma(a) => {
             let (p_, q_) = (a.ar().len(), a.ma().len());
             Arma::new(q[..p_].to_vec(), q[p_..p_ + q_].to_vec(), q[p_ + q_])

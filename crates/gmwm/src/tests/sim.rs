@@ -440,8 +440,9 @@ fn closed_form_wv(g: &Process, tau: f64) -> f64 {
                     - 2.0 * (theta + phi) * (1.0 + theta * phi) * k_term(phi, tau))
                 / (tau * tau * (1.0 - phi).powi(3) * (1.0 + phi))
         }
-        // GM is an AR1 at a rate, checked through models below
-        Process::Arma(_) | Process::Gm(_) | Process::Sin(_) => {
+        // GM is an AR1 at a rate, checked through models below; MAF against §4.1 in its module
+        // and by simulation in tests/maf.rs
+        Process::Arma(_) | Process::Gm(_) | Process::Sin(_) | Process::Maf(_) => {
             unreachable!("no closed form in §4.2")
         }
     }
