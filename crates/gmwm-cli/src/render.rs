@@ -61,20 +61,22 @@ impl CsvRows for AllanVariance {
     /// ([`gmwm::AllanKind::columns`]).
     fn header(&self) -> String {
         let (var, dev) = self.kind().columns();
-        format!("series,tau,tau_s,{var},{dev},ci_low,ci_high")
+        format!("series,tau,tau_s,{var},{dev},ci_low,ci_high,{dev}_ci_low,{dev}_ci_high")
     }
     fn write_rows(&self, name: &str, out: &mut dyn Write) -> std::io::Result<()> {
         for k in 0..self.avar().len() {
             writeln!(
                 out,
-                "{},{},{:e},{:e},{:e},{:e},{:e}",
+                "{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
                 csv_field(name),
                 self.tau()[k],
                 self.tau_s()[k],
                 self.avar()[k],
                 self.adev()[k],
                 self.ci_low()[k],
-                self.ci_high()[k]
+                self.ci_high()[k],
+                self.ci_low()[k].sqrt(),
+                self.ci_high()[k].sqrt()
             )?;
         }
         Ok(())

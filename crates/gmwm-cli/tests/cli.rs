@@ -77,8 +77,23 @@ fn avar_json_and_csv_have_the_documented_fields() {
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let s = &doc["series"][0];
     let len = s["tau"].as_array().unwrap().len();
-    for key in ["tau_s", "avar", "adev", "ci_low", "ci_high"] {
+    for key in [
+        "tau_s",
+        "avar",
+        "adev",
+        "ci_low",
+        "ci_high",
+        "adev_ci_low",
+        "adev_ci_high",
+    ] {
         assert_eq!(s[key].as_array().unwrap().len(), len, "{key}");
+    }
+    // the deviation's interval is the variance's, square-rooted
+    let at = |key: &str, j: usize| s[key][j].as_f64().unwrap();
+    for j in 0..len {
+        assert!((at("adev_ci_low", j) - at("ci_low", j).sqrt()).abs() <= 1e-15 * at("adev", j));
+        assert!((at("adev_ci_high", j) - at("ci_high", j).sqrt()).abs() <= 1e-15 * at("adev", j));
+        assert!(at("adev_ci_low", j) <= at("adev", j) && at("adev", j) <= at("adev_ci_high", j));
     }
     gmwm()
         .args(["avar", "--columns", "1", "--csv", "--kind", "modified"])
@@ -86,7 +101,7 @@ fn avar_json_and_csv_have_the_documented_fields() {
         .assert()
         .success()
         .stdout(predicate::str::starts_with(
-            "series,tau,tau_s,mavar,mdev,ci_low,ci_high\ngyro_x,",
+            "series,tau,tau_s,mavar,mdev,ci_low,ci_high,mdev_ci_low,mdev_ci_high\ngyro_x,",
         ));
 }
 
@@ -1143,7 +1158,10 @@ fn issue_15_allan_kinds_name_their_columns_and_say_allan() {
             .unwrap();
         let csv = String::from_utf8_lossy(&csv.stdout);
         assert!(
-            csv.starts_with(&format!("series,tau,tau_s,{header},ci_low,ci_high\n")),
+            csv.starts_with(&format!(
+                "series,tau,tau_s,{header},ci_low,ci_high,{dev}_ci_low,{dev}_ci_high\n",
+                dev = header.split(',').nth(1).unwrap()
+            )),
             "{kind}: {csv}"
         );
         let table = gmwm()

@@ -45,6 +45,13 @@ def test_avar_to_dict_is_the_cli_json():
     assert doc == cli_json("avar", str(ADIS), "--columns", "gyro_y", "--kind", "hadamard")
 
 
+def test_avar_pairs_the_deviation_with_a_deviation_interval():
+    s = gmwm.avar(str(ADIS), columns=["gyro_x"])["gyro_x"]
+    np.testing.assert_allclose(s.adev_ci_low, np.sqrt(s.ci_low), rtol=1e-15)
+    np.testing.assert_allclose(s.adev_ci_high, np.sqrt(s.ci_high), rtol=1e-15)
+    assert np.all((s.adev_ci_low <= s.adev) & (s.adev <= s.adev_ci_high))
+
+
 def test_fit_to_dict_is_the_cli_json():
     model = "AR1()+WN()+RW()"
     py = gmwm.fit(str(ADIS), columns=["gyro_x"], model=model, G=2000, seed=7).to_dict()

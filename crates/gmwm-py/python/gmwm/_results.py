@@ -49,8 +49,9 @@ class Series(_Document):
     """One column's wavelet or Allan-type variance (docs/methods.md §1–§3).
 
     Attributes: ``name``, ``n``, ``freq_hz``, ``alpha``, ``tau`` (samples), ``tau_s``
-    (seconds), ``value`` (the variance: ``wv`` or ``avar``), ``ci_low``, ``ci_high``, and for
-    Allan-type variances ``adev``.
+    (seconds), ``value`` (the variance: ``wv`` or ``avar``), ``ci_low``, ``ci_high`` (on the
+    variance's scale), and for Allan-type variances ``adev`` with its interval on the deviation
+    scale, ``adev_ci_low`` and ``adev_ci_high``.
     """
 
     def __init__(self, doc: Dict[str, Any]):
@@ -66,6 +67,10 @@ class Series(_Document):
         self.ci_low = _array(doc["ci_low"])
         self.ci_high = _array(doc["ci_high"])
         self.adev = _array(doc["adev"]) if "adev" in doc else None
+        # the interval on the deviation scale, to pair with ``adev`` (``ci_low``/``ci_high`` are
+        # on the variance scale)
+        self.adev_ci_low = _array(doc["adev_ci_low"]) if "adev_ci_low" in doc else None
+        self.adev_ci_high = _array(doc["adev_ci_high"]) if "adev_ci_high" in doc else None
 
     def _summary(self) -> str:
         return f"{self.name}, {self.kind} at {len(self.tau)} scales"
@@ -114,6 +119,9 @@ class SeriesResult(_Document):
                 }
                 if s.adev is not None:
                     row["adev"] = s.adev[j]
+                if s.adev_ci_low is not None:
+                    row["adev_ci_low"] = s.adev_ci_low[j]
+                    row["adev_ci_high"] = s.adev_ci_high[j]
                 rows.append(row)
         return pd.DataFrame(rows)
 

@@ -240,6 +240,13 @@ pub struct AllanVariance {
     pub(crate) ci_low: Vec<f64>,
     /// Upper chi-square confidence bound, variance scale (docs/methods.md §1.7 through §3.3/§3.4).
     pub(crate) ci_high: Vec<f64>,
+    /// The interval on the deviation scale, `sqrt(ci_low)`: what a figure or table that shows
+    /// the deviation pairs with it.
+    #[serde(default)]
+    pub(crate) adev_ci_low: Vec<f64>,
+    /// `sqrt(ci_high)`, the interval's upper end on the deviation scale.
+    #[serde(default)]
+    pub(crate) adev_ci_high: Vec<f64>,
     /// Equivalent degrees of freedom of the chi-square interval (see [`allan_variance`]).
     pub(crate) edf: Vec<f64>,
     /// Number of terms (squared differences) summed by the estimator.
@@ -308,6 +315,16 @@ impl AllanVariance {
         &self.ci_high
     }
 
+    /// The interval's lower end on the deviation scale, `sqrt(ci_low)`.
+    pub fn adev_ci_low(&self) -> &[f64] {
+        &self.adev_ci_low
+    }
+
+    /// The interval's upper end on the deviation scale, `sqrt(ci_high)`.
+    pub fn adev_ci_high(&self) -> &[f64] {
+        &self.adev_ci_high
+    }
+
     /// Equivalent degrees of freedom of the chi-square interval (see [`allan_variance`]).
     #[cfg(test)]
     pub(crate) fn edf(&self) -> &[f64] {
@@ -362,19 +379,28 @@ impl fmt::Display for AllanVariance {
         )?;
         writeln!(
             f,
-            "{:>10} {:>12} {:>13} {:>13} {:>13} {:>13}",
-            "tau", "tau_s", var, dev, "ci_low", "ci_high"
+            "{:>10} {:>12} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}",
+            "tau",
+            "tau_s",
+            var,
+            dev,
+            "ci_low",
+            "ci_high",
+            format!("{dev}_low"),
+            format!("{dev}_high")
         )?;
         for i in 0..self.tau.len() {
             writeln!(
                 f,
-                "{:>10} {:>12.6} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e}",
+                "{:>10} {:>12.6} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e}",
                 self.tau[i],
                 self.tau_s[i],
                 self.avar[i],
                 self.adev[i],
                 self.ci_low[i],
-                self.ci_high[i]
+                self.ci_high[i],
+                self.ci_low[i].sqrt(),
+                self.ci_high[i].sqrt()
             )?;
         }
         Ok(())
@@ -475,6 +501,8 @@ pub fn allan_variance(
         adev: Vec::with_capacity(len),
         ci_low: Vec::with_capacity(len),
         ci_high: Vec::with_capacity(len),
+        adev_ci_low: Vec::with_capacity(len),
+        adev_ci_high: Vec::with_capacity(len),
         edf: Vec::with_capacity(len),
         terms: Vec::with_capacity(len),
         error: Vec::with_capacity(len),
@@ -489,6 +517,8 @@ pub fn allan_variance(
         out.adev.push(row.value.sqrt());
         out.ci_low.push(lo);
         out.ci_high.push(hi);
+        out.adev_ci_low.push(lo.sqrt());
+        out.adev_ci_high.push(hi.sqrt());
         out.edf.push(edf);
         out.terms.push(row.terms);
         out.error.push(package_error(n, m));

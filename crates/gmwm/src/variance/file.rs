@@ -137,6 +137,8 @@ pub fn allan_from_wv(wv: &WaveletVariance) -> Result<AllanVariance, ParamError> 
         adev: avar.iter().map(|v| v.sqrt()).collect(),
         ci_low: wv.ci_low.iter().map(|v| 2.0 * v).collect(),
         ci_high: wv.ci_high.iter().map(|v| 2.0 * v).collect(),
+        adev_ci_low: wv.ci_low.iter().map(|v| (2.0 * v).sqrt()).collect(),
+        adev_ci_high: wv.ci_high.iter().map(|v| (2.0 * v).sqrt()).collect(),
         edf: wv.eta.clone(),
         terms: wv.n_coefficients.clone(),
         error: tau
