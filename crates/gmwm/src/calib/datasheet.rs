@@ -412,25 +412,24 @@ pub struct TermComparison {
 }
 
 impl TermComparison {
-    /// The verdict in words, e.g. `"datasheet above the interval: better than the datasheet"`.
+    /// The verdict in words, e.g. `"datasheet above the interval: better than specified"`.
     pub fn verdict_text(&self) -> &'static str {
         match (self.verdict, self.upper_bound) {
-            (DatasheetVerdict::Inside, false) => "datasheet inside the measured interval",
-            (DatasheetVerdict::Inside, true) => {
-                "datasheet at or below the measured upper bound: consistent"
-            }
+            (DatasheetVerdict::Inside, false) => "datasheet inside the interval: as specified",
+            (DatasheetVerdict::Inside, true) => "datasheet within the bound: consistent",
             (DatasheetVerdict::Above, false) => {
-                "datasheet above the measured interval: better than the datasheet"
+                "datasheet above the interval: better than specified"
             }
-            (DatasheetVerdict::Above, true) => {
-                "datasheet above the measured upper bound: better than the datasheet"
-            }
-            (DatasheetVerdict::Below, _) => {
-                "datasheet below the measured interval: worse than the datasheet"
-            }
+            (DatasheetVerdict::Above, true) => "datasheet above the bound: better than specified",
+            (DatasheetVerdict::Below, _) => "datasheet below the interval: worse than specified",
             (DatasheetVerdict::NoInterval, _) => "no measured interval: no verdict",
             (DatasheetVerdict::NotMeasured, _) => "not measured on this axis",
         }
+    }
+
+    /// An SI value of the term in the datasheet's unit.
+    pub fn in_datasheet_unit(&self, si: f64) -> f64 {
+        si * self.value / self.value_si
     }
 }
 
