@@ -20,13 +20,13 @@ use crate::render::Style;
 use anyhow::{Context, Result};
 use gmwm::calib::export::ExportFormat;
 use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, Datasheet, DEFAULT_FULL_MODEL};
-use gmwm::units::SignalUnit;
 use gmwm::imu::{ColumnSelector, ReadOptions};
 use gmwm::inference::same_model::SameModelOptions;
 use gmwm::inference::InferenceOptions;
 use gmwm::model::Model;
 use gmwm::monitor::MonitorOptions;
 use gmwm::shared::SharedOptions;
+use gmwm::units::SignalUnit;
 use gmwm::{
     AllanKind, AllanOptions, AvConvention, Gmwm, RobustOptions, Transform, WaveletFilter,
     Weighting, Wic, WvOptions,
@@ -951,7 +951,10 @@ fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
             ..
         } => {
             if datasheet.datasheet.is_some()
-                && !matches!(args.kind, AllanKind::Overlapping | AllanKind::NonOverlapping)
+                && !matches!(
+                    args.kind,
+                    AllanKind::Overlapping | AllanKind::NonOverlapping
+                )
             {
                 return Err(UsageError(format!(
                     "--datasheet draws the Allan-deviation lines of N, B, K (IEEE Std 952 slope \

@@ -301,11 +301,7 @@ fn one<'a, T>(a: &'a AxisCalibration, data: &'a T) -> [Column<'a, T>; 1] {
 
 /// The axis' column, placed by the sensor and axis the engine recognised.
 fn column<'a, T>(a: &'a AxisCalibration, data: &'a T) -> Column<'a, T> {
-    let lines = a
-        .datasheet
-        .as_ref()
-        .map(|d| d.lines())
-        .unwrap_or_default();
+    let lines = a.datasheet.as_ref().map(|d| d.lines()).unwrap_or_default();
     let c = Column::new(&a.column, &a.unit, data).with_datasheet(lines);
     match a.kind {
         Some(SignalKind::Gyroscope) => c.with_sensor(Sensor::Gyroscope, &a.axis),
@@ -362,9 +358,11 @@ fn datasheet_table(out: &mut String, d: &DatasheetComparison) {
             ],
         );
     }
-    out.push_str("</tbody></table>\n<p class=\"small\">The measured values are those of the \
+    out.push_str(
+        "</tbody></table>\n<p class=\"small\">The measured values are those of the \
         Estimates table (N and K from the GMWM fit, B from the Allan deviation's minimum / 0.664); \
-        the figures draw the datasheet's lines dashed grey.</p>\n");
+        the figures draw the datasheet's lines dashed grey.</p>\n",
+    );
 }
 
 fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(), PlotError> {

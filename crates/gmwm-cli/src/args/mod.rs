@@ -16,8 +16,7 @@ use gmwm::{AllanKind, AvConvention, RobustConvention, Transform, Weighting};
 use std::path::PathBuf;
 use values::{
     alpha, at_least_1, at_least_2, choice, datasheet, efficiency, inflation, positive_hz, seed,
-    signal_unit,
-    tolerance, whole,
+    signal_unit, tolerance, whole,
 };
 
 const EXAMPLES: &str = "\

@@ -539,13 +539,7 @@ fn summary(
 fn datasheet_lines(d: &DatasheetComparison, out: &mut impl Write) -> Result<()> {
     for t in d.terms() {
         // the datasheet's number as given
-        let sheet = format!(
-            "{} {} = {} {}",
-            t.value,
-            t.unit,
-            num(t.value_si),
-            t.unit_si
-        );
+        let sheet = format!("{} {} = {} {}", t.value, t.unit, num(t.value_si), t.unit_si);
         let measured = match (t.measured_si, t.ci_low_si, t.ci_high_si) {
             (None, ..) => "not measured".to_string(),
             (Some(m), ..) if t.upper_bound => format!(

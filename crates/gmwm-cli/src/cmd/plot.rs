@@ -3,14 +3,14 @@
 
 use super::Command;
 use crate::config::{FigureConfig, PlotConfig, PlotKind};
+use crate::error::UsageError;
 use crate::input::{is_wv, InputConfig};
 use crate::prepare::Inputs;
 use crate::style::OutputStyle;
 use anyhow::{Context, Result};
+use gmwm::calib::datasheet::DatasheetLine;
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{Sensor, SensorInfo};
-use crate::error::UsageError;
-use gmwm::calib::datasheet::DatasheetLine;
 use gmwm::units::{SignalKind, SignalUnit};
 use gmwm_plot::{Column, Figure};
 use std::io::Write;
@@ -162,11 +162,7 @@ fn draw<T>(
             );
         }
     }
-    save(
-        build(&columns(items, &units, &lines)),
-        &config.figure,
-        out,
-    )
+    save(build(&columns(items, &units, &lines)), &config.figure, out)
 }
 
 impl Command for PlotConfig {
