@@ -90,9 +90,6 @@ pub enum Error {
     /// Calibrating a recording failed.
     #[error(transparent)]
     Calibration(#[from] crate::calib::CalibError),
-    /// A datasheet text could not be read.
-    #[error(transparent)]
-    Datasheet(#[from] crate::calib::DatasheetError),
     /// A navigation-stack file could not be rendered.
     #[error(transparent)]
     Export(#[from] crate::calib::export::ExportError),

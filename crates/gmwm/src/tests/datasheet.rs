@@ -142,9 +142,12 @@ fn datasheet_reads_both_sensors_in_si() {
     assert_eq!(d.to_string().parse::<Datasheet>().unwrap(), d);
 }
 
+/// Whether an error is the expected variant.
+type IsVariant = fn(&DatasheetError) -> bool;
+
 #[test]
 fn datasheet_refuses_bad_items_naming_them() {
-    let cases: [(&str, fn(&DatasheetError) -> bool, &str); 11] = [
+    let cases: [(&str, IsVariant, &str); 11] = [
         ("", |e| matches!(e, DatasheetError::Empty), "no item"),
         (" , ", |e| matches!(e, DatasheetError::Empty), "no item"),
         (
