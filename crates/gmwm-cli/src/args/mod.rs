@@ -323,7 +323,9 @@ accelerometer, and its dimension must be the key's:
   N  deg/sqrt(h), deg/h/sqrt(Hz), deg/s/sqrt(Hz), rad/s/sqrt(Hz) | m/s/sqrt(h), ug/sqrt(Hz), m/s^2/sqrt(Hz)
   B  deg/h, deg/s, rad/s | mg, ug, m/s^2
   K  deg/h/sqrt(h), rad/s^2/sqrt(Hz) | m/s/h/sqrt(h), m/s^3/sqrt(Hz)
-(° and √ are accepted for deg and sqrt). Both sensors may be given in one flag; an optional
+(° and √ are accepted for deg and sqrt). B is IEEE Std 952's bias instability, the Allan
+deviation's minimum / 0.664: a datasheet quoting the minimum itself as in-run bias stability
+compares as B = value / 0.664. Both sensors may be given in one flag; an optional
 gyro: or accel: prefix is checked against the unit. Each line is drawn on the axes of its sensor
 in the figure's unit, which needs the unit of the samples (sidecar or --gyro-unit/--accel-unit).
 Example (ADIS16405):
