@@ -320,9 +320,10 @@ dashed grey lines (plot avar, ieee, wv, fit): KEY=VALUE UNIT items separated by 
 Keys: N white-noise density (angle / velocity random walk), B bias instability, K rate /
 acceleration random walk. The unit says the sensor: an angle is a gyroscope, a length or g an
 accelerometer, and its dimension must be the key's:
-  N  deg/sqrt(h), deg/h/sqrt(Hz), deg/s/sqrt(Hz), rad/s/sqrt(Hz) | m/s/sqrt(h), ug/sqrt(Hz), m/s^2/sqrt(Hz)
-  B  deg/h, deg/s, rad/s | mg, ug, m/s^2
-  K  deg/h/sqrt(h), rad/s^2/sqrt(Hz) | m/s/h/sqrt(h), m/s^3/sqrt(Hz)
+  gyroscope      N deg/sqrt(h), deg/h/sqrt(Hz), deg/s/sqrt(Hz), rad/s/sqrt(Hz)
+                 B deg/h, deg/s, rad/s          K deg/h/sqrt(h), rad/s^2/sqrt(Hz)
+  accelerometer  N m/s/sqrt(h), ug/sqrt(Hz), m/s^2/sqrt(Hz)
+                 B mg, ug, m/s^2                K m/s/h/sqrt(h), m/s^3/sqrt(Hz)
 (° and √ are accepted for deg and sqrt). B is IEEE Std 952's bias instability, the Allan
 deviation's minimum / 0.664: a datasheet quoting the minimum itself as in-run bias stability
 compares as B = value / 0.664. Both sensors may be given in one flag; an optional
