@@ -19,13 +19,14 @@ use crate::recordings::{is_glob, is_rosbag2_folder};
 use crate::render::Style;
 use anyhow::{Context, Result};
 use gmwm::calib::export::ExportFormat;
-use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, DEFAULT_FULL_MODEL};
+use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, Datasheet, DEFAULT_FULL_MODEL};
 use gmwm::imu::{ColumnSelector, ReadOptions};
 use gmwm::inference::same_model::SameModelOptions;
 use gmwm::inference::InferenceOptions;
 use gmwm::model::Model;
 use gmwm::monitor::MonitorOptions;
 use gmwm::shared::SharedOptions;
+use gmwm::units::SignalUnit;
 use gmwm::{
     AllanKind, AllanOptions, AvConvention, Gmwm, RobustOptions, Transform, WaveletFilter,
     Weighting, Wic, WvOptions,
@@ -621,12 +622,13 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             draws: a.draws,
             seed: a.seed,
             rule: a.rule,
-            gyro_unit: a.gyro_unit,
-            accel_unit: a.accel_unit,
+            gyro_unit: a.units.gyro_unit,
+            accel_unit: a.units.accel_unit,
             // the contamination check compares with the robust WV at --eff
             robust_check: Some(robust_at_eff(&a.estimator)?),
             tolerance: a.tolerance,
             force_units: a.force_units,
+            datasheet: a.datasheet.datasheet.clone(),
         };
         let exports = exports(a)?;
         let adjustment = match (a.inflate, a.conservative) {
@@ -874,6 +876,12 @@ impl From<&TopicsArgs> for TopicsConfig {
 pub struct PlotConfig {
     /// File, layout and size.
     pub figure: FigureConfig,
+    /// `--gyro-unit`, `--accel-unit`: the units of the samples, over the recording's.
+    pub gyro_unit: Option<SignalUnit>,
+    /// `--accel-unit`.
+    pub accel_unit: Option<SignalUnit>,
+    /// `--datasheet`: lines drawn on the axes of each value's sensor.
+    pub datasheet: Option<Datasheet>,
     /// The figure and the configuration of the command whose results it draws.
     pub kind: PlotKind,
 }
@@ -933,11 +941,31 @@ fn no_table_output(output: &OutputArgs) -> Result<()> {
 /// Flags the figure cannot honour.
 fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
     let (output, figure) = match command {
-        PlotCommand::Wv { args, figure } | PlotCommand::Compare { args, figure } => {
+        PlotCommand::Wv { args, figure, .. } | PlotCommand::Compare { args, figure, .. } => {
             (&args.output, figure)
         }
-        PlotCommand::Avar { args, figure } => (&args.output, figure),
-        PlotCommand::Ieee { args, figure } => {
+        PlotCommand::Avar {
+            args,
+            figure,
+            datasheet,
+            ..
+        } => {
+            if datasheet.datasheet.is_some()
+                && !matches!(
+                    args.kind,
+                    AllanKind::Overlapping | AllanKind::NonOverlapping
+                )
+            {
+                return Err(UsageError(format!(
+                    "--datasheet draws the Allan-deviation lines of N, B, K (IEEE Std 952 slope \
+                     laws), which do not hold for --kind {}: drop --kind or --datasheet",
+                    args.kind
+                ))
+                .into());
+            }
+            (&args.output, figure)
+        }
+        PlotCommand::Ieee { args, figure, .. } => {
             if args.kind != AllanKind::Overlapping {
                 return Err(UsageError(
                     "gmwm plot ieee reads the overlapping Allan variance (IEEE Std 952): drop --kind"
@@ -947,7 +975,7 @@ fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
             }
             (&args.output, figure)
         }
-        PlotCommand::Fit { args, figure } => {
+        PlotCommand::Fit { args, figure, .. } => {
             if args.inference {
                 return Err(UsageError(
                     "gmwm plot fit draws the fit: --inference belongs to gmwm fit".into(),
@@ -956,8 +984,21 @@ fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
             }
             (&args.output, figure)
         }
-        PlotCommand::Select { args, figure } => (&args.output, figure),
+        PlotCommand::Select { args, figure, .. } => (&args.output, figure),
     };
+    if let PlotCommand::Wv {
+        args, datasheet, ..
+    } = command
+    {
+        if datasheet.datasheet.is_some() && args.estimator.filter != "haar" {
+            return Err(UsageError(format!(
+                "--datasheet draws the lines of N, B, K in the Haar wavelet variance \
+                 (docs/methods.md §3.4): not with --filter {}",
+                args.estimator.filter
+            ))
+            .into());
+        }
+    }
     no_table_output(output)?;
     let layered = matches!(command, PlotCommand::Wv { .. } | PlotCommand::Avar { .. });
     if figure.overlay && !layered {
@@ -1046,7 +1087,28 @@ impl TryFrom<&PlotArgs> for PlotConfig {
             }
             PlotCommand::Ieee { args, .. } => PlotKind::Ieee(args.try_into()?),
         };
-        Ok(Self { figure, kind })
+        let (units, datasheet) = match &a.figure {
+            PlotCommand::Wv {
+                units, datasheet, ..
+            }
+            | PlotCommand::Avar {
+                units, datasheet, ..
+            }
+            | PlotCommand::Fit {
+                units, datasheet, ..
+            }
+            | PlotCommand::Ieee {
+                units, datasheet, ..
+            } => (units, datasheet.datasheet.clone()),
+            PlotCommand::Compare { units, .. } | PlotCommand::Select { units, .. } => (units, None),
+        };
+        Ok(Self {
+            figure,
+            kind,
+            gyro_unit: units.gyro_unit,
+            accel_unit: units.accel_unit,
+            datasheet,
+        })
     }
 }
 

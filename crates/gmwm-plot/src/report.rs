@@ -12,7 +12,9 @@ use crate::figures::{
 use crate::style::number;
 use crate::{Figure, PlotError};
 use base64::Engine as _;
-use gmwm::calib::{AxisCalibration, CalibrationReport, Estimate, EstimateStatus};
+use gmwm::calib::{
+    AxisCalibration, CalibrationReport, DatasheetComparison, Estimate, EstimateStatus,
+};
 use gmwm::imu::Sensor;
 use gmwm::selection::RowStatus;
 use gmwm::units::SignalKind;
@@ -299,12 +301,68 @@ fn one<'a, T>(a: &'a AxisCalibration, data: &'a T) -> [Column<'a, T>; 1] {
 
 /// The axis' column, placed by the sensor and axis the engine recognised.
 fn column<'a, T>(a: &'a AxisCalibration, data: &'a T) -> Column<'a, T> {
-    let c = Column::new(&a.column, &a.unit, data);
+    let lines = a.datasheet.as_ref().map(|d| d.lines()).unwrap_or_default();
+    let c = Column::new(&a.column, &a.unit, data).with_datasheet(lines);
     match a.kind {
         Some(SignalKind::Gyroscope) => c.with_sensor(Sensor::Gyroscope, &a.axis),
         Some(SignalKind::Accelerometer) => c.with_sensor(Sensor::Accelerometer, &a.axis),
         None => c,
     }
+}
+
+/// The axis against its datasheet: each value as given and in SI, the measured one in the
+/// datasheet's unit with its interval, the ratio and the verdict (the engine's comparison).
+fn datasheet_table(out: &mut String, d: &DatasheetComparison) {
+    out.push_str("<h3>Against the datasheet</h3><table>\n");
+    header(
+        out,
+        &[
+            "term",
+            "datasheet",
+            "datasheet (SI)",
+            "measured (datasheet unit) [interval]",
+            "measured / datasheet",
+            "verdict",
+        ],
+    );
+    out.push_str("<tbody>\n");
+    for t in d.terms() {
+        let unit = esc(&t.unit);
+        let measured = match (t.measured_si, t.ci_low_si, t.ci_high_si) {
+            (None, ..) => "not measured".to_string(),
+            (Some(m), ..) if t.upper_bound => {
+                format!("≤ {} {unit} (upper bound)", number(t.in_datasheet_unit(m)))
+            }
+            (Some(m), Some(lo), Some(hi)) => format!(
+                "{} [{}, {}] {unit}",
+                number(t.in_datasheet_unit(m)),
+                number(t.in_datasheet_unit(lo)),
+                number(t.in_datasheet_unit(hi))
+            ),
+            (Some(m), ..) => format!("{} {unit} (no interval)", number(t.in_datasheet_unit(m))),
+        };
+        let ratio = match t.ratio {
+            Some(r) if t.upper_bound => format!("≤ {}", number(r)),
+            Some(r) => number(r),
+            None => "—".to_string(),
+        };
+        row(
+            out,
+            &[
+                t.key.to_string(),
+                format!("{} {unit}", t.value),
+                format!("{} {}", number(t.value_si), esc(&t.unit_si)),
+                measured,
+                ratio,
+                esc(t.verdict_text()),
+            ],
+        );
+    }
+    out.push_str(
+        "</tbody></table>\n<p class=\"small\">The measured values are those of the \
+        Estimates table (N and K from the GMWM fit, B from the Allan deviation's minimum / 0.664); \
+        the figures draw the datasheet's lines dashed grey.</p>\n",
+    );
 }
 
 fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(), PlotError> {
@@ -464,6 +522,9 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
         row(out, &[term.to_string(), read, g]);
     }
     out.push_str("</tbody></table>\n");
+    if let Some(d) = &a.datasheet {
+        datasheet_table(out, d);
+    }
     let pair = (a.allan.clone(), a.ieee.clone());
     out.push_str(&figure_html(
         &ieee_figure(&one(a, &pair)),

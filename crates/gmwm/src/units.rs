@@ -462,6 +462,232 @@ pub fn forms(
     }
 }
 
+/// A datasheet unit read from text (`deg/sqrt(h)`, `ug/sqrt(Hz)`, `deg/h`, `mg`, ...): the
+/// sensor and noise term its dimension says, and its factor to the continuous SI unit of the
+/// module table.
+///
+/// The dimension decides: an angle (gyroscope) or a length (accelerometer) over time, with the
+/// time exponent of the signal (rad/s, m/s²) times `√s` for a white-noise density N
+/// (`°/√h = rad/s/√Hz` up to a factor), the signal itself for a bias instability B, and over
+/// `√s` for a random-walk density K (`°/h/√h`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DatasheetUnit {
+    /// The sensor whose signal the unit is built on.
+    pub kind: SignalKind,
+    /// The noise term of the unit's dimension: noise density, bias instability or random walk.
+    pub term: NoiseTerm,
+    /// The factor to continuous SI: `value_si = value * to_si`.
+    pub to_si: f64,
+}
+
+/// Why a datasheet unit was not understood.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DatasheetUnitError {
+    /// A symbol that is not a unit (`furlong`) or an exponent that is not a number.
+    #[error("{unit:?}: unknown symbol {symbol:?}; build the unit from deg, rad, m, g, mg, ug, \
+             dps, dph, s, h, Hz with /, ^ and sqrt(), e.g. deg/sqrt(h), deg/h, m/s/sqrt(h), mg, ug/sqrt(Hz)")]
+    Unknown {
+        /// The unit as given.
+        unit: String,
+        /// The part not understood.
+        symbol: String,
+    },
+    /// The unit measures neither an angle nor a length over time (`s`, `deg·m`).
+    #[error(
+        "{unit:?} is neither a gyroscope unit (an angle: deg, rad) nor an accelerometer \
+             unit (a length or g: m, g, mg, ug)"
+    )]
+    NotInertial {
+        /// The unit as given.
+        unit: String,
+    },
+    /// An inertial unit whose time dimension is none of N, B, K (`deg` is a quantization,
+    /// `deg/h^2` a rate ramp).
+    #[error(
+        "{unit:?} is a {kind} unit but not of a noise density (e.g. {n}), a bias \
+             instability ({b}) or a random walk ({k})"
+    )]
+    NotNoiseTerm {
+        /// The unit as given.
+        unit: String,
+        /// Its sensor.
+        kind: SignalKind,
+        /// An N unit of that sensor.
+        n: &'static str,
+        /// A B unit.
+        b: &'static str,
+        /// A K unit.
+        k: &'static str,
+    },
+}
+
+/// The datasheet units a user is shown for a term and sensor: the module table's, in ASCII.
+pub fn datasheet_examples(term: NoiseTerm, kind: SignalKind) -> &'static str {
+    match (kind, term) {
+        (SignalKind::Gyroscope, NoiseTerm::NoiseDensity) => {
+            "deg/sqrt(h), deg/s/sqrt(Hz), rad/s/sqrt(Hz)"
+        }
+        (SignalKind::Gyroscope, NoiseTerm::RandomWalk) => "deg/h/sqrt(h), rad/s^2/sqrt(Hz)",
+        (SignalKind::Gyroscope, _) => "deg/h, deg/s, rad/s",
+        (SignalKind::Accelerometer, NoiseTerm::NoiseDensity) => {
+            "m/s/sqrt(h), ug/sqrt(Hz), m/s^2/sqrt(Hz)"
+        }
+        (SignalKind::Accelerometer, NoiseTerm::RandomWalk) => "m/s/h/sqrt(h), m/s^3/sqrt(Hz)",
+        (SignalKind::Accelerometer, _) => "mg, ug, m/s^2",
+    }
+}
+
+/// One symbol of a datasheet unit: exponents of angle, length and time, and its SI factor.
+fn datasheet_symbol(symbol: &str) -> Option<([f64; 3], f64)> {
+    let deg = PI / 180.0;
+    let g = STANDARD_GRAVITY;
+    let h = SECONDS_PER_HOUR;
+    // gravity units are case-sensitive (G is gauss), as in `match_unit`
+    Some(match symbol {
+        "g" | "g0" | "gn" => ([0.0, 1.0, -2.0], g),
+        "mg" => ([0.0, 1.0, -2.0], g * 1e-3),
+        "ug" => ([0.0, 1.0, -2.0], g * 1e-6),
+        "m" => ([0.0, 1.0, 0.0], 1.0),
+        "mm" => ([0.0, 1.0, 0.0], 1e-3),
+        _ => match symbol.to_ascii_lowercase().as_str() {
+            "rad" => ([1.0, 0.0, 0.0], 1.0),
+            "mrad" => ([1.0, 0.0, 0.0], 1e-3),
+            "urad" => ([1.0, 0.0, 0.0], 1e-6),
+            "deg" | "degree" | "degrees" => ([1.0, 0.0, 0.0], deg),
+            "mdeg" => ([1.0, 0.0, 0.0], deg * 1e-3),
+            "dps" => ([1.0, 0.0, -1.0], deg),
+            "mdps" => ([1.0, 0.0, -1.0], deg * 1e-3),
+            "dph" => ([1.0, 0.0, -1.0], deg / h),
+            "s" | "sec" | "second" | "seconds" => ([0.0, 0.0, 1.0], 1.0),
+            "min" => ([0.0, 0.0, 1.0], 60.0),
+            "h" | "hr" | "hour" | "hours" => ([0.0, 0.0, 1.0], h),
+            "hz" => ([0.0, 0.0, -1.0], 1.0),
+            _ => return None,
+        },
+    })
+}
+
+/// An exponent: an integer, a decimal or a fraction `a/b`, in optional parentheses.
+fn exponent(text: &str) -> Option<f64> {
+    let t = text.trim().trim_start_matches('(').trim_end_matches(')');
+    let v = match t.split_once('/') {
+        Some((a, b)) => a.trim().parse::<f64>().ok()? / b.trim().parse::<f64>().ok()?,
+        None => t.parse::<f64>().ok()?,
+    };
+    v.is_finite().then_some(v)
+}
+
+/// One factor of a datasheet unit (`deg`, `h^2`, `sqrt(Hz)`, `√h`, `s^(-1/2)`): its exponents
+/// and SI factor.
+fn datasheet_factor(factor: &str) -> Option<([f64; 3], f64)> {
+    let (base, power) = if let Some(inner) = factor.strip_prefix("sqrt") {
+        let inner = inner.trim();
+        let inner = inner
+            .strip_prefix('(')
+            .and_then(|i| i.strip_suffix(')'))
+            .unwrap_or(inner);
+        (inner.trim(), 0.5)
+    } else if let Some((b, e)) = factor.split_once('^') {
+        (b.trim(), exponent(e)?)
+    } else {
+        (factor, 1.0)
+    };
+    if base.starts_with("sqrt") {
+        let (dims, f) = datasheet_factor(base)?;
+        return Some((dims.map(|d| d * power), f.powf(power)));
+    }
+    let (dims, f) = datasheet_symbol(base)?;
+    Some((dims.map(|d| d * power), f.powf(power)))
+}
+
+/// docs/methods.md §14.2: reads a datasheet unit (`deg/sqrt(h)`, `°/√h`, `deg/h`, `mg`,
+/// `ug/sqrt(Hz)`, `µg/√Hz`, `m/s/sqrt(h)`, `deg/h/sqrt(h)`, `rad/s/sqrt(Hz)`, `m/s^2/sqrt(Hz)`,
+/// ...): factors joined by `/` (each divides) or spaces (each multiplies), each a symbol with
+/// an optional exponent (`h^2`, `s^(-1/2)`) or under `sqrt()` / `√`. Symbols: deg, rad (and
+/// mrad, urad, mdeg), dps, mdps, dph; m, g, mg, ug (case-sensitive: G is gauss); s, min, h, hr,
+/// Hz. The dimension gives the sensor and the term ([`DatasheetUnit`]).
+///
+/// # Errors
+/// [`DatasheetUnitError`]: an unknown symbol, a unit that is not inertial, or one of another
+/// term (a quantization, a rate ramp).
+pub fn datasheet_unit(text: &str) -> Result<DatasheetUnit, DatasheetUnitError> {
+    let unit = text.trim().to_string();
+    let t = normalise(&unit)
+        .replace('√', "sqrt")
+        .replace(['µ', 'μ'], "u")
+        .replace(" /", "/")
+        .replace("/ ", "/");
+    let unknown = |symbol: &str| DatasheetUnitError::Unknown {
+        unit: unit.clone(),
+        symbol: symbol.to_string(),
+    };
+    // split at the slashes outside parentheses (an exponent may be a fraction: h^(1/2))
+    let mut parts = vec![String::new()];
+    let mut depth = 0i32;
+    for c in t.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            _ => {}
+        }
+        if c == '/' && depth == 0 {
+            parts.push(String::new());
+        } else if let Some(last) = parts.last_mut() {
+            last.push(c);
+        }
+    }
+    let mut dims = [0.0f64; 3];
+    let mut to_si = 1.0f64;
+    for (i, part) in parts.iter().enumerate() {
+        let sign = if i == 0 { 1.0 } else { -1.0 };
+        let factors: Vec<&str> = part.split_whitespace().collect();
+        if factors.is_empty() {
+            return Err(unknown(part));
+        }
+        for f in factors {
+            let (d, k) = datasheet_factor(f).ok_or_else(|| unknown(f))?;
+            for (a, b) in dims.iter_mut().zip(d) {
+                *a += sign * b;
+            }
+            to_si *= k.powf(sign);
+        }
+    }
+    let near = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    let kind = match (
+        near(dims[0], 1.0),
+        near(dims[1], 0.0),
+        near(dims[0], 0.0),
+        near(dims[1], 1.0),
+    ) {
+        (true, true, _, _) => SignalKind::Gyroscope,
+        (_, _, true, true) => SignalKind::Accelerometer,
+        _ => return Err(DatasheetUnitError::NotInertial { unit }),
+    };
+    // time exponent relative to the signal's (rad/s: -1, m/s²: -2)
+    let signal = match kind {
+        SignalKind::Gyroscope => -1.0,
+        SignalKind::Accelerometer => -2.0,
+    };
+    let rel = dims[2] - signal;
+    let term = if near(rel, 0.5) {
+        NoiseTerm::NoiseDensity
+    } else if near(rel, 0.0) {
+        NoiseTerm::BiasInstability
+    } else if near(rel, -0.5) {
+        NoiseTerm::RandomWalk
+    } else {
+        return Err(DatasheetUnitError::NotNoiseTerm {
+            unit,
+            kind,
+            n: datasheet_examples(NoiseTerm::NoiseDensity, kind),
+            b: datasheet_examples(NoiseTerm::BiasInstability, kind),
+            k: datasheet_examples(NoiseTerm::RandomWalk, kind),
+        });
+    };
+    Ok(DatasheetUnit { kind, term, to_si })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

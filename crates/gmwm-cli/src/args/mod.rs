@@ -15,8 +15,8 @@ use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
 use gmwm::{AllanKind, AvConvention, RobustConvention, Transform, Weighting};
 use std::path::PathBuf;
 use values::{
-    alpha, at_least_1, at_least_2, choice, efficiency, inflation, positive_hz, seed, signal_unit,
-    tolerance, whole,
+    alpha, at_least_1, at_least_2, choice, datasheet, efficiency, inflation, positive_hz, seed,
+    signal_unit, tolerance, whole,
 };
 
 const EXAMPLES: &str = "\
@@ -145,6 +145,8 @@ One table at the end (--json - for JSON); exit code 1 if any recording failed.
 Examples:
   gmwm calibrate imu.csv.gz --gyro-unit deg/s --accel-unit g
   gmwm calibrate imu.csv.gz --kalibr imu.yaml --json calib.json
+  gmwm calibrate imu.csv.gz --datasheet \"N=2 deg/sqrt(h), B=25.2 deg/h, N=0.2 m/s/sqrt(h), B=0.2 mg\"
+      each axis against its datasheet: ratio measured/datasheet, inside/above/below
   gmwm calibrate flight.bag --topic /imu0 --kalibr imu.yaml --conservative
   gmwm calibrate run.mcap --export openvins kalibr_imu_chain.yaml --export px4 imu.sdf
   gmwm calibrate log.bin --format ln200 --axis-policy per-axis --kalibr imu.yaml
@@ -225,13 +227,12 @@ pub struct CalibrateArgs {
     /// Input.
     #[command(flatten)]
     pub input: InputArgs,
-    /// Unit of the gyroscope samples: rad/s, deg/s or deg/h [default: the sidecar's, SI for
-    /// ROS and binary IMU records].
-    #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
-    pub gyro_unit: Option<gmwm::units::SignalUnit>,
-    /// Unit of the accelerometer samples: m/s^2, g or mg [default: as --gyro-unit].
-    #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
-    pub accel_unit: Option<gmwm::units::SignalUnit>,
+    /// Units of the samples.
+    #[command(flatten)]
+    pub units: UnitArgs,
+    /// The sensor's datasheet.
+    #[command(flatten)]
+    pub datasheet: DatasheetArgs,
     /// Full model: every sub-model is a candidate of the WIC selection
     /// [default: 3*AR1()+WN()+QN()+RW()+DR()].
     #[arg(long, value_name = "MODEL")]
@@ -298,6 +299,48 @@ pub struct CalibrateArgs {
     pub report: Option<PathBuf>,
 }
 
+/// `--gyro-unit`, `--accel-unit`: the unit of the samples, as `gmwm calibrate` and
+/// `gmwm plot` take it.
+#[derive(Debug, Clone, Copy, Args)]
+pub struct UnitArgs {
+    /// Unit of the gyroscope samples: rad/s, deg/s or deg/h [default: the sidecar's, SI for
+    /// ROS and binary IMU records].
+    #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
+    pub gyro_unit: Option<gmwm::units::SignalUnit>,
+    /// Unit of the accelerometer samples: m/s^2, g or mg [default: the sidecar's, SI for ROS
+    /// and binary IMU records].
+    #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
+    pub accel_unit: Option<gmwm::units::SignalUnit>,
+}
+
+/// What `--datasheet` takes, for `--help`.
+const DATASHEET_HELP: &str = "\
+The sensor's datasheet values, compared with the measured ones (calibrate, report) or drawn as
+dashed grey lines (plot avar, ieee, wv, fit): KEY=VALUE UNIT items separated by commas.
+Keys: N white-noise density (angle / velocity random walk), B bias instability, K rate /
+acceleration random walk. The unit says the sensor: an angle is a gyroscope, a length or g an
+accelerometer, and its dimension must be the key's:
+  gyroscope      N deg/sqrt(h), deg/h/sqrt(Hz), deg/s/sqrt(Hz), rad/s/sqrt(Hz)
+                 B deg/h, deg/s, rad/s          K deg/h/sqrt(h), rad/s^2/sqrt(Hz)
+  accelerometer  N m/s/sqrt(h), ug/sqrt(Hz), m/s^2/sqrt(Hz)
+                 B mg, ug, m/s^2                K m/s/h/sqrt(h), m/s^3/sqrt(Hz)
+(° and √ are accepted for deg and sqrt). B is IEEE Std 952's bias instability, the Allan
+deviation's minimum / 0.664: a datasheet quoting the minimum itself as in-run bias stability
+compares as B = value / 0.664. Both sensors may be given in one flag; an optional
+gyro: or accel: prefix is checked against the unit. Each line is drawn on the axes of its sensor
+in the figure's unit, which needs the unit of the samples (sidecar or --gyro-unit/--accel-unit).
+Example (ADIS16405):
+  --datasheet \"N=2 deg/sqrt(h), B=25.2 deg/h, N=0.2 m/s/sqrt(h), B=0.2 mg\"";
+
+/// `--datasheet`.
+#[derive(Debug, Clone, Args)]
+pub struct DatasheetArgs {
+    /// The sensor's datasheet, e.g. "N=2 deg/sqrt(h), B=25 deg/h, accel:B=0.2 mg" (keys N, B,
+    /// K; the unit says the sensor).
+    #[arg(long, value_name = "SPEC", value_parser = datasheet, long_help = DATASHEET_HELP)]
+    pub datasheet: Option<gmwm::calib::Datasheet>,
+}
+
 const REPORT_EXAMPLES: &str = "\
 The page is one file: figures are embedded, nothing is fetched, it prints one axis per page.
 Its numbers are those of `gmwm calibrate --json`, which the page also carries verbatim.
@@ -332,7 +375,9 @@ Examples:
   gmwm plot compare cont.csv.gz --eff 0.6 -o robust.svg   classical against robust WV
   gmwm plot fit imu.csv.gz --columns gyro_x --model \"2*AR1()+WN()+RW()\" -o fit.svg
   gmwm plot select imu.csv.gz --columns gyro_x --model \"2*AR1()+WN()+RW()+QN()\" -o select.png
-  gmwm plot ieee imu.csv.gz --columns gyro_x -o ieee.svg";
+  gmwm plot ieee imu.csv.gz --columns gyro_x -o ieee.svg
+  gmwm plot ieee imu.csv.gz --gyro-unit deg/s --datasheet \"N=2 deg/sqrt(h), B=25 deg/h\" -o ieee.png
+      the datasheet's N line, B floor and K line (dashed grey) on the gyroscope axes";
 
 /// `gmwm plot`.
 #[derive(Debug, Args)]
@@ -351,6 +396,12 @@ pub enum PlotCommand {
         /// Data and estimator flags, as `gmwm wv`.
         #[command(flatten)]
         args: WvArgs,
+        /// Units of the samples, as `gmwm calibrate`.
+        #[command(flatten)]
+        units: UnitArgs,
+        /// Datasheet lines.
+        #[command(flatten)]
+        datasheet: DatasheetArgs,
         /// Figure file and layout.
         #[command(flatten)]
         figure: FigureArgs,
@@ -361,6 +412,12 @@ pub enum PlotCommand {
         /// Data and estimator flags, as `gmwm avar`.
         #[command(flatten)]
         args: AvarArgs,
+        /// Units of the samples, as `gmwm calibrate`.
+        #[command(flatten)]
+        units: UnitArgs,
+        /// Datasheet lines.
+        #[command(flatten)]
+        datasheet: DatasheetArgs,
         /// Figure file and layout.
         #[command(flatten)]
         figure: FigureArgs,
@@ -372,6 +429,9 @@ pub enum PlotCommand {
         /// Data and estimator flags, as `gmwm wv` (--robust is implied for the second series).
         #[command(flatten)]
         args: WvArgs,
+        /// Units of the samples, as `gmwm calibrate`.
+        #[command(flatten)]
+        units: UnitArgs,
         /// Figure file.
         #[command(flatten)]
         figure: FigureArgs,
@@ -382,6 +442,12 @@ pub enum PlotCommand {
         /// Data and model flags, as `gmwm fit`.
         #[command(flatten)]
         args: FitArgs,
+        /// Units of the samples, as `gmwm calibrate`.
+        #[command(flatten)]
+        units: UnitArgs,
+        /// Datasheet lines.
+        #[command(flatten)]
+        datasheet: DatasheetArgs,
         /// Figure file.
         #[command(flatten)]
         figure: FigureArgs,
@@ -392,6 +458,9 @@ pub enum PlotCommand {
         /// Data and model flags, as `gmwm select`.
         #[command(flatten)]
         args: SelectArgs,
+        /// Units of the samples, as `gmwm calibrate`.
+        #[command(flatten)]
+        units: UnitArgs,
         /// Figure file.
         #[command(flatten)]
         figure: FigureArgs,
@@ -402,6 +471,12 @@ pub enum PlotCommand {
         /// Data flags, as `gmwm avar` (overlapping Allan variance).
         #[command(flatten)]
         args: AvarArgs,
+        /// Units of the samples, as `gmwm calibrate`.
+        #[command(flatten)]
+        units: UnitArgs,
+        /// Datasheet lines.
+        #[command(flatten)]
+        datasheet: DatasheetArgs,
         /// Figure file.
         #[command(flatten)]
         figure: FigureArgs,

@@ -199,6 +199,12 @@ pub fn signal_unit(s: &str) -> Result<gmwm::units::SignalUnit, String> {
     })
 }
 
+/// `--datasheet`: the engine's reading, its error naming the bad item.
+pub fn datasheet(s: &str) -> Result<gmwm::calib::Datasheet, String> {
+    s.parse::<gmwm::calib::Datasheet>()
+        .map_err(|e| e.to_string())
+}
+
 /// `--inflate`: a factor of at least 1.
 pub fn inflation(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {

@@ -9,8 +9,8 @@ use crate::style::{OutputStyle, Ticks};
 use anyhow::{Context, Result};
 use gmwm::calib::export::{render, ExportFormat};
 use gmwm::calib::{
-    AxisCalibration, Calibration, CalibrationReport, CalibrationSource, Estimate, EstimateStatus,
-    NavSet,
+    AxisCalibration, Calibration, CalibrationReport, CalibrationSource, DatasheetComparison,
+    Estimate, EstimateStatus, NavSet,
 };
 use gmwm::selection::SelectionRule;
 use std::io::Write;
@@ -534,6 +534,45 @@ fn summary(
     Ok(())
 }
 
+/// The axis against its datasheet, one line per term: the datasheet value (as given and SI),
+/// the measured one in the datasheet's unit with its interval, the ratio and the verdict.
+fn datasheet_lines(d: &DatasheetComparison, out: &mut impl Write) -> Result<()> {
+    for t in d.terms() {
+        // the datasheet's number as given
+        let sheet = format!("{} {} = {} {}", t.value, t.unit, num(t.value_si), t.unit_si);
+        let measured = match (t.measured_si, t.ci_low_si, t.ci_high_si) {
+            (None, ..) => "not measured".to_string(),
+            (Some(m), ..) if t.upper_bound => format!(
+                "measured <= {} {} (upper bound), ratio <= {}",
+                num(t.in_datasheet_unit(m)),
+                t.unit,
+                t.ratio.map_or_else(|| "-".to_string(), num)
+            ),
+            (Some(m), Some(lo), Some(hi)) => format!(
+                "measured {} [{}, {}] {}, ratio {}",
+                num(t.in_datasheet_unit(m)),
+                num(t.in_datasheet_unit(lo)),
+                num(t.in_datasheet_unit(hi)),
+                t.unit,
+                t.ratio.map_or_else(|| "-".to_string(), num)
+            ),
+            (Some(m), ..) => format!(
+                "measured {} {}, ratio {}",
+                num(t.in_datasheet_unit(m)),
+                t.unit,
+                t.ratio.map_or_else(|| "-".to_string(), num)
+            ),
+        };
+        writeln!(
+            out,
+            "  {:<18}{sheet}; {measured}; {}",
+            format!("datasheet {}", t.key),
+            t.verdict_text()
+        )?;
+    }
+    Ok(())
+}
+
 fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
     writeln!(out)?;
     let unit_note = match (&a.data_unit, a.unit.as_str()) {
@@ -638,6 +677,9 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
         })
         .collect();
     writeln!(out, "  {:<18}{}", "IEEE 952", ieee.join(", "))?;
+    if let Some(d) = &a.datasheet {
+        datasheet_lines(d, out)?;
+    }
     writeln!(out, "  {:<18}{}", "fit", a.verdict.summary)?;
     if let Some(c) = a.contamination.as_ref().filter(|c| c.matters) {
         writeln!(out, "  {:<18}{}", "contamination", c.summary)?;

@@ -3,21 +3,35 @@
 
 use super::Command;
 use crate::config::{FigureConfig, PlotConfig, PlotKind};
+use crate::error::UsageError;
 use crate::input::{is_wv, InputConfig};
 use crate::prepare::Inputs;
 use crate::style::OutputStyle;
 use anyhow::{Context, Result};
+use gmwm::calib::datasheet::DatasheetLine;
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{Sensor, SensorInfo};
-use gmwm::units::SignalUnit;
+use gmwm::units::{SignalKind, SignalUnit};
 use gmwm_plot::{Column, Figure};
 use std::io::Write;
 use std::path::Path;
 
-/// The unit of each column for axis labels and legends: the one its name or the sidecar
-/// states (SI for ROS recordings and binary IMU records), as its symbol; `u` when unknown.
-fn column_units(input: &InputConfig, names: &[String]) -> Vec<String> {
+/// The sensor and the unit of each column for axis labels, legends and datasheet lines: the
+/// unit `--gyro-unit`/`--accel-unit` give for its sensor, else the one its name or the sidecar
+/// states (SI for ROS recordings and binary IMU records); `None` when unknown.
+fn column_units(
+    config: &PlotConfig,
+    input: &InputConfig,
+    names: &[String],
+) -> Result<Vec<(Sensor, Option<SignalUnit>)>> {
     let ros = input.probe().container().is_some();
+    if ros && (config.gyro_unit.is_some() || config.accel_unit.is_some()) {
+        return Err(UsageError(format!(
+            "{}: a ROS recording (sensor_msgs/Imu) is SI by definition: drop --gyro-unit/--accel-unit",
+            input.file.display()
+        ))
+        .into());
+    }
     let sidecar = if ros || is_wv(input) {
         None
     } else {
@@ -30,7 +44,7 @@ fn column_units(input: &InputConfig, names: &[String]) -> Vec<String> {
             .and_then(|s| s.format.as_deref())
             .and_then(|f| f.parse::<gmwm::imu::InputFormat>().ok())
             .is_some_and(|f| matches!(f, gmwm::imu::InputFormat::ImuRecord(_)));
-    names
+    Ok(names
         .iter()
         .map(|name| {
             // the sensor from the name, else the sidecar's meaning (as SensorInfo::of_table)
@@ -42,6 +56,11 @@ fn column_units(input: &InputConfig, names: &[String]) -> Vec<String> {
                         .and_then(SensorInfo::infer)
                 })
                 .map_or(Sensor::Other, |(s, _)| s);
+            let given = match sensor {
+                Sensor::Gyroscope => config.gyro_unit,
+                Sensor::Accelerometer => config.accel_unit,
+                Sensor::Other => None,
+            };
             let text = if ros {
                 match sensor {
                     Sensor::Gyroscope => Some("rad/s".to_string()),
@@ -51,17 +70,26 @@ fn column_units(input: &InputConfig, names: &[String]) -> Vec<String> {
             } else {
                 SensorInfo::column_unit(name, sensor, sidecar.as_ref(), record)
             };
-            text.and_then(|t| t.parse::<SignalUnit>().ok())
-                .map_or_else(|| "u".to_string(), |u| u.symbol().to_string())
+            let unit = given.or_else(|| text.and_then(|t| t.parse::<SignalUnit>().ok()));
+            (sensor, unit)
         })
-        .collect()
+        .collect())
 }
 
-fn columns<'a, T>(items: &'a [(String, T)], units: &'a [String]) -> Vec<Column<'a, T>> {
+/// The figure's columns: each in its unit (`u` when unknown) with the datasheet's lines of its
+/// sensor in that unit.
+fn columns<'a, T>(
+    items: &'a [(String, T)],
+    units: &'a [String],
+    lines: &[Vec<DatasheetLine>],
+) -> Vec<Column<'a, T>> {
     items
         .iter()
         .zip(units)
-        .map(|((name, data), unit)| Column::new(name, unit, data))
+        .zip(lines)
+        .map(|(((name, data), unit), lines)| {
+            Column::new(name, unit, data).with_datasheet(lines.clone())
+        })
         .collect()
 }
 
@@ -86,16 +114,55 @@ fn names<T>(items: &[(String, T)]) -> Vec<String> {
     items.iter().map(|(n, _)| n.clone()).collect()
 }
 
-/// Draws `items` with `build` in the columns' units and writes the figure.
+/// Draws `items` with `build` in the columns' units, with the datasheet's lines on the
+/// columns of its sensors, and writes the figure; a note for a datasheet that finds no column
+/// to draw on, or a column of its sensor whose unit is unknown.
 fn draw<T>(
+    config: &PlotConfig,
     input: &InputConfig,
     items: &[(String, T)],
     build: impl Fn(&[Column<'_, T>]) -> Figure,
-    figure: &FigureConfig,
+    style: OutputStyle,
     out: &mut impl Write,
 ) -> Result<()> {
-    let units = column_units(input, &names(items));
-    save(build(&columns(items, &units)), figure, out)
+    let placed = column_units(config, input, &names(items))?;
+    let units: Vec<String> = placed
+        .iter()
+        .map(|(_, u)| u.map_or_else(|| "u".to_string(), |u| u.symbol().to_string()))
+        .collect();
+    let lines: Vec<Vec<DatasheetLine>> = placed
+        .iter()
+        .map(|(_, u)| match (&config.datasheet, u) {
+            (Some(sheet), Some(u)) => sheet.lines(*u),
+            _ => Vec::new(),
+        })
+        .collect();
+    if let Some(sheet) = &config.datasheet {
+        for ((name, _), (sensor, unit)) in items.iter().zip(&placed) {
+            let kind = match sensor {
+                Sensor::Gyroscope => SignalKind::Gyroscope,
+                Sensor::Accelerometer => SignalKind::Accelerometer,
+                Sensor::Other => continue,
+            };
+            if unit.is_none() && sheet.has(kind) {
+                let flag = match kind {
+                    SignalKind::Gyroscope => "--gyro-unit",
+                    SignalKind::Accelerometer => "--accel-unit",
+                };
+                style.note(
+                    &input.file,
+                    &format!("column {name}: unit unknown, no datasheet line drawn (give {flag})"),
+                );
+            }
+        }
+        if lines.iter().all(Vec::is_empty) {
+            style.note(
+                &input.file,
+                "--datasheet: no column of the datasheet's sensors with a known unit: no line drawn",
+            );
+        }
+    }
+    save(build(&columns(items, &units, &lines)), &config.figure, out)
 }
 
 impl Command for PlotConfig {
@@ -130,26 +197,27 @@ impl Command for PlotConfig {
 
 /// Computes the figure's data and draws it.
 fn run(config: &PlotConfig, style: OutputStyle, out: &mut impl Write) -> Result<()> {
-    let figure = &config.figure;
-    let layout = figure.layout;
+    let layout = config.figure.layout;
     match &config.kind {
         PlotKind::Wv(c) => {
             let items = super::wv::compute(c, style)?;
             draw(
+                config,
                 &c.input,
                 &items,
                 |cols| gmwm_plot::wv_figure(cols, layout),
-                figure,
+                style,
                 out,
             )
         }
         PlotKind::Avar(c) => {
             let items = super::avar::compute(c, style)?;
             draw(
+                config,
                 &c.input,
                 &items,
                 |cols| gmwm_plot::allan_figure(cols, layout),
-                figure,
+                style,
                 out,
             )
         }
@@ -167,17 +235,17 @@ fn run(config: &PlotConfig, style: OutputStyle, out: &mut impl Write) -> Result<
                     gmwm::wavelet_variance(x, loaded.freq_hz, &c.robust)?,
                 ))
             })?;
-            draw(input, &items, gmwm_plot::compare_figure, figure, out)
+            draw(config, input, &items, gmwm_plot::compare_figure, style, out)
         }
         PlotKind::Fit(c) => {
             let fits = super::fit::compute(c, style)?;
-            draw(&c.input, &fits, gmwm_plot::fit_figure, figure, out)
+            draw(config, &c.input, &fits, gmwm_plot::fit_figure, style, out)
         }
         PlotKind::Select(c) => {
             let selections = super::select::compute(c, style)?;
             let top = c.top;
             let build = |cols: &[Column<'_, _>]| gmwm_plot::selection_figure(cols, top);
-            draw(&c.input, &selections, build, figure, out)
+            draw(config, &c.input, &selections, build, style, out)
         }
         PlotKind::Ieee(c) => {
             let items = super::avar::compute(c, style)?;
@@ -188,7 +256,7 @@ fn run(config: &PlotConfig, style: OutputStyle, out: &mut impl Write) -> Result<
                     .with_context(|| format!("{}: column {name}", c.input.file.display()))?;
                 pairs.push((name, (av, readoff)));
             }
-            draw(&c.input, &pairs, gmwm_plot::ieee_figure, figure, out)
+            draw(config, &c.input, &pairs, gmwm_plot::ieee_figure, style, out)
         }
     }
 }

@@ -3,7 +3,8 @@
 use super::*;
 
 /// Allan, modified Allan or Hadamard deviations with their bands (square roots of the
-/// variance's interval), laid out as [`wv_figure`].
+/// variance's interval), laid out as [`wv_figure`]; on the Allan deviation, a column's
+/// datasheet lines dashed grey.
 pub fn allan_figure(columns: &[Column<'_, AllanVariance>], layout: Layout) -> Figure {
     let curves: Vec<Curve<'_>> = columns
         .iter()
@@ -15,6 +16,13 @@ pub fn allan_figure(columns: &[Column<'_, AllanVariance>], layout: Layout) -> Fi
             value: c.data.adev().to_vec(),
             low: c.data.ci_low().iter().map(|v| v.sqrt()).collect(),
             high: c.data.ci_high().iter().map(|v| v.sqrt()).collect(),
+            // the IEEE slope laws are those of the Allan variance only
+            datasheet: match c.data.kind() {
+                AllanKind::Overlapping | AllanKind::NonOverlapping => {
+                    datasheet_series(&c.datasheet, c.data.tau_s(), Quantity::Adev)
+                }
+                _ => Vec::new(),
+            },
         })
         .collect();
     let (what, quantity) = match columns.first().map(|c| c.data.kind()) {

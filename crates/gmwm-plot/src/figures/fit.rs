@@ -4,7 +4,8 @@ use super::*;
 
 /// A fit (paper Figs. 3a, 3b): the empirical WV with its band, the model's implied WV and,
 /// with more than one component, each component's implied WV as its own line, the legend
-/// naming each process with its values in the data unit.
+/// naming each process with its values in the data unit; the column's datasheet lines dashed
+/// grey.
 pub fn fit_figure(columns: &[Column<'_, GmwmFit>]) -> Figure {
     let panels = columns
         .iter()
@@ -28,6 +29,11 @@ pub fn fit_figure(columns: &[Column<'_, GmwmFit>]) -> Figure {
                     );
                 }
             }
+            series.extend(datasheet_series(
+                &c.datasheet,
+                &fit.implied_wv().tau_s,
+                Quantity::Wv,
+            ));
             Panel {
                 title: format!("{}: {}", c.name, fit.model().without_values()),
                 x_label: WV_SCALE.to_string(),

@@ -7,7 +7,8 @@ use super::*;
 struct SlopeLine {
     symbol: &'static str,
     value: Option<f64>,
-    sigma: fn(f64, f64) -> f64,
+    /// The term: its line is the engine's ([`gmwm::calib::ieee::term_avar`]).
+    term: NoiseTerm,
     at_tau_s: f64,
     colour: usize,
     legend: String,
@@ -16,7 +17,7 @@ struct SlopeLine {
 /// The IEEE Std 952 read-off (docs/methods.md §14.3) on the Allan deviation: the −1/2 slope line
 /// through N at 1 s, the flat line at the minimum (B × 0.664) and the +1/2 slope line through
 /// K at 3 s, each with its read-off point; a term without a value is left out and named in
-/// the title.
+/// the title. The column's datasheet lines are drawn dashed grey beside them.
 pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figure {
     let panels = columns
         .iter()
@@ -40,7 +41,7 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 SlopeLine {
                     symbol: "N",
                     value: readoff.n.value,
-                    sigma: |n, t| n / t.sqrt(),
+                    term: NoiseTerm::NoiseDensity,
                     at_tau_s: readoff.n.at_tau_s,
                     colour: 4,
                     legend: format!(
@@ -52,7 +53,7 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 SlopeLine {
                     symbol: "B",
                     value: readoff.b.value,
-                    sigma: |b, _| b * gmwm::calib::ieee::FLICKER_FACTOR,
+                    term: NoiseTerm::BiasInstability,
                     at_tau_s: readoff.b.at_tau_s,
                     colour: 3,
                     legend: format!(
@@ -64,7 +65,7 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 SlopeLine {
                     symbol: "K",
                     value: readoff.k.value,
-                    sigma: |k, t| k * (t / 3.0).sqrt(),
+                    term: NoiseTerm::RandomWalk,
                     at_tau_s: readoff.k.at_tau_s,
                     colour: 5,
                     legend: format!(
@@ -79,7 +80,7 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 let SlopeLine {
                     symbol,
                     value,
-                    sigma: line,
+                    term,
                     at_tau_s: at,
                     colour,
                     legend: unit_text,
@@ -87,6 +88,9 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                 let Some(v) = value else {
                     missing.push(symbol);
                     continue;
+                };
+                let line = |v: f64, t: f64| {
+                    gmwm::calib::ieee::term_avar(term, v, t).map_or(f64::NAN, f64::sqrt)
                 };
                 let ys: Vec<f64> = xs.iter().map(|&t| line(v, t)).collect();
                 let dashed = Mark::Line {
@@ -101,6 +105,7 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                         .labelled(format!("{symbol} = {} {unit_text}", number(v))),
                 );
             }
+            series.extend(datasheet_series(&c.datasheet, av.tau_s(), Quantity::Adev));
             let mut title = format!("{}: IEEE 952 read-off", c.name);
             if !missing.is_empty() {
                 title.push_str(&format!(" ({}: region too short)", missing.join(", ")));

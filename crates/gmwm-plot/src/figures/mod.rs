@@ -4,6 +4,7 @@
 use crate::chart::{BarRow, Bars, Mark, Panel, PanelKind, Series};
 use crate::style::number;
 use crate::Figure;
+use gmwm::calib::datasheet::DatasheetLine;
 use gmwm::calib::ieee::IeeeReadoff;
 use gmwm::fit::PooledFit;
 use gmwm::imu::{Sensor, SensorInfo};
@@ -42,6 +43,9 @@ pub struct Column<'a, T> {
     pub sensor_axis: Option<(Sensor, String)>,
     /// What is drawn.
     pub data: &'a T,
+    /// The datasheet's lines of the column's sensor, in its unit (dashed grey on the Allan
+    /// and WV figures; none by default).
+    pub datasheet: Vec<DatasheetLine>,
 }
 
 impl<'a, T> Column<'a, T> {
@@ -52,7 +56,14 @@ impl<'a, T> Column<'a, T> {
             unit,
             sensor_axis: None,
             data,
+            datasheet: Vec::new(),
         }
+    }
+
+    /// With the datasheet's lines (in the column's unit: [`gmwm::calib::Datasheet::lines`]).
+    pub fn with_datasheet(mut self, lines: Vec<DatasheetLine>) -> Self {
+        self.datasheet = lines;
+        self
     }
 
     /// With the sensor and axis the reader recognised (e.g. from a sidecar's meaning).
@@ -132,6 +143,59 @@ pub(super) fn estimate_series(
     [band, points]
 }
 
+/// The quantity a figure shows, for its datasheet lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Quantity {
+    /// Allan deviation against the cluster time.
+    Adev,
+    /// Haar wavelet variance against the scale.
+    Wv,
+}
+
+/// The datasheet's lines across the span of `tau_s`, dashed grey and labelled (the engine's
+/// [`DatasheetLine::adev`], [`DatasheetLine::wv`]). A line is clipped to the panel but sets
+/// its vertical range at its read-off point (N at 1 s, K at 3 s of cluster time, twice that in
+/// WV scale; B anywhere), clamped into the span, so that a datasheet far from the data still
+/// shows where it is read.
+pub(super) fn datasheet_series(lines: &[DatasheetLine], tau_s: &[f64], q: Quantity) -> Vec<Series> {
+    let span = tau_s
+        .iter()
+        .copied()
+        .filter(|t| t.is_finite() && *t > 0.0)
+        .fold(None, |acc: Option<(f64, f64)>, t| match acc {
+            None => Some((t, t)),
+            Some((lo, hi)) => Some((lo.min(t), hi.max(t))),
+        });
+    let Some((lo, hi)) = span else {
+        return Vec::new();
+    };
+    let dashed = Mark::Line {
+        width: 2,
+        dashed: true,
+    };
+    let mut series = Vec::new();
+    for line in lines {
+        let y = |t: f64| match q {
+            Quantity::Adev => line.adev(t),
+            Quantity::Wv => line.wv(t),
+        };
+        let scale = match q {
+            Quantity::Adev => 1.0,
+            Quantity::Wv => 2.0,
+        };
+        let at = line.at_tau_s().map_or(lo, |t| t * scale).clamp(lo, hi);
+        // a straight line on log-log axes: its two ends
+        series.push(
+            Series::new(dashed, &[lo, hi], &[y(lo), y(hi)])
+                .clipped()
+                .labelled(line.label.clone()),
+        );
+        // the read-off point: one point, not drawn, setting the range
+        series.push(Series::new(dashed, &[at], &[y(at)]));
+    }
+    series
+}
+
 pub(super) const SENSOR_TITLES: [&str; 3] = ["gyroscope", "accelerometer", "other"];
 
 /// What one column of a variance figure contributes: scale, value, band, and labels.
@@ -144,6 +208,8 @@ pub(super) struct Curve<'a> {
     value: Vec<f64>,
     low: Vec<f64>,
     high: Vec<f64>,
+    /// The datasheet's lines ([`datasheet_series`]).
+    datasheet: Vec<Series>,
 }
 
 pub(super) fn variance_figure(
@@ -187,7 +253,9 @@ pub(super) fn variance_figure(
                                 y_label: y_label(c.unit),
                                 kind: PanelKind::LogLog(
                                     estimate_series(&c.tau_s, &c.value, &c.low, &c.high, None)
-                                        .to_vec(),
+                                        .into_iter()
+                                        .chain(c.datasheet.iter().cloned())
+                                        .collect(),
                                 ),
                             }
                         }
@@ -202,7 +270,13 @@ pub(super) fn variance_figure(
                 }
             }
             let panels: Vec<Panel> = panels;
-            let size = (420 * cols as u32 + 80, 380 * rows.len() as u32 + 40);
+            // datasheet lines bring a legend: wider panels keep the plot area
+            let panel_width = if curves.iter().any(|c| !c.datasheet.is_empty()) {
+                680
+            } else {
+                420
+            };
+            let size = (panel_width * cols as u32 + 80, 380 * rows.len() as u32 + 40);
             Figure::new(panels, (rows.len(), cols), size)
         }
         Layout::Overlay => {
@@ -220,6 +294,8 @@ pub(super) fn variance_figure(
                     series.push(band);
                     series.push(points.labelled(format!("axis {axis}")));
                 }
+                // the sensor's datasheet, once (its axes share the datasheet and, as read, the unit)
+                series.extend(members[0].datasheet.iter().cloned());
                 panels.push(Panel {
                     title: format!("{title} ({what})"),
                     x_label: x_label.to_string(),

@@ -149,8 +149,48 @@ const TERMS: [Term; 5] = [
 ];
 const Q: usize = 0;
 const N: usize = 1;
+const B: usize = 2;
 const K: usize = 3;
 const R: usize = 4;
+
+/// docs/methods.md §14.2, §14.3: the Allan variance at cluster time `tau_s` of one IEEE term of
+/// coefficient `c` alone, the line each read-off fits: `N²/τ` (N), `(0.664 B)²` (B, the
+/// flicker floor with [`FLICKER_FACTOR`]), `K² τ/3` (K), `3 Q²/τ²` (Q), `R² τ²/2` (R); `None`
+/// for a term that is not one of the five. The IEEE figure and the datasheet lines draw
+/// their square roots.
+///
+/// ```
+/// use gmwm::calib::ieee::term_avar;
+/// use gmwm::units::NoiseTerm;
+/// // N = 2e-3 at 4 s: AV = 4e-6 / 4
+/// assert!((term_avar(NoiseTerm::NoiseDensity, 2e-3, 4.0).unwrap() - 1e-6).abs() < 1e-18);
+/// // K read at 3 s: the deviation equals K there
+/// assert!((term_avar(NoiseTerm::RandomWalk, 5.0, 3.0).unwrap() - 25.0).abs() < 1e-12);
+/// ```
+pub fn term_avar(term: NoiseTerm, c: f64, tau_s: f64) -> Option<f64> {
+    let (j, factor) = match term {
+        NoiseTerm::Quantization => (Q, 1.0),
+        NoiseTerm::NoiseDensity => (N, 1.0),
+        NoiseTerm::BiasInstability => (B, FLICKER_FACTOR * FLICKER_FACTOR),
+        NoiseTerm::RandomWalk => (K, 1.0),
+        NoiseTerm::RateRamp => (R, 1.0),
+        _ => return None,
+    };
+    Some(factor * c * c * (TERMS[j].basis)(tau_s))
+}
+
+/// docs/methods.md §14.3: the cluster time at which a line term is read (1 s for N, 3 s for K,
+/// √3 s for Q, √2 s for R); `None` for B (read at the minimum) and the other terms.
+pub fn read_off_tau_s(term: NoiseTerm) -> Option<f64> {
+    let j = match term {
+        NoiseTerm::Quantization => Q,
+        NoiseTerm::NoiseDensity => N,
+        NoiseTerm::RandomWalk => K,
+        NoiseTerm::RateRamp => R,
+        _ => return None,
+    };
+    Some(TERMS[j].at_tau_s)
+}
 
 /// The usable scales of an Allan variance: finite positive tau and AV.
 struct Scales {

@@ -1,5 +1,6 @@
 //! Calibration: from a recording to navigation-filter parameters.
 pub(crate) mod contamination;
+pub mod datasheet;
 pub mod export;
 pub mod ieee;
 pub(crate) mod nav;
@@ -9,6 +10,7 @@ pub mod streamed;
 pub(crate) mod verdict;
 
 pub use contamination::{Contamination, FitUses};
+pub use datasheet::{Datasheet, DatasheetComparison, DatasheetError};
 
 #[cfg(test)]
 pub(crate) use contamination::compare_classical_robust;

@@ -3,6 +3,7 @@
 //! SI units with intervals, the IEEE Std 952 read-off and a verdict on the fit.
 
 use super::contamination::{compare_classical_robust, Contamination, FitUses};
+use super::datasheet::{Datasheet, DatasheetComparison, Measured};
 use super::ieee::{ieee_readoff, IeeeReadoff};
 use super::verdict::{verdict, FitVerdict, DEFAULT_TOLERANCE};
 use crate::fit::canonical::long_run_variance;
@@ -80,6 +81,8 @@ pub struct CalibrationOptions {
     /// Apply `gyro_unit`/`accel_unit` to a ROS recording too (SI by definition, refused
     /// otherwise: [`CalibError::UnitOnRos`]).
     pub force_units: bool,
+    /// The sensor's datasheet, compared with each axis of its sensor (default `None`).
+    pub datasheet: Option<Datasheet>,
 }
 
 impl Default for CalibrationOptions {
@@ -100,6 +103,7 @@ impl Default for CalibrationOptions {
             stream_from: crate::calib::STREAM_FROM,
             tolerance: DEFAULT_TOLERANCE,
             force_units: false,
+            datasheet: None,
         }
     }
 }
@@ -231,7 +235,8 @@ pub struct GaussMarkovBias {
 /// `model` (the selected candidate), `canonical_model`, `identified_model`, `noise_density`, `random_walk`,
 /// `bias_instability`, `quantization`, `rate_ramp` ([`Estimate`] or null),
 /// `gauss_markov_bias`, `ieee`, `verdict`, `canonical`, `inference`, `selection` (the table),
-/// `wv`, `allan`, `notes`, and for a pooled calibration `recording_wvs`.
+/// `wv`, `allan`, `notes`, with a datasheet `datasheet` ([`DatasheetComparison`]), and for a
+/// pooled calibration `recording_wvs`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AxisCalibration {
     /// Column name.
@@ -286,6 +291,10 @@ pub struct AxisCalibration {
     pub contamination: Option<Contamination>,
     /// What the read-off did that a user should know, one line each.
     pub notes: Vec<String>,
+    /// The datasheet's N, B, K against this axis' (`None`, and left out of the JSON, without a
+    /// datasheet value for the axis' sensor or when its unit is unknown).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub datasheet: Option<DatasheetComparison>,
     /// A pooled calibration's recordings' own WVs of this axis (unit², the estimator of
     /// `wv`), input order, which `wv` pools; empty (and left out of the JSON) for one
     /// recording.
@@ -683,6 +692,7 @@ impl Calibration {
         let read = readoff.read(&allan, &ieee, &mut notes);
         notes.extend(readings(&selection, &canonical));
         let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
+        let datasheet = self.datasheet(kind, unit_kind, &read, &mut notes);
         Ok(AxisCalibration {
             column: column.to_string(),
             kind,
@@ -710,6 +720,7 @@ impl Calibration {
             wv,
             allan,
             contamination,
+            datasheet,
             notes,
             recording_wvs: Vec::new(),
         })
@@ -884,6 +895,41 @@ impl Calibration {
         )?;
         let canonical = fit.canonical_with(selection.separation_limit)?;
         Ok((inference, canonical))
+    }
+
+    /// The datasheet's values of the axis' sensor against its N, B, K (module doc of
+    /// [`super::datasheet`]); a note when the sensor's unit is unknown.
+    fn datasheet(
+        &self,
+        kind: Option<SignalKind>,
+        unit_kind: Option<SignalKind>,
+        read: &ReadOffs,
+        notes: &mut Vec<String>,
+    ) -> Option<DatasheetComparison> {
+        let sheet = self.options.datasheet.as_ref()?;
+        let Some(k) = unit_kind else {
+            if kind.is_some_and(|k| sheet.has(k)) {
+                notes.push(
+                    "datasheet not compared: the unit of the samples is unknown (give \
+                     --gyro-unit/--accel-unit)"
+                        .to_string(),
+                );
+            }
+            return None;
+        };
+        let measured = |e: &Option<Estimate>| {
+            e.as_ref().map(|e| Measured {
+                value: e.value,
+                interval: e.ci_low.zip(e.ci_high),
+                upper_bound: e.status == EstimateStatus::UpperBound,
+            })
+        };
+        sheet.compare(
+            k,
+            measured(&read.noise_density),
+            measured(&read.bias_instability),
+            measured(&read.random_walk),
+        )
     }
 
     /// The classical WV of the axis against the robust one ([`compare_classical_robust`]);

@@ -9,6 +9,7 @@ mod calib;
 mod canonical;
 mod common;
 mod contamination;
+mod datasheet;
 mod export;
 mod fit_mc;
 mod fit_ref;
