@@ -833,9 +833,21 @@ impl Calibration {
         .flatten();
         let (fit, inference, canonical, refined) =
             identified.unwrap_or((fit, inference, canonical, refined));
+        let replaced = term.starts_with("MAF")
+            && base
+                .model
+                .without_values()
+                .to_string()
+                .split('+')
+                .any(|c| c == "WN()");
+        let how = if replaced {
+            "in the white noise's place"
+        } else {
+            "added"
+        };
         let sig = |x: f64| crate::fit::report::significant(x, 3);
         notes.push(format!(
-            "guided by the WV's shape: the selected model missed {} of {} scales (worst {:.0}% at {} s, likely {}); with {term} added it misses {} (objective {} -> {}); the WIC table ranks the selection's candidates, not this refinement",
+            "guided by the WV's shape: the selected model missed {} of {} scales (worst {:.0}% at {} s, likely {}); with {term} {how} it misses {} (objective {} -> {}); the WIC table ranks the selection's candidates, not this refinement",
             verdict.scales_missed,
             verdict.levels,
             100.0 * worst.deviation.abs(),

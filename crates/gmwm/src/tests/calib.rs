@@ -639,7 +639,9 @@ fn calibration_finds_the_sensor_filter() {
     let half = (n.ci_high.unwrap() - n.ci_low.unwrap()) / 2.0;
     assert!((n.value - 1e-3).abs() < 3.0 * half, "{n:?}");
     assert!(
-        a.notes.iter().any(|s| s.contains("with MAF(4) added")),
+        a.notes
+            .iter()
+            .any(|s| s.contains("with MAF(4) in the white noise's place")),
         "{:?}",
         a.notes
     );
