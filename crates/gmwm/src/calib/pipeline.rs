@@ -1425,7 +1425,12 @@ impl<'a> Readoff<'a> {
         let params = self.params_of(from);
         let (value, lo, hi) = self.delta(&params, q);
         match expected {
-            Some(e) if (e - value).abs() > SAME_VALUE_REL * e.abs() => (e, None, None),
+            // a refit term within a quarter of the interval of the fit's own value: the two are
+            // the same estimate to the data, and the fit's value keeps its interval
+            Some(e) if (e - value).abs() > SAME_VALUE_REL * e.abs() => match (lo, hi) {
+                (Some(l), Some(h)) if (e - value).abs() <= 0.25 * (h - l) => (value, lo, hi),
+                _ => (e, None, None),
+            },
             _ => (value, lo, hi),
         }
     }
