@@ -893,6 +893,15 @@ pub enum PlotKind {
     Select(SelectConfig),
     /// `plot ieee`: the overlapping Allan variance, as `gmwm avar`.
     Ieee(AvarConfig),
+    /// `plot psd`: the Welch PSD of each column.
+    Psd(PsdConfig),
+}
+
+/// `gmwm plot psd`: one recording's samples (not a saved wavelet variance).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PsdConfig {
+    /// What to read.
+    pub input: InputConfig,
 }
 
 /// `gmwm plot compare`: one recording, two estimators.
@@ -957,6 +966,8 @@ fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
             (&args.output, figure)
         }
         PlotCommand::Select { args, figure } => (&args.output, figure),
+        // no table flags to refuse
+        PlotCommand::Psd { figure, .. } => return figure.try_into(),
     };
     no_table_output(output)?;
     let layered = matches!(command, PlotCommand::Wv { .. } | PlotCommand::Avar { .. });
@@ -1045,6 +1056,9 @@ impl TryFrom<&PlotArgs> for PlotConfig {
                 PlotKind::Select(args.try_into()?)
             }
             PlotCommand::Ieee { args, .. } => PlotKind::Ieee(args.try_into()?),
+            PlotCommand::Psd { args, .. } => PlotKind::Psd(PsdConfig {
+                input: (&args.input).try_into()?,
+            }),
         };
         Ok(Self { figure, kind })
     }
