@@ -11,8 +11,9 @@ fn asd(psd: &Psd) -> Vec<f64> {
 }
 
 /// The white-noise reference of a fitted density `n` (unit/√Hz): the one-sided `√PSD` of that
-/// white noise is `√2 · N` (`σ² = N² f_s`, one-sided level `2 N²`), drawn flat over `f`.
-fn white_noise_line(f: &[f64], n: f64, unit: &str, colour: usize) -> Option<Series> {
+/// white noise is `√2 · N` (`σ² = N² f_s`, one-sided level `2 N²`), drawn flat over `f` and
+/// labelled `label`.
+fn white_noise_line(f: &[f64], n: f64, label: String, colour: usize) -> Option<Series> {
     let (lo, hi) = (f.first()?, f.last()?);
     let level = std::f64::consts::SQRT_2 * n;
     Some(
@@ -26,11 +27,16 @@ fn white_noise_line(f: &[f64], n: f64, unit: &str, colour: usize) -> Option<Seri
         )
         .coloured(colour)
         .clipped()
-        .labelled(format!(
-            "white noise N = {} {} (line at √2·N)",
-            number(n),
-            term_unit(NoiseTerm::NoiseDensity, unit)
-        )),
+        .labelled(label),
+    )
+}
+
+/// A white-noise density with its unit: `N = 0.04043 deg/s/√Hz`.
+fn density_text(n: f64, unit: &str) -> String {
+    format!(
+        "N = {} {}",
+        number(n),
+        term_unit(NoiseTerm::NoiseDensity, unit)
     )
 }
 
@@ -44,8 +50,9 @@ fn psd_y_label(unit: &str) -> String {
 /// Welch power spectral densities drawn as the one-sided amplitude spectral density `√PSD`
 /// (data unit/√Hz, the unit of a datasheet's noise density) against frequency, one panel per
 /// column (`Layout::Grid`) or one per sensor type with the axes overlaid; with a fitted
-/// white-noise density `N` (the pair's second member), its level `√2·N` as a dashed line, so
-/// that vibration humps above it and the sensor's filter roll-off below it read at a glance.
+/// white-noise density `N` (the pair's second member), its level `√2·N` as a dashed line (`N`
+/// in the panel's title, or the line's legend when axes are overlaid), so that vibration humps
+/// above it and the sensor's filter roll-off below it read at a glance.
 pub fn psd_figure(columns: &[Column<'_, (Psd, Option<f64>)>], layout: Layout) -> Figure {
     if columns.is_empty() {
         let empty = Panel {
@@ -67,16 +74,21 @@ pub fn psd_figure(columns: &[Column<'_, (Psd, Option<f64>)>], layout: Layout) ->
             f,
             &asd(psd),
         );
-        // a legend only beside a reference line: alone, the curve is what the axis says
-        let series = match n.and_then(|n| white_noise_line(f, n, c.unit, 5)) {
-            Some(reference) => vec![line.labelled("√PSD (Welch)"), reference],
-            None => vec![line],
-        };
-        Panel {
-            title: format!("{} (√PSD, Welch)", c.name),
-            x_label: PSD_FREQUENCY.to_string(),
-            y_label: psd_y_label(c.unit),
-            kind: PanelKind::LogLog(series),
+        // a legend only beside a reference line (short: the panels of a grid are narrow;
+        // the density's value is in the title)
+        match n.and_then(|n| Some((n, white_noise_line(f, n, "√2·N".to_string(), 5)?))) {
+            Some((n, reference)) => Panel {
+                title: format!("{}: {}", c.name, density_text(n, c.unit)),
+                x_label: PSD_FREQUENCY.to_string(),
+                y_label: psd_y_label(c.unit),
+                kind: PanelKind::LogLog(vec![line.labelled("√PSD"), reference]),
+            },
+            None => Panel {
+                title: format!("{} (√PSD, Welch)", c.name),
+                x_label: PSD_FREQUENCY.to_string(),
+                y_label: psd_y_label(c.unit),
+                kind: PanelKind::LogLog(vec![line]),
+            },
         }
     };
     match layout {
@@ -110,7 +122,7 @@ pub fn psd_figure(columns: &[Column<'_, (Psd, Option<f64>)>], layout: Layout) ->
                     });
                 }
             }
-            let size = (480 * cols as u32 + 80, 400 * rows.len() as u32 + 40);
+            let size = (540 * cols as u32 + 80, 400 * rows.len() as u32 + 40);
             Figure::new(panels, (rows.len(), cols), size)
         }
         Layout::Overlay => {
@@ -137,7 +149,11 @@ pub fn psd_figure(columns: &[Column<'_, (Psd, Option<f64>)>], layout: Layout) ->
                         .coloured(k + 1)
                         .labelled(format!("axis {}", c.place().1)),
                     );
-                    series.extend(n.and_then(|n| white_noise_line(f, n, c.unit, k + 1)));
+                    let axis = c.place().1;
+                    series.extend(n.and_then(|n| {
+                        let label = format!("{axis}: √2·N, {}", density_text(n, c.unit));
+                        white_noise_line(f, n, label, k + 1)
+                    }));
                 }
                 panels.push(Panel {
                     title: format!("{title} (√PSD, Welch)"),
