@@ -261,3 +261,23 @@ fn psd_refuses_short_series_bad_rates_and_non_finite_samples() {
     let msg = welch_psd(&x[..100], 1.0).unwrap_err().to_string();
     assert!(msg.contains("100 samples") && msg.contains("256"), "{msg}");
 }
+
+#[test]
+fn psd_segment_mean_is_removed() {
+    // an offset of 1000 (a bias, gravity on an accelerometer) changes nothing: each segment's
+    // mean is removed before the window, so no DC leaks into the first frequencies through the
+    // Hann window's main lobe (it would add 0.25 · 1000² · L / (f Σw²) at k = 1)
+    let x = white_noise(1 << 14, 1.0, SEED + 5);
+    let shifted: Vec<f64> = x.iter().map(|v| v + 1000.0).collect();
+    let (a, b) = (
+        welch_psd(&x, 10.0).unwrap(),
+        welch_psd(&shifted, 10.0).unwrap(),
+    );
+    for (k, (p, q)) in a.density().iter().zip(b.density()).enumerate() {
+        // rounding of x + 1000 (1e-13 of 1000) against a density of order 0.2
+        assert!(
+            (p - q).abs() <= 1e-8 * p.max(1e-3),
+            "frequency {k}: {p} vs {q}"
+        );
+    }
+}
