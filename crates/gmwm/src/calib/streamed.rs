@@ -14,7 +14,7 @@
 //!   the starting values then come from the WV alone (no series range for drift draws), and
 //!   V is the exact covariance ([`crate::variance::implied_cov`]), which needs no series;
 //! - **the power spectral density**: Welch's estimator takes the samples chunk by chunk
-//!   ([`Welch`]), so the robust check's pass below feeds it its blocks, in order, and the PSD
+//!   (`Welch`), so the robust check's pass below feeds it its blocks, in order, and the PSD
 //!   is that of the whole series (without the robust check, no PSD, with a note);
 //! - **the contamination check**: the robust WV is a root per level over all the level's
 //!   coefficients, which an exact streamed computation would need several passes and the

@@ -10,13 +10,13 @@
 //! that level is `2 N²`, and the amplitude spectral density `√PSD` reads `√2 · N`.
 //!
 //! # Estimator
-//! Segments of `L` samples (a power of two, [`segment_length`]), 50% overlap, a periodic Hann
+//! Segments of `L` samples (a power of two, `segment_length`), 50% overlap, a periodic Hann
 //! window, the segment's mean removed before windowing; the squared moduli of the segments'
 //! DFTs averaged and scaled by `1 / (f_s Σ w²)`, doubled for `0 < k < L/2` (P. D. Welch 1967,
 //! IEEE Trans. Audio Electroacoust. AU-15(2), pp. 70–73, with the one-sided fold). Samples after
 //! the last full segment are not used.
 //!
-//! Streaming: [`Welch`] takes the samples chunk by chunk (memory `O(L)` whatever the length);
+//! Streaming: `Welch` takes the samples chunk by chunk (memory `O(L)` whatever the length);
 //! [`welch_psd`] runs it over a slice without copying it.
 
 use crate::error::{check_finite, check_freq, InputError, ParamError, SeriesError};
@@ -27,17 +27,17 @@ use std::sync::Arc;
 
 /// Shortest segment of the length rule: 256 samples give 128 frequencies, the fewest that still
 /// show a hump apart from the filter's roll-off; a series shorter than this has no PSD.
-pub const MIN_SEGMENT: usize = 256;
+pub(crate) const MIN_SEGMENT: usize = 256;
 /// Longest segment of the length rule: 2^16 samples (1 MiB of complex buffer), a resolution of
 /// `f_s / 65536` (0.0015 Hz at 100 Hz), far below where vibration and filters show; longer
 /// segments would only add FFT cost on long recordings.
-pub const MAX_SEGMENT: usize = 1 << 16;
+pub(crate) const MAX_SEGMENT: usize = 1 << 16;
 /// The length rule aims at `N / L >= 8`, i.e. at least 15 overlapping segments, so that each
 /// frequency's estimate averages enough segments (relative standard error about
 /// `√(1.06 / 15) = 0.27`: Welch's variance factor `1 + 2 ρ(½)²` with `ρ(½) ≈ 0.167` for the
 /// 50%-overlapped Hann window, Welch 1967 p. 72) while the
 /// lowest frequency `f_s / L = 8 f_s / N` stays near the WV's coarsest scales.
-pub const SEGMENTS_PER_LENGTH: usize = 8;
+pub(crate) const SEGMENTS_PER_LENGTH: usize = 8;
 /// Points of the log-frequency binned PSD of figures and JSON ([`Psd::binned`]).
 pub const BINNED_POINTS: usize = 100;
 
@@ -45,7 +45,7 @@ pub const BINNED_POINTS: usize = 100;
 /// `n / SEGMENTS_PER_LENGTH`, between `MIN_SEGMENT` and `MAX_SEGMENT`; `MIN_SEGMENT` when
 /// `n` holds one such segment but not eight, and `None` when `n < MIN_SEGMENT`. The rate does
 /// not change `L`; it sets the resolution `f_s / L`.
-pub fn segment_length(n: usize) -> Option<usize> {
+pub(crate) fn segment_length(n: usize) -> Option<usize> {
     if n < MIN_SEGMENT {
         return None;
     }
@@ -191,7 +191,7 @@ impl std::fmt::Display for Psd {
 }
 
 /// Welch's estimator fed chunk by chunk (module doc): memory `O(L)`, cost `O(N log L)`.
-pub struct Welch {
+pub(crate) struct Welch {
     fft: Arc<dyn Fft<f64>>,
     window: Vec<f64>,
     /// `Σ w²`.
@@ -224,7 +224,7 @@ impl Welch {
     /// # Errors
     /// [`ParamError`] for a segment length that is not a power of two of at least 8, or a rate
     /// that is not a positive number.
-    pub fn new(segment_length: usize, freq_hz: f64) -> Result<Self, ParamError> {
+    pub(crate) fn new(segment_length: usize, freq_hz: f64) -> Result<Self, ParamError> {
         check_freq(freq_hz)?;
         if segment_length < 8 || !segment_length.is_power_of_two() {
             return Err(ParamError::new(
@@ -259,7 +259,7 @@ impl Welch {
     ///
     /// # Errors
     /// [`SeriesError::NonFinite`] with the sample's 0-based index in the whole series.
-    pub fn push(&mut self, x: &[f64]) -> Result<(), SeriesError> {
+    pub(crate) fn push(&mut self, x: &[f64]) -> Result<(), SeriesError> {
         if let Err(SeriesError::NonFinite { index, value }) = check_finite(x) {
             return Err(SeriesError::NonFinite {
                 index: self.seen + index,
@@ -302,7 +302,7 @@ impl Welch {
     ///
     /// # Errors
     /// [`SeriesError::TooShort`] when fewer samples than one segment were pushed.
-    pub fn finish(self) -> Result<Psd, SeriesError> {
+    pub(crate) fn finish(self) -> Result<Psd, SeriesError> {
         let l = self.window.len();
         if self.segments == 0 {
             return Err(if self.seen == 0 {
@@ -340,7 +340,8 @@ impl Welch {
     }
 }
 
-/// The Welch PSD of `x` sampled at `freq_hz` (module doc), segments of [`segment_length`].
+/// The Welch PSD of `x` sampled at `freq_hz` (module doc), segments of `L` samples: the largest
+/// power of two at most `N / 8`, between 256 and 65536 (`segment_length`).
 ///
 /// Cost: `O(N log L)` time, `O(L)` memory besides `x`.
 ///
