@@ -901,6 +901,15 @@ pub enum PlotKind {
     Select(SelectConfig),
     /// `plot ieee`: the overlapping Allan variance, as `gmwm avar`.
     Ieee(AvarConfig),
+    /// `plot psd`: the Welch PSD of each column.
+    Psd(PsdConfig),
+}
+
+/// `gmwm plot psd`: one recording's samples (not a saved wavelet variance).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PsdConfig {
+    /// What to read.
+    pub input: InputConfig,
 }
 
 /// `gmwm plot compare`: one recording, two estimators.
@@ -985,6 +994,8 @@ fn figure_config(command: &PlotCommand) -> Result<FigureConfig> {
             (&args.output, figure)
         }
         PlotCommand::Select { args, figure, .. } => (&args.output, figure),
+        // no table flags to refuse
+        PlotCommand::Psd { figure, .. } => return figure.try_into(),
     };
     if let PlotCommand::Wv {
         args, datasheet, ..
@@ -1086,6 +1097,9 @@ impl TryFrom<&PlotArgs> for PlotConfig {
                 PlotKind::Select(args.try_into()?)
             }
             PlotCommand::Ieee { args, .. } => PlotKind::Ieee(args.try_into()?),
+            PlotCommand::Psd { args, .. } => PlotKind::Psd(PsdConfig {
+                input: (&args.input).try_into()?,
+            }),
         };
         let (units, datasheet) = match &a.figure {
             PlotCommand::Wv {
@@ -1100,7 +1114,9 @@ impl TryFrom<&PlotArgs> for PlotConfig {
             | PlotCommand::Ieee {
                 units, datasheet, ..
             } => (units, datasheet.datasheet.clone()),
-            PlotCommand::Compare { units, .. } | PlotCommand::Select { units, .. } => (units, None),
+            PlotCommand::Compare { units, .. }
+            | PlotCommand::Select { units, .. }
+            | PlotCommand::Psd { units, .. } => (units, None),
         };
         Ok(Self {
             figure,

@@ -90,10 +90,13 @@ fn plot_every_figure_on_the_real_recordings() {
         &dir.path().join("fit.svg"),
     ))
     .unwrap();
+    // the fit's WN collapses to 1e-30 (the AR1 of 5.5 ms takes the white noise): the legend
+    // says so instead of printing N = 1.0×10⁻¹⁶
     assert!(
-        svg.contains("WN: N = ") && svg.contains("RW: K = "),
-        "legend with values"
+        svg.contains("WN: negligible (below the plot)") && svg.contains("RW: K = "),
+        "legend with values, a collapsed term as negligible"
     );
+    assert!(!svg.contains("WN: N = "), "no value of a collapsed term");
 
     let png = plot(
         &[
@@ -214,7 +217,8 @@ fn report_numbers_are_the_json_and_chromium_finds_no_fault() {
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("(HTML report, 25 figures)"), "{stdout}");
+    // four an axis, the WVs' and the PSDs'
+    assert!(stdout.contains("(HTML report, 26 figures)"), "{stdout}");
     let html = std::fs::read_to_string(&html_path).unwrap();
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
@@ -252,7 +256,11 @@ fn report_numbers_are_the_json_and_chromium_finds_no_fault() {
     for needle in ["src=\"http", "href=\"http", "url(http", "@import"] {
         assert!(!html.contains(needle), "external reference {needle}");
     }
-    browser_check(&html_path, &dir.path().join("report.png"), 25);
+    assert!(
+        html.contains("Power spectral density of every axis"),
+        "the PSD figure beside the WVs"
+    );
+    browser_check(&html_path, &dir.path().join("report.png"), 26);
 }
 
 /// Runs the browser checker; with `GMWM_SKIP_BROWSER=1` the check is skipped, saying so.

@@ -48,6 +48,10 @@ pub struct Series {
     /// Whether the series sets the vertical range (data and bands do; model lines that fall
     /// far below the data are clipped and said to be below the plot in the legend).
     pub sets_range: bool,
+    /// The legend entry instead of `label` when every value lies below the plotted range
+    /// (`None`: `label` with "(below the plot)"): a fitted term that collapsed to nothing reads
+    /// "WN: negligible" rather than a value such as 4.7×10⁻³⁹.
+    pub label_below: Option<String>,
 }
 
 impl Series {
@@ -61,6 +65,7 @@ impl Series {
             y: y.to_vec(),
             upper: None,
             sets_range: true,
+            label_below: None,
         }
     }
 
@@ -75,6 +80,12 @@ impl Series {
     /// With a legend entry.
     pub fn labelled(mut self, label: impl Into<String>) -> Self {
         self.label = Some(label.into());
+        self
+    }
+
+    /// With the legend entry `label` when it falls wholly below the plotted range.
+    pub fn labelled_below(mut self, label: impl Into<String>) -> Self {
+        self.label_below = Some(label.into());
         self
     }
 
@@ -140,10 +151,14 @@ pub struct Panel {
 }
 
 impl Panel {
-    /// The legend entries, in drawing order.
+    /// The legend entries as drawn, in drawing order (with "(below the plot)" and the like
+    /// where a series has no point inside the panel's range).
     pub fn legend(&self) -> Vec<String> {
         match &self.kind {
-            PanelKind::LogLog(series) => series.iter().filter_map(|s| s.label.clone()).collect(),
+            PanelKind::LogLog(series) => legend_entries(series, ranges(series).1)
+                .into_iter()
+                .map(|(label, _, _)| label)
+                .collect(),
             PanelKind::Bars(b) => b.segment_labels.to_vec(),
         }
     }
@@ -159,17 +174,27 @@ fn positive_range<'a>(values: impl Iterator<Item = &'a f64>) -> Option<(f64, f64
         })
 }
 
-/// A logarithmic range padded by 5% of its decades on each side (half a decade each side when
-/// it is a single value, so that one level still has axes).
+/// Narrowest logarithmic range drawn, decades: any decade holds at least three of the 1-2-5
+/// multiples of the powers of ten (the widest span of two, 2 to 10 excluded, is 0.7 decades),
+/// so that a nearly flat series is labelled by round numbers rather than by 4, 5, ... 9.
+const MIN_LOG_SPAN: f64 = 1.0;
+
+/// A logarithmic range padded by 5% of its decades on each side, and widened evenly to
+/// `MIN_LOG_SPAN` decades (so that one level, or a nearly flat series, still has labelled axes).
 fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
     let (a, b) = (lo.log10(), hi.log10());
-    let pad = if b - a < 1e-9 { 0.5 } else { 0.05 * (b - a) };
+    let pad = (0.05 * (b - a)).max(0.5 * (MIN_LOG_SPAN - (b - a)));
     (10f64.powf(a - pad), 10f64.powf(b + pad))
 }
 
-/// Tick marks of a logarithmic axis: powers of ten (every other one beyond eight decades),
-/// or 1-2-5 multiples when fewer than two powers fall in the range; and the light grid lines
-/// at 2..9 times each power.
+/// Fewest labelled ticks on a logarithmic axis: with two, a reader cannot tell the scale from
+/// one reading (an accelerometer's Allan deviation spanning less than a decade showed one).
+const MIN_LOG_LABELS: usize = 3;
+
+/// Tick marks of a logarithmic axis: powers of ten (every other one beyond eight decades);
+/// when fewer than [`MIN_LOG_LABELS`] powers fall in the range, the first of the multiples 1-3,
+/// 1-2-5, then 1 to 9 of each power that gives that many; and the light grid lines at 2..9
+/// times each power.
 fn log_ticks((lo, hi): (f64, f64)) -> (Vec<f64>, Vec<f64>) {
     let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
     let decades = (b - a).max(0);
@@ -178,18 +203,27 @@ fn log_ticks((lo, hi): (f64, f64)) -> (Vec<f64>, Vec<f64>) {
         .filter(|k| (k - a) % step == 0)
         .map(|k| 10f64.powi(k))
         .collect();
-    if bold.len() < 2 {
-        let k0 = lo.log10().floor() as i32;
-        let k1 = hi.log10().ceil() as i32;
-        bold = (k0..=k1)
-            .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
-            .filter(|v| *v >= lo && *v <= hi)
-            .collect();
+    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let multiples = |ms: &[f64]| -> Vec<f64> {
+        (k0..=k1)
+            .flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| *v >= lo * (1.0 - 1e-12) && *v <= hi * (1.0 + 1e-12))
+            .collect()
+    };
+    for ms in [
+        &[1.0, 3.0][..],
+        &[1.0, 2.0, 5.0][..],
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0][..],
+    ] {
+        if bold.len() >= MIN_LOG_LABELS {
+            break;
+        }
+        bold = multiples(ms);
     }
     let light = if decades <= 8 {
-        (lo.log10().floor() as i32..=hi.log10().ceil() as i32)
-            .flat_map(|k| (2..10).map(move |m| f64::from(m) * 10f64.powi(k)))
-            .filter(|v| *v >= lo && *v <= hi)
+        multiples(&[2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+            .into_iter()
+            .filter(|v| !bold.iter().any(|b| (b / v - 1.0).abs() < 1e-9))
             .collect()
     } else {
         Vec::new()
@@ -372,12 +406,9 @@ fn legend_width<DB: DrawingBackend>(
     (widest + 60).min(area.dim_in_pixel().0 / 2)
 }
 
-/// Draws a log-log panel.
-fn draw_loglog<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    panel: &Panel,
-    series: &[Series],
-) -> Result<(), PlotError> {
+/// The horizontal and vertical ranges of a log-log panel: every series' positive abscissae,
+/// the ordinates of those that set the range (all of them when none does), padded.
+fn ranges(series: &[Series]) -> ((f64, f64), (f64, f64)) {
     let xr = positive_range(series.iter().flat_map(|s| s.x.iter()))
         .map(padded)
         .unwrap_or((0.1, 10.0));
@@ -390,8 +421,14 @@ fn draw_loglog<DB: DrawingBackend>(
     .or_else(|| positive_range(series.iter().flat_map(|s| s.y.iter())))
     .map(padded)
     .unwrap_or((0.1, 10.0));
+    (xr, yr)
+}
+
+/// The legend entries of a log-log panel whose vertical range is `yr`: a series with no point
+/// inside it says so (below the plot: its `label_below` when it has one).
+fn legend_entries(series: &[Series], yr: (f64, f64)) -> Vec<(String, RGBColor, Mark)> {
     // a series with no point inside the vertical range says so in the legend
-    let entries: Vec<(String, RGBColor, Mark)> = series
+    series
         .iter()
         .filter_map(|s| {
             let label = s.label.as_ref()?;
@@ -406,13 +443,26 @@ fn draw_loglog<DB: DrawingBackend>(
             } else if finite.is_empty() {
                 format!("{label} (no value to draw)")
             } else if finite.iter().all(|v| *v < yr.0) {
-                format!("{label} (below the plot)")
+                match &s.label_below {
+                    Some(below) => format!("{below} (below the plot)"),
+                    None => format!("{label} (below the plot)"),
+                }
             } else {
                 format!("{label} (outside the plot)")
             };
             Some((label, s.rgb(), s.mark))
         })
-        .collect();
+        .collect()
+}
+
+/// Draws a log-log panel.
+fn draw_loglog<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    series: &[Series],
+) -> Result<(), PlotError> {
+    let (xr, yr) = ranges(series);
+    let entries = legend_entries(series, yr);
     let (w, _) = area.dim_in_pixel();
     let (plot, legend) = if entries.is_empty() {
         (area.clone(), None)
@@ -427,7 +477,7 @@ fn draw_loglog<DB: DrawingBackend>(
         .caption(&panel.title, (FONT, TITLE_SIZE))
         .margin(12)
         .x_label_area_size(52)
-        .y_label_area_size(74)
+        .y_label_area_size(84)
         .build_cartesian_2d(
             (xr.0..xr.1)
                 .log_scale()
@@ -675,8 +725,29 @@ mod tests {
         let (bold, light) = log_ticks((0.5e-3, 2e2));
         assert_eq!(bold.len(), 6);
         assert!(light.contains(&2e-3));
+        // two powers only: 1-3 multiples
+        let (bold, _) = log_ticks((2e-4, 5e-2));
+        assert_eq!(bold.len(), 5, "{bold:?}");
+        // less than a decade: 1-2-5, or every multiple
         let (bold, _) = log_ticks((1.5, 9.0));
-        assert_eq!(bold, vec![2.0, 5.0]);
+        assert_eq!(bold, vec![2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+        let (bold, _) = log_ticks((1.5, 12.0));
+        assert_eq!(bold, vec![2.0, 5.0, 10.0]);
+    }
+
+    #[test]
+    fn log_ticks_label_every_axis_at_least_three_times() {
+        // ranges from a sliver to twelve decades, at any offset
+        for lo_exp in [-40.0, -7.3, -3.01, 0.0, 0.49, 2.7] {
+            for span in [0.05, 0.2, 0.45, 0.7, 0.99, 1.3, 1.9, 2.05, 3.5, 8.7, 12.0] {
+                let (lo, hi) = padded((10f64.powf(lo_exp), 10f64.powf(lo_exp + span)));
+                let (bold, light) = log_ticks((lo, hi));
+                assert!(bold.len() >= MIN_LOG_LABELS, "{lo:e}..{hi:e}: {bold:?}");
+                assert!(bold.iter().all(|v| *v >= lo * 0.999 && *v <= hi * 1.001));
+                assert!(bold.windows(2).all(|w| w[0] < w[1]));
+                assert!(light.iter().all(|l| !bold.contains(l)));
+            }
+        }
     }
 
     #[test]

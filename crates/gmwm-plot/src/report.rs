@@ -6,8 +6,8 @@
 //! `gmwm calibrate --json` writes it) is embedded in the page.
 
 use crate::figures::{
-    compare_figure, fit_figure, ieee_figure, recordings_figure, selection_figure, wv_figure,
-    Column, Layout, WIC_ROWS,
+    compare_figure, fit_figure, ieee_figure, psd_figure, recordings_figure, selection_figure,
+    wv_figure, Column, Layout, WIC_ROWS,
 };
 use crate::style::number;
 use crate::{Figure, PlotError};
@@ -293,6 +293,41 @@ fn status_text(status: RowStatus) -> &'static str {
 
 /// Rows of the selection table shown: the best ten and every selected or equivalent one.
 const TABLE_ROWS: usize = 10;
+
+/// The Welch PSD of every axis that has one, beside the WVs, with the fitted white-noise
+/// density's level where the calibration has one (an upper bound is no level).
+fn psd_section(out: &mut String, report: &CalibrationReport) -> Result<(), PlotError> {
+    let pairs: Vec<(&AxisCalibration, (gmwm::variance::psd::Psd, Option<f64>))> = report
+        .axes
+        .iter()
+        .filter_map(|a| {
+            let n = a
+                .noise_density
+                .as_ref()
+                .filter(|e| e.status != EstimateStatus::UpperBound)
+                .map(|e| e.value);
+            Some((a, (a.psd.clone()?, n)))
+        })
+        .collect();
+    if pairs.is_empty() {
+        out.push_str("<p>No power spectral density (see each axis' notes).</p>\n");
+        return Ok(());
+    }
+    let columns: Vec<Column<'_, _>> = pairs.iter().map(|(a, p)| column(a, p)).collect();
+    let first = &pairs[0].1 .0;
+    out.push_str(&figure_html(
+        &psd_figure(&columns, Layout::Grid),
+        &format!(
+            "Power spectral density of every axis as the one-sided √PSD (Welch: Hann window, 50% overlap, {} segments of {} samples, resolution {} Hz; means of {} log-spaced frequency bins). Humps above the flat white-noise floor are vibration or other periodic errors, the fall before f/2 = {} Hz the sensor's own filter. The dashed line is the fitted white-noise density N at its one-sided level √2·N.",
+            first.segments(),
+            first.segment_length(),
+            number(first.resolution_hz()),
+            gmwm::variance::psd::BINNED_POINTS,
+            number(report.freq_hz / 2.0)
+        ),
+    )?);
+    Ok(())
+}
 
 /// The axis' column of a figure.
 fn one<'a, T>(a: &'a AxisCalibration, data: &'a T) -> [Column<'a, T>; 1] {
@@ -621,6 +656,7 @@ pub fn render(report: &CalibrationReport, ctx: &ReportContext) -> Result<String,
             100.0 * (1.0 - report.alpha)
         ),
     )?);
+    psd_section(&mut out, report)?;
     out.push_str("</section>\n");
     if !report.recordings.is_empty() {
         let pairs: Vec<(gmwm::WaveletVariance, Vec<gmwm::WaveletVariance>)> = report

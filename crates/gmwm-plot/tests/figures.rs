@@ -6,11 +6,12 @@
 
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{read_table, ReadOptions};
+use gmwm::variance::psd::{welch_psd, BINNED_POINTS};
 use gmwm::variance::read_wv_json;
 use gmwm::{allan_variance, AllanOptions, Gmwm, RobustOptions, WaveletVariance, Wic, WvOptions};
 use gmwm_plot::{
-    allan_figure, compare_figure, fit_figure, ieee_figure, selection_figure, wv_figure, Column,
-    Figure, Layout, PanelKind,
+    allan_figure, compare_figure, fit_figure, ieee_figure, psd_figure, selection_figure, wv_figure,
+    Column, Figure, Layout, PanelKind,
 };
 use std::path::PathBuf;
 
@@ -228,10 +229,16 @@ fn figures_fit_decomposition_names_every_process_with_its_value() {
     let legend = figure.legend();
     // band, empirical, model, and one line per component
     assert_eq!(legend.len(), 3 + 4, "{legend:?}");
+    // the fast AR1 (T = 5.5 ms, below the sampling interval) takes the white noise, whose
+    // term collapses to nothing: it reads as negligible, never as N = 4.7×10⁻³⁹
     assert!(
         legend
             .iter()
-            .any(|l| l.starts_with("WN: N = ") && l.contains("deg/s/√Hz")),
+            .any(|l| l == "WN: negligible (below the plot)"),
+        "{legend:?}"
+    );
+    assert!(
+        !legend.iter().any(|l| l.starts_with("WN: N = ")),
         "{legend:?}"
     );
     assert!(
@@ -271,10 +278,16 @@ fn figures_fit_with_a_component_below_the_plot_says_so() {
         .expect("an AR1 component line");
     ar1.y.iter_mut().for_each(|v| *v *= 1e-12);
     let svg = render(&figure, "fit_component_below");
+    // a term that collapsed below the plot reads as negligible, not as its tiny values
     assert!(
         svg.texts
             .iter()
-            .any(|t| t.starts_with("AR1: ") && t.ends_with("(below the plot)")),
+            .any(|t| t == "AR1: negligible (below the plot)"),
+        "{:?}",
+        svg.texts
+    );
+    assert!(
+        !svg.texts.iter().any(|t| t.starts_with("AR1: T = ")),
         "{:?}",
         svg.texts
     );
@@ -464,4 +477,66 @@ fn figures_without_columns_are_an_empty_figure_not_an_error() {
     assert!(figure.svg().is_ok());
     let figure = wv_figure(&[], Layout::Overlay);
     assert!(figure.svg().is_ok());
+}
+
+#[test]
+fn figures_psd_of_the_adis_imu_with_the_white_noise_level() {
+    let (cols, freq) = recording("adis_16405_imu1.csv.gz", 1 << 18);
+    let pairs: Vec<(String, _)> = cols
+        .iter()
+        .map(|(name, x)| {
+            let psd = welch_psd(x, freq).unwrap().binned(BINNED_POINTS);
+            // a white-noise density for the reference line: the floor's, N = sqrt(level / 2)
+            let n = (psd.density()[psd.density().len() / 2] / 2.0).sqrt();
+            (name.clone(), (psd, Some(n)))
+        })
+        .collect();
+    let units = ["deg/s", "deg/s", "deg/s", "g", "g", "g"];
+    let columns: Vec<Column<'_, _>> = pairs
+        .iter()
+        .zip(units)
+        .map(|((name, p), u)| Column::new(name, u, p))
+        .collect();
+    let grid = psd_figure(&columns, Layout::Grid);
+    assert_eq!(grid.grid, (2, 3));
+    let svg = render(&grid, "psd_adis_grid");
+    assert!(
+        svg.polylines >= 6 * 2,
+        "a curve and a line per panel: {}",
+        svg.polylines
+    );
+    assert!(
+        svg.texts.iter().any(|t| t == "√PSD, one-sided [deg/s/√Hz]"),
+        "{:?}",
+        svg.texts
+    );
+    // the density in the title, its √2·N line in the legend
+    assert!(
+        svg.texts
+            .iter()
+            .any(|t| t.starts_with("accel_x: N = ") && t.ends_with(" g/√Hz")),
+        "{:?}",
+        svg.texts
+    );
+    assert!(svg.texts.iter().any(|t| t == "√2·N"), "{:?}", svg.texts);
+    let overlay = psd_figure(&columns, Layout::Overlay);
+    assert_eq!(overlay.grid, (2, 1));
+    let svg = render(&overlay, "psd_adis_overlay");
+    assert!(
+        svg.texts
+            .iter()
+            .any(|t| t.starts_with("Z: √2·N, N = ") && t.ends_with(" deg/s/√Hz")),
+        "{:?}",
+        svg.texts
+    );
+    // without a white-noise density: the curve alone, no legend
+    let bare: Vec<(String, _)> = pairs
+        .iter()
+        .map(|(n, (p, _))| (n.clone(), (p.clone(), None)))
+        .collect();
+    let columns: Vec<Column<'_, _>> = bare
+        .iter()
+        .map(|(name, p)| Column::new(name, "deg/s", p))
+        .collect();
+    assert!(psd_figure(&columns[..1], Layout::Grid).legend().is_empty());
 }

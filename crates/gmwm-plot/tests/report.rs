@@ -55,12 +55,15 @@ fn report_holds_every_section_and_the_calibration_numbers() {
         ..ReportContext::default()
     };
     let html = render(&report, &ctx).unwrap();
-    // one WV grid, then per axis selection, fit, IEEE and classical-vs-robust figures
-    assert_eq!(html.matches("<figure>").count(), 1 + 4 * report.axes.len());
+    // one WV grid and one PSD grid, then per axis selection, fit, IEEE and classical-vs-robust
+    // figures
+    assert_eq!(html.matches("<figure>").count(), 2 + 4 * report.axes.len());
     assert_eq!(
         html.matches("data:image/svg+xml;base64,").count(),
-        1 + 4 * report.axes.len()
+        2 + 4 * report.axes.len()
     );
+    assert!(html.contains("Power spectral density of every axis"));
+    assert!(report.axes.iter().all(|a| a.psd.is_some()));
     for section in [
         "id=\"recording\"",
         "id=\"overview\"",
@@ -86,6 +89,15 @@ fn report_holds_every_section_and_the_calibration_numbers() {
 }
 
 #[test]
+fn report_without_a_psd_says_so_instead_of_a_figure() {
+    let mut report = Calibration::new(options()).run(&imu()).unwrap();
+    report.axes.iter_mut().for_each(|a| a.psd = None);
+    let html = render(&report, &ReportContext::default()).unwrap();
+    assert_eq!(html.matches("<figure>").count(), 1 + 4 * report.axes.len());
+    assert!(html.contains("No power spectral density"));
+}
+
+#[test]
 fn report_says_when_contamination_was_not_checked() {
     let report = Calibration::new(CalibrationOptions {
         robust_check: None,
@@ -94,7 +106,7 @@ fn report_says_when_contamination_was_not_checked() {
     .run(&imu())
     .unwrap();
     let html = render(&report, &ReportContext::default()).unwrap();
-    assert_eq!(html.matches("<figure>").count(), 1 + 3 * report.axes.len());
+    assert_eq!(html.matches("<figure>").count(), 2 + 3 * report.axes.len());
     assert!(html.contains("Not compared"));
     assert!(html.contains("No filter file was exported"));
 }

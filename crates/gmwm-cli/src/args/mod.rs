@@ -376,6 +376,7 @@ Examples:
   gmwm plot fit imu.csv.gz --columns gyro_x --model \"2*AR1()+WN()+RW()\" -o fit.svg
   gmwm plot select imu.csv.gz --columns gyro_x --model \"2*AR1()+WN()+RW()+QN()\" -o select.png
   gmwm plot ieee imu.csv.gz --columns gyro_x -o ieee.svg
+  gmwm plot psd imu.csv.gz --columns gyro_x,gyro_y -o psd.png   √PSD (Welch): vibration, filter
   gmwm plot ieee imu.csv.gz --gyro-unit deg/s --datasheet \"N=2 deg/sqrt(h), B=25 deg/h\" -o ieee.png
       the datasheet's N line, B floor and K line (dashed grey) on the gyroscope axes";
 
@@ -481,6 +482,30 @@ pub enum PlotCommand {
         #[command(flatten)]
         figure: FigureArgs,
     },
+    /// The power spectral density (Welch: Hann, 50% overlap, segments of a power of two up to
+    /// 2^16 samples, at least 8 a recording where it is long enough), drawn as the one-sided
+    /// √PSD in unit/√Hz on log-frequency bins: vibration humps and the sensor's filter
+    /// roll-off, which the WV smears over an octave. White noise of density N reads √2·N.
+    #[command(allow_negative_numbers = true)]
+    Psd {
+        /// Data flags.
+        #[command(flatten)]
+        args: PsdArgs,
+        /// Units of the samples, as `gmwm calibrate`.
+        #[command(flatten)]
+        units: UnitArgs,
+        /// Figure file and layout.
+        #[command(flatten)]
+        figure: FigureArgs,
+    },
+}
+
+/// `gmwm plot psd`: the recording to read.
+#[derive(Debug, Args)]
+pub struct PsdArgs {
+    /// Input.
+    #[command(flatten)]
+    pub input: InputArgs,
 }
 
 /// Where a figure goes and how it is laid out.
@@ -490,7 +515,7 @@ pub struct FigureArgs {
     #[arg(short = 'o', long = "output", value_name = "FIGURE", required = true)]
     pub output: PathBuf,
     /// One panel per sensor type with the axes overlaid (paper Fig. 1b) instead of a grid of
-    /// panels (wv, avar).
+    /// panels (wv, avar, psd).
     #[arg(long)]
     pub overlay: bool,
     /// Width in pixels [default: by the figure's panels].

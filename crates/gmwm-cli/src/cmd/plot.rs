@@ -1,5 +1,5 @@
 //! `gmwm plot`: one figure of the matching command's results (gmwm-plot renders; the numbers
-//! are those `gmwm wv|avar|fit|select --json` gives).
+//! are those `gmwm wv|avar|fit|select --json` gives, and the engine's Welch PSD for `psd`).
 
 use super::Command;
 use crate::config::{FigureConfig, PlotConfig, PlotKind};
@@ -12,6 +12,7 @@ use gmwm::calib::datasheet::DatasheetLine;
 use gmwm::calib::ieee::ieee_readoff;
 use gmwm::imu::{Sensor, SensorInfo};
 use gmwm::units::{SignalKind, SignalUnit};
+use gmwm::variance::psd::{welch_psd, BINNED_POINTS};
 use gmwm_plot::{Column, Figure};
 use std::io::Write;
 use std::path::Path;
@@ -173,6 +174,7 @@ impl Command for PlotConfig {
             PlotKind::Compare(c) => &mut c.input,
             PlotKind::Fit(c) => &mut c.input,
             PlotKind::Select(c) => &mut c.input,
+            PlotKind::Psd(c) => &mut c.input,
         })
     }
 
@@ -186,7 +188,7 @@ impl Command for PlotConfig {
             PlotKind::Fit(c) => c.wv.levels,
             PlotKind::Select(c) => c.wv.levels,
             // compare's --levels: the engine's error without the flag, as before
-            PlotKind::Avar(_) | PlotKind::Ieee(_) | PlotKind::Compare(_) => None,
+            PlotKind::Avar(_) | PlotKind::Ieee(_) | PlotKind::Compare(_) | PlotKind::Psd(_) => None,
         }
     }
 
@@ -257,6 +259,28 @@ fn run(config: &PlotConfig, style: OutputStyle, out: &mut impl Write) -> Result<
                 pairs.push((name, (av, readoff)));
             }
             draw(config, &c.input, &pairs, gmwm_plot::ieee_figure, style, out)
+        }
+        PlotKind::Psd(c) => {
+            let input = &c.input;
+            anyhow::ensure!(
+                !is_wv(input),
+                "{}: a PSD needs the samples, not a saved wavelet variance",
+                input.file.display()
+            );
+            let loaded = crate::input::load(input, style)?;
+            // the column is borrowed, never copied: Welch keeps one segment (at most 2^16)
+            let items = crate::input::analyse_columns(&loaded, &input.file, |x| {
+                let psd = welch_psd(x, loaded.freq_hz)?;
+                Ok((psd.binned(BINNED_POINTS), None))
+            })?;
+            draw(
+                config,
+                input,
+                &items,
+                |cols| gmwm_plot::psd_figure(cols, layout),
+                style,
+                out,
+            )
         }
     }
 }

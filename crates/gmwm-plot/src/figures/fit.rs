@@ -25,7 +25,8 @@ pub fn fit_figure(columns: &[Column<'_, GmwmFit>]) -> Figure {
                         )
                         .coloured(k + 1)
                         .clipped()
-                        .labelled(component_label(fit, k, c.unit)),
+                        .labelled(component_label(fit, k, c.unit))
+                        .labelled_below(negligible_label(fit, k)),
                     );
                 }
             }

@@ -1,5 +1,6 @@
-//! The figures of docs/methods.md §11 (paper Figs. 1–4) and the IEEE Std 952 read-off, built from
-//! the engine's results. Each builder only arranges numbers the engine computed.
+//! The figures of docs/methods.md §11 (paper Figs. 1–4), the IEEE Std 952 read-off and the
+//! Welch PSD, built from the engine's results. Each builder only arranges numbers the engine
+//! computed.
 
 use crate::chart::{BarRow, Bars, Mark, Panel, PanelKind, Series};
 use crate::style::number;
@@ -10,6 +11,7 @@ use gmwm::fit::PooledFit;
 use gmwm::imu::{Sensor, SensorInfo};
 use gmwm::shared::SharedFit;
 use gmwm::units::{si_unit, NoiseTerm, SignalUnit};
+use gmwm::variance::psd::Psd;
 use gmwm::{AllanKind, AllanVariance, GmwmFit, ModelSelection, WaveletVariance};
 
 mod allan;
@@ -17,6 +19,7 @@ mod compare;
 mod fit;
 mod ieee;
 mod pooled;
+mod psd;
 mod recordings;
 mod selection;
 mod shared;
@@ -27,6 +30,7 @@ pub use compare::compare_figure;
 pub use fit::fit_figure;
 pub use ieee::ieee_figure;
 pub use pooled::pooled_figure;
+pub use psd::{psd_figure, PSD_FREQUENCY};
 pub use recordings::recordings_figure;
 pub use selection::selection_figure;
 pub use shared::shared_figure;
@@ -352,6 +356,16 @@ pub(super) fn component_label(fit: &GmwmFit, index: usize, unit: &str) -> String
     } else {
         format!("{kind}: {}", values.join(", "))
     }
+}
+
+/// The legend entry of a fitted component whose implied WV lies wholly below the plotted
+/// range: its process without a value (`WN: negligible`), since a term that collapsed to
+/// nothing has values such as 4.7×10⁻³⁹ that mean nothing to a reader.
+pub(super) fn negligible_label(fit: &GmwmFit, index: usize) -> String {
+    format!(
+        "{}: negligible",
+        fit.model().components()[index].kind.name()
+    )
 }
 
 /// The empirical WV with its band and the fitted model's implied WV (total, thick), as series.

@@ -19,6 +19,7 @@ use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms}
 use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
 use crate::variance::allan_from_wv;
 use crate::variance::pooled::PooledWv;
+use crate::variance::psd::{welch_psd, Psd, BINNED_POINTS};
 use crate::variance::robust::RobustOptions;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use rayon::prelude::*;
@@ -235,8 +236,10 @@ pub struct GaussMarkovBias {
 /// `model` (the selected candidate), `canonical_model`, `identified_model`, `noise_density`, `random_walk`,
 /// `bias_instability`, `quantization`, `rate_ramp` ([`Estimate`] or null),
 /// `gauss_markov_bias`, `ieee`, `verdict`, `canonical`, `inference`, `selection` (the table),
-/// `wv`, `allan`, `notes`, with a datasheet `datasheet` ([`DatasheetComparison`]), and for a
-/// pooled calibration `recording_wvs`.
+/// `wv`, `allan`, `psd` (the log-frequency binned Welch PSD in `unit`²/Hz, one-sided:
+/// `frequency_hz`, `density`, `unit`, ...; null with a note when it was not computed),
+/// `notes`, with a datasheet `datasheet` ([`DatasheetComparison`]), and for a pooled
+/// calibration `recording_wvs`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AxisCalibration {
     /// Column name.
@@ -286,6 +289,11 @@ pub struct AxisCalibration {
     pub wv: WaveletVariance,
     /// The overlapping Allan variance (unit²).
     pub allan: AllanVariance,
+    /// The Welch power spectral density (one-sided, unit²/Hz), binned on
+    /// `BINNED_POINTS` log-spaced frequencies (`crate::variance::psd`); `None`, with a note,
+    /// when the samples were not at hand (a pooled calibration, a streamed one without its
+    /// spectral pass) or too short for one segment.
+    pub psd: Option<Psd>,
     /// The classical WV against the robust one: whether contamination matters (`None` when
     /// the check is off or the robust WV could not be computed, with a note).
     pub contamination: Option<Contamination>,
@@ -693,6 +701,7 @@ impl Calibration {
         notes.extend(readings(&selection, &canonical));
         let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
         let datasheet = self.datasheet(kind, unit_kind, &read, &mut notes);
+        let psd = psd_of(&data, freq_hz, &unit_label, &mut notes);
         Ok(AxisCalibration {
             column: column.to_string(),
             kind,
@@ -719,6 +728,7 @@ impl Calibration {
             selection,
             wv,
             allan,
+            psd,
             contamination,
             datasheet,
             notes,
@@ -1106,6 +1116,29 @@ fn allan_of(
     })
 }
 
+/// The binned Welch PSD of an axis in `unit`²/Hz: of its samples in memory (borrowed, one
+/// segment of at most 2^16 samples besides), or as the streamed pass computed it; `None` with a
+/// note when neither is at hand or the series is shorter than one segment.
+fn psd_of(data: &AxisData<'_>, freq_hz: f64, unit: &str, notes: &mut Vec<String>) -> Option<Psd> {
+    let psd = match data {
+        AxisData::Series(x) => welch_psd(x, freq_hz).map_err(|e| e.to_string()),
+        AxisData::Streamed { psd: Some(p), .. } => p.as_deref().cloned().map_err(String::clone),
+        AxisData::Streamed { psd: None, .. } => Err(
+            "the recording was streamed without its spectral pass (it rides on the robust check, which the options turn off)".to_string(),
+        ),
+        AxisData::Pooled { .. } => {
+            Err("a pooled calibration has no single series to take it from".to_string())
+        }
+    };
+    match psd {
+        Ok(p) => Some(p.binned(BINNED_POINTS).in_unit(unit)),
+        Err(why) => {
+            notes.push(format!("no power spectral density: {why}"));
+            None
+        }
+    }
+}
+
 /// How the selected fit reads as the canonical model (a drift read as a random walk, ...),
 /// then what the identified fit's canonical model adds.
 fn readings(selection: &ModelSelection, canonical: &CanonicalModel) -> Vec<String> {
@@ -1147,10 +1180,12 @@ pub(crate) struct InputAxis<'a> {
 pub(crate) enum AxisData<'a> {
     /// The samples.
     Series(&'a [f64]),
-    /// The classical WV and, for the contamination check, the robust one (`None`: no check).
+    /// The classical WV and, for the contamination check, the robust one (`None`: no check),
+    /// and the Welch PSD accumulated in the same pass (`None`: no such pass).
     Streamed {
         wv: Box<WaveletVariance>,
         robust: Option<Result<Box<WaveletVariance>, String>>,
+        psd: Option<Result<Box<Psd>, String>>,
     },
     /// The pooled WVs of several recordings (docs/methods.md §5.12), already in SI: the
     /// classical one and the robust one (the fit's when the options ask for a robust WV, else
@@ -1166,9 +1201,10 @@ impl AxisData<'_> {
     /// are converted by [`in_si`] instead.
     fn scaled(self, to_si: f64) -> Self {
         match self {
-            AxisData::Streamed { wv, robust } if to_si != 1.0 => AxisData::Streamed {
+            AxisData::Streamed { wv, robust, psd } if to_si != 1.0 => AxisData::Streamed {
                 wv: Box::new(wv.scaled(to_si * to_si)),
                 robust: robust.map(|r| r.map(|w| Box::new(w.scaled(to_si * to_si)))),
+                psd: psd.map(|r| r.map(|p| Box::new(p.scaled(to_si * to_si)))),
             },
             d => d,
         }

@@ -4,7 +4,7 @@
 //! [`StreamedTable`] writes in its one pass over the
 //! file (`Calibration::run_table`).
 //!
-//! The pipeline of [`Calibration::run`] needs the samples only for four things, and each has a
+//! The pipeline of [`Calibration::run`] needs the samples only for five things, and each has a
 //! streamed form:
 //! - **the classical Haar WV**: streamed from the file for every axis at once
 //!   ([`binary_wavelet_variance`]); identical to the in-memory estimate within 1e-12;
@@ -13,6 +13,9 @@
 //! - **the model selection and the fit**: they use the WV only (`crate::Wic::select_wv`);
 //!   the starting values then come from the WV alone (no series range for drift draws), and
 //!   V is the exact covariance ([`crate::variance::implied_cov`]), which needs no series;
+//! - **the power spectral density**: Welch's estimator takes the samples chunk by chunk
+//!   (`Welch`), so the robust check's pass below feeds it its blocks, in order, and the PSD
+//!   is that of the whole series (without the robust check, no PSD, with a note);
 //! - **the contamination check**: the robust WV is a root per level over all the level's
 //!   coefficients, which an exact streamed computation would need several passes and the
 //!   coefficients near the root for. Here it is estimated on consecutive blocks of
@@ -43,6 +46,7 @@ use crate::inference::Progress;
 use crate::variance::binary_wavelet_variance;
 use crate::variance::ci::eta3;
 use crate::variance::default_levels;
+use crate::variance::psd::{segment_length, Psd, Welch, MIN_SEGMENT};
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
 use crate::wavelet::{Transform, WaveletFilter};
 use rayon::prelude::*;
@@ -248,16 +252,20 @@ impl Calibration {
                 || {
                     robust_opts
                         .as_ref()
-                        .map(|o| robust_pass(path, layout, &streamed, o))
+                        .map(|o| robust_pass(path, layout, &streamed, o, (n, freq_hz)))
                         .transpose()
                 },
             );
             (c?, r?)
         };
-        let left_out = pooled.as_ref().map_or(0, |(_, left_out)| *left_out);
+        let left_out = pooled.as_ref().map_or(0, |(_, left_out, _)| *left_out);
+        let (pooled, psds) = match pooled {
+            Some((p, _, psds)) => (Some(p), Some(psds)),
+            None => (None, None),
+        };
         let robust = pooled
             .zip(robust_opts)
-            .map(|((p, _), o)| robust_wvs(p, &classical, &o));
+            .map(|(p, o)| robust_wvs(p, &classical, &o));
         // an axis whose WV fails (a constant column, say) is left out with a check line, as
         // the in-memory pipeline does; only when every axis fails is that an error
         let mut checks = Vec::new();
@@ -270,6 +278,7 @@ impl Calibration {
                     data[k] = Some(AxisData::Streamed {
                         wv: Box::new(wv),
                         robust: robust.as_ref().map(|r| r[i].clone()),
+                        psd: psds.as_ref().map(|p| p[i].clone()),
                     })
                 }
                 Err(e) => {
@@ -487,24 +496,57 @@ fn classical_pass(
 /// counts (`None` once a block has no root at that level).
 type Pooled = Vec<Vec<Option<(f64, usize)>>>;
 
-/// The blocks' robust WVs of each column, pooled (module docs), and the samples of the short
-/// last block left out.
+/// Each column's Welch PSD from the streamed pass (an error as text: too short, say).
+type StreamedPsds = Vec<Result<Box<Psd>, String>>;
+
+/// The blocks' robust WVs of each column, pooled (module docs), the samples of the short last
+/// block left out of them, and each column's Welch PSD of all its `n` samples at `freq_hz`,
+/// fed block by block.
 fn robust_pass(
     path: &Path,
     layout: &BinaryLayout,
     columns: &[usize],
     opts: &WvOptions,
-) -> Result<(Pooled, usize), Error> {
+    (n, freq_hz): (usize, f64),
+) -> Result<(Pooled, usize, StreamedPsds), Error> {
     let levels = opts.levels.unwrap_or(ROBUST_LEVELS);
     let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, ROBUST_BLOCK)?;
     // per column and level: sum of count x estimate, sum of counts; None once undefined
     let mut pooled: Pooled = vec![vec![Some((0.0, 0)); levels]; columns.len()];
     let mut buffers = vec![Vec::with_capacity(ROBUST_BLOCK); columns.len()];
+    let too_short = || {
+        crate::error::SeriesError::TooShort {
+            n,
+            needed: MIN_SEGMENT,
+            what: "a Welch PSD (one segment)".into(),
+        }
+        .to_string()
+    };
+    let mut welch: Vec<Result<Welch, String>> = (0..columns.len())
+        .map(|_| {
+            let l = segment_length(n).ok_or_else(too_short)?;
+            Welch::new(l, freq_hz).map_err(|e| e.to_string())
+        })
+        .collect();
+    let finish = |welch: Vec<Result<Welch, String>>| -> StreamedPsds {
+        welch
+            .into_iter()
+            .map(|w| Ok(Box::new(w?.finish().map_err(|e| e.to_string())?)))
+            .collect()
+    };
     let mut blocks = 0usize;
     while let Some(rows) = chunks.next_chunk_of(columns, &mut buffers)? {
+        // every sample goes to the PSD; a column whose samples fail keeps its error
+        welch.par_iter_mut().zip(&buffers).for_each(|(w, x)| {
+            if let Ok(acc) = w {
+                if let Err(e) = acc.push(x) {
+                    *w = Err(e.to_string());
+                }
+            }
+        });
         // a short last block holding fewer than 64 windows of the coarsest level is left out
         if rows < 64 << levels && blocks > 0 {
-            return Ok((pooled, rows));
+            return Ok((pooled, rows, finish(welch)));
         }
         blocks += 1;
         let block_levels = levels.min(default_levels(rows, Transform::Modwt, WaveletFilter::Haar));
@@ -536,7 +578,7 @@ fn robust_pass(
             }
         }
     }
-    Ok((pooled, 0))
+    Ok((pooled, 0, finish(welch)))
 }
 
 /// The pooled robust WV of each column (module docs); `classical` gives the intervals'

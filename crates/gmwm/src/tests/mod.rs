@@ -24,6 +24,7 @@ mod model;
 mod monitor;
 mod pooled;
 mod process;
+mod psd;
 mod read;
 mod robust;
 mod ros;

@@ -95,6 +95,13 @@ fn streamed_calibration_matches_in_memory() {
         let c = s.contamination.as_ref().expect("a robust check");
         assert_eq!(c.levels, ROBUST_LEVELS.min(m.wv.wv().len()));
         assert!(!c.matters, "{}: {}", s.column, c.summary);
+        // the PSD fed block by block is the in-memory one: the same segments, in order
+        let (ps, pm) = (s.psd.as_ref().unwrap(), m.psd.as_ref().unwrap());
+        assert_eq!(ps.frequency_hz(), pm.frequency_hz());
+        assert_eq!(ps.unit(), "(rad/s)^2/Hz");
+        for (a, b) in ps.density().iter().zip(pm.density()) {
+            assert!(rel(*a, *b) < 1e-12, "{} PSD {a} vs {b}", s.column);
+        }
     }
 }
 

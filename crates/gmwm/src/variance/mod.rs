@@ -1,5 +1,6 @@
 //! Variances of a series across scales: wavelet variance (classical and robust), Allan, modified
-//! Allan and Hadamard variances, and their confidence intervals.
+//! Allan and Hadamard variances, and their confidence intervals; beside them the power spectral
+//! density by Welch's method (`psd`), the same variance spread over frequency.
 
 pub mod allan;
 pub mod ci;
@@ -10,6 +11,7 @@ pub(crate) mod haar;
 pub(crate) mod haar_robust;
 pub mod implied_cov;
 pub mod pooled;
+pub mod psd;
 pub mod robust;
 pub(crate) mod simd;
 pub(crate) mod stream;
