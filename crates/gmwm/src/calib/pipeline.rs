@@ -671,6 +671,8 @@ impl Calibration {
             self.options.wv.alpha,
             self.options.tolerance,
         );
+        // the spectrum: in the results, and where a vibration line is looked for
+        let psd = psd_of(&data, freq_hz, &unit_label, &mut notes);
         // at most two refinements: a term for the worst miss, then one for the next
         let mut current = (
             selection.selected.to_string(),
@@ -680,7 +682,14 @@ impl Calibration {
             verdict,
         );
         for _ in 0..2 {
-            match self.refine(&selection, &current.1, &wv, &current.4, freq_hz, &mut notes) {
+            match self.refine(
+                &selection,
+                &current.1,
+                &wv,
+                &current.4,
+                (freq_hz, psd.as_ref()),
+                &mut notes,
+            ) {
                 Some(r) => current = r,
                 None => break,
             }
@@ -701,7 +710,6 @@ impl Calibration {
         notes.extend(readings(&selection, &canonical));
         let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
         let datasheet = self.datasheet(kind, unit_kind, &read, &mut notes);
-        let psd = psd_of(&data, freq_hz, &unit_label, &mut notes);
         Ok(AxisCalibration {
             column: column.to_string(),
             kind,
@@ -786,11 +794,11 @@ impl Calibration {
         base: &GmwmFit,
         wv: &WaveletVariance,
         verdict: &FitVerdict,
-        freq_hz: f64,
+        (freq_hz, psd): (f64, Option<&Psd>),
         notes: &mut Vec<String>,
     ) -> Option<(String, GmwmFit, Inference, CanonicalModel, FitVerdict)> {
         let worst = verdict.worst.as_ref()?;
-        let terms = refinement_terms(base, verdict, freq_hz, self.options.tolerance);
+        let terms = refinement_terms(base, verdict, freq_hz, self.options.tolerance, psd);
         let base_objective = base.objective;
         // each candidate term fitted on the same WV; the one that explains the most scales,
         // then the lowest objective, if it explains more than the base and lowers the objective
@@ -1707,15 +1715,24 @@ fn refinement_terms(
     verdict: &FitVerdict,
     freq_hz: f64,
     tolerance: f64,
+    psd: Option<&Psd>,
 ) -> Vec<String> {
     let scales = &verdict.scales;
-    let sin_at = |tau_s: f64| format!("SIN(omega={})", (0.742 / (tau_s * freq_hz)).min(0.45));
+    // a vibration line whose WV peaks at tau, when the spectrum (where there is one) shows a
+    // line near its frequency: else a sinusoid would only bend the model towards the WV's shape
+    let sin_at = |tau_s: f64| {
+        let omega = (0.742 / (tau_s * freq_hz)).min(0.45);
+        psd.map_or(true, |p| has_spectral_line(p, omega * freq_hz))
+            .then(|| format!("SIN(omega={omega})"))
+    };
     let mut terms: Vec<String> = Vec::new();
     for miss in super::verdict::misses(base, verdict) {
         let term = match miss.cause {
-            "hump" => Some(sin_at(miss.tau_s)),
-            // a vibration line near the Nyquist end (the filter is tried below)
-            "sensor filter" => Some(sin_at(miss.tau_s)),
+            "hump" => sin_at(miss.tau_s),
+            // a vibration line near the Nyquist end (the filter is tried below); not at the
+            // first scale, where a line at 0.37 cycles per sample would take the white noise's
+            // variance (the filter's shape is the likelier cause there)
+            "sensor filter" if miss.tau_s * freq_hz > 2.5 => sin_at(miss.tau_s),
             "floor" => Some("FN()".to_string()),
             "long scales" if miss.deviation < 0.0 => Some("RW()".to_string()),
             "overshoot" => {
@@ -1725,7 +1742,7 @@ fn refinement_terms(
                     (j.saturating_sub(2)..(j + 3).min(scales.len().saturating_sub(2)))
                         .filter(|&k| scales[k].deviation < -0.5 * tolerance)
                         .min_by(|&a, &b| scales[a].deviation.total_cmp(&scales[b].deviation))
-                        .map(|k| sin_at(scales[k].tau_s))
+                        .and_then(|k| sin_at(scales[k].tau_s))
                 })
             }
             _ => None,
@@ -1746,6 +1763,37 @@ fn refinement_terms(
     }
     terms
 }
+
+/// Whether the binned spectrum `psd` has a line near `f0` Hz, where a sinusoid whose Haar WV
+/// peaks at the matching scale would put it: a local maximum within an octave of `f0` at least
+/// `LINE_OVER_MEDIAN` times the median density within two octaves (a line, not a slope).
+pub(crate) fn has_spectral_line(psd: &Psd, f0: f64) -> bool {
+    let (f, d) = (psd.frequency_hz(), psd.density());
+    let around: Vec<f64> = f
+        .iter()
+        .zip(d)
+        .filter(|(&f, _)| f >= f0 / 4.0 && f <= 4.0 * f0)
+        .map(|(_, &d)| d)
+        .collect();
+    if around.len() < 3 {
+        return true; // too coarse to tell: no veto
+    }
+    let mut sorted = around.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    (1..d.len().saturating_sub(1)).any(|k| {
+        f[k] >= f0 / 2.0
+            && f[k] <= 2.0 * f0
+            && d[k] > d[k - 1]
+            && d[k] >= d[k + 1]
+            && d[k] >= LINE_OVER_MEDIAN * median
+    })
+}
+
+/// How far above the local median a spectral line must rise ([`has_spectral_line`]): the
+/// binned Welch density scatters by about a quarter at the lowest frequencies of 2^18 samples,
+/// so that the highest of an octave of white-noise bins stays below 1.7 times the median.
+const LINE_OVER_MEDIAN: f64 = 2.0;
 
 /// `nu2_1 / nu2_2` below which the first scales look filtered (white noise gives 2; a
 /// 2-sample moving average 0.8).

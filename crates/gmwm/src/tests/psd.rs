@@ -281,3 +281,27 @@ fn psd_segment_mean_is_removed() {
         );
     }
 }
+
+/// The veto on vibration lines of the calibration's refinement (`calib::pipeline`): a sinusoid
+/// at 7.3 Hz in white noise is a line near 7.3 Hz, and near its WV's hump frequency an octave
+/// off; white noise alone has none at any frequency; a line far from `f0` does not count.
+#[test]
+fn spectral_line_is_found_where_a_sinusoid_is_and_nowhere_in_white_noise() {
+    use gmwm::calib::pipeline::has_spectral_line;
+    let (n, fs) = (1usize << 18, 100.0);
+    let noise = white_noise(n, 1.0, 5);
+    let line: Vec<f64> = noise
+        .iter()
+        .enumerate()
+        .map(|(t, w)| w + 0.3 * (2.0 * std::f64::consts::PI * 7.3 * t as f64 / fs).sin())
+        .collect();
+    let with = welch_psd(&line, fs).unwrap().binned(BINNED_POINTS);
+    let without = welch_psd(&noise, fs).unwrap().binned(BINNED_POINTS);
+    for f0 in [7.3, 5.0, 12.0] {
+        assert!(has_spectral_line(&with, f0), "line near {f0} Hz");
+    }
+    for f0 in [0.05, 0.5, 2.0, 7.3, 20.0, 40.0] {
+        assert!(!has_spectral_line(&without, f0), "white noise at {f0} Hz");
+    }
+    assert!(!has_spectral_line(&with, 0.5), "a line 4 octaves away");
+}
