@@ -694,6 +694,9 @@ impl Calibration {
                 None => break,
             }
         }
+        if let Some(r) = self.flicker_for_gauss_markov(&selection, &current, &wv, &mut notes) {
+            current = r;
+        }
         let (model, fit, inference, canonical, verdict) = current;
         let allan =
             allan_of(&data, freq_hz, self.options.wv.alpha).map_err(|e| errors.engine(e))?;
@@ -877,6 +880,89 @@ impl Calibration {
         ));
         let model = fit.model.without_values().to_string();
         Some((model, fit, inference, canonical, refined))
+    }
+
+    /// A bias-instability floor spent on Gauss–Markov terms (issue 28): when the model has two
+    /// or more AR1/GM terms, the same model with a flicker term `FN()` in their place is fitted
+    /// on the same WV and kept when it explains every scale the model explains and its
+    /// objective is no more than `2` per parameter it saves above the model's (the AIC's
+    /// penalty on the GMWM objective, a chi-square statistic under the efficient weights):
+    /// a floor is then one term with the bias instability as its parameter, instead of
+    /// invented correlation times and a random walk inflated by their tails.
+    #[allow(clippy::type_complexity)]
+    fn flicker_for_gauss_markov(
+        &self,
+        selection: &ModelSelection,
+        current: &(String, GmwmFit, Inference, CanonicalModel, FitVerdict),
+        wv: &WaveletVariance,
+        notes: &mut Vec<String>,
+    ) -> Option<(String, GmwmFit, Inference, CanonicalModel, FitVerdict)> {
+        let (_, base, _, _, verdict) = current;
+        let text = base.model.without_values().to_string();
+        let parts: Vec<&str> = text.split('+').collect();
+        let correlated = |c: &str| c.ends_with("AR1()") || c.ends_with("GM()");
+        let count: usize = parts
+            .iter()
+            .filter(|c| correlated(c))
+            .map(|c| {
+                c.split('*')
+                    .next()
+                    .and_then(|k| k.parse().ok())
+                    .unwrap_or(1)
+            })
+            .sum();
+        if count < 2 || parts.contains(&"FN()") {
+            return None;
+        }
+        let kept: Vec<&str> = parts.into_iter().filter(|c| !correlated(c)).collect();
+        // every correlated term replaced, or all but one (the sensor's sub-sample filter, or a
+        // hump, may need its own)
+        let (candidate, fit, inference, canonical, refined) = ["", "AR1()+"]
+            .into_iter()
+            .filter_map(|one| {
+                let candidate = format!(
+                    "{one}{}",
+                    kept.iter()
+                        .chain(["FN()"].iter())
+                        .copied()
+                        .collect::<Vec<_>>()
+                        .join("+")
+                );
+                let model: Model = candidate.parse().ok()?;
+                let fit = self.refit(model, selection).ok()?;
+                let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
+                let refined = super::verdict::verdict(
+                    &fit,
+                    wv,
+                    &inference,
+                    self.options.wv.alpha,
+                    self.options.tolerance,
+                );
+                let saved = base.theta.len().saturating_sub(fit.theta.len()) as f64;
+                let explains_as_much = verdict
+                    .scales
+                    .iter()
+                    .zip(&refined.scales)
+                    .all(|(b, r)| r.explained || !b.explained);
+                (explains_as_much && fit.objective <= base.objective + 2.0 * saved)
+                    .then_some((candidate, fit, inference, canonical, refined))
+            })
+            .min_by(|a, b| a.1.theta.len().cmp(&b.1.theta.len()))?;
+        let saved = base.theta.len().saturating_sub(fit.theta.len());
+        let sig = |x: f64| crate::fit::report::significant(x, 3);
+        notes.push(format!(
+            "a bias-instability floor: {candidate} explains every scale {text} explains with {} fewer parameters (objective {} -> {}), so a flicker term takes the place of Gauss-Markov terms",
+            saved,
+            sig(base.objective),
+            sig(fit.objective),
+        ));
+        Some((
+            fit.model.without_values().to_string(),
+            fit,
+            inference,
+            canonical,
+            refined,
+        ))
     }
 
     /// The identified fit (the canonical model's reduced model, fitted: a candidate of the

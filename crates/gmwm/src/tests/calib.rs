@@ -525,7 +525,16 @@ fn pooled_calibration_coverage_full() {
 }
 
 fn gyro_axis(truth: &str, full: &str, tolerance: f64) -> gmwm::calib::AxisCalibration {
-    let x = simulate_model(&truth.parse().unwrap(), N, FREQ, 31).unwrap();
+    gyro_axis_of_length(truth, full, tolerance, N)
+}
+
+fn gyro_axis_of_length(
+    truth: &str,
+    full: &str,
+    tolerance: f64,
+    n: usize,
+) -> gmwm::calib::AxisCalibration {
+    let x = simulate_model(&truth.parse().unwrap(), n, FREQ, 31).unwrap();
     let imu = Imu::new(
         vec![column("gyro_x", x)],
         vec![info(Sensor::Gyroscope, Some("rad/s"))],
@@ -642,6 +651,31 @@ fn calibration_finds_the_sensor_filter() {
         a.notes
             .iter()
             .any(|s| s.contains("with MAF(4) in the white noise's place")),
+        "{:?}",
+        a.notes
+    );
+}
+
+/// A bias-instability floor spent on Gauss–Markov terms: white noise, flicker (B = 3.16e-4)
+/// and a random walk over 2.9 h, calibrated among the sub-models of `2*AR1()+WN()+RW()`. The selection's
+/// Gauss–Markov pair is replaced by `FN()`, which explains as much with fewer parameters; B
+/// then comes from the flicker term within 20% of the truth and N within 3%.
+#[test]
+fn calibration_reads_a_flicker_floor_as_flicker() {
+    let truth = "FN(b2=1e-7)+WN(sigma2=1e-4)+RW(gamma2=1e-12)";
+    // 2^20 samples (2.9 h at 100 Hz): at 2^17 the floor is too short to tell from WN + RW
+    let a = gyro_axis_of_length(truth, "2*AR1()+WN()+RW()", 0.1, 1 << 20);
+    assert!(a.identified_model.contains("FN"), "{}", a.identified_model);
+    assert!(a.verdict.explains_wv, "{}", a.verdict.summary);
+    let b = a.bias_instability.as_ref().unwrap();
+    assert!((b.value / 1e-7f64.sqrt() - 1.0).abs() < 0.2, "{b:?}");
+    assert!(b.source.contains("FN"), "{}", b.source);
+    let n = a.noise_density.as_ref().unwrap();
+    assert!((n.value / 1e-3 - 1.0).abs() < 0.03, "{n:?}");
+    assert!(
+        a.notes
+            .iter()
+            .any(|s| s.contains("a bias-instability floor")),
         "{:?}",
         a.notes
     );
