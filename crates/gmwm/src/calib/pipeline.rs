@@ -1625,10 +1625,17 @@ impl<'a> Readoff<'a> {
                 if est.value > b || est.ci_high.is_some_and(|h| h > b) =>
             {
                 let capped_value = est.value > b;
+                let what = if capped_value {
+                    format!("the random-walk term's K = {}", sig(est.value))
+                } else {
+                    format!(
+                        "the upper end of the random-walk term's interval ({}, K = {})",
+                        est.ci_high.map_or_else(|| "none".to_string(), sig),
+                        sig(est.value)
+                    )
+                };
                 notes.push(format!(
-                    "the random-walk term's K = {} (interval up to {}) exceeds what the Allan variance allows: at most {} (the upper end of its band at {} s); {} is exported",
-                    sig(est.value),
-                    est.ci_high.map_or_else(|| "none".to_string(), sig),
+                    "{what} exceeds what the Allan variance allows: at most {} (the upper end of its band at {} s); {} is exported",
                     sig(b),
                     sig(tau_s),
                     if capped_value { "the bound" } else { "the estimate, its interval capped at the bound," }
