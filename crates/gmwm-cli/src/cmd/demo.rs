@@ -175,6 +175,11 @@ fn table(out: &mut impl Write, r: &DemoReport) -> Result<()> {
             p.estimate / p.truth
         )?;
     }
+    for p in &r.parameters {
+        if let Some(why) = far_from_truth(r, p) {
+            writeln!(out, "{why}")?;
+        }
+    }
     writeln!(
         out,
         "objective Q = {:.6e}; optimiser: {}",
@@ -212,4 +217,42 @@ impl Command for DemoConfig {
     fn run(&self, _: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
         run(self, &mut out)
     }
+}
+
+/// For an estimate more than 2x from the truth: where its term carries the WV (over half of the
+/// truth's implied WV) and how wide the empirical WV's interval is there, which is why (one
+/// line), or `None`.
+fn far_from_truth(r: &DemoReport, p: &TruthVsEstimate) -> Option<String> {
+    let ratio = p.estimate / p.truth;
+    if (0.5..=2.0).contains(&ratio) {
+        return None;
+    }
+    let k: usize = p.name.split(['[', ']']).nth(1)?.parse().ok()?;
+    let (wv, implied) = (r.empirical, r.implied);
+    let term = &implied.processes.get(k)?.wv;
+    let levels: Vec<usize> = (0..wv.levels().min(term.len()))
+        .filter(|&j| term[j] > 0.5 * implied.wv[j])
+        .collect();
+    let (&first, &last) = (levels.first()?, levels.last()?);
+    let span = |j: usize| wv.ci_high()[j] / wv.ci_low()[j];
+    let (lo, hi) = levels
+        .iter()
+        .map(|&j| span(j))
+        .fold((f64::INFINITY, 0.0f64), |(a, b), s| (a.min(s), b.max(s)));
+    Some(format!(
+        "  {} is {}: its term carries the WV only at levels {}-{} ({:.0}-{:.0} s), where the 95% interval spans {:.0}-{:.0}x; at {} samples the data pin it down no better (`gmwm fit --inference` gives its interval)",
+        p.name,
+        if ratio < 1.0 {
+            format!("{:.0}x below the truth", 1.0 / ratio)
+        } else {
+            format!("{ratio:.0}x above the truth")
+        },
+        first + 1,
+        last + 1,
+        wv.tau_s()[first],
+        wv.tau_s()[last],
+        lo,
+        hi,
+        r.n
+    ))
 }
