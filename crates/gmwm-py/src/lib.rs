@@ -630,7 +630,7 @@ fn read<'py>(
 /// `arrays` named `names` with `units` at `freq`, or of the recordings at `paths` calibrated as
 /// one sensor (`gmwm calibrate --pool`).
 #[pyfunction]
-#[pyo3(signature = (path=None, arrays=None, paths=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, tolerance=0.1, force_units=false, progress=None))]
+#[pyo3(signature = (path=None, arrays=None, paths=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, tolerance=0.1, force_units=false, datasheet=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn calibrate(
     py: Python<'_>,
@@ -665,6 +665,7 @@ fn calibrate(
     rostopic: Option<String>,
     tolerance: f64,
     force_units: bool,
+    datasheet: Option<&str>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     if !(tolerance > 0.0 && tolerance <= 1.0) {
@@ -705,6 +706,12 @@ fn calibrate(
         robust_check: Some(RobustOptions::new(eff, convention).map_err(engine)?),
         tolerance,
         force_units,
+        datasheet: datasheet
+            .map(|t| {
+                t.parse::<gmwm::calib::Datasheet>()
+                    .map_err(|e| err(format!("invalid datasheet {t:?}: {e}")))
+            })
+            .transpose()?,
         ..CalibrationOptions::default()
     };
     let policy: AxisPolicy = choice("axis_policy", axis_policy)?;

@@ -188,6 +188,20 @@ def test_calibrate_tolerance_reaches_the_verdict(imu):
         gmwm.calibrate(imu, freq=100, names=names, model="WN()", tolerance=2.0)
 
 
+def test_calibrate_compares_with_a_datasheet(imu):
+    names = ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]
+    units = ["rad/s"] * 3 + ["m/s^2"] * 3
+    cal = gmwm.calibrate(
+        imu, freq=100, names=names, units=units, model="WN()", bootstrap=10, G=200, datasheet="N=2 deg/sqrt(h)"
+    )
+    n = cal.axis("gyro_x")["datasheet"]["N"]
+    # 2 deg/sqrt(h) = 2 (pi / 180) / 60 rad/s/sqrt(Hz)
+    assert abs(n["value_si"] / (2 * np.pi / 180 / 60) - 1) < 1e-12, n
+    assert "N" not in (cal.axis("accel_x").get("datasheet") or {})
+    with pytest.raises(ValueError, match="datasheet"):
+        gmwm.calibrate(imu, freq=100, names=names, model="WN()", datasheet="N=2 furlongs")
+
+
 def test_progress_is_called_and_the_gil_is_released(imu):
     import threading
 

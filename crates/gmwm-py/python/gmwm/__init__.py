@@ -239,7 +239,9 @@ def calibrate(
     verdict, the contamination check, the navigation sets): ``gyro_unit``, ``accel_unit``,
     ``model``, ``rule``, ``bootstrap``, ``covariance``, ``G``, ``seed``, ``eff``, ``robust``, ``alpha``,
     ``axis_policy``, ``inflate``, ``conservative``, ``rostopic``, ``tolerance`` (the verdict's,
-    0.1), ``force_units`` (unit flags on a ROS recording); for a path also the read options
+    0.1), ``force_units`` (unit flags on a ROS recording), ``datasheet`` (as ``gmwm calibrate
+    --datasheet``: "N=2 deg/sqrt(h), B=25.2 deg/h, N=0.2 m/s/sqrt(h)", compared per axis in
+    ``axes[].datasheet``); for a path also the read options
     (``columns``, ``format``, ``topic``, ...)."""
     if _is_path(data):
         doc = _native.calibrate(path=os.fspath(data), freq=freq, draws=G, progress=progress, **options)
