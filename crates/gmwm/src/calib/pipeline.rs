@@ -815,16 +815,8 @@ impl Calibration {
                     .filter(|c| !(term.starts_with("MAF") && *c == "WN()"))
                     .collect();
                 let text = format!("{}+{term}", kept.join("+"));
-                let model: Model = text.parse().ok()?;
-                let fit = self.refit(model, selection).ok()?;
-                let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
-                let refined = super::verdict::verdict(
-                    &fit,
-                    wv,
-                    &inference,
-                    self.options.wv.alpha,
-                    self.options.tolerance,
-                );
+                let (fit, inference, canonical, refined) =
+                    self.judged(text.parse().ok()?, selection, wv)?;
                 (refined.scales_missed < verdict.scales_missed && fit.objective < base_objective)
                     .then_some((term, fit, inference, canonical, refined))
             })
@@ -839,19 +831,9 @@ impl Calibration {
         let reduced = &canonical.reduced;
         let identified = (reduced.without_values().to_string()
             != fit.model.without_values().to_string())
-        .then(|| {
-            let fit = self.refit(reduced.clone(), selection).ok()?;
-            let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
-            let v = super::verdict::verdict(
-                &fit,
-                wv,
-                &inference,
-                self.options.wv.alpha,
-                self.options.tolerance,
-            );
-            (v.scales_missed <= refined.scales_missed).then_some((fit, inference, canonical, v))
-        })
-        .flatten();
+        .then(|| self.judged(reduced.clone(), selection, wv))
+        .flatten()
+        .filter(|j| j.3.scales_missed <= refined.scales_missed);
         let (fit, inference, canonical, refined) =
             identified.unwrap_or((fit, inference, canonical, refined));
         let replaced = term.starts_with("MAF")
@@ -928,16 +910,8 @@ impl Calibration {
                         .collect::<Vec<_>>()
                         .join("+")
                 );
-                let model: Model = candidate.parse().ok()?;
-                let fit = self.refit(model, selection).ok()?;
-                let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
-                let refined = super::verdict::verdict(
-                    &fit,
-                    wv,
-                    &inference,
-                    self.options.wv.alpha,
-                    self.options.tolerance,
-                );
+                let (fit, inference, canonical, refined) =
+                    self.judged(candidate.parse().ok()?, selection, wv)?;
                 let saved = base.theta.len().saturating_sub(fit.theta.len()) as f64;
                 let explains_as_much = verdict
                     .scales
@@ -979,6 +953,27 @@ impl Calibration {
         };
         let (inference, canonical) = self.infer_on(selection, &fit)?;
         Ok((fit, inference, canonical))
+    }
+
+    /// `model` fitted on the selection's WV, its inference on the selection's V, its canonical
+    /// model and its verdict: a candidate of refinement, judged as the selection is. `None`
+    /// when it cannot be fitted.
+    fn judged(
+        &self,
+        model: Model,
+        selection: &ModelSelection,
+        wv: &WaveletVariance,
+    ) -> Option<(GmwmFit, Inference, CanonicalModel, FitVerdict)> {
+        let fit = self.refit(model, selection).ok()?;
+        let (inference, canonical) = self.infer_on(selection, &fit).ok()?;
+        let v = verdict(
+            &fit,
+            wv,
+            &inference,
+            self.options.wv.alpha,
+            self.options.tolerance,
+        );
+        Some((fit, inference, canonical, v))
     }
 
     /// `model` fitted on the selection's WV, with the options' seed and draws.

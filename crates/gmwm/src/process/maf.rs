@@ -32,7 +32,6 @@
 //! `L - 1` innovations before the first sample, [`StartMode::Zero`] takes them as 0. Cost: one
 //! normal draw and two adds per sample.
 
-use super::draw::{Dominance, Draw};
 use super::{
     half_widths, LatentProcess, Occurs, Orders, ParamTransform, Params, ProcessKind, Role,
     Simulate, Spec, BASE,
@@ -62,30 +61,12 @@ pub(crate) const SPEC: Spec = Spec {
     build: |kind, v, _| Ok(Maf::new(kind.orders().1, v[0])?.into()),
     role: Role::WhiteNoise,
     transforms: |_, _| vec![ParamTransform::Log],
-    draw,
+    // as white noise's: the starting value and the read-off of a long-run variance
+    draw: super::wn::draw,
     unit_shapes: |_, _| vec![(vec![1.0], |t| t)],
-    physical: |v, f, u| {
-        vec![(
-            "white_noise_density",
-            (v[0] / f).sqrt(),
-            format!("{u}/sqrt(Hz)"),
-        )]
-    },
+    physical: super::wn::white_noise_density,
     ..BASE
 };
-
-/// Starting value: as white noise's (docs/methods.md §6.3), `U(sigma2_T / 2, sigma2_T)` where
-/// white noise dominates the first scales, else `U(1e-5 sigma2_T, 0.1 sigma2_T)`.
-fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
-    let (st, dominant) = (d.ctx.sigma2_t, d.ctx.only_wn || d.ctx.dom == Dominance::Wn);
-    out.push(given[0].unwrap_or_else(|| {
-        if dominant {
-            d.unif(st / 2.0, st)
-        } else {
-            d.unif(1e-5 * st, 0.1 * st)
-        }
-    }));
-}
 
 /// White noise through an `L`-sample moving average; `sigma2` is its long-run variance per
 /// sample (module doc).

@@ -25,19 +25,24 @@ pub(crate) const SPEC: Spec = Spec {
     transforms: |_, _| vec![ParamTransform::Log],
     draw,
     unit_shapes: |_, _| vec![(vec![1.0], |t| t)],
-    physical: |v, f, u| {
-        vec![(
-            "white_noise_density",
-            (v[0] / f).sqrt(),
-            format!("{u}/sqrt(Hz)"),
-        )]
-    },
+    physical: white_noise_density,
     ..BASE
 };
 
+/// The white-noise density `sqrt(sigma2 / f)` of a term whose first parameter is its (long-run)
+/// per-sample variance: WN, and the filter term `MAF(L)` (`maf.rs`).
+pub(crate) fn white_noise_density(v: &[f64], f: f64, u: &str) -> Vec<super::Physical> {
+    vec![(
+        "white_noise_density",
+        (v[0] / f).sqrt(),
+        format!("{u}/sqrt(Hz)"),
+    )]
+}
+
 /// docs/methods.md §6.3: `U(sigma2_T / 2, sigma2_T)` where white noise dominates the first
-/// scales (or is the only term), else `U(1e-5 sigma2_T, 0.1 sigma2_T)`.
-fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
+/// scales (or is the only term), else `U(1e-5 sigma2_T, 0.1 sigma2_T)`; also the filter term's
+/// (`maf.rs`).
+pub(crate) fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
     let (st, dominant) = (d.ctx.sigma2_t, d.ctx.only_wn || d.ctx.dom == Dominance::Wn);
     out.push(given[0].unwrap_or_else(|| {
         if dominant {
