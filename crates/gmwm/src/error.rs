@@ -60,7 +60,7 @@ pub enum ModelError {
     Empty,
     /// WN, QN, RW or DR (or an ARMA kind) appears more than once.
     #[error(
-        "{kind} appears {count} times but may appear at most once; only GM and AR1 may repeat \
+        "{kind} appears {count} times but may appear at most once; only GM, AR1 and SIN may repeat \
          (docs/methods.md §0.2)"
     )]
     Repeated {

@@ -817,8 +817,10 @@ impl Calibration {
                 let text = format!("{}+{term}", kept.join("+"));
                 let (fit, inference, canonical, refined) =
                     self.judged(text.parse().ok()?, selection, wv)?;
-                (refined.scales_missed < verdict.scales_missed && fit.objective < base_objective)
-                    .then_some((term, fit, inference, canonical, refined))
+                (refined.scales_missed < verdict.scales_missed
+                    && fit.objective < base_objective
+                    && vibration_on_spectral_lines(&canonical, psd))
+                .then_some((term, fit, inference, canonical, refined))
             })
             .min_by(|a, b| {
                 (a.4.scales_missed, a.1.objective)
@@ -833,7 +835,9 @@ impl Calibration {
             != fit.model.without_values().to_string())
         .then(|| self.judged(reduced.clone(), selection, wv))
         .flatten()
-        .filter(|j| j.3.scales_missed <= refined.scales_missed);
+        .filter(|j| {
+            j.3.scales_missed <= refined.scales_missed && vibration_on_spectral_lines(&j.2, psd)
+        });
         let (fit, inference, canonical, refined) =
             identified.unwrap_or((fit, inference, canonical, refined));
         let replaced = term.starts_with("MAF")
@@ -1856,6 +1860,32 @@ fn refinement_terms(
 /// peaks at the matching scale would put it: a local maximum within an octave of `f0` at least
 /// `LINE_OVER_MEDIAN` times the median density within two octaves (a line, not a slope).
 pub(crate) fn has_spectral_line(psd: &Psd, f0: f64) -> bool {
+    spectral_line_within(psd, f0, 2.0)
+}
+
+/// Whether every vibration line of `canonical` (each term's physical `frequency`) lies on a
+/// line of the spectrum, within a factor [`LINE_MATCH`] of its frequency: a sinusoid the fit
+/// moved off the line it started from is bending the model towards the WV's shape (the
+/// sensor's roll-off above 10 Hz on the ADIS accelerometers took a 13.6 Hz "line" of three
+/// times the power of the 10 Hz one and cut N by 27%), not measuring a vibration. True
+/// without a spectrum.
+fn vibration_on_spectral_lines(canonical: &CanonicalModel, psd: Option<&Psd>) -> bool {
+    let Some(psd) = psd else { return true };
+    canonical
+        .terms
+        .iter()
+        .flat_map(|t| &t.physical)
+        .filter(|p| p.name == "frequency")
+        .all(|p| spectral_line_within(psd, p.value, LINE_MATCH))
+}
+
+/// How close to a spectral line a fitted vibration frequency must lie
+/// ([`vibration_on_spectral_lines`]): two bins of the binned spectrum (about 11% apart); the
+/// shared recordings' fitted lines lie within 11% of their bins, the roll-off's within 36%.
+pub(crate) const LINE_MATCH: f64 = 1.25;
+
+/// [`has_spectral_line`] with the local maximum within a factor `within` of `f0`.
+pub(crate) fn spectral_line_within(psd: &Psd, f0: f64, within: f64) -> bool {
     let (f, d) = (psd.frequency_hz(), psd.density());
     let around: Vec<f64> = f
         .iter()
@@ -1870,8 +1900,8 @@ pub(crate) fn has_spectral_line(psd: &Psd, f0: f64) -> bool {
     sorted.sort_by(f64::total_cmp);
     let median = sorted[sorted.len() / 2];
     (1..d.len().saturating_sub(1)).any(|k| {
-        f[k] >= f0 / 2.0
-            && f[k] <= 2.0 * f0
+        f[k] >= f0 / within
+            && f[k] <= within * f0
             && d[k] > d[k - 1]
             && d[k] >= d[k + 1]
             && d[k] >= LINE_OVER_MEDIAN * median

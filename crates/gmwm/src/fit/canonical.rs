@@ -752,6 +752,23 @@ impl GmwmFit {
                 _ => terms_parts.push(p.clone()),
             }
         }
+        // a component rule 2 read as white noise or a random walk stands in that term even when
+        // a later refit moved its share into another part and dropped the merged one
+        for r in &readings {
+            let (role, c) = match *r {
+                Reading::WhiteAtObservedScales { component, .. } => (Role::WhiteNoise, component),
+                Reading::RandomWalkAtObservedScales { component, .. } => {
+                    (Role::RandomWalk, component)
+                }
+                _ => continue,
+            };
+            if let Some(p) = terms_parts.iter_mut().find(|p| p.role() == role) {
+                if !p.from.contains(&c) {
+                    p.from.push(c);
+                    p.from.sort_unstable();
+                }
+            }
+        }
         let terms_parts = canonical_order(terms_parts, freq);
         let guess =
             |parts: &[Part]| Model::new(parts.iter().map(|p| Component::guess(p.kind())).collect());
@@ -994,14 +1011,16 @@ fn model_of(parts: &[Part]) -> Result<Model, crate::model::ModelError> {
 }
 
 /// Canonical term order: by role ([`Role`]: correlated terms by decreasing correlation time
-/// (phi decreasing), then WN, QN, FN, RW, DR, then anything else), in the given order within a
-/// role.
+/// (phi decreasing), then WN, QN, FN, RW, DR, then anything else), within a role by the kind's
+/// rank (vibration lines by frequency), else in the given order.
 fn canonical_order(mut parts: Vec<Part>, freq_hz: f64) -> Vec<Part> {
     let phi = |p: &Part| p.ar1(freq_hz).map_or(0.0, |a| a.phi);
+    let rank = |p: &Part| (spec(p.kind()).rank)(&p.values());
     parts.sort_by(|a, b| {
         a.role()
             .cmp(&b.role())
             .then_with(|| phi(b).total_cmp(&phi(a)))
+            .then_with(|| rank(a).total_cmp(&rank(b)))
     });
     parts
 }

@@ -20,7 +20,7 @@
 //! (WN at 3, ...), which is rarely what the user meant.
 //!
 //! # Rules (docs/methods.md §0.2, plus one of ours)
-//! - `GM` and `AR1` may repeat (`k*GM()`), but may not be mixed in one model;
+//! - `GM`, `AR1` and `SIN` may repeat (`k*GM()`), but GM and AR1 may not be mixed in one model;
 //! - `WN`, `QN`, `RW`, `DR` appear at most once each (identifiability);
 //! - **at most one ARMA-family term** (`MA1`, `ARMA11`, `AR(p)`, `MA(q)`, `ARMA(p,q)`): two such
 //!   terms are not identifiable from one another by the wavelet variance (a sum of ARMAs is an
@@ -261,17 +261,15 @@ pub(crate) fn validate(components: &[Component]) -> Result<(), (usize, ModelErro
     let mixed = KINDS.iter().find_map(|&kind| {
         let base = spec(kind).reparametrises?;
         let (n, m) = (count(kind), count(base));
-        (n > 0 && m > 0).then_some((n, m))
+        (n > 0 && m > 0).then_some((kind, base, n, m))
     });
-    if let Some((gm, ar1)) = mixed {
-        // point at the first component of whichever kind came second
-        let first_rep = components
-            .iter()
-            .find(|c| c.kind.may_repeat())
-            .map(|c| c.kind);
+    if let Some((kind, base, gm, ar1)) = mixed {
+        // point at the first component of whichever of the two kinds came second
+        let pair = |c: &&Component| c.kind == kind || c.kind == base;
+        let first = components.iter().find(pair).map(|c| c.kind);
         let at = components
             .iter()
-            .position(|c| c.kind.may_repeat() && Some(c.kind) != first_rep)
+            .position(|c| pair(&c) && Some(c.kind) != first)
             .unwrap_or(0);
         return Err((at, ModelError::GmAr1Mixed { gm, ar1 }));
     }

@@ -14,7 +14,7 @@
 //! ```
 //! - Process and parameter names are ASCII case-insensitive; whitespace may appear between any
 //!   two tokens; `WN` without `()` is accepted (guess mode).
-//! - `k*X(...)` repeats X k times with the same values; only GM and AR1 may repeat.
+//! - `k*X(...)` repeats X k times with the same values; only GM, AR1 and SIN may repeat.
 //! - Parameter names are those of [`ProcessKind::param_names`] (`phi`, `sigma2`, `sigma2_gm`,
 //!   `ar1`, `ma2`, ...); fewer values than parameters leave the rest unspecified (`None`).
 //! - ARMA values are given after the orders: `ARMA(p,q)(...)`, likewise `AR(p)(...)`.
@@ -253,7 +253,7 @@ pub(crate) fn parse_model(text: &str) -> Res<Model> {
 fn rule_texts(e: &ModelError) -> (String, String) {
     match e {
         ModelError::Repeated { kind, count } => (
-            format!("{kind} at most once (docs/methods.md §0.2: only GM and AR1 may repeat)"),
+            format!("{kind} at most once (docs/methods.md §0.2: only GM, AR1 and SIN may repeat)"),
             format!("{kind} {count} times"),
         ),
         ModelError::GmAr1Mixed { gm, ar1 } => (

@@ -106,6 +106,7 @@ pub(crate) const GM_SPEC: Spec = Spec {
         forms: gm_forms,
     }),
     physical: |v, freq_hz, u| markov_physical(v, freq_hz, u, gm_forms),
+    ..BASE
 };
 
 /// docs/methods.md §4.3: `(phi, sigma2, beta, sigma2_gm)` of an AR1 `[phi, sigma2]`.

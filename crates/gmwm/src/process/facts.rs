@@ -63,6 +63,10 @@ pub(crate) struct Spec {
     /// Its physical read-off at a rate, the data unit named `unit` (docs/methods.md §14):
     /// `(name, value, unit)`; none by default.
     pub(crate) physical: fn(&[f64], f64, &str) -> Vec<Physical>,
+    /// Its place among the terms of its role in the canonical model, ascending, from its values
+    /// (a repeated kind's terms in a fixed order, e.g. vibration lines by frequency); `0` by
+    /// default (the fitted order kept).
+    pub(crate) rank: fn(&[f64]) -> f64,
 }
 
 /// What a term is to a navigation filter, in the canonical model's order (docs/methods.md
@@ -129,6 +133,7 @@ pub(crate) const BASE: Spec = Spec {
     unit_shapes: |_, _| Vec::new(),
     markov: None,
     physical: |_, _, _| Vec::new(),
+    rank: |_| 0.0,
 };
 
 /// The one-parameter kind of a role (white noise, random walk, ...): the first in the table.

@@ -43,7 +43,7 @@ use crate::process::StartMode;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// `SIN(amplitude, omega)`: at most once in a model; no navigation read-off of N, K, B, its
+/// `SIN(amplitude, omega)`: any number of times in a model (one per vibration line); no navigation read-off of N, K, B, its
 /// physical read-off is its frequency (Hz) and amplitude.
 pub(crate) const SPEC: Spec = Spec {
     name: "SIN",
@@ -56,12 +56,14 @@ pub(crate) const SPEC: Spec = Spec {
         (0, 0),
     ),
     orders: None,
-    occurs: Occurs::Once,
+    occurs: Occurs::Repeats,
     build: |_, v, _| Ok(Sin::new(v[0], v[1])?.into()),
     role: Role::Periodic,
     transforms: |_, _| vec![ParamTransform::Log, ParamTransform::LogitHalf],
     draw,
     physical,
+    // several vibration lines are listed by frequency
+    rank: |v| v[1],
     ..BASE
 };
 
@@ -83,17 +85,30 @@ const HUMP_HEIGHT: f64 = 0.525;
 
 /// The humps of the empirical WV: the levels among `2..=J - 3` (the last levels are too noisy
 /// to place a hump) where it exceeds the geometric mean of its neighbours (`ln nu2` locally
-/// concave), as `(tau_j, nu2_j - sqrt(nu2_{j-1} nu2_{j+1}))`, largest excess first.
+/// concave) by a larger share than at the levels either side (one entry per hump, not one per
+/// level of a wide hump), as `(tau_j, nu2_j - sqrt(nu2_{j-1} nu2_{j+1}))`, largest excess first
+/// (a sinusoid's side lobes, beside the zeros of its WV, are humps of large share and small
+/// excess).
 fn wv_humps(wv: &[f64]) -> Vec<(f64, f64)> {
     let last = wv.len().saturating_sub(3);
+    let share = |j: usize| {
+        if j == 0 || j + 1 >= wv.len() {
+            return f64::NEG_INFINITY;
+        }
+        let mean = (wv[j - 1] * wv[j + 1]).sqrt();
+        let e = (wv[j] - mean) / mean;
+        if e.is_finite() {
+            e
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
     let mut humps: Vec<(f64, f64)> = (1..last)
+        .filter(|&j| share(j) > 0.0 && share(j) >= share(j - 1) && share(j) >= share(j + 1))
         .map(|j| {
-            (
-                2f64.powi(j as i32 + 1),
-                wv[j] - (wv[j - 1] * wv[j + 1]).sqrt(),
-            )
+            let e = wv[j] - (wv[j - 1] * wv[j + 1]).sqrt();
+            (2f64.powi(j as i32 + 1), e)
         })
-        .filter(|&(_, e)| e > 0.0 && e.is_finite())
         .collect();
     humps.sort_by(|a, b| b.1.total_cmp(&a.1));
     humps
@@ -102,7 +117,8 @@ fn wv_humps(wv: &[f64]) -> Vec<(f64, f64)> {
 /// Starting values (the §6.3 search, paper Appendix C, extended): a sinusoid's signature is
 /// a hump peaking at `tau = 0.742 / omega` samples of height about `0.525 amplitude^2 / 2`
 /// (module doc). [`HUMP_SHARE`] of the draws start at one of the two largest humps of the
-/// empirical WV ([`wv_humps`]), at random:
+/// empirical WV ([`wv_humps`]), at random (at the hump nearest a given `omega`'s peak when
+/// `omega` is given):
 /// `omega` log-uniform within a factor 2 of `0.742 / tau` (one level either side) and
 /// `amplitude^2 / 2` within a factor 3 of the excess over `0.525`. The others, and all
 /// draws when the WV has no hump, are broad: `omega` log-uniform between two cycles over the
@@ -113,10 +129,22 @@ fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f
     let st = d.ctx.sigma2_t;
     let humps = wv_humps(&d.ctx.wv);
     let hump = if !humps.is_empty() && d.unif(0.0, 1.0) < HUMP_SHARE {
-        // one of the two largest humps, at random
-        let k = humps.len().min(2);
-        let i = (d.unif(0.0, k as f64) as usize).min(k - 1);
-        Some(humps[i])
+        match given[1] {
+            // the hump where the given line's WV peaks
+            Some(omega) => {
+                let peak = 2.0 * HUMP_X / (PI * omega);
+                humps
+                    .iter()
+                    .copied()
+                    .min_by(|a, b| (a.0 / peak).ln().abs().total_cmp(&(b.0 / peak).ln().abs()))
+            }
+            // one of the two largest humps, at random
+            None => {
+                let k = humps.len().min(2);
+                let i = (d.unif(0.0, k as f64) as usize).min(k - 1);
+                Some(humps[i])
+            }
+        }
     } else {
         None
     };
@@ -335,6 +363,18 @@ mod tests {
         assert_eq!(tau, 128.0);
         assert!(excess > 0.0);
         assert!(wv_humps(&[1.0, 0.5, 0.25, 0.125, 0.0625, 0.03]).is_empty());
+        // two lines over white noise: one entry per line (a wide hump spans two levels), the
+        // larger excess first, so that two SIN() draws start at both
+        let (a, b) = (
+            Sin::new(1.0, 0.073).unwrap(),
+            Sin::new(0.4, 0.0055).unwrap(),
+        );
+        let wv: Vec<f64> = (a.wv(18).iter().zip(b.wv(18)))
+            .zip(half_widths(18))
+            .map(|((x, y), m)| x + y + 1.0 / (2.0 * m))
+            .collect();
+        let taus: Vec<f64> = wv_humps(&wv).iter().take(2).map(|h| h.0).collect();
+        assert_eq!(taus, [16.0, 128.0], "{:?}", wv_humps(&wv));
     }
 
     /// The f64 hot path and the jets agree; the §4.1 sum agrees at the first levels.

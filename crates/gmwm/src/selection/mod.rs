@@ -124,7 +124,9 @@ pub enum SelectionError {
         kind: ProcessKind,
     },
     /// WN, QN, RW or DR more than once in a candidate.
-    #[error("candidate {candidate}: {kind} appears more than once; only AR1 and GM may repeat")]
+    #[error(
+        "candidate {candidate}: {kind} appears more than once; only AR1, GM and SIN may repeat"
+    )]
     Repeated {
         /// Text of the candidate.
         candidate: String,

@@ -595,6 +595,36 @@ fn verdict_explains_the_true_model_and_names_a_missing_hump() {
     }
 }
 
+/// Two vibration lines (a bench at 0.4 Hz, a fan at 5 Hz): a selection among `WN()+RW()`
+/// misses both humps, and the refinement adds one `SIN()` per line, each on its spectral line,
+/// listed by frequency in the canonical model, with the white-noise density kept.
+#[test]
+fn refinement_adds_one_vibration_line_per_hump() {
+    let truth = "WN(sigma2=1e-4)+SIN(amplitude=0.02, omega=0.05)+SIN(amplitude=0.01, omega=0.004)";
+    let axis = gyro_axis(truth, "WN()+RW()", 0.1);
+    assert!(
+        axis.model.contains("2*SIN()"),
+        "{}: {:?}",
+        axis.model,
+        axis.notes
+    );
+    assert!(axis.verdict.explains_wv, "{}", axis.verdict.summary);
+    let lines: Vec<f64> = axis
+        .canonical
+        .terms
+        .iter()
+        .flat_map(|t| &t.physical)
+        .filter(|p| p.name == "frequency")
+        .map(|p| p.value)
+        .collect();
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    for (f, truth) in lines.iter().zip([0.4, 5.0]) {
+        assert!((f / truth - 1.0).abs() < 0.02, "{lines:?}");
+    }
+    let n = axis.noise_density.as_ref().unwrap().value;
+    assert!((n / 1e-3 - 1.0).abs() < 0.03, "N {n}");
+}
+
 /// A Gauss–Markov term is not a random walk: without a random-walk term K is the Allan-band
 /// bound, marked as one, whatever the slowest correlated term's driving noise.
 #[test]

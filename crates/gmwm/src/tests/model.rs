@@ -317,12 +317,27 @@ fn model_rule_violations_are_rejected() {
         ("2*WN()", 1),
         ("GM()+WN()+AR1()", 11),
         ("WN()+2*AR1()+GM()", 14),
+        // a repeated vibration line does not hide which of GM and AR1 came second
+        ("2*SIN()+GM()+WN()+AR1()", 19),
         ("MA1()+ARMA(1,1)", 7),
     ] {
         let e = Model::parse(text).unwrap_err();
         assert!(matches!(e.kind(), ParseErrorKind::Rule(_)), "{text}: {e}");
         assert_eq!(e.column(), column, "{text}: {e}\n{}", e.render());
     }
+}
+
+/// Vibration lines repeat (one `SIN()` per line, issue 28) like AR1/GM terms: `k*SIN()` parses,
+/// prints back collapsed, and mixes with one repeating AR1 kind.
+#[test]
+fn vibration_lines_may_repeat() {
+    for text in ["2*SIN()+WN()", "2*AR1()+WN()+RW()+2*SIN()"] {
+        let m = Model::parse(text).unwrap();
+        assert_eq!(m.to_string(), text);
+        assert_eq!(m.count(ProcessKind::Sin), 2);
+    }
+    let m = Model::parse("SIN(amplitude=1, omega=0.1)+SIN(amplitude=2, omega=0.01)").unwrap();
+    assert_eq!(m.count(ProcessKind::Sin), 2);
 }
 
 /// Coarse error classes for the bad-string table.

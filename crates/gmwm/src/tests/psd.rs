@@ -304,4 +304,18 @@ fn spectral_line_is_found_where_a_sinusoid_is_and_nowhere_in_white_noise() {
         assert!(!has_spectral_line(&without, f0), "white noise at {f0} Hz");
     }
     assert!(!has_spectral_line(&with, 0.5), "a line 4 octaves away");
+    // a fitted vibration frequency must lie on the line, not an octave off
+    use gmwm::calib::pipeline::{spectral_line_within, LINE_MATCH};
+    for f0 in [7.3, 6.5, 8.5] {
+        assert!(
+            spectral_line_within(&with, f0, LINE_MATCH),
+            "{f0} Hz on the line"
+        );
+    }
+    for f0 in [5.0, 10.0, 12.0] {
+        assert!(
+            !spectral_line_within(&with, f0, LINE_MATCH),
+            "{f0} Hz off the line"
+        );
+    }
 }
