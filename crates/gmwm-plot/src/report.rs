@@ -395,7 +395,8 @@ fn datasheet_table(out: &mut String, d: &DatasheetComparison) {
     }
     out.push_str(
         "</tbody></table>\n<p class=\"small\">The measured values are those of the \
-        Estimates table (N and K from the GMWM fit, B from the Allan deviation's minimum / 0.664); \
+        Estimates table, whose source column says where each comes from (a term of the GMWM fit; \
+        B from a flicker term, else the Allan deviation's floor / 0.664); \
         the figures draw the datasheet's lines dashed grey.</p>\n",
     );
 }
@@ -406,13 +407,24 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
         out,
         "<section class=\"axis\" id=\"axis-{id}\"><h2>{id}</h2>"
     );
+    let selected = a.selection.selected().without_values().to_string();
+    let reason = a.selection.reason();
+    // the refinement guided by the WV's shape may have changed the selection's model
+    let how = if selected == a.model {
+        esc(&capitalised(&reason))
+    } else {
+        format!(
+            "The WIC selected {} ({}); the notes below say how the WV's shape refined it.",
+            esc(&selected),
+            esc(reason.trim_end_matches('.'))
+        )
+    };
     let _ = writeln!(
         out,
-        "<p>Selected <b>{}</b> (canonical model {}; estimates from the identified fit of {}). {}</p>",
+        "<p>Model <b>{}</b> (canonical model {}; estimates from the identified fit of {}). {how}</p>",
         esc(&a.model),
         esc(&a.canonical_model),
         esc(&a.identified_model),
-        esc(&capitalised(&a.selection.reason()))
     );
     let unit = a.unit.as_str();
 

@@ -1168,9 +1168,17 @@ impl ModelSelection {
             }
             _ => "it has fewer parameters",
         };
+        // a row tied with the first (WIC_TIE_REL, ranked by fewer parameters) may lie below it
+        let side = if sel.delta_wic >= 0.0 {
+            "above the minimum"
+        } else {
+            "below the first row, a tie ranked by fewer parameters"
+        };
         format!(
-            "WIC {:.3e} above the minimum ({}), within one standard error ({:.3e}); {why}",
-            sel.delta_wic, self.rows[0].score.canonical_model, sel.delta_wic_se
+            "WIC {:.3e} {side} ({}), within one standard error ({:.3e}); {why}",
+            sel.delta_wic.abs(),
+            self.rows[0].score.canonical_model,
+            sel.delta_wic_se
         )
     }
 }
