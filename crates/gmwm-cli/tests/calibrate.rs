@@ -376,3 +376,53 @@ fn calibrate_checks_units() {
         &["--tolerance", "(0, 1]"],
     );
 }
+
+/// `gmwm calibrate` on a saved wavelet variance: the precomputed WV of adis_16405_imu1 (the R
+/// package wv's, `../shared/data/precomputed/adis_wv.json`) gives the recording's own
+/// calibration: on every axis the same canonical model and N within 1% (the WV file holds one
+/// scale fewer; starting values come from the WV alone), the spectrum, gravity and
+/// contamination checks said to be absent.
+#[test]
+fn calibrate_a_saved_wavelet_variance_as_its_recording() {
+    let recording = data_dir().join("adis_16405_imu1.csv.gz");
+    let saved = data_dir().join("precomputed/adis_wv.json");
+    assert!(saved.is_file(), "missing {}", saved.display());
+    let units = ["--gyro-unit", "deg/s", "--accel-unit", "g", "--json", "-"];
+    let run = |file: &Path| {
+        let out = gmwm()
+            .arg("calibrate")
+            .arg(file)
+            .args(units)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (a, b) = (run(&recording), run(&saved));
+    let (axes_a, axes_b) = (a["axes"].as_array().unwrap(), b["axes"].as_array().unwrap());
+    assert_eq!(axes_a.len(), 6);
+    assert_eq!(axes_b.len(), 6);
+    for (x, y) in axes_a.iter().zip(axes_b) {
+        assert_eq!(x["column"], y["column"]);
+        assert_eq!(
+            x["canonical_model"], y["canonical_model"],
+            "{}",
+            x["column"]
+        );
+        let (nx, ny) = (
+            x["noise_density"]["value"].as_f64().unwrap(),
+            y["noise_density"]["value"].as_f64().unwrap(),
+        );
+        assert!(
+            (ny / nx - 1.0).abs() < 0.01,
+            "{}: N {nx} vs {ny}",
+            x["column"]
+        );
+    }
+    let checks = b["checks"].to_string();
+    assert!(checks.contains("saved wavelet variances"), "{checks}");
+}

@@ -708,7 +708,8 @@ Data file: CSV/TSV (optionally .gz), raw little-endian binary, binary IMU record
 (--format imar|ln200|ln200ig|ixsea|navchip-int|navchip-flt), a ROS recording (ROS1 .bag, ROS2
 .mcap or .db3, or the rosbag2 folder holding one; its sensor_msgs/Imu topic, --topic if it has
 several, becomes gyro_x ... accel_z in rad/s and m/s^2 at the rate of its header stamps) or a
-wavelet variance saved by `gmwm wv --json` (not for calibrate, which needs the samples).
+wavelet variance saved by `gmwm wv --json` (calibrate and report take it too, and then say what
+needs the samples: the spectrum, the gravity and contamination checks).
 
 FILE is read by its name, its JSON sidecar and its content: .f64/.f32 (also .f64le, .f64.bin)
 are raw little-endian binary; a sidecar FILE.json (or NAME.json beside NAME.csv.gz) gives the

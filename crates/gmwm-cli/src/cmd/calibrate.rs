@@ -183,6 +183,9 @@ fn calibrate_one(
 ) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
     let exports = &config.exports;
     let calibration = Calibration::new(config.options.clone());
+    if crate::input::is_wv(&config.input) {
+        return calibrate_saved_wv(config, &calibration, exports, mode);
+    }
     // the engine reads the recording the way its kind and length ask (memory, one spooled
     // pass, or a raw binary file streamed), from the probe the configuration carries
     let source = calibration.open(
@@ -207,6 +210,57 @@ fn calibrate_one(
         .bar((axes * per_axis) as u64, "calibrating", "candidate fits");
     let report = calibration
         .run_source(&source, &Ticks(&progress))
+        .with_context(|| recording.path.display().to_string())?;
+    progress.finish_and_clear();
+    Ok((recording, report))
+}
+
+/// A wavelet variance saved by `gmwm wv --json` (or computed elsewhere in that shape, such as
+/// the precomputed WVs of recordings not at hand), calibrated as a streamed recording is
+/// ([`Calibration::run_wv`]); `--columns` picks series, `--freq` overrides the file's rate.
+fn calibrate_saved_wv(
+    config: &CalibrateConfig,
+    calibration: &Calibration,
+    exports: &[(ExportFormat, PathBuf)],
+    mode: Mode,
+) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
+    let input = &config.input;
+    let series = crate::input::load_wv(input, None)?;
+    let columns = gmwm::calib::streamed::wv_columns(&series);
+    let n = series.first().map_or(0, |(_, wv)| wv.n());
+    let samples = gmwm::imu::SampleAccount::all_used(
+        columns.iter().map(|(c, _)| c.clone()).collect(),
+        "row",
+        n as u64,
+    );
+    let recording = crate::input::LoadedRecording {
+        path: crate::input::shown_path(&input.file),
+        columns,
+        imu: None,
+        topic: None,
+        source: gmwm::imu::RecordingSource::Table,
+        timing: None,
+        notes: vec![format!(
+            "{} wavelet variance(s) read, of {n} samples each: calibrated from them, without the samples",
+            series.len()
+        )],
+        samples,
+    };
+    if !exports.is_empty() {
+        check_units_known(config, &recording)?;
+    }
+    let per_axis = calibration.candidates_per_axis()?;
+    let progress = mode.style.bar(
+        (series.len() * per_axis) as u64,
+        "calibrating",
+        "candidate fits",
+    );
+    let name = input
+        .file
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned());
+    let report = calibration
+        .run_wv(name.as_deref(), &series, &Ticks(&progress))
         .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();
     Ok((recording, report))

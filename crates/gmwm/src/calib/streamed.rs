@@ -325,6 +325,89 @@ impl Calibration {
     }
 }
 
+impl Calibration {
+    /// Calibrates from wavelet variances computed elsewhere, one per axis named by its column
+    /// (`gmwm wv --json`, or the precomputed WVs of recordings not at hand), as a streamed
+    /// recording is: the selection, fit, inference and verdict use the WV only, the Allan
+    /// variance is exact from it (`AV(m) = 2 nu2(2m)`, docs/methods.md §3.4), and what needs
+    /// the samples is left out with a check line saying so: the spectrum (a vibration line is
+    /// then not checked against one), the gravity check and the contamination check.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming the series when one is not a classical Haar MODWT WV (the pipeline
+    /// fits those) or when the series differ in rate or length (one recording's axes); the
+    /// pipeline's errors.
+    pub fn run_wv(
+        &self,
+        name: Option<&str>,
+        series: &[(String, WaveletVariance)],
+        progress: &dyn Progress,
+    ) -> Result<CalibrationReport, Error> {
+        let Some((_, first)) = series.first() else {
+            return Err(ParamError::new("wavelet variances", 0, "at least one series").into());
+        };
+        for (column, wv) in series {
+            let what = |v: String, expected: &str| -> Error {
+                ParamError::new(
+                    "wavelet variance",
+                    format!("series {column}: {v}"),
+                    expected,
+                )
+                .into()
+            };
+            if wv.robust().is_some()
+                || wv.transform() != Transform::Modwt
+                || wv.filter() != WaveletFilter::Haar
+            {
+                return Err(what(
+                    "a robust or non-Haar-MODWT WV".into(),
+                    "the classical Haar MODWT WV the calibration fits",
+                ));
+            }
+            if wv.freq_hz() != first.freq_hz() || wv.n() != first.n() {
+                return Err(what(
+                    format!("{} samples at {} Hz", wv.n(), wv.freq_hz()),
+                    &format!(
+                        "the rate and length of the first series ({} samples at {} Hz): the axes of one recording",
+                        first.n(),
+                        first.freq_hz()
+                    ),
+                ));
+            }
+        }
+        let infos: Vec<SensorInfo> = wv_columns(series).into_iter().map(|c| c.1).collect();
+        let axes: Vec<InputAxis<'_>> = series
+            .iter()
+            .zip(&infos)
+            .map(|((column, wv), info)| InputAxis {
+                column,
+                info,
+                data: AxisData::Streamed {
+                    wv: Box::new(wv.clone()),
+                    robust: None,
+                    psd: Some(Err(
+                        "calibrated from a saved wavelet variance, without the samples".into(),
+                    )),
+                },
+            })
+            .collect();
+        let checks = vec![format!(
+            "calibrated from saved wavelet variances ({} samples per axis): the Allan variance from the WV (exact at its cluster times), starting values from the WV; without the samples there is no spectrum (a vibration line is not checked against one), no gravity check and no contamination check",
+            first.n()
+        )];
+        self.run_axes(name, first.freq_hz(), first.n(), axes, checks, progress)
+    }
+}
+
+/// The columns of saved wavelet variances ([`Calibration::run_wv`]) and what each measures, by
+/// its name (`gyro_x`, `accel_z`, ...; units from the calibration's flags).
+pub fn wv_columns(series: &[(String, WaveletVariance)]) -> Vec<(String, SensorInfo)> {
+    series
+        .iter()
+        .map(|(column, _)| (column.clone(), SensorInfo::of_column(column, None, false)))
+        .collect()
+}
+
 /// A recording opened for a calibration, read the way its kind and length ask, as
 /// [`Calibration::open`] settled once from the recording's [`Probe`].
 #[derive(Debug)]

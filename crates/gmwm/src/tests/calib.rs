@@ -552,6 +552,97 @@ fn gyro_axis_of_length(
     .remove(0)
 }
 
+/// A calibration from saved wavelet variances (`Calibration::run_wv`: a `gmwm wv --json` file
+/// or the precomputed WVs of recordings not at hand) reads the same model and noise as the
+/// recording's own calibration: the same selected model, N within 0.5% and K within 10% (the
+/// starting values come from the WV alone, so the optimiser may stop elsewhere within the
+/// noise), in the unit the options give; a robust WV and series of different lengths are
+/// refused naming the series.
+#[test]
+fn calibration_from_saved_wavelet_variances_matches_the_recording() {
+    use gmwm::{wavelet_variance, WvOptions};
+    let imu = imu(Some("rad/s"), 1.0);
+    let options = CalibrationOptions {
+        gyro_unit: Some("rad/s".parse().unwrap()),
+        accel_unit: Some("m/s^2".parse().unwrap()),
+        ..options()
+    };
+    let calibration = Calibration::new(options);
+    let from_samples = calibration.run(&imu).unwrap();
+    let wv =
+        |c: usize| wavelet_variance(imu.axes()[c].values(), FREQ, &WvOptions::default()).unwrap();
+    let series = vec![
+        ("gyro_x".to_string(), wv(0)),
+        ("accel_x".to_string(), wv(1)),
+    ];
+    let from_wv = calibration
+        .run_wv(Some("saved"), &series, &gmwm::progress::NoProgress)
+        .unwrap();
+    assert_eq!(from_wv.axes.len(), 2);
+    for (a, b) in from_samples.axes.iter().zip(&from_wv.axes) {
+        assert_eq!(a.canonical_model, b.canonical_model, "{}", a.column);
+        let (na, nb) = (
+            a.noise_density.as_ref().unwrap(),
+            b.noise_density.as_ref().unwrap(),
+        );
+        assert_eq!(na.unit, nb.unit);
+        assert!(
+            (nb.value / na.value - 1.0).abs() < 5e-3,
+            "{}: N {} vs {}",
+            a.column,
+            na.value,
+            nb.value
+        );
+        let (ka, kb) = (
+            a.random_walk.as_ref().unwrap(),
+            b.random_walk.as_ref().unwrap(),
+        );
+        assert!(
+            (kb.value / ka.value - 1.0).abs() < 0.1,
+            "{}: K {} vs {}",
+            a.column,
+            ka.value,
+            kb.value
+        );
+    }
+    assert!(from_wv
+        .checks
+        .iter()
+        .any(|c| c.contains("saved wavelet variances")));
+    // refusals naming the series
+    let robust = wavelet_variance(
+        imu.axes()[0].values(),
+        FREQ,
+        &WvOptions {
+            robust: Some(gmwm::RobustOptions::default()),
+            ..WvOptions::default()
+        },
+    )
+    .unwrap();
+    let e = calibration
+        .run_wv(
+            None,
+            &[("gyro_x".to_string(), robust)],
+            &gmwm::progress::NoProgress,
+        )
+        .unwrap_err();
+    assert!(e.to_string().contains("gyro_x"), "{e}");
+    let short = wavelet_variance(
+        &imu.axes()[1].values()[..N / 2],
+        FREQ,
+        &WvOptions::default(),
+    )
+    .unwrap();
+    let e = calibration
+        .run_wv(
+            None,
+            &[series[0].clone(), ("accel_x".to_string(), short)],
+            &gmwm::progress::NoProgress,
+        )
+        .unwrap_err();
+    assert!(e.to_string().contains("accel_x"), "{e}");
+}
+
 /// The verdict (calib/verdict.rs) and the refinement it guides: the true model explains its WV;
 /// a selection without the sinusoid misses the hump, and the refinement adds `SIN()` starting
 /// at the hump (and says so); a model that cannot follow the data misses, naming the worst
