@@ -771,6 +771,33 @@ fn calibrate(
         });
         return doc.map_err(engine);
     }
+    // a wavelet variance saved by `gmwm wv --json` (or precomputed): calibrated from it, as
+    // `gmwm calibrate FILE.json` does
+    if let Some(wv_path) = path
+        .as_ref()
+        .filter(|p| format == "auto" && gmwm::variance::is_wv_json(p))
+    {
+        let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+        let series = gmwm::variance::read_wv_json(wv_path, read.freq_hz)
+            .and_then(|all| gmwm::variance::select_series(wv_path, all, &read.columns))
+            .map_err(engine)?;
+        let (rows, note) = gmwm::calib::streamed::wv_account(&series);
+        let doc = py.detach(|| -> Result<String, gmwm::calib::CalibError> {
+            let name = wv_path
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned());
+            let report = Calibration::new(options).run_wv(name.as_deref(), &series, &reporter)?;
+            let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
+            Ok(json(&gmwm::document::calibration(
+                wv_path,
+                &[note],
+                Some(&rows),
+                &report,
+                &sets,
+            )))
+        });
+        return doc.map_err(engine);
+    }
     // the recording: a file read as the CLI reads it, or the given columns
     let (imu, file, notes, topic_read, rows) = match (path, arrays) {
         (Some(path), None) => {

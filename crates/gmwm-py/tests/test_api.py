@@ -98,6 +98,21 @@ def test_calibrate_to_dict_is_the_cli_json():
     assert table.loc[0, "noise_density"] == cli["axes"][0]["noise_density"]["value"]
 
 
+def test_calibrate_a_saved_wavelet_variance_is_the_cli_json():
+    saved = DATA / "precomputed" / "imar_wv.json"
+    py = gmwm.calibrate(str(saved), columns=["gyro_x"], bootstrap=10, G=2000)
+    out = subprocess.run(
+        [str(GMWM_BIN), "calibrate", str(saved), "--columns", "gyro_x", "--bootstrap", "10",
+         "--G", "2000", "--json", "-"],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert out.returncode == 0, out.stderr
+    cli = json.loads(out.stdout)
+    assert py.to_dict() == cli
+    assert cli["samples"] == 5_760_000
+    assert any("saved wavelet variances" in c for c in cli["checks"])
+
+
 def test_calibrate_pooled_is_the_cli_json():
     second = ADIS.parent / "adis_16405_imu2.csv.gz"
     py = gmwm.calibrate_pooled(

@@ -227,12 +227,7 @@ fn calibrate_saved_wv(
     let input = &config.input;
     let series = crate::input::load_wv(input, None)?;
     let columns = gmwm::calib::streamed::wv_columns(&series);
-    let n = series.first().map_or(0, |(_, wv)| wv.n());
-    let samples = gmwm::imu::SampleAccount::all_used(
-        columns.iter().map(|(c, _)| c.clone()).collect(),
-        "row",
-        n as u64,
-    );
+    let (samples, note) = gmwm::calib::streamed::wv_account(&series);
     let recording = crate::input::LoadedRecording {
         path: crate::input::shown_path(&input.file),
         columns,
@@ -240,10 +235,7 @@ fn calibrate_saved_wv(
         topic: None,
         source: gmwm::imu::RecordingSource::Table,
         timing: None,
-        notes: vec![format!(
-            "{} wavelet variance(s) read, of {n} samples each: calibrated from them, without the samples",
-            series.len()
-        )],
+        notes: vec![note],
         samples,
     };
     if !exports.is_empty() {

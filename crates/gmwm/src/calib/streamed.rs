@@ -408,6 +408,20 @@ pub fn wv_columns(series: &[(String, WaveletVariance)]) -> Vec<(String, SensorIn
         .collect()
 }
 
+/// The account of saved wavelet variances ([`Calibration::run_wv`]) as a recording's: every
+/// series' `n` samples used, and the note that says so.
+pub fn wv_account(series: &[(String, WaveletVariance)]) -> (crate::imu::SampleAccount, String) {
+    let n = series.first().map_or(0, |(_, wv)| wv.n());
+    let names = series.iter().map(|(c, _)| c.clone()).collect();
+    (
+        crate::imu::SampleAccount::all_used(names, "row", n as u64),
+        format!(
+            "{} wavelet variance(s) read, of {n} samples each: calibrated from them, without the samples",
+            series.len()
+        ),
+    )
+}
+
 /// A recording opened for a calibration, read the way its kind and length ask, as
 /// [`Calibration::open`] settled once from the recording's [`Probe`].
 #[derive(Debug)]
