@@ -233,7 +233,7 @@ fn calibrate_saved_wv(
         columns,
         imu: None,
         topic: None,
-        source: gmwm::imu::RecordingSource::Table,
+        source: gmwm::imu::RecordingSource::SavedWv,
         timing: None,
         notes: vec![note],
         samples,
@@ -374,10 +374,18 @@ fn write_report(
             gmwm::imu::RecordingSource::Ros { container, topic } => {
                 format!("{container}, topic {topic}")
             }
+            gmwm::imu::RecordingSource::SavedWv => {
+                "saved wavelet variances (no samples)".to_string()
+            }
             _ => "delimited text or raw binary columns".to_string(),
         },
         reader_notes: recording.notes.clone(),
-        timing: recording.timing.as_ref().map(ToString::to_string),
+        timing: match recording.source {
+            gmwm::imu::RecordingSource::SavedWv => {
+                Some("no samples: the rate the saved WV gives (or --freq)".to_string())
+            }
+            _ => recording.timing.as_ref().map(ToString::to_string),
+        },
         command: command_line(),
         exports: files,
         json: serde_json::to_string(doc)?,

@@ -39,6 +39,9 @@ pub enum RecordingSource {
         /// The topic.
         topic: String,
     },
+    /// Wavelet variances saved without the samples (`gmwm wv --json`,
+    /// `crate::calib::Calibration::run_wv`).
+    SavedWv,
 }
 
 /// A recording opened for calibration.
