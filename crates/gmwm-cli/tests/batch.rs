@@ -521,3 +521,45 @@ fn batch_warns_of_implausible_raw_floats_per_recording() {
         assert!(stderr.contains(&warning), "{args:?}: {stderr}");
     }
 }
+
+/// `--datasheet` in batch mode: each recording's row counts its datasheet values by verdict, in
+/// the table and the JSON summary (gyro N given 10x the simulated 0.1 rad/s/√Hz: better than
+/// specified; accel N 10x below the simulated 0.2 m/s²/√Hz: worse), also when up to date;
+/// without a datasheet neither the column nor the key.
+#[test]
+fn batch_counts_datasheet_verdicts_per_recording() {
+    let tmp = tempfile::tempdir().unwrap();
+    let files = recordings(tmp.path(), 2);
+    let out = tmp.path().join("calib");
+    let batch = |sheet: bool| {
+        let mut cmd = gmwm();
+        cmd.arg("calibrate")
+            .args(&files)
+            .args(FAST)
+            .args(["--gyro-unit", "rad/s", "--accel-unit", "m/s^2", "--out-dir"])
+            .arg(&out);
+        if sheet {
+            // 0.1 rad/s/√Hz = 343.8 °/√h; 0.2 m/s²/√Hz = 12 m/s/√h
+            cmd.args(["--datasheet", "N=3438 deg/sqrt(h), N=1.2 m/s/sqrt(h)"]);
+        }
+        cmd
+    };
+    let (table, _) = run(&mut batch(true), 0);
+    assert!(table.contains("datasheet"), "{table}");
+    assert_eq!(
+        table.matches("0 as specified, 1 better, 1 worse").count(),
+        2,
+        "{table}"
+    );
+    let summary = run_json(batch(true).args(["--json", "-"]));
+    assert_eq!(summary["counts"]["up_to_date"], 2);
+    for r in summary["recordings"].as_array().unwrap() {
+        assert_eq!(r["datasheet"]["better"], 1, "{r}");
+        assert_eq!(r["datasheet"]["worse"], 1, "{r}");
+        assert_eq!(r["datasheet"]["as_specified"], 0, "{r}");
+    }
+    let summary = run_json(batch(false).args(["--force", "--json", "-"]));
+    for r in summary["recordings"].as_array().unwrap() {
+        assert!(r.get("datasheet").is_none(), "{r}");
+    }
+}

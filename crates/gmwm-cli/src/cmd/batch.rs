@@ -198,6 +198,64 @@ struct Detail {
     count: Option<usize>,
     /// calibrate: axes whose model explains the WV; wv: the most levels of a series.
     second: Option<usize>,
+    /// calibrate with `--datasheet`: the datasheet values by verdict over the axes.
+    datasheet: Option<DatasheetCounts>,
+}
+
+/// A calibration's datasheet values by verdict (`axes[].datasheet.*.verdict`): as specified
+/// (inside the measured interval), better, worse, and without a verdict.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct DatasheetCounts {
+    inside: usize,
+    better: usize,
+    worse: usize,
+    no_verdict: usize,
+}
+
+impl DatasheetCounts {
+    /// The counts of a calibration document; `None` when no axis was compared.
+    fn of(doc: &serde_json::Value) -> Option<Self> {
+        let mut c = Self::default();
+        let mut any = false;
+        for axis in doc["axes"].as_array()? {
+            let Some(terms) = axis["datasheet"].as_object() else {
+                continue;
+            };
+            for term in terms.values() {
+                any = true;
+                match term["verdict"].as_str() {
+                    Some("inside") => c.inside += 1,
+                    Some("above") => c.better += 1,
+                    Some("below") => c.worse += 1,
+                    _ => c.no_verdict += 1,
+                }
+            }
+        }
+        any.then_some(c)
+    }
+
+    fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "as_specified": self.inside,
+            "better": self.better,
+            "worse": self.worse,
+            "no_verdict": self.no_verdict,
+        })
+    }
+}
+
+impl std::fmt::Display for DatasheetCounts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} as specified, {} better, {} worse",
+            self.inside, self.better, self.worse
+        )?;
+        if self.no_verdict > 0 {
+            write!(f, ", {} no verdict", self.no_verdict)?;
+        }
+        Ok(())
+    }
 }
 
 /// A recording's outcome.
@@ -254,6 +312,7 @@ fn calibrate_one(
                             .filter(|x| x["verdict"]["explains_wv"].as_bool() == Some(true))
                             .count()
                     }),
+                    datasheet: DatasheetCounts::of(&doc),
                 };
                 return Ok((Status::UpToDate, outputs, detail));
             }
@@ -277,6 +336,12 @@ fn calibrate_one(
     let detail = Detail {
         count: Some(axes),
         second: Some(explained),
+        // the document just written carries the comparison
+        datasheet: one
+            .json
+            .as_deref()
+            .and_then(read_json)
+            .and_then(|doc| DatasheetCounts::of(&doc)),
     };
     Ok((Status::Done, written, detail))
 }
@@ -290,6 +355,7 @@ fn wv_detail(doc: &serde_json::Value) -> Option<Detail> {
             .iter()
             .filter_map(|s| s["wv"].as_array().map(Vec::len))
             .max(),
+        datasheet: None,
     })
 }
 
@@ -318,6 +384,7 @@ fn wv_one(
     let detail = Detail {
         count: Some(items.len()),
         second: items.iter().map(|(_, wv)| wv.wv().len()).max(),
+        datasheet: None,
     };
     Ok((Status::Done, outputs, detail))
 }
@@ -537,17 +604,39 @@ fn table(outcomes: &[Outcome], w: &Words, out: &mut impl Write) -> Result<()> {
         .max(6);
     let c0 = w.columns[0].len();
     let c1 = w.columns[1].len();
+    // a datasheet column when a datasheet was compared
+    let sheet: Vec<String> = outcomes
+        .iter()
+        .map(|o| {
+            o.detail
+                .datasheet
+                .map(|d| d.to_string())
+                .unwrap_or_default()
+        })
+        .collect();
+    let dw = sheet.iter().map(String::len).max().unwrap_or(0);
+    let sheet_head = if dw > 0 {
+        format!("{:<dw$}  ", "datasheet")
+    } else {
+        String::new()
+    };
+    let dw = dw.max(if dw > 0 { 9 } else { 0 });
     writeln!(
         out,
-        "{:<fw$}  {:<sw$}  {:>c0$}  {:>c1$}  output",
+        "{:<fw$}  {:<sw$}  {:>c0$}  {:>c1$}  {sheet_head}output",
         "recording", "status", w.columns[0], w.columns[1]
     )?;
-    for (o, file) in outcomes.iter().zip(&files) {
+    for ((o, file), d) in outcomes.iter().zip(&files).zip(&sheet) {
+        let d = if dw > 0 {
+            format!("{d:<dw$}  ")
+        } else {
+            String::new()
+        };
         match &o.error {
             Some(e) => writeln!(out, "{file:<fw$}  {:<sw$}  {e}", status(o))?,
             None => writeln!(
                 out,
-                "{file:<fw$}  {:<sw$}  {:>c0$}  {:>c1$}  {}",
+                "{file:<fw$}  {:<sw$}  {:>c0$}  {:>c1$}  {d}{}",
                 status(o),
                 cell(o.detail.count),
                 cell(o.detail.second),
@@ -589,6 +678,9 @@ fn summary_json(outcomes: &[Outcome], w: &Words) -> serde_json::Value {
             row.insert("error".into(), o.error.clone().into());
             row.insert(w.keys[0].into(), o.detail.count.into());
             row.insert(w.keys[1].into(), o.detail.second.into());
+            if let Some(d) = o.detail.datasheet {
+                row.insert("datasheet".into(), d.json());
+            }
             serde_json::Value::Object(row)
         })
         .collect();
