@@ -1113,10 +1113,14 @@ impl TryFrom<&PlotArgs> for PlotConfig {
             }
             | PlotCommand::Ieee {
                 units, datasheet, ..
+            }
+            | PlotCommand::Compare {
+                units, datasheet, ..
+            }
+            | PlotCommand::Select {
+                units, datasheet, ..
             } => (units, datasheet.datasheet.clone()),
-            PlotCommand::Compare { units, .. }
-            | PlotCommand::Select { units, .. }
-            | PlotCommand::Psd { units, .. } => (units, None),
+            PlotCommand::Psd { units, .. } => (units, None),
         };
         Ok(Self {
             figure,

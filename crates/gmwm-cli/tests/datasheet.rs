@@ -186,6 +186,18 @@ fn plot_with_datasheet_is_written_with_its_lines() {
             "fit",
             &["--columns", "gyro_x", "--model", "AR1()+WN()", "--G", "200"][..],
         ),
+        ("compare", &["--columns", "gyro_x,accel_x"][..]),
+        (
+            "select",
+            &[
+                "--columns",
+                "gyro_x",
+                "--model",
+                "AR1()+WN()+RW()",
+                "--G",
+                "200",
+            ][..],
+        ),
     ] {
         let svg = dir.path().join(format!("{figure}.svg"));
         let out = gmwm()

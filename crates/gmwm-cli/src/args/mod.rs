@@ -316,7 +316,7 @@ pub struct UnitArgs {
 /// What `--datasheet` takes, for `--help`.
 const DATASHEET_HELP: &str = "\
 The sensor's datasheet values, compared with the measured ones (calibrate, report) or drawn as
-dashed grey lines (plot avar, ieee, wv, fit): KEY=VALUE UNIT items separated by commas.
+dashed grey lines (plot avar, ieee, wv, fit, compare, select): KEY=VALUE UNIT items separated by commas.
 Keys: N white-noise density (angle / velocity random walk), B bias instability, K rate /
 acceleration random walk. The unit says the sensor: an angle is a gyroscope, a length or g an
 accelerometer, and its dimension must be the key's:
@@ -433,6 +433,9 @@ pub enum PlotCommand {
         /// Units of the samples, as `gmwm calibrate`.
         #[command(flatten)]
         units: UnitArgs,
+        /// Datasheet lines.
+        #[command(flatten)]
+        datasheet: DatasheetArgs,
         /// Figure file.
         #[command(flatten)]
         figure: FigureArgs,
@@ -462,6 +465,9 @@ pub enum PlotCommand {
         /// Units of the samples, as `gmwm calibrate`.
         #[command(flatten)]
         units: UnitArgs,
+        /// Datasheet lines.
+        #[command(flatten)]
+        datasheet: DatasheetArgs,
         /// Figure file.
         #[command(flatten)]
         figure: FigureArgs,

@@ -3,7 +3,8 @@
 use super::*;
 
 /// The classical against the robust WV of each column (paper Fig. 2): where outliers inflate
-/// the classical estimate, its points leave the robust band.
+/// the classical estimate, its points leave the robust band; the column's datasheet lines
+/// dashed grey.
 pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]) -> Figure {
     let panels = columns
         .iter()
@@ -29,12 +30,21 @@ pub fn compare_figure(columns: &[Column<'_, (WaveletVariance, WaveletVariance)>]
                 title: format!("{}: classical and robust WV", c.name),
                 x_label: WV_SCALE.to_string(),
                 y_label: wv_label(c.unit),
-                kind: PanelKind::LogLog(vec![
-                    cb.labelled(format!("classical {level:.0}% interval")),
-                    rb.labelled(format!("robust {level:.0}% interval")),
-                    cp.labelled("classical WV"),
-                    rp.labelled(format!("robust WV (efficiency {eff})")),
-                ]),
+                kind: PanelKind::LogLog(
+                    [
+                        cb.labelled(format!("classical {level:.0}% interval")),
+                        rb.labelled(format!("robust {level:.0}% interval")),
+                        cp.labelled("classical WV"),
+                        rp.labelled(format!("robust WV (efficiency {eff})")),
+                    ]
+                    .into_iter()
+                    .chain(datasheet_series(
+                        &c.datasheet,
+                        classical.tau_s(),
+                        Quantity::Wv,
+                    ))
+                    .collect(),
+                ),
             }
         })
         .collect();

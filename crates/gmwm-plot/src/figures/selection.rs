@@ -4,7 +4,8 @@ use super::*;
 
 /// Model selection (paper Fig. 4): per column, the empirical WV against the selected model's
 /// implied WV, beside the candidates' WIC with objective and optimism stacked (the best `rows`
-/// canonical models, 0 for all, always with the selected one, marked ▶).
+/// canonical models, 0 for all, always with the selected one, marked ▶); the column's datasheet
+/// lines dashed grey on the WV panel.
 pub fn selection_figure(columns: &[Column<'_, ModelSelection>], rows: usize) -> Figure {
     let mut panels = Vec::new();
     for c in columns {
@@ -14,7 +15,12 @@ pub fn selection_figure(columns: &[Column<'_, ModelSelection>], rows: usize) -> 
             title: format!("{}: selected {}", c.name, short_model(&selected)),
             x_label: WV_SCALE.to_string(),
             y_label: wv_label(c.unit),
-            kind: PanelKind::LogLog(empirical_and_model(s.fit(), "selected model (implied WV)")),
+            kind: PanelKind::LogLog({
+                let mut series = empirical_and_model(s.fit(), "selected model (implied WV)");
+                let tau_s = &s.fit().implied_wv().tau_s;
+                series.extend(datasheet_series(&c.datasheet, tau_s, Quantity::Wv));
+                series
+            }),
         });
         let selected_row = s
             .rows()
