@@ -558,8 +558,14 @@ fn batch_counts_datasheet_verdicts_per_recording() {
         assert_eq!(r["datasheet"]["worse"], 1, "{r}");
         assert_eq!(r["datasheet"]["as_specified"], 0, "{r}");
     }
-    let summary = run_json(batch(false).args(["--force", "--json", "-"]));
+    // dropping the datasheet redoes the recordings: no column, no key
+    let summary = run_json(batch(false).args(["--json", "-"]));
+    assert_eq!(summary["counts"]["calibrated"], 2, "{summary}");
     for r in summary["recordings"].as_array().unwrap() {
         assert!(r.get("datasheet").is_none(), "{r}");
     }
+    // and giving it again redoes them with their counts
+    let summary = run_json(batch(true).args(["--json", "-"]));
+    assert_eq!(summary["counts"]["calibrated"], 2, "{summary}");
+    assert_eq!(summary["recordings"][0]["datasheet"]["worse"], 1);
 }

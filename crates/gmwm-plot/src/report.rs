@@ -414,7 +414,7 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
         esc(&capitalised(&reason))
     } else {
         format!(
-            "The WIC selected {} ({}); the notes below say how the WV's shape refined it.",
+            "The WIC selected {} ({}); the notes below say how the calibration refined it.",
             esc(&selected),
             esc(reason.trim_end_matches('.'))
         )

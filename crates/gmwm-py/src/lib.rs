@@ -775,7 +775,7 @@ fn calibrate(
     // `gmwm calibrate FILE.json` does
     if let Some(wv_path) = path
         .as_ref()
-        .filter(|p| format == "auto" && gmwm::variance::is_wv_json(p))
+        .filter(|p| arrays.is_none() && format == "auto" && gmwm::variance::is_wv_json(p))
     {
         let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
         let series = gmwm::variance::read_wv_json(wv_path, read.freq_hz)

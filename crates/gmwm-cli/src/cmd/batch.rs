@@ -304,7 +304,10 @@ fn calibrate_one(
             outputs.push(json.clone());
             let axes = doc["axes"].as_array();
             let known = exports.is_empty() || !labels.is_empty();
-            if known && all_newer(&outputs, input_time(&p.recording)) {
+            // a document without the datasheet now given (or with one no longer given) is
+            // redone, so that the row's counts are the flags'
+            let sheet = config.options.datasheet.is_some() == DatasheetCounts::of(&doc).is_some();
+            if known && sheet && all_newer(&outputs, input_time(&p.recording)) {
                 let detail = Detail {
                     count: axes.map(Vec::len),
                     second: axes.map(|a| {

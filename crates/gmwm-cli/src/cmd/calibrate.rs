@@ -225,7 +225,7 @@ fn calibrate_saved_wv(
     mode: Mode,
 ) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
     let input = &config.input;
-    let series = crate::input::load_wv(input, None)?;
+    let series = crate::input::load_wv(input, config.options.wv.levels)?;
     let columns = gmwm::calib::streamed::wv_columns(&series);
     let (samples, note) = gmwm::calib::streamed::wv_account(&series);
     let recording = crate::input::LoadedRecording {

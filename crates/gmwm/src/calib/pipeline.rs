@@ -687,14 +687,16 @@ impl Calibration {
                 &current.1,
                 &wv,
                 &current.4,
-                (freq_hz, psd.as_ref()),
+                (freq_hz, psd.as_ref(), &vibration_lines(&current.3)),
                 &mut notes,
             ) {
                 Some(r) => current = r,
                 None => break,
             }
         }
-        if let Some(r) = self.flicker_for_gauss_markov(&selection, &current, &wv, &mut notes) {
+        if let Some(r) =
+            self.flicker_for_gauss_markov(&selection, &current, &wv, psd.as_ref(), &mut notes)
+        {
             current = r;
         }
         let (model, fit, inference, canonical, verdict) = current;
@@ -797,12 +799,21 @@ impl Calibration {
         base: &GmwmFit,
         wv: &WaveletVariance,
         verdict: &FitVerdict,
-        (freq_hz, psd): (f64, Option<&Psd>),
+        (freq_hz, psd, base_lines): (f64, Option<&Psd>, &[f64]),
         notes: &mut Vec<String>,
     ) -> Option<(String, GmwmFit, Inference, CanonicalModel, FitVerdict)> {
         let worst = verdict.worst.as_ref()?;
         let terms = refinement_terms(base, verdict, freq_hz, self.options.tolerance, psd);
         let base_objective = base.objective;
+        // the lines a refit must keep where they were (without a spectrum): the model's and the
+        // one a term proposes
+        let required = |term: &str| -> Vec<f64> {
+            base_lines
+                .iter()
+                .copied()
+                .chain(proposed_line_hz(term, freq_hz))
+                .collect()
+        };
         // each candidate term fitted on the same WV; the one that explains the most scales,
         // then the lowest objective, if it explains more than the base and lowers the objective
         let (term, fit, inference, canonical, refined) = terms
@@ -819,8 +830,7 @@ impl Calibration {
                     self.judged(text.parse().ok()?, selection, wv)?;
                 (refined.scales_missed < verdict.scales_missed
                     && fit.objective < base_objective
-                    && vibration_on_spectral_lines(&canonical, psd)
-                    && (psd.is_some() || line_stays(&canonical, &term, freq_hz)))
+                    && lines_hold(&canonical, psd, &required(&term)))
                 .then_some((term, fit, inference, canonical, refined))
             })
             .min_by(|a, b| {
@@ -837,7 +847,7 @@ impl Calibration {
         .then(|| self.judged(reduced.clone(), selection, wv))
         .flatten()
         .filter(|j| {
-            j.3.scales_missed <= refined.scales_missed && vibration_on_spectral_lines(&j.2, psd)
+            j.3.scales_missed <= refined.scales_missed && lines_hold(&j.2, psd, &required(&term))
         });
         let (fit, inference, canonical, refined) =
             identified.unwrap_or((fit, inference, canonical, refined));
@@ -882,9 +892,11 @@ impl Calibration {
         selection: &ModelSelection,
         current: &(String, GmwmFit, Inference, CanonicalModel, FitVerdict),
         wv: &WaveletVariance,
+        psd: Option<&Psd>,
         notes: &mut Vec<String>,
     ) -> Option<(String, GmwmFit, Inference, CanonicalModel, FitVerdict)> {
-        let (_, base, _, _, verdict) = current;
+        let (_, base, _, base_canonical, verdict) = current;
+        let lines = vibration_lines(base_canonical);
         let text = base.model.without_values().to_string();
         let parts: Vec<&str> = text.split('+').collect();
         let correlated = |c: &str| c.ends_with("AR1()") || c.ends_with("GM()");
@@ -923,8 +935,10 @@ impl Calibration {
                     .iter()
                     .zip(&refined.scales)
                     .all(|(b, r)| r.explained || !b.explained);
-                (explains_as_much && fit.objective <= base.objective + 2.0 * saved)
-                    .then_some((candidate, fit, inference, canonical, refined))
+                (explains_as_much
+                    && fit.objective <= base.objective + 2.0 * saved
+                    && lines_hold(&canonical, psd, &lines))
+                .then_some((candidate, fit, inference, canonical, refined))
             })
             .min_by(|a, b| a.1.theta.len().cmp(&b.1.theta.len()))?;
         let saved = base.theta.len().saturating_sub(fit.theta.len());
@@ -1801,8 +1815,9 @@ fn random_walk_upper_bound(av: &AllanVariance) -> Option<(f64, f64)> {
 /// dip beside an overshoot (its WV peaks at `tau ~ 0.742 / omega` samples), a flicker `FN()`
 /// for a floor, a `RW()` for the longest scales above the model; and the sensor's
 /// moving-average filter `MAF(2)`, `MAF(4)` when the first scales fall slower than white
-/// noise's. A kind the model already has once is
-/// refused by the model's parser, so its candidate drops out.
+/// noise's. A kind that occurs once (FN, RW, MAF, ...) and is already in the model is refused
+/// by the model's parser, so its candidate drops out; a `SIN()` may join the model's lines, and
+/// [`lines_hold`] keeps each of them where it was.
 fn refinement_terms(
     base: &GmwmFit,
     verdict: &FitVerdict,
@@ -1880,32 +1895,50 @@ fn vibration_on_spectral_lines(canonical: &CanonicalModel, psd: Option<&Psd>) ->
         .all(|p| spectral_line_within(psd, p.value, LINE_MATCH))
 }
 
-/// Without a spectrum (a saved WV), whether the vibration line a refinement `term` proposed
-/// (`SIN(omega=...)`, [`refinement_terms`]) is still where the WV's shape put it, within a
-/// factor [`LINE_MATCH`], in `canonical`: a line the fit moved further was found by bending the
-/// model, not at a hump (the precomputed WV of adis_16405_imu1 accel_x: proposed at 9.3 Hz, it
-/// moved to 13.6 Hz onto the sensor's roll-off and N fell 31% below the level the recording's
-/// spectrum shows). True for any other term.
-fn line_stays(canonical: &CanonicalModel, term: &str, freq_hz: f64) -> bool {
-    let Some(f0) = term
-        .strip_prefix("SIN(omega=")
-        .and_then(|r| r.strip_suffix(')'))
-        .and_then(|w| w.parse::<f64>().ok())
-        .map(|omega| omega * freq_hz)
-    else {
-        return true;
-    };
+/// The vibration lines of `canonical`: each term's physical `frequency`, Hz.
+fn vibration_lines(canonical: &CanonicalModel) -> Vec<f64> {
     canonical
         .terms
         .iter()
         .flat_map(|t| &t.physical)
         .filter(|p| p.name == "frequency")
-        .any(|p| p.value >= f0 / LINE_MATCH && p.value <= f0 * LINE_MATCH)
+        .map(|p| p.value)
+        .collect()
+}
+
+/// The line a refinement `term` proposes (`SIN(omega=...)`, [`refinement_terms`]), Hz.
+fn proposed_line_hz(term: &str, freq_hz: f64) -> Option<f64> {
+    term.strip_prefix("SIN(omega=")
+        .and_then(|r| r.strip_suffix(')'))
+        .and_then(|w| w.parse::<f64>().ok())
+        .map(|omega| omega * freq_hz)
+}
+
+/// Whether a refit's vibration lines are measured, not bent into place: with a spectrum, each
+/// on a spectral line ([`vibration_on_spectral_lines`]); without one (a saved WV, a pooled
+/// calibration), each line of `required` (the refined model's, and the one a term proposed
+/// where the WV's shape put it) still has a fitted line within a factor [`LINE_MATCH`]. A line
+/// the fit moved further was found by bending the model: on the precomputed WV of
+/// adis_16405_imu1 accel_x a line proposed at 9.3 Hz moved to 13.6 Hz onto the sensor's
+/// roll-off and N fell 31% below the level the recording's spectrum shows, while the lines
+/// confirmed by the shared recordings' spectra moved by 0.89 to 1.09 times.
+fn lines_hold(canonical: &CanonicalModel, psd: Option<&Psd>, required: &[f64]) -> bool {
+    if psd.is_some() {
+        return vibration_on_spectral_lines(canonical, psd);
+    }
+    let fitted = vibration_lines(canonical);
+    required.iter().all(|&f0| {
+        fitted
+            .iter()
+            .any(|&f| f >= f0 / LINE_MATCH && f <= f0 * LINE_MATCH)
+    })
 }
 
 /// How close to a spectral line a fitted vibration frequency must lie
-/// ([`vibration_on_spectral_lines`]): two bins of the binned spectrum (about 11% apart); the
-/// shared recordings' fitted lines lie within 11% of their bins, the roll-off's within 36%.
+/// ([`vibration_on_spectral_lines`]), or, without a spectrum, to where it was proposed
+/// ([`lines_hold`]): two bins of the binned spectrum (about 11% apart); the shared recordings'
+/// fitted lines lie within 11% of their bins and within 0.89 to 1.09 times their proposals, the
+/// roll-off's 1.36 times from its bin and 1.47 times from its proposal.
 pub(crate) const LINE_MATCH: f64 = 1.25;
 
 /// [`has_spectral_line`] with the local maximum within a factor `within` of `f0`.

@@ -334,9 +334,10 @@ impl Calibration {
     /// then not checked against one), the gravity check and the contamination check.
     ///
     /// # Errors
-    /// [`ParamError`] naming the series when one is not a classical Haar MODWT WV (the pipeline
-    /// fits those) or when the series differ in rate or length (one recording's axes); the
-    /// pipeline's errors.
+    /// [`ParamError`] for robust options (a robust calibration estimates its own WV from the
+    /// samples); naming the series when one is not a classical Haar MODWT WV (the pipeline fits
+    /// those), when its intervals are at another level than the options' `alpha`, or when the
+    /// series differ in rate or length (one recording's axes); the pipeline's errors.
     pub fn run_wv(
         &self,
         name: Option<&str>,
@@ -346,6 +347,14 @@ impl Calibration {
         let Some((_, first)) = series.first() else {
             return Err(ParamError::new("wavelet variances", 0, "at least one series").into());
         };
+        if self.options().wv.robust.is_some() {
+            return Err(ParamError::new(
+                "robust",
+                "a saved wavelet variance",
+                "the samples: a robust calibration estimates its own WV",
+            )
+            .into());
+        }
         for (column, wv) in series {
             let what = |v: String, expected: &str| -> Error {
                 ParamError::new(
@@ -362,6 +371,15 @@ impl Calibration {
                 return Err(what(
                     "a robust or non-Haar-MODWT WV".into(),
                     "the classical Haar MODWT WV the calibration fits",
+                ));
+            }
+            if (wv.alpha() - self.options().wv.alpha).abs() > 1e-12 {
+                return Err(what(
+                    format!("intervals at alpha = {}", wv.alpha()),
+                    &format!(
+                        "the calibration's alpha = {} (give it as --alpha, or save the WV at that level)",
+                        self.options().wv.alpha
+                    ),
                 ));
             }
             if wv.freq_hz() != first.freq_hz() || wv.n() != first.n() {
@@ -408,13 +426,15 @@ pub fn wv_columns(series: &[(String, WaveletVariance)]) -> Vec<(String, SensorIn
         .collect()
 }
 
-/// The account of saved wavelet variances ([`Calibration::run_wv`]) as a recording's: every
-/// series' `n` samples used, and the note that says so.
+/// The account of saved wavelet variances ([`Calibration::run_wv`]) as a recording's, counted
+/// in samples (the series' `n`, which the WV was computed from; no row of a file is read), and
+/// the note that says so.
 pub fn wv_account(series: &[(String, WaveletVariance)]) -> (crate::imu::SampleAccount, String) {
     let n = series.first().map_or(0, |(_, wv)| wv.n());
     let names = series.iter().map(|(c, _)| c.clone()).collect();
     (
-        crate::imu::SampleAccount::all_used(names, "row", n as u64),
+        // the WV's samples, not rows of a file at hand
+        crate::imu::SampleAccount::all_used(names, "sample", n as u64),
         format!(
             "{} wavelet variance(s) read, of {n} samples each: calibrated from them, without the samples",
             series.len()

@@ -191,7 +191,8 @@ impl Orders {
 pub(crate) enum Occurs {
     /// At most once (identifiability): WN, QN, RW, DR.
     Once,
-    /// Any number of times (`k*GM()`), but two repeating kinds may not be mixed.
+    /// Any number of times (`k*GM()`, `2*SIN()`); a kind and the kind it reparametrises (GM
+    /// and AR1) may not be mixed.
     Repeats,
     /// At most one term of the whole ARMA family (a sum of ARMAs is an ARMA).
     ArmaFamily,

@@ -108,8 +108,8 @@ pub(crate) fn nested_candidates(full: &Model) -> Result<Vec<Model>, SelectionErr
 }
 
 /// docs/methods.md §8.5: the common denominator of a list of candidates: as many AR1 (or GM) terms
-/// as the candidate with most of them, then WN, QN, RW, DR when any candidate has them, in that
-/// order; guess mode. E.g. {AR1 WN}, {AR1 AR1 RW}, {QN DR} give `2*AR1()+WN()+QN()+RW()+DR()`.
+/// as the candidate with most of them, likewise SIN, then WN, QN, RW, DR when any candidate has
+/// them, in that order; guess mode. E.g. {AR1 WN}, {AR1 AR1 RW}, {QN DR} give `2*AR1()+WN()+QN()+RW()+DR()`.
 ///
 /// # Errors
 /// [`SelectionError::NoCandidates`] for an empty list; the refusals of §8.5 naming the

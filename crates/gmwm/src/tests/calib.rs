@@ -562,12 +562,12 @@ fn gyro_axis_of_length(
 fn calibration_from_saved_wavelet_variances_matches_the_recording() {
     use gmwm::{wavelet_variance, WvOptions};
     let imu = imu(Some("rad/s"), 1.0);
-    let options = CalibrationOptions {
+    let with_units = CalibrationOptions {
         gyro_unit: Some("rad/s".parse().unwrap()),
         accel_unit: Some("m/s^2".parse().unwrap()),
         ..options()
     };
-    let calibration = Calibration::new(options);
+    let calibration = Calibration::new(with_units);
     let from_samples = calibration.run(&imu).unwrap();
     let wv =
         |c: usize| wavelet_variance(imu.axes()[c].values(), FREQ, &WvOptions::default()).unwrap();
@@ -641,6 +641,35 @@ fn calibration_from_saved_wavelet_variances_matches_the_recording() {
         )
         .unwrap_err();
     assert!(e.to_string().contains("accel_x"), "{e}");
+    // a robust calibration needs the samples; intervals at another level than the options'
+    let robust_options = Calibration::new(CalibrationOptions {
+        wv: WvOptions {
+            robust: Some(gmwm::RobustOptions::default()),
+            ..WvOptions::default()
+        },
+        ..options()
+    });
+    let e = robust_options
+        .run_wv(None, &series, &gmwm::progress::NoProgress)
+        .unwrap_err();
+    assert!(e.to_string().contains("robust"), "{e}");
+    let at_10 = wavelet_variance(
+        imu.axes()[0].values(),
+        FREQ,
+        &WvOptions {
+            alpha: 0.1,
+            ..WvOptions::default()
+        },
+    )
+    .unwrap();
+    let e = calibration
+        .run_wv(
+            None,
+            &[("gyro_x".to_string(), at_10)],
+            &gmwm::progress::NoProgress,
+        )
+        .unwrap_err();
+    assert!(e.to_string().contains("alpha"), "{e}");
 }
 
 /// The verdict (calib/verdict.rs) and the refinement it guides: the true model explains its WV;
