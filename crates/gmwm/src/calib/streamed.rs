@@ -350,8 +350,8 @@ impl Calibration {
         if self.options().wv.robust.is_some() {
             return Err(ParamError::new(
                 "robust",
-                "a saved wavelet variance",
-                "the samples: a robust calibration estimates its own WV",
+                "on (with a saved wavelet variance)",
+                "off: a robust calibration estimates its own WV from the samples",
             )
             .into());
         }
@@ -375,10 +375,11 @@ impl Calibration {
             }
             if (wv.alpha() - self.options().wv.alpha).abs() > 1e-12 {
                 return Err(what(
-                    format!("intervals at alpha = {}", wv.alpha()),
+                    format!("intervals at alpha {}", wv.alpha()),
                     &format!(
-                        "the calibration's alpha = {} (give it as --alpha, or save the WV at that level)",
-                        self.options().wv.alpha
+                        "intervals at the calibration's alpha {} (give --alpha {}, or save the WV at that level)",
+                        self.options().wv.alpha,
+                        wv.alpha()
                     ),
                 ));
             }
