@@ -388,20 +388,7 @@ fn calibrate_a_saved_wavelet_variance_as_its_recording() {
     let saved = data_dir().join("precomputed/adis_wv.json");
     assert!(saved.is_file(), "missing {}", saved.display());
     let units = ["--gyro-unit", "deg/s", "--accel-unit", "g", "--json", "-"];
-    let run = |file: &Path| {
-        let out = gmwm()
-            .arg("calibrate")
-            .arg(file)
-            .args(units)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
-    };
+    let run = |file: &Path| run_json(gmwm().arg("calibrate").arg(file).args(units));
     let (a, b) = (run(&recording), run(&saved));
     let (axes_a, axes_b) = (a["axes"].as_array().unwrap(), b["axes"].as_array().unwrap());
     assert_eq!(axes_a.len(), 6);

@@ -1879,22 +1879,6 @@ pub(crate) fn has_spectral_line(psd: &Psd, f0: f64) -> bool {
     spectral_line_within(psd, f0, 2.0)
 }
 
-/// Whether every vibration line of `canonical` (each term's physical `frequency`) lies on a
-/// line of the spectrum, within a factor [`LINE_MATCH`] of its frequency: a sinusoid the fit
-/// moved off the line it started from is bending the model towards the WV's shape (the
-/// sensor's roll-off above 10 Hz on the ADIS accelerometers took a 13.6 Hz "line" of three
-/// times the power of the 10 Hz one and cut N by 27%), not measuring a vibration. True
-/// without a spectrum.
-fn vibration_on_spectral_lines(canonical: &CanonicalModel, psd: Option<&Psd>) -> bool {
-    let Some(psd) = psd else { return true };
-    canonical
-        .terms
-        .iter()
-        .flat_map(|t| &t.physical)
-        .filter(|p| p.name == "frequency")
-        .all(|p| spectral_line_within(psd, p.value, LINE_MATCH))
-}
-
 /// The vibration lines of `canonical`: each term's physical `frequency`, Hz.
 fn vibration_lines(canonical: &CanonicalModel) -> Vec<f64> {
     canonical
@@ -1915,28 +1899,29 @@ fn proposed_line_hz(term: &str, freq_hz: f64) -> Option<f64> {
 }
 
 /// Whether a refit's vibration lines are measured, not bent into place: with a spectrum, each
-/// on a spectral line ([`vibration_on_spectral_lines`]); without one (a saved WV, a pooled
-/// calibration), each line of `required` (the refined model's, and the one a term proposed
-/// where the WV's shape put it) still has a fitted line within a factor [`LINE_MATCH`]. A line
-/// the fit moved further was found by bending the model: on the precomputed WV of
-/// adis_16405_imu1 accel_x a line proposed at 9.3 Hz moved to 13.6 Hz onto the sensor's
-/// roll-off and N fell 31% below the level the recording's spectrum shows, while the lines
-/// confirmed by the shared recordings' spectra moved by 0.89 to 1.09 times.
+/// lies on a spectral line within a factor [`LINE_MATCH`] (the ADIS accelerometers' roll-off
+/// above 10 Hz otherwise took a 13.6 Hz "line" of three times the power of the 10 Hz one and
+/// cut N by 27%); without one (a saved WV, a pooled calibration), each line of `required` (the
+/// refined model's, and the one a term proposed where the WV's shape put it) still has a fitted
+/// line within that factor (on the precomputed WV of adis_16405_imu1 accel_x a line proposed
+/// at 9.3 Hz moved to 13.6 Hz and N fell 31% below the spectrum's level, while the lines the
+/// shared recordings' spectra confirm moved by 0.89 to 1.09 times).
 fn lines_hold(canonical: &CanonicalModel, psd: Option<&Psd>, required: &[f64]) -> bool {
-    if psd.is_some() {
-        return vibration_on_spectral_lines(canonical, psd);
-    }
     let fitted = vibration_lines(canonical);
-    required.iter().all(|&f0| {
-        fitted
+    match psd {
+        Some(psd) => fitted
             .iter()
-            .any(|&f| f >= f0 / LINE_MATCH && f <= f0 * LINE_MATCH)
-    })
+            .all(|&f| spectral_line_within(psd, f, LINE_MATCH)),
+        None => required.iter().all(|&f0| {
+            fitted
+                .iter()
+                .any(|&f| f >= f0 / LINE_MATCH && f <= f0 * LINE_MATCH)
+        }),
+    }
 }
 
-/// How close to a spectral line a fitted vibration frequency must lie
-/// ([`vibration_on_spectral_lines`]), or, without a spectrum, to where it was proposed
-/// ([`lines_hold`]): two bins of the binned spectrum (about 11% apart); the shared recordings'
+/// How close to a spectral line a fitted vibration frequency must lie, or, without a spectrum,
+/// to where it was proposed ([`lines_hold`]): two bins of the binned spectrum (about 11% apart); the shared recordings'
 /// fitted lines lie within 11% of their bins and within 0.89 to 1.09 times their proposals, the
 /// roll-off's 1.36 times from its bin and 1.47 times from its proposal.
 pub(crate) const LINE_MATCH: f64 = 1.25;

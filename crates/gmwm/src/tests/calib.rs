@@ -610,66 +610,41 @@ fn calibration_from_saved_wavelet_variances_matches_the_recording() {
         .iter()
         .any(|c| c.contains("saved wavelet variances")));
     // refusals naming the series
-    let robust = wavelet_variance(
-        imu.axes()[0].values(),
-        FREQ,
-        &WvOptions {
-            robust: Some(gmwm::RobustOptions::default()),
-            ..WvOptions::default()
-        },
-    )
-    .unwrap();
-    let e = calibration
-        .run_wv(
-            None,
-            &[("gyro_x".to_string(), robust)],
-            &gmwm::progress::NoProgress,
-        )
-        .unwrap_err();
-    assert!(e.to_string().contains("gyro_x"), "{e}");
-    let short = wavelet_variance(
-        &imu.axes()[1].values()[..N / 2],
-        FREQ,
-        &WvOptions::default(),
-    )
-    .unwrap();
-    let e = calibration
-        .run_wv(
-            None,
-            &[series[0].clone(), ("accel_x".to_string(), short)],
-            &gmwm::progress::NoProgress,
-        )
-        .unwrap_err();
-    assert!(e.to_string().contains("accel_x"), "{e}");
+    let refused = |c: &Calibration, s: &[(String, gmwm::WaveletVariance)]| {
+        c.run_wv(None, s, &gmwm::progress::NoProgress)
+            .unwrap_err()
+            .to_string()
+    };
+    let gyro_wv = |opts: WvOptions| {
+        let wv = wavelet_variance(imu.axes()[0].values(), FREQ, &opts).unwrap();
+        vec![("gyro_x".to_string(), wv)]
+    };
+    let robust_wv = WvOptions {
+        robust: Some(gmwm::RobustOptions::default()),
+        ..WvOptions::default()
+    };
+    let e = refused(&calibration, &gyro_wv(robust_wv));
+    assert!(e.contains("gyro_x"), "{e}");
+    let half = &imu.axes()[1].values()[..N / 2];
+    let short = wavelet_variance(half, FREQ, &WvOptions::default()).unwrap();
+    let e = refused(
+        &calibration,
+        &[series[0].clone(), ("accel_x".to_string(), short)],
+    );
+    assert!(e.contains("accel_x"), "{e}");
     // a robust calibration needs the samples; intervals at another level than the options'
     let robust_options = Calibration::new(CalibrationOptions {
-        wv: WvOptions {
-            robust: Some(gmwm::RobustOptions::default()),
-            ..WvOptions::default()
-        },
+        wv: robust_wv,
         ..options()
     });
-    let e = robust_options
-        .run_wv(None, &series, &gmwm::progress::NoProgress)
-        .unwrap_err();
-    assert!(e.to_string().contains("robust"), "{e}");
-    let at_10 = wavelet_variance(
-        imu.axes()[0].values(),
-        FREQ,
-        &WvOptions {
-            alpha: 0.1,
-            ..WvOptions::default()
-        },
-    )
-    .unwrap();
-    let e = calibration
-        .run_wv(
-            None,
-            &[("gyro_x".to_string(), at_10)],
-            &gmwm::progress::NoProgress,
-        )
-        .unwrap_err();
-    assert!(e.to_string().contains("alpha"), "{e}");
+    let e = refused(&robust_options, &series);
+    assert!(e.contains("robust"), "{e}");
+    let at_10 = WvOptions {
+        alpha: 0.1,
+        ..WvOptions::default()
+    };
+    let e = refused(&calibration, &gyro_wv(at_10));
+    assert!(e.contains("alpha"), "{e}");
 }
 
 /// The verdict (calib/verdict.rs) and the refinement it guides: the true model explains its WV;

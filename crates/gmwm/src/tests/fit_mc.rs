@@ -169,25 +169,39 @@ const SIN_FREQ_HZ: f64 = 100.0;
 /// replicate `(frequency in Hz, amplitude, WN sigma2, RW gamma2)` from the fit's canonical
 /// physical read-off and its parameters.
 fn sin_replicates(r: usize, seed: u64) -> Vec<Vec<f64>> {
-    let truth = Model::parse(SIN_TRUTH).unwrap();
+    vibration_replicates(SIN_TRUTH, "SIN()+WN()+RW()", r, seed, |fit| {
+        let canonical = fit.canonical().unwrap();
+        let kind = gmwm::model::ProcessKind::Sin;
+        let t = fit.theta();
+        vec![
+            canonical.physical(kind, "frequency").unwrap(),
+            canonical.physical(kind, "amplitude").unwrap(),
+            t[2],
+            t[3],
+        ]
+    })
+}
+
+/// Fits `model` to `r` replicates of `truth` at N = 2^18 and [`SIN_FREQ_HZ`] (every fit must
+/// converge) and returns `read` of each fit.
+fn vibration_replicates(
+    truth: &str,
+    model: &str,
+    r: usize,
+    seed: u64,
+    read: impl Fn(&gmwm::GmwmFit) -> Vec<f64> + Sync,
+) -> Vec<Vec<f64>> {
+    let truth = Model::parse(truth).unwrap();
     (0..r as u64)
         .into_par_iter()
         .map(|i| {
             let x = simulate_model(&truth, 1 << 18, SIN_FREQ_HZ, replicate_seed(seed, i)).unwrap();
-            let fit = Gmwm::parse("SIN()+WN()+RW()")
+            let fit = Gmwm::parse(model)
                 .unwrap()
                 .fit(&x, SIN_FREQ_HZ, &WvOptions::default())
                 .unwrap_or_else(|e| panic!("replicate {i}: {e}"));
             assert!(fit.convergence().converged, "replicate {i}: {fit}");
-            let canonical = fit.canonical().unwrap();
-            let kind = gmwm::model::ProcessKind::Sin;
-            let t = fit.theta();
-            vec![
-                canonical.physical(kind, "frequency").unwrap(),
-                canonical.physical(kind, "amplitude").unwrap(),
-                t[2],
-                t[3],
-            ]
+            read(&fit)
         })
         .collect()
 }
@@ -258,32 +272,22 @@ const TWO_LINES_TRUTH: &str =
 /// Fits `2*SIN()+WN()+RW()` to `r` replicates of [`TWO_LINES_TRUTH`] at N = 2^18; per replicate
 /// the canonical model's `(frequency, amplitude)` of each line in its order, then WN sigma2.
 fn two_line_replicates(r: usize, seed: u64) -> Vec<Vec<f64>> {
-    let truth = Model::parse(TWO_LINES_TRUTH).unwrap();
-    (0..r as u64)
-        .into_par_iter()
-        .map(|i| {
-            let x = simulate_model(&truth, 1 << 18, SIN_FREQ_HZ, replicate_seed(seed, i)).unwrap();
-            let fit = Gmwm::parse("2*SIN()+WN()+RW()")
-                .unwrap()
-                .fit(&x, SIN_FREQ_HZ, &WvOptions::default())
-                .unwrap_or_else(|e| panic!("replicate {i}: {e}"));
-            assert!(fit.convergence().converged, "replicate {i}: {fit}");
-            let canonical = fit.canonical().unwrap();
-            let mut row: Vec<f64> = canonical
-                .terms
-                .iter()
-                .filter(|t| t.kind == gmwm::model::ProcessKind::Sin)
-                .flat_map(|t| {
-                    ["frequency", "amplitude"]
-                        .map(|name| t.physical.iter().find(|p| p.name == name).unwrap().value)
-                })
-                .collect();
-            assert_eq!(row.len(), 4, "replicate {i}: {canonical}");
-            let n = canonical.physical(gmwm::model::ProcessKind::Wn, "white_noise_density");
-            row.push(n.unwrap().powi(2) * SIN_FREQ_HZ);
-            row
-        })
-        .collect()
+    vibration_replicates(TWO_LINES_TRUTH, "2*SIN()+WN()+RW()", r, seed, |fit| {
+        let canonical = fit.canonical().unwrap();
+        let mut row: Vec<f64> = canonical
+            .terms
+            .iter()
+            .filter(|t| t.kind == gmwm::model::ProcessKind::Sin)
+            .flat_map(|t| {
+                ["frequency", "amplitude"]
+                    .map(|name| t.physical.iter().find(|p| p.name == name).unwrap().value)
+            })
+            .collect();
+        assert_eq!(row.len(), 4, "{canonical}");
+        let n = canonical.physical(gmwm::model::ProcessKind::Wn, "white_noise_density");
+        row.push(n.unwrap().powi(2) * SIN_FREQ_HZ);
+        row
+    })
 }
 
 /// The truth of [`two_line_replicates`]' rows: the canonical model lists the lines by
