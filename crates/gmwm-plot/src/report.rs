@@ -415,7 +415,8 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
     } else {
         format!(
             "The WIC selected {} ({}); the notes below say how the calibration refined it.",
-            esc(&selected),
+            // as the selection's figure and table name it
+            esc(&a.selection.selected_canonical().model.to_string()),
             esc(reason.trim_end_matches('.'))
         )
     };
