@@ -16,13 +16,11 @@
 //! The first byte of several inputs is a selector (options, record type, column count); see
 //! each function.
 
-use gmwm::imu::ros::{list_topics, read_imu_messages, ImuMessages};
-use gmwm::imu::{
-    read_table, ColumnSelector, HeaderMode, Imu, ImuRecordType, InputFormat, ReadError,
+use gmwm::{
+    allan_from_wv, is_wv_json, list_topics, read_imu_messages, read_table, read_wv_json,
+    ColumnSelector, HeaderMode, Imu, ImuMessages, ImuRecordType, InputFormat, Model, ReadError,
     ReadOptions, Recording, RecordingOptions, Sidecar, Table,
 };
-use gmwm::model::Model;
-use gmwm::variance::{allan_from_wv, is_wv_json, read_wv_json};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 

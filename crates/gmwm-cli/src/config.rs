@@ -18,18 +18,11 @@ use crate::input::InputConfig;
 use crate::recordings::{is_glob, is_rosbag2_folder};
 use crate::render::Style;
 use anyhow::{Context, Result};
-use gmwm::calib::export::ExportFormat;
-use gmwm::calib::{Adjustment, AxisPolicy, CalibrationOptions, Datasheet, DEFAULT_FULL_MODEL};
-use gmwm::imu::{ColumnSelector, ReadOptions};
-use gmwm::inference::same_model::SameModelOptions;
-use gmwm::inference::InferenceOptions;
-use gmwm::model::Model;
-use gmwm::monitor::MonitorOptions;
-use gmwm::shared::SharedOptions;
-use gmwm::units::SignalUnit;
 use gmwm::{
-    AllanKind, AllanOptions, AvConvention, Gmwm, RobustOptions, Transform, WaveletFilter,
-    Weighting, Wic, WvOptions,
+    Adjustment, AllanKind, AllanOptions, AvConvention, AxisPolicy, CalibrationOptions,
+    ColumnSelector, Datasheet, ExportFormat, Gmwm, InferenceOptions, Model, MonitorOptions,
+    ReadOptions, RobustOptions, SameModelOptions, SharedOptions, SignalUnit, Transform,
+    WaveletFilter, Weighting, Wic, WvOptions, DEFAULT_FULL_MODEL,
 };
 use gmwm_plot::{ImageFormat, Layout};
 use std::path::{Path, PathBuf};
@@ -140,7 +133,7 @@ impl TryFrom<&InputArgs> for InputConfig {
             file: a.file.clone(),
             read,
             topic: a.topic.clone(),
-            stream_from: a.stream_from.unwrap_or(gmwm::calib::STREAM_FROM),
+            stream_from: a.stream_from.unwrap_or(gmwm::STREAM_FROM),
             probe: Default::default(),
         })
     }
@@ -197,7 +190,7 @@ fn wv_options(a: &WvEstimatorArgs) -> Result<WvOptions> {
     } else {
         None
     };
-    gmwm::variance::ci::check_alpha(a.alpha)?;
+    gmwm::check_alpha(a.alpha)?;
     Ok(WvOptions {
         transform: a.transform,
         filter: a.filter.parse::<WaveletFilter>()?,
@@ -328,7 +321,7 @@ impl TryFrom<&AvarArgs> for AvarConfig {
     type Error = anyhow::Error;
 
     fn try_from(a: &AvarArgs) -> Result<Self> {
-        gmwm::variance::ci::check_alpha(a.alpha)?;
+        gmwm::check_alpha(a.alpha)?;
         let allan = AllanOptions {
             kind: a.kind,
             alpha: a.alpha,
@@ -1263,7 +1256,7 @@ impl TryFrom<&SameModelArgs> for SameModelConfig {
                 ..ReadOptions::default()
             },
             topic: None,
-            stream_from: gmwm::calib::STREAM_FROM,
+            stream_from: gmwm::STREAM_FROM,
             probe: Default::default(),
         };
         Ok(Self {
@@ -1312,7 +1305,7 @@ impl TryFrom<&SharedArgs> for SharedConfig {
             text.parse::<Model>()
                 .with_context(|| format!("invalid {flag} {text:?}"))
         };
-        if let Some(why) = gmwm::variance::ci::significance_level_problem(a.alpha) {
+        if let Some(why) = gmwm::significance_level_problem(a.alpha) {
             anyhow::bail!("invalid --alpha {}: {why}", a.alpha);
         }
         anyhow::ensure!(a.draws >= 1, "invalid --G 0: at least one draw");
@@ -1405,7 +1398,7 @@ impl TryFrom<&MonitorArgs> for MonitorConfig {
     type Error = anyhow::Error;
 
     fn try_from(a: &MonitorArgs) -> Result<Self> {
-        if let Some(why) = gmwm::variance::ci::significance_level_problem(a.alpha) {
+        if let Some(why) = gmwm::significance_level_problem(a.alpha) {
             anyhow::bail!("invalid --alpha {}: {why}", a.alpha);
         }
         let robust = gmwm::RobustOptions::new(a.eff, gmwm::RobustConvention::Exact)
@@ -1439,9 +1432,9 @@ mod tests {
     use super::*;
     use crate::args::Cli;
     use clap::Parser;
-    use gmwm::imu::{HeaderMode, ImuRecordType, InputFormat, TimeUnit};
-    use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
     use gmwm::RobustConvention;
+    use gmwm::{HeaderMode, ImuRecordType, InputFormat, TimeUnit};
+    use gmwm::{OptimismConvention, OptimismMethod, SelectionRule};
 
     /// The arguments clap parses from `gmwm ARGV`.
     fn parse(argv: &[&str]) -> Command {

@@ -3,9 +3,10 @@
 
 use crate::style::OutputStyle;
 use anyhow::{Context, Result};
-use gmwm::imu::{quote, read_table, InputFormat, ReadWarning, Table};
-use gmwm::variance::{is_wv_json, read_wv_json, select_series};
-use gmwm::WaveletVariance;
+use gmwm::{
+    is_wv_json, quote, read_table, read_wv_json, select_series, InputFormat, ReadWarning, Table,
+    WaveletVariance,
+};
 use std::path::{Path, PathBuf};
 
 /// Where the data come from and how to read them: FILE and the engine's read options
@@ -16,23 +17,23 @@ pub struct InputConfig {
     /// The data file (or rosbag2 folder).
     pub file: PathBuf,
     /// The engine's read options; `read.freq_hz` is `--freq`, `read.columns` is `--columns`.
-    pub read: gmwm::imu::ReadOptions,
+    pub read: gmwm::ReadOptions,
     /// `--topic`: the IMU topic of a ROS recording.
     pub topic: Option<String>,
     /// `--stream-from`: rows from which a text or IMU-record recording is streamed
-    /// ([`gmwm::calib::STREAM_FROM`] by default).
+    /// ([`gmwm::STREAM_FROM`] by default).
     pub stream_from: u64,
     /// What FILE is, probed once ([`InputConfig::probe`]).
-    pub probe: std::sync::OnceLock<gmwm::imu::Probe>,
+    pub probe: std::sync::OnceLock<gmwm::Probe>,
 }
 
 impl InputConfig {
-    /// What FILE is ([`gmwm::imu::Probe`]: a ROS container, a folder, a file), probed the
+    /// What FILE is ([`gmwm::Probe`]: a ROS container, a folder, a file), probed the
     /// first time it is asked and kept: every reader and the calibration's choice between
     /// memory and streaming take it from here.
-    pub fn probe(&self) -> &gmwm::imu::Probe {
+    pub fn probe(&self) -> &gmwm::Probe {
         self.probe
-            .get_or_init(|| gmwm::imu::Probe::of(&self.file, &self.read))
+            .get_or_init(|| gmwm::Probe::of(&self.file, &self.read))
     }
 
     /// The same reading of another FILE (its own probe).
@@ -116,9 +117,9 @@ fn report(style: OutputStyle, table: &Table) {
 pub(crate) fn report_parts(
     style: OutputStyle,
     file: &std::path::Path,
-    timing: Option<&gmwm::imu::TimingReport>,
+    timing: Option<&gmwm::TimingReport>,
     skipped: &[String],
-    samples: &gmwm::imu::SampleAccount,
+    samples: &gmwm::SampleAccount,
     warnings: &[ReadWarning],
 ) {
     if let Some(t) = timing {
@@ -237,7 +238,7 @@ pub fn analyse_columns<T: Send>(
         .iter()
         .map(|c| c.values.as_slice())
         .collect();
-    let results = gmwm::variance::per_column(&columns, f);
+    let results = gmwm::per_column(&columns, f);
     loaded
         .table
         .columns
@@ -260,17 +261,17 @@ pub struct LoadedRecording {
     /// The file.
     pub path: std::path::PathBuf,
     /// Its columns and what each measures.
-    pub columns: Vec<(String, gmwm::imu::SensorInfo)>,
+    pub columns: Vec<(String, gmwm::SensorInfo)>,
     /// Its samples; `None` for a recording the calibration streams from the file.
-    pub imu: Option<gmwm::imu::Imu>,
+    pub imu: Option<gmwm::Imu>,
     /// The ROS topic read, if any.
     pub topic: Option<String>,
     /// What it was read from.
-    pub source: gmwm::imu::RecordingSource,
+    pub source: gmwm::RecordingSource,
     /// What the time stamps say, when there are stamps (a time column or ROS header stamps).
-    pub timing: Option<gmwm::imu::TimingReport>,
+    pub timing: Option<gmwm::TimingReport>,
     /// How many samples were read and used per axis (row accounting).
-    pub samples: gmwm::imu::SampleAccount,
+    pub samples: gmwm::SampleAccount,
     /// What the reader noticed, one line each.
     pub notes: Vec<String>,
 }
@@ -278,18 +279,18 @@ pub struct LoadedRecording {
 /// Opens the recording named by `input` as an IMU (the engine's `Recording`: text, raw
 /// binary, binary IMU records or a ROS recording).
 pub fn load_recording(input: &InputConfig) -> Result<LoadedRecording> {
-    let opts = gmwm::imu::RecordingOptions {
+    let opts = gmwm::RecordingOptions {
         read: input.read.clone(),
         topic: input.topic.clone(),
     };
-    let rec = gmwm::imu::Recording::open_probed(input.probe(), &opts)?;
+    let rec = gmwm::Recording::open_probed(input.probe(), &opts)?;
     let mut loaded = memory_recording(&rec);
     loaded.imu = Some(rec.imu);
     Ok(loaded)
 }
 
 /// What a recording read into memory is, as shown (its samples stay with `rec`).
-pub fn memory_recording(rec: &gmwm::imu::Recording) -> LoadedRecording {
+pub fn memory_recording(rec: &gmwm::Recording) -> LoadedRecording {
     LoadedRecording {
         path: shown_path(&rec.path),
         columns: rec
@@ -307,14 +308,14 @@ pub fn memory_recording(rec: &gmwm::imu::Recording) -> LoadedRecording {
     }
 }
 
-/// A raw binary recording the calibration streams ([`gmwm::calib::Calibration::streams`]):
+/// A raw binary recording the calibration streams ([`gmwm::Calibration::streams`]):
 /// its columns and what each measures from the sidecar, no samples read.
 pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
-    let columns = gmwm::calib::streamed::columns(&input.file, &input.read)?;
+    let columns = gmwm::binary_file_columns(&input.file, &input.read)?;
     // the columns left out, as the in-memory reader notes them
-    let skipped = match gmwm::imu::binary_layout(&input.file, &input.read)? {
+    let skipped = match gmwm::binary_layout(&input.file, &input.read)? {
         Some(layout) => {
-            let sidecar = gmwm::imu::find_sidecar(&input.file)?;
+            let sidecar = gmwm::find_sidecar(&input.file)?;
             layout
                 .selection(&input.file, &input.read, sidecar.as_ref())?
                 .1
@@ -326,9 +327,9 @@ pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
         path: shown_path(&input.file),
         imu: None,
         topic: None,
-        source: gmwm::imu::RecordingSource::Table,
+        source: gmwm::RecordingSource::Table,
         timing: None,
-        notes: gmwm::imu::recording::left_out_note(&skipped)
+        notes: gmwm::left_out_note(&skipped)
             .into_iter()
             .chain([samples.to_string()])
             .collect(),
@@ -340,10 +341,10 @@ pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
 /// The account of a raw binary file streamed whole: every row read and used in `columns`.
 fn streamed_samples(
     input: &InputConfig,
-    columns: &[(String, gmwm::imu::SensorInfo)],
-) -> Result<gmwm::imu::SampleAccount> {
+    columns: &[(String, gmwm::SensorInfo)],
+) -> Result<gmwm::SampleAccount> {
     let names = columns.iter().map(|(n, _)| n.clone()).collect();
-    let rows = match gmwm::imu::binary_layout(&input.file, &input.read)? {
+    let rows = match gmwm::binary_layout(&input.file, &input.read)? {
         Some(layout) => {
             let width = layout.format.value_width().unwrap_or(8) * layout.ncols;
             let bytes = std::fs::metadata(&input.file)
@@ -353,17 +354,17 @@ fn streamed_samples(
         }
         None => 0,
     };
-    Ok(gmwm::imu::SampleAccount::all_used(names, "row", rows))
+    Ok(gmwm::SampleAccount::all_used(names, "row", rows))
 }
 
 /// A text or IMU-record recording the calibration streams, read once into its spool
-/// ([`gmwm::imu::read::stream::StreamedTable`]): its columns, what each measures, and what the
+/// ([`gmwm::StreamedTable`]): its columns, what each measures, and what the
 /// reader noticed, as [`load_recording`] gives them.
-pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> LoadedRecording {
+pub fn streamed_table_recording(t: &gmwm::StreamedTable) -> LoadedRecording {
     // a ROS topic's notes are all of them, as the in-memory reader gives them
     let mut notes = match t.topic {
         Some(_) => Vec::new(),
-        None => gmwm::imu::recording::table_notes(
+        None => gmwm::table_notes(
             t.facts.record_type,
             t.facts.timing.as_ref(),
             &t.facts.skipped,
@@ -378,14 +379,14 @@ pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> L
         imu: None,
         topic: t.topic.clone(),
         source: match (t.facts.record_type, &t.topic, t.container) {
-            (_, Some(topic), Some(container)) => gmwm::imu::RecordingSource::Ros {
+            (_, Some(topic), Some(container)) => gmwm::RecordingSource::Ros {
                 container: container.to_string(),
                 topic: topic.clone(),
             },
-            (Some(r), _, _) => gmwm::imu::RecordingSource::Records {
+            (Some(r), _, _) => gmwm::RecordingSource::Records {
                 record_type: r.name().to_string(),
             },
-            _ => gmwm::imu::RecordingSource::Table,
+            _ => gmwm::RecordingSource::Table,
         },
         timing: t.facts.timing.clone(),
         samples: t.facts.samples.clone(),
@@ -395,9 +396,9 @@ pub fn streamed_table_recording(t: &gmwm::imu::read::stream::StreamedTable) -> L
 
 /// A ROS recording read as a table: the IMU topic's six axes at the header stamps' rate.
 fn load_ros(input: &InputConfig, style: OutputStyle) -> Result<Loaded> {
-    let rec = gmwm::imu::Recording::open(
+    let rec = gmwm::Recording::open(
         &input.file,
-        &gmwm::imu::RecordingOptions {
+        &gmwm::RecordingOptions {
             read: input.read.clone(),
             topic: input.topic.clone(),
         },
@@ -407,7 +408,7 @@ fn load_ros(input: &InputConfig, style: OutputStyle) -> Result<Loaded> {
     }
     let freq_hz = rec.imu.freq_hz();
     let table = Table {
-        facts: gmwm::imu::TableFacts {
+        facts: gmwm::TableFacts {
             path: rec.path,
             freq_hz: Some(freq_hz),
             sidecar: None,

@@ -1,10 +1,9 @@
 //! The files the commands write: atomically (a temporary file beside the destination,
-//! renamed over it once complete, [`gmwm::imu::write::AtomicFile`]), so an interrupted run
+//! renamed over it once complete, [`gmwm::AtomicFile`]), so an interrupted run
 //! leaves the previous file or none, and never over one of the command's inputs.
 
 use anyhow::{bail, Result};
-use gmwm::imu::write::{write_atomic, AtomicFile};
-use gmwm::imu::ReadError;
+use gmwm::{write_atomic, AtomicFile, ReadError};
 use std::path::Path;
 
 /// Writes `bytes` to `path` atomically; the error reads `cannot write PATH: cause`.

@@ -7,7 +7,7 @@ use crate::input::InputConfig;
 use crate::recordings::is_rosbag2_folder;
 use crate::spool::{self, Spool};
 use anyhow::Result;
-use gmwm::imu::InputFormat;
+use gmwm::InputFormat;
 use std::path::{Path, PathBuf};
 
 /// What a command reads, as its preparation needs to know it.
@@ -109,7 +109,7 @@ fn check_recording(input: &InputConfig) -> Result<()> {
 }
 
 /// A warning when FILE is raw f64/f32 whose first values no sensor gives
-/// ([`gmwm::imu::plausible::raw_floats`]); silent when it is not raw floats or cannot be read
+/// ([`gmwm::raw_floats`]); silent when it is not raw floats or cannot be read
 /// (the reader then says why).
 pub fn warn_implausible(input: &InputConfig) {
     if input.read.format == InputFormat::Auto
@@ -117,12 +117,12 @@ pub fn warn_implausible(input: &InputConfig) {
     {
         return;
     }
-    let layout = match gmwm::imu::binary_layout(&input.file, &input.read) {
+    let layout = match gmwm::binary_layout(&input.file, &input.read) {
         Ok(layout) => layout,
         // a size that is no whole number of rows (the reader says so next): the values are
         // still looked at when the format was given, as text read as f64 often has that size
         Err(_) => matches!(input.read.format, InputFormat::F64 | InputFormat::F32).then(|| {
-            gmwm::imu::BinaryLayout {
+            gmwm::BinaryLayout {
                 format: input.read.format,
                 ncols: 1,
                 names: Vec::new(),
@@ -130,7 +130,7 @@ pub fn warn_implausible(input: &InputConfig) {
         }),
     };
     if let Some(layout) = layout {
-        if let Ok(Some(bad)) = gmwm::imu::plausible::raw_floats(&input.file, &layout) {
+        if let Ok(Some(bad)) = gmwm::raw_floats(&input.file, &layout) {
             eprintln!("gmwm: warning: {}", spool::shown(&bad.to_string()));
         }
     }

@@ -4,7 +4,7 @@
 
 use crate::error::UsageError;
 use anyhow::{Context, Result};
-use gmwm::imu::InputFormat;
+use gmwm::InputFormat;
 use std::path::{Path, PathBuf};
 
 /// A FILE argument that gmwm expands itself: it does not exist as written and holds a glob
@@ -58,7 +58,7 @@ fn is_recording(path: &Path, format: InputFormat) -> bool {
 
 /// The JSON sidecar a reader would use for `path`, if one exists.
 pub fn sidecar_of(path: &Path) -> Option<PathBuf> {
-    gmwm::imu::sidecar::sidecar_candidates(path)
+    gmwm::sidecar_candidates(path)
         .into_iter()
         .find(|p| p.is_file())
 }

@@ -135,7 +135,7 @@ pub fn save_figure(fig: &gmwm_plot::Figure, path: &std::path::Path) -> Result<()
 /// The unit a figure labels a column with: the sensor unit a sidecar's text names
 /// (`deg/s (inferred ...)` -> `deg/s`), else `u`.
 pub fn figure_unit(unit: Option<&str>) -> String {
-    unit.and_then(|u| u.parse::<gmwm::units::SignalUnit>().ok())
+    unit.and_then(|u| u.parse::<gmwm::SignalUnit>().ok())
         .map_or_else(|| "u".to_string(), |u| u.symbol().to_string())
 }
 

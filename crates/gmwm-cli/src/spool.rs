@@ -89,7 +89,7 @@ pub fn spool(path: &Path) -> Result<(PathBuf, Spool)> {
         .and_then(|_| file.flush())
         .with_context(|| format!("{shown_name}: cannot read it"))?;
     if !stdin {
-        for candidate in gmwm::imu::sidecar::sidecar_candidates(path) {
+        for candidate in gmwm::sidecar_candidates(path) {
             if candidate.is_file() {
                 if let Some(n) = candidate.file_name() {
                     let _ = std::fs::copy(&candidate, dir.join(n));

@@ -5,7 +5,7 @@
 //! Warnings and errors are always printed; standard output carries the results alone, the same
 //! whatever the style.
 
-use gmwm::inference::Progress;
+use gmwm::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::Path;

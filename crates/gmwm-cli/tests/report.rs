@@ -328,8 +328,8 @@ fn report_browser_checker_catches_each_fault() {
 fn calibrate_report_flag_writes_the_same_page() {
     let dir = tempfile::tempdir().unwrap();
     // a gyroscope at 100 Hz in rad/s: a time column gives the rate, the header the unit
-    let model: gmwm::model::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();
-    let x = gmwm::sim::simulate_model(&model, 1 << 14, 100.0, 3).unwrap();
+    let model: gmwm::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();
+    let x = gmwm::simulate_model(&model, 1 << 14, 100.0, 3).unwrap();
     let mut text = String::from("time,gyro_x [rad/s]\n");
     for (i, v) in x.iter().enumerate() {
         text.push_str(&format!("{},{v}\n", i as f64 / 100.0));

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 
 /// A CSV with columns gyro_x, gyro_y, gyro_z (a shared AR1 plus white noise) and accel_x.
 fn triad(dir: &Path, n: usize) -> PathBuf {
-    use gmwm::model::Model;
-    use gmwm::sim::simulate_model;
+    use gmwm::simulate_model;
+    use gmwm::Model;
     let v = simulate_model(
         &Model::parse("AR1(phi=0.99, sigma2=0.02)").unwrap(),
         n,

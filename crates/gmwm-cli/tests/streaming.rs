@@ -35,11 +35,8 @@ fn recordings() -> Vec<(String, Columns)> {
     names
         .into_iter()
         .map(|name| {
-            let table = gmwm::imu::read_table(
-                &shared_data().join(&name),
-                &gmwm::imu::ReadOptions::default(),
-            )
-            .unwrap();
+            let table = gmwm::read_table(&shared_data().join(&name), &gmwm::ReadOptions::default())
+                .unwrap();
             let columns = table
                 .columns
                 .into_iter()
@@ -151,7 +148,7 @@ fn streaming_equals_in_memory_on_every_shared_recording_and_raw_format() {
 }
 
 /// Issue 14: `gmwm fit` of a raw binary file streams it too (the WV and the range of the start
-/// search in one pass, [`gmwm::variance::binary_columns_wv`]); its fit equals the fit of the
+/// search in one pass, [`gmwm::binary_columns_wv`]); its fit equals the fit of the
 /// same values loaded (through a time column, which turns streaming off), with the same N and
 /// range, to the optimiser's precision (the two WVs differ by rounding only).
 #[test]

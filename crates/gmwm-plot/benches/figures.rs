@@ -2,12 +2,11 @@
 //! four components) as SVG and as PNG, and the six-panel WV grid as SVG.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use gmwm::sim::simulate_model;
-use gmwm::{Gmwm, WvOptions};
+use gmwm::{simulate_model, Gmwm, WvOptions};
 use gmwm_plot::{fit_figure, wv_figure, Column, Layout};
 
 fn bench(c: &mut Criterion) {
-    let model: gmwm::model::Model =
+    let model: gmwm::Model =
         "AR1(phi=0.999, sigma2=1e-8)+AR1(phi=0.9, sigma2=1e-6)+WN(sigma2=1e-4)+RW(gamma2=1e-12)"
             .parse()
             .unwrap();

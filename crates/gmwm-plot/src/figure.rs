@@ -129,8 +129,8 @@ impl Figure {
             ImageFormat::Png => self.png()?,
         };
         // atomically: an interrupted run leaves the previous figure or none
-        gmwm::imu::write::write_atomic(path, &bytes).map_err(|e| match e {
-            gmwm::imu::ReadError::Io { source, .. } => PlotError::Io {
+        gmwm::write_atomic(path, &bytes).map_err(|e| match e {
+            gmwm::ReadError::Io { source, .. } => PlotError::Io {
                 path: path.display().to_string(),
                 source,
             },

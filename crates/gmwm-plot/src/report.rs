@@ -12,12 +12,10 @@ use crate::figures::{
 use crate::style::number;
 use crate::{Figure, PlotError};
 use base64::Engine as _;
-use gmwm::calib::{
-    AxisCalibration, CalibrationReport, DatasheetComparison, Estimate, EstimateStatus,
+use gmwm::{
+    AxisCalibration, CalibrationReport, DatasheetComparison, Estimate, EstimateStatus, RowStatus,
+    Sensor, SignalKind,
 };
-use gmwm::imu::Sensor;
-use gmwm::selection::RowStatus;
-use gmwm::units::SignalKind;
 use std::fmt::Write as _;
 
 /// Everything the page shows besides the calibration itself.
@@ -297,7 +295,7 @@ const TABLE_ROWS: usize = 10;
 /// The Welch PSD of every axis that has one, beside the WVs, with the fitted white-noise
 /// density's level where the calibration has one (an upper bound is no level).
 fn psd_section(out: &mut String, report: &CalibrationReport) -> Result<(), PlotError> {
-    let pairs: Vec<(&AxisCalibration, (gmwm::variance::psd::Psd, Option<f64>))> = report
+    let pairs: Vec<(&AxisCalibration, (gmwm::Psd, Option<f64>))> = report
         .axes
         .iter()
         .filter_map(|a| {
@@ -322,7 +320,7 @@ fn psd_section(out: &mut String, report: &CalibrationReport) -> Result<(), PlotE
             first.segments(),
             first.segment_length(),
             number(first.resolution_hz()),
-            gmwm::variance::psd::BINNED_POINTS,
+            gmwm::BINNED_POINTS,
             number(report.freq_hz / 2.0)
         ),
     )?);

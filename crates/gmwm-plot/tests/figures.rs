@@ -4,11 +4,10 @@
 //! decodes to the stated size. With `GMWM_FIGURES_DIR` set, the figures are also written there
 //! for a person to look at.
 
-use gmwm::calib::ieee::ieee_readoff;
-use gmwm::imu::{read_table, ReadOptions};
-use gmwm::variance::psd::{welch_psd, BINNED_POINTS};
-use gmwm::variance::read_wv_json;
-use gmwm::{allan_variance, AllanOptions, Gmwm, RobustOptions, WaveletVariance, Wic, WvOptions};
+use gmwm::{
+    allan_variance, ieee_readoff, read_table, read_wv_json, welch_psd, AllanOptions, Gmwm,
+    ReadOptions, RobustOptions, WaveletVariance, Wic, WvOptions, BINNED_POINTS,
+};
 use gmwm_plot::{
     allan_figure, compare_figure, fit_figure, ieee_figure, psd_figure, selection_figure, wv_figure,
     Column, Figure, Layout, PanelKind,
@@ -419,8 +418,8 @@ fn figures_ieee_lines_of_white_noise_and_random_walk_go_through_their_read_offs(
     // both regions are read, and each point lies on its line (docs/methods.md §14.3). Seed 1: a
     // series whose RW region is read (in 2 of 20 seeds the top octaves go to the rate ramp and
     // the read-off gives no K; the engine's ieee tests cover that case)
-    let model: gmwm::model::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();
-    let x = gmwm::sim::simulate_model(&model, 1 << 20, 100.0, 1).unwrap();
+    let model: gmwm::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();
+    let x = gmwm::simulate_model(&model, 1 << 20, 100.0, 1).unwrap();
     let av = allan_variance(&x, 100.0, &AllanOptions::default()).unwrap();
     let readoff = ieee_readoff(&av).unwrap();
     let (n, k) = (

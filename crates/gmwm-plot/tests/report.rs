@@ -1,14 +1,14 @@
 //! The HTML report of a calibration of a simulated IMU: structure, figures, numbers from the
 //! calibration, self-containment, and an axis whose contamination check is off.
 
-use gmwm::calib::{Calibration, CalibrationOptions};
-use gmwm::imu::{Column as ImuColumn, Imu, Sensor, SensorInfo};
-use gmwm::sim::simulate_model;
+use gmwm::{
+    simulate_model, Calibration, CalibrationOptions, Column as ImuColumn, Imu, Sensor, SensorInfo,
+};
 use gmwm_plot::report::{render, ReportContext};
 use gmwm_plot::style::number;
 
 fn imu() -> Imu {
-    let model: gmwm::model::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();
+    let model: gmwm::Model = "WN(sigma2=1e-4)+RW(gamma2=1e-10)".parse().unwrap();
     let columns = ["gyro_x", "accel_x"]
         .iter()
         .enumerate()

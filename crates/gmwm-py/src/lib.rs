@@ -3,18 +3,13 @@
 //! (`gmwm::document`, the CLI's `--json`), engine errors as `gmwm.GmwmError`; the GIL is released
 //! while the engine works. The Python package (`python/gmwm`) wraps these in typed results.
 
-use gmwm::calib::{Adjustment, AxisPolicy, Calibration, CalibrationOptions};
-use gmwm::imu::{
-    read_table, ColumnSelector, HeaderMode, Imu, InputFormat, ReadOptions, Recording,
-    RecordingOptions, SensorInfo, TimeUnit,
-};
-use gmwm::inference::{infer_with_progress, CovarianceMethod, InferenceOptions, Progress};
-use gmwm::model::Model;
-use gmwm::names::Named;
-use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
 use gmwm::{
-    allan_variance, wavelet_variance, AllanKind, AllanOptions, AvConvention, Gmwm,
-    RobustConvention, RobustOptions, Transform, WaveletFilter, Weighting, Wic, WvOptions,
+    allan_variance, infer_with_progress, read_table, wavelet_variance, Adjustment, AllanKind,
+    AllanOptions, AvConvention, AxisPolicy, Calibration, CalibrationOptions, ColumnSelector,
+    CovarianceMethod, Gmwm, HeaderMode, Imu, InferenceOptions, InputFormat, Model, Named,
+    OptimismConvention, OptimismMethod, Progress, ReadOptions, Recording, RecordingOptions,
+    RobustConvention, RobustOptions, SelectionRule, SensorInfo, TimeUnit, Transform, WaveletFilter,
+    Weighting, Wic, WvOptions,
 };
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
@@ -71,7 +66,7 @@ fn columns_of<'a>(arrays: &'a Borrowed<'_>) -> Vec<Cow<'a, [f64]>> {
         .collect()
 }
 
-/// `f` on every column in parallel (the engine's [`gmwm::variance::per_column`], as the CLI),
+/// `f` on every column in parallel (the engine's [`gmwm::per_column`], as the CLI),
 /// each result named by its column; the first failure as one line naming the column.
 fn per_column<T: Send, E: std::fmt::Display + Send>(
     names: &[String],
@@ -81,7 +76,7 @@ fn per_column<T: Send, E: std::fmt::Display + Send>(
     let slices: Vec<&[f64]> = cols.iter().map(|c| c.as_ref()).collect();
     names
         .iter()
-        .zip(gmwm::variance::per_column(&slices, f))
+        .zip(gmwm::per_column(&slices, f))
         .map(|(n, r)| {
             r.map(|t| (n.clone(), t))
                 .map_err(|e| format!("column {n}: {e}"))
@@ -143,7 +138,7 @@ fn wv_options(
     } else {
         None
     };
-    if let Some(why) = gmwm::variance::ci::significance_level_problem(alpha) {
+    if let Some(why) = gmwm::significance_level_problem(alpha) {
         return Err(err(format!("invalid alpha {alpha}: {why}")));
     }
     if levels == Some(0) {
@@ -212,7 +207,7 @@ fn avar(
 ) -> PyResult<String> {
     check_columns(&arrays, &names)?;
     check_freq(freq)?;
-    if let Some(why) = gmwm::variance::ci::significance_level_problem(alpha) {
+    if let Some(why) = gmwm::significance_level_problem(alpha) {
         return Err(err(format!("invalid alpha {alpha}: {why}")));
     }
     let opts = AllanOptions {
@@ -263,7 +258,7 @@ fn simulate<'py>(
     let model: Model = model.parse().map_err(engine)?;
     let k = model.components().len();
     let result = py.detach(|| -> Result<(Vec<f64>, Vec<Vec<f64>>), gmwm::Error> {
-        let mut sim = gmwm::sim::Simulator::for_model(&model, freq, seed)?;
+        let mut sim = gmwm::Simulator::for_model(&model, freq, seed)?;
         if !components {
             let mut x = vec![0.0; n];
             sim.fill(&mut x);
@@ -575,7 +570,7 @@ fn read<'py>(
     Vec<String>,
 )> {
     let opts = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
-    let probe = gmwm::imu::Probe::of(&path, &opts);
+    let probe = gmwm::Probe::of(&path, &opts);
     let read = py.detach(|| -> Result<_, gmwm::Error> {
         if probe.is_ros() {
             let rec = Recording::open_probed(
@@ -592,7 +587,7 @@ fn read<'py>(
             return Ok((cols, Some(freq), units, rec.notes));
         }
         if let Some(t) = &topic {
-            return Err(gmwm::error::ParamError::new(
+            return Err(gmwm::ParamError::new(
                 "topic",
                 t,
                 format!(
@@ -611,7 +606,7 @@ fn read<'py>(
         if let Some(t) = &table.facts.timing {
             notes.push(t.to_string());
         }
-        notes.extend(gmwm::imu::recording::left_out_note(&table.facts.skipped));
+        notes.extend(gmwm::left_out_note(&table.facts.skipped));
         notes.push(table.facts.samples.to_string());
         notes.extend(table.facts.warnings.iter().map(ToString::to_string));
         Ok((table.columns, table.facts.freq_hz, units, notes))
@@ -678,7 +673,7 @@ fn calibrate(
             "invalid bootstrap {bootstrap}: at least 2 (a covariance needs two replicates)"
         )));
     }
-    let unit = |u: Option<&str>, what: &str| -> PyResult<Option<gmwm::units::SignalUnit>> {
+    let unit = |u: Option<&str>, what: &str| -> PyResult<Option<gmwm::SignalUnit>> {
         u.map(|t| {
             t.parse().map_err(|_| {
                 err(format!(
@@ -692,7 +687,7 @@ fn calibrate(
     let wv = wv_options(robust, eff, robust_convention, "haar", "modwt", None, alpha)?;
     let options = CalibrationOptions {
         full_model: model
-            .unwrap_or(gmwm::calib::DEFAULT_FULL_MODEL)
+            .unwrap_or(gmwm::DEFAULT_FULL_MODEL)
             .parse()
             .map_err(engine)?,
         wv,
@@ -708,7 +703,7 @@ fn calibrate(
         force_units,
         datasheet: datasheet
             .map(|t| {
-                t.parse::<gmwm::calib::Datasheet>()
+                t.parse::<gmwm::Datasheet>()
                     .map_err(|e| err(format!("invalid datasheet {t:?}: {e}")))
             })
             .transpose()?,
@@ -753,7 +748,7 @@ fn calibrate(
             .flat_map(|(l, r)| r.notes.iter().map(move |n| format!("{l}: {n}")))
             .collect();
         let rostopic = rostopic.or_else(|| recordings.first().and_then(|r| r.topic.clone()));
-        let doc = py.detach(|| -> Result<String, gmwm::calib::CalibError> {
+        let doc = py.detach(|| -> Result<String, gmwm::CalibError> {
             let named: Vec<(&str, &Imu)> = labels
                 .iter()
                 .zip(&recordings)
@@ -775,14 +770,14 @@ fn calibrate(
     // `gmwm calibrate FILE.json` does
     if let Some(wv_path) = path
         .as_ref()
-        .filter(|p| arrays.is_none() && format == "auto" && gmwm::variance::is_wv_json(p))
+        .filter(|p| arrays.is_none() && format == "auto" && gmwm::is_wv_json(p))
     {
         let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
-        let series = gmwm::variance::read_wv_json(wv_path, read.freq_hz)
-            .and_then(|all| gmwm::variance::select_series(wv_path, all, &read.columns))
+        let series = gmwm::read_wv_json(wv_path, read.freq_hz)
+            .and_then(|all| gmwm::select_series(wv_path, all, &read.columns))
             .map_err(engine)?;
-        let (rows, note) = gmwm::calib::streamed::wv_account(&series);
-        let doc = py.detach(|| -> Result<String, gmwm::calib::CalibError> {
+        let (rows, note) = gmwm::wv_account(&series);
+        let doc = py.detach(|| -> Result<String, gmwm::CalibError> {
             let name = wv_path
                 .file_name()
                 .map(|f| f.to_string_lossy().into_owned());
@@ -822,7 +817,7 @@ fn calibrate(
                 .zip(&units)
                 .map(|(n, u)| {
                     let (sensor, axis) =
-                        SensorInfo::infer(n).unwrap_or((gmwm::imu::Sensor::Other, n.clone()));
+                        SensorInfo::infer(n).unwrap_or((gmwm::Sensor::Other, n.clone()));
                     SensorInfo {
                         sensor,
                         axis,
@@ -834,7 +829,7 @@ fn calibrate(
             let owned = names
                 .iter()
                 .zip(columns_of(&arrays))
-                .map(|(n, x)| gmwm::imu::Column {
+                .map(|(n, x)| gmwm::Column {
                     name: n.clone(),
                     values: x.into_owned(),
                 })
@@ -845,7 +840,7 @@ fn calibrate(
         _ => return Err(err("give a path or arrays, not both")),
     };
     let rostopic = rostopic.or(topic_read);
-    let doc = py.detach(|| -> Result<String, gmwm::calib::CalibError> {
+    let doc = py.detach(|| -> Result<String, gmwm::CalibError> {
         let report = Calibration::new(options).run_with_progress(&imu, &reporter)?;
         let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
         Ok(json(&gmwm::document::calibration(

@@ -11,10 +11,10 @@
 #![allow(clippy::needless_range_loop)]
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gmwm::calib::{Calibration, CalibrationOptions};
-use gmwm::imu::{ImuRecordType, InputFormat, ReadOptions, Recording, RecordingOptions};
-use gmwm::model::Model;
-use gmwm::sim::simulate_model;
+use gmwm::{
+    simulate_model, Calibration, CalibrationOptions, ImuRecordType, InputFormat, Model,
+    ReadOptions, Recording, RecordingOptions,
+};
 use std::io::Write;
 use std::path::Path;
 

@@ -7,10 +7,7 @@
 //!
 //! Run: `cargo bench -p gmwm --bench fit` (a filter such as `-- 1000000` selects cells).
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use gmwm::fit::Gmwm;
-use gmwm::model::Model;
-use gmwm::sim::simulate_model;
-use gmwm::{RobustOptions, WvOptions};
+use gmwm::{simulate_model, Gmwm, Model, RobustOptions, WvOptions};
 use std::time::Duration;
 
 const TRUTH: &str = "AR1(phi=0.9, sigma2=1)+AR1(phi=0.99, sigma2=0.1)+AR1(phi=0.999, sigma2=0.01)";
@@ -37,11 +34,7 @@ fn benches(c: &mut Criterion) {
             // naming it); the robust cells fit all but the last two levels.
             let opts = WvOptions {
                 levels: robust.then(|| {
-                    gmwm::variance::default_levels(
-                        n,
-                        gmwm::Transform::Modwt,
-                        gmwm::WaveletFilter::Haar,
-                    ) - 2
+                    gmwm::default_levels(n, gmwm::Transform::Modwt, gmwm::WaveletFilter::Haar) - 2
                 }),
                 ..opts
             };

@@ -2,7 +2,7 @@
 //! model 3*AR1 + WN + QN + RW at J = 20 levels (a navigation-grade gyro fit), summing per-process
 //! results as the GMWM objective does.
 use criterion::{criterion_group, criterion_main, Criterion};
-use gmwm::process::{Ar1, LatentProcess, Process, Qn, Rw, Wn};
+use gmwm::{Ar1, LatentProcess, Process, Qn, Rw, Wn};
 
 /// Levels of a 1e6-sample (or longer) record.
 const LEVELS: usize = 20;

@@ -5,11 +5,9 @@
 //! The fit itself (from the truth, stage 2) is setup, not timed. R's `summary(inference = TRUE)`
 //! at N = 1e6 takes 68–99 s (classical) on the reference machine.
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gmwm::fit::{Gmwm, GmwmFit};
-use gmwm::inference::{infer, InferenceOptions};
-use gmwm::model::Model;
-use gmwm::sim::simulate_model;
-use gmwm::{wavelet_variance, WvOptions};
+use gmwm::{
+    infer, simulate_model, wavelet_variance, Gmwm, GmwmFit, InferenceOptions, Model, WvOptions,
+};
 use std::time::Duration;
 
 fn truth() -> Model {

@@ -5,9 +5,7 @@
 //! 106 s on gyro_x of adis_16405_imu1 (N = 1e6) on the reference machine
 //! (`shared/ref/auto_imu_adis_16405_imu1_gyro_x.json`, `elapsed_s`).
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gmwm::model::Model;
-use gmwm::selection::Wic;
-use gmwm::sim::simulate_model;
+use gmwm::{simulate_model, Model, Wic};
 
 const N: usize = 1_000_000;
 

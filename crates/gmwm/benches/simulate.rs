@@ -4,8 +4,7 @@
 //! built outside the timed loop, output buffer reused.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use gmwm::process::{Ar1, Process, Qn, Rw, Wn};
-use gmwm::sim::Simulator;
+use gmwm::{Ar1, Process, Qn, Rw, Simulator, Wn};
 
 fn navchip() -> Vec<Process> {
     vec![

@@ -4,9 +4,7 @@
 //!
 //! `cargo run --release -p gmwm --example fit_timing -- [N] [RUNS]`
 
-use gmwm::model::Model;
-use gmwm::sim::simulate_model;
-use gmwm::{Gmwm, WvOptions};
+use gmwm::{simulate_model, Gmwm, Model, WvOptions};
 use std::time::Instant;
 
 /// The bench's truth: a Gauss–Markov bias, white noise and a random walk at 100 Hz.

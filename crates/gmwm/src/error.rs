@@ -101,13 +101,13 @@ pub enum ModelError {
         /// What would be valid.
         expected: &'static str,
     },
-    /// A multiplier `k` in `k * gm()` outside 1..=[`MAX_MULTIPLIER`](crate::model::MAX_MULTIPLIER).
+    /// A multiplier `k` in `k * gm()` outside 1..=`MAX_MULTIPLIER` (100).
     #[error("multiplier {k} is invalid: expected an integer from 1 to 100")]
     BadMultiplier {
         /// The multiplier given.
         k: usize,
     },
-    /// A parameter value outside its basic domain ([`ParamDomain`](crate::process::ParamDomain)).
+    /// A parameter value outside its basic domain (`ParamDomain`).
     #[error(
         "component {component} (0-based) {kind}: {name} = {value} is invalid: expected {expected}"
     )]

@@ -27,24 +27,24 @@
 #[cfg(test)]
 extern crate self as gmwm;
 
-pub mod calib;
+mod calib;
 pub mod document;
-pub mod error;
-pub mod fit;
-pub mod imu;
-pub mod inference;
+mod error;
+mod fit;
+mod imu;
+mod inference;
 pub(crate) mod math;
-pub mod model;
-pub mod monitor;
-pub mod names;
-pub mod process;
-pub mod progress;
-pub mod selection;
-pub mod shared;
-pub mod sim;
-pub mod units;
-pub mod variance;
-pub mod wavelet;
+mod model;
+mod monitor;
+mod names;
+mod process;
+mod progress;
+mod selection;
+mod shared;
+mod sim;
+mod units;
+mod variance;
+mod wavelet;
 
 // The engine's tests against reference data, properties and Monte Carlo; they reach the
 // crate-internal kernels, so they live inside the crate (the public API has its own test,
@@ -52,15 +52,103 @@ pub mod wavelet;
 #[cfg(test)]
 mod tests;
 
-pub use error::{InputError, ParamError, SeriesError};
-pub use fit::{FitError, Gmwm, GmwmFit, Weighting, Weights};
-pub use selection::{auto_imu, ModelSelection, SelectionError, Wic};
+// The public API, flat: the modules are private and every name a library user calls is
+// re-exported here, grouped as the method reads (docs/architecture.md). `document` stays a
+// module because its builders are named after the command whose JSON they make.
+
+// Errors.
+pub use error::{InputError, ModelError, ParamError, SeriesError};
+pub use names::Named;
+pub use progress::Progress;
+pub use units::{DatasheetUnitError, Quantity, UnitForms};
+
+// Wavelets, wavelet variances, Allan variances and spectra (docs/methods.md §1-§4).
 pub use variance::allan::{allan_variance, AllanKind, AllanOptions, AllanVariance, AvConvention};
+pub use variance::ci::{check_alpha, significance_level_problem};
+pub use variance::psd::{welch_psd, Psd, BINNED_POINTS};
 pub use variance::robust::{RobustConvention, RobustOptions};
 #[cfg(test)]
 pub(crate) use variance::wv::HaarWvAccumulator;
-pub use variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
+pub use variance::wv::{wavelet_variance, WaveletVariance, WvOptions, WvWarning};
+pub use variance::{
+    allan_from_wv, binary_columns_wv, binary_wavelet_variance, default_levels, is_wv_json,
+    per_column, read_wv_json, select_series, StreamedColumn,
+};
 pub use wavelet::{Transform, WaveletFilter};
+
+// Latent models and their processes (§0.2, §2).
+pub use model::{Component, ComponentWv, ImpliedWv, Model, ModelParseError, ParseErrorKind};
+pub use process::{
+    Ar1, Arma, Arma11, Dr, Flicker, Gm, LatentProcess, Ma1, Maf, Process, ProcessKind, Qn, Rw, Sin,
+    StartMode, TransformPreset, Wn,
+};
+pub use sim::{simulate_model, DemoSensor, Simulator};
+
+// GMWM fits, their inference and model selection (§5-§8).
+pub use fit::canonical::TermParameter;
+pub use fit::{
+    CanonicalModel, CanonicalTerm, Convergence, FitError, FitRecording, Gmwm, GmwmFit,
+    NavParameter, ParameterEstimate, Parametrisation, PhiOrder, PooledFit, PooledRecording,
+    StartInputs, StopReason, Weighting, Weights,
+};
+pub use inference::same_model::{
+    compare_wvs, same_model_test_of, SameModelOptions, SameModelTest, ScaleContribution,
+};
+pub use inference::{
+    infer, infer_with_progress, CovarianceMethod, Inference, InferenceOptions, ParameterInference,
+    WvComparison,
+};
+pub use inference::{
+    BootstrapGof, InferenceMethod, InferenceWarning, IntervalScale, JTest, VShape, ZConvention,
+};
+pub use selection::{
+    auto_imu, select_pooled, AxisSelection, CandidateScore, ImuSelection, ModelSelection,
+    OptimismConvention, OptimismMethod, PooledCandidate, PooledSelection, RowStatus,
+    SelectionError, SelectionRow, SelectionRule, SelectionTable, Wic,
+};
+pub use shared::{
+    fit_shared, CrossCovariance, NoSharedTest, SharedFit, SharedOptions, SharedParameter,
+};
+
+// Recordings: readers, writers, sidecars, ROS containers (docs/methods.md §10).
+pub use imu::plausible::{raw_floats, ImplausibleFloats};
+pub use imu::read::stream::{streams_from, StreamedTable};
+pub use imu::read::RATE_TOLERANCE;
+pub use imu::recording::{left_out_note, table_notes};
+pub use imu::ros::{
+    choose_topic, list_topics, read_imu_messages, ImuMessages, RosContainer, TopicInfo,
+};
+pub use imu::ros::{MessageError, RosError};
+pub use imu::sidecar::sidecar_candidates;
+pub use imu::write::{write_atomic, write_csv_header, write_csv_rows, write_sidecar, AtomicFile};
+pub use imu::{
+    binary_layout, find_sidecar, quote, read_table, time_column_unit, BinaryLayout, Column,
+    ColumnSelector, HeaderMode, Imu, ImuRecordType, InputFormat, OutputFormat, Probe, ReadError,
+    ReadOptions, ReadWarning, Recording, RecordingOptions, RecordingSource, SampleAccount, Sensor,
+    SensorInfo, SeriesWriter, Sidecar, SidecarColumn, Table, TableFacts, TimeUnit, TimingReport,
+};
+pub use imu::{Axis, ColumnSummary, Gap, SidecarUnits, Tally, TimingWarning};
+pub use units::{si_unit, NoiseTerm, SignalKind, SignalUnit};
+
+// The calibration: a recording to a navigation filter's parameters (§14).
+pub use calib::datasheet::{
+    DatasheetError, DatasheetLine, DatasheetValue, DatasheetVerdict, TermComparison,
+};
+pub use calib::export::{render_export, ExportError, ExportFormat, NavNoise, SensorNoise};
+pub use calib::ieee::{ieee_readoff, term_avar, CoefficientReadoff, IeeeReadoff};
+pub use calib::streamed::{binary_file_columns, wv_account, wv_columns};
+pub use calib::{
+    Adjustment, AxisCalibration, AxisPolicy, CalibError, Calibration, CalibrationOptions,
+    CalibrationReport, CalibrationSource, Datasheet, DatasheetComparison, Estimate, EstimateStatus,
+    NavSet, DEFAULT_FULL_MODEL, DEFAULT_TOLERANCE, STREAM_FROM,
+};
+pub use calib::{
+    Contamination, FitUses, FitVerdict, GaussMarkovBias, PooledInput, ScaleFit, ScaleMiss,
+};
+pub use monitor::{
+    monitor_against, LevelOut, MonitorEvent, MonitorOptions, MonitorReport, MonitorWindow,
+    Reference,
+};
 
 /// Any error the engine can return.
 #[derive(Debug, thiserror::Error)]

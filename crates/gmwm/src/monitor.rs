@@ -67,7 +67,7 @@ use serde::Serialize;
 /// Smallest equivalent degrees of freedom `M_j / 2^j` (§1.7) of a level the monitor tests.
 pub(crate) const MIN_ETA: f64 = 8.0;
 
-/// Settings of [`monitor`].
+/// Settings of `monitor`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MonitorOptions {
     /// Window length `L` in samples; default 2^16 (11 min at 100 Hz: levels up to 2^12 samples).
@@ -177,7 +177,7 @@ fn centre(w: &WaveletVariance, levels: usize) -> Vec<Option<(f64, f64)>> {
         .collect()
 }
 
-/// Result of [`monitor`] for one series.
+/// Result of `monitor` for one series.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MonitorReport {
     /// The model (with values) the band comes from.
@@ -231,9 +231,9 @@ pub struct MonitorReport {
 /// against `model` (every value given, e.g. a calibration's estimate).
 ///
 /// ```
-/// use gmwm::model::Model;
+/// use gmwm::Model;
 /// use gmwm::monitor::{monitor, MonitorOptions};
-/// use gmwm::sim::simulate_model;
+/// use gmwm::simulate_model;
 /// let model = Model::parse("WN(sigma2=1)").unwrap();
 /// let mut x = simulate_model(&model, 1 << 15, 1.0, 1).unwrap();
 /// for v in &mut x[20_000..21_000] { *v *= 3.0; } // a burst of extra noise
@@ -247,6 +247,7 @@ pub struct MonitorReport {
 /// [`ParamError`] for a model without all its values, a window shorter than 16 samples or
 /// longer than the series (naming `window`), a zero step, a bad `alpha`; as
 /// [`wavelet_variance`] for a series with non-finite values.
+#[cfg(test)]
 pub fn monitor(
     x: &[f64],
     freq_hz: f64,
@@ -256,12 +257,12 @@ pub fn monitor(
     monitor_against(x, freq_hz, model, Reference::Model, opts)
 }
 
-/// [`monitor`] with the windows compared with `reference` (module doc): the model's WV, or the
+/// `monitor` with the windows compared with `reference` (module doc): the model's WV, or the
 /// calibration's empirical WV (at the levels both the window and it have), the model then
 /// giving the shape of a window's variance.
 ///
 /// # Errors
-/// As [`monitor`]; [`ParamError`] for a reference WV of another rate or with a level that is
+/// As `monitor`; [`ParamError`] for a reference WV of another rate or with a level that is
 /// not positive and finite.
 pub fn monitor_against(
     x: &[f64],

@@ -9,8 +9,8 @@ use crate::error::ParamError;
 ///
 /// # Examples
 /// ```
-/// use gmwm::names::Named;
-/// use gmwm::selection::SelectionRule;
+/// use gmwm::Named;
+/// use gmwm::SelectionRule;
 ///
 /// assert_eq!(SelectionRule::names(), ["navigation", "parsimonious", "wic-minimum"]);
 /// assert_eq!(SelectionRule::from_name("Parsimonious"), Ok(SelectionRule::Parsimonious));

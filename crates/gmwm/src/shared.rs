@@ -222,9 +222,9 @@ fn union_model(shared: &Model, specific: &Model) -> Model {
 /// `axes` (name, samples) at `freq_hz`.
 ///
 /// ```
-/// use gmwm::model::Model;
-/// use gmwm::shared::{fit_shared, SharedOptions};
-/// use gmwm::sim::simulate_model;
+/// use gmwm::Model;
+/// use gmwm::{fit_shared, SharedOptions};
+/// use gmwm::simulate_model;
 /// let v = simulate_model(&Model::parse("AR1(phi=0.99, sigma2=0.02)").unwrap(), 8192, 1.0, 1).unwrap();
 /// let axes: Vec<Vec<f64>> = (0..3u64)
 ///     .map(|i| {

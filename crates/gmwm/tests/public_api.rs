@@ -2,11 +2,10 @@
 //! own tests (reference data, properties, Monte Carlo) live inside the crate, `src/tests/`,
 //! because they reach kernels this API does not show.
 
-use gmwm::calib::{Calibration, CalibrationOptions};
-use gmwm::imu::{read_table, Imu, ReadOptions};
-use gmwm::model::Model;
-use gmwm::sim::simulate_model;
-use gmwm::{wavelet_variance, Gmwm, WvOptions};
+use gmwm::{
+    read_table, simulate_model, wavelet_variance, Calibration, CalibrationOptions, Gmwm, Imu,
+    Model, ReadOptions, WvOptions,
+};
 use std::io::Write;
 
 const FREQ_HZ: f64 = 100.0;

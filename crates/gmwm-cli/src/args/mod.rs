@@ -8,11 +8,11 @@ mod values;
 pub use several::{Against, MonitorArgs, SameModelArgs, SharedArgs};
 
 use clap::{Args, Parser, Subcommand};
-use gmwm::calib::AxisPolicy;
-use gmwm::imu::{HeaderMode, InputFormat, TimeUnit};
-use gmwm::inference::CovarianceMethod;
-use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
-use gmwm::{AllanKind, AvConvention, RobustConvention, Transform, Weighting};
+use gmwm::{
+    AllanKind, AvConvention, AxisPolicy, CovarianceMethod, HeaderMode, InputFormat,
+    OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimeUnit, Transform,
+    Weighting,
+};
 use std::path::PathBuf;
 use values::{
     alpha, at_least_1, at_least_2, choice, datasheet, efficiency, inflation, positive_hz, seed,
@@ -285,7 +285,7 @@ pub struct CalibrateArgs {
     pub conservative: bool,
     /// The verdict's tolerance: a scale is explained when the model's WV is inside the band or
     /// within this fraction of the empirical WV (0.1 = 10%).
-    #[arg(long, value_name = "FRACTION", default_value_t = gmwm::calib::DEFAULT_TOLERANCE, value_parser = tolerance)]
+    #[arg(long, value_name = "FRACTION", default_value_t = gmwm::DEFAULT_TOLERANCE, value_parser = tolerance)]
     pub tolerance: f64,
     /// Apply --gyro-unit/--accel-unit to a ROS recording too (sensor_msgs/Imu is SI by
     /// definition, so they are refused there without this).
@@ -306,11 +306,11 @@ pub struct UnitArgs {
     /// Unit of the gyroscope samples: rad/s, deg/s or deg/h [default: the sidecar's, SI for
     /// ROS and binary IMU records].
     #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
-    pub gyro_unit: Option<gmwm::units::SignalUnit>,
+    pub gyro_unit: Option<gmwm::SignalUnit>,
     /// Unit of the accelerometer samples: m/s^2, g or mg [default: the sidecar's, SI for ROS
     /// and binary IMU records].
     #[arg(long, value_name = "UNIT", value_parser = signal_unit)]
-    pub accel_unit: Option<gmwm::units::SignalUnit>,
+    pub accel_unit: Option<gmwm::SignalUnit>,
 }
 
 /// What `--datasheet` takes, for `--help`.
@@ -338,7 +338,7 @@ pub struct DatasheetArgs {
     /// The sensor's datasheet, e.g. "N=2 deg/sqrt(h), B=25 deg/h, accel:B=0.2 mg" (keys N, B,
     /// K; the unit says the sensor).
     #[arg(long, value_name = "SPEC", value_parser = datasheet, long_help = DATASHEET_HELP)]
-    pub datasheet: Option<gmwm::calib::Datasheet>,
+    pub datasheet: Option<gmwm::Datasheet>,
 }
 
 const REPORT_EXAMPLES: &str = "\
@@ -905,7 +905,7 @@ pub struct TopicsArgs {
 /// The help of `--export`: the stacks' names from the engine's one list, Kalibr (which
 /// `--kalibr` also writes) last.
 fn export_help() -> String {
-    use gmwm::calib::export::ExportFormat;
+    use gmwm::ExportFormat;
     let others: Vec<&str> = ExportFormat::ALL
         .iter()
         .filter(|f| **f != ExportFormat::KALIBR)

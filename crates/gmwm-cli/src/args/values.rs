@@ -1,14 +1,13 @@
 //! Value parsers of the flags: numbers refused outside their domain with a usage error, and
-//! the engine's named choices ([`gmwm::names::Named`]) parsed by the engine's `FromStr`, with
+//! the engine's named choices ([`gmwm::Named`]) parsed by the engine's `FromStr`, with
 //! their possible values (and the help of each, in the CLI's words) listed by `--help`.
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
-use gmwm::calib::AxisPolicy;
-use gmwm::imu::{HeaderMode, ImuRecordType, InputFormat, TimeUnit};
-use gmwm::inference::CovarianceMethod;
-use gmwm::names::Named;
-use gmwm::selection::{OptimismConvention, OptimismMethod, SelectionRule};
-use gmwm::{AllanKind, AvConvention, RobustConvention, Transform, Weighting};
+use gmwm::{
+    AllanKind, AvConvention, AxisPolicy, CovarianceMethod, HeaderMode, ImuRecordType, InputFormat,
+    Named, OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimeUnit,
+    Transform, Weighting,
+};
 use std::str::FromStr;
 
 /// An engine choice as `--help` shows it: each value's help, in the CLI's words (the engine
@@ -193,16 +192,15 @@ impl ValueHelp for AxisPolicy {
 }
 
 /// `--gyro-unit`, `--accel-unit`.
-pub fn signal_unit(s: &str) -> Result<gmwm::units::SignalUnit, String> {
-    s.parse::<gmwm::units::SignalUnit>().map_err(|_| {
+pub fn signal_unit(s: &str) -> Result<gmwm::SignalUnit, String> {
+    s.parse::<gmwm::SignalUnit>().map_err(|_| {
         "must be rad/s, deg/s, deg/h (gyroscope) or m/s^2, g, mg (accelerometer)".into()
     })
 }
 
 /// `--datasheet`: the engine's reading, its error naming the bad item.
-pub fn datasheet(s: &str) -> Result<gmwm::calib::Datasheet, String> {
-    s.parse::<gmwm::calib::Datasheet>()
-        .map_err(|e| e.to_string())
+pub fn datasheet(s: &str) -> Result<gmwm::Datasheet, String> {
+    s.parse::<gmwm::Datasheet>().map_err(|e| e.to_string())
 }
 
 /// `--inflate`: a factor of at least 1.
@@ -238,13 +236,13 @@ pub fn efficiency(s: &str) -> Result<f64, String> {
 }
 
 /// `--alpha`: a significance level in (0, 0.5]
-/// ([`gmwm::variance::ci::significance_level_problem`]).
+/// ([`gmwm::significance_level_problem`]).
 pub fn alpha(s: &str) -> Result<f64, String> {
     let v = s
         .trim()
         .parse::<f64>()
         .map_err(|_| "must be a significance level in (0, 0.5]: 0.05 gives 95% intervals")?;
-    match gmwm::variance::ci::significance_level_problem(v) {
+    match gmwm::significance_level_problem(v) {
         None => Ok(v),
         Some(why) => Err(why),
     }

@@ -7,8 +7,7 @@ use crate::prepare::Inputs;
 use crate::render;
 use crate::style::OutputStyle;
 use anyhow::Result;
-use gmwm::variance::allan_from_wv;
-use gmwm::{allan_variance, AllanVariance};
+use gmwm::{allan_from_wv, allan_variance, AllanVariance};
 use std::io::Write;
 use std::path::Path;
 
@@ -26,7 +25,7 @@ fn run_saved(config: &AvarConfig, style: OutputStyle) -> Result<Vec<(String, All
             "{}: series {}: --alpha {} needs the raw recording; the file's intervals are at \
              alpha {}",
             file.display(),
-            gmwm::imu::quote(name),
+            gmwm::quote(name),
             opts.alpha,
             wv.alpha()
         );

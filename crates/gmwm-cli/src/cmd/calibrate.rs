@@ -7,12 +7,10 @@ use crate::error::UsageError;
 use crate::prepare::Inputs;
 use crate::style::{OutputStyle, Ticks};
 use anyhow::{Context, Result};
-use gmwm::calib::export::{render, ExportFormat};
-use gmwm::calib::{
-    AxisCalibration, Calibration, CalibrationReport, CalibrationSource, DatasheetComparison,
-    Estimate, EstimateStatus, NavSet,
+use gmwm::{
+    render_export, AxisCalibration, Calibration, CalibrationReport, CalibrationSource,
+    DatasheetComparison, Estimate, EstimateStatus, ExportFormat, NavSet, SelectionRule,
 };
-use gmwm::selection::SelectionRule;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -71,7 +69,7 @@ pub struct Calibrated {
 /// Refuses, before any work, an output file that is the recording or its sidecar.
 fn check_outputs(config: &CalibrateConfig, report_path: Option<&Path>) -> Result<()> {
     let file = config.input.file.as_path();
-    let sidecars = gmwm::imu::sidecar::sidecar_candidates(file);
+    let sidecars = gmwm::sidecar_candidates(file);
     let inputs: Vec<&Path> = std::iter::once(file)
         .chain(sidecars.iter().map(PathBuf::as_path))
         .collect();
@@ -113,7 +111,7 @@ pub fn execute_in(
     for (format, path) in exports {
         for set in &sets {
             let target = per_axis_path(path, &set.label);
-            let result = render(*format, &set.noise)
+            let result = render_export(*format, &set.noise)
                 .map_err(anyhow::Error::from)
                 // the file is named below
                 .and_then(|text| Ok(crate::output::write_io(&target, text.as_bytes())?));
@@ -190,7 +188,7 @@ fn calibrate_one(
     // pass, or a raw binary file streamed), from the probe the configuration carries
     let source = calibration.open(
         config.input.probe(),
-        &gmwm::imu::RecordingOptions {
+        &gmwm::RecordingOptions {
             read: config.input.read.clone(),
             topic: config.input.topic.clone(),
         },
@@ -226,14 +224,14 @@ fn calibrate_saved_wv(
 ) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
     let input = &config.input;
     let series = crate::input::load_wv(input, config.options.wv.levels)?;
-    let columns = gmwm::calib::streamed::wv_columns(&series);
-    let (samples, note) = gmwm::calib::streamed::wv_account(&series);
+    let columns = gmwm::wv_columns(&series);
+    let (samples, note) = gmwm::wv_account(&series);
     let recording = crate::input::LoadedRecording {
         path: crate::input::shown_path(&input.file),
         columns,
         imu: None,
         topic: None,
-        source: gmwm::imu::RecordingSource::SavedWv,
+        source: gmwm::RecordingSource::SavedWv,
         timing: None,
         notes: vec![note],
         samples,
@@ -298,7 +296,7 @@ fn calibrate_pooled(
         .iter()
         .map(|r| crate::spool::shown(&r.path.display().to_string()))
         .collect();
-    let named: Vec<(&str, &gmwm::imu::Imu)> = names
+    let named: Vec<(&str, &gmwm::Imu)> = names
         .iter()
         .zip(&loaded)
         .filter_map(|(n, r)| Some((n.as_str(), r.imu.as_ref()?)))
@@ -350,7 +348,7 @@ fn write_report(
                 Some(p) => per_axis_path(p, &set.label).display().to_string(),
                 None => format!("not written (add --kalibr FILE); {}", set.label),
             };
-            let content = match render(*format, &set.noise) {
+            let content = match render_export(*format, &set.noise) {
                 Ok(text) => text,
                 Err(e) => format!("# cannot be exported: {e}"),
             };
@@ -368,20 +366,18 @@ fn write_report(
                 .join(", "),
         },
         source: match &recording.source {
-            gmwm::imu::RecordingSource::Records { record_type } => {
+            gmwm::RecordingSource::Records { record_type } => {
                 format!("binary IMU records ({record_type})")
             }
-            gmwm::imu::RecordingSource::Ros { container, topic } => {
+            gmwm::RecordingSource::Ros { container, topic } => {
                 format!("{container}, topic {topic}")
             }
-            gmwm::imu::RecordingSource::SavedWv => {
-                "saved wavelet variances (no samples)".to_string()
-            }
+            gmwm::RecordingSource::SavedWv => "saved wavelet variances (no samples)".to_string(),
             _ => "delimited text or raw binary columns".to_string(),
         },
         reader_notes: recording.notes.clone(),
         timing: match recording.source {
-            gmwm::imu::RecordingSource::SavedWv => {
+            gmwm::RecordingSource::SavedWv => {
                 Some("no samples: the rate the saved WV gives (or --freq)".to_string())
             }
             _ => recording.timing.as_ref().map(ToString::to_string),
@@ -421,7 +417,7 @@ fn check_units_known(
     config: &CalibrateConfig,
     recording: &crate::input::LoadedRecording,
 ) -> Result<()> {
-    use gmwm::imu::Sensor;
+    use gmwm::Sensor;
     let options = &config.options;
     for (name, info) in &recording.columns {
         let (given, flag) = match info.sensor {
@@ -432,7 +428,7 @@ fn check_units_known(
         let known = info
             .unit
             .as_deref()
-            .is_some_and(|u| u.parse::<gmwm::units::SignalUnit>().is_ok());
+            .is_some_and(|u| u.parse::<gmwm::SignalUnit>().is_ok());
         if !given && !known {
             return Err(UsageError(format!(
                 "{}: the unit of column {} is unknown{} and the exported files are SI: give {flag}",
@@ -440,7 +436,7 @@ fn check_units_known(
                 name,
                 info.unit
                     .as_deref()
-                    .map(|u| format!(" ({})", gmwm::imu::quote(u)))
+                    .map(|u| format!(" ({})", gmwm::quote(u)))
                     .unwrap_or_default()
             ))
             .into());
@@ -569,8 +565,8 @@ fn summary(
                 continue;
             };
             let kind = match a.kind {
-                Some(gmwm::units::SignalKind::Gyroscope) => "gyro",
-                Some(gmwm::units::SignalKind::Accelerometer) => "accel",
+                Some(gmwm::SignalKind::Gyroscope) => "gyro",
+                Some(gmwm::SignalKind::Accelerometer) => "accel",
                 None => "other",
             };
             let line = format!("{kind} {what}: {c}");
@@ -725,7 +721,7 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
             Some(v) => format!(
                 "{sym} = {} {}",
                 num(v),
-                gmwm::units::si_unit(*term, a.kind.filter(|_| a.unit != "u"), &a.unit)
+                gmwm::si_unit(*term, a.kind.filter(|_| a.unit != "u"), &a.unit)
             ),
             None => format!("{sym} = -"),
         })

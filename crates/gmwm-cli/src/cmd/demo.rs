@@ -8,9 +8,7 @@ use crate::prepare::Inputs;
 use crate::render::Style;
 use crate::style::OutputStyle;
 use anyhow::Result;
-use gmwm::model::ImpliedWv;
-use gmwm::sim::DemoSensor;
-use gmwm::{wavelet_variance, Gmwm, GmwmFit, WaveletVariance};
+use gmwm::{wavelet_variance, DemoSensor, Gmwm, GmwmFit, ImpliedWv, WaveletVariance};
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -46,11 +44,11 @@ pub fn run(config: &DemoConfig, out: &mut impl Write) -> Result<()> {
     let implied = sensor.model.implied_wv(wv.levels(), sensor.freq_hz)?;
     let started = std::time::Instant::now();
     let fit = Gmwm::new(sensor.model.without_values())
-        .fit_from_wv(&wv, gmwm::fit::StartInputs::from_series(&x))?;
+        .fit_from_wv(&wv, gmwm::StartInputs::from_series(&x))?;
     let fit_time = started.elapsed();
     // the fit lists AR1/GM blocks by phi descending (docs/methods.md §5.6): order the truth alike
     let truth: Vec<f64> = sensor.model.values().into_iter().flatten().collect();
-    let truth = gmwm::fit::Parametrisation::canonical_order(&sensor.model, &truth)?;
+    let truth = gmwm::Parametrisation::canonical_order(&sensor.model, &truth)?;
     let parameters = fit
         .param_names()
         .iter()

@@ -9,9 +9,10 @@ use crate::prepare::Inputs;
 use crate::render::Style;
 use crate::style::OutputStyle;
 use anyhow::Result;
-use gmwm::fit::{CanonicalModel, StartInputs};
-use gmwm::inference::{infer_with_progress, Inference, InferenceOptions};
-use gmwm::{GmwmFit, WaveletVariance, Weighting};
+use gmwm::{
+    infer_with_progress, CanonicalModel, GmwmFit, Inference, InferenceOptions, StartInputs,
+    WaveletVariance, Weighting,
+};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;

@@ -10,9 +10,7 @@ use crate::prepare::Inputs;
 use crate::render::Style;
 use crate::style::OutputStyle;
 use anyhow::{Context, Result};
-use gmwm::model::Model;
-use gmwm::monitor::{monitor_against, MonitorReport, Reference};
-use gmwm::units::SignalUnit;
+use gmwm::{monitor_against, Model, MonitorReport, Reference, SignalUnit};
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -126,7 +124,7 @@ pub fn compute(config: &MonitorConfig, style: OutputStyle) -> Result<Vec<AxisMon
         "{file}: sampled at {freq} Hz but {cal_shown} was calibrated at {cal_freq} Hz: the \
          model's scales would not match (give --freq if the file's rate is wrong)"
     );
-    let infos = gmwm::imu::SensorInfo::of_table(&loaded.table);
+    let infos = gmwm::SensorInfo::of_table(&loaded.table);
     let mut items = Vec::new();
     for (col, info) in loaded.table.columns.iter().zip(&infos) {
         let cal = cal_axes

@@ -8,11 +8,10 @@ use crate::input::{is_wv, InputConfig};
 use crate::prepare::Inputs;
 use crate::style::OutputStyle;
 use anyhow::{Context, Result};
-use gmwm::calib::datasheet::DatasheetLine;
-use gmwm::calib::ieee::ieee_readoff;
-use gmwm::imu::{Sensor, SensorInfo};
-use gmwm::units::{SignalKind, SignalUnit};
-use gmwm::variance::psd::{welch_psd, BINNED_POINTS};
+use gmwm::{
+    ieee_readoff, welch_psd, DatasheetLine, Sensor, SensorInfo, SignalKind, SignalUnit,
+    BINNED_POINTS,
+};
 use gmwm_plot::{Column, Figure};
 use std::io::Write;
 use std::path::Path;
@@ -36,15 +35,15 @@ fn column_units(
     let sidecar = if ros || is_wv(input) {
         None
     } else {
-        gmwm::imu::find_sidecar(&input.file).ok().flatten()
+        gmwm::find_sidecar(&input.file).ok().flatten()
     };
     // binary IMU records by --format or by the sidecar's format, as the reader resolves it
-    let record = matches!(input.read.format, gmwm::imu::InputFormat::ImuRecord(_))
+    let record = matches!(input.read.format, gmwm::InputFormat::ImuRecord(_))
         || sidecar
             .as_ref()
             .and_then(|s| s.format.as_deref())
-            .and_then(|f| f.parse::<gmwm::imu::InputFormat>().ok())
-            .is_some_and(|f| matches!(f, gmwm::imu::InputFormat::ImuRecord(_)));
+            .and_then(|f| f.parse::<gmwm::InputFormat>().ok())
+            .is_some_and(|f| matches!(f, gmwm::InputFormat::ImuRecord(_)));
     Ok(names
         .iter()
         .map(|name| {

@@ -8,9 +8,7 @@ use crate::prepare::Inputs;
 use crate::render::Style;
 use crate::style::{OutputStyle, Ticks};
 use anyhow::Result;
-use gmwm::model::Model;
-use gmwm::selection::RowStatus;
-use gmwm::ModelSelection;
+use gmwm::{Model, ModelSelection, RowStatus};
 use std::io::Write;
 use std::path::Path;
 

@@ -9,8 +9,7 @@ use crate::prepare::Inputs;
 use crate::render::Style;
 use crate::style::OutputStyle;
 use anyhow::Result;
-use gmwm::model::Model;
-use gmwm::shared::{fit_shared, SharedFit};
+use gmwm::{fit_shared, Model, SharedFit};
 use std::io::Write;
 use std::path::Path;
 
@@ -57,13 +56,13 @@ pub fn compute(config: &SharedConfig, style: OutputStyle) -> Result<(SharedFit, 
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let infos = gmwm::imu::SensorInfo::of_table(table);
+    let infos = gmwm::SensorInfo::of_table(table);
     if let Some((i, info)) = infos
         .iter()
         .enumerate()
         .find(|(_, s)| s.sensor != infos[0].sensor || s.unit != infos[0].unit)
     {
-        let what = |s: &gmwm::imu::SensorInfo| {
+        let what = |s: &gmwm::SensorInfo| {
             format!(
                 "{} in {}",
                 s.sensor.tag(),

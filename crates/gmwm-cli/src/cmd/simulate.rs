@@ -6,9 +6,10 @@ use crate::config::SimulateConfig;
 use crate::prepare::Inputs;
 use crate::style::OutputStyle;
 use anyhow::{Context, Result};
-use gmwm::imu::write::{write_csv_header, write_csv_rows, write_sidecar};
-use gmwm::imu::{OutputFormat, SeriesWriter, Sidecar, SidecarColumn};
-use gmwm::sim::Simulator;
+use gmwm::{
+    write_csv_header, write_csv_rows, write_sidecar, OutputFormat, SeriesWriter, Sidecar,
+    SidecarColumn, Simulator,
+};
 use std::io::Write;
 use std::path::Path;
 

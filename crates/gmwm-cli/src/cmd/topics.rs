@@ -5,7 +5,7 @@ use crate::config::TopicsConfig;
 use crate::prepare::Inputs;
 use crate::style::OutputStyle;
 use anyhow::Result;
-use gmwm::imu::ros::{choose_topic, list_topics, RosContainer, TopicInfo};
+use gmwm::{choose_topic, list_topics, RosContainer, TopicInfo};
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;

@@ -8,14 +8,15 @@ use crate::prepare::Inputs;
 use crate::render;
 use crate::style::OutputStyle;
 use anyhow::Result;
-use gmwm::imu::{binary_layout, BinaryLayout};
-use gmwm::variance::{binary_columns_wv, StreamedColumn};
-use gmwm::{wavelet_variance, Transform, WaveletFilter, WaveletVariance, WvOptions};
+use gmwm::{
+    binary_columns_wv, binary_layout, wavelet_variance, BinaryLayout, StreamedColumn, Transform,
+    WaveletFilter, WaveletVariance, WvOptions,
+};
 use std::io::Write;
 use std::path::Path;
 
 /// Raw binary input (from `--format`, the name or the sidecar) with the classical Haar MODWT
-/// estimator and no time column streams ([`gmwm::variance::binary_wavelet_variance`]): the
+/// estimator and no time column streams ([`gmwm::binary_wavelet_variance`]): the
 /// columns are never loaded, and memory does not grow with the file.
 pub(crate) fn streamable(input: &InputConfig, opts: &WvOptions) -> Result<Option<BinaryLayout>> {
     if input.read.time_column.is_some()
@@ -28,11 +29,7 @@ pub(crate) fn streamable(input: &InputConfig, opts: &WvOptions) -> Result<Option
     }
     let layout = binary_layout(&input.file, &input.read)?;
     // a column named like a time column is a time column: the in-memory reader handles it
-    Ok(layout.filter(|l| {
-        l.names
-            .iter()
-            .all(|n| gmwm::imu::time_column_unit(n).is_none())
-    }))
+    Ok(layout.filter(|l| l.names.iter().all(|n| gmwm::time_column_unit(n).is_none())))
 }
 
 fn run_streaming(
@@ -53,7 +50,7 @@ pub(crate) fn stream_columns(
     opts: &WvOptions,
     style: OutputStyle,
 ) -> Result<Vec<(String, StreamedColumn)>> {
-    let sidecar = gmwm::imu::find_sidecar(&input.file)?;
+    let sidecar = gmwm::find_sidecar(&input.file)?;
     let (columns, skipped) = layout.selection(&input.file, &input.read, sidecar.as_ref())?;
     crate::input::note_not_analysed(style, &input.file, &skipped);
     let freq_hz = match input.read.freq_hz {
@@ -68,7 +65,7 @@ pub(crate) fn stream_columns(
         .zip(streamed)
         .collect();
     if let Some((_, first)) = named.first() {
-        let account = gmwm::imu::SampleAccount::all_used(
+        let account = gmwm::SampleAccount::all_used(
             named.iter().map(|(n, _)| n.clone()).collect(),
             "row",
             first.wv.n() as u64,
@@ -79,7 +76,7 @@ pub(crate) fn stream_columns(
 }
 
 fn stream_freq(path: &std::path::Path) -> Result<f64> {
-    let sidecar = gmwm::imu::find_sidecar(path)?;
+    let sidecar = gmwm::find_sidecar(path)?;
     Ok(match sidecar.and_then(|s| s.sampling_frequency_hz) {
         Some(f) => f,
         None if crate::spool::is_stdin(path) => {
@@ -103,7 +100,7 @@ fn stream_freq(path: &std::path::Path) -> Result<f64> {
 /// Text, binary IMU records or a ROS recording of at least `--stream-from` rows (a text file:
 /// 8 bytes a row; a ROS recording: the messages of its largest IMU topic), with the classical
 /// Haar MODWT estimator, stream
-/// ([`gmwm::imu::read::stream::StreamedTable`]): one pass over the file, memory bounded.
+/// ([`gmwm::StreamedTable`]): one pass over the file, memory bounded.
 pub(crate) fn streams_text(input: &InputConfig, opts: &WvOptions) -> Result<bool> {
     if crate::spool::is_stdin(&input.file)
         || opts.robust.is_some()
@@ -112,7 +109,7 @@ pub(crate) fn streams_text(input: &InputConfig, opts: &WvOptions) -> Result<bool
     {
         return Ok(false);
     }
-    Ok(gmwm::imu::read::stream::streams_from(
+    Ok(gmwm::streams_from(
         input.probe(),
         &input.read,
         input.stream_from,
@@ -126,9 +123,9 @@ fn run_streamed_table(
     opts: &WvOptions,
     style: OutputStyle,
 ) -> Result<Vec<(String, WaveletVariance)>> {
-    let table = gmwm::imu::read::stream::StreamedTable::open_recording(
+    let table = gmwm::StreamedTable::open_recording(
         input.probe(),
-        &gmwm::imu::RecordingOptions {
+        &gmwm::RecordingOptions {
             read: input.read.clone(),
             topic: input.topic.clone(),
         },
@@ -175,7 +172,7 @@ fn run_saved(config: &WvConfig, style: OutputStyle) -> Result<Vec<(String, Wavel
             alpha == 0.05,
             "{}: series {}: --alpha {} needs the series; the file's intervals are at alpha {}",
             file.display(),
-            gmwm::imu::quote(name),
+            gmwm::quote(name),
             alpha,
             wv.alpha()
         );

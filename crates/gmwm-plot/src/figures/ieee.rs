@@ -7,7 +7,7 @@ use super::*;
 struct SlopeLine {
     symbol: &'static str,
     value: Option<f64>,
-    /// The term: its line is the engine's ([`gmwm::calib::ieee::term_avar`]).
+    /// The term: its line is the engine's ([`gmwm::term_avar`]).
     term: NoiseTerm,
     at_tau_s: f64,
     colour: usize,
@@ -89,9 +89,7 @@ pub fn ieee_figure(columns: &[Column<'_, (AllanVariance, IeeeReadoff)>]) -> Figu
                     missing.push(symbol);
                     continue;
                 };
-                let line = |v: f64, t: f64| {
-                    gmwm::calib::ieee::term_avar(term, v, t).map_or(f64::NAN, f64::sqrt)
-                };
+                let line = |v: f64, t: f64| gmwm::term_avar(term, v, t).map_or(f64::NAN, f64::sqrt);
                 let ys: Vec<f64> = xs.iter().map(|&t| line(v, t)).collect();
                 let dashed = Mark::Line {
                     width: 2,

@@ -5,14 +5,10 @@
 use crate::chart::{BarRow, Bars, Mark, Panel, PanelKind, Series};
 use crate::style::number;
 use crate::Figure;
-use gmwm::calib::datasheet::DatasheetLine;
-use gmwm::calib::ieee::IeeeReadoff;
-use gmwm::fit::PooledFit;
-use gmwm::imu::{Sensor, SensorInfo};
-use gmwm::shared::SharedFit;
-use gmwm::units::{si_unit, NoiseTerm, SignalUnit};
-use gmwm::variance::psd::Psd;
-use gmwm::{AllanKind, AllanVariance, GmwmFit, ModelSelection, WaveletVariance};
+use gmwm::{
+    si_unit, AllanKind, AllanVariance, DatasheetLine, GmwmFit, IeeeReadoff, ModelSelection,
+    NoiseTerm, PooledFit, Psd, Sensor, SensorInfo, SharedFit, SignalUnit, WaveletVariance,
+};
 
 mod allan;
 mod compare;
@@ -64,7 +60,7 @@ impl<'a, T> Column<'a, T> {
         }
     }
 
-    /// With the datasheet's lines (in the column's unit: [`gmwm::calib::Datasheet::lines`]).
+    /// With the datasheet's lines (in the column's unit: [`gmwm::Datasheet::lines`]).
     pub fn with_datasheet(mut self, lines: Vec<DatasheetLine>) -> Self {
         self.datasheet = lines;
         self
@@ -111,7 +107,7 @@ pub(super) fn pretty(unit: &str) -> String {
 
 /// The unit of a noise term for a series in `unit`: SI names when the data are in SI
 /// (`rad/s`, `m/s^2`), else in terms of the data unit; the engine's one formula
-/// ([`gmwm::units::si_unit`], docs/methods.md §14.2), so figures and report agree.
+/// ([`gmwm::si_unit`], docs/methods.md §14.2), so figures and report agree.
 pub(super) fn term_unit(term: NoiseTerm, unit: &str) -> String {
     match unit.parse::<SignalUnit>() {
         Ok(u) if u.to_si() == 1.0 => si_unit(term, Some(u.kind()), unit),

@@ -25,7 +25,7 @@ pub fn selection_figure(columns: &[Column<'_, ModelSelection>], rows: usize) -> 
         let selected_row = s
             .rows()
             .iter()
-            .position(|r| r.status == gmwm::selection::RowStatus::Selected);
+            .position(|r| r.status == gmwm::RowStatus::Selected);
         let limit = if rows == 0 { s.rows().len() } else { rows };
         let mut shown: Vec<usize> = (0..s.rows().len().min(limit)).collect();
         if let Some(i) = selected_row {

@@ -49,7 +49,7 @@ pub fn shared_figure(fit: &SharedFit, unit: &str) -> Figure {
     // the model without its values: the estimates are in the table
     let shared_label = format!(
         "shared {}",
-        fit.shared_model.parse::<gmwm::model::Model>().map_or_else(
+        fit.shared_model.parse::<gmwm::Model>().map_or_else(
             |_| fit.shared_model.clone(),
             |m| short_model(&m.without_values().to_string())
         )

@@ -64,7 +64,7 @@ const SVD_EPS: f64 = 1e-13;
 
 /// One IEEE Std 952 coefficient read off the Allan deviation (docs/methods.md §14.3).
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Readoff {
+pub struct CoefficientReadoff {
     /// The coefficient (data unit), or `None` where its region holds fewer than two scales.
     pub value: Option<f64>,
     /// Lower confidence bound (module doc).
@@ -81,24 +81,24 @@ pub struct Readoff {
 
 /// The five IEEE Std 952 coefficients (docs/methods.md §14.3), in the data unit `u`.
 ///
-/// Wire format: `N`, `B`, `K`, `Q`, `R`, each a [`Readoff`].
+/// Wire format: `N`, `B`, `K`, `Q`, `R`, each a [`CoefficientReadoff`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IeeeReadoff {
     /// Angle / velocity random walk N (u/√Hz), −1/2-slope line at 1 s.
     #[serde(rename = "N")]
-    pub n: Readoff,
+    pub n: CoefficientReadoff,
     /// Bias instability B (u), minimum deviation / 0.664.
     #[serde(rename = "B")]
-    pub b: Readoff,
+    pub b: CoefficientReadoff,
     /// Rate random walk K (u/s/√Hz), +1/2-slope line at 3 s.
     #[serde(rename = "K")]
-    pub k: Readoff,
+    pub k: CoefficientReadoff,
     /// Quantization Q (u·s), −1-slope line at √3 s.
     #[serde(rename = "Q")]
-    pub q: Readoff,
+    pub q: CoefficientReadoff,
     /// Rate ramp R (u/s), +1-slope line at √2 s.
     #[serde(rename = "R")]
-    pub r: Readoff,
+    pub r: CoefficientReadoff,
 }
 
 /// A term of the five-term model.
@@ -155,13 +155,13 @@ const R: usize = 4;
 
 /// docs/methods.md §14.2, §14.3: the Allan variance at cluster time `tau_s` of one IEEE term of
 /// coefficient `c` alone, the line each read-off fits: `N²/τ` (N), `(0.664 B)²` (B, the
-/// flicker floor with [`FLICKER_FACTOR`]), `K² τ/3` (K), `3 Q²/τ²` (Q), `R² τ²/2` (R); `None`
+/// flicker floor with `FLICKER_FACTOR`), `K² τ/3` (K), `3 Q²/τ²` (Q), `R² τ²/2` (R); `None`
 /// for a term that is not one of the five. The IEEE figure and the datasheet lines draw
 /// their square roots.
 ///
 /// ```
-/// use gmwm::calib::ieee::term_avar;
-/// use gmwm::units::NoiseTerm;
+/// use gmwm::term_avar;
+/// use gmwm::NoiseTerm;
 /// // N = 2e-3 at 4 s: AV = 4e-6 / 4
 /// assert!((term_avar(NoiseTerm::NoiseDensity, 2e-3, 4.0).unwrap() - 1e-6).abs() < 1e-18);
 /// // K read at 3 s: the deviation equals K there
@@ -366,7 +366,7 @@ fn seconds(t: f64) -> String {
 }
 
 /// docs/methods.md §14.3: the read-off of a line term (N, K, Q or R).
-fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
+fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> CoefficientReadoff {
     let term = &TERMS[j];
     let idx = near_read_off(s, region(s, c, j), term.at_tau_s);
     let tau_s: Vec<f64> = idx.iter().map(|&i| s.tau_s[i]).collect();
@@ -384,7 +384,7 @@ fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
                 seconds(tau_s[0])
             )
         };
-        return Readoff {
+        return CoefficientReadoff {
             value: None,
             ci_low: None,
             ci_high: None,
@@ -412,7 +412,7 @@ fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> Readoff {
         term.region,
         seconds(term.at_tau_s),
     );
-    Readoff {
+    CoefficientReadoff {
         value,
         ci_low,
         ci_high,
@@ -433,7 +433,7 @@ const RELIABLE_SPAN: f64 = 10.0;
 /// three do). An interior minimum is a floor: B with its interval. A minimum at either end of
 /// those scales is no floor: B is then the bound `min ADEV / 0.664` there, given as the value
 /// without a lower end, and the note says which end and its cluster time.
-fn bias_readoff(s: &Scales) -> Readoff {
+fn bias_readoff(s: &Scales) -> CoefficientReadoff {
     let reliable: Vec<usize> = (0..s.len())
         .filter(|&i| s.ci_low[i] > 0.0 && s.ci_high[i] / s.ci_low[i] <= RELIABLE_SPAN)
         .collect();
@@ -456,7 +456,7 @@ fn bias_readoff(s: &Scales) -> Readoff {
         .copied()
         .find(|&k| k > 0 && k + 1 < scales.len());
     let Some(k) = interior.or_else(|| at_min.first().copied()) else {
-        return Readoff {
+        return CoefficientReadoff {
             value: None,
             ci_low: None,
             ci_high: None,
@@ -508,7 +508,7 @@ fn bias_readoff(s: &Scales) -> Readoff {
             ),
         )
     };
-    Readoff {
+    CoefficientReadoff {
         value,
         ci_low,
         ci_high,
@@ -550,7 +550,7 @@ pub fn ieee_readoff(av: &AllanVariance) -> Result<IeeeReadoff, ParamError> {
 
 impl IeeeReadoff {
     /// The read-offs with their symbols, in table order N, B, K, Q, R.
-    pub fn rows(&self) -> [(&'static str, NoiseTerm, &Readoff); 5] {
+    pub fn rows(&self) -> [(&'static str, NoiseTerm, &CoefficientReadoff); 5] {
         [
             ("N", NoiseTerm::NoiseDensity, &self.n),
             ("B", NoiseTerm::BiasInstability, &self.b),

@@ -10,7 +10,7 @@ pub mod streamed;
 pub(crate) mod verdict;
 
 pub use contamination::{Contamination, FitUses};
-pub use datasheet::{Datasheet, DatasheetComparison, DatasheetError};
+pub use datasheet::{Datasheet, DatasheetComparison};
 
 #[cfg(test)]
 pub(crate) use contamination::compare_classical_robust;

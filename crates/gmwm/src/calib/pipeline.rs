@@ -346,8 +346,8 @@ pub(crate) const SHORT_RECORDING_SCALE_S: f64 = 1000.0;
 /// The calibration pipeline (module doc).
 ///
 /// ```no_run
-/// use gmwm::calib::{Calibration, CalibrationOptions};
-/// use gmwm::imu::{read_table, Imu, ReadOptions};
+/// use gmwm::{Calibration, CalibrationOptions};
+/// use gmwm::{read_table, Imu, ReadOptions};
 /// let table = read_table("imu.csv.gz".as_ref(), &ReadOptions::default())?;
 /// let imu = Imu::from_table(table)?;
 /// let report = Calibration::new(CalibrationOptions::default()).run(&imu)?;

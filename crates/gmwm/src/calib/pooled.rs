@@ -47,8 +47,8 @@ impl Calibration {
     /// report of [`Calibration::run`] on their pooled WVs, its `recordings` listing them.
     ///
     /// ```no_run
-    /// use gmwm::calib::{Calibration, CalibrationOptions};
-    /// use gmwm::imu::{read_table, Imu, ReadOptions};
+    /// use gmwm::{Calibration, CalibrationOptions};
+    /// use gmwm::{read_table, Imu, ReadOptions};
     /// let imus = ["imu1.csv.gz", "imu2.csv.gz"]
     ///     .iter()
     ///     .map(|f| Imu::from_table(read_table(f.as_ref(), &ReadOptions::default())?))
@@ -434,7 +434,7 @@ fn recording_agreement(
 
 #[cfg(test)]
 mod tests {
-    use crate::fit::pooled::{pooled_objective, Recording};
+    use crate::fit::pooled::{pooled_objective, FitRecording};
     use crate::fit::{Objective, Parametrisation, StartInputs, Weights};
     use crate::model::Model;
     use crate::sim::simulate_model;
@@ -469,12 +469,12 @@ mod tests {
             .unwrap()
         };
         let single = Objective::new(&model, param(), &pooled.wv().wv, &omega, 10.0).unwrap();
-        let recordings: Vec<Recording> = pooled
+        let recordings: Vec<FitRecording> = pooled
             .parts()
             .iter()
             .zip(&xs)
             .enumerate()
-            .map(|(k, (wv, x))| Recording {
+            .map(|(k, (wv, x))| FitRecording {
                 wv: wv.clone(),
                 weights: Weights::from_variances(
                     pooled

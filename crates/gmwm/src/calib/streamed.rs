@@ -71,7 +71,7 @@ impl Calibration {
     /// every 8 bytes, its rows being known only once read).
     ///
     /// # Errors
-    /// As [`binary_layout`] and [`BinaryChunks::open`].
+    /// As [`binary_layout`] and `BinaryChunks::open`.
     pub fn streams(&self, probe: &Probe, read: &ReadOptions) -> Result<bool, Error> {
         Ok(self.stream_layout(probe, read)?.is_some() || self.streams_table(probe, read)?)
     }
@@ -528,7 +528,10 @@ impl Calibration {
 /// # Errors
 /// A file that is not raw binary f64/f32 ([`ParamError`]); a sidecar that cannot be read; a
 /// selected column the file does not have.
-pub fn columns(path: &Path, read: &ReadOptions) -> Result<Vec<(String, SensorInfo)>, Error> {
+pub fn binary_file_columns(
+    path: &Path,
+    read: &ReadOptions,
+) -> Result<Vec<(String, SensorInfo)>, Error> {
     let layout = binary_layout(path, read)?.ok_or_else(|| {
         ParamError::new(
             "input",

@@ -80,20 +80,7 @@
 //! with its values and physical read-off ([`NavParameter`]), the readings that led there, the
 //! reduced model and the separation of its refit from the fitted WV.
 //!
-//! ```
-//! use gmwm::fit::{Gmwm, StartInputs};
-//! use gmwm::model::Model;
-//! use gmwm::{sim::simulate_model, wavelet_variance, WvOptions};
-//! // two AR1s at nearly one correlation time and a white noise, fitted to data with one AR1
-//! let truth = Model::parse("AR1(phi=0.99, sigma2=1e-2)+WN(sigma2=1)").unwrap();
-//! let x = simulate_model(&truth, 100_000, 100.0, 3).unwrap();
-//! let start = "AR1(phi=0.991, sigma2=5e-3)+AR1(phi=0.989, sigma2=5e-3)+WN(sigma2=1)";
-//! let fit = Gmwm::parse(start).unwrap().fit(&x, 100.0, &WvOptions::default()).unwrap();
-//! let canonical = fit.canonical().unwrap();
-//! assert_eq!(canonical.model.to_string(), "AR1()+WN()");
-//! assert_eq!(canonical.reduced.to_string(), "AR1()+WN()");
-//! assert!(canonical.separation <= gmwm::fit::SEPARATION_LIMIT);
-//! ```
+//! Worked example: the test `tests::examples::example_canonical`.
 
 use super::active::active_components;
 use super::report::{physical_parameters, significant, NavParameter};
@@ -142,12 +129,7 @@ fn contributing(implied: &ImpliedWv, log_variance: &[f64]) -> Vec<bool> {
 /// The separation of two implied WVs (module doc): `sqrt(sum_j ln(a_j / b_j)^2 /
 /// log_variance_j)`. Levels where either value is not a positive finite number are skipped.
 ///
-/// ```
-/// use gmwm::fit::canonical::wv_separation;
-/// // one level, a factor e apart, log-variance 0.25 (sd 0.5): two standard errors
-/// let d = wv_separation(&[1.0], &[std::f64::consts::E], &[0.25]);
-/// assert!((d - 2.0).abs() < 1e-12);
-/// ```
+/// Worked example: the test `tests::examples::example_canonical_wv_separation`.
 pub fn wv_separation(a: &[f64], b: &[f64], log_variance: &[f64]) -> f64 {
     a.iter()
         .zip(b)
@@ -607,7 +589,7 @@ struct State {
 }
 
 impl GmwmFit {
-    /// The canonical model of this fit with the default [`SEPARATION_LIMIT`] (module doc).
+    /// The canonical model of this fit with the default `SEPARATION_LIMIT` (module doc).
     ///
     /// Cost: one implied WV, plus one stage-2 refit per tried reduction (a drift, a slow or fast
     /// AR1/GM, or a pair of adjacent AR1/GMs), a few milliseconds each.

@@ -21,9 +21,9 @@ pub(crate) const DEFAULT_BOOTSTRAP_REPLICATES: usize = 100;
 /// [`Gmwm::new`] and the `with_*` setters, then call [`Gmwm::fit_wv`] or [`Gmwm::fit_series`].
 ///
 /// ```
-/// use gmwm::fit::Gmwm;
-/// use gmwm::model::Model;
-/// use gmwm::{sim::simulate_model, wavelet_variance, WvOptions};
+/// use gmwm::Gmwm;
+/// use gmwm::Model;
+/// use gmwm::{simulate_model, wavelet_variance, WvOptions};
 /// let truth = Model::parse("AR1(phi=0.9, sigma2=0.1)+WN(sigma2=1)").unwrap();
 /// let x = simulate_model(&truth, 10_000, 1.0, 1).unwrap();
 /// let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
@@ -258,7 +258,7 @@ impl Gmwm {
     /// this estimator's seed and G and the stored N and range.
     ///
     /// ```
-    /// use gmwm::{fit::Gmwm, model::Model, sim::simulate_model, WvOptions};
+    /// use gmwm::{simulate_model, Gmwm, Model, WvOptions};
     /// let truth = Model::parse("AR1(phi=0.99, sigma2=0.01)+WN(sigma2=1)").unwrap();
     /// let x = simulate_model(&truth, 20_000, 1.0, 3).unwrap();
     /// let full = Gmwm::parse("AR1()+WN()+RW()").unwrap().with_draws(2000);

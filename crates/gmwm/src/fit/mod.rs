@@ -32,7 +32,7 @@ pub(crate) use objective::Objective;
 pub(crate) use optimize::minimize;
 pub(crate) use optimize::LmOptions;
 pub use optimize::{Convergence, StopReason};
-pub use pooled::{PooledFit, PooledRecording, Recording};
+pub use pooled::{FitRecording, PooledFit, PooledRecording};
 pub(crate) use report::Ar1GmForms;
 pub use report::{NavParameter, ParameterEstimate};
 #[cfg(test)]

@@ -74,13 +74,13 @@ pub(crate) const POOLED_V_REPLICATES: usize = 100;
 
 /// One recording of a pooled fit: its WV, its weights and the search inputs (N, range).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Recording {
+pub struct FitRecording {
     pub(crate) wv: WaveletVariance,
     pub(crate) weights: Weights,
     pub(crate) inputs: StartInputs,
 }
 
-impl Recording {
+impl FitRecording {
     /// The recording of the series `x` at `freq_hz`: its WV (`wv_opts`) and the weights of
     /// `weighting` (the bootstrap weighting gives the fast weights, module doc).
     ///
@@ -142,7 +142,7 @@ impl Recording {
 /// one WV estimator, and at least as many levels as parameters in each (docs/methods.md §5.11).
 pub(crate) fn check_recordings(
     model: &Model,
-    recordings: &[Recording],
+    recordings: &[FitRecording],
     min: usize,
 ) -> Result<(), FitError> {
     if recordings.len() < min {
@@ -184,7 +184,7 @@ pub(crate) fn check_recordings(
 pub(crate) fn pooled_objective(
     model: &Model,
     param: Parametrisation,
-    recordings: &[Recording],
+    recordings: &[FitRecording],
     full: Option<&[FullWeights]>,
     freq_hz: f64,
 ) -> Result<Objective, FitError> {
@@ -262,7 +262,7 @@ pub struct PooledFit {
     pub(crate) freq_hz: f64,
     pub(crate) recordings: Vec<PooledRecording>,
     #[serde(skip)]
-    pub(crate) inputs: Vec<Recording>,
+    pub(crate) inputs: Vec<FitRecording>,
     /// Whether step 2 (model-variance weights, module doc) ran; `false`: the step-1 weights.
     pub(crate) reweighted: bool,
 }
@@ -329,7 +329,7 @@ impl PooledFit {
     }
 
     /// The inputs the fit was made on, with the weights of its final step.
-    pub fn inputs(&self) -> &[Recording] {
+    pub fn inputs(&self) -> &[FitRecording] {
         &self.inputs
     }
 }
@@ -339,15 +339,15 @@ impl Gmwm {
     /// doc): the separate fits give the starts, the pooled objective is minimised from each.
     ///
     /// ```
-    /// use gmwm::fit::{Gmwm, Recording};
-    /// use gmwm::{model::Model, sim::simulate_model, Weighting, WvOptions};
+    /// use gmwm::{FitRecording, Gmwm};
+    /// use gmwm::{simulate_model, Model, Weighting, WvOptions};
     /// let truth = Model::parse("WN(sigma2=1)+RW(gamma2=1e-4)").unwrap();
-    /// let recs: Vec<Recording> = [4000, 8000, 16000]
+    /// let recs: Vec<FitRecording> = [4000, 8000, 16000]
     ///     .iter()
     ///     .enumerate()
     ///     .map(|(k, &n)| {
     ///         let x = simulate_model(&truth, n, 1.0, k as u64).unwrap();
-    ///         Recording::from_series(&x, 1.0, &WvOptions::default(), Weighting::Fast).unwrap()
+    ///         FitRecording::from_series(&x, 1.0, &WvOptions::default(), Weighting::Fast).unwrap()
     ///     })
     ///     .collect();
     /// let fit = Gmwm::parse("WN()+RW()").unwrap().with_draws(2000).fit_pooled(&recs).unwrap();
@@ -359,7 +359,7 @@ impl Gmwm {
     /// [`FitError::TooFewRecordings`] for no recording; [`FitError::RateMismatch`],
     /// [`FitError::EstimatorMismatch`], [`FitError::RecordingTooShort`] naming the recording
     /// (1-based); errors of the separate fits and the optimiser.
-    pub fn fit_pooled(&self, recordings: &[Recording]) -> Result<PooledFit, FitError> {
+    pub fn fit_pooled(&self, recordings: &[FitRecording]) -> Result<PooledFit, FitError> {
         check_recordings(self.model(), recordings, 1)?;
         let separate: Vec<super::GmwmFit> = recordings
             .par_iter()
@@ -372,7 +372,7 @@ impl Gmwm {
     /// The pooled fit from given starts, with the separate fits attached.
     pub(crate) fn fit_pooled_from(
         &self,
-        recordings: &[Recording],
+        recordings: &[FitRecording],
         separate: Option<&[super::GmwmFit]>,
         starts: &[Vec<f64>],
     ) -> Result<PooledFit, FitError> {
@@ -385,7 +385,7 @@ impl Gmwm {
         // step 2 (module doc): each recording weighted by the model's variance of its WV at
         // the step-1 estimate, which does not move with the recording's own WV
         let model1 = self.model().with_values(&theta1)?;
-        let step2: Result<Vec<Recording>, FitError> = recordings
+        let step2: Result<Vec<FitRecording>, FitError> = recordings
             .iter()
             .enumerate()
             .map(|(k, r)| {
@@ -400,7 +400,7 @@ impl Gmwm {
                     &NoProgress,
                 )?;
                 let diag = (0..r.levels()).map(|l| v.v[(l, l)]).collect();
-                Ok(Recording {
+                Ok(FitRecording {
                     weights: Weights::from_v(diag, "model variance of the WV")?,
                     ..r.clone()
                 })
@@ -423,7 +423,11 @@ impl Gmwm {
             Err(_) => (recordings.to_vec(), theta1, q1, conv1, false),
         };
         let model = self.model().with_values(&theta)?;
-        let jmax = recordings.iter().map(Recording::levels).max().unwrap_or(0);
+        let jmax = recordings
+            .iter()
+            .map(FitRecording::levels)
+            .max()
+            .unwrap_or(0);
         let implied = model.implied_wv(jmax, freq_hz)?;
         let parts = recordings
             .iter()

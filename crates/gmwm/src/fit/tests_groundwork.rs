@@ -5,8 +5,8 @@ use gmwm::fit::{
     minimize, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StopReason,
     TransformPreset, Weights,
 };
-use gmwm::model::Model;
-use gmwm::sim::simulate_model;
+use gmwm::simulate_model;
+use gmwm::Model;
 use gmwm::{wavelet_variance, WvOptions};
 
 /// docs/methods.md §5.9 test values carry 7 significant digits.
@@ -251,7 +251,7 @@ fn minimize_on_simulated_ar1_wn_rw_lands_near_the_truth() {
 
 #[test]
 fn gmwm_fits_simulated_data_with_both_weightings() {
-    use gmwm::fit::{Gmwm, GmwmFit, Weighting};
+    use gmwm::{Gmwm, GmwmFit, Weighting};
     let truth = model("AR1(phi=0.99, sigma2=0.01)+WN(sigma2=1)");
     let x = simulate_model(&truth, 50_000, 1.0, 5).unwrap();
     let wv = wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap();
@@ -332,7 +332,7 @@ fn gmwm_fits_simulated_data_with_both_weightings() {
 
 #[test]
 fn gmwm_orders_ar1_components_by_phi() {
-    use gmwm::fit::Gmwm;
+    use gmwm::Gmwm;
     let text = "AR1(phi=0.999, sigma2=1e-4)+AR1(phi=0.9, sigma2=1e-2)+WN(sigma2=1)";
     let truth = model(text);
     let (nu, w) = exact_problem(&truth, 1 << 16, 1.0, 9);

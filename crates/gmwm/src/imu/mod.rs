@@ -17,7 +17,7 @@
 //! column.
 //!
 //! ```no_run
-//! use gmwm::imu::{read_table, Imu, ReadOptions};
+//! use gmwm::{read_table, Imu, ReadOptions};
 //! use std::path::Path;
 //! let table = read_table(Path::new("adis_16405_imu1.csv.gz"), &ReadOptions::default())?;
 //! let imu = Imu::from_table(table)?;
@@ -45,11 +45,11 @@ pub use probe::Probe;
 #[cfg(test)]
 pub(crate) use read::sniff;
 pub use read::{
-    binary_layout, read_table, BinaryChunks, BinaryLayout, Column, ColumnSelector, Content,
-    HeaderMode, ImuRecordType, InputFormat, ReadOptions, ReadWarning, Table, TableFacts,
+    binary_layout, read_table, BinaryChunks, BinaryLayout, Column, ColumnSelector, HeaderMode,
+    ImuRecordType, InputFormat, ReadOptions, ReadWarning, Table, TableFacts,
 };
 #[cfg(test)]
-pub(crate) use read::{for_each_chunk, read_imu_record_file};
+pub(crate) use read::{for_each_chunk, read_imu_record_file, Content};
 pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use samples::{SampleAccount, Tally};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};

@@ -9,7 +9,7 @@
 //! lines, messages on other topics) and the samples the stamps say are missing.
 //!
 //! ```
-//! use gmwm::imu::{SampleAccount, Tally};
+//! use gmwm::{SampleAccount, Tally};
 //! let account = SampleAccount {
 //!     columns: vec!["gyro_x".into(), "gyro_y".into()],
 //!     unit: "row",

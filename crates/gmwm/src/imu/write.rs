@@ -98,7 +98,7 @@ impl OutputFormat {
 ///
 /// # Examples
 /// ```
-/// use gmwm::imu::write::AtomicFile;
+/// use gmwm::AtomicFile;
 /// use std::io::Write;
 /// let dir = std::env::temp_dir().join(format!("gmwm-doc-atomic-{}", std::process::id()));
 /// std::fs::create_dir_all(&dir).unwrap();

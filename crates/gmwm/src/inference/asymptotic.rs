@@ -209,12 +209,7 @@ pub(crate) fn scales(model: &Model, scale: IntervalScale) -> Vec<Scale> {
 /// error `se` (natural units) for a parameter of `domain`, `z` from `z_value`.
 ///
 /// # Examples
-/// ```
-/// use gmwm::inference::asymptotic::{wald_interval, IntervalScale};
-/// // docs/methods.md §7 test value: theta 1, SE 1.745743, package z 1.644854
-/// let (lo, hi) = wald_interval(1.0, 1.745743, 1.644854, None, IntervalScale::Natural);
-/// assert!((lo + 1.871492).abs() < 1e-6 && (hi - 3.871492).abs() < 1e-6);
-/// ```
+/// Worked example: the test `tests::examples::example_asymptotic_wald_interval`.
 pub fn wald_interval(
     estimate: f64,
     se: f64,

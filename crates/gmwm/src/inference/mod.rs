@@ -19,14 +19,13 @@ pub use crate::sim::covariance::CovarianceMethod;
 pub(crate) use crate::sim::covariance::VSource;
 #[cfg(test)]
 pub(crate) use asymptotic::z_value;
-pub use asymptotic::{sandwich, wald_interval, IntervalScale, Sandwich, ZConvention};
+#[cfg(test)]
+pub(crate) use asymptotic::{sandwich, wald_interval};
+pub use asymptotic::{IntervalScale, ZConvention};
 #[cfg(test)]
 pub(crate) use bootstrap::wv_bootstrap;
 pub use gof::JTest;
-pub use same_model::{
-    compare_wvs, same_model_test, same_model_test_of, SameModelOptions, SameModelTest,
-    ScaleContribution, WvComparison,
-};
+pub use same_model::WvComparison;
 pub(crate) use summary::infer_with_covariance;
 pub use summary::{
     infer, infer_with_progress, BootstrapGof, Inference, InferenceMethod, InferenceOptions,

@@ -4,7 +4,7 @@
 
 use super::asymptotic::{sandwich, scales, z_value, ZConvention};
 use super::{IntervalScale, ParameterInference};
-use crate::fit::pooled::{PooledFit, Recording, POOLED_V_REPLICATES};
+use crate::fit::pooled::{FitRecording, PooledFit, POOLED_V_REPLICATES};
 use crate::fit::{FitError, Gmwm, StartInputs, Weights};
 use crate::model::Model;
 use crate::progress::NoProgress;
@@ -51,11 +51,16 @@ impl PooledFit {
     /// (§4.6), the implied and the empirical WV.
     pub(crate) fn stacked(&self, v_model: &Model, seed: u64) -> Result<Stacked, FitError> {
         let p = self.theta.len();
-        let jmax = self.inputs.iter().map(Recording::levels).max().unwrap_or(0);
+        let jmax = self
+            .inputs
+            .iter()
+            .map(FitRecording::levels)
+            .max()
+            .unwrap_or(0);
         let jac = self.model.jacobian(jmax, self.freq_hz)?;
         let hess = self.model.hessian(jmax, self.freq_hz)?;
         let implied = self.model.implied_wv(jmax, self.freq_hz)?.wv;
-        let total: usize = self.inputs.iter().map(Recording::levels).sum();
+        let total: usize = self.inputs.iter().map(FitRecording::levels).sum();
         let mut a = DMatrix::zeros(total, p);
         let mut omega = DVector::zeros(total);
         let mut v = DMatrix::zeros(total, total);
@@ -196,9 +201,9 @@ fn sd(x: &[f64]) -> f64 {
 /// weights (diag weights when the originals are diag is not kept: fast, docs/methods.md §7.4).
 pub(crate) fn simulate_recordings(
     model: &Model,
-    like: &[Recording],
+    like: &[FitRecording],
     seed: u64,
-) -> Result<Vec<Recording>, FitError> {
+) -> Result<Vec<FitRecording>, FitError> {
     like.iter()
         .enumerate()
         .map(|(k, r)| {
@@ -208,7 +213,7 @@ pub(crate) fn simulate_recordings(
             sim.fill(&mut x);
             let wv = wavelet_variance(&x, r.wv.freq_hz, &r.wv.options())?;
             let weights = Weights::fast(&wv)?;
-            Ok(Recording {
+            Ok(FitRecording {
                 wv,
                 weights,
                 inputs: StartInputs::from_series(&x),

@@ -67,7 +67,7 @@ use super::gof::chi_square_upper_tail;
 use super::pooled::simulate_recordings;
 use crate::error::ParamError;
 use crate::fit::pooled::{
-    best_of, check_recordings, pooled_objective, PooledFit, Recording, POOLED_V_REPLICATES,
+    best_of, check_recordings, pooled_objective, FitRecording, PooledFit, POOLED_V_REPLICATES,
 };
 use crate::fit::weights::FullWeights;
 use crate::fit::{FitError, Gmwm, GmwmFit, Objective, Parametrisation};
@@ -123,7 +123,7 @@ pub struct ScaleContribution {
     pub recordings: usize,
 }
 
-/// Settings of [`same_model_test`].
+/// Settings of `same_model_test`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SameModelOptions {
     /// Bootstrap replicates B (`None`: the asymptotic p-value only).
@@ -217,14 +217,14 @@ fn distance(
 /// search, the pooled fast fit, then the efficient fits.
 ///
 /// ```
-/// use gmwm::fit::{Gmwm, Recording};
+/// use gmwm::{FitRecording, Gmwm};
 /// use gmwm::inference::same_model::{same_model_test, SameModelOptions};
-/// use gmwm::{model::Model, sim::simulate_model, Weighting, WvOptions};
+/// use gmwm::{simulate_model, Model, Weighting, WvOptions};
 /// let truth = Model::parse("WN(sigma2=1)+RW(gamma2=1e-4)").unwrap();
-/// let recs: Vec<Recording> = (0..3)
+/// let recs: Vec<FitRecording> = (0..3)
 ///     .map(|k| {
 ///         let x = simulate_model(&truth, 8000, 1.0, k).unwrap();
-///         Recording::from_series(&x, 1.0, &WvOptions::default(), Weighting::Fast).unwrap()
+///         FitRecording::from_series(&x, 1.0, &WvOptions::default(), Weighting::Fast).unwrap()
 ///     })
 ///     .collect();
 /// let gmwm = Gmwm::parse("WN(sigma2=1)+RW(gamma2=1e-4)").unwrap();
@@ -238,9 +238,10 @@ fn distance(
 /// [`FitError::TooFewRecordings`] for fewer than 2; the checks of [`Gmwm::fit_pooled`]; errors
 /// of the covariance (a model the exact V does not cover falls back to a bootstrap V), the
 /// Cholesky of `V_k` and the fits.
+#[cfg(test)]
 pub fn same_model_test(
     gmwm: &Gmwm,
-    recordings: &[Recording],
+    recordings: &[FitRecording],
     opts: &SameModelOptions,
 ) -> Result<SameModelTest, FitError> {
     check_recordings(gmwm.model(), recordings, 2)?;
@@ -248,10 +249,10 @@ pub fn same_model_test(
     same_model_test_of(gmwm, &pooled, opts)
 }
 
-/// [`same_model_test`] on a pooled fit already made ([`Gmwm::fit_pooled`] with this `gmwm`).
+/// `same_model_test` on a pooled fit already made ([`Gmwm::fit_pooled`] with this `gmwm`).
 ///
 /// # Errors
-/// As [`same_model_test`].
+/// As `same_model_test`.
 pub fn same_model_test_of(
     gmwm: &Gmwm,
     pooled: &PooledFit,
@@ -270,7 +271,11 @@ pub fn same_model_test_of(
     let k = recordings.len();
     let p = gmwm.model().n_params();
     let df = (k - 1) * p;
-    let jmax = recordings.iter().map(Recording::levels).max().unwrap_or(0);
+    let jmax = recordings
+        .iter()
+        .map(FitRecording::levels)
+        .max()
+        .unwrap_or(0);
     let freq = pooled.freq_hz();
     let per_scale = (0..jmax)
         .map(|j| {
@@ -324,7 +329,7 @@ pub fn same_model_test_of(
 /// separate fast fits started at `start` (module doc).
 fn replicate_statistic(
     gmwm: &Gmwm,
-    recs: &[Recording],
+    recs: &[FitRecording],
     start: &[f64],
     seed: u64,
 ) -> Result<f64, FitError> {

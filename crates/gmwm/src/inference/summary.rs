@@ -58,7 +58,7 @@ pub struct InferenceOptions {
     /// asymptotic sandwich (§7.1).
     pub bootstrap: Option<usize>,
     /// How the asymptotic mode's V is obtained (default [`CovarianceMethod::Auto`]: exact
-    /// when the model is covered, [`crate::sim::covariance`]).
+    /// when the model is covered, `covariance`).
     pub v_method: CovarianceMethod,
     /// Replicates H of a bootstrap V of the asymptotic mode (default 100, as the package).
     pub v_replicates: usize,
@@ -161,7 +161,7 @@ pub enum InferenceWarning {
     /// Parameters without influence on the implied WV at the estimate (a Jacobian column of
     /// exactly zero or non-finite Omega-norm: the edge of their domain, e.g. a GM `beta` so large
     /// that `phi` underflowed to 0, which makes the GM a white noise): no standard error; the
-    /// canonical model ([`crate::fit::canonical`]) names what the component is. A column that
+    /// canonical model (`canonical`) names what the component is. A column that
     /// is merely small stays in the sandwich, where a rank deficiency is reported instead.
     NoInfluence {
         /// The parameters' labels.

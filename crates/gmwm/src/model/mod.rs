@@ -5,11 +5,13 @@
 //! vector `theta` is the concatenation of the components' parameters in model order, with the
 //! names and order of docs/methods.md §0.2 ([`ProcessKind::param_names`]).
 //!
-//! Three ways to build one, all validated by the same rules ([`Model::new`]):
+//! Two ways to build one, both validated by the same rules ([`Model::new`]):
 //! - text, as users of the R package write it: [`Model::parse`] / [`str::parse`], grammar in
 //!   [`parse`](mod@parse);
-//! - free functions and operators: `(3 * gm() + wn() + qn() + rw()).build()` (see [`ModelSpec`]);
 //! - components directly: `Model::new(vec![Component::guess(ProcessKind::Wn)])`.
+//!
+//! The crate's own tests also build models with free functions and operators,
+//! `(3 * gm() + wn() + qn() + rw()).build()` (`builder.rs`, compiled for tests only).
 //!
 //! # Guess mode and user values (docs/methods.md §0.3)
 //! Every parameter value is optional ([`Component::values`] holds `Option<f64>`). A component
@@ -29,24 +31,18 @@
 //!   `p + q >= 1`, each at most `MAX_ORDER`;
 //! - every given value is finite and in its basic domain ([`ParamDomain`]).
 //!
-//! ```
-//! use gmwm::model::{gm, qn, rw, wn, Model};
-//! let text: Model = "3*GM()+WN()+QN()+RW()".parse().unwrap();
-//! let built = (3 * gm() + wn() + qn() + rw()).build().unwrap();
-//! assert_eq!(text, built);
-//! assert_eq!(built.n_params(), 9);
-//! assert!(built.is_guess_mode());
-//! assert_eq!(built.to_string(), "3*GM()+WN()+QN()+RW()");
-//! ```
+//! Worked example: the test `tests::examples::example_model_builder`.
 
+#[cfg(test)]
 mod builder;
 pub mod parse;
 mod realize;
 
-pub use builder::{ar, ar1, ar1_with, dr, gm, ma, ma1, qn, rw, wn, wn_with, ModelSpec};
-
 #[cfg(test)]
-pub(crate) use builder::{ar_with, arma, arma11_with, arma_with, dr_with, gm_with};
+pub(crate) use builder::{
+    ar, ar1, ar1_with, ar_with, arma, arma11_with, arma_with, dr, dr_with, gm, gm_with, ma, ma1,
+    qn, rw, wn, wn_with, ModelSpec,
+};
 pub use parse::{ModelParseError, ParseErrorKind};
 pub use realize::{ComponentWv, ImpliedWv};
 
@@ -107,7 +103,7 @@ impl Component {
     ///
     /// # Errors
     /// [`ModelError::UnknownParameter`] (with the valid names) or [`ModelError::BadParameter`]
-    /// when `value` is outside the parameter's [`ParamDomain`].
+    /// when `value` is outside the parameter's `ParamDomain`.
     pub fn with(mut self, name: &str, value: f64) -> Result<Component, ModelError> {
         let index = self
             .kind
@@ -178,7 +174,7 @@ pub(crate) fn check_value(
 impl fmt::Display for Component {
     /// Canonical text: `WN()`, `AR(2)`, `AR1(phi=0.9, sigma2=0.1)`, `ARMA(2,1)(ar1=0.5)`; only
     /// the given values are written, by name, in the shortest text that parses back to the same
-    /// bits ([`format_value`]).
+    /// bits (`format_value`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let has_orders = spec(self.kind).orders.is_some();
         f.write_str(&self.kind.name())?;
@@ -206,12 +202,7 @@ impl fmt::Display for Component {
 ///
 /// `format_value(v).parse::<f64>()` returns exactly `v` (same bits, including `-0`).
 ///
-/// ```
-/// use gmwm::model::format_value;
-/// assert_eq!(format_value(0.1), "0.1");
-/// assert_eq!(format_value(7.08e-9), "7.08e-9");
-/// assert_eq!(format_value(2.5e6), "2.5e6");
-/// ```
+/// Worked example: the test `tests::examples::example_format_value`.
 pub fn format_value(v: f64) -> String {
     let a = v.abs();
     if a != 0.0 && (!(1e-4..1e6).contains(&a)) {
@@ -222,7 +213,7 @@ pub fn format_value(v: f64) -> String {
 }
 
 /// A validated latent error model: an ordered, non-empty sum of components obeying the rules of
-/// docs/methods.md §0.2 (see the [module docs](self)).
+/// docs/methods.md §0.2.
 ///
 /// Its `Display` is the canonical text, which [`Model::parse`] reads back to an equal model
 /// (bitwise-equal values); serde (de)serialises a model as that string.
@@ -311,7 +302,7 @@ impl Model {
     }
 
     /// Parses the text language of the R package, e.g. `"3*GM()+WN()+QN()+RW()"` or
-    /// `"AR1(phi=0.9, sigma2=0.1)+WN()"`; grammar in [`parse`](mod@parse).
+    /// `"AR1(phi=0.9, sigma2=0.1)+WN()"`; grammar in docs/methods.md §0.2.
     ///
     /// # Errors
     /// [`ModelParseError`] with the byte offset and column of the offending character; a
@@ -415,7 +406,7 @@ impl Model {
 
 impl fmt::Display for Model {
     /// Canonical text: components joined by `+`; consecutive identical value-less GM/AR1
-    /// components collapse to `k*GM()`, k at most [`MAX_MULTIPLIER`] (a longer run is split, so
+    /// components collapse to `k*GM()`, k at most `MAX_MULTIPLIER` (a longer run is split, so
     /// that the text parses back); values by name ([`Component`]'s `Display`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let mut i = 0;

@@ -24,7 +24,7 @@
 //! Errors carry the byte offset and 1-based character column of the offending character;
 //! [`ModelParseError::render`] draws the caret:
 //! ```
-//! use gmwm::model::{Model, ParseErrorKind};
+//! use gmwm::{Model, ParseErrorKind};
 //! let e = Model::parse("AR1(phi=0.9,, sigma2=1)").unwrap_err();
 //! assert_eq!((e.column(), e.kind()), (13, &ParseErrorKind::Syntax));
 //! assert_eq!(
@@ -74,7 +74,7 @@ pub enum ParseErrorKind {
     },
     /// A malformed or non-finite number.
     BadNumber,
-    /// A multiplier `k` outside 1..=[`MAX_MULTIPLIER`].
+    /// A multiplier `k` outside 1..=`MAX_MULTIPLIER`.
     BadMultiplier,
     /// A model rule (docs/methods.md §0.2) or a value domain is violated; the position points at
     /// the offending term or value.

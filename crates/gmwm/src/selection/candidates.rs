@@ -17,6 +17,7 @@ use std::collections::BTreeSet;
 pub(crate) const MAX_NESTED_TERMS: usize = 20;
 
 /// The term list of a model, space-joined as the package names its rows (`"AR1 AR1 WN"`).
+#[cfg(test)]
 pub fn terms(model: &Model) -> String {
     model
         .kinds()

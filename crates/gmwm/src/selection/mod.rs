@@ -65,9 +65,9 @@
 //! before), never an underfit.
 //!
 //! ```
-//! use gmwm::model::Model;
-//! use gmwm::selection::Wic;
-//! use gmwm::sim::simulate_model;
+//! use gmwm::Model;
+//! use gmwm::Wic;
+//! use gmwm::simulate_model;
 //! let truth = Model::parse("AR1(phi=0.9, sigma2=1)+WN(sigma2=4)").unwrap();
 //! let x = simulate_model(&truth, 4000, 1.0, 3).unwrap();
 //! let wic = Wic::nested(Model::parse("AR1()+WN()+RW()").unwrap())
@@ -90,14 +90,17 @@ pub(crate) mod optimism;
 pub mod pooled;
 pub mod wic;
 
-pub use candidates::terms;
+#[cfg(test)]
+pub(crate) use candidates::terms;
 
 #[cfg(test)]
 pub(crate) use candidates::{common_denominator, nested_candidates};
 pub use imu::{auto_imu, AxisSelection, ImuSelection};
 #[cfg(test)]
+pub(crate) use optimism::asymptotic_optimism;
+#[cfg(test)]
 pub(crate) use optimism::d_matrix;
-pub use optimism::{asymptotic_optimism, OptimismConvention, OptimismMethod};
+pub use optimism::{OptimismConvention, OptimismMethod};
 pub use pooled::{select_pooled, PooledCandidate, PooledSelection};
 pub use wic::{
     CandidateScore, ModelSelection, RowStatus, SelectionRow, SelectionRule, SelectionTable, Wic,

@@ -108,16 +108,7 @@ pub(crate) fn d_matrix(
 /// [`FitError::Length`] when the sizes disagree.
 ///
 /// # Examples
-/// ```
-/// use gmwm::selection::{asymptotic_optimism, OptimismConvention};
-/// use nalgebra::DMatrix;
-/// // docs/methods.md §8 test values: WN + RW at tau = 2, 4, 8, Omega = diag(1, 2, 3), D = 0, V = I
-/// let a = DMatrix::from_column_slice(3, 2, &[0.5, 0.25, 0.125, 0.25, 0.375, 0.6875]);
-/// let omega = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 2.0, 3.0]));
-/// let o = asymptotic_optimism(&a, &DMatrix::zeros(2, 2), &omega, &DMatrix::identity(3, 3),
-///     OptimismConvention::Corrected).unwrap();
-/// assert!((o - 8.299065).abs() < 1e-6);
-/// ```
+/// Worked example: the test `tests::examples::example_optimism_asymptotic_optimism`.
 pub fn asymptotic_optimism(
     a: &DMatrix<f64>,
     d: &DMatrix<f64>,

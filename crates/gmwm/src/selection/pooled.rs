@@ -16,7 +16,7 @@
 
 use super::candidates::nested_candidates;
 use super::optimism::{asymptotic_optimism, d_matrix, OptimismConvention};
-use crate::fit::{FitError, Gmwm, PooledFit, Recording};
+use crate::fit::{FitError, FitRecording, Gmwm, PooledFit};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -57,7 +57,7 @@ pub struct PooledSelection {
 /// of the full model's covariance.
 pub fn select_pooled(
     gmwm: &Gmwm,
-    recordings: &[Recording],
+    recordings: &[FitRecording],
     seed: u64,
 ) -> Result<PooledSelection, FitError> {
     let full = gmwm.fit_pooled(recordings)?;

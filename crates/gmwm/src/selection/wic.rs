@@ -55,7 +55,7 @@ pub struct Wic {
 }
 
 /// How the selected row is chosen among the rows of canonical models (module docs of
-/// [`super`]): every rule ranks the rows by WIC; they differ in what they do with the rows
+/// `super`): every rule ranks the rows by WIC; they differ in what they do with the rows
 /// whose WIC exceeds the minimum by at most one standard error of that difference
 /// (`WIC_EQUIVALENCE_SE`, `wic_difference_se`): the criterion cannot tell those apart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -952,7 +952,7 @@ impl Context<'_> {
 /// One candidate of the selection (docs/methods.md §8.6).
 ///
 /// Wire format: `model` (canonical text, guess mode), `canonical_model` (its fit read as a
-/// canonical model, [`crate::fit::canonical`]), `objective` (`Q(theta_hat)`, §5.1),
+/// canonical model, `canonical`), `objective` (`Q(theta_hat)`, §5.1),
 /// `optimism`, `wic` (= objective + optimism), `gof_p_value` (null when undefined: J <= p,
 /// B <= J + 2 bootstrap replicates (too few to invert V), V not positive definite or an
 /// estimate on the boundary of its transform domain), `gof_p_value_upper_bound` (true when

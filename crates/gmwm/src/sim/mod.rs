@@ -19,4 +19,6 @@ pub use demo::DemoSensor;
 pub(crate) use demo::{DEMO_FREQ_HZ, DEMO_MODEL};
 pub use model::simulate_model;
 pub(crate) use simulator::replicate_seed;
-pub use simulator::{quantisation_noise, simulate, Simulator, StartMode};
+pub use simulator::Simulator;
+#[cfg(test)]
+pub(crate) use simulator::{quantisation_noise, simulate, StartMode};

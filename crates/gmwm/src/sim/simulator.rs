@@ -14,6 +14,7 @@
 //! match R's Mersenne Twister, so only the laws match the package (docs/methods.md §12).
 
 use crate::error::ParamError;
+#[cfg(test)]
 use crate::process::qn::qn_value;
 use crate::process::sampler::{stream, Sampler};
 use crate::process::Process;
@@ -135,11 +136,12 @@ impl Simulator {
 ///
 /// # Examples
 /// ```
-/// use gmwm::process::Dr;
+/// use gmwm::Dr;
 /// use gmwm::sim::simulate;
 /// let x = simulate(&[Dr::new(2.0).unwrap().into()], 4, 1).unwrap();
 /// assert_eq!(x, vec![2.0, 4.0, 6.0, 8.0]); // docs/methods.md §10.3 test value
 /// ```
+#[cfg(test)]
 pub fn simulate(processes: &[Process], n: usize, seed: u64) -> Result<Vec<f64>, ParamError> {
     if n == 0 {
         return Err(ParamError::new("n", n, "must be at least 1"));
@@ -170,6 +172,7 @@ pub(crate) fn replicate_seed(seed: u64, replicate: u64) -> u64 {
 /// let x = gmwm::sim::quantisation_noise(1.0, &[0.0, s12, 0.0]);
 /// assert!((x[0] - 3.4641016).abs() < 1e-7 && (x[1] + 3.4641016).abs() < 1e-7);
 /// ```
+#[cfg(test)]
 pub fn quantisation_noise(q2: f64, u: &[f64]) -> Vec<f64> {
     let s = q2.sqrt();
     u.windows(2).map(|w| qn_value(s, w[0], w[1])).collect()

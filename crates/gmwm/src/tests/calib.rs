@@ -1,7 +1,7 @@
 //! The calibration pipeline (`gmwm::calib`) on simulated IMUs of known noise: the read-off in
 //! continuous SI units, its intervals, unit conversion, the navigation sets and bad input.
 
-use gmwm::calib::export::{render, ExportFormat};
+use gmwm::calib::export::{render_export, ExportFormat};
 use gmwm::calib::{Adjustment, AxisPolicy, CalibError, Calibration, CalibrationOptions};
 use gmwm::imu::{Column, Imu, Sensor, SensorInfo};
 use gmwm::model::Model;
@@ -170,7 +170,7 @@ fn calibration_without_unit_reports_data_unit() {
     assert_eq!(n.unit, "u/√Hz");
     let sets = r.nav_sets(AxisPolicy::Worst, Adjustment::Estimate, None);
     assert_eq!(sets[0].noise.gyroscope.noise_density, None);
-    let err = render(ExportFormat::KALIBR, &sets[0].noise).unwrap_err();
+    let err = render_export(ExportFormat::KALIBR, &sets[0].noise).unwrap_err();
     assert!(err.to_string().contains("gyroscope_noise_density"), "{err}");
 }
 
@@ -199,7 +199,7 @@ fn nav_sets_follow_policy_and_adjustment() {
         per.iter().map(|s| &s.label).collect::<Vec<_>>()
     );
     assert_eq!(per[0].label, "x");
-    let yaml = render(ExportFormat::KALIBR, &worst.noise).unwrap();
+    let yaml = render_export(ExportFormat::KALIBR, &worst.noise).unwrap();
     assert!(yaml.contains("gyroscope_noise_density"));
 }
 

@@ -2,7 +2,7 @@
 //! holds the right numbers under the right keys; missing values are typed errors naming the key.
 
 use crate::tests::common::rel_diff;
-use gmwm::calib::export::{render, ExportError, ExportFormat, NavNoise, SensorNoise};
+use gmwm::calib::export::{render_export, ExportError, ExportFormat, NavNoise, SensorNoise};
 use std::collections::BTreeMap;
 
 /// Values are written with 8 significant digits: relative rounding at most 5e-8.
@@ -128,7 +128,7 @@ fn check_comments(text: &str, prefix: &str) {
 
 #[test]
 fn export_kalibr_holds_the_densities_under_kalibr_keys() {
-    let text = render(ExportFormat::KALIBR, &noise()).unwrap();
+    let text = render_export(ExportFormat::KALIBR, &noise()).unwrap();
     println!("{text}");
     assert!(!text.starts_with('%'), "Kalibr's PyYAML rejects %YAML:1.0");
     let pairs = yaml_pairs(&text);
@@ -150,7 +150,7 @@ fn export_kalibr_holds_the_densities_under_kalibr_keys() {
 
 #[test]
 fn export_openvins_nests_the_kalibr_keys_under_imu0() {
-    let text = render(ExportFormat::OPENVINS, &noise()).unwrap();
+    let text = render_export(ExportFormat::OPENVINS, &noise()).unwrap();
     println!("{text}");
     assert!(text.starts_with("%YAML:1.0\n"));
     let pairs = yaml_pairs(&text);
@@ -176,7 +176,7 @@ fn export_openvins_nests_the_kalibr_keys_under_imu0() {
 
 #[test]
 fn export_vins_writes_its_short_keys() {
-    let text = render(ExportFormat::VINS, &noise()).unwrap();
+    let text = render_export(ExportFormat::VINS, &noise()).unwrap();
     println!("{text}");
     assert!(text.starts_with("%YAML:1.0\n"));
     let pairs = yaml_pairs(&text);
@@ -197,7 +197,7 @@ fn export_vins_writes_its_short_keys() {
 
 #[test]
 fn export_orbslam3_writes_its_imu_block() {
-    let text = render(ExportFormat::ORBSLAM3, &noise()).unwrap();
+    let text = render_export(ExportFormat::ORBSLAM3, &noise()).unwrap();
     println!("{text}");
     assert!(text.starts_with("%YAML:1.0\n"));
     let pairs = yaml_pairs(&text);
@@ -252,7 +252,7 @@ fn xml_leaves(text: &str) -> BTreeMap<String, String> {
 
 #[test]
 fn export_px4_is_a_balanced_plugin_fragment_with_the_gauss_markov_bias() {
-    let text = render(ExportFormat::PX4, &noise()).unwrap();
+    let text = render_export(ExportFormat::PX4, &noise()).unwrap();
     println!("{text}");
     assert!(
         text.contains("<plugin name=\"gazebo_imu_plugin\" filename=\"libgazebo_imu_plugin.so\">")
@@ -288,17 +288,17 @@ fn export_missing_values_are_errors_naming_the_key() {
     let mut n = noise();
     n.gyroscope.random_walk = None;
     // PX4's random walk drives its Gauss–Markov bias: it is the GM driving density, present
-    let px4 = render(ExportFormat::PX4, &n).unwrap();
+    let px4 = render_export(ExportFormat::PX4, &n).unwrap();
     assert!(px4.contains("gyroscopeRandomWalk"));
     n.gyroscope.bias_driving_density = None;
-    let e = render(ExportFormat::PX4, &n).unwrap_err();
+    let e = render_export(ExportFormat::PX4, &n).unwrap_err();
     assert!(e.to_string().contains("gyroscopeRandomWalk"), "{e}");
     assert!(
         e.to_string().contains("--model"),
         "the hint says how to get one: {e}"
     );
     for (format, key) in cases {
-        let e = render(format, &n).unwrap_err();
+        let e = render_export(format, &n).unwrap_err();
         assert!(
             matches!(e, ExportError::Missing { key: k, format: f, .. } if k == key && f == format),
             "{e:?}"
@@ -309,16 +309,16 @@ fn export_missing_values_are_errors_naming_the_key() {
     let mut n = noise();
     n.accelerometer.bias_correlation_time_s = None;
     n.accelerometer.bias_sigma = None;
-    let e = render(ExportFormat::PX4, &n).unwrap_err();
+    let e = render_export(ExportFormat::PX4, &n).unwrap_err();
     assert!(
         e.to_string().contains("accelerometerBiasCorrelationTime"),
         "{e}"
     );
-    assert!(render(ExportFormat::KALIBR, &n).is_ok());
+    assert!(render_export(ExportFormat::KALIBR, &n).is_ok());
     // not a positive finite number
     let mut n = noise();
     n.accelerometer.noise_density = Some(f64::NAN);
-    let e = render(ExportFormat::ORBSLAM3, &n).unwrap_err();
+    let e = render_export(ExportFormat::ORBSLAM3, &n).unwrap_err();
     assert!(
         matches!(
             e,
@@ -332,7 +332,7 @@ fn export_missing_values_are_errors_naming_the_key() {
     let mut n = noise();
     n.update_rate_hz = 0.0;
     assert!(matches!(
-        render(ExportFormat::KALIBR, &n),
+        render_export(ExportFormat::KALIBR, &n),
         Err(ExportError::Invalid {
             key: "update_rate",
             ..
@@ -344,7 +344,7 @@ fn export_missing_values_are_errors_naming_the_key() {
 fn export_without_a_topic_writes_a_marked_placeholder() {
     let mut n = noise();
     n.rostopic = None;
-    let text = render(ExportFormat::KALIBR, &n).unwrap();
+    let text = render_export(ExportFormat::KALIBR, &n).unwrap();
     assert_eq!(yaml_pairs(&text)["rostopic"], "/imu0");
     assert!(text.contains("# the IMU topic was not given: /imu0 is a placeholder"));
 }

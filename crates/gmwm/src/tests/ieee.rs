@@ -86,7 +86,7 @@ fn dr(r: f64) -> impl Fn(f64) -> f64 {
     move |t| r * r * t * t / 2.0
 }
 
-fn value(r: &gmwm::calib::ieee::Readoff) -> f64 {
+fn value(r: &gmwm::calib::ieee::CoefficientReadoff) -> f64 {
     r.value.unwrap_or_else(|| panic!("no value: {:?}", r.note))
 }
 

@@ -10,6 +10,7 @@ mod canonical;
 mod common;
 mod contamination;
 mod datasheet;
+mod examples;
 mod export;
 mod fit_mc;
 mod fit_ref;

@@ -7,7 +7,9 @@
 //! The CI-run tests are sized to a few seconds in release; the `#[ignore]` studies give the
 //! figures of docs/methods.md §5.11 and §7.7.
 
-use gmwm::fit::{FitError, Gmwm, Objective, Parametrisation, PhiOrder, Recording, TransformPreset};
+use gmwm::fit::{
+    FitError, FitRecording, Gmwm, Objective, Parametrisation, PhiOrder, TransformPreset,
+};
 use gmwm::inference::same_model::{compare_wvs, same_model_test, SameModelOptions};
 use gmwm::inference::{infer, InferenceOptions};
 use gmwm::model::Model;
@@ -18,13 +20,13 @@ use rayon::prelude::*;
 const TRUTH: &str = "WN(sigma2=1)+RW(gamma2=1e-4)";
 const THETA: [f64; 2] = [1.0, 1e-4];
 
-fn recordings(truth: &Model, lengths: &[usize], seed: u64) -> Vec<Recording> {
+fn recordings(truth: &Model, lengths: &[usize], seed: u64) -> Vec<FitRecording> {
     lengths
         .iter()
         .enumerate()
         .map(|(k, &n)| {
             let x = simulate_model(truth, n, 1.0, replicate_seed(seed, k as u64)).unwrap();
-            Recording::from_series(&x, 1.0, &WvOptions::default(), Weighting::Fast).unwrap()
+            FitRecording::from_series(&x, 1.0, &WvOptions::default(), Weighting::Fast).unwrap()
         })
         .collect()
 }
@@ -109,8 +111,8 @@ fn mismatched_recordings_give_one_clear_error_each() {
     let truth = Model::parse(TRUTH).unwrap();
     let x = simulate_model(&truth, 4000, 1.0, 1).unwrap();
     let opts = WvOptions::default();
-    let a = Recording::from_series(&x, 100.0, &opts, Weighting::Fast).unwrap();
-    let b = Recording::from_series(&x, 200.0, &opts, Weighting::Fast).unwrap();
+    let a = FitRecording::from_series(&x, 100.0, &opts, Weighting::Fast).unwrap();
+    let b = FitRecording::from_series(&x, 200.0, &opts, Weighting::Fast).unwrap();
     let g = Gmwm::parse("WN()+RW()").unwrap().with_draws(500);
     let e = g.fit_pooled(&[a.clone(), b]).unwrap_err();
     assert!(
@@ -122,10 +124,10 @@ fn mismatched_recordings_give_one_clear_error_each() {
         "{e}"
     );
     // within RATE_TOLERANCE (1%): accepted
-    let close = Recording::from_series(&x, 100.5, &opts, Weighting::Fast).unwrap();
+    let close = FitRecording::from_series(&x, 100.5, &opts, Weighting::Fast).unwrap();
     g.fit_pooled(&[a.clone(), close]).unwrap();
     // too short: 8 samples have 2 levels, the model 3 parameters
-    let short = Recording::from_series(&x[..8], 100.0, &opts, Weighting::Fast).unwrap();
+    let short = FitRecording::from_series(&x[..8], 100.0, &opts, Weighting::Fast).unwrap();
     let g3 = Gmwm::parse("AR1()+WN()").unwrap().with_draws(500);
     let e = g3.fit_pooled(&[a.clone(), short]).unwrap_err();
     assert!(
@@ -145,7 +147,7 @@ fn mismatched_recordings_give_one_clear_error_each() {
         robust: Some(Default::default()),
         ..opts
     };
-    let r = Recording::from_series(&x, 100.0, &robust, Weighting::Fast).unwrap();
+    let r = FitRecording::from_series(&x, 100.0, &robust, Weighting::Fast).unwrap();
     let e = g.fit_pooled(&[a.clone(), r]).unwrap_err();
     assert!(
         matches!(e, FitError::EstimatorMismatch { recording: 2 }),

@@ -32,7 +32,7 @@ pub(crate) fn eta3(kept: usize, j: usize) -> f64 {
 /// rather than obey it; the engine itself takes any level in `(0, 1)`.
 ///
 /// ```
-/// use gmwm::variance::ci::significance_level_problem;
+/// use gmwm::significance_level_problem;
 /// assert!(significance_level_problem(0.05).is_none());
 /// assert!(significance_level_problem(0.95).unwrap().contains("for 95% intervals give 0.05"));
 /// ```

@@ -53,16 +53,7 @@ use nalgebra::DMatrix;
 /// The Haar MODWT wavelet cross-covariance of `x` and `y` at levels `1..=levels` (module docs,
 /// docs/methods.md §15.1): `(nu2_hat(x + y) - nu2_hat(x - y)) / 4`.
 ///
-/// ```
-/// use gmwm::variance::cross::wavelet_cross_covariance;
-/// // the cross-covariance of a series with itself is its wavelet variance (§1.10 test values)
-/// let x: Vec<f64> = (1..=8).map(f64::from).collect();
-/// let c = wavelet_cross_covariance(&x, &x, 2).unwrap();
-/// assert!((c[0] - 0.25).abs() < 1e-12 && (c[1] - 1.0).abs() < 1e-12);
-/// // and with its negative, minus it
-/// let y: Vec<f64> = x.iter().map(|v| -v).collect();
-/// assert!((wavelet_cross_covariance(&x, &y, 2).unwrap()[0] + 0.25).abs() < 1e-12);
-/// ```
+/// Worked example: the test `tests::examples::example_cross_wavelet_cross_covariance`.
 ///
 /// # Errors
 /// [`ParamError`] named `y` when the lengths differ; as [`wavelet_variance`] (non-finite

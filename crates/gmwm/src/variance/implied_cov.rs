@@ -444,15 +444,7 @@ pub(crate) fn exact_covariance_of(
 /// the parametric bootstrap of docs/methods.md §7.4 as its replicates grow, without simulating
 /// (module docs give the formulas). Divide by the efficiency for a robust WV.
 ///
-/// ```
-/// use gmwm::model::Model;
-/// use gmwm::variance::implied_cov::exact_wv_covariance;
-/// let model = Model::parse("WN(sigma2=1)").unwrap();
-/// let v = exact_wv_covariance(&model, 4096, 1.0, 3).unwrap();
-/// // level 1 of white noise: nu2 = 1/2, Var(nu2_hat) = (3 M - 1) / (4 M^2) with M = N - 1
-/// let m = 4095.0;
-/// assert!((v[(0, 0)] - (3.0 * m - 1.0) / (4.0 * m * m)).abs() < 1e-12 * v[(0, 0)]);
-/// ```
+/// Worked example: the test `tests::examples::example_implied_cov_exact_wv_covariance`.
 ///
 /// # Errors
 /// [`InputError`] for a model without values or a bad rate; [`ParamError`] (as `InputError`)

@@ -39,20 +39,7 @@ use crate::variance::wv::WaveletVariance;
 
 /// The wavelet variance of several recordings of one sensor pooled level by level (module doc).
 ///
-/// ```
-/// use gmwm::variance::pooled::PooledWv;
-/// use gmwm::{sim::simulate_model, model::Model, wavelet_variance, WvOptions};
-/// let wn = Model::parse("WN(sigma2=1)").unwrap();
-/// let wvs = [4000, 16000].iter().enumerate().map(|(k, &n)| {
-///     let x = simulate_model(&wn, n, 1.0, k as u64).unwrap();
-///     wavelet_variance(&x, 1.0, &WvOptions::default()).unwrap()
-/// }).collect();
-/// let pooled = PooledWv::new(wvs).unwrap();
-/// // the longer recording reaches two more levels; at level 1 it has four times the weight
-/// assert_eq!(pooled.wv().levels(), pooled.parts()[1].levels());
-/// assert!((pooled.weights(1)[0] / pooled.weights(0)[0] - 4.0).abs() < 0.01);
-/// assert_eq!(pooled.wv().n(), 20000);
-/// ```
+/// Worked example: the test `tests::examples::example_pooled_pooledwv`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PooledWv {
     /// The pooled WV: `n` the total length, `eta` and `n_coefficients` summed per level.

@@ -353,7 +353,7 @@ impl Welch {
 /// ```
 /// // a sinusoid of 12.5 Hz at 100 Hz: the PSD peaks there
 /// let x: Vec<f64> = (0..4096).map(|t| (std::f64::consts::TAU * 0.125 * t as f64).sin()).collect();
-/// let psd = gmwm::variance::psd::welch_psd(&x, 100.0).unwrap();
+/// let psd = gmwm::welch_psd(&x, 100.0).unwrap();
 /// let peak = (0..psd.density().len()).max_by(|&a, &b| psd.density()[a].total_cmp(&psd.density()[b])).unwrap();
 /// assert!((psd.frequency_hz()[peak] - 12.5).abs() <= psd.resolution_hz());
 /// ```

@@ -127,7 +127,7 @@ impl RobustOptions {
         self.convention
     }
 
-    /// The tuning constant `c` of these options (docs/methods.md §2.3, [`tuning_constant`]),
+    /// The tuning constant `c` of these options (docs/methods.md §2.3, `tuning_constant`),
     /// solved once when the options were made.
     pub fn tuning_constant(&self) -> f64 {
         self.c
@@ -253,10 +253,7 @@ const BINOM8_PACKAGE: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, 8.0
 /// with `mu_{2k}` from `truncated_normal_moments`.
 ///
 /// # Examples
-/// ```
-/// // docs/methods.md §2.5 test value: a(4.400278) = 0.5691689
-/// assert!((gmwm::variance::robust::a_of_c(4.400278) - 0.5691689).abs() < 1e-7);
-/// ```
+/// Worked example: the test `tests::examples::example_robust_a_of_c`.
 pub fn a_of_c(c: f64) -> f64 {
     let mu = truncated_normal_moments(c);
     expand(&mu, 1, &BINOM4, c)
@@ -321,11 +318,7 @@ const C_MAX: f64 = 100.0;
 /// [`ParamError`] (name `eff`) unless `eff` is finite and in `(0, 0.99]`.
 ///
 /// # Examples
-/// ```
-/// use gmwm::variance::robust::{tuning_constant, RobustConvention};
-/// let c = tuning_constant(0.6, RobustConvention::Exact).unwrap();
-/// assert!((c - 4.400278).abs() < 1e-6);
-/// ```
+/// Worked example: the test `tests::examples::example_robust_tuning_constant`.
 pub fn tuning_constant(eff: f64, convention: RobustConvention) -> Result<f64, ParamError> {
     check_eff(eff)?;
     match convention {
@@ -422,13 +415,7 @@ pub(crate) const FIXED_POINT_MAX_ITER: usize = 500;
 ///   reaches `a(c)`).
 ///
 /// # Examples
-/// ```
-/// use gmwm::variance::robust::{robust_scale, RobustConvention};
-/// let y = [-1.2, 0.3, 0.8, -0.4, 1.1, -0.9, 0.2, -0.1, 0.6, -0.7];
-/// // docs/methods.md §2.5 test value (port default with c = 4.400278)
-/// let s2 = robust_scale(&y, 4.400278, RobustConvention::Exact).unwrap();
-/// assert!((s2 - 0.6909524).abs() < 1e-6);
-/// ```
+/// Worked example: the test `tests::examples::example_robust_robust_scale`.
 pub fn robust_scale(y: &[f64], c: f64, convention: RobustConvention) -> Result<f64, InputError> {
     check_c(c)?;
     if y.is_empty() {
@@ -993,11 +980,7 @@ fn mean_psi2_scaled(y: &[f64], sd: f64, s: f64, c: f64) -> f64 {
 /// Returns `(lo_r, hi_r)`; non-finite inputs propagate as NaN.
 ///
 /// # Examples
-/// ```
-/// // docs/methods.md §2.5 test value
-/// let (lo, hi) = gmwm::variance::robust::robust_ci(0.6481826, 0.525, 0.2045587, 3.158041, 0.6, None);
-/// assert!((lo - 0.1374296).abs() < 1e-6 && (hi - 4.844999).abs() < 1e-5);
-/// ```
+/// Worked example: the test `tests::examples::example_robust_robust_ci`.
 pub fn robust_ci(
     nu_r: f64,
     nu_c: f64,

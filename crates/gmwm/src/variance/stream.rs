@@ -81,8 +81,8 @@ impl Plan {
 /// rows of the file; it does not grow with the file's length.
 ///
 /// ```no_run
-/// use gmwm::imu::{BinaryLayout, InputFormat};
-/// use gmwm::variance::binary_wavelet_variance;
+/// use gmwm::{BinaryLayout, InputFormat};
+/// use gmwm::binary_wavelet_variance;
 /// use std::path::Path;
 /// let layout = BinaryLayout {
 ///     format: InputFormat::F64,
@@ -97,7 +97,7 @@ impl Plan {
 ///     &gmwm::WvOptions::default(),
 /// )?;
 /// println!("{}", wvs[0]);
-/// # Ok::<(), gmwm::imu::ReadError>(())
+/// # Ok::<(), gmwm::ReadError>(())
 /// ```
 ///
 /// # Errors

@@ -439,7 +439,7 @@ pub(crate) fn check_levels(n: usize, levels: usize, opts: &WvOptions) -> Result<
 /// with chi-square intervals (§1.7; robust intervals §2.5).
 ///
 /// The classical Haar MODWT path is a streaming O(N·J) pass (`HaarWvAccumulator`); other
-/// filters and the DWT go through the transform ([`Modwt`], [`Dwt`]) and keep O(N·J) memory.
+/// filters and the DWT go through the transform (`Modwt`, `Dwt`) and keep O(N·J) memory.
 /// The DWT estimate is normalised to the MODWT scale (`mean(W^2) / 2^j`), unlike the package's
 /// raw mean which is `2^j` times larger (§13.3); its equivalent degrees of freedom are the
 /// number of kept DWT coefficients (independent for white noise), not `M_j / 2^j`.

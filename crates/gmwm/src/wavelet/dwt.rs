@@ -13,13 +13,7 @@ use super::{
 /// Plan once, run on every series; the plan is a plain comparable value, `Send + Sync`.
 ///
 /// # Examples
-/// ```
-/// use gmwm::wavelet::{Dwt, WaveletFilter};
-/// // docs/methods.md §1.4: Haar W_{1,t} = (x_{2t+1} - x_{2t}) / sqrt2
-/// let w = Dwt::new(WaveletFilter::Haar, 1).unwrap().transform(&[1.0, 3.0, 2.0, 5.0]).unwrap();
-/// assert!((w.kept(1)[0] - 2.0 / 2f64.sqrt()).abs() < 1e-15);
-/// assert!((w.kept(1)[1] - 3.0 / 2f64.sqrt()).abs() < 1e-15);
-/// ```
+/// Worked example: the test `tests::examples::example_dwt_dwt`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Dwt {
     filter: WaveletFilter,
@@ -37,11 +31,13 @@ impl Dwt {
     }
 
     /// The filter.
+    #[cfg(test)]
     pub fn filter(&self) -> WaveletFilter {
         self.filter
     }
 
     /// The number of levels `J`.
+    #[cfg(test)]
     pub fn levels(&self) -> usize {
         self.levels
     }

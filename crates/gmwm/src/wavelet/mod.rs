@@ -105,11 +105,7 @@ pub(crate) fn pow2(j: usize) -> usize {
 /// `t >= n_j`. Saturates at `usize::MAX` instead of overflowing.
 ///
 /// # Examples
-/// ```
-/// use gmwm::wavelet::modwt_boundary;
-/// assert_eq!(modwt_boundary(2, 3), 7); // Haar: 2^j - 1
-/// assert_eq!(modwt_boundary(8, 2), 21); // la8: 3 * 7
-/// ```
+/// Worked example: the test `tests::examples::example_modwt_boundary`.
 pub fn modwt_boundary(filter_len: usize, j: usize) -> usize {
     (pow2(j) - 1).saturating_mul(filter_len.saturating_sub(1))
 }
@@ -120,12 +116,7 @@ pub fn modwt_boundary(filter_len: usize, j: usize) -> usize {
 /// Computed exactly in integers as `(L - 2) - floor((L - 2) / 2^j)`.
 ///
 /// # Examples
-/// ```
-/// use gmwm::wavelet::dwt_boundary;
-/// assert_eq!(dwt_boundary(2, 5), 0); // Haar
-/// assert_eq!(dwt_boundary(8, 1), 3); // ceil(6 * 1/2)
-/// assert_eq!(dwt_boundary(8, 2), 5); // ceil(6 * 3/4)
-/// ```
+/// Worked example: the test `tests::examples::example_dwt_boundary`.
 pub fn dwt_boundary(filter_len: usize, j: usize) -> usize {
     let m = filter_len.saturating_sub(2);
     m - m / pow2(j)

@@ -13,15 +13,7 @@ use super::{
 /// Plan once, run on every series; the plan is a plain comparable value, `Send + Sync`.
 ///
 /// # Examples
-/// ```
-/// use gmwm::wavelet::{Modwt, WaveletFilter};
-/// // docs/methods.md §1.10: x = 1..8, Haar, J = 3
-/// let x: Vec<f64> = (1..=8).map(f64::from).collect();
-/// let w = Modwt::new(WaveletFilter::Haar, 3).unwrap().transform(&x).unwrap();
-/// assert_eq!(w.kept(1), &[0.5; 7]);
-/// assert_eq!(w.kept(2), &[1.0; 5]);
-/// assert_eq!(w.kept(3), &[2.0]); // the single remaining coefficient is kept (§1.3)
-/// ```
+/// Worked example: the test `tests::examples::example_modwt_modwt`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Modwt {
     filter: WaveletFilter,
@@ -39,11 +31,13 @@ impl Modwt {
     }
 
     /// The filter.
+    #[cfg(test)]
     pub fn filter(&self) -> WaveletFilter {
         self.filter
     }
 
     /// The number of levels `J`.
+    #[cfg(test)]
     pub fn levels(&self) -> usize {
         self.levels
     }

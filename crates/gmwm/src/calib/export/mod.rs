@@ -348,7 +348,7 @@ pub(super) fn check_rate(format: ExportFormat, noise: &NavNoise) -> Result<f64, 
 /// [`ExportError::Missing`] naming the key of a value the format needs (all formats need both
 /// noise densities and random walks; PX4 also the bias correlation times and sigmas);
 /// [`ExportError::Invalid`] for a value or rate that is not a positive finite number.
-pub fn render(format: ExportFormat, noise: &NavNoise) -> Result<String, ExportError> {
+pub fn render_export(format: ExportFormat, noise: &NavNoise) -> Result<String, ExportError> {
     format.0.render(noise)
 }
 

@@ -256,16 +256,7 @@ pub(crate) fn read_binary_table(
 /// Streaming reader of one column of a raw binary file, chunk by chunk, in bounded memory
 /// (`chunk_len · ncols · width` bytes plus a 1 MiB buffer); the column is never materialised.
 ///
-/// ```no_run
-/// # use gmwm::imu::{BinaryChunks, InputFormat};
-/// # use std::path::Path;
-/// let mut chunks = BinaryChunks::open(Path::new("x.f64le.bin"), InputFormat::F64, 1, 1, 1 << 16)?;
-/// let mut sum = 0.0;
-/// while let Some(chunk) = chunks.next_chunk()? {
-///     sum += chunk.iter().sum::<f64>();
-/// }
-/// # Ok::<(), gmwm::imu::ReadError>(())
-/// ```
+/// Worked example: the test `tests::examples::example_read_binary_binarychunks`.
 #[derive(Debug)]
 pub struct BinaryChunks {
     path: PathBuf,

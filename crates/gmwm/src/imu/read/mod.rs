@@ -542,7 +542,7 @@ impl BinaryLayout {
 
 /// The raw binary layout of `path` if [`read_table`] would read it as raw f64/f32 (from
 /// `opts.format`, the name or the sidecar), `None` otherwise; for readers that stream
-/// ([`BinaryChunks`]).
+/// (`BinaryChunks`).
 ///
 /// # Errors
 /// As `resolve_format` and [`find_sidecar`]; [`ReadError::Empty`] or

@@ -59,11 +59,11 @@ use std::path::{Path, PathBuf};
 /// variance, in memory bounded whatever its length.
 ///
 /// ```no_run
-/// use gmwm::imu::read::stream::StreamedTable;
+/// use gmwm::StreamedTable;
 /// let table = StreamedTable::open("imu.csv.gz".as_ref(), &Default::default())?;
 /// let wvs = table.wavelet_variance(table.facts.freq_hz.unwrap_or(1.0), &Default::default())?;
 /// println!("{} rows, {:?}", table.rows, wvs[0].wv());
-/// # Ok::<(), gmwm::imu::ReadError>(())
+/// # Ok::<(), gmwm::ReadError>(())
 /// ```
 #[derive(Debug)]
 pub struct StreamedTable {

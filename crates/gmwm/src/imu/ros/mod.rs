@@ -21,7 +21,7 @@
 //! which holds none of the messages.
 //!
 //! ```no_run
-//! use gmwm::imu::ros::{list_topics, read_imu_messages};
+//! use gmwm::{list_topics, read_imu_messages};
 //! use std::path::Path;
 //! let (container, topics) = list_topics(Path::new("run.mcap"))?;
 //! for t in &topics {
@@ -29,7 +29,7 @@
 //! }
 //! let imu = read_imu_messages(Path::new("run.mcap"), None)?; // the single IMU topic
 //! println!("{} messages on {}", imu.len(), imu.topic);
-//! # Ok::<(), gmwm::imu::ReadError>(())
+//! # Ok::<(), gmwm::ReadError>(())
 //! ```
 
 mod cdr;
