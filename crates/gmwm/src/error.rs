@@ -286,7 +286,7 @@ pub(crate) fn check_series(x: &[f64]) -> Result<(), SeriesError> {
 ///
 /// # Errors
 /// [`ParamError`] named `freq` (the CLI flag).
-pub fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
+pub(crate) fn check_freq(freq_hz: f64) -> Result<(), ParamError> {
     if freq_hz.is_finite() && freq_hz > 0.0 {
         Ok(())
     } else {

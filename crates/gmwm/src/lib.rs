@@ -21,6 +21,7 @@
 //! assert!((wv.wv()[0] - 0.25).abs() < 1e-12 && (wv.wv()[1] - 1.0).abs() < 1e-12);
 //! ```
 #![deny(missing_docs)]
+#![warn(unreachable_pub)]
 
 // Unit tests that exercise crate-internal kernels are written against `gmwm::` paths, like the
 // integration tests they were moved from.
@@ -85,11 +86,11 @@ pub use process::{
 pub use sim::{simulate_model, DemoSensor, Simulator};
 
 // GMWM fits, their inference and model selection (§5-§8).
-pub use fit::canonical::TermParameter;
+pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
+pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{
-    CanonicalModel, CanonicalTerm, Convergence, FitError, FitRecording, Gmwm, GmwmFit,
-    NavParameter, ParameterEstimate, Parametrisation, PhiOrder, PooledFit, PooledRecording,
-    StartInputs, StopReason, Weighting, Weights,
+    Convergence, FitError, FitRecording, Gmwm, GmwmFit, NavParameter, ParameterEstimate, PooledFit,
+    PooledRecording, StartInputs, StopReason, Weighting, Weights,
 };
 pub use inference::same_model::{
     compare_wvs, same_model_test_of, SameModelOptions, SameModelTest, ScaleContribution,
@@ -112,8 +113,12 @@ pub use shared::{
 
 // Recordings: readers, writers, sidecars, ROS containers (docs/methods.md §10).
 pub use imu::plausible::{raw_floats, ImplausibleFloats};
+pub use imu::read::binary::ImuRecordType;
 pub use imu::read::stream::{streams_from, StreamedTable};
-pub use imu::read::RATE_TOLERANCE;
+pub use imu::read::{
+    binary_layout, read_table, BinaryLayout, Column, ColumnSelector, HeaderMode, InputFormat,
+    ReadOptions, ReadWarning, Table, TableFacts, RATE_TOLERANCE,
+};
 pub use imu::recording::{left_out_note, table_notes};
 pub use imu::ros::{
     choose_topic, list_topics, read_imu_messages, ImuMessages, RosContainer, TopicInfo,
@@ -122,10 +127,9 @@ pub use imu::ros::{MessageError, RosError};
 pub use imu::sidecar::sidecar_candidates;
 pub use imu::write::{write_atomic, write_csv_header, write_csv_rows, write_sidecar, AtomicFile};
 pub use imu::{
-    binary_layout, find_sidecar, quote, read_table, time_column_unit, BinaryLayout, Column,
-    ColumnSelector, HeaderMode, Imu, ImuRecordType, InputFormat, OutputFormat, Probe, ReadError,
-    ReadOptions, ReadWarning, Recording, RecordingOptions, RecordingSource, SampleAccount, Sensor,
-    SensorInfo, SeriesWriter, Sidecar, SidecarColumn, Table, TableFacts, TimeUnit, TimingReport,
+    find_sidecar, quote, time_column_unit, Imu, OutputFormat, Probe, ReadError, Recording,
+    RecordingOptions, RecordingSource, SampleAccount, Sensor, SensorInfo, SeriesWriter, Sidecar,
+    SidecarColumn, TimeUnit, TimingReport,
 };
 pub use imu::{Axis, ColumnSummary, Gap, SidecarUnits, Tally, TimingWarning};
 pub use units::{si_unit, NoiseTerm, SignalKind, SignalUnit};

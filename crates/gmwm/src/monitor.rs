@@ -248,7 +248,7 @@ pub struct MonitorReport {
 /// longer than the series (naming `window`), a zero step, a bad `alpha`; as
 /// [`wavelet_variance`] for a series with non-finite values.
 #[cfg(test)]
-pub fn monitor(
+pub(crate) fn monitor(
     x: &[f64],
     freq_hz: f64,
     model: &Model,

@@ -407,7 +407,7 @@ pub(crate) fn from_datasheet(term: NoiseTerm, kind: SignalKind, value: f64) -> O
 /// per sample `omega = R / f`; GM `phi = exp(-1 / (T f))`. B, the GM sigma (already a
 /// per-sample sd) and the GM driving density (its discrete innovation also needs the sigma)
 /// have none. A `freq_hz` that is not a positive finite number gives no discrete form.
-pub fn forms(
+pub(crate) fn forms(
     term: NoiseTerm,
     kind: Option<SignalKind>,
     data_unit: &str,
@@ -471,7 +471,7 @@ pub fn forms(
 /// (`°/√h = rad/s/√Hz` up to a factor), the signal itself for a bias instability B, and over
 /// `√s` for a random-walk density K (`°/h/√h`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DatasheetUnit {
+pub(crate) struct DatasheetUnit {
     /// The sensor whose signal the unit is built on.
     pub kind: SignalKind,
     /// The noise term of the unit's dimension: noise density, bias instability or random walk.
@@ -523,7 +523,7 @@ pub enum DatasheetUnitError {
 }
 
 /// The datasheet units a user is shown for a term and sensor: the module table's, in ASCII.
-pub fn datasheet_examples(term: NoiseTerm, kind: SignalKind) -> &'static str {
+pub(crate) fn datasheet_examples(term: NoiseTerm, kind: SignalKind) -> &'static str {
     match (kind, term) {
         (SignalKind::Gyroscope, NoiseTerm::NoiseDensity) => {
             "deg/sqrt(h), deg/s/sqrt(Hz), rad/s/sqrt(Hz)"
@@ -611,7 +611,7 @@ fn datasheet_factor(factor: &str) -> Option<([f64; 3], f64)> {
 /// # Errors
 /// [`DatasheetUnitError`]: an unknown symbol, a unit that is not inertial, or one of another
 /// term (a quantization, a rate ramp).
-pub fn datasheet_unit(text: &str) -> Result<DatasheetUnit, DatasheetUnitError> {
+pub(crate) fn datasheet_unit(text: &str) -> Result<DatasheetUnit, DatasheetUnitError> {
     let unit = text.trim().to_string();
     let t = normalise(&unit)
         .replace('√', "sqrt")

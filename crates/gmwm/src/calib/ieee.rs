@@ -45,7 +45,7 @@ use std::fmt;
 
 /// docs/methods.md §14.3: the flicker-floor factor `sqrt(2 ln 2 / π) = 0.6643`, rounded to 0.664 as
 /// in IEEE Std 952 and docs/methods.md §14.5 (min ADEV 1e-4 gives B = 1.506024e-4 only with 0.664).
-pub const FLICKER_FACTOR: f64 = 0.664;
+pub(crate) const FLICKER_FACTOR: f64 = 0.664;
 
 /// Share of the fitted AV a term must carry at a scale for the scale to join its region.
 /// 0.9 bounds the contamination of a read-off by the other terms to 5.4% (module doc) while
@@ -181,7 +181,7 @@ pub fn term_avar(term: NoiseTerm, c: f64, tau_s: f64) -> Option<f64> {
 
 /// docs/methods.md §14.3: the cluster time at which a line term is read (1 s for N, 3 s for K,
 /// √3 s for Q, √2 s for R); `None` for B (read at the minimum) and the other terms.
-pub fn read_off_tau_s(term: NoiseTerm) -> Option<f64> {
+pub(crate) fn read_off_tau_s(term: NoiseTerm) -> Option<f64> {
     let j = match term {
         NoiseTerm::Quantization => Q,
         NoiseTerm::NoiseDensity => N,

@@ -1,12 +1,12 @@
 //! Calibration: from a recording to navigation-filter parameters.
 pub(crate) mod contamination;
-pub mod datasheet;
-pub mod export;
-pub mod ieee;
+pub(crate) mod datasheet;
+pub(crate) mod export;
+pub(crate) mod ieee;
 pub(crate) mod nav;
 pub(crate) mod pipeline;
-pub mod pooled;
-pub mod streamed;
+pub(crate) mod pooled;
+pub(crate) mod streamed;
 pub(crate) mod verdict;
 
 pub use contamination::{Contamination, FitUses};

@@ -45,7 +45,7 @@ pub(crate) struct SubModel {
 impl SubModel {
     /// The full theta: `theta` (the sub-model's parameters) at the kept indices, `boundary`
     /// (the full fit's values) elsewhere.
-    pub fn expand(&self, theta: &[f64], boundary: &[f64]) -> Vec<f64> {
+    pub(crate) fn expand(&self, theta: &[f64], boundary: &[f64]) -> Vec<f64> {
         let mut out = boundary.to_vec();
         for (&k, &t) in self.keep.iter().zip(theta) {
             out[k] = t;

@@ -92,7 +92,7 @@ use std::fmt;
 
 /// Two fits whose implied WVs are at most this many standard errors of the WV apart (the
 /// separation of the module doc) cannot be told apart by the data.
-pub const SEPARATION_LIMIT: f64 = 2.0;
+pub(crate) const SEPARATION_LIMIT: f64 = 2.0;
 
 /// A component whose removal moves the implied WV by at most this separation (a hundredth of a
 /// standard error of the WV, summed over the levels) is fitted to nothing, whether or not the
@@ -130,7 +130,7 @@ fn contributing(implied: &ImpliedWv, log_variance: &[f64]) -> Vec<bool> {
 /// log_variance_j)`. Levels where either value is not a positive finite number are skipped.
 ///
 /// Worked example: the test `tests::examples::example_canonical_wv_separation`.
-pub fn wv_separation(a: &[f64], b: &[f64], log_variance: &[f64]) -> f64 {
+pub(crate) fn wv_separation(a: &[f64], b: &[f64], log_variance: &[f64]) -> f64 {
     a.iter()
         .zip(b)
         .zip(log_variance)

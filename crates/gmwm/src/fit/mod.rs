@@ -11,22 +11,22 @@
 
 pub(crate) mod active;
 pub(crate) mod auto;
-pub mod canonical;
+pub(crate) mod canonical;
 pub(crate) mod gmwm;
 pub(crate) mod objective;
 pub(crate) mod optimize;
-pub mod pooled;
-pub mod report;
+pub(crate) mod pooled;
+pub(crate) mod report;
 pub(crate) mod revive;
-pub mod start;
+pub(crate) mod start;
 pub(crate) mod transform;
-pub mod weights;
+pub(crate) mod weights;
 
 #[cfg(test)]
 mod tests_groundwork;
 
 pub(crate) use canonical::Reading;
-pub use canonical::{CanonicalModel, CanonicalTerm, SEPARATION_LIMIT};
+pub(crate) use canonical::{CanonicalModel, CanonicalTerm, SEPARATION_LIMIT};
 pub use gmwm::{Gmwm, GmwmFit};
 pub(crate) use objective::Objective;
 pub(crate) use optimize::minimize;
@@ -40,7 +40,7 @@ pub(crate) use start::starting_values;
 pub use start::StartInputs;
 pub(crate) use start::StartOptions;
 
-pub use transform::{Parametrisation, PhiOrder, TransformPreset};
+pub(crate) use transform::{Parametrisation, PhiOrder, TransformPreset};
 
 pub(crate) use transform::ParamTransform;
 pub use weights::{Weighting, Weights};

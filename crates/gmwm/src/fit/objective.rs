@@ -91,7 +91,7 @@ impl Objective {
     /// [`FitError::Length`] when the weights, WV or parametrisation disagree in size;
     /// [`FitError::BadWv`] for a non-finite or non-positive `nu2_hat_j`;
     /// [`FitError::TooFewLevels`] when the model has more parameters than levels (§5.7).
-    pub fn new(
+    pub(crate) fn new(
         model: &Model,
         param: Parametrisation,
         nu_hat: &[f64],
@@ -313,12 +313,12 @@ impl Objective {
     }
 
     /// Number of levels J.
-    pub fn levels(&self) -> usize {
+    pub(crate) fn levels(&self) -> usize {
         self.nu_hat.len()
     }
 
     /// Number of parameters p.
-    pub fn n_params(&self) -> usize {
+    pub(crate) fn n_params(&self) -> usize {
         self.param.n_params()
     }
 
@@ -328,12 +328,12 @@ impl Objective {
     }
 
     /// The model template (no values).
-    pub fn model(&self) -> &Model {
+    pub(crate) fn model(&self) -> &Model {
         &self.model
     }
 
     /// `sum_j omega_j nu2_hat_j^2`, the objective at a zero implied WV: the scale of `Q`.
-    pub fn scale(&self) -> f64 {
+    pub(crate) fn scale(&self) -> f64 {
         if self.whitening.is_some() {
             let mut r = vec![0.0; self.levels()];
             self.whiten(&self.nu_hat, &mut r);
@@ -581,7 +581,7 @@ impl Objective {
     /// [`FitError::Length`]; [`FitError::Input`] when theta(u) is not a valid model (e.g. a
     /// transformed variance that underflowed to 0).
     #[cfg(test)]
-    pub fn value(&self, u: &[f64]) -> Result<f64, FitError> {
+    pub(crate) fn value(&self, u: &[f64]) -> Result<f64, FitError> {
         self.check_u(u)?;
         let mut ev = self.buffer();
         self.evaluate(u, &mut ev, false)?;

@@ -13,7 +13,7 @@
 
 use super::FitError;
 use crate::model::Model;
-pub use crate::process::TransformPreset;
+pub(crate) use crate::process::TransformPreset;
 pub(crate) use crate::process::{logistic, ParamTransform, RESTART_EDGE};
 use crate::process::{spec, ChainSlot as Slot};
 use serde::{Deserialize, Serialize};

@@ -253,12 +253,12 @@ impl FullWeights {
 
     /// `Omega = V^{-1} = W' W`.
     #[cfg(test)]
-    pub fn omega(&self) -> DMatrix<f64> {
+    pub(crate) fn omega(&self) -> DMatrix<f64> {
         self.whitening.transpose() * &self.whitening
     }
 
     /// Number of levels.
-    pub fn levels(&self) -> usize {
+    pub(crate) fn levels(&self) -> usize {
         self.v.nrows()
     }
 }

@@ -28,28 +28,30 @@
 //! ```
 
 mod error;
-pub mod plausible;
+pub(crate) mod plausible;
 mod probe;
-pub mod read;
-pub mod recording;
-pub mod ros;
+pub(crate) mod read;
+pub(crate) mod recording;
+pub(crate) mod ros;
 mod samples;
 mod sensor;
-pub mod sidecar;
-pub mod timing;
-pub mod write;
+pub(crate) mod sidecar;
+pub(crate) mod timing;
+pub(crate) mod write;
 
 pub(crate) use error::escape_name;
 pub use error::{quote, ReadError};
 pub use probe::Probe;
 #[cfg(test)]
 pub(crate) use read::sniff;
-pub use read::{
-    binary_layout, read_table, BinaryChunks, BinaryLayout, Column, ColumnSelector, HeaderMode,
-    ImuRecordType, InputFormat, ReadOptions, ReadWarning, Table, TableFacts,
+pub(crate) use read::{
+    binary_layout, BinaryChunks, BinaryLayout, ImuRecordType, InputFormat, ReadOptions, ReadWarning,
 };
 #[cfg(test)]
-pub(crate) use read::{for_each_chunk, read_imu_record_file, Content};
+pub(crate) use read::{
+    for_each_chunk, read_imu_record_file, read_table, Column, ColumnSelector, Content, HeaderMode,
+    Table,
+};
 pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use samples::{SampleAccount, Tally};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};

@@ -411,7 +411,7 @@ impl Imu {
         self.timing.as_ref()
     }
 
-    /// Soft problems found while reading the file ([`TableFacts::warnings`](crate::imu::TableFacts::warnings)).
+    /// Soft problems found while reading the file ([`TableFacts::warnings`](crate::TableFacts::warnings)).
     pub fn warnings(&self) -> &[ReadWarning] {
         &self.warnings
     }

@@ -68,7 +68,7 @@ pub(crate) fn z_value(alpha: f64, convention: ZConvention) -> Result<f64, ParamE
 
 /// The sandwich covariance of docs/methods.md §7.1 and the rank of `A' Omega A`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Sandwich {
+pub(crate) struct Sandwich {
     /// `Psi = H V H'` (p x p).
     pub psi: DMatrix<f64>,
     /// `H = (A' Omega A)^+ A' Omega` (p x J).
@@ -94,7 +94,7 @@ pub(crate) const PINV_RCOND: f64 = 1e-12;
 /// [`FitError::Length`] for inconsistent sizes; [`FitError::Input`] when a column of `A` has
 /// zero or non-finite `Omega`-norm (a parameter without influence on the WV: its variance is not
 /// identified).
-pub fn sandwich(
+pub(crate) fn sandwich(
     a: &DMatrix<f64>,
     omega: &DMatrix<f64>,
     v: &DMatrix<f64>,
@@ -210,7 +210,7 @@ pub(crate) fn scales(model: &Model, scale: IntervalScale) -> Vec<Scale> {
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_asymptotic_wald_interval`.
-pub fn wald_interval(
+pub(crate) fn wald_interval(
     estimate: f64,
     se: f64,
     z: f64,

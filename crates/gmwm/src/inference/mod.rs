@@ -5,14 +5,14 @@
 //! intervals ([`asymptotic`], §7.1, §7.2, §7.6); the J-test ([`gof`], §7.3); and one entry
 //! point, [`infer`] (`summary`, §7.5).
 
-pub mod asymptotic;
+pub(crate) mod asymptotic;
 pub(crate) mod bootstrap;
-pub mod gof;
+pub(crate) mod gof;
 mod pooled;
-pub mod same_model;
+pub(crate) mod same_model;
 pub(crate) mod summary;
 
-pub use crate::progress::Progress;
+pub(crate) use crate::progress::Progress;
 
 pub(crate) use crate::progress::NoProgress;
 pub use crate::sim::covariance::CovarianceMethod;

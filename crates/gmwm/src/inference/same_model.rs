@@ -239,7 +239,7 @@ fn distance(
 /// of the covariance (a model the exact V does not cover falls back to a bootstrap V), the
 /// Cholesky of `V_k` and the fits.
 #[cfg(test)]
-pub fn same_model_test(
+pub(crate) fn same_model_test(
     gmwm: &Gmwm,
     recordings: &[FitRecording],
     opts: &SameModelOptions,

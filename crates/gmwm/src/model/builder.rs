@@ -18,47 +18,47 @@ use super::{Component, Model, ModelError, ProcessKind, MAX_MULTIPLIER};
 use std::ops::{Add, Mul};
 
 /// White noise in guess mode, `WN()`.
-pub fn wn() -> Component {
+pub(crate) fn wn() -> Component {
     Component::guess(ProcessKind::Wn)
 }
 
 /// Quantisation noise in guess mode, `QN()`.
-pub fn qn() -> Component {
+pub(crate) fn qn() -> Component {
     Component::guess(ProcessKind::Qn)
 }
 
 /// Random walk in guess mode, `RW()`.
-pub fn rw() -> Component {
+pub(crate) fn rw() -> Component {
     Component::guess(ProcessKind::Rw)
 }
 
 /// Drift in guess mode, `DR()`.
-pub fn dr() -> Component {
+pub(crate) fn dr() -> Component {
     Component::guess(ProcessKind::Dr)
 }
 
 /// AR1 in guess mode, `AR1()`.
-pub fn ar1() -> Component {
+pub(crate) fn ar1() -> Component {
     Component::guess(ProcessKind::Ar1)
 }
 
 /// Gauss–Markov in guess mode, `GM()`.
-pub fn gm() -> Component {
+pub(crate) fn gm() -> Component {
     Component::guess(ProcessKind::Gm)
 }
 
 /// MA1 in guess mode, `MA1()`.
-pub fn ma1() -> Component {
+pub(crate) fn ma1() -> Component {
     Component::guess(ProcessKind::Ma1)
 }
 
 /// AR(p) in guess mode, `AR(p)`; the order is checked by [`ModelSpec::build`] / [`Model::new`].
-pub fn ar(p: usize) -> Component {
+pub(crate) fn ar(p: usize) -> Component {
     Component::guess(ProcessKind::Ar(p))
 }
 
 /// MA(q) in guess mode, `MA(q)`; the order is checked by [`ModelSpec::build`] / [`Model::new`].
-pub fn ma(q: usize) -> Component {
+pub(crate) fn ma(q: usize) -> Component {
     Component::guess(ProcessKind::Ma(q))
 }
 
@@ -80,7 +80,7 @@ fn given(
 ///
 /// # Errors
 /// [`ModelError::BadParameter`] unless `sigma2` is a finite variance > 0.
-pub fn wn_with(sigma2: f64) -> Result<Component, ModelError> {
+pub(crate) fn wn_with(sigma2: f64) -> Result<Component, ModelError> {
     given(ProcessKind::Wn, [sigma2])
 }
 
@@ -97,7 +97,7 @@ pub(crate) fn dr_with(omega: f64) -> Result<Component, ModelError> {
 ///
 /// # Errors
 /// [`ModelError::BadParameter`] unless `phi` is in (-1, 1) and `sigma2` > 0 is finite.
-pub fn ar1_with(phi: f64, sigma2: f64) -> Result<Component, ModelError> {
+pub(crate) fn ar1_with(phi: f64, sigma2: f64) -> Result<Component, ModelError> {
     given(ProcessKind::Ar1, [phi, sigma2])
 }
 

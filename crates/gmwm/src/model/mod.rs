@@ -35,7 +35,7 @@
 
 #[cfg(test)]
 mod builder;
-pub mod parse;
+pub(crate) mod parse;
 mod realize;
 
 #[cfg(test)]
@@ -46,9 +46,9 @@ pub(crate) use builder::{
 pub use parse::{ModelParseError, ParseErrorKind};
 pub use realize::{ComponentWv, ImpliedWv};
 
-pub use crate::error::ModelError;
+pub(crate) use crate::error::ModelError;
 pub(crate) use crate::process::MAX_ORDER;
-pub use crate::process::{ParamDomain, ProcessKind};
+pub(crate) use crate::process::{ParamDomain, ProcessKind};
 
 use crate::process::{spec, Occurs, KINDS};
 use std::fmt;
@@ -57,7 +57,7 @@ use std::fmt;
 ///
 /// A guard against absurd allocations from typos; the package's largest automatic search
 /// (docs/methods.md §8.4) uses 3 GMs, and more than a handful is never identifiable.
-pub const MAX_MULTIPLIER: usize = 100;
+pub(crate) const MAX_MULTIPLIER: usize = 100;
 
 /// One term of a model: a process kind and its (optional) parameter values (docs/methods.md
 /// §0.2–§0.3).
@@ -203,7 +203,7 @@ impl fmt::Display for Component {
 /// `format_value(v).parse::<f64>()` returns exactly `v` (same bits, including `-0`).
 ///
 /// Worked example: the test `tests::examples::example_format_value`.
-pub fn format_value(v: f64) -> String {
+pub(crate) fn format_value(v: f64) -> String {
     let a = v.abs();
     if a != 0.0 && (!(1e-4..1e6).contains(&a)) {
         format!("{v:e}")

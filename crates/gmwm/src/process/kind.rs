@@ -18,7 +18,7 @@ pub(crate) const MAX_ORDER: usize = 100;
 /// lists the transforms the optimiser applies on these domains).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
-pub enum ParamDomain {
+pub(crate) enum ParamDomain {
     /// A variance (`sigma2`, `sigma2_gm`, `q2`, `gamma2`): finite and > 0 (log transform).
     Variance,
     /// The GM `beta`: finite and > 0 (`phi = exp(-beta / freq)` lies in (0, 1), docs/methods.md
@@ -41,7 +41,7 @@ pub enum ParamDomain {
 
 impl ParamDomain {
     /// Whether `value` lies in this domain.
-    pub fn contains(self, value: f64) -> bool {
+    pub(crate) fn contains(self, value: f64) -> bool {
         match self {
             ParamDomain::Variance | ParamDomain::Rate | ParamDomain::Positive => {
                 value.is_finite() && value > 0.0
@@ -53,7 +53,7 @@ impl ParamDomain {
     }
 
     /// What a valid value looks like, for error messages.
-    pub fn expected(self) -> &'static str {
+    pub(crate) fn expected(self) -> &'static str {
         match self {
             ParamDomain::Variance => "a finite variance > 0",
             ParamDomain::Rate => "a finite rate > 0",

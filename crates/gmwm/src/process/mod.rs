@@ -55,7 +55,7 @@ pub(crate) use draw::Dominance;
 pub(crate) use facts::{
     kind_of, Markov, MarkovForms, Occurs, Orders, Params, Physical, Role, Spec, UnitShape, BASE,
 };
-pub use kind::ParamDomain;
+pub(crate) use kind::ParamDomain;
 pub(crate) use kind::MAX_ORDER;
 pub(crate) use param::ChainSlot;
 pub use param::TransformPreset;

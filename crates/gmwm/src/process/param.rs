@@ -39,7 +39,7 @@ pub(crate) enum ParamTransform {
 
 impl ParamTransform {
     /// The open domain of theta, in words (for error messages).
-    pub fn domain(self) -> &'static str {
+    pub(crate) fn domain(self) -> &'static str {
         match self {
             ParamTransform::Identity => "a finite number",
             ParamTransform::Log => "a finite number > 0",
@@ -72,7 +72,7 @@ impl ParamTransform {
     /// `theta` moved just inside the domain when it lies exactly on its closed edge (an
     /// estimate whose `u` ran off to +-inf rounds onto it: a variance or drift of 0, a phi of
     /// 0 or 1); other values unchanged. See `Parametrisation::to_u_restart` (`crate::fit::transform`).
-    pub fn inside(self, theta: f64) -> f64 {
+    pub(crate) fn inside(self, theta: f64) -> f64 {
         let e = RESTART_EDGE;
         match self {
             ParamTransform::Log | ParamTransform::LogAbs if theta == 0.0 => f64::MIN_POSITIVE,

@@ -18,7 +18,7 @@ pub(crate) const MAX_NESTED_TERMS: usize = 20;
 
 /// The term list of a model, space-joined as the package names its rows (`"AR1 AR1 WN"`).
 #[cfg(test)]
-pub fn terms(model: &Model) -> String {
+pub(crate) fn terms(model: &Model) -> String {
     model
         .kinds()
         .iter()

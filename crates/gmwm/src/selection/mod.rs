@@ -85,10 +85,10 @@
 //! ```
 
 pub(crate) mod candidates;
-pub mod imu;
+pub(crate) mod imu;
 pub(crate) mod optimism;
-pub mod pooled;
-pub mod wic;
+pub(crate) mod pooled;
+pub(crate) mod wic;
 
 #[cfg(test)]
 pub(crate) use candidates::terms;

@@ -109,7 +109,7 @@ pub(crate) fn d_matrix(
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_optimism_asymptotic_optimism`.
-pub fn asymptotic_optimism(
+pub(crate) fn asymptotic_optimism(
     a: &DMatrix<f64>,
     d: &DMatrix<f64>,
     omega: &DMatrix<f64>,

@@ -126,7 +126,7 @@ impl WvBootstrap {
     }
 
     /// The diagonal of the covariance (per-level bootstrap variances).
-    pub fn variances(&self) -> Vec<f64> {
+    pub(crate) fn variances(&self) -> Vec<f64> {
         self.cov.diagonal().iter().copied().collect()
     }
 }

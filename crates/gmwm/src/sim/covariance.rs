@@ -69,7 +69,7 @@ pub(crate) struct VSource(pub(crate) Option<usize>);
 
 impl VSource {
     /// `"exact"` or `"bootstrap"`.
-    pub fn method(&self) -> &'static str {
+    pub(crate) fn method(&self) -> &'static str {
         match self.0 {
             None => "exact",
             Some(_) => "bootstrap",
@@ -77,7 +77,7 @@ impl VSource {
     }
 
     /// Replicates behind a bootstrap V; `None` when exact.
-    pub fn replicates(&self) -> Option<usize> {
+    pub(crate) fn replicates(&self) -> Option<usize> {
         self.0
     }
 }

@@ -8,8 +8,8 @@
 //! (docs/methods.md §7.4).
 
 pub(crate) mod bootstrap;
-pub mod covariance;
-pub mod demo;
+pub(crate) mod covariance;
+pub(crate) mod demo;
 mod model;
 mod simulator;
 

@@ -18,7 +18,7 @@ use crate::error::ParamError;
 use crate::process::qn::qn_value;
 use crate::process::sampler::{stream, Sampler};
 use crate::process::Process;
-pub use crate::process::StartMode;
+pub(crate) use crate::process::StartMode;
 
 /// A streaming simulator of a sum of independent [`Process`]es (docs/methods.md §10.2,
 /// `gen_model`).
@@ -142,7 +142,7 @@ impl Simulator {
 /// assert_eq!(x, vec![2.0, 4.0, 6.0, 8.0]); // docs/methods.md §10.3 test value
 /// ```
 #[cfg(test)]
-pub fn simulate(processes: &[Process], n: usize, seed: u64) -> Result<Vec<f64>, ParamError> {
+pub(crate) fn simulate(processes: &[Process], n: usize, seed: u64) -> Result<Vec<f64>, ParamError> {
     if n == 0 {
         return Err(ParamError::new("n", n, "must be at least 1"));
     }
@@ -173,7 +173,7 @@ pub(crate) fn replicate_seed(seed: u64, replicate: u64) -> u64 {
 /// assert!((x[0] - 3.4641016).abs() < 1e-7 && (x[1] + 3.4641016).abs() < 1e-7);
 /// ```
 #[cfg(test)]
-pub fn quantisation_noise(q2: f64, u: &[f64]) -> Vec<f64> {
+pub(crate) fn quantisation_noise(q2: f64, u: &[f64]) -> Vec<f64> {
     let s = q2.sqrt();
     u.windows(2).map(|w| qn_value(s, w[0], w[1])).collect()
 }

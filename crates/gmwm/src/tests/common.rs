@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 /// Neumaier-compensated sum (the engine's own `math::sum` is crate-internal).
-pub fn neumaier_sum(values: impl IntoIterator<Item = f64>) -> f64 {
+pub(super) fn neumaier_sum(values: impl IntoIterator<Item = f64>) -> f64 {
     let (mut sum, mut comp) = (0.0f64, 0.0f64);
     for v in values {
         let t = sum + v;
@@ -19,7 +19,7 @@ pub fn neumaier_sum(values: impl IntoIterator<Item = f64>) -> f64 {
 }
 
 /// `../shared/data` beside the repository, or `$GMWM_DATA_DIR`.
-pub fn data_dir() -> PathBuf {
+pub(super) fn data_dir() -> PathBuf {
     match std::env::var_os("GMWM_DATA_DIR") {
         Some(d) => PathBuf::from(d),
         None => shared_dir().join("data"),
@@ -27,17 +27,17 @@ pub fn data_dir() -> PathBuf {
 }
 
 /// `../shared/ref` beside the repository.
-pub fn ref_dir() -> PathBuf {
+pub(super) fn ref_dir() -> PathBuf {
     shared_dir().join("ref")
 }
 
 /// `../shared` beside the repository (the crate lives in `<repo>/crates/gmwm`).
-pub fn shared_dir() -> PathBuf {
+pub(super) fn shared_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared")
 }
 
 /// Reads a reference JSON file from `../shared/ref`, failing with its path.
-pub fn read_ref(name: &str) -> serde_json::Value {
+pub(super) fn read_ref(name: &str) -> serde_json::Value {
     let path = ref_dir().join(name);
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("cannot read reference file {}: {e}", path.display()));
@@ -45,7 +45,7 @@ pub fn read_ref(name: &str) -> serde_json::Value {
 }
 
 /// A JSON array of numbers (nulls become NaN).
-pub fn f64s(v: &serde_json::Value) -> Vec<f64> {
+pub(super) fn f64s(v: &serde_json::Value) -> Vec<f64> {
     v.as_array()
         .unwrap_or_else(|| panic!("not an array: {v}"))
         .iter()
@@ -54,19 +54,19 @@ pub fn f64s(v: &serde_json::Value) -> Vec<f64> {
 }
 
 /// Relative difference with an absolute floor.
-pub fn rel_diff(a: f64, b: f64) -> f64 {
+pub(super) fn rel_diff(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
 }
 
 /// Reads a whole dataset `<name>.csv.gz` of `../shared/data` with the library's reader.
-pub fn read_dataset(name: &str) -> gmwm::imu::Table {
+pub(super) fn read_dataset(name: &str) -> gmwm::imu::Table {
     let path = data_dir().join(format!("{name}.csv.gz"));
     gmwm::imu::read_table(&path, &gmwm::imu::ReadOptions::default())
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
 }
 
 /// One column of a dataset.
-pub fn read_column(name: &str, column: &str) -> Vec<f64> {
+pub(super) fn read_column(name: &str, column: &str) -> Vec<f64> {
     let table = read_dataset(name);
     table
         .columns
@@ -77,7 +77,7 @@ pub fn read_column(name: &str, column: &str) -> Vec<f64> {
 }
 
 /// Seeded white noise N(0, sigma2).
-pub fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
+pub(super) fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
     use rand::SeedableRng;
     use rand_distr::Distribution;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
@@ -93,7 +93,7 @@ pub fn white_noise(n: usize, sigma2: f64, seed: u64) -> Vec<f64> {
 /// `wv` edited as its JSON document (`gmwm wv --json`: `null` for an undefined value) and read
 /// back by the engine's WV file reader: the public way to a wavelet variance computed elsewhere,
 /// used here to fabricate edge cases (an undefined level, exact values, more degrees of freedom).
-pub fn edited_wv(
+pub(super) fn edited_wv(
     wv: &gmwm::WaveletVariance,
     edit: impl FnOnce(&mut serde_json::Value),
 ) -> gmwm::WaveletVariance {

@@ -58,7 +58,7 @@ use nalgebra::DMatrix;
 /// # Errors
 /// [`ParamError`] named `y` when the lengths differ; as [`wavelet_variance`] (non-finite
 /// samples, a series too short for `levels`).
-pub fn wavelet_cross_covariance(
+pub(crate) fn wavelet_cross_covariance(
     x: &[f64],
     y: &[f64],
     levels: usize,

@@ -450,7 +450,7 @@ pub(crate) fn exact_covariance_of(
 /// [`InputError`] for a model without values or a bad rate; [`ParamError`] (as `InputError`)
 /// for a process the formulas do not cover (generic ARMA, a negative autoregressive
 /// coefficient) or more levels than the series holds.
-pub fn exact_wv_covariance(
+pub(crate) fn exact_wv_covariance(
     model: &Model,
     n: usize,
     freq_hz: f64,

@@ -2,20 +2,20 @@
 //! Allan and Hadamard variances, and their confidence intervals; beside them the power spectral
 //! density by Welch's method (`psd`), the same variance spread over frequency.
 
-pub mod allan;
-pub mod ci;
+pub(crate) mod allan;
+pub(crate) mod ci;
 pub(crate) mod cov;
-pub mod cross;
+pub(crate) mod cross;
 mod file;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
-pub mod implied_cov;
-pub mod pooled;
-pub mod psd;
-pub mod robust;
+pub(crate) mod implied_cov;
+pub(crate) mod pooled;
+pub(crate) mod psd;
+pub(crate) mod robust;
 pub(crate) mod simd;
 pub(crate) mod stream;
-pub mod wv;
+pub(crate) mod wv;
 
 pub use file::{allan_from_wv, is_wv_json, read_wv_json, select_series};
 pub use stream::{binary_columns_wv, binary_wavelet_variance, StreamedColumn};

@@ -41,7 +41,7 @@ use crate::variance::wv::WaveletVariance;
 ///
 /// Worked example: the test `tests::examples::example_pooled_pooledwv`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct PooledWv {
+pub(crate) struct PooledWv {
     /// The pooled WV: `n` the total length, `eta` and `n_coefficients` summed per level.
     pub(crate) wv: WaveletVariance,
     /// The recordings' own WVs, input order.
@@ -55,7 +55,7 @@ impl PooledWv {
     /// [`ParamError`] for no WV, WVs of rates differing by more than
     /// [`crate::imu::read::RATE_TOLERANCE`] or of different estimators (transform, filter,
     /// interval level, robustness), naming the recording (1-based).
-    pub fn new(parts: Vec<WaveletVariance>) -> Result<Self, ParamError> {
+    pub(crate) fn new(parts: Vec<WaveletVariance>) -> Result<Self, ParamError> {
         let Some(first) = parts.first() else {
             return Err(ParamError::new(
                 "wavelet variances",
@@ -137,12 +137,12 @@ impl PooledWv {
     }
 
     /// The pooled WV.
-    pub fn wv(&self) -> &WaveletVariance {
+    pub(crate) fn wv(&self) -> &WaveletVariance {
         &self.wv
     }
 
     /// The recordings' WVs, input order.
-    pub fn parts(&self) -> &[WaveletVariance] {
+    pub(crate) fn parts(&self) -> &[WaveletVariance] {
         &self.parts
     }
 
@@ -150,7 +150,7 @@ impl PooledWv {
     ///
     /// # Panics
     /// For `k` beyond the recordings.
-    pub fn weights(&self, k: usize) -> Vec<f64> {
+    pub(crate) fn weights(&self, k: usize) -> Vec<f64> {
         let p = &self.parts[k];
         (0..p.levels()).map(|j| p.eta[j] / self.wv.eta[j]).collect()
     }

@@ -254,7 +254,7 @@ const BINOM8_PACKAGE: [f64; 9] = [1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, 8.0
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_robust_a_of_c`.
-pub fn a_of_c(c: f64) -> f64 {
+pub(crate) fn a_of_c(c: f64) -> f64 {
     let mu = truncated_normal_moments(c);
     expand(&mu, 1, &BINOM4, c)
 }
@@ -278,7 +278,7 @@ fn m_and_q(c: f64, binom8: &[f64; 9]) -> (f64, f64) {
 ///
 /// `eff` is increasing in `c` from 0 at `c ~ 2.39498` (where `M` vanishes) to 1 as `c -> inf`;
 /// below that point the formula rises again (spurious branch with `M < 0`).
-pub fn efficiency(c: f64) -> f64 {
+pub(crate) fn efficiency(c: f64) -> f64 {
     let (m, q) = m_and_q(c, &BINOM8);
     m * m / (2.0 * q)
 }
@@ -319,7 +319,7 @@ const C_MAX: f64 = 100.0;
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_robust_tuning_constant`.
-pub fn tuning_constant(eff: f64, convention: RobustConvention) -> Result<f64, ParamError> {
+pub(crate) fn tuning_constant(eff: f64, convention: RobustConvention) -> Result<f64, ParamError> {
     check_eff(eff)?;
     match convention {
         RobustConvention::Exact => {
@@ -416,7 +416,11 @@ pub(crate) const FIXED_POINT_MAX_ITER: usize = 500;
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_robust_robust_scale`.
-pub fn robust_scale(y: &[f64], c: f64, convention: RobustConvention) -> Result<f64, InputError> {
+pub(crate) fn robust_scale(
+    y: &[f64],
+    c: f64,
+    convention: RobustConvention,
+) -> Result<f64, InputError> {
     check_c(c)?;
     if y.is_empty() {
         return Err(SeriesError::Empty.into());
@@ -981,7 +985,7 @@ fn mean_psi2_scaled(y: &[f64], sd: f64, s: f64, c: f64) -> f64 {
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_robust_robust_ci`.
-pub fn robust_ci(
+pub(crate) fn robust_ci(
     nu_r: f64,
     nu_c: f64,
     lo_c: f64,

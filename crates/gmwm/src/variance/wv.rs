@@ -734,7 +734,7 @@ impl HaarWvAccumulator {
     /// # Errors
     /// [`ParamError`] when `levels` is 0 or above [`MAX_LEVELS`].
     #[cfg(test)]
-    pub fn new(levels: usize) -> Result<Self, ParamError> {
+    pub(crate) fn new(levels: usize) -> Result<Self, ParamError> {
         if levels == 0 || levels > MAX_LEVELS {
             return Err(ParamError::new(
                 "levels",
@@ -997,7 +997,7 @@ impl HaarWvAccumulator {
     /// The samples run through the pyramid in blocks that start at multiples of 4096 samples in
     /// the series, so any chunking gives the same bits; a non-finite sample is reported by the
     /// push (or [`finish`](Self::finish)) that completes its block.
-    pub fn push(&mut self, chunk: &[f64]) -> Result<(), SeriesError> {
+    pub(crate) fn push(&mut self, chunk: &[f64]) -> Result<(), SeriesError> {
         let mut rest = chunk;
         if !self.pending.is_empty() {
             let take = (BLOCK - self.pending.len()).min(rest.len());
@@ -1068,7 +1068,11 @@ impl HaarWvAccumulator {
     /// # Errors
     /// [`SeriesError`] when nothing was pushed, the series is constant, or it is too short for
     /// the levels requested; [`ParamError`] for a bad `freq_hz` or `alpha`.
-    pub fn finish(mut self, freq_hz: f64, alpha: f64) -> Result<WaveletVariance, InputError> {
+    pub(crate) fn finish(
+        mut self,
+        freq_hz: f64,
+        alpha: f64,
+    ) -> Result<WaveletVariance, InputError> {
         check_alpha(alpha)?;
         check_freq(freq_hz)?;
         self.flush()?;

@@ -29,11 +29,11 @@ pub(crate) mod naive;
 #[cfg(test)]
 mod tests_oracle;
 
-pub use dwt::Dwt;
+pub(crate) use dwt::Dwt;
 #[cfg(test)]
 pub(crate) use filter::quadrature_mirror;
 pub use filter::WaveletFilter;
-pub use modwt::Modwt;
+pub(crate) use modwt::Modwt;
 
 /// Largest number of levels a [`Modwt`] or [`Dwt`] plan accepts (`2^60` samples would be
 /// needed; the bound keeps every `2^j` representable in a 64-bit `usize`).
@@ -106,7 +106,7 @@ pub(crate) fn pow2(j: usize) -> usize {
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_modwt_boundary`.
-pub fn modwt_boundary(filter_len: usize, j: usize) -> usize {
+pub(crate) fn modwt_boundary(filter_len: usize, j: usize) -> usize {
     (pow2(j) - 1).saturating_mul(filter_len.saturating_sub(1))
 }
 
@@ -117,7 +117,7 @@ pub fn modwt_boundary(filter_len: usize, j: usize) -> usize {
 ///
 /// # Examples
 /// Worked example: the test `tests::examples::example_dwt_boundary`.
-pub fn dwt_boundary(filter_len: usize, j: usize) -> usize {
+pub(crate) fn dwt_boundary(filter_len: usize, j: usize) -> usize {
     let m = filter_len.saturating_sub(2);
     m - m / pow2(j)
 }
@@ -125,7 +125,7 @@ pub fn dwt_boundary(filter_len: usize, j: usize) -> usize {
 /// Wavelet coefficients of every level of a MODWT or DWT, boundary coefficients included
 /// (docs/methods.md §1.2–§1.4).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct WaveletCoefficients {
+pub(crate) struct WaveletCoefficients {
     /// `w[j-1]` = all coefficients `W_{j,0..}` of level `j` (N of them for the MODWT,
     /// `N / 2^j` for the DWT), boundary ones included.
     pub w: Vec<Vec<f64>>,
@@ -140,7 +140,7 @@ impl WaveletCoefficients {
     ///
     /// # Panics
     /// If `j == 0` or `j > self.levels()` (a caller bug, not a data problem).
-    pub fn kept(&self, j: usize) -> &[f64] {
+    pub(crate) fn kept(&self, j: usize) -> &[f64] {
         assert!(
             j >= 1 && j <= self.levels(),
             "level {j} out of range 1..={}",
@@ -151,7 +151,7 @@ impl WaveletCoefficients {
     }
 
     /// Number of levels `J`.
-    pub fn levels(&self) -> usize {
+    pub(crate) fn levels(&self) -> usize {
         self.w.len()
     }
 }
@@ -169,7 +169,7 @@ pub(crate) struct WaveletScratch {
 
 impl WaveletScratch {
     /// Empty buffers; they grow on first use and are then reused.
-    pub fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self::default()
     }
 

@@ -15,7 +15,7 @@ use super::{
 /// # Examples
 /// Worked example: the test `tests::examples::example_modwt_modwt`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct Modwt {
+pub(crate) struct Modwt {
     filter: WaveletFilter,
     levels: usize,
 }
@@ -25,20 +25,20 @@ impl Modwt {
     ///
     /// # Errors
     /// [`ParamError`] named `levels` unless `1 <= levels <= 60`.
-    pub fn new(filter: WaveletFilter, levels: usize) -> Result<Self, ParamError> {
+    pub(crate) fn new(filter: WaveletFilter, levels: usize) -> Result<Self, ParamError> {
         check_levels(levels)?;
         Ok(Self { filter, levels })
     }
 
     /// The filter.
     #[cfg(test)]
-    pub fn filter(&self) -> WaveletFilter {
+    pub(crate) fn filter(&self) -> WaveletFilter {
         self.filter
     }
 
     /// The number of levels `J`.
     #[cfg(test)]
-    pub fn levels(&self) -> usize {
+    pub(crate) fn levels(&self) -> usize {
         self.levels
     }
 
@@ -80,7 +80,7 @@ impl Modwt {
     ///
     /// # Errors
     /// As `check_len`.
-    pub fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, InputError> {
+    pub(crate) fn transform(&self, x: &[f64]) -> Result<WaveletCoefficients, InputError> {
         let mut out = WaveletCoefficients::default();
         self.transform_with_scratch(x, &mut out, &mut WaveletScratch::new())?;
         Ok(out)

@@ -81,7 +81,7 @@ fn circular_filter(f: &[f64], x: &[f64], count: usize, end: impl Fn(usize) -> us
 ///
 /// # Panics
 /// If `x` is empty.
-pub fn modwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform {
+pub(crate) fn modwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform {
     assert!(!x.is_empty(), "the oracle needs a non-empty series");
     let n = x.len();
     let w = (1..=levels)
@@ -102,7 +102,7 @@ pub fn modwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform 
 ///
 /// # Panics
 /// If `x` is empty or `2^levels` does not divide its length.
-pub fn dwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform {
+pub(crate) fn dwt(filter: WaveletFilter, levels: usize, x: &[f64]) -> NaiveTransform {
     let n = x.len();
     assert!(
         n > 0 && n % (1usize << levels) == 0,

@@ -258,7 +258,7 @@ pub(crate) fn read_binary_table(
 ///
 /// Worked example: the test `tests::examples::example_read_binary_binarychunks`.
 #[derive(Debug)]
-pub struct BinaryChunks {
+pub(crate) struct BinaryChunks {
     path: PathBuf,
     reader: BufReader<File>,
     width: usize,
@@ -280,7 +280,7 @@ impl BinaryChunks {
     /// [`ReadError::InvalidOption`] for a text format, `ncols = 0` or `chunk_len = 0`;
     /// [`ReadError::ColumnOutOfRange`]; [`ReadError::Io`]; [`ReadError::Empty`];
     /// [`ReadError::BinarySize`] if the size is not a multiple of `width · ncols`.
-    pub fn open(
+    pub(crate) fn open(
         path: &Path,
         format: InputFormat,
         ncols: usize,
@@ -315,7 +315,7 @@ impl BinaryChunks {
     }
 
     /// Number of rows (samples per column) of the file.
-    pub fn rows(&self) -> u64 {
+    pub(crate) fn rows(&self) -> u64 {
         self.rows
     }
 
@@ -324,7 +324,7 @@ impl BinaryChunks {
     /// # Errors
     /// [`ReadError::Io`] (including a file truncated while reading) and
     /// [`ReadError::BinaryNonFinite`] with the 0-based sample index.
-    pub fn next_chunk(&mut self) -> Result<Option<&[f64]>, ReadError> {
+    pub(crate) fn next_chunk(&mut self) -> Result<Option<&[f64]>, ReadError> {
         let Some(n) = self.read_rows()? else {
             return Ok(None);
         };

@@ -7,10 +7,10 @@
 pub(crate) mod binary;
 pub(crate) mod positioned;
 mod ros_stream;
-pub mod stream;
+pub(crate) mod stream;
 pub(crate) mod text;
 
-pub use binary::{BinaryChunks, ImuRecordType};
+pub(crate) use binary::{BinaryChunks, ImuRecordType};
 
 #[cfg(test)]
 pub(crate) use binary::{for_each_chunk, read_imu_record_file};
@@ -173,7 +173,7 @@ impl InputFormat {
 
 /// What the first bytes of a file are (`sniff`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Content {
+pub(crate) enum Content {
     /// Plain text.
     Text,
     /// A gzip stream whose start decompresses to text.
