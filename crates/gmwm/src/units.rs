@@ -473,11 +473,11 @@ pub(crate) fn forms(
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct DatasheetUnit {
     /// The sensor whose signal the unit is built on.
-    pub kind: SignalKind,
+    pub(crate) kind: SignalKind,
     /// The noise term of the unit's dimension: noise density, bias instability or random walk.
-    pub term: NoiseTerm,
+    pub(crate) term: NoiseTerm,
     /// The factor to continuous SI: `value_si = value * to_si`.
-    pub to_si: f64,
+    pub(crate) to_si: f64,
 }
 
 /// Why a datasheet unit was not understood.

@@ -563,7 +563,7 @@ pub struct DatasheetLine {
     pub key: &'static str,
     term: NoiseTerm,
     /// The coefficient in the figure's unit (continuous time).
-    pub coefficient: f64,
+    pub(crate) coefficient: f64,
     /// The legend entry: `datasheet N = 2 deg/sqrt(h)`.
     pub label: String,
 }

@@ -36,7 +36,7 @@ pub struct FitVerdict {
     /// Number of scales.
     pub levels: usize,
     /// Scales neither inside the band nor within the tolerance.
-    pub scales_missed: usize,
+    pub(crate) scales_missed: usize,
     /// The missed scale furthest from the empirical WV, with its likely cause.
     pub worst: Option<ScaleMiss>,
     /// Every scale: the empirical and implied WV and how far apart they are.
@@ -66,7 +66,7 @@ pub struct ScaleFit {
     /// `implied / empirical - 1`.
     pub deviation: f64,
     /// Whether the implied WV is inside the empirical WV's band.
-    pub inside_band: bool,
+    pub(crate) inside_band: bool,
     /// Inside the band or within the tolerance.
     pub explained: bool,
 }
@@ -83,7 +83,7 @@ pub struct ScaleMiss {
     /// `implied / empirical - 1` there.
     pub deviation: f64,
     /// The component that dominates the implied WV there.
-    pub nearest_term: String,
+    pub(crate) nearest_term: String,
     /// The likely cause, a short name.
     pub cause: &'static str,
     /// What to try, one line.

@@ -35,11 +35,11 @@ pub(crate) fn active_components(implied: &ImpliedWv) -> Vec<bool> {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct SubModel {
     /// The active components, in model order, without values.
-    pub model: Model,
+    pub(crate) model: Model,
     /// Indices into the full theta of the sub-model's parameters.
-    pub keep: Vec<usize>,
+    pub(crate) keep: Vec<usize>,
     /// The fit's estimates of those parameters (a starting point for refits).
-    pub start: Vec<f64>,
+    pub(crate) start: Vec<f64>,
 }
 
 impl SubModel {

@@ -399,7 +399,7 @@ pub struct CanonicalModel {
     /// cannot tell from the fitted model's; fit it for identified estimates and intervals.
     pub reduced: Model,
     /// Separation of the reduced model's refit from the fitted WV.
-    pub separation: f64,
+    pub(crate) separation: f64,
     /// Objective of the reduced model's fit.
     pub objective: f64,
     /// Implied WV of the reduced model's fit (a component read as white noise by rule 3 keeps

@@ -72,13 +72,13 @@ impl Stack {
 #[derive(Debug, Clone)]
 pub(crate) struct Eval {
     /// theta(u).
-    pub theta: Vec<f64>,
+    pub(crate) theta: Vec<f64>,
     /// d theta / d u, row-major p x p.
     pub(crate) dtheta: Vec<f64>,
     /// Whitened residuals, J.
-    pub r: Vec<f64>,
+    pub(crate) r: Vec<f64>,
     /// d r / d u, row-major J x p.
-    pub jac: Vec<f64>,
+    pub(crate) jac: Vec<f64>,
     /// Implied WV nu2(theta), J.
     pub(crate) nu: Vec<f64>,
 }

@@ -42,17 +42,17 @@ pub struct ParameterEstimate {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub(crate) struct Ar1GmForms {
     /// Process as written in the model (`AR1` or `GM`).
-    pub process: String,
+    pub(crate) process: String,
     /// 0-based position of the component in the model.
-    pub index: usize,
+    pub(crate) index: usize,
     /// Per-sample autoregressive coefficient.
-    pub phi: f64,
+    pub(crate) phi: f64,
     /// Per-sample innovation variance.
-    pub sigma2: f64,
+    pub(crate) sigma2: f64,
     /// Inverse correlation time, 1/s.
-    pub beta: f64,
+    pub(crate) beta: f64,
     /// Stationary variance (data unit squared).
-    pub sigma2_gm: f64,
+    pub(crate) sigma2_gm: f64,
     /// Correlation time `1 / beta`, seconds.
     pub(crate) correlation_time_s: f64,
 }

@@ -159,9 +159,9 @@ fn draw_into(
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct StartOptions {
     /// RNG seed (the package's default is 1337).
-    pub seed: u64,
+    pub(crate) seed: u64,
     /// Number of draws G; `None` for [`default_draws`].
-    pub draws: Option<usize>,
+    pub(crate) draws: Option<usize>,
 }
 
 impl Default for StartOptions {
@@ -186,11 +186,11 @@ pub(crate) fn default_draws(n: usize) -> usize {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub(crate) struct StartValues {
     /// The best draw, model order, original parametrisation (GM as `beta`, `sigma2_gm`).
-    pub theta: Vec<f64>,
+    pub(crate) theta: Vec<f64>,
     /// Its flattening objective `F`.
     pub(crate) flattening: f64,
     /// Draws made (fewer than G after an early stop).
-    pub draws: usize,
+    pub(crate) draws: usize,
     /// The dominance found (§6.2).
     pub(crate) dominance: Dominance,
 }

@@ -70,11 +70,11 @@ pub(crate) fn z_value(alpha: f64, convention: ZConvention) -> Result<f64, ParamE
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Sandwich {
     /// `Psi = H V H'` (p x p).
-    pub psi: DMatrix<f64>,
+    pub(crate) psi: DMatrix<f64>,
     /// `H = (A' Omega A)^+ A' Omega` (p x J).
-    pub h: DMatrix<f64>,
+    pub(crate) h: DMatrix<f64>,
     /// Numerical rank of `A' Omega A` (p when the model is locally identified).
-    pub rank: usize,
+    pub(crate) rank: usize,
 }
 
 /// Relative singular-value cut-off of the pseudo-inverse: singular values of the

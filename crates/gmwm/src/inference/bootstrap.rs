@@ -27,17 +27,17 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub(crate) struct FitBootstrap {
     /// Number of replicates B.
-    pub replicates: usize,
+    pub(crate) replicates: usize,
     /// The estimate the replicates were simulated from (model order).
-    pub theta_hat: Vec<f64>,
+    pub(crate) theta_hat: Vec<f64>,
     /// Replicate estimates `theta*_b` (refit from `theta_hat`, stage 2 only), B x p.
-    pub estimates: Vec<Vec<f64>>,
+    pub(crate) estimates: Vec<Vec<f64>>,
     /// Mean of the replicate estimates.
-    pub mean: Vec<f64>,
+    pub(crate) mean: Vec<f64>,
     /// Standard deviation of the replicate estimates (divisor B - 1).
-    pub sd: Vec<f64>,
+    pub(crate) sd: Vec<f64>,
     /// `V = Cov(nu2_hat*)` (J x J, divisor B - 1).
-    pub v: DMatrix<f64>,
+    pub(crate) v: DMatrix<f64>,
     /// `C = Cov(nu2_hat*, nu2(theta*))` (J x J, divisor B - 1; row index the empirical WV
     /// level, column the implied one), the input of the WIC bootstrap optimism `2 tr(C Omega)`
     /// (docs/methods.md §8.3).
@@ -73,11 +73,11 @@ pub(crate) fn replicate_weighting(gmwm: &Gmwm) -> Weighting {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub(crate) struct FitBootstrapOptions {
     /// Replicates B (at least 2).
-    pub replicates: usize,
+    pub(crate) replicates: usize,
     /// Master seed of the replicates.
-    pub seed: u64,
+    pub(crate) seed: u64,
     /// `Some(G)`: also fit each replicate from a fresh search with G draws (bootstrap GoF).
-    pub gof_draws: Option<usize>,
+    pub(crate) gof_draws: Option<usize>,
 }
 
 /// docs/methods.md §7.4 `all_bootstrapper(B)`: simulates `replicates` series of length `n` from the

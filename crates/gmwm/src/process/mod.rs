@@ -377,11 +377,11 @@ pub(crate) fn jets_hessian<const N: usize>(jets: &[Jet<N>]) -> Vec<Vec<Vec<f64>>
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Jet<const N: usize> {
     /// Value.
-    pub v: f64,
+    pub(crate) v: f64,
     /// Gradient.
-    pub g: [f64; N],
+    pub(crate) g: [f64; N],
     /// Hessian.
-    pub h: [[f64; N]; N],
+    pub(crate) h: [[f64; N]; N],
 }
 
 impl<const N: usize> Jet<N> {

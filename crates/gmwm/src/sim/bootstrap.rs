@@ -79,9 +79,9 @@ where
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub(crate) struct WvBootstrap {
     /// Number of replicates H.
-    pub replicates: usize,
+    pub(crate) replicates: usize,
     /// Replicate mean of the WV, per level.
-    pub mean: Vec<f64>,
+    pub(crate) mean: Vec<f64>,
     /// Full J x J covariance of the replicate WV vectors (divisor H - 1).
     pub(crate) cov: DMatrix<f64>,
 }

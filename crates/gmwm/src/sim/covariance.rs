@@ -53,9 +53,9 @@ impl CovarianceMethod {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct WvCovariance {
     /// `J x J`.
-    pub v: DMatrix<f64>,
+    pub(crate) v: DMatrix<f64>,
     /// Replicates behind a bootstrap `V`; `None` for the exact one.
-    pub replicates: Option<usize>,
+    pub(crate) replicates: Option<usize>,
 }
 
 impl WvCovariance {}

@@ -222,11 +222,11 @@ pub(crate) const MAX_FILTER_LEN: usize = 24;
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Taps {
     /// `scale * h_l`, zero beyond `len`.
-    pub h: [f64; MAX_FILTER_LEN],
+    pub(crate) h: [f64; MAX_FILTER_LEN],
     /// `scale * g_l`, zero beyond `len`.
-    pub g: [f64; MAX_FILTER_LEN],
+    pub(crate) g: [f64; MAX_FILTER_LEN],
     /// Filter length `L`.
-    pub len: usize,
+    pub(crate) len: usize,
 }
 
 impl Taps {

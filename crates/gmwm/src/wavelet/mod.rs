@@ -128,10 +128,10 @@ pub(crate) fn dwt_boundary(filter_len: usize, j: usize) -> usize {
 pub(crate) struct WaveletCoefficients {
     /// `w[j-1]` = all coefficients `W_{j,0..}` of level `j` (N of them for the MODWT,
     /// `N / 2^j` for the DWT), boundary ones included.
-    pub w: Vec<Vec<f64>>,
+    pub(crate) w: Vec<Vec<f64>>,
     /// `boundary[j-1]` = number of leading level-`j` coefficients touched by the periodic
     /// boundary, to drop before estimation (docs/methods.md §1.3, §1.4).
-    pub boundary: Vec<usize>,
+    pub(crate) boundary: Vec<usize>,
 }
 
 impl WaveletCoefficients {

@@ -14,7 +14,7 @@ use super::{quadrature_mirror, WaveletFilter};
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct EquivalentFilters {
     /// Equivalent wavelet filter, width `L_j = (2^j - 1)(L - 1) + 1`.
-    pub wavelet: Vec<f64>,
+    pub(crate) wavelet: Vec<f64>,
     /// Equivalent scaling filter, width `L_j`.
     pub(crate) scaling: Vec<f64>,
 }
@@ -24,7 +24,7 @@ pub(crate) struct EquivalentFilters {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct NaiveTransform {
     /// `w[j-1]` = level-j wavelet coefficients (no boundary removal).
-    pub w: Vec<Vec<f64>>,
+    pub(crate) w: Vec<Vec<f64>>,
     /// Scaling coefficients `V_J`.
     pub(crate) scaling: Vec<f64>,
 }

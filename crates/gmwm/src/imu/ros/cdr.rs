@@ -14,11 +14,11 @@ pub(crate) struct ImuFields<'a> {
     /// `header.stamp` in ns since the epoch.
     pub(crate) stamp_ns: i64,
     /// `header.frame_id` bytes (without a terminating NUL).
-    pub frame_id: &'a [u8],
+    pub(crate) frame_id: &'a [u8],
     /// rad/s.
-    pub angular_velocity: [f64; 3],
+    pub(crate) angular_velocity: [f64; 3],
     /// m/s^2.
-    pub linear_acceleration: [f64; 3],
+    pub(crate) linear_acceleration: [f64; 3],
 }
 
 /// Byte offsets, relative to the first float64 (orientation.x), of the fields after the header,

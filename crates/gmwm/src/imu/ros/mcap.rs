@@ -21,13 +21,13 @@ use std::path::Path;
 /// One channel (topic + schema + encoding) of an MCAP file.
 #[derive(Debug, Clone)]
 pub(crate) struct Channel {
-    pub id: u16,
-    pub topic: String,
+    pub(crate) id: u16,
+    pub(crate) topic: String,
     /// Schema name, e.g. `sensor_msgs/msg/Imu` (empty for a schemaless channel).
-    pub message_type: String,
+    pub(crate) message_type: String,
     /// Message encoding, e.g. `cdr` or `ros1`.
-    pub encoding: String,
-    pub messages: u64,
+    pub(crate) encoding: String,
+    pub(crate) messages: u64,
 }
 
 /// The channels of a file, and its summary when it has one.

@@ -30,10 +30,10 @@ const OP_CONNECTION: u8 = 0x07;
 /// One connection (publisher of a topic) of a bag.
 #[derive(Debug, Clone)]
 pub(crate) struct Connection {
-    pub id: u32,
-    pub topic: String,
-    pub message_type: String,
-    pub messages: u64,
+    pub(crate) id: u32,
+    pub(crate) topic: String,
+    pub(crate) message_type: String,
+    pub(crate) messages: u64,
 }
 
 /// The bag's connections and which chunks (file positions) hold which connections.

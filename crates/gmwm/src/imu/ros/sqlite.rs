@@ -16,12 +16,12 @@ use std::path::Path;
 /// One row of `topics`, with its message count.
 #[derive(Debug, Clone)]
 pub(crate) struct Topic {
-    pub id: i64,
-    pub name: String,
-    pub message_type: String,
+    pub(crate) id: i64,
+    pub(crate) name: String,
+    pub(crate) message_type: String,
     /// `serialization_format`, `cdr` for ROS 2.
-    pub encoding: String,
-    pub messages: u64,
+    pub(crate) encoding: String,
+    pub(crate) messages: u64,
 }
 
 fn sql_error(path: &Path, e: rusqlite::Error) -> RosError {
