@@ -89,8 +89,8 @@ pub use sim::{simulate_model, DemoSensor, Simulator};
 pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
 pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{
-    Convergence, FitError, FitRecording, Gmwm, GmwmFit, NavParameter, ParameterEstimate, PooledFit,
-    PooledRecording, StartInputs, StopReason, Weighting, Weights,
+    Convergence, FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter,
+    ParameterEstimate, PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
 };
 pub use inference::same_model::{
     compare_wvs, same_model_test_of, SameModelOptions, SameModelTest, ScaleContribution,

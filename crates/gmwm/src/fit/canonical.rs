@@ -951,6 +951,7 @@ impl GmwmFit {
         if next.is_empty() {
             return Ok(None);
         }
+        let objective = fit.objective;
         let implied = if next.len() == fit.model.n_components() {
             fit.implied_wv
         } else {
@@ -959,7 +960,7 @@ impl GmwmFit {
         Ok(Some(State {
             parts: next,
             implied,
-            objective: fit.objective,
+            objective,
         }))
     }
 }

@@ -3,10 +3,11 @@
 //! a fit's WV (`update`, §5.9); the fit with generated starting values (§6) is in
 //! [`super::auto`].
 
+use super::estimates::FitEstimates;
 use super::revive::{revival_start, MAX_REVIVALS};
 use super::{
-    minimize, Convergence, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StartInputs,
-    StartOptions, TransformPreset, Weighting, Weights,
+    minimize, FitError, LmOptions, Objective, Parametrisation, PhiOrder, StartInputs, StartOptions,
+    TransformPreset, Weighting, Weights,
 };
 use crate::error::ParamError;
 use crate::model::{ImpliedWv, Model};
@@ -354,16 +355,18 @@ impl Gmwm {
             empirical: None,
             inputs: None,
             collapsed: Vec::new(),
-            model: fitted,
-            theta,
-            param_names,
+            estimates: FitEstimates {
+                model: fitted,
+                theta,
+                param_names,
+                objective: min.objective,
+                convergence: min.convergence,
+                freq_hz,
+            },
             start,
-            objective: min.objective,
-            convergence: min.convergence,
             nu_hat: nu_hat.to_vec(),
             implied_wv,
             weights,
-            freq_hz,
             preset: self.preset,
             phi_order: self.phi_order,
         };
@@ -386,28 +389,19 @@ impl Gmwm {
 /// `empirical` (the WV with its CI), `inputs` (`n`, `range`), `freq_hz`, `preset`,
 /// `phi_order`. [`GmwmFit::parameters`] and [`GmwmFit::navigation`] give the per-parameter
 /// and physical-unit views.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct GmwmFit {
-    /// The model with the estimates.
-    pub(crate) model: Model,
-    /// Estimates in model order (original parametrisation).
-    pub(crate) theta: Vec<f64>,
-    /// Labels of `theta`, `KIND[component].name`.
-    pub(crate) param_names: Vec<String>,
+    /// The model with the estimates, `theta`, their labels, `Q(theta_hat)` (docs/methods.md
+    /// §5.1), how the optimiser ended and the sampling rate: what every fit reports.
+    pub(crate) estimates: FitEstimates,
     /// The starting values used (after the §5.6 ordering).
     pub(crate) start: Vec<f64>,
-    /// `Q(theta_hat)` (docs/methods.md §5.1).
-    pub(crate) objective: f64,
-    /// How the optimiser ended.
-    pub(crate) convergence: Convergence,
     /// The empirical WV fitted.
     pub(crate) nu_hat: Vec<f64>,
     /// Implied WV at the estimates, per component too (§5.5 step 11).
     pub(crate) implied_wv: ImpliedWv,
     /// The weights (V and Omega diagonals).
     pub(crate) weights: Weights,
-    /// Sampling rate in Hz.
-    pub(crate) freq_hz: f64,
     /// Transform preset used.
     pub(crate) preset: TransformPreset,
     /// AR1/GM parametrisation used.
@@ -419,48 +413,66 @@ pub struct GmwmFit {
     pub(crate) org_v: Option<Vec<f64>>,
     /// Replicates H of the bootstrap weighting, when used.
     pub(crate) bootstrap_replicates: Option<usize>,
-    /// The empirical WV fitted, with its CI (`None` only for a bare [`Gmwm::fit_weighted`]).
+    /// The empirical WV fitted, with its CI (`None` only for a bare `Gmwm::fit_weighted`).
     pub(crate) empirical: Option<WaveletVariance>,
     /// Series length and range behind the starting values (docs/methods.md §6.1), kept for
     /// `update`.
     pub(crate) inputs: Option<StartInputs>,
     /// Labels of the parameters of the components fitted to nothing (implied WV below
-    /// [`super::NEGLIGIBLE_WV_SHARE`] of the model's at every level,
+    /// `super::NEGLIGIBLE_WV_SHARE` of the model's at every level,
     /// [`GmwmFit::active_parameters`]): the fit is a boundary point and a smaller model fits as
     /// well. Inference reports these parameters without a standard error.
     pub(crate) collapsed: Vec<String>,
 }
 
+/// The estimates every fit reports ([`FitEstimates`]), read through the fit: `fit.theta()`.
+impl std::ops::Deref for GmwmFit {
+    type Target = FitEstimates;
+    fn deref(&self) -> &FitEstimates {
+        &self.estimates
+    }
+}
+
+impl std::ops::DerefMut for GmwmFit {
+    fn deref_mut(&mut self) -> &mut FitEstimates {
+        &mut self.estimates
+    }
+}
+
+/// The wire format of the type's doc, field by field in that order (the estimates are not one
+/// block there: `start` comes before `objective`, `freq_hz` after `weights`).
+impl Serialize for GmwmFit {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let e = &self.estimates;
+        let mut st = serializer.serialize_struct("GmwmFit", 18)?;
+        st.serialize_field("model", &e.model)?;
+        st.serialize_field("theta", &e.theta)?;
+        st.serialize_field("param_names", &e.param_names)?;
+        st.serialize_field("start", &self.start)?;
+        st.serialize_field("objective", &e.objective)?;
+        st.serialize_field("convergence", &e.convergence)?;
+        st.serialize_field("nu_hat", &self.nu_hat)?;
+        st.serialize_field("implied_wv", &self.implied_wv)?;
+        st.serialize_field("weights", &self.weights)?;
+        st.serialize_field("freq_hz", &e.freq_hz)?;
+        st.serialize_field("preset", &self.preset)?;
+        st.serialize_field("phi_order", &self.phi_order)?;
+        st.serialize_field("weighting", &self.weighting)?;
+        st.serialize_field("org_v", &self.org_v)?;
+        st.serialize_field("bootstrap_replicates", &self.bootstrap_replicates)?;
+        st.serialize_field("empirical", &self.empirical)?;
+        st.serialize_field("inputs", &self.inputs)?;
+        st.serialize_field("collapsed", &self.collapsed)?;
+        st.end()
+    }
+}
+
 /// Read access to the results; the fields are the engine's own.
 impl GmwmFit {
-    /// The model with the estimates.
-    pub fn model(&self) -> &Model {
-        &self.model
-    }
-
-    /// Estimates in model order (original parametrisation).
-    pub fn theta(&self) -> &[f64] {
-        &self.theta
-    }
-
-    /// Labels of `theta`, `KIND[component].name`.
-    pub fn param_names(&self) -> &[String] {
-        &self.param_names
-    }
-
     /// The starting values used (after the §5.6 ordering).
     pub fn start(&self) -> &[f64] {
         &self.start
-    }
-
-    /// `Q(theta_hat)` (docs/methods.md §5.1).
-    pub fn objective(&self) -> f64 {
-        self.objective
-    }
-
-    /// How the optimiser ended.
-    pub fn convergence(&self) -> Convergence {
-        self.convergence
     }
 
     /// The empirical WV fitted.
@@ -476,11 +488,6 @@ impl GmwmFit {
     /// The weights (V and Omega diagonals).
     pub fn weights(&self) -> &Weights {
         &self.weights
-    }
-
-    /// Sampling rate in Hz.
-    pub fn freq_hz(&self) -> f64 {
-        self.freq_hz
     }
 
     /// Which weighting produced `weights` (docs/methods.md §5.2).

@@ -12,6 +12,7 @@
 pub(crate) mod active;
 pub(crate) mod auto;
 pub(crate) mod canonical;
+mod estimates;
 pub(crate) mod gmwm;
 pub(crate) mod objective;
 pub(crate) mod optimize;
@@ -27,6 +28,7 @@ mod tests_groundwork;
 
 pub(crate) use canonical::Reading;
 pub(crate) use canonical::{CanonicalModel, CanonicalTerm, SEPARATION_LIMIT};
+pub use estimates::FitEstimates;
 pub use gmwm::{Gmwm, GmwmFit};
 pub(crate) use objective::Objective;
 pub(crate) use optimize::minimize;

@@ -54,6 +54,7 @@
 //! from the pooled estimate, recomputes their WVs and fast weights and refits the pooled
 //! objective from the estimate.
 
+use super::estimates::FitEstimates;
 use super::weights::FullWeights;
 use super::{
     minimize, FitError, Gmwm, Objective, Parametrisation, StartInputs, Weighting, Weights,
@@ -254,12 +255,9 @@ pub(crate) fn best_of(
 /// and `objective`)).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PooledFit {
-    pub(crate) model: Model,
-    pub(crate) theta: Vec<f64>,
-    pub(crate) param_names: Vec<String>,
-    pub(crate) objective: f64,
-    pub(crate) convergence: super::Convergence,
-    pub(crate) freq_hz: f64,
+    /// The pooled estimates; `objective` is `Q_pool`, `freq_hz` the first recording's.
+    #[serde(flatten)]
+    pub(crate) estimates: FitEstimates,
     pub(crate) recordings: Vec<PooledRecording>,
     #[serde(skip)]
     pub(crate) inputs: Vec<FitRecording>,
@@ -286,37 +284,15 @@ pub struct PooledRecording {
     pub separate_objective: f64,
 }
 
+/// The pooled estimates ([`FitEstimates`]), read through the fit: `fit.theta()`.
+impl std::ops::Deref for PooledFit {
+    type Target = FitEstimates;
+    fn deref(&self) -> &FitEstimates {
+        &self.estimates
+    }
+}
+
 impl PooledFit {
-    /// The model with the pooled estimates.
-    pub fn model(&self) -> &Model {
-        &self.model
-    }
-
-    /// Pooled estimates, model order (original parametrisation).
-    pub fn theta(&self) -> &[f64] {
-        &self.theta
-    }
-
-    /// Labels of `theta`.
-    pub fn param_names(&self) -> &[String] {
-        &self.param_names
-    }
-
-    /// `Q_pool(theta_hat) = sum_k Q_k(theta_hat)`.
-    pub fn objective(&self) -> f64 {
-        self.objective
-    }
-
-    /// How the optimiser ended.
-    pub fn convergence(&self) -> super::Convergence {
-        self.convergence
-    }
-
-    /// Sampling rate in Hz (the first recording's).
-    pub fn freq_hz(&self) -> f64 {
-        self.freq_hz
-    }
-
     /// Per-recording parts, input order.
     pub fn recordings(&self) -> &[PooledRecording] {
         &self.recordings
@@ -455,12 +431,14 @@ impl Gmwm {
             })
             .collect();
         Ok(PooledFit {
-            model,
-            theta,
-            param_names,
-            objective: q,
-            convergence,
-            freq_hz,
+            estimates: FitEstimates {
+                model,
+                theta,
+                param_names,
+                objective: q,
+                convergence,
+                freq_hz,
+            },
             recordings: parts,
             inputs: recordings,
             reweighted,

@@ -168,7 +168,7 @@ pub(crate) fn fit_bootstrap(
                 converged: refit.convergence.converged,
                 theta: match &sub {
                     Some(s) => s.expand(&refit.theta, &fit.theta),
-                    None => refit.theta,
+                    None => refit.estimates.theta,
                 },
                 nu_hat: wv.wv.clone(),
                 implied: refit.implied_wv.wv,

@@ -151,7 +151,7 @@ impl PooledFit {
                 let recs =
                     simulate_recordings(&self.model, &self.inputs, replicate_seed(seed, b as u64))?;
                 let fit = gmwm.fit_pooled_from(&recs, None, std::slice::from_ref(&self.theta))?;
-                Ok(fit.theta)
+                Ok(fit.estimates.theta)
             })
             .collect()
     }
