@@ -5,9 +5,9 @@
 
 use gmwm::{
     allan_variance, infer_with_progress, read_table, wavelet_variance, Adjustment, AllanKind,
-    AllanOptions, AvConvention, AxisPolicy, Calibration, CalibrationOptions, ColumnSelector,
-    CovarianceMethod, Gmwm, HeaderMode, Imu, InferenceOptions, InputFormat, Model, Named,
-    OptimismConvention, OptimismMethod, Progress, ReadOptions, Recording, RecordingOptions,
+    AllanOptions, AvConvention, AxisPolicy, Calibration, CalibrationOptions, CalibrationSource,
+    ColumnSelector, CovarianceMethod, Gmwm, HeaderMode, Imu, InferenceOptions, InputFormat, Model,
+    Named, OptimismConvention, OptimismMethod, Progress, ReadOptions, Recording, RecordingOptions,
     RobustConvention, RobustOptions, SelectionRule, SensorInfo, TimeUnit, Transform, WaveletFilter,
     Weighting, Wic, WvOptions,
 };
@@ -748,18 +748,21 @@ fn calibrate(
             .flat_map(|(l, r)| r.notes.iter().map(move |n| format!("{l}: {n}")))
             .collect();
         let rostopic = rostopic.or_else(|| recordings.first().and_then(|r| r.topic.clone()));
-        let doc = py.detach(|| -> Result<String, gmwm::CalibError> {
-            let named: Vec<(&str, &Imu)> = labels
+        let file = recordings
+            .first()
+            .map(|r| r.path.clone())
+            .unwrap_or_default();
+        let pooled = CalibrationSource::Pooled(
+            labels
                 .iter()
-                .zip(&recordings)
-                .map(|(l, r)| (l.as_str(), &r.imu))
-                .collect();
-            let report = Calibration::new(options).run_pooled_with_progress(&named, &reporter)?;
+                .cloned()
+                .zip(recordings)
+                .map(|(l, r)| (l, r.imu))
+                .collect(),
+        );
+        let doc = py.detach(|| -> Result<String, gmwm::CalibError> {
+            let report = Calibration::new(options).run_source(&pooled, &reporter)?;
             let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
-            let file = recordings
-                .first()
-                .map(|r| r.path.clone())
-                .unwrap_or_default();
             Ok(json(&gmwm::document::calibration(
                 &file, &notes, None, &report, &sets,
             )))
@@ -781,7 +784,8 @@ fn calibrate(
             let name = wv_path
                 .file_name()
                 .map(|f| f.to_string_lossy().into_owned());
-            let report = Calibration::new(options).run_wv(name.as_deref(), &series, &reporter)?;
+            let source = CalibrationSource::SavedWv { name, series };
+            let report = Calibration::new(options).run_source(&source, &reporter)?;
             let sets = report.nav_sets(policy, adjustment, rostopic.as_deref());
             Ok(json(&gmwm::document::calibration(
                 wv_path,

@@ -197,6 +197,10 @@ fn calibrate_one(
         CalibrationSource::Memory(r) => crate::input::memory_recording(r),
         CalibrationSource::Spooled(t) => crate::input::streamed_table_recording(t),
         CalibrationSource::Raw { .. } => crate::input::streamed_recording(&config.input)?,
+        // `open` reads one recording; several, or saved WVs, are sources the caller builds
+        CalibrationSource::Pooled(_) | CalibrationSource::SavedWv { .. } => {
+            anyhow::bail!("{}: not one recording", config.input.file.display())
+        }
     };
     if !exports.is_empty() {
         check_units_known(config, &recording)?;
@@ -241,7 +245,7 @@ fn calibrate_saved_wv(
     }
     let per_axis = calibration.candidates_per_axis()?;
     let progress = mode.style.bar(
-        (series.len() * per_axis) as u64,
+        (recording.columns.len() * per_axis) as u64,
         "calibrating",
         "candidate fits",
     );
@@ -250,7 +254,10 @@ fn calibrate_saved_wv(
         .file_name()
         .map(|f| f.to_string_lossy().into_owned());
     let report = calibration
-        .run_wv(name.as_deref(), &series, &Ticks(&progress))
+        .run_source(
+            &CalibrationSource::SavedWv { name, series },
+            &Ticks(&progress),
+        )
         .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();
     Ok((recording, report))
@@ -296,18 +303,21 @@ fn calibrate_pooled(
         .iter()
         .map(|r| crate::spool::shown(&r.path.display().to_string()))
         .collect();
-    let named: Vec<(&str, &gmwm::Imu)> = names
-        .iter()
-        .zip(&loaded)
-        .filter_map(|(n, r)| Some((n.as_str(), r.imu.as_ref()?)))
-        .collect();
+    // the recordings move into the source; what stays behind is each one's path and notes
+    let pooled = CalibrationSource::Pooled(
+        names
+            .iter()
+            .zip(&mut loaded)
+            .filter_map(|(n, r)| Some((n.clone(), r.imu.take()?)))
+            .collect(),
+    );
     let per_axis = calibration.candidates_per_axis()?;
     let axes = loaded[0].columns.len();
     let progress = mode
         .style
         .bar((axes * per_axis) as u64, "calibrating", "candidate fits");
     let report = calibration
-        .run_pooled_with_progress(&named, &Ticks(&progress))
+        .run_source(&pooled, &Ticks(&progress))
         .map_err(gmwm::Error::from)?;
     progress.finish_and_clear();
     // each recording's notes, named by it

@@ -332,7 +332,7 @@ pub struct CalibrationReport {
     pub axes: Vec<AxisCalibration>,
     /// Checks on the recording as a whole that a user should read, one line each.
     pub checks: Vec<String>,
-    /// The recordings of a pooled calibration ([`Calibration::run_pooled`]), input order;
+    /// The recordings of a pooled calibration (`CalibrationSource::Pooled`), input order;
     /// empty (and left out of the JSON) for one recording.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub recordings: Vec<super::pooled::PooledInput>,

@@ -22,7 +22,7 @@ use super::{CalibError, Calibration, CalibrationReport};
 use crate::error::ParamError;
 use crate::imu::{Imu, Sensor, SensorInfo};
 use crate::inference::same_model::{compare_wvs, WvComparison};
-use crate::inference::{NoProgress, Progress};
+use crate::inference::Progress;
 use crate::units::{SignalKind, SignalUnit};
 use crate::variance::pooled::PooledWv;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
@@ -44,34 +44,15 @@ pub struct PooledInput {
 
 impl Calibration {
     /// Calibrates one model for the sensor of all `recordings` (named, module doc): the
-    /// report of [`Calibration::run`] on their pooled WVs, its `recordings` listing them.
-    ///
-    /// ```no_run
-    /// use gmwm::{Calibration, CalibrationOptions};
-    /// use gmwm::{read_table, Imu, ReadOptions};
-    /// let imus = ["imu1.csv.gz", "imu2.csv.gz"]
-    ///     .iter()
-    ///     .map(|f| Imu::from_table(read_table(f.as_ref(), &ReadOptions::default())?))
-    ///     .collect::<Result<Vec<_>, _>>()?;
-    /// let named = [("imu1.csv.gz", &imus[0]), ("imu2.csv.gz", &imus[1])];
-    /// let report = Calibration::new(CalibrationOptions::default()).run_pooled(&named)?;
-    /// assert_eq!(report.recordings.len(), 2);
-    /// # Ok::<(), Box<dyn std::error::Error>>(())
-    /// ```
+    /// report of [`Calibration::run`] on their pooled WVs, its `recordings` listing them; each
+    /// scored candidate is reported to `progress`. Reached through
+    /// [`CalibrationSource::Pooled`](crate::calib::CalibrationSource::Pooled).
     ///
     /// # Errors
     /// [`CalibError::Pool`] naming the recording: fewer than two, a rate more than 1% from
     /// the first's, an inertial axis of the first that it lacks, a unit known in one recording
     /// and not in another, a WV that cannot be computed; the errors of [`Calibration::run`].
-    pub fn run_pooled(&self, recordings: &[(&str, &Imu)]) -> Result<CalibrationReport, CalibError> {
-        self.run_pooled_with_progress(recordings, &NoProgress)
-    }
-
-    /// [`Calibration::run_pooled`] reporting each scored candidate to `progress`.
-    ///
-    /// # Errors
-    /// As [`Calibration::run_pooled`].
-    pub fn run_pooled_with_progress(
+    pub(crate) fn run_pooled(
         &self,
         recordings: &[(&str, &Imu)],
         progress: &dyn Progress,

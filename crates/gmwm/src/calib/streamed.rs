@@ -39,7 +39,7 @@ use crate::calib::CalibError as Error;
 use crate::error::ParamError;
 use crate::imu::read::stream::{streamed_size, streams_from, StreamedTable};
 use crate::imu::{
-    binary_layout, find_sidecar, BinaryChunks, BinaryLayout, Probe, ReadError, ReadOptions,
+    binary_layout, find_sidecar, BinaryChunks, BinaryLayout, Imu, Probe, ReadError, ReadOptions,
     Recording, RecordingOptions, SensorInfo,
 };
 use crate::inference::Progress;
@@ -338,7 +338,7 @@ impl Calibration {
     /// samples); naming the series when one is not a classical Haar MODWT WV (the pipeline fits
     /// those), when its intervals are at another level than the options' `alpha`, or when the
     /// series differ in rate or length (one recording's axes); the pipeline's errors.
-    pub fn run_wv(
+    pub(crate) fn run_wv(
         &self,
         name: Option<&str>,
         series: &[(String, WaveletVariance)],
@@ -418,7 +418,7 @@ impl Calibration {
     }
 }
 
-/// The columns of saved wavelet variances ([`Calibration::run_wv`]) and what each measures, by
+/// The columns of saved wavelet variances (`Calibration::run_wv`) and what each measures, by
 /// its name (`gyro_x`, `accel_z`, ...; units from the calibration's flags).
 pub fn wv_columns(series: &[(String, WaveletVariance)]) -> Vec<(String, SensorInfo)> {
     series
@@ -427,7 +427,7 @@ pub fn wv_columns(series: &[(String, WaveletVariance)]) -> Vec<(String, SensorIn
         .collect()
 }
 
-/// The account of saved wavelet variances ([`Calibration::run_wv`]) as a recording's, counted
+/// The account of saved wavelet variances (`Calibration::run_wv`) as a recording's, counted
 /// in samples (the series' `n`, which the WV was computed from; no row of a file is read), and
 /// the note that says so.
 pub fn wv_account(series: &[(String, WaveletVariance)]) -> (crate::imu::SampleAccount, String) {
@@ -458,6 +458,17 @@ pub enum CalibrationSource {
         probe: Probe,
         /// How it is read.
         read: ReadOptions,
+    },
+    /// Several recordings of one sensor, each named, calibrated as one sensor
+    /// (docs/methods.md §5.12, `Calibration::run_pooled`).
+    Pooled(Vec<(String, Imu)>),
+    /// Wavelet variances saved by `gmwm wv --json`, by series name, calibrated as a streamed
+    /// recording's (`Calibration::run_wv`); `name` is the file's.
+    SavedWv {
+        /// The file's name, for the report.
+        name: Option<String>,
+        /// The series, by name (`gyro_x`, ...).
+        series: Vec<(String, WaveletVariance)>,
     },
 }
 
@@ -499,10 +510,26 @@ impl Calibration {
         })
     }
 
-    /// Calibrates a recording opened by [`Calibration::open`]: [`Calibration::run`] on one in
-    /// memory; streamed from its spool (text, IMU records, ROS) or from the file (raw binary)
-    /// otherwise, with the same report up to the contamination check and the starting values
-    /// (module docs).
+    /// Calibrates a recording opened by [`Calibration::open`], or several recordings or saved
+    /// wavelet variances given as a [`CalibrationSource`]: [`Calibration::run`] on one in
+    /// memory; streamed from its spool (text, IMU records, ROS) or from the file (raw binary),
+    /// with the same report up to the contamination check and the starting values (module
+    /// docs); pooled over several recordings (docs/methods.md §5.12); from saved WVs as a
+    /// streamed recording is.
+    ///
+    /// ```no_run
+    /// use gmwm::{read_table, Calibration, CalibrationOptions, CalibrationSource, Imu, ReadOptions};
+    /// let pooled = ["imu1.csv.gz", "imu2.csv.gz"]
+    ///     .iter()
+    ///     .map(|f| Ok((f.to_string(), Imu::from_table(read_table(f.as_ref(), &ReadOptions::default())?)?)))
+    ///     .collect::<Result<Vec<_>, gmwm::Error>>()?;
+    /// struct Quiet; // no progress shown
+    /// impl gmwm::Progress for Quiet {}
+    /// let calibration = Calibration::new(CalibrationOptions::default());
+    /// let report = calibration.run_source(&CalibrationSource::Pooled(pooled), &Quiet)?;
+    /// assert_eq!(report.recordings.len(), 2);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     ///
     /// # Errors
     /// As those.
@@ -517,6 +544,16 @@ impl Calibration {
             }
             CalibrationSource::Spooled(table) => self.run_table(table, progress),
             CalibrationSource::Raw { probe, read } => self.run_probed(probe, read, progress),
+            CalibrationSource::Pooled(recordings) => {
+                let named: Vec<(&str, &Imu)> = recordings
+                    .iter()
+                    .map(|(n, imu)| (n.as_str(), imu))
+                    .collect();
+                self.run_pooled(&named, progress)
+            }
+            CalibrationSource::SavedWv { name, series } => {
+                self.run_wv(name.as_deref(), series, progress)
+            }
         }
     }
 }

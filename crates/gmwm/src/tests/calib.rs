@@ -330,7 +330,9 @@ fn pooled_calibration_reads_off_known_noise_from_recordings_of_different_lengths
     ];
     let named: Vec<(&str, &Imu)> = ["a.csv", "b.csv", "c.csv"].into_iter().zip(&imus).collect();
     let cal = Calibration::new(options());
-    let report = cal.run_pooled(&named).unwrap();
+    let report = cal
+        .run_pooled(&named, &gmwm::inference::NoProgress)
+        .unwrap();
     assert_eq!(report.recordings.len(), 3);
     assert_eq!(report.recordings[1].name, "b.csv");
     assert_eq!(report.samples, (1 << 15) + (1 << 16) + (1 << 17));
@@ -376,7 +378,9 @@ fn pooled_calibration_names_a_recording_of_another_model() {
         gyro_imu(&loud, 1 << 16, FREQ, 33, "rad/s", 1.0),
     ];
     let named: Vec<(&str, &Imu)> = ["a", "b", "loud"].into_iter().zip(&imus).collect();
-    let report = Calibration::new(options()).run_pooled(&named).unwrap();
+    let report = Calibration::new(options())
+        .run_pooled(&named, &gmwm::inference::NoProgress)
+        .unwrap();
     let notes = &report.axes[0].notes;
     let loud_note = notes
         .iter()
@@ -407,7 +411,11 @@ fn pooled_calibration_refuses_mismatched_recordings() {
     let t = truth(GYRO_N, GYRO_K, None);
     let a = gyro_imu(&t, 1 << 12, FREQ, 41, "rad/s", 1.0);
     let cal = Calibration::new(options());
-    let err = |named: &[(&str, &Imu)]| cal.run_pooled(named).unwrap_err().to_string();
+    let err = |named: &[(&str, &Imu)]| {
+        cal.run_pooled(named, &gmwm::inference::NoProgress)
+            .unwrap_err()
+            .to_string()
+    };
     let fast = gyro_imu(&t, 1 << 12, 200.0, 42, "rad/s", 1.0);
     let e = err(&[("a", &a), ("fast", &fast)]);
     assert!(e.starts_with("fast: sampled at 200 Hz"), "{e}");
@@ -439,7 +447,7 @@ fn pooled_calibration_refuses_mismatched_recordings() {
     let e = err(&[("a", &a)]);
     assert!(e.contains("at least two"), "{e}");
     assert!(matches!(
-        cal.run_pooled(&[("a", &a), ("y", &other)]),
+        cal.run_pooled(&[("a", &a), ("y", &other)], &gmwm::inference::NoProgress),
         Err(CalibError::Pool { .. })
     ));
 }
@@ -467,7 +475,9 @@ fn pooled_calibration_coverage(r: usize) -> (f64, f64, f64, f64) {
                 .map(|(k, &n)| gyro_imu(&t, n, FREQ, 1000 * rep as u64 + k as u64, "rad/s", 1.0))
                 .collect();
             let named: Vec<(&str, &Imu)> = ["a", "b", "c"].into_iter().zip(&imus).collect();
-            let report = cal.run_pooled(&named).unwrap();
+            let report = cal
+                .run_pooled(&named, &gmwm::inference::NoProgress)
+                .unwrap();
             let a = &report.axes[0];
             // an upper bound (K not detected) covers when the truth is below it; a read-off
             // without an interval counts as not covering
