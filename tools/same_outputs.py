@@ -284,12 +284,13 @@ def cases():
     # --- calibrate ---
     add(C("calibrate-full", "calibrate", IMU1, "--json", "cal.json", "--kalibr", "imu.yaml",
           "--report", "report.html", files=["cal.json", "imu.yaml", "report.html"]))
+    # px4 is refused on this recording since its gyro model has no Gauss-Markov bias (the
+    # flicker term explains it): the refusal and the other four files are compared
     add(C("calibrate-exports", "calibrate", IMU2, "--columns", "gyro_x,accel_x",
           "--kalibr", "kalibr.yaml", "--export", "openvins", "openvins.yaml",
           "--export", "vins", "vins.yaml", "--export", "orbslam3", "orbslam3.yaml",
           "--export", "px4", "px4.sdf", "--export", "kalibr", "kalibr2.yaml",
-          files=["kalibr.yaml", "openvins.yaml", "vins.yaml", "orbslam3.yaml", "px4.sdf",
-                 "kalibr2.yaml"]))
+          files=["kalibr.yaml", "openvins.yaml", "vins.yaml", "orbslam3.yaml", "kalibr2.yaml"]))
     add(C("calibrate-json-stdout", "calibrate", IMU3, "--columns", "gyro_y,accel_z",
           "--json", "-"))
     add(C("calibrate-per-axis", "calibrate", IMU4, "--columns", "gyro_x,gyro_y,accel_x,accel_y",
