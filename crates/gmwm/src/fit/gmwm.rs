@@ -12,14 +12,16 @@ use super::{
 use crate::error::ParamError;
 use crate::model::{ImpliedWv, Model};
 use crate::sim::bootstrap::wv_bootstrap;
-use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
+#[cfg(test)]
+use crate::variance::wv::wavelet_variance;
+use crate::variance::wv::{WaveletVariance, WvOptions};
 use serde::Serialize;
 
 /// Default number of bootstrap replicates H behind [`Weighting::Bootstrap`] (docs/methods.md §5.7).
 pub(crate) const DEFAULT_BOOTSTRAP_REPLICATES: usize = 100;
 
 /// GMWM estimator settings (docs/methods.md §5): the model and how to fit it. Build with
-/// [`Gmwm::new`] and the `with_*` setters, then call [`Gmwm::fit_wv`] or [`Gmwm::fit_series`].
+/// [`Gmwm::new`] and the `with_*` setters, then call [`Gmwm::fit`] (a series) or [`Gmwm::fit_wv`] (its WV).
 ///
 /// ```
 /// use gmwm::Gmwm;
@@ -159,7 +161,7 @@ impl Gmwm {
 
     /// Fits the model to an empirical WV (docs/methods.md §5.5) from `start` (theta in model order,
     /// original parametrisation). Works with the fast and bootstrap weightings; the diag weights
-    /// need the series ([`Gmwm::fit_series`]).
+    /// need the series ([`Gmwm::fit`]).
     ///
     /// # Errors
     /// [`FitError::Length`] for a wrong-length start or [`Weighting::Diag`]; errors of
@@ -197,7 +199,8 @@ impl Gmwm {
     ///
     /// # Errors
     /// As [`wavelet_variance`] (wrapped in [`FitError::Input`]) and [`Gmwm::fit_wv`].
-    pub fn fit_series(
+    #[cfg(test)]
+    pub(crate) fn fit_series(
         &self,
         x: &[f64],
         freq_hz: f64,

@@ -227,7 +227,8 @@ impl Sin {
     }
 
     /// Autocovariance `gamma_h = (amplitude^2 / 2) cos(2 pi omega h)` at lags `0..lags`.
-    pub fn autocovariance(&self, lags: usize) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn autocovariance(&self, lags: usize) -> Vec<f64> {
         let p = 0.5 * self.amplitude * self.amplitude;
         (0..lags)
             .map(|h| {
@@ -295,7 +296,7 @@ impl LatentProcess for Sin {
         jets_hessian(&self.jets(levels))
     }
     /// A line spectrum has no density: `None` (the §1.9 quadrature does not apply; the tests
-    /// check the WV against the §4.1 sum of [`Sin::autocovariance`]).
+    /// check the WV against the §4.1 sum of `Sin::autocovariance`).
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let _ = f;
         None

@@ -28,6 +28,7 @@ pub(crate) use crate::process::StartMode;
 #[derive(Debug, Clone)]
 pub struct Simulator {
     processes: Vec<Process>,
+    #[cfg(test)]
     seed: u64,
     start: StartMode,
     samplers: Vec<Box<dyn Sampler>>,
@@ -55,6 +56,7 @@ impl Simulator {
         let samplers = build(&processes, seed, start)?;
         Ok(Self {
             processes,
+            #[cfg(test)]
             seed,
             start,
             samplers,
@@ -63,7 +65,8 @@ impl Simulator {
 
     /// Chooses how AR parts start (docs/methods.md §10.1, §13.21) and restarts the simulation from
     /// its first sample (same seed). Cost: the burn-ins of generic ARMA components again.
-    pub fn with_start(mut self, mode: StartMode) -> Self {
+    #[cfg(test)]
+    pub(crate) fn with_start(mut self, mode: StartMode) -> Self {
         self.start = mode;
         // Validation and burn-in lengths do not depend on the mode beyond what `new` checked:
         // the R burn-in is shorter than the stationary one, so it cannot fail where that

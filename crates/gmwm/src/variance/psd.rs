@@ -87,7 +87,7 @@ impl Psd {
         &self.density
     }
 
-    /// Unit of the density (`u^2/Hz` until [`Psd::in_unit`] names the data's).
+    /// Unit of the density (`u^2/Hz` until `Psd::in_unit` names the data's).
     pub fn unit(&self) -> &str {
         &self.unit
     }
@@ -113,12 +113,13 @@ impl Psd {
     }
 
     /// Whether the values are log-frequency bin means.
-    pub fn is_binned(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn is_binned(&self) -> bool {
         self.binned
     }
 
     /// The same densities with their unit named after the data's: `(unit)^2/Hz`.
-    pub fn in_unit(mut self, data_unit: &str) -> Self {
+    pub(crate) fn in_unit(mut self, data_unit: &str) -> Self {
         self.unit = if data_unit.contains('/') || data_unit.contains('*') {
             format!("({data_unit})^2/Hz")
         } else {

@@ -129,7 +129,7 @@ impl RobustOptions {
 
     /// The tuning constant `c` of these options (docs/methods.md §2.3, `tuning_constant`),
     /// solved once when the options were made.
-    pub fn tuning_constant(&self) -> f64 {
+    pub(crate) fn tuning_constant(&self) -> f64 {
         self.c
     }
 }

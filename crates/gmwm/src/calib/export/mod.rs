@@ -93,9 +93,9 @@ impl ExportFormat {
     /// OpenVINS `kalibr_imu_chain.yaml`.
     pub const OPENVINS: ExportFormat = ExportFormat(&openvins::OpenVins);
     /// VINS-Fusion config (IMU block).
-    pub(crate) const VINS: ExportFormat = ExportFormat(&vins::Vins);
+    pub const VINS: ExportFormat = ExportFormat(&vins::Vins);
     /// ORB-SLAM3 settings (IMU block).
-    pub(crate) const ORBSLAM3: ExportFormat = ExportFormat(&orbslam3::OrbSlam3);
+    pub const ORBSLAM3: ExportFormat = ExportFormat(&orbslam3::OrbSlam3);
     /// PX4 SITL / Gazebo IMU plugin SDF fragment.
     pub const PX4: ExportFormat = ExportFormat(&px4::Px4);
 
