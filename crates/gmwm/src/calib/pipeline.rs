@@ -1248,12 +1248,16 @@ fn psd_of(data: &AxisData<'_>, freq_hz: f64, unit: &str, notes: &mut Vec<String>
 }
 
 /// How the selected fit reads as the canonical model (a drift read as a random walk, ...),
-/// then what the identified fit's canonical model adds.
+/// then what the identified fit's canonical model adds; a reading of both is said once, with the
+/// identified fit's values.
 fn readings(selection: &ModelSelection, canonical: &CanonicalModel) -> Vec<String> {
+    // the selection's readings first, unless the final model reads the same thing of the same
+    // process (then with its own values: a refinement refits every term)
     let mut readings: Vec<String> = selection
         .selected_canonical
         .readings
         .iter()
+        .filter(|r| !canonical.readings.iter().any(|c| c.same_subject(r)))
         .map(ToString::to_string)
         .collect();
     for r in &canonical.readings {

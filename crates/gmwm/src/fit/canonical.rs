@@ -264,6 +264,25 @@ impl Reading {
         matches!(self, Reading::CorrelationBeyondRecording { .. })
     }
 
+    /// Whether `other` reads the same kind of thing of the same process (values aside): two
+    /// fits of one model, such as the WIC's selection and the calibration's refinement of it,
+    /// say it once.
+    pub(crate) fn same_subject(&self, other: &Reading) -> bool {
+        fn process(r: &Reading) -> &str {
+            match r {
+                Reading::AtBoundary { process, .. }
+                | Reading::WhiteAtObservedScales { process, .. }
+                | Reading::RandomWalkAtObservedScales { process, .. }
+                | Reading::CorrelationBeyondRecording { process, .. }
+                | Reading::Merged { process, .. }
+                | Reading::WhiteAtSamplingRate { process, .. } => process,
+                Reading::DriftAsRandomWalk { .. } => "DR",
+            }
+        }
+        std::mem::discriminant(self) == std::mem::discriminant(other)
+            && process(self) == process(other)
+    }
+
     fn set_separation(&mut self, d: f64) {
         match self {
             Reading::WhiteAtObservedScales { separation, .. }

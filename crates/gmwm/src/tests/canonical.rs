@@ -403,3 +403,38 @@ fn issue_10_adis_gyro_x_white_noise_density_matches_the_allan_read_off() {
         "canonical N {n} vs Allan {ieee}"
     );
 }
+
+#[test]
+fn one_reading_of_a_refitted_term_is_said_once_with_either_fits_values() {
+    // the WIC's selection and the calibration's refinement both read an AR1 below the sampling
+    // interval, at slightly different correlation times and indexes: one subject
+    let selected = Reading::WhiteAtSamplingRate {
+        component: 1,
+        process: "AR1".into(),
+        correlation_time_s: 0.005467,
+        sampling_interval_s: 0.01,
+        separation: 3.0,
+    };
+    let refined = Reading::WhiteAtSamplingRate {
+        component: 0,
+        process: "AR1".into(),
+        correlation_time_s: 0.005460,
+        sampling_interval_s: 0.01,
+        separation: 3.1,
+    };
+    assert!(selected.same_subject(&refined));
+    // another process, or another reading of the same process, is another subject
+    let gm = Reading::WhiteAtSamplingRate {
+        component: 0,
+        process: "GM".into(),
+        correlation_time_s: 0.005460,
+        sampling_interval_s: 0.01,
+        separation: 3.1,
+    };
+    assert!(!gm.same_subject(&refined));
+    let boundary = Reading::AtBoundary {
+        component: 0,
+        process: "AR1".into(),
+    };
+    assert!(!boundary.same_subject(&refined));
+}
