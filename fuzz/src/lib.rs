@@ -25,10 +25,10 @@ use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 
 /// The body of a target: takes any bytes, panics on a broken property.
-pub(super) type Body = fn(&[u8]);
+pub type Body = fn(&[u8]);
 
 /// Every target: name (as in `fuzz/Cargo.toml` and `fuzz/corpus/<name>/`) and body.
-pub(super) const TARGETS: &[(&str, Body)] = &[
+pub const TARGETS: &[(&str, Body)] = &[
     ("text", text),
     ("raw_binary", raw_binary),
     ("imu_record", imu_record),
@@ -143,7 +143,7 @@ fn check_read(read: Result<Table, ReadError>) -> Option<Table> {
 /// Selector byte: bits 0-1 the file name (`x.csv`, `x.tsv`, `x.txt`, `x.csv.gz`), bits 2-3 the
 /// format (auto, auto, csv, tsv), bits 4-5 the header mode (auto, present, absent, auto),
 /// bit 6 the time column forced to column 1; the rest is the file.
-pub(super) fn text(data: &[u8]) {
+pub fn text(data: &[u8]) {
     let Some((&sel, content)) = data.split_first() else {
         return;
     };
@@ -186,7 +186,7 @@ pub(super) fn text(data: &[u8]) {
 /// bit 4 the format from the name (`x.f64`/`x.f32`, else given explicitly); the rest is the
 /// file. A read succeeds exactly when the size is a positive multiple of the record and every
 /// value is finite, and then returns exactly the decoded values.
-pub(super) fn raw_binary(data: &[u8]) {
+pub fn raw_binary(data: &[u8]) {
     let Some((&sel, content)) = data.split_first() else {
         return;
     };
@@ -236,7 +236,7 @@ pub(super) fn raw_binary(data: &[u8]) {
 /// Binary IMU epoch records (METHODS §9.2) of every type through [`read_table`].
 ///
 /// Selector byte: the record type ([`ImuRecordType::ALL`], modulo 6); the rest is the file.
-pub(super) fn imu_record(data: &[u8]) {
+pub fn imu_record(data: &[u8]) {
     let Some((&sel, content)) = data.split_first() else {
         return;
     };
@@ -313,23 +313,23 @@ fn ros(ext: &str, data: &[u8]) {
 }
 
 /// A ROS1 bag (`x.bag`).
-pub(super) fn ros1_bag(data: &[u8]) {
+pub fn ros1_bag(data: &[u8]) {
     ros("bag", data);
 }
 
 /// An MCAP file (`x.mcap`).
-pub(super) fn mcap(data: &[u8]) {
+pub fn mcap(data: &[u8]) {
     ros("mcap", data);
 }
 
 /// A rosbag2 sqlite3 storage file (`x.db3`).
-pub(super) fn db3(data: &[u8]) {
+pub fn db3(data: &[u8]) {
     ros("db3", data);
 }
 
 /// A WV JSON (`gmwm wv --json`) through [`read_wv_json`], then [`allan_from_wv`] on each
 /// series.
-pub(super) fn wv_json(data: &[u8]) {
+pub fn wv_json(data: &[u8]) {
     let path = scratch("wv_json", &[("x.json", data)]);
     let _ = is_wv_json(&path);
     match read_wv_json(&path, None) {
@@ -360,7 +360,7 @@ pub(super) fn wv_json(data: &[u8]) {
 ///
 /// Input: the sidecar text, optionally followed by a NUL byte and the data file's bytes (by
 /// default 12 increasing little-endian f64).
-pub(super) fn sidecar(data: &[u8]) {
+pub fn sidecar(data: &[u8]) {
     let (json, payload) = match data.iter().position(|&b| b == 0) {
         Some(k) => (&data[..k], data[k + 1..].to_vec()),
         None => (
@@ -388,7 +388,7 @@ pub(super) fn sidecar(data: &[u8]) {
 
 /// The model text language through [`Model::parse`]: a parsed model's canonical text
 /// (`Display`) parses back to the same model and is a fixed point; an error renders.
-pub(super) fn model_text(data: &[u8]) {
+pub fn model_text(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };

@@ -72,7 +72,7 @@ impl Calibration {
     ///
     /// # Errors
     /// As [`binary_layout`] and `BinaryChunks::open`.
-    pub fn streams(&self, probe: &Probe, read: &ReadOptions) -> Result<bool, Error> {
+    pub(crate) fn streams(&self, probe: &Probe, read: &ReadOptions) -> Result<bool, Error> {
         Ok(self.stream_layout(probe, read)?.is_some() || self.streams_table(probe, read)?)
     }
 
@@ -476,7 +476,7 @@ impl Calibration {
     /// Opens the recording probed as `probe` for [`Calibration::run_source`]: a long
     /// recording that the options calibrate with the classical Haar WV is streamed (a raw
     /// binary file from the file, text, IMU records and ROS topics through one spooled pass,
-    /// [`Calibration::streams`]); any other is read into memory ([`Recording::open`]). A topic
+    /// `Calibration::streams`); any other is read into memory ([`Recording::open`]). A topic
     /// is for ROS recordings: with another file the in-memory reader refuses it.
     ///
     /// # Errors

@@ -4,6 +4,8 @@
 //! in a reader), and as property tests on mutated seeds and arbitrary bytes. The long libFuzzer
 //! runs are in `fuzz/README.md`.
 
+// the fuzz crate's public bodies, private here
+#[allow(unreachable_pub)]
 #[path = "../../../../fuzz/src/lib.rs"]
 mod bodies;
 
