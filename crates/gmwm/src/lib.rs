@@ -34,7 +34,7 @@ mod error;
 mod fit;
 mod imu;
 mod inference;
-pub(crate) mod math;
+mod math;
 mod model;
 mod monitor;
 mod names;

@@ -271,6 +271,82 @@ pub fn monitor_against(
     reference: Reference<'_>,
     opts: &MonitorOptions,
 ) -> Result<MonitorReport, Error> {
+    let (step, levels) = window_plan(x.len(), freq_hz, model, reference, opts)?;
+    let big = opts.window;
+    let implied = model.implied_wv(levels, freq_hz)?;
+    let model_wv = implied.wv.clone();
+    let (classical_ref, robust_ref) = reference_centres(reference, &model_wv)?;
+    let (eta, exact_eta) = window_eta(model, big, freq_hz, &model_wv);
+    let alpha_level = opts.alpha / (2 * levels) as f64;
+    let classical_band = Band::of(&classical_ref, &eta, 1.0, alpha_level)?;
+    let robust_band =
+        Band::of(&robust_ref, &eta, opts.robust.eff(), alpha_level)?.ok_or_else(|| {
+            ParamError::new(
+                "model",
+                model.to_string(),
+                "a model with a positive finite WV variance at every tested level",
+            )
+        })?;
+    let wv_opts = WvOptions {
+        levels: Some(levels),
+        robust: Some(opts.robust),
+        ..WvOptions::default()
+    };
+    use rayon::prelude::*;
+    let windows: Vec<MonitorWindow> = window_starts(x.len(), big, step)
+        .par_iter()
+        .map(|&a| {
+            window_check(
+                &x[a..a + big],
+                a,
+                freq_hz,
+                &wv_opts,
+                (&robust_band, &robust_ref.nu),
+                (&classical_band, &classical_ref.nu),
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    let events = events_of(&windows);
+    let flagged = windows.iter().filter(|w| w.flagged).count();
+    let classical_band = classical_band.unwrap_or_default();
+    Ok(MonitorReport {
+        model: model.to_string(),
+        reference: match reference {
+            Reference::Model => "model",
+            Reference::Wv { .. } => "calibration WV",
+        },
+        reference_wv: classical_ref.nu,
+        robust_reference_wv: robust_ref.nu,
+        freq_hz,
+        window: big,
+        step,
+        alpha: opts.alpha,
+        alpha_level,
+        eff: opts.robust.eff(),
+        tau_s: implied.tau_s.clone(),
+        model_wv,
+        eta,
+        band_low: robust_band.low,
+        band_high: robust_band.high,
+        classical_band_low: classical_band.low,
+        classical_band_high: classical_band.high,
+        exact_eta,
+        windows,
+        events,
+        flagged,
+    })
+}
+
+/// The checks of `monitor_against`'s inputs, and the window step and the number of levels
+/// compared: those with `M_j / 2^j >= MIN_ETA` in a window, at most `opts.levels` and the
+/// reference WV's.
+fn window_plan(
+    n: usize,
+    freq_hz: f64,
+    model: &Model,
+    reference: Reference<'_>,
+    opts: &MonitorOptions,
+) -> Result<(usize, usize), Error> {
     check_alpha(opts.alpha)?;
     if !(freq_hz.is_finite() && freq_hz > 0.0) {
         return Err(ParamError::new("freq", freq_hz, "a positive number of hertz").into());
@@ -283,7 +359,6 @@ pub fn monitor_against(
         )
         .into());
     }
-    let n = x.len();
     let big = opts.window;
     if big < 16 {
         return Err(ParamError::new("window", big, "at least 16 samples").into());
@@ -330,41 +405,64 @@ pub fn monitor_against(
         }
         levels = levels.min(w.levels());
     }
-    let implied = model.implied_wv(levels, freq_hz)?;
-    let model_wv = implied.wv.clone();
-    // the bands' centres (classical, robust) and the log-scale variances of those centres
-    // (docs/methods.md §16.6)
-    let none = vec![0.0; levels];
-    let ((nu, centre_var), (nu_r, centre_var_r)) = match reference {
-        Reference::Model => ((model_wv.clone(), none.clone()), (model_wv.clone(), none)),
-        Reference::Wv { classical, robust } => {
-            let c = centre(classical, levels);
-            let r = robust.map(|r| centre(r, levels));
-            let mut out = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
-            for j in 0..levels {
-                let Some((v, var)) = c[j] else {
-                    return Err(ParamError::new(
-                        "reference WV",
-                        format!("level {}", j + 1),
-                        "a positive finite value with positive degrees of freedom (eta)",
-                    )
-                    .into());
-                };
-                let (vr, var_r) = r.as_ref().and_then(|r| r[j]).unwrap_or((v, var));
-                out.0 .0.push(v);
-                out.0 .1.push(var);
-                out.1 .0.push(vr);
-                out.1 .1.push(var_r);
-            }
-            out
-        }
+    Ok((step, levels))
+}
+
+/// A band's centre per level and the log-scale variance of that centre (0 for the model's
+/// own WV, which is known; docs/methods.md §16.6).
+struct Centres {
+    nu: Vec<f64>,
+    log_var: Vec<f64>,
+}
+
+/// The classical and the robust bands' centres: the model's WV, or the calibration's WVs at
+/// the levels compared (the robust falling back to the classical where it has none).
+fn reference_centres(
+    reference: Reference<'_>,
+    model_wv: &[f64],
+) -> Result<(Centres, Centres), Error> {
+    let levels = model_wv.len();
+    let known = || Centres {
+        nu: model_wv.to_vec(),
+        log_var: vec![0.0; levels],
     };
-    let widened = |r: f64, var: f64| 2.0 / (2.0 / r + var);
-    let (eta, exact_eta) = match exact_wv_covariance(model, big, freq_hz, levels) {
+    let Reference::Wv { classical, robust } = reference else {
+        return Ok((known(), known()));
+    };
+    let c = centre(classical, levels);
+    let r = robust.map(|r| centre(r, levels));
+    let empty = || Centres {
+        nu: Vec::with_capacity(levels),
+        log_var: Vec::with_capacity(levels),
+    };
+    let (mut classical_ref, mut robust_ref) = (empty(), empty());
+    for j in 0..levels {
+        let Some((v, var)) = c[j] else {
+            return Err(ParamError::new(
+                "reference WV",
+                format!("level {}", j + 1),
+                "a positive finite value with positive degrees of freedom (eta)",
+            )
+            .into());
+        };
+        let (vr, var_r) = r.as_ref().and_then(|r| r[j]).unwrap_or((v, var));
+        classical_ref.nu.push(v);
+        classical_ref.log_var.push(var);
+        robust_ref.nu.push(vr);
+        robust_ref.log_var.push(var_r);
+    }
+    Ok((classical_ref, robust_ref))
+}
+
+/// The equivalent degrees of freedom of a window's WV per level under the model: exact
+/// (`2 nu^2 / V_jj`, `true`) where the exact covariance covers the model, else `M_j / 2^j`.
+fn window_eta(model: &Model, big: usize, freq_hz: f64, model_wv: &[f64]) -> (Vec<f64>, bool) {
+    let levels = model_wv.len();
+    match exact_wv_covariance(model, big, freq_hz, levels) {
         Ok(v) => (
             (0..levels)
                 .map(|j| 2.0 * model_wv[j] * model_wv[j] / v[(j, j)])
-                .collect::<Vec<f64>>(),
+                .collect(),
             true,
         ),
         Err(_) => (
@@ -376,30 +474,45 @@ pub fn monitor_against(
                 .collect(),
             false,
         ),
-    };
-    let alpha_level = opts.alpha / (2 * levels) as f64;
-    let mut band_low = Vec::with_capacity(levels);
-    let mut band_high = Vec::with_capacity(levels);
-    let mut c_low = Vec::with_capacity(levels);
-    let mut c_high = Vec::with_capacity(levels);
-    for j in 0..levels {
-        let e = widened(eta[j], centre_var[j]);
-        if e.is_finite() && e > 0.0 {
-            c_low.push(nu[j] * chi_square_quantile(alpha_level / 2.0, e)? / e);
-            c_high.push(nu[j] * chi_square_quantile(1.0 - alpha_level / 2.0, e)? / e);
-        }
-        let r = widened(opts.robust.eff() * eta[j], centre_var_r[j]);
-        if !(r.is_finite() && r > 0.0) {
-            return Err(Error::Param(ParamError::new(
-                "model",
-                model.to_string(),
-                "a model with a positive finite WV variance at every tested level",
-            )));
-        }
-        band_low.push(nu_r[j] * chi_square_quantile(alpha_level / 2.0, r)? / r);
-        band_high.push(nu_r[j] * chi_square_quantile(1.0 - alpha_level / 2.0, r)? / r);
     }
-    // window starts
+}
+
+/// A band per level around a reference WV (docs/methods.md §16.6).
+#[derive(Default)]
+struct Band {
+    low: Vec<f64>,
+    high: Vec<f64>,
+}
+
+impl Band {
+    /// The chi-square band at `alpha_level` on each side around `centres`, with the window's
+    /// `eta` scaled by `eff` (the robust estimator's efficiency) and widened by the centre's own
+    /// uncertainty; `None` where a level has no positive finite degrees of freedom (the
+    /// classical band then checks no level).
+    fn of(
+        centres: &Centres,
+        eta: &[f64],
+        eff: f64,
+        alpha_level: f64,
+    ) -> Result<Option<Band>, Error> {
+        let widened = |r: f64, var: f64| 2.0 / (2.0 / r + var);
+        let mut band = Band::default();
+        for (j, &nu) in centres.nu.iter().enumerate() {
+            let e = widened(eff * eta[j], centres.log_var[j]);
+            if !(e.is_finite() && e > 0.0) {
+                return Ok(None);
+            }
+            band.low
+                .push(nu * chi_square_quantile(alpha_level / 2.0, e)? / e);
+            band.high
+                .push(nu * chi_square_quantile(1.0 - alpha_level / 2.0, e)? / e);
+        }
+        Ok(Some(band))
+    }
+}
+
+/// The windows' first samples: every `step`, plus one ending at the recording's end.
+fn window_starts(n: usize, big: usize, step: usize) -> Vec<usize> {
     let mut starts: Vec<usize> = (0..)
         .map(|k| k * step)
         .take_while(|s| s + big <= n)
@@ -407,57 +520,64 @@ pub fn monitor_against(
     if starts.last().is_some_and(|&s| s + big < n) {
         starts.push(n - big);
     }
-    let wv_opts = WvOptions {
-        levels: Some(levels),
-        robust: Some(opts.robust),
-        ..WvOptions::default()
-    };
+    starts
+}
+
+/// One window's robust and classical WVs against their bands: the levels outside.
+fn window_check(
+    part: &[f64],
+    start: usize,
+    freq_hz: f64,
+    wv_opts: &WvOptions,
+    (robust_band, robust_nu): (&Band, &[f64]),
+    (classical_band, classical_nu): (&Option<Band>, &[f64]),
+) -> Result<MonitorWindow, Error> {
     let classical_opts = WvOptions {
         robust: None,
-        ..wv_opts
+        ..*wv_opts
     };
-    use rayon::prelude::*;
-    let windows: Vec<MonitorWindow> = starts
-        .par_iter()
-        .map(|&a| -> Result<MonitorWindow, Error> {
-            let part = &x[a..a + big];
-            let values = wavelet_variance(part, freq_hz, &wv_opts)?.wv().to_vec();
-            let classical = wavelet_variance(part, freq_hz, &classical_opts)?
-                .wv()
-                .to_vec();
-            let check = |estimator, v: &[f64], lo: &[f64], hi: &[f64], nu: &[f64]| {
-                (0..levels)
-                    .filter_map(|j| {
-                        let side = if v[j] > hi[j] {
-                            "high"
-                        } else if v[j] < lo[j] {
-                            "low"
-                        } else {
-                            return None;
-                        };
-                        Some(LevelOut {
-                            level: j + 1,
-                            estimator,
-                            side,
-                            ratio: v[j] / nu[j],
-                        })
-                    })
-                    .collect::<Vec<_>>()
-            };
-            let mut out = check("robust", &values, &band_low, &band_high, &nu_r);
-            out.extend(check("classical", &classical, &c_low, &c_high, &nu));
-            Ok(MonitorWindow {
-                start: a,
-                end: a + big,
-                start_s: a as f64 / freq_hz,
-                end_s: (a + big) as f64 / freq_hz,
-                wv: values,
-                classical_wv: classical,
-                flagged: !out.is_empty(),
-                out,
+    let values = wavelet_variance(part, freq_hz, wv_opts)?.wv().to_vec();
+    let classical = wavelet_variance(part, freq_hz, &classical_opts)?
+        .wv()
+        .to_vec();
+    let check = |estimator, v: &[f64], band: &Band, nu: &[f64]| {
+        (0..band.low.len())
+            .filter_map(|j| {
+                let side = if v[j] > band.high[j] {
+                    "high"
+                } else if v[j] < band.low[j] {
+                    "low"
+                } else {
+                    return None;
+                };
+                Some(LevelOut {
+                    level: j + 1,
+                    estimator,
+                    side,
+                    ratio: v[j] / nu[j],
+                })
             })
-        })
-        .collect::<Result<_, _>>()?;
+            .collect::<Vec<_>>()
+    };
+    let mut out = check("robust", &values, robust_band, robust_nu);
+    if let Some(band) = classical_band {
+        out.extend(check("classical", &classical, band, classical_nu));
+    }
+    let end = start + part.len();
+    Ok(MonitorWindow {
+        start,
+        end,
+        start_s: start as f64 / freq_hz,
+        end_s: end as f64 / freq_hz,
+        wv: values,
+        classical_wv: classical,
+        flagged: !out.is_empty(),
+        out,
+    })
+}
+
+/// Flagged windows that overlap or touch, merged into events.
+fn events_of(windows: &[MonitorWindow]) -> Vec<MonitorEvent> {
     let mut events: Vec<MonitorEvent> = Vec::new();
     for w in windows.iter().filter(|w| w.flagged) {
         match events.last_mut() {
@@ -475,33 +595,7 @@ pub fn monitor_against(
             }),
         }
     }
-    let flagged = windows.iter().filter(|w| w.flagged).count();
-    Ok(MonitorReport {
-        model: model.to_string(),
-        reference: match reference {
-            Reference::Model => "model",
-            Reference::Wv { .. } => "calibration WV",
-        },
-        reference_wv: nu,
-        robust_reference_wv: nu_r,
-        freq_hz,
-        window: big,
-        step,
-        alpha: opts.alpha,
-        alpha_level,
-        eff: opts.robust.eff(),
-        tau_s: implied.tau_s.clone(),
-        model_wv,
-        eta,
-        band_low,
-        band_high,
-        classical_band_low: c_low,
-        classical_band_high: c_high,
-        exact_eta,
-        windows,
-        events,
-        flagged,
-    })
+    events
 }
 
 #[cfg(test)]
