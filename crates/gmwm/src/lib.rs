@@ -13,6 +13,20 @@
 //! - section numbers such as "§1.7" refer to the methods reference of this repository,
 //!   `docs/methods.md`: the formulas, defaults and test values, section by section.
 //!
+//! Where to start (the items below are one flat list; these are the entry points):
+//! - a recording to a navigation filter's parameters: [`Calibration`] ([`Calibration::open`]
+//!   and [`Calibration::run_source`] for a file, several recordings or saved wavelet
+//!   variances; [`Calibration::run`] for an [`Imu`] in memory), then
+//!   [`CalibrationReport::nav_sets`] and [`render_export`] for the filter files;
+//! - wavelet and Allan variances: [`wavelet_variance`], [`allan_variance`];
+//! - a model fitted and judged: [`Model`], [`Gmwm`] ([`GmwmFit`]), [`infer`], [`auto_imu`]
+//!   (the WIC selection, [`ModelSelection`]);
+//! - reading files: [`Probe`], [`Recording`], [`read_table`]; the JSON the command line prints:
+//!   [`document`].
+//!
+//! An item's documentation that points to its "module doc" means the comment at the top of the
+//! item's source file (the `Source` link): the modules are private, their method notes are not.
+//!
 //! ```
 //! use gmwm::{wavelet_variance, WvOptions};
 //! // ramp x_t = t + 1: Haar MODWT WV 0.25 at tau = 2, 1.0 at tau = 4 (docs/methods.md §1.10)
