@@ -436,12 +436,6 @@ impl std::ops::Deref for GmwmFit {
     }
 }
 
-impl std::ops::DerefMut for GmwmFit {
-    fn deref_mut(&mut self) -> &mut FitEstimates {
-        &mut self.estimates
-    }
-}
-
 /// The wire format of the type's doc, field by field in that order (the estimates are not one
 /// block there: `start` comes before `objective`, `freq_hz` after `weights`).
 impl Serialize for GmwmFit {
