@@ -562,7 +562,7 @@ pub struct CalibrateConfig {
     /// The navigation-filter files to write, (stack, path), `--kalibr` first then each
     /// `--export` in order.
     pub exports: Vec<(ExportFormat, PathBuf)>,
-    /// `--inflate K` or `--conservative` (the estimates otherwise).
+    /// `--inflate K`, `--conservative` or `--horizon T` (the estimates otherwise).
     pub adjustment: Adjustment,
     /// `--axis-policy`.
     pub policy: AxisPolicy,
@@ -622,12 +622,14 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             tolerance: a.tolerance,
             force_units: a.force_units,
             datasheet: a.datasheet.datasheet.clone(),
+            horizon_s: a.horizon,
         };
         let exports = exports(a)?;
-        let adjustment = match (a.inflate, a.conservative) {
-            (Some(k), _) => Adjustment::inflate(k)?,
-            (None, true) => Adjustment::Conservative,
-            (None, false) => Adjustment::Estimate,
+        let adjustment = match (a.inflate, a.conservative, a.horizon) {
+            (_, _, Some(t)) => Adjustment::horizon(t)?,
+            (Some(k), ..) => Adjustment::inflate(k)?,
+            (None, true, None) => Adjustment::Conservative,
+            (None, false, None) => Adjustment::Estimate,
         };
         Ok(Self {
             input,

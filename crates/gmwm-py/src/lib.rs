@@ -625,7 +625,7 @@ fn read<'py>(
 /// `arrays` named `names` with `units` at `freq`, or of the recordings at `paths` calibrated as
 /// one sensor (`gmwm calibrate --pool`).
 #[pyfunction]
-#[pyo3(signature = (path=None, arrays=None, paths=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, rostopic=None, tolerance=0.1, force_units=false, datasheet=None, progress=None))]
+#[pyo3(signature = (path=None, arrays=None, paths=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, horizon=None, rostopic=None, tolerance=0.1, force_units=false, datasheet=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn calibrate(
     py: Python<'_>,
@@ -657,6 +657,7 @@ fn calibrate(
     axis_policy: &str,
     inflate: Option<f64>,
     conservative: bool,
+    horizon: Option<f64>,
     rostopic: Option<String>,
     tolerance: f64,
     force_units: bool,
@@ -707,14 +708,18 @@ fn calibrate(
                     .map_err(|e| err(format!("invalid datasheet {t:?}: {e}")))
             })
             .transpose()?,
+        horizon_s: horizon,
         ..CalibrationOptions::default()
     };
     let policy: AxisPolicy = choice("axis_policy", axis_policy)?;
-    let adjustment = match (inflate, conservative) {
-        (Some(_), true) => return Err(err("give inflate or conservative, not both")),
-        (Some(k), false) => Adjustment::inflate(k).map_err(engine)?,
-        (None, true) => Adjustment::Conservative,
-        (None, false) => Adjustment::Estimate,
+    let adjustment = match (inflate, conservative, horizon) {
+        (Some(_), true, _) | (Some(_), _, Some(_)) | (_, true, Some(_)) => {
+            return Err(err("give one of inflate, conservative and horizon"))
+        }
+        (_, _, Some(t)) => Adjustment::horizon(t).map_err(engine)?,
+        (Some(k), ..) => Adjustment::inflate(k).map_err(engine)?,
+        (None, true, None) => Adjustment::Conservative,
+        (None, false, None) => Adjustment::Estimate,
     };
     let reporter = PyProgress {
         callback: progress,

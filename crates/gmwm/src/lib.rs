@@ -161,7 +161,8 @@ pub use calib::{
     NavSet, DEFAULT_FULL_MODEL, DEFAULT_TOLERANCE, STREAM_FROM,
 };
 pub use calib::{
-    Contamination, FitUses, FitVerdict, GaussMarkovBias, PooledInput, ScaleFit, ScaleMiss,
+    Contamination, FitUses, FitVerdict, GaussMarkovBias, HorizonBound, PooledInput, ScaleFit,
+    ScaleMiss,
 };
 pub use monitor::{
     monitor_against, LevelOut, MonitorEvent, MonitorOptions, MonitorReport, MonitorWindow,

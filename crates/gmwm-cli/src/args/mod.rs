@@ -15,8 +15,8 @@ use gmwm::{
 };
 use std::path::PathBuf;
 use values::{
-    alpha, at_least_1, at_least_2, choice, datasheet, efficiency, inflation, positive_hz, seed,
-    signal_unit, tolerance, whole,
+    alpha, at_least_1, at_least_2, choice, datasheet, efficiency, horizon_seconds, inflation,
+    positive_hz, seed, signal_unit, tolerance, whole,
 };
 
 const EXAMPLES: &str = "\
@@ -151,6 +151,8 @@ Examples:
   gmwm calibrate run.mcap --export openvins kalibr_imu_chain.yaml --export px4 imu.sdf
   gmwm calibrate log.bin --format ln200 --axis-policy per-axis --kalibr imu.yaml
   gmwm calibrate imu.csv.gz --model \"2*AR1()+WN()+RW()\" --inflate 2 --export vins vins.yaml
+  gmwm calibrate imu.csv.gz --horizon 600 --kalibr imu.yaml
+      a white noise + random walk that bounds the sensor's model over a 10-minute mission
   gmwm calibrate runs/ --out-dir calib/ --kalibr imu.yaml      every recording in runs/
   gmwm calibrate 'runs/*.csv.gz' a.bag --json summary.json      a glob (quoted) and a file
   gmwm calibrate imu1.csv.gz imu2.csv.gz imu3.csv.gz --pool --kalibr imu.yaml
@@ -277,12 +279,21 @@ pub struct CalibrateArgs {
     /// Which axis speaks for a sensor triad in the exported files.
     #[arg(long, value_parser = choice::<AxisPolicy>(), default_value_t = AxisPolicy::Worst)]
     pub axis_policy: AxisPolicy,
-    /// Multiply the exported noise densities and random walks by K (stated in the file).
+    /// Multiply the exported noise densities and random walks by K (stated in the file; cruder
+    /// than --horizon, which computes the factors from the model).
     #[arg(long, value_name = "K", value_parser = inflation, conflicts_with = "conservative")]
     pub inflate: Option<f64>,
-    /// Export the upper ends of the intervals instead of the estimates (stated in the file).
+    /// Export the upper ends of the intervals instead of the estimates (stated in the file;
+    /// cruder than --horizon: it covers the estimation error, not the terms a white noise and a
+    /// random walk leave out).
     #[arg(long)]
     pub conservative: bool,
+    /// Mission length T in seconds (a flight, a drive): export per axis the white noise and
+    /// random walk with the least inflation whose Allan variance (1/f to T) and integrated-error
+    /// variance (angle or velocity, up to T) are at least the fitted model's; the table and
+    /// JSON give the pair and its inflation over the estimates.
+    #[arg(long, value_name = "T", value_parser = horizon_seconds, conflicts_with_all = ["conservative", "inflate"])]
+    pub horizon: Option<f64>,
     /// The verdict's tolerance: a scale is explained when the model's WV is inside the band or
     /// within this fraction of the empirical WV (0.1 = 10%).
     #[arg(long, value_name = "FRACTION", default_value_t = gmwm::DEFAULT_TOLERANCE, value_parser = tolerance)]

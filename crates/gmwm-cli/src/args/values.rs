@@ -211,6 +211,14 @@ pub fn inflation(s: &str) -> Result<f64, String> {
     }
 }
 
+/// `--horizon`: a mission length in seconds, > 0.
+pub fn horizon_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err("must be a mission length in seconds > 0, e.g. 600".into()),
+    }
+}
+
 /// `--tolerance`: a fraction in (0, 1].
 pub fn tolerance(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {

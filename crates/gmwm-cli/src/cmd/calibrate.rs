@@ -674,6 +674,23 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
         )?,
     }
     writeln!(out, "{}", line("random walk", &a.random_walk))?;
+    if let Some(h) = &a.horizon {
+        let times = |f: Option<f64>| f.map_or_else(|| "-".to_string(), |f| format!("x{}", num(f)));
+        writeln!(
+            out,
+            "  {:<18}N {} {}/sqrt(Hz) ({}), K {} {}*sqrt(Hz) ({}): bounds the model up to {} s; at {} s its integrated-error variance is {}x the model's",
+            format!("horizon {} s", num(h.horizon_s)),
+            num(h.noise_density),
+            a.unit,
+            times(h.noise_inflation),
+            num(h.random_walk),
+            a.unit,
+            times(h.random_walk_inflation),
+            num(h.horizon_s),
+            num(h.horizon_s),
+            num(h.excess_at_horizon)
+        )?;
+    }
     if let Some(g) = &a.gauss_markov_bias {
         writeln!(
             out,

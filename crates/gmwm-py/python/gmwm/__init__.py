@@ -238,7 +238,9 @@ def calibrate(
     identified fit with intervals, N/B/K in SI and datasheet units, the IEEE 952 read-off, the
     verdict, the contamination check, the navigation sets): ``gyro_unit``, ``accel_unit``,
     ``model``, ``rule``, ``bootstrap``, ``covariance``, ``G``, ``seed``, ``eff``, ``robust``, ``alpha``,
-    ``axis_policy``, ``inflate``, ``conservative``, ``rostopic``, ``tolerance`` (the verdict's,
+    ``axis_policy``, ``inflate``, ``conservative``, ``horizon`` (a mission length in seconds:
+    per axis the white noise + random walk bounding the model up to it, in ``axes[].horizon``
+    and the navigation sets), ``rostopic``, ``tolerance`` (the verdict's,
     0.1), ``force_units`` (unit flags on a ROS recording), ``datasheet`` (as ``gmwm calibrate
     --datasheet``: "N=2 deg/sqrt(h), B=25.2 deg/h, N=0.2 m/s/sqrt(h)", compared per axis in
     ``axes[].datasheet``); for a path also the read options

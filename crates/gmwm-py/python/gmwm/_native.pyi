@@ -57,7 +57,8 @@ def calibrate(path: Optional[str] = ..., arrays: Optional[Sequence[F64]] = ...,
               draws: Optional[int] = ...,
               seed: int = ..., eff: float = ..., robust_convention: str = ..., robust: bool = ...,
               alpha: float = ..., axis_policy: str = ..., inflate: Optional[float] = ...,
-              conservative: bool = ..., rostopic: Optional[str] = ..., progress: Progress = ...) -> str:
+              conservative: bool = ..., horizon: Optional[float] = ...,
+              rostopic: Optional[str] = ..., progress: Progress = ...) -> str:
     """The calibration pipeline of `gmwm calibrate` on a recording, on arrays, or on several
     recordings of one sensor (`paths`: `gmwm calibrate --pool`)."""
 

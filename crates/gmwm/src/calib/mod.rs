@@ -2,6 +2,7 @@
 pub(crate) mod contamination;
 pub(crate) mod datasheet;
 pub(crate) mod export;
+pub(crate) mod horizon;
 pub(crate) mod ieee;
 pub(crate) mod nav;
 pub(crate) mod pipeline;
@@ -11,6 +12,7 @@ pub(crate) mod verdict;
 
 pub use contamination::{Contamination, FitUses};
 pub use datasheet::{Datasheet, DatasheetComparison};
+pub use horizon::HorizonBound;
 
 #[cfg(test)]
 pub(crate) use contamination::compare_classical_robust;

@@ -2,6 +2,7 @@
 //! §14.4): which axis speaks for a sensor triad, and how conservative the values are.
 
 use super::export::{NavNoise, SensorNoise};
+use super::horizon::HorizonBound;
 use super::pipeline::{AxisCalibration, CalibrationReport, Estimate};
 use crate::error::ParamError;
 use crate::units::{SignalKind, SignalUnit};
@@ -53,10 +54,16 @@ pub enum Adjustment {
     #[default]
     Estimate,
     /// The upper ends of the intervals (the estimate where an interval is missing, said in a
-    /// comment).
+    /// comment): cruder than [`Adjustment::Horizon`], it widens by the estimation error, not
+    /// by what the model has beyond white noise and a random walk.
     Conservative,
-    /// The estimates multiplied by a factor (VIO users tune with inflated noise).
+    /// The estimates multiplied by a factor (the folklore of VIO tuning; cruder than
+    /// [`Adjustment::Horizon`], which computes the factors).
     Inflate(f64),
+    /// The white-noise + random-walk pair bounding each axis' model up to this horizon, s
+    /// ([`AxisCalibration::horizon_bound`]): its Allan variance and integrated-error variance
+    /// are at least the model's up to the horizon, with the least inflation.
+    Horizon(f64),
 }
 
 impl Adjustment {
@@ -76,9 +83,27 @@ impl Adjustment {
         }
     }
 
+    /// Checks a horizon: finite and positive, in seconds (whether it spans a sample is
+    /// checked against the rate by [`AxisCalibration::horizon_bound`]).
+    ///
+    /// # Errors
+    /// [`ParamError`] for a horizon that is not finite and positive.
+    pub fn horizon(seconds: f64) -> Result<Self, ParamError> {
+        if seconds.is_finite() && seconds > 0.0 {
+            Ok(Self::Horizon(seconds))
+        } else {
+            Err(ParamError::new(
+                "horizon",
+                seconds,
+                "a mission length in seconds > 0 (600 for ten minutes)",
+            ))
+        }
+    }
+
     fn apply(self, e: &Estimate, missing: &mut Vec<String>, key: &str) -> f64 {
         match self {
-            Self::Estimate => e.value,
+            // the horizon's values are the axis' bound, taken before this is reached
+            Self::Estimate | Self::Horizon(_) => e.value,
             Self::Inflate(k) => k * e.value,
             Self::Conservative => e.ci_high.unwrap_or_else(|| {
                 missing.push(key.to_string());
@@ -167,6 +192,9 @@ impl CalibrationReport {
                     Adjustment::Inflate(k) => format!(
                         "values: noise densities and random walks are the estimates x {k} (--inflate {k})"
                     ),
+                    Adjustment::Horizon(t) => format!(
+                        "values: per axis the white noise + random walk with the least inflation whose Allan variance (1/f to {t} s) and integrated-error variance (angle or velocity, up to {t} s from a known bias) are at least the fitted model's (--horizon {t})"
+                    ),
                 });
                 if !missing.is_empty() {
                     missing.sort();
@@ -191,6 +219,20 @@ impl CalibrationReport {
     }
 }
 
+/// One axis' horizon pair in words: its inflation over the estimates and its margin at `T`.
+fn horizon_comment(column: &str, b: &HorizonBound) -> String {
+    let times = |f: Option<f64>| f.map_or("(no estimate)".to_string(), |f| format!("x {f:.3}"));
+    format!(
+        "{column}: horizon bound {} s: noise density {}, random walk {} over the estimates; integrated-error variance at {} s {:.2}x the model's; touches {}",
+        b.horizon_s,
+        times(b.noise_inflation),
+        times(b.random_walk_inflation),
+        b.horizon_s,
+        b.excess_at_horizon,
+        b.binding
+    )
+}
+
 /// Combines the axes of one kind into one [`SensorNoise`].
 fn triad(
     axes: &[&AxisCalibration],
@@ -212,17 +254,47 @@ fn triad(
     if of_kind.is_empty() {
         return SensorNoise::default();
     }
-    let mut pick = |key: &str, get: &dyn Fn(&AxisCalibration) -> Option<&Estimate>| {
+    // the horizon's pair per axis (computed by the calibration, else here)
+    let bounds: Vec<Option<HorizonBound>> = of_kind
+        .iter()
+        .map(|a| match adjustment {
+            Adjustment::Horizon(t) => {
+                let bound = match &a.horizon {
+                    Some(b) if b.horizon_s == t => Ok(b.clone()),
+                    _ => a.horizon_bound(t),
+                };
+                match bound {
+                    Ok(b) => {
+                        comments.push(horizon_comment(&a.column, &b));
+                        Some(b)
+                    }
+                    Err(e) => {
+                        comments.push(format!(
+                            "{}: no horizon bound ({e}); its estimates are written",
+                            a.column
+                        ));
+                        None
+                    }
+                }
+            }
+            _ => None,
+        })
+        .collect();
+    let mut pick = |key: &str,
+                    get: &dyn Fn(&AxisCalibration) -> Option<&Estimate>,
+                    bounded: &dyn Fn(&HorizonBound) -> f64| {
         let values: Vec<(&str, f64, &str)> = of_kind
             .iter()
-            .filter_map(|a| {
-                get(a).map(|e| {
+            .zip(&bounds)
+            .filter_map(|(a, bound)| match bound {
+                Some(b) => Some((a.column.as_str(), bounded(b), "the horizon bound")),
+                None => get(a).map(|e| {
                     (
                         a.column.as_str(),
                         adjustment.apply(e, missing, &format!("{name}_{key}")),
                         e.source.as_str(),
                     )
-                })
+                }),
             })
             .collect();
         if values.is_empty() {
@@ -255,8 +327,12 @@ fn triad(
             }
         }
     };
-    let noise_density = pick("noise_density", &|a| a.noise_density.as_ref());
-    let random_walk = pick("random_walk", &|a| a.random_walk.as_ref());
+    let noise_density = pick("noise_density", &|a| a.noise_density.as_ref(), &|b| {
+        b.noise_density
+    });
+    let random_walk = pick("random_walk", &|a| a.random_walk.as_ref(), &|b| {
+        b.random_walk
+    });
     // the Gauss–Markov bias (correlation time, sigma, driving density) comes from one axis:
     // the one with the largest bias sigma, all three from its bias term
     let gm = of_kind

@@ -4,6 +4,7 @@
 
 use super::contamination::{compare_classical_robust, Contamination, FitUses};
 use super::datasheet::{Datasheet, DatasheetComparison, Measured};
+use super::horizon::HorizonBound;
 use super::ieee::{ieee_readoff, IeeeReadoff};
 use super::verdict::{verdict, FitVerdict, DEFAULT_TOLERANCE};
 use crate::fit::canonical::long_run_variance;
@@ -84,6 +85,9 @@ pub struct CalibrationOptions {
     pub force_units: bool,
     /// The sensor's datasheet, compared with each axis of its sensor (default `None`).
     pub datasheet: Option<Datasheet>,
+    /// A mission horizon, s: each axis gets the white-noise + random-walk pair that bounds its
+    /// model up to it ([`AxisCalibration::horizon_bound`]; default `None`).
+    pub horizon_s: Option<f64>,
 }
 
 impl Default for CalibrationOptions {
@@ -105,6 +109,7 @@ impl Default for CalibrationOptions {
             tolerance: DEFAULT_TOLERANCE,
             force_units: false,
             datasheet: None,
+            horizon_s: None,
         }
     }
 }
@@ -303,6 +308,10 @@ pub struct AxisCalibration {
     /// datasheet value for the axis' sensor or when its unit is unknown).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub datasheet: Option<DatasheetComparison>,
+    /// The white-noise + random-walk pair bounding the model up to the mission horizon of
+    /// [`CalibrationOptions::horizon_s`] (left out of the JSON without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horizon: Option<HorizonBound>,
     /// A pooled calibration's recordings' own WVs of this axis (unit², the estimator of
     /// `wv`), input order, which `wv` pools; empty (and left out of the JSON) for one
     /// recording.
@@ -715,7 +724,7 @@ impl Calibration {
         notes.extend(readings(&selection, &canonical));
         let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
         let datasheet = self.datasheet(kind, unit_kind, &read, &mut notes);
-        Ok(AxisCalibration {
+        let mut axis = AxisCalibration {
             column: column.to_string(),
             kind,
             axis: axis_label.to_string(),
@@ -745,8 +754,13 @@ impl Calibration {
             contamination,
             datasheet,
             notes,
+            horizon: None,
             recording_wvs: Vec::new(),
-        })
+        };
+        if let Some(t) = self.options.horizon_s {
+            axis.horizon = Some(axis.horizon_bound(t).map_err(|e| errors.engine(e))?);
+        }
+        Ok(axis)
     }
 
     /// The WIC selection of the full model's sub-models on the axis' WV (docs/methods.md §8).

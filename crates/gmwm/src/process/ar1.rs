@@ -14,8 +14,8 @@
 
 use super::draw::Draw;
 use super::{
-    negative_phi, ChainSlot, CovariancePart, Markov, MarkovForms, ParamTransform, Physical,
-    ProcessKind, Role, UnitShape, BASE,
+    ChainSlot, CovariancePart, Markov, MarkovForms, ParamTransform, Physical, ProcessKind, Role,
+    UnitShape, BASE,
 };
 use crate::process::sampler::SimRng;
 use serde::Serialize;
@@ -665,9 +665,6 @@ impl Sampler for Ar1Sampler {
 
 impl Simulate for Ar1 {
     fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
-        if self.phi < 0.0 {
-            return Err(negative_phi(self.phi));
-        }
         let r0 = self.sigma2 / ((1.0 - self.phi) * (1.0 + self.phi));
         Ok(CovariancePart::Autoregressive {
             phi: self.phi,

@@ -266,7 +266,6 @@ impl Arma {
     /// `(r+1) x (r+1)` linear system (`r = max(p, q+1)`), then the AR recursion; `gamma_0` is
     /// exact, not the package's 1000-term MA(inf) truncation (§13.12). Values are NaN only if
     /// the system were singular, which stationarity (checked by [`Arma::new`]) excludes.
-    #[cfg(test)]
     pub(crate) fn autocovariance(&self, max_lag: usize) -> Vec<f64> {
         autocovariance(&self.ar, &self.ma, self.sigma2, max_lag)
     }

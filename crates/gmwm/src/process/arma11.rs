@@ -8,7 +8,7 @@
 //! and the AR1 part uses the stable evaluation of [`super::ar1`]. This is used for
 //! `phi > 1/2`; below, the closed form is used as written.
 
-use super::{negative_phi, CovariancePart, ParamTransform, Role, BASE};
+use super::{CovariancePart, ParamTransform, Role, BASE};
 use crate::process::sampler::SimRng;
 use serde::Serialize;
 
@@ -172,9 +172,6 @@ impl Step for Arma11Sampler {
 
 impl Simulate for Arma11 {
     fn covariance_part(&self) -> Result<CovariancePart, ParamError> {
-        if self.phi < 0.0 {
-            return Err(negative_phi(self.phi));
-        }
         let (phi, theta, s2) = (self.phi, self.theta, self.sigma2);
         let den = (1.0 - phi) * (1.0 + phi);
         Ok(CovariancePart::Autoregressive {

@@ -166,6 +166,20 @@ pub(crate) fn unit_wv(m: f64) -> f64 {
     ((16.0 * m * m - 1.0) * odd_harmonic_difference(m) + 3.0 * odd_harmonic(m)) / (8.0 * PI * m * m)
 }
 
+impl Flicker {
+    /// `Var(sum_{t=1}^{n} (x_t - x_0))`, the sum of `n` samples relative to the value before
+    /// them (a bias held at its start value): with the variogram `V(h) = (2 b2 / pi) H(h)`
+    /// (module doc), `Cov(x_s - x_0, x_t - x_0) = V(s) + V(t) - V(|s - t|)` sums to
+    /// `2 sum_{h=1}^{n} h V(h)`, and `sum_{h<=n} h H(h) = n (n + 1) H(n) / 2 - (n^2 - H(n)) / 8`
+    /// (exchange the sums; `k (k - 1) / (2k - 1) = ((2k - 1) - 1 / (2k - 1)) / 4`), so
+    ///
+    /// `(4 b2 / pi) [n (n + 1) H(n) / 2 - (n^2 - H(n)) / 8]`, about `(b2 / pi) n^2 ln n`.
+    pub(crate) fn held_sum_variance(&self, n: f64) -> f64 {
+        let h = odd_harmonic(n);
+        4.0 * self.b2 / PI * (0.5 * n * (n + 1.0) * h - (n * n - h) / 8.0)
+    }
+}
+
 impl LatentProcess for Flicker {
     fn name(&self) -> &'static str {
         SPEC.name

@@ -116,6 +116,17 @@ impl Maf {
         }
     }
 
+    /// `G(n) = Var(x_1 + ... + x_n) = n gamma_0 + 2 sum_{h<n} (n - h) gamma_h`: beyond the
+    /// filter, `n sigma2 - sigma2 (L^2 - 1) / (3 L)` (white noise's, less the filter's edges).
+    pub(crate) fn increment_variance(&self, n: usize) -> f64 {
+        let lags = n.min(self.length);
+        let mut g = n as f64 * self.unit_autocovariance(0);
+        for h in 1..lags {
+            g += 2.0 * (n - h) as f64 * self.unit_autocovariance(h);
+        }
+        self.sigma2 * g
+    }
+
     /// The Haar WV at `tau = 2m` per unit `sigma2` (module doc).
     fn unit_wv(&self, m: f64) -> f64 {
         let l = self.length as f64;

@@ -131,7 +131,7 @@ pub(crate) enum CovariancePart {
     /// A drift of this slope.
     Drift(f64),
     /// An autocovariance `gamma(0) = r0`, `gamma(h) = r1 phi^(h - 1)` for `h >= 1` (AR1, GM,
-    /// MA1 with `phi = 0`, ARMA11), `phi >= 0`.
+    /// MA1 with `phi = 0`, ARMA11), `phi` in (-1, 1); the exact covariance takes `phi >= 0`.
     Autoregressive {
         /// The decay per lag.
         phi: f64,
@@ -140,15 +140,6 @@ pub(crate) enum CovariancePart {
         /// `gamma(1)`.
         r1: f64,
     },
-}
-
-/// The refusal of a negative `phi` by the exact covariance.
-pub(crate) fn negative_phi(phi: f64) -> ParamError {
-    ParamError::new(
-        "phi",
-        phi,
-        "phi >= 0 for the exact WV covariance (a negative autoregression alternates in sign; --covariance auto or bootstrap simulates V)",
-    )
 }
 
 /// Declares the one table of processes: each row a [`ProcessKind`] (with its orders, and an

@@ -226,6 +226,16 @@ impl Sin {
         self.omega * freq_hz
     }
 
+    /// `G(n) = Var(x_1 + ... + x_n) = (amplitude^2 / 2) sin^2(pi omega n) / sin^2(pi omega)`:
+    /// the autocovariance below summed over the `n x n` lags (a Dirichlet kernel).
+    pub(crate) fn increment_variance(&self, n: f64) -> f64 {
+        let p = 0.5 * self.amplitude * self.amplitude;
+        // reduce omega n modulo 1 before the sine: n reaches 1e9
+        let c = self.omega * n;
+        let r = (PI * (c - c.floor())).sin() / (PI * self.omega).sin();
+        p * r * r
+    }
+
     /// Autocovariance `gamma_h = (amplitude^2 / 2) cos(2 pi omega h)` at lags `0..lags`.
     #[cfg(test)]
     pub(crate) fn autocovariance(&self, lags: usize) -> Vec<f64> {

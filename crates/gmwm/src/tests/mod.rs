@@ -17,6 +17,7 @@ mod fit_ref;
 mod fit_start;
 mod flicker;
 mod fuzz_props;
+mod horizon;
 mod ieee;
 mod inference;
 mod maf;

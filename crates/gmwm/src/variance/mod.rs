@@ -7,6 +7,7 @@ pub(crate) mod ci;
 pub(crate) mod cov;
 pub(crate) mod cross;
 mod file;
+pub(crate) mod growth;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
 pub(crate) mod implied_cov;
