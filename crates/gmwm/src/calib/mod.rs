@@ -6,6 +6,7 @@ pub(crate) mod horizon;
 pub(crate) mod ieee;
 pub(crate) mod nav;
 pub(crate) mod pipeline;
+pub(crate) mod plan;
 pub(crate) mod pooled;
 pub(crate) mod streamed;
 pub(crate) mod verdict;
@@ -21,6 +22,7 @@ pub use pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationOptions, CalibrationReport, Estimate,
     EstimateStatus, GaussMarkovBias, DEFAULT_FULL_MODEL,
 };
+pub use plan::{Plan, PlanTarget, PlannedQuantity, PLAN_LENGTHS_S};
 pub use pooled::PooledInput;
 #[cfg(test)]
 pub(crate) use streamed::ROBUST_LEVELS;

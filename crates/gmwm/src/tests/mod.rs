@@ -24,6 +24,7 @@ mod maf;
 mod methods_reference;
 mod model;
 mod monitor;
+mod plan;
 mod pooled;
 mod process;
 mod psd;
