@@ -40,6 +40,8 @@ pub enum Config {
     Simulate(SimulateConfig),
     /// `gmwm implied`.
     Implied(ImpliedConfig),
+    /// `gmwm plan`.
+    Plan(crate::cmd::plan::PlanConfig),
     /// `gmwm fit`.
     Fit(FitConfig),
     /// `gmwm select`.
@@ -76,6 +78,7 @@ impl TryFrom<&Command> for Config {
             Command::Avar(a) => Self::Avar(a.try_into()?),
             Command::Simulate(a) => Self::Simulate(a.try_into()?),
             Command::Implied(a) => Self::Implied(a.try_into()?),
+            Command::Plan(a) => Self::Plan(a.try_into()?),
             Command::Calibrate(a) => calibrate_or_batch(a)?,
             Command::Topics(a) => Self::Topics(a.into()),
             Command::Plot(a) => Self::Plot(a.try_into()?),

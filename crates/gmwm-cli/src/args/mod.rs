@@ -85,6 +85,11 @@ pub enum Command {
         after_long_help = "Examples:\n  gmwm implied --model \"3*AR1(phi=0.9, sigma2=1)+WN(sigma2=2)\" --levels 10\n  gmwm implied --model \"GM(beta=0.25, sigma2_gm=7.08e-9)+RW(gamma2=3.9e-14)\" --levels 20 --freq 250 --json"
     )]
     Implied(ImpliedArgs),
+    /// How long to record: the predicted interval half-widths of N, B, K and each correlation
+    /// time for recordings from minutes to days, from a model, a datasheet or a calibration,
+    /// and the length a target needs (docs/methods.md §18).
+    #[command(allow_negative_numbers = true, after_long_help = PLAN_EXAMPLES)]
+    Plan(PlanArgs),
     /// Estimate a latent error model by GMWM on each selected column (docs/methods.md §5), from a
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
@@ -700,6 +705,51 @@ pub struct SimulateArgs {
     /// file's file system (refused without it, stating the size).
     #[arg(long)]
     pub yes: bool,
+}
+
+const PLAN_EXAMPLES: &str = "\
+The prediction is the asymptotic covariance of the GMWM estimates at each length, with the exact
+covariance of the wavelet variance (a flicker term through Gauss-Markov stand-ins; B of a model
+without flicker is the IEEE read-off of the Allan minimum). It holds for the model given; the
+self-audit says what selecting a model adds.
+
+Examples:
+  gmwm plan calib.json                               each calibrated axis (gmwm calibrate --json)
+  gmwm plan calib.json --columns gyro_x --target \"K=20%,B=10%\"
+  gmwm plan --datasheet \"N=0.15 deg/sqrt(h), B=2 deg/h, K=0.5 deg/h/sqrt(h)\" --freq 200
+  gmwm plan --model \"GM(beta=0.01, sigma2_gm=1e-9)+WN(sigma2=1e-6)+RW(gamma2=1e-14)\" --freq 100 --lengths 30min,2h,1d --json";
+
+/// `gmwm plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// A calibration (`gmwm calibrate --json`): each axis' identified model.
+    #[arg(value_name = "FILE", conflicts_with_all = ["model", "datasheet"])]
+    pub file: Option<PathBuf>,
+    /// The axes of FILE (names, comma-separated) [default: all].
+    #[arg(long, value_name = "NAMES", requires = "file")]
+    pub columns: Option<String>,
+    /// A fully specified model (with --freq).
+    #[arg(long, value_name = "MODEL", conflicts_with = "datasheet")]
+    pub model: Option<String>,
+    /// A datasheet, as calibrate takes it (with --freq): N as white noise, B as flicker, K as
+    /// a random walk.
+    #[arg(long, value_name = "VALUES", value_parser = datasheet)]
+    pub datasheet: Option<gmwm::Datasheet>,
+    /// Sampling rate in Hz (for --model and --datasheet).
+    #[arg(long, value_name = "HZ", value_parser = positive_hz)]
+    pub freq: Option<f64>,
+    /// Recording lengths: numbers with s, min, h or d [default: 10min,30min,1h,3h,6h,12h,1d,2d,7d].
+    #[arg(long, value_name = "LIST")]
+    pub lengths: Option<String>,
+    /// Targets: QUANTITY=PERCENT items (N, B, K, T1, ...), e.g. \"K=20%,B=10%\".
+    #[arg(long, value_name = "LIST")]
+    pub target: Option<String>,
+    /// Significance level of the intervals.
+    #[arg(long, default_value_t = 0.05, value_parser = alpha)]
+    pub alpha: f64,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `gmwm implied`.

@@ -10,6 +10,7 @@ pub mod demo;
 pub mod fit;
 pub mod implied;
 pub mod monitor;
+pub mod plan;
 pub mod plot;
 pub mod report;
 pub mod same_model;
@@ -46,6 +47,7 @@ pub fn of(config: &mut Config) -> &mut dyn Command {
         Config::Avar(c) => c,
         Config::Simulate(c) => c,
         Config::Implied(c) => c,
+        Config::Plan(c) => c,
         Config::Fit(c) => c,
         Config::Select(c) => c,
         Config::Calibrate(c) => c,

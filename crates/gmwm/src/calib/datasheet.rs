@@ -545,6 +545,51 @@ impl Datasheet {
         })
     }
 
+    /// The error model the `kind` values state, in continuous SI at `freq_hz`, for planning a
+    /// recording (docs/methods.md §18): `N` as `WN(sigma2 = N^2 f)`, `B` as flicker
+    /// `FN(b2 = B^2)` (whose Allan floor is exactly `0.664 B`, IEEE 952's convention), `K` as
+    /// `RW(gamma2 = K^2 / f)`; with the conversion in words. `None` without a value for the
+    /// sensor.
+    pub fn model_for(&self, kind: SignalKind, freq_hz: f64) -> Option<(crate::Model, String)> {
+        let mut components = Vec::new();
+        let mut said = Vec::new();
+        for (term, text) in [
+            (NoiseTerm::BiasInstability, "FN"),
+            (NoiseTerm::NoiseDensity, "WN"),
+            (NoiseTerm::RandomWalk, "RW"),
+        ] {
+            let Some(v) = self.value(kind, term) else {
+                continue;
+            };
+            let x = v.value_si;
+            let (component, conversion) = match text {
+                "FN" => (format!("FN(b2={:e})", x * x), "b2 = B^2"),
+                "WN" => (
+                    format!("WN(sigma2={:e})", x * x * freq_hz),
+                    "sigma2 = N^2 f",
+                ),
+                _ => (
+                    format!("RW(gamma2={:e})", x * x / freq_hz),
+                    "gamma2 = K^2 / f",
+                ),
+            };
+            said.push(format!(
+                "{v} = {} {}: {conversion}",
+                crate::model::format_value(x),
+                v.unit_si
+            ));
+            components.push(component);
+        }
+        if components.is_empty() {
+            return None;
+        }
+        let model = components.join("+").parse().ok()?;
+        Some((
+            model,
+            format!("datasheet at {freq_hz} Hz: {}", said.join("; ")),
+        ))
+    }
+
     /// The lines of the values of `unit`'s sensor on a figure of data in `unit`, in that unit
     /// (`value_si / unit.to_si()`: N, B and K all scale with the signal).
     pub fn lines(&self, unit: SignalUnit) -> Vec<DatasheetLine> {

@@ -6,6 +6,7 @@ use super::contamination::{compare_classical_robust, Contamination, FitUses};
 use super::datasheet::{Datasheet, DatasheetComparison, Measured};
 use super::horizon::HorizonBound;
 use super::ieee::{ieee_readoff, IeeeReadoff};
+use super::plan::Plan;
 use super::verdict::{verdict, FitVerdict, DEFAULT_TOLERANCE};
 use crate::fit::canonical::long_run_variance;
 use crate::fit::{CanonicalModel, FitError, Gmwm, GmwmFit};
@@ -312,6 +313,11 @@ pub struct AxisCalibration {
     /// [`CalibrationOptions::horizon_s`] (left out of the JSON without one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub horizon: Option<HorizonBound>,
+    /// The precision of K, B and the correlation times at this recording's length and at two
+    /// and four times it, under the identified model ([`Plan`]; left out of the JSON when the
+    /// model has none of them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plan: Option<Plan>,
     /// A pooled calibration's recordings' own WVs of this axis (unit², the estimator of
     /// `wv`), input order, which `wv` pools; empty (and left out of the JSON) for one
     /// recording.
@@ -722,6 +728,11 @@ impl Calibration {
         );
         let read = readoff.read(&allan, &ieee, &mut notes);
         notes.extend(readings(&selection, &canonical));
+        let plan =
+            super::plan::longer_recording(&fit.model, freq_hz, samples).map(|(plan, line)| {
+                notes.push(line);
+                plan
+            });
         let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
         let datasheet = self.datasheet(kind, unit_kind, &read, &mut notes);
         let mut axis = AxisCalibration {
@@ -755,6 +766,7 @@ impl Calibration {
             datasheet,
             notes,
             horizon: None,
+            plan,
             recording_wvs: Vec::new(),
         };
         if let Some(t) = self.options.horizon_s {

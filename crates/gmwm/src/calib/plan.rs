@@ -12,7 +12,7 @@
 //! - `V` the exact covariance of the WV at length `n` (`crate::variance::implied_cov`), for
 //!   a model of WN, QN, RW, DR, AR1/GM, MA1 and ARMA11 terms. The other terms enter `V`
 //!   through a stand-in (stated in the plan's notes): flicker as the Gauss–Markov terms, one
-//!   per two octaves, whose summed WV matches flicker's over the levels (non-negative least
+//!   per three octaves, whose summed WV matches flicker's over the levels (non-negative least
 //!   squares on the relative error, below 1% in practice); the sensor filter `MAF(L)` as the
 //!   white noise it is beyond its `L` samples; a sinusoid is left out (its WV sits at its own
 //!   levels and leaves the others' variance alone).
@@ -160,15 +160,15 @@ impl Plan {
             })
             .collect();
         let mut out_targets = Vec::new();
+        let mut notes = planner.notes.clone();
         for (name, goal) in targets {
             let Some(index) = planner.quantities.iter().position(|q| &q.name == name) else {
                 let names: Vec<&str> = planner.quantities.iter().map(|q| q.name.as_str()).collect();
-                return Err(InputError::from(ParamError::new(
-                    "target",
-                    name.clone(),
-                    format!("a quantity of this model: {}", names.join(", ")),
-                ))
-                .into());
+                notes.push(format!(
+                    "target {name}: not a quantity of this model (it has {})",
+                    names.join(", ")
+                ));
+                continue;
             };
             if !(goal.is_finite() && *goal > 0.0) {
                 return Err(InputError::from(ParamError::new(
@@ -191,7 +191,7 @@ impl Plan {
             lengths_s: lengths_s.to_vec(),
             quantities,
             targets: out_targets,
-            notes: planner.notes.clone(),
+            notes,
         })
     }
 }
@@ -199,8 +199,11 @@ impl Plan {
 /// What a quantity is a function of.
 #[derive(Debug, Clone, PartialEq)]
 enum Of {
-    /// `sqrt(sum of the white variances / f)` over these parameters.
-    WhiteDensity(Vec<usize>),
+    /// `sqrt(sum of the long-run variances / f)` over these terms: WN and MAF (the variance
+    /// at this offset), and AR1 terms faster than a sample (`phi` at the offset, `sigma2`
+    /// after it; long-run variance `sigma2 / (1 - phi)^2`), which a calibration reports as
+    /// white noise.
+    WhiteDensity(Vec<(usize, bool)>),
     /// `sqrt(gamma2 f)` of the parameter.
     RandomWalk(usize),
     /// `sqrt(b2)` of the parameter.
@@ -246,10 +249,14 @@ impl Planner {
         let mut white = Vec::new();
         let mut offset = 0;
         let mut correlated = 0;
-        for p in &processes {
+        for (component, p) in processes.iter().enumerate() {
             let np = p.params().len();
             match p {
-                Process::Wn(_) | Process::Maf(_) => white.push(offset),
+                Process::Wn(_) | Process::Maf(_) => white.push((offset, false)),
+                // faster than a sample: white noise to a calibration (its canonical model)
+                Process::Ar1(a) if correlation_time(p, freq_hz) < 1.0 / freq_hz && a.phi() > 0.0 => {
+                    white.push((offset, true))
+                }
                 Process::Rw(r) => quantities.push(Quantity {
                     name: "K".into(),
                     value: (r.gamma2() * freq_hz).sqrt(),
@@ -272,7 +279,7 @@ impl Planner {
                         name: format!("T{correlated}"),
                         value: t,
                         unit: "s".into(),
-                        source: format!("correlation time of {}[{}]", p.name(), correlated),
+                        source: format!("correlation time of {}[{component}]", p.name()),
                         of: Of::CorrelationTime { index: offset, gm },
                     });
                 }
@@ -289,8 +296,7 @@ impl Planner {
             offset += np;
         }
         if !white.is_empty() {
-            // WN and MAF have one parameter, the (long-run) variance
-            let s2: f64 = white.iter().map(|&i| theta[i]).sum();
+            let s2: f64 = white.iter().map(|&w| long_run_variance(&theta, w)).sum();
             quantities.insert(
                 0,
                 Quantity {
@@ -321,7 +327,7 @@ impl Planner {
             _ => 3,
         });
         if processes.iter().any(|p| matches!(p, Process::Flicker(_))) {
-            notes.push("V (the WV covariance) of the flicker term from its stand-in: Gauss–Markov terms one per two octaves whose summed WV matches flicker's at the levels".into());
+            notes.push("V (the WV covariance) of the flicker term from its stand-in: Gauss–Markov terms one per three octaves whose summed WV matches flicker's at the levels".into());
         }
         if processes.iter().any(|p| matches!(p, Process::Maf(_))) {
             notes.push(
@@ -408,10 +414,20 @@ impl Planner {
     fn log_gradient(&self, of: &Of) -> Vec<f64> {
         let mut g = vec![0.0; self.theta.len()];
         match of {
-            Of::WhiteDensity(idx) => {
-                let sum: f64 = idx.iter().map(|&i| self.theta[i]).sum();
-                for &i in idx {
-                    g[i] = 0.5 / sum;
+            Of::WhiteDensity(terms) => {
+                let sum: f64 = terms
+                    .iter()
+                    .map(|&w| long_run_variance(&self.theta, w))
+                    .sum();
+                for &(i, ar1) in terms {
+                    if ar1 {
+                        let (phi, s2) = (self.theta[i], self.theta[i + 1]);
+                        let e = 1.0 - phi;
+                        g[i] = 0.5 * 2.0 * s2 / (e * e * e) / sum;
+                        g[i + 1] = 0.5 / (e * e) / sum;
+                    } else {
+                        g[i] = 0.5 / sum;
+                    }
                 }
             }
             Of::RandomWalk(i) | Of::Flicker(i) => g[*i] = 0.5 / self.theta[*i],
@@ -458,6 +474,15 @@ impl Planner {
             previous = Some((l, w));
         }
         Ok(None)
+    }
+}
+
+/// The long-run variance of a white term (`Of::WhiteDensity`).
+fn long_run_variance(theta: &[f64], (i, ar1): (usize, bool)) -> f64 {
+    if ar1 {
+        theta[i + 1] / ((1.0 - theta[i]) * (1.0 - theta[i]))
+    } else {
+        theta[i]
     }
 }
 
@@ -546,7 +571,12 @@ fn stand_in(
     Ok(out)
 }
 
-/// Gauss–Markov terms, correlation times `2^(2i)` samples, whose summed WV matches that of
+/// Ratio of the correlation times of flicker's stand-in terms: three octaves (the exact
+/// covariance's cost grows with the number of terms; two octaves gave the same half-widths
+/// to a few percent at three times the cost).
+const STAND_IN_SPACING: f64 = 8.0;
+
+/// Gauss–Markov terms, correlation times `8^i / 2` samples, whose summed WV matches that of
 /// `FN(b2)` at levels `1..=levels` (non-negative least squares on the relative error,
 /// coordinate descent).
 fn flicker_stand_in(b2: f64, levels: usize, freq_hz: f64) -> Result<Vec<Process>, InputError> {
@@ -560,7 +590,7 @@ fn flicker_stand_in(b2: f64, levels: usize, freq_hz: f64) -> Result<Vec<Process>
         let g = Gm::new(beta, 1.0, freq_hz)?;
         let wv = g.wv(levels);
         basis.push((beta, wv.iter().zip(&target).map(|(w, y)| w / y).collect()));
-        t *= 4.0;
+        t *= STAND_IN_SPACING;
     }
     // minimise sum_j (sum_i c_i B_ij - 1)^2, c >= 0
     let k = basis.len();
@@ -588,4 +618,47 @@ fn flicker_stand_in(b2: f64, levels: usize, freq_hz: f64) -> Result<Vec<Process>
         }
     }
     Ok(out)
+}
+
+/// The planning line of a calibration (docs/methods.md §18): the precision of K, B and the
+/// correlation times from this recording's length `samples`, and from two and four times it,
+/// under the identified `model`; `None` when the model has none of them or is not covered.
+pub(crate) fn longer_recording(
+    model: &Model,
+    freq_hz: f64,
+    samples: usize,
+) -> Option<(Plan, String)> {
+    let length = samples as f64 / freq_hz;
+    let plan = Plan::new(
+        model,
+        freq_hz,
+        &[length, 2.0 * length, 4.0 * length],
+        0.05,
+        &[],
+    )
+    .ok()?;
+    let shown: Vec<&PlannedQuantity> = plan.quantities.iter().filter(|q| q.name != "N").collect();
+    if shown.is_empty() {
+        return None;
+    }
+    let at = |i: usize| {
+        shown
+            .iter()
+            .map(|q| match q.half_width[i] {
+                Some(w) if w <= 1.0 => format!("{} within ±{:.0}%", q.name, 100.0 * w),
+                _ => format!("{} not determined", q.name),
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let hours = |k: f64| format!("{:.1} h", k * length / 3600.0);
+    let line = format!(
+        "planning (gmwm plan, under the identified model): this recording gives {}; one of {} would give {}; one of {}: {}",
+        at(0),
+        hours(2.0),
+        at(1),
+        hours(4.0),
+        at(2)
+    );
+    Some((plan, line))
 }
