@@ -41,7 +41,7 @@ pub enum Config {
     /// `gmwm implied`.
     Implied(ImpliedConfig),
     /// `gmwm plan`.
-    Plan(crate::cmd::plan::PlanConfig),
+    Plan(PlanConfig),
     /// `gmwm fit`.
     Fit(FitConfig),
     /// `gmwm select`.
@@ -578,6 +578,8 @@ pub struct CalibrateConfig {
     /// `--pool`: every FILE argument as given (files, folders, globs), calibrated as one
     /// sensor; empty for one recording.
     pub pool: Vec<PathBuf>,
+    /// `--audit R`: replicates of the self-audit per axis (0: none).
+    pub audit: usize,
 }
 
 /// The files of `--kalibr` and `--export STACK FILE`, Kalibr first.
@@ -644,6 +646,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             rostopic: a.rostopic.clone(),
             report: a.report.clone(),
             pool: Vec::new(),
+            audit: a.audit.unwrap_or(if a.report.is_some() { 8 } else { 0 }),
         })
     }
 }
@@ -1428,6 +1431,203 @@ impl TryFrom<&MonitorArgs> for MonitorConfig {
             },
             against: a.against,
             output: OutputConfig::from(&a.output),
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// gmwm plan
+
+/// One model to plan for, named.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanSubject {
+    /// The axis or sensor it stands for.
+    pub name: String,
+    /// The unit of its values (`u` when unknown).
+    pub unit: String,
+    /// The model, every value given.
+    pub model: Model,
+    /// Its rate, Hz.
+    pub freq_hz: f64,
+    /// Where it comes from, in words.
+    pub from: String,
+}
+
+/// `gmwm plan`, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanConfig {
+    /// The models.
+    pub subjects: Vec<PlanSubject>,
+    /// `--lengths`, s.
+    pub lengths_s: Vec<f64>,
+    /// `--target`: (quantity, relative half-width).
+    pub targets: Vec<(String, f64)>,
+    /// `--alpha`.
+    pub alpha: f64,
+    /// `--json`.
+    pub json: bool,
+    /// FILE, when given.
+    pub file: Option<PathBuf>,
+}
+
+/// `30min`, `2h`, `1d`, `600` (s) in seconds.
+fn length(text: &str) -> Result<f64> {
+    let t = text.trim();
+    let split = t.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let factor = match unit.trim() {
+        "" | "s" => 1.0,
+        "min" | "m" => 60.0,
+        "h" => 3600.0,
+        "d" => 86400.0,
+        _ => f64::NAN,
+    };
+    match number.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && factor.is_finite() => Ok(v * factor),
+        _ => Err(UsageError(format!(
+            "invalid --lengths item {t:?}: a length with s, min, h or d, e.g. 30min, 3h, 1d"
+        ))
+        .into()),
+    }
+}
+
+/// `K=20%` or `K=0.2`.
+fn target(text: &str) -> Result<(String, f64)> {
+    let bad = || {
+        UsageError(format!(
+            "invalid --target item {text:?}: QUANTITY=PERCENT, e.g. K=20% (N, B, K, T1, ...)"
+        ))
+    };
+    let (name, value) = text.split_once('=').ok_or_else(bad)?;
+    let value = value.trim();
+    let v = match value.strip_suffix('%') {
+        Some(p) => p.trim().parse::<f64>().map(|x| x / 100.0),
+        None => value.parse::<f64>(),
+    }
+    .map_err(|_| bad())?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(bad().into());
+    }
+    Ok((name.trim().to_string(), v))
+}
+
+/// Each axis of a calibration document: its identified model with its values.
+fn subjects_of_calibration(path: &Path, columns: Option<&str>) -> Result<Vec<PlanSubject>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let doc: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let axes = doc["axes"].as_array().ok_or_else(|| {
+        UsageError(format!(
+            "{}: not a calibration (no axes[]; write one with gmwm calibrate --json)",
+            path.display()
+        ))
+    })?;
+    let wanted: Option<Vec<&str>> = columns.map(|c| c.split(',').map(str::trim).collect());
+    let mut out = Vec::new();
+    for (i, a) in axes.iter().enumerate() {
+        let column = a["column"].as_str().unwrap_or("?").to_string();
+        if wanted
+            .as_ref()
+            .is_some_and(|w| !w.contains(&column.as_str()))
+        {
+            continue;
+        }
+        let field = |what: &str| {
+            UsageError(format!(
+                "{}: axes[{i}] ({column}) has no {what}",
+                path.display()
+            ))
+        };
+        let text = a["fit"]["model"]
+            .as_str()
+            .ok_or_else(|| field("fit.model"))?;
+        let freq_hz = a["fit"]["freq_hz"]
+            .as_f64()
+            .ok_or_else(|| field("fit.freq_hz"))?;
+        let model: Model = text
+            .parse()
+            .with_context(|| format!("{}: axes[{i}] ({column}) fit.model", path.display()))?;
+        out.push(PlanSubject {
+            name: column,
+            unit: a["unit"].as_str().unwrap_or("u").to_string(),
+            model,
+            freq_hz,
+            from: format!("identified model of {}", path.display()),
+        });
+    }
+    if out.is_empty() {
+        return Err(UsageError(format!(
+            "{}: no axis {}",
+            path.display(),
+            columns.unwrap_or("")
+        ))
+        .into());
+    }
+    Ok(out)
+}
+
+impl TryFrom<&crate::args::PlanArgs> for PlanConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &crate::args::PlanArgs) -> Result<Self> {
+        let need_freq = || {
+            a.freq.ok_or_else(|| {
+                UsageError("--freq HZ: the sampling rate the model or datasheet is at".into())
+            })
+        };
+        let subjects = match (&a.file, &a.model, &a.datasheet) {
+            (Some(f), ..) => subjects_of_calibration(f, a.columns.as_deref())?,
+            (None, Some(m), _) => vec![PlanSubject {
+                name: "model".into(),
+                unit: "u".into(),
+                model: m.parse()?,
+                freq_hz: need_freq()?,
+                from: "--model".into(),
+            }],
+            (None, None, Some(d)) => {
+                let f = need_freq()?;
+                [gmwm::SignalKind::Gyroscope, gmwm::SignalKind::Accelerometer]
+                    .into_iter()
+                    .filter_map(|kind| {
+                        d.model_for(kind, f).map(|(model, from)| PlanSubject {
+                            name: match kind {
+                                gmwm::SignalKind::Gyroscope => "gyro".into(),
+                                gmwm::SignalKind::Accelerometer => "accel".into(),
+                            },
+                            unit: match kind {
+                                gmwm::SignalKind::Gyroscope => "rad/s".into(),
+                                gmwm::SignalKind::Accelerometer => "m/s^2".into(),
+                            },
+                            model,
+                            freq_hz: f,
+                            from,
+                        })
+                    })
+                    .collect()
+            }
+            (None, None, None) => {
+                return Err(UsageError(
+                    "give a calibration FILE, --model or --datasheet (see gmwm plan --help)".into(),
+                )
+                .into())
+            }
+        };
+        let lengths_s = match &a.lengths {
+            Some(l) => l.split(',').map(length).collect::<Result<Vec<_>>>()?,
+            None => gmwm::PLAN_LENGTHS_S.to_vec(),
+        };
+        let targets = match &a.target {
+            Some(t) => t.split(',').map(target).collect::<Result<Vec<_>>>()?,
+            None => Vec::new(),
+        };
+        Ok(Self {
+            subjects,
+            lengths_s,
+            targets,
+            alpha: a.alpha,
+            json: a.json,
+            file: a.file.clone(),
         })
     }
 }

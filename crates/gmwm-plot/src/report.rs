@@ -399,6 +399,92 @@ fn datasheet_table(out: &mut String, d: &DatasheetComparison) {
     );
 }
 
+/// `+1.2%`, or a dash.
+fn percent(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:+.1}%", 100.0 * x)
+    } else {
+        "–".into()
+    }
+}
+
+/// The self-audit of an axis: how far to trust each number, and GMWM against the IEEE read-off.
+fn audit_section(out: &mut String, column: &str, au: &gmwm::Audit) {
+    let _ = writeln!(
+        out,
+        "<h3 id=\"audit-{}\">Self-audit: how far to trust these numbers</h3>\n<p>The identified model <code>{}</code> was simulated {} times at this recording's length and rate and each simulation recalibrated from scratch. The same canonical model (<b>{}</b>) was selected in {:.0}% of them{}. For each number: the calibration's median error against the simulated value, its spread, how often its 95% interval held the value, and the same for the IEEE 952 slope read-off on the same recordings.</p>",
+        esc(column),
+        esc(&au.model),
+        au.replicates,
+        esc(&au.canonical_model),
+        100.0 * au.same_model,
+        if au.failed > 0 { format!(" ({} calibrations failed)", au.failed) } else { String::new() }
+    );
+    out.push_str("<table>\n");
+    header(
+        out,
+        &[
+            "",
+            "simulated value",
+            "GMWM bias",
+            "GMWM spread",
+            "interval coverage",
+            "IEEE bias",
+            "IEEE spread",
+            "more accurate",
+        ],
+    );
+    out.push_str("<tbody>\n");
+    for q in &au.quantities {
+        let coverage = match q.gmwm.coverage {
+            Some(c) => format!("{:.0}% ({} intervals)", 100.0 * c, q.gmwm.intervals),
+            None => "no intervals".into(),
+        };
+        // root mean square error relative to the value: bias and spread together
+        let rmse = |s: &gmwm::AuditStats| (s.bias * s.bias + s.spread * s.spread).sqrt();
+        let (ib, is, better) = match &q.ieee {
+            Some(i) => (
+                percent(i.bias),
+                percent(i.spread).trim_start_matches('+').to_string(),
+                if rmse(&q.gmwm) <= rmse(i) {
+                    "GMWM"
+                } else {
+                    "IEEE"
+                }
+                .to_string(),
+            ),
+            None => ("–".into(), "–".into(), "GMWM (no read-off)".into()),
+        };
+        let _ = write!(out, "<tr>");
+        for c in [
+            q.name.clone(),
+            format!("{} {}", number(q.target), esc(&q.unit)),
+            percent(q.gmwm.bias),
+            percent(q.gmwm.spread).trim_start_matches('+').to_string(),
+            coverage,
+            ib,
+            is,
+            better,
+        ] {
+            let _ = write!(out, "<td>{c}</td>");
+        }
+        out.push_str("</tr>\n");
+    }
+    out.push_str("</tbody></table>\n");
+    if au.models.len() > 1 {
+        let list: Vec<String> = au
+            .models
+            .iter()
+            .map(|(m, n)| format!("{} ({n})", esc(m)))
+            .collect();
+        let _ = writeln!(
+            out,
+            "<p class=\"small\">Models selected: {}.</p>",
+            list.join(", ")
+        );
+    }
+}
+
 fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(), PlotError> {
     let id = esc(&a.column);
     let _ = writeln!(
@@ -602,6 +688,9 @@ fn axis_section(out: &mut String, a: &AxisCalibration, alpha: f64) -> Result<(),
             )?);
         }
         None => out.push_str("<p>Not compared (see the notes).</p>\n"),
+    }
+    if let Some(au) = &a.audit {
+        audit_section(out, &a.column, au);
     }
     if !a.notes.is_empty() {
         out.push_str("<h3>Notes</h3><ul class=\"notes\">");

@@ -161,8 +161,9 @@ pub use calib::{
     NavSet, DEFAULT_FULL_MODEL, DEFAULT_TOLERANCE, STREAM_FROM,
 };
 pub use calib::{
-    Contamination, FitUses, FitVerdict, GaussMarkovBias, HorizonBound, Plan, PlanTarget,
-    PlannedQuantity, PooledInput, ScaleFit, ScaleMiss, PLAN_LENGTHS_S,
+    Audit, AuditQuantity, AuditStats, Contamination, FitUses, FitVerdict, GaussMarkovBias,
+    HorizonBound, Plan, PlanTarget, PlannedQuantity, PooledInput, ScaleFit, ScaleMiss,
+    PLAN_LENGTHS_S,
 };
 pub use monitor::{
     monitor_against, LevelOut, MonitorEvent, MonitorOptions, MonitorReport, MonitorWindow,

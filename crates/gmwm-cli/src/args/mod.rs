@@ -158,6 +158,8 @@ Examples:
   gmwm calibrate imu.csv.gz --model \"2*AR1()+WN()+RW()\" --inflate 2 --export vins vins.yaml
   gmwm calibrate imu.csv.gz --horizon 600 --kalibr imu.yaml
       a white noise + random walk that bounds the sensor's model over a 10-minute mission
+  gmwm calibrate imu.csv.gz --audit 50 --json calib.json
+      how far to trust each number: 50 simulated recordings of the model, each recalibrated
   gmwm calibrate runs/ --out-dir calib/ --kalibr imu.yaml      every recording in runs/
   gmwm calibrate 'runs/*.csv.gz' a.bag --json summary.json      a glob (quoted) and a file
   gmwm calibrate imu1.csv.gz imu2.csv.gz imu3.csv.gz --pool --kalibr imu.yaml
@@ -299,6 +301,12 @@ pub struct CalibrateArgs {
     /// JSON give the pair and its inflation over the estimates.
     #[arg(long, value_name = "T", value_parser = horizon_seconds, conflicts_with_all = ["conservative", "inflate"])]
     pub horizon: Option<f64>,
+    /// Self-audit: simulate each axis' identified model R times at the recording's length and
+    /// rate, calibrate every replicate, and report per exported number its bias, spread and
+    /// interval coverage, the IEEE read-off's beside it, and how often the same model is
+    /// selected [default: 0; 8 with --report].
+    #[arg(long, value_name = "R")]
+    pub audit: Option<usize>,
     /// The verdict's tolerance: a scale is explained when the model's WV is inside the band or
     /// within this fraction of the empirical WV (0.1 = 10%).
     #[arg(long, value_name = "FRACTION", default_value_t = gmwm::DEFAULT_TOLERANCE, value_parser = tolerance)]

@@ -94,12 +94,13 @@ pub fn execute_in(
 ) -> Result<Calibrated> {
     let print_summary = mode.print_summary;
     let exports = &config.exports;
-    let (recording, report) = if config.pool.is_empty() {
+    let (recording, mut report) = if config.pool.is_empty() {
         check_outputs(config, report_path)?;
         calibrate_one(config, mode)?
     } else {
         calibrate_pooled(config, report_path, mode)?
     };
+    let audited = audit(config, &mut report, mode)?;
     // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
     // says so in a comment
     let rostopic = config.rostopic.clone().or_else(|| recording.topic.clone());
@@ -158,6 +159,13 @@ pub fn execute_in(
     if !json_to_stdout {
         if print_summary {
             summary(&recording, &report, out)?;
+            if let Some(seconds) = audited {
+                writeln!(
+                    out,
+                    "\nself-audit: {} simulated recordings per axis, each recalibrated, in {seconds:.1} s",
+                    config.audit
+                )?;
+            }
         }
         for w in &written {
             writeln!(out, "wrote {w}")?;
@@ -172,6 +180,30 @@ pub fn execute_in(
         explained: report.axes.iter().filter(|a| a.verdict.explains_wv).count(),
         written: paths,
     })
+}
+
+/// `--audit R`: the self-audit of every axis, attached to it; its wall time, s (`None` when
+/// not run: R = 0, or a pooled calibration, which has no one length to simulate).
+fn audit(
+    config: &CalibrateConfig,
+    report: &mut CalibrationReport,
+    mode: Mode,
+) -> Result<Option<f64>> {
+    if config.audit == 0 || !config.pool.is_empty() {
+        return Ok(None);
+    }
+    let started = std::time::Instant::now();
+    let calibration = Calibration::new(config.options.clone());
+    let axes = report.axes.iter().filter(|a| a.kind.is_some()).count();
+    let bar = mode
+        .style
+        .bar((axes * config.audit) as u64, "self-audit", "recalibrations");
+    let audits = calibration.audit(report, config.audit, config.options.seed, &Ticks(&bar))?;
+    bar.finish_and_clear();
+    for (axis, audit) in report.axes.iter_mut().zip(audits) {
+        axis.audit = audit;
+    }
+    Ok(Some(started.elapsed().as_secs_f64()))
 }
 
 /// One recording read (streamed when long) and calibrated.
@@ -633,6 +665,58 @@ fn datasheet_lines(d: &DatasheetComparison, out: &mut impl Write) -> Result<()> 
     Ok(())
 }
 
+/// The self-audit of an axis: per number, the calibration's and the IEEE read-off's bias and
+/// spread, and the coverage of the calibration's intervals.
+fn audit_lines(au: &gmwm::Audit, out: &mut impl Write) -> Result<()> {
+    let pct = |x: f64| {
+        if x.is_finite() {
+            format!("{:+.1}%", 100.0 * x)
+        } else {
+            "-".into()
+        }
+    };
+    writeln!(
+        out,
+        "  {:<18}{} simulated recordings of the identified model: same canonical model in {:.0}%{}",
+        "self-audit",
+        au.replicates,
+        100.0 * au.same_model,
+        if au.failed > 0 {
+            format!(", {} failed", au.failed)
+        } else {
+            String::new()
+        }
+    )?;
+    for q in &au.quantities {
+        let coverage = match q.gmwm.coverage {
+            Some(c) => format!(
+                "interval covers {:.0}% ({} of {})",
+                100.0 * c,
+                (c * q.gmwm.intervals as f64).round(),
+                q.gmwm.intervals
+            ),
+            None => "no intervals".into(),
+        };
+        let ieee = match &q.ieee {
+            Some(i) => format!(
+                "IEEE bias {}, spread {}",
+                pct(i.bias),
+                pct(i.spread).trim_start_matches('+')
+            ),
+            None => "IEEE -".into(),
+        };
+        writeln!(
+            out,
+            "    {} {}: GMWM bias {}, spread {}, {coverage} | {ieee}",
+            q.name,
+            num(q.target),
+            pct(q.gmwm.bias),
+            pct(q.gmwm.spread).trim_start_matches('+'),
+        )?;
+    }
+    Ok(())
+}
+
 fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
     writeln!(out)?;
     let unit_note = match (&a.data_unit, a.unit.as_str()) {
@@ -690,6 +774,9 @@ fn axis_block(a: &AxisCalibration, out: &mut impl Write) -> Result<()> {
             num(h.horizon_s),
             num(h.excess_at_horizon)
         )?;
+    }
+    if let Some(au) = &a.audit {
+        audit_lines(au, out)?;
     }
     if let Some(g) = &a.gauss_markov_bias {
         writeln!(

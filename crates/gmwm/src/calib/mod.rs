@@ -1,4 +1,5 @@
 //! Calibration: from a recording to navigation-filter parameters.
+pub(crate) mod audit;
 pub(crate) mod contamination;
 pub(crate) mod datasheet;
 pub(crate) mod export;
@@ -11,6 +12,7 @@ pub(crate) mod pooled;
 pub(crate) mod streamed;
 pub(crate) mod verdict;
 
+pub use audit::{Audit, AuditQuantity, AuditStats};
 pub use contamination::{Contamination, FitUses};
 pub use datasheet::{Datasheet, DatasheetComparison};
 pub use horizon::HorizonBound;

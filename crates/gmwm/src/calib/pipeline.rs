@@ -2,6 +2,7 @@
 //! selected by WIC, the identified fit with inference, the canonical read-off in continuous
 //! SI units with intervals, the IEEE Std 952 read-off and a verdict on the fit.
 
+use super::audit::Audit;
 use super::contamination::{compare_classical_robust, Contamination, FitUses};
 use super::datasheet::{Datasheet, DatasheetComparison, Measured};
 use super::horizon::HorizonBound;
@@ -318,6 +319,10 @@ pub struct AxisCalibration {
     /// model has none of them).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plan: Option<Plan>,
+    /// The self-audit of this axis ([`Calibration::audit`]; left out of the JSON when none
+    /// was run).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub audit: Option<Audit>,
     /// A pooled calibration's recordings' own WVs of this axis (unit², the estimator of
     /// `wv`), input order, which `wv` pools; empty (and left out of the JSON) for one
     /// recording.
@@ -767,6 +772,7 @@ impl Calibration {
             notes,
             horizon: None,
             plan,
+            audit: None,
             recording_wvs: Vec::new(),
         };
         if let Some(t) = self.options.horizon_s {
