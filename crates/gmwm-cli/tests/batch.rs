@@ -140,7 +140,18 @@ fn a_folder_calibrates_in_one_command_resumes_and_names_the_corrupt_recording() 
     let bad = corrupt(&runs, "broken.csv");
     std::fs::write(runs.join("README.md"), "not a recording").unwrap();
 
-    let (table, stderr) = run(gmwm().arg("calibrate").arg(&runs).args(FAST), 1);
+    let (output, stderr) = run(gmwm().arg("calibrate").arg(&runs).args(FAST), 1);
+    // the table, then the spread of N, B, K across the 20 calibrated recordings (issue 29)
+    let (table, spread) = output.split_once("\n\nacross ").expect("a spread section");
+    assert!(
+        spread.starts_with("20 recordings of one sensor"),
+        "{spread}"
+    );
+    let n_row = spread
+        .lines()
+        .find(|l| l.trim_start().starts_with("gyro_x    N"))
+        .unwrap();
+    assert!(n_row.contains("spread"), "{n_row}");
     let lines: Vec<&str> = table.lines().collect();
     assert_eq!(lines.len(), 23, "header, 21 rows, counts: {table}");
     assert!(lines[0].starts_with("recording") && lines[0].contains("status"));

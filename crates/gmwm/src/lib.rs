@@ -156,14 +156,14 @@ pub use calib::export::{render_export, ExportError, ExportFormat, NavNoise, Sens
 pub use calib::ieee::{ieee_readoff, term_avar, CoefficientReadoff, IeeeReadoff};
 pub use calib::streamed::{binary_file_columns, wv_account, wv_columns};
 pub use calib::{
+    spread_across, Audit, AuditQuantity, AuditStats, Contamination, FitUses, FitVerdict,
+    GaussMarkovBias, HorizonBound, Plan, PlanTarget, PlannedQuantity, PooledInput, RecordedAxis,
+    ScaleFit, ScaleMiss, SpreadAcross, SpreadRow, PLAN_LENGTHS_S,
+};
+pub use calib::{
     Adjustment, AxisCalibration, AxisPolicy, CalibError, Calibration, CalibrationOptions,
     CalibrationReport, CalibrationSource, Datasheet, DatasheetComparison, Estimate, EstimateStatus,
     NavSet, DEFAULT_FULL_MODEL, DEFAULT_TOLERANCE, STREAM_FROM,
-};
-pub use calib::{
-    Audit, AuditQuantity, AuditStats, Contamination, FitUses, FitVerdict, GaussMarkovBias,
-    HorizonBound, Plan, PlanTarget, PlannedQuantity, PooledInput, ScaleFit, ScaleMiss,
-    PLAN_LENGTHS_S,
 };
 pub use monitor::{
     monitor_against, LevelOut, MonitorEvent, MonitorOptions, MonitorReport, MonitorWindow,

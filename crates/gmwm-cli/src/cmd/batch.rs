@@ -527,19 +527,34 @@ fn run(config: &BatchConfig, style: OutputStyle, out: &mut impl Write) -> Result
         BatchJob::Wv { json: true, .. } => Some(PathBuf::from("-")),
         BatchJob::Wv { json: false, .. } => None,
     };
+    let spread = match &config.job {
+        BatchJob::Calibrate { .. } => spread_of(&outcomes),
+        BatchJob::Wv { .. } => None,
+    };
+    let summary = || {
+        let mut v = summary_json(&outcomes, &w);
+        if let Some(s) = &spread {
+            v["spread"] = serde_json::to_value(s).unwrap_or_default();
+        }
+        v
+    };
     match json_to.as_deref() {
         Some(p) if p == Path::new("-") => {
-            serde_json::to_writer_pretty(&mut *out, &summary_json(&outcomes, &w))?;
+            serde_json::to_writer_pretty(&mut *out, &summary())?;
             writeln!(out)?;
         }
         Some(p) => {
             table(&outcomes, &w, out)?;
-            let mut text = serde_json::to_vec_pretty(&summary_json(&outcomes, &w))?;
+            spread_table(spread.as_ref(), out)?;
+            let mut text = serde_json::to_vec_pretty(&summary())?;
             text.push(b'\n');
             crate::output::write(p, &text)?;
             writeln!(out, "wrote {} (JSON summary)", p.display())?;
         }
-        None => table(&outcomes, &w, out)?,
+        None => {
+            table(&outcomes, &w, out)?;
+            spread_table(spread.as_ref(), out)?;
+        }
     }
     out.flush()?;
     let failed: Vec<String> = outcomes
@@ -562,6 +577,57 @@ fn run(config: &BatchConfig, style: OutputStyle, out: &mut impl Write) -> Result
             failed.len(),
             outcomes.len()
         );
+    }
+    Ok(())
+}
+
+/// The spread of N, B, K across the calibrated recordings (their calibration documents),
+/// `None` with fewer than two.
+fn spread_of(outcomes: &[Outcome]) -> Option<gmwm::SpreadAcross> {
+    let mut axes = Vec::new();
+    for o in outcomes.iter().filter(|o| o.status != Status::Failed) {
+        let Some(doc) = o
+            .outputs
+            .iter()
+            .find(|p| p.to_string_lossy().ends_with("calibration.json"))
+            .and_then(|p| read_json(p))
+        else {
+            continue;
+        };
+        axes.extend(gmwm::RecordedAxis::from_calibration(&stem(&o.file), &doc));
+    }
+    let spread = gmwm::spread_across(&axes);
+    (spread.recordings >= 2).then_some(spread)
+}
+
+/// The spread across recordings, after the batch table.
+fn spread_table(spread: Option<&gmwm::SpreadAcross>, out: &mut impl Write) -> Result<()> {
+    let Some(s) = spread else { return Ok(()) };
+    writeln!(
+        out,
+        "\nacross {} recordings of one sensor (median, range, relative spread):",
+        s.recordings
+    )?;
+    for r in &s.rows {
+        writeln!(
+            out,
+            "  {:<10}{} {:.3e} {}  [{:.3e} .. {:.3e}]  spread {:.0}%{}",
+            r.column,
+            r.quantity,
+            r.median,
+            r.unit,
+            r.min,
+            r.max,
+            100.0 * r.spread,
+            if r.bounds > 0 {
+                format!(" ({} of {} upper bounds)", r.bounds, r.recordings)
+            } else {
+                String::new()
+            }
+        )?;
+    }
+    for w in &s.warnings {
+        writeln!(out, "  warning: {w}")?;
     }
     Ok(())
 }

@@ -9,6 +9,7 @@ pub(crate) mod nav;
 pub(crate) mod pipeline;
 pub(crate) mod plan;
 pub(crate) mod pooled;
+pub(crate) mod spread;
 pub(crate) mod streamed;
 pub(crate) mod verdict;
 
@@ -26,6 +27,7 @@ pub use pipeline::{
 };
 pub use plan::{Plan, PlanTarget, PlannedQuantity, PLAN_LENGTHS_S};
 pub use pooled::PooledInput;
+pub use spread::{spread_across, RecordedAxis, SpreadAcross, SpreadRow};
 #[cfg(test)]
 pub(crate) use streamed::ROBUST_LEVELS;
 pub use streamed::{CalibrationSource, STREAM_FROM};
