@@ -1468,6 +1468,8 @@ pub struct PlanConfig {
     pub json: bool,
     /// FILE, when given.
     pub file: Option<PathBuf>,
+    /// `--plot FILE`.
+    pub plot: Option<PathBuf>,
 }
 
 /// `30min`, `2h`, `1d`, `600` (s) in seconds.
@@ -1628,6 +1630,7 @@ impl TryFrom<&crate::args::PlanArgs> for PlanConfig {
             alpha: a.alpha,
             json: a.json,
             file: a.file.clone(),
+            plot: a.plot.clone(),
         })
     }
 }

@@ -102,3 +102,24 @@ fn plan_refuses_bad_flags() {
     );
     assert_usage_error(gmwm().args(["plan"]), &["--model"]);
 }
+
+#[test]
+fn plan_draws_its_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("plan.png");
+    let out = gmwm()
+        .args([
+            "plan", "--model", MODEL, "--freq", "100", "--target", "K=20%", "--plot",
+        ])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG"), "a PNG");
+    assert!(bytes.len() > 10_000, "a drawn figure, not an empty canvas");
+}

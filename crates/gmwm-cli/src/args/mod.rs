@@ -725,7 +725,8 @@ Examples:
   gmwm plan calib.json                               each calibrated axis (gmwm calibrate --json)
   gmwm plan calib.json --columns gyro_x --target \"K=20%,B=10%\"
   gmwm plan --datasheet \"N=0.15 deg/sqrt(h), B=2 deg/h, K=0.5 deg/h/sqrt(h)\" --freq 200
-  gmwm plan --model \"GM(beta=0.01, sigma2_gm=1e-9)+WN(sigma2=1e-6)+RW(gamma2=1e-14)\" --freq 100 --lengths 30min,2h,1d --json";
+  gmwm plan --model \"GM(beta=0.01, sigma2_gm=1e-9)+WN(sigma2=1e-6)+RW(gamma2=1e-14)\" --freq 100 --lengths 30min,2h,1d --json
+  gmwm plan calib.json --target K=20% --plot plan.png      the figure: precision against length";
 
 /// `gmwm plan`.
 #[derive(Debug, Args)]
@@ -755,6 +756,9 @@ pub struct PlanArgs {
     /// Significance level of the intervals.
     #[arg(long, default_value_t = 0.05, value_parser = alpha)]
     pub alpha: f64,
+    /// Also draw the precision against the length to FILE (.png or .svg).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<PathBuf>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,

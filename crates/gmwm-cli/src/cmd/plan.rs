@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use gmwm::Plan;
 use serde::Serialize;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// One plan with its subject, as JSON.
 #[derive(Serialize)]
@@ -103,7 +103,7 @@ impl Command for PlanConfig {
     }
 
     fn outputs(&self) -> Vec<&Path> {
-        Vec::new()
+        self.plot.iter().map(PathBuf::as_path).collect()
     }
 
     fn levels(&self) -> Option<usize> {
@@ -122,6 +122,17 @@ impl Command for PlanConfig {
             )
             .with_context(|| format!("{}: {}", s.name, s.model))?;
             plans.push(plan);
+        }
+        if let Some(path) = &self.plot {
+            let named: Vec<(&str, &Plan)> = self
+                .subjects
+                .iter()
+                .map(|s| s.name.as_str())
+                .zip(&plans)
+                .collect();
+            gmwm_plot::plan_figure(&named)
+                .save(path)
+                .with_context(|| path.display().to_string())?;
         }
         if self.json {
             let named: Vec<Named<'_>> = self
