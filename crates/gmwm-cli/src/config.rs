@@ -646,7 +646,11 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             rostopic: a.rostopic.clone(),
             report: a.report.clone(),
             pool: Vec::new(),
-            audit: a.audit.unwrap_or(if a.report.is_some() { 8 } else { 0 }),
+            audit: a.audit.unwrap_or(if a.report.is_some() {
+                DEFAULT_REPORT_AUDIT
+            } else {
+                0
+            }),
         })
     }
 }
@@ -792,6 +796,10 @@ fn wv_or_batch(a: &WvCommand) -> Result<Config> {
     }))
 }
 
+/// Replicates of the self-audit in a report when `--audit` is not given: enough to show a
+/// bias or a coverage gap of the size the real recordings have, at about 5 s per axis.
+const DEFAULT_REPORT_AUDIT: usize = 8;
+
 /// `gmwm report`: the calibration, as `gmwm calibrate`, and the HTML file it is written to.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReportConfig {
@@ -847,10 +855,10 @@ impl TryFrom<&ReportArgs> for ReportConfig {
             .clone()
             .or_else(|| a.calibrate.report.clone())
             .unwrap_or_else(|| default_report(file));
-        Ok(Self {
-            calibrate: (&a.calibrate).try_into()?,
-            output,
-        })
+        let mut calibrate: CalibrateConfig = (&a.calibrate).try_into()?;
+        // a report carries the self-audit unless --audit says otherwise (as calibrate --report)
+        calibrate.audit = a.calibrate.audit.unwrap_or(DEFAULT_REPORT_AUDIT);
+        Ok(Self { calibrate, output })
     }
 }
 
