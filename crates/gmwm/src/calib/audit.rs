@@ -19,12 +19,12 @@
 use super::pipeline::{
     AxisCalibration, CalibError, Calibration, CalibrationReport, Estimate, EstimateStatus,
 };
+use super::plan::readoff_levels;
 use crate::imu::{Imu, Sensor, SensorInfo};
 use crate::process::{LatentProcess, Process};
 use crate::progress::Progress;
 use crate::sim::simulate_model;
 use crate::units::SignalKind;
-use crate::variance::ci::{eta3, interval_unchecked};
 use crate::Column;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -208,13 +208,10 @@ fn model_b(processes: &[Process], samples: usize, alpha: f64) -> Option<f64> {
     for p in processes {
         p.add_wv(&mut nu);
     }
-    let reliable: Vec<f64> = (1..=levels)
-        .filter(|&j| {
-            let eta = eta3(samples + 1 - (1 << j), j);
-            let (lo, hi) = interval_unchecked(1.0, eta, alpha);
-            hi <= 10.0 * lo
-        })
-        .map(|j| nu[j - 1])
+    let reliable: Vec<f64> = readoff_levels(samples, levels, alpha)
+        .into_iter()
+        .zip(&nu)
+        .filter_map(|(kept, v)| kept.then_some(*v))
         .collect();
     let (k, min) = reliable
         .iter()

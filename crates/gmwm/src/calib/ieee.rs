@@ -426,7 +426,7 @@ fn line_readoff(s: &Scales, c: &[f64; 5], j: usize) -> CoefficientReadoff {
 /// read-off to rest on it: 10, about nine clusters or more. The last points of a recording
 /// rest on a handful of clusters, their intervals span 40x and more, and one of them dipping
 /// would hide a floor the earlier scales show.
-const RELIABLE_SPAN: f64 = 10.0;
+pub(crate) const RELIABLE_SPAN: f64 = 10.0;
 
 /// docs/methods.md §14.3: bias instability, minimum deviation / [`FLICKER_FACTOR`] (module doc),
 /// over the scales whose interval spans at most [`RELIABLE_SPAN`] (all scales when fewer than

@@ -31,6 +31,7 @@
 //! The prediction holds for the model given; what selecting a model adds to the spread is the
 //! self-audit's business (docs/methods.md §19).
 
+use super::ieee::RELIABLE_SPAN;
 use super::pipeline::CalibError;
 use crate::error::{InputError, ParamError};
 use crate::inference::asymptotic::{sandwich, z_value, ZConvention};
@@ -309,7 +310,7 @@ impl Planner {
             );
         }
         if !quantities.iter().any(|q| q.name == "B") {
-            if let Some(b) = allan_minimum_b(&processes, freq_hz) {
+            if let Some(b) = allan_minimum_b(&processes) {
                 quantities.push(Quantity {
                     name: "B".into(),
                     value: b,
@@ -386,15 +387,7 @@ impl Planner {
                 let se_log = match &q.of {
                     Of::AllanMinimum => {
                         allan_minimum_level(&nu)?;
-                        // the read-off's scales: those whose interval spans at most 10x
-                        let reliable: Vec<bool> = eta
-                            .iter()
-                            .map(|&e| {
-                                let (lo, hi) = interval_unchecked(1.0, e, self.alpha);
-                                hi <= RELIABLE_SPAN * lo
-                            })
-                            .collect();
-                        minimum_spread(&nu, &v, &reliable)
+                        minimum_spread(&nu, &v, &readoff_levels(n, levels, self.alpha))
                     }
                     of => {
                         let g = self.log_gradient(of);
@@ -502,9 +495,18 @@ fn allan_minimum_level(nu: &[f64]) -> Option<usize> {
     (j > 0 && j + 1 < nu.len()).then_some(j)
 }
 
-/// The read-off's reliable scales: an interval spanning at most this factor
-/// (`crate::calib::ieee`).
-const RELIABLE_SPAN: f64 = 10.0;
+/// Which of the `levels` Haar levels of a recording of `samples` the IEEE read-off of B
+/// looks at: those whose chi-square interval (`eta_j = max(M_j / 2^j, 1)`, the Allan
+/// variance's at `tau = 2^(j-1)`) spans at most `RELIABLE_SPAN` (`crate::calib::ieee`).
+pub(crate) fn readoff_levels(samples: usize, levels: usize, alpha: f64) -> Vec<bool> {
+    (1..=levels)
+        .map(|j| {
+            let eta = eta3(samples + 1 - (1 << j), j);
+            let (lo, hi) = interval_unchecked(1.0, eta, alpha);
+            hi <= RELIABLE_SPAN * lo
+        })
+        .collect()
+}
 
 /// Draws of the WV from its normal law behind [`minimum_spread`].
 const MINIMUM_DRAWS: usize = 4000;
@@ -543,7 +545,7 @@ fn minimum_spread(nu: &[f64], v: &DMatrix<f64>, reliable: &[bool]) -> Option<f64
 
 /// B of the IEEE read-off of a model without flicker: `sqrt(min AV) / 0.664` over the
 /// dyadic cluster times of a long recording (2^26 samples); `None` without an interior minimum.
-fn allan_minimum_b(processes: &[Process], _freq_hz: f64) -> Option<f64> {
+fn allan_minimum_b(processes: &[Process]) -> Option<f64> {
     let levels = 26;
     let mut nu = vec![0.0; levels];
     for p in processes {
