@@ -157,29 +157,14 @@ fn replicate(
     freq_hz: f64,
     seed: u64,
 ) -> Result<Option<Replicate>, CalibError> {
-    let x = simulate_model(a.fit.model(), a.samples, freq_hz, seed)?;
-    let sensor = match kind {
-        SignalKind::Gyroscope => Sensor::Gyroscope,
-        SignalKind::Accelerometer => Sensor::Accelerometer,
+    let unit = (a.unit != "u").then_some(a.unit.as_str());
+    let simulated = SimulatedAxis {
+        column: &a.column,
+        axis: &a.axis,
+        kind,
+        unit,
     };
-    let imu = Imu::new(
-        vec![Column {
-            name: a.column.clone(),
-            values: x,
-        }],
-        vec![SensorInfo {
-            sensor,
-            axis: a.axis.clone(),
-            unit: (a.unit != "u").then(|| a.unit.clone()),
-        }],
-        freq_hz,
-    )
-    .map_err(crate::InputError::from)?;
-    // a replicate whose calibration fails counts as failed, not as an error of the audit
-    let Ok(r) = inner.run(&imu) else {
-        return Ok(None);
-    };
-    let Some(b) = r.axes.into_iter().next() else {
+    let Some(b) = simulated.calibrate(inner, a.fit.model(), a.samples, freq_hz, seed)? else {
         return Ok(None);
     };
     Ok(Some(Replicate {
@@ -189,10 +174,56 @@ fn replicate(
     }))
 }
 
+/// The axis a simulated recording stands for: its column, axis, kind and unit.
+pub(crate) struct SimulatedAxis<'a> {
+    pub(crate) column: &'a str,
+    pub(crate) axis: &'a str,
+    pub(crate) kind: SignalKind,
+    /// Unit of the samples (`None`: unknown, results in the data unit).
+    pub(crate) unit: Option<&'a str>,
+}
+
+impl SimulatedAxis<'_> {
+    /// `model` simulated (`samples` at `freq_hz`, seeded) and calibrated as this axis with
+    /// `inner`'s options; `None` when that calibration fails (a replicate that fails counts
+    /// as failed, not as an error of the study).
+    ///
+    /// # Errors
+    /// [`CalibError`] when the model cannot be simulated.
+    pub(crate) fn calibrate(
+        &self,
+        inner: &Calibration,
+        model: &crate::model::Model,
+        samples: usize,
+        freq_hz: f64,
+        seed: u64,
+    ) -> Result<Option<AxisCalibration>, CalibError> {
+        let x = simulate_model(model, samples, freq_hz, seed)?;
+        let sensor = match self.kind {
+            SignalKind::Gyroscope => Sensor::Gyroscope,
+            SignalKind::Accelerometer => Sensor::Accelerometer,
+        };
+        let imu = Imu::new(
+            vec![Column {
+                name: self.column.to_string(),
+                values: x,
+            }],
+            vec![SensorInfo {
+                sensor,
+                axis: self.axis.to_string(),
+                unit: self.unit.map(str::to_string),
+            }],
+            freq_hz,
+        )
+        .map_err(crate::InputError::from)?;
+        Ok(inner.run(&imu).ok().and_then(|r| r.axes.into_iter().next()))
+    }
+}
+
 /// B of the simulated model: its flicker term's, else `min sqrt(2 nu2_j) / 0.664` over the
 /// levels the read-off uses at this length (those whose interval spans at most 10x), `None`
 /// when that minimum is at either end of them (no floor: the read-off gives a bound).
-fn model_b(processes: &[Process], samples: usize, alpha: f64) -> Option<f64> {
+pub(crate) fn model_b(processes: &[Process], samples: usize, alpha: f64) -> Option<f64> {
     if let Some(b) = processes.iter().find_map(|p| match p {
         Process::Flicker(f) => Some(f.bias_instability()),
         _ => None,

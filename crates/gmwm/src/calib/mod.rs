@@ -2,6 +2,7 @@
 pub(crate) mod audit;
 pub(crate) mod contamination;
 pub(crate) mod datasheet;
+pub(crate) mod effective;
 pub(crate) mod export;
 pub(crate) mod horizon;
 pub(crate) mod ieee;

@@ -731,13 +731,22 @@ impl Calibration {
             &unit_label,
             freq_hz,
         );
-        let read = readoff.read(&allan, &ieee, &mut notes);
+        let mut read = readoff.read(&allan, &ieee, &mut notes);
         notes.extend(readings(&selection, &canonical));
         let plan =
             super::plan::longer_recording(&fit.model, freq_hz, samples).map(|(plan, line)| {
                 notes.push(line);
                 plan
             });
+        if let Some(plan) = &plan {
+            self.effective_random_walk(
+                (&selection, &wv, &fit, plan),
+                (&allan, &ieee),
+                (unit_kind, &unit_label, freq_hz),
+                &mut read,
+                &mut notes,
+            );
+        }
         let contamination = self.contamination(&data, freq_hz, &wv, &mut notes);
         let datasheet = self.datasheet(kind, unit_kind, &read, &mut notes);
         let mut axis = AxisCalibration {
@@ -942,14 +951,25 @@ impl Calibration {
                     .unwrap_or(1)
             })
             .sum();
-        if count < 2 || parts.contains(&"FN()") {
+        if count == 0 || parts.contains(&"FN()") {
             return None;
+        }
+        // a single correlated term is taken for a floor only when the recording determines its
+        // correlation time: an undetermined slow one is the effective random walk's
+        // (`super::effective`), a hump or a floor the data cannot tell
+        if count == 1 {
+            let length = wv.n() as f64 / base.freq_hz();
+            let plan = Plan::new(&base.model, base.freq_hz(), &[length], 0.05, &[]).ok()?;
+            if !super::effective::unresolved_slow_terms(&plan, 0.0).is_empty() {
+                return None;
+            }
         }
         let kept: Vec<&str> = parts.into_iter().filter(|c| !correlated(c)).collect();
         // every correlated term replaced, or all but one (the sensor's sub-sample filter, or a
         // hump, may need its own)
-        let (candidate, fit, inference, canonical, refined) = ["", "AR1()+"]
-            .into_iter()
+        let keep_one: &[&str] = if count >= 2 { &["", "AR1()+"] } else { &[""] };
+        let (candidate, fit, inference, canonical, refined) = keep_one
+            .iter()
             .filter_map(|one| {
                 let candidate = format!(
                     "{one}{}",
@@ -988,6 +1008,66 @@ impl Calibration {
             canonical,
             refined,
         ))
+    }
+
+    /// K as the effective random walk (`super::effective`, docs/methods.md §20) when the
+    /// identified model has a slow correlated term the planner leaves undetermined at this
+    /// length: that model without those terms, with a random walk, fitted on the same WV and
+    /// read off into `read.random_walk` (the term's Gauss–Markov bias marked undetermined);
+    /// `None`, `read`'s K kept, when there is no such term or the refit gives no K.
+    #[allow(clippy::type_complexity)]
+    fn effective_random_walk(
+        &self,
+        (selection, wv, fit, plan): (&ModelSelection, &WaveletVariance, &GmwmFit, &Plan),
+        (allan, ieee): (&AllanVariance, &IeeeReadoff),
+        (kind, unit, freq_hz): (Option<SignalKind>, &str, f64),
+        read: &mut ReadOffs,
+        notes: &mut Vec<String>,
+    ) -> Option<()> {
+        let terms = super::effective::unresolved_slow_terms(plan, ieee.b.at_tau_s);
+        if terms.is_empty() {
+            return None;
+        }
+        // the Gauss–Markov bias of an undetermined term: its values, no intervals
+        if let Some(g) = read.gauss_markov_bias.as_mut() {
+            let t = g.correlation_time.value;
+            if terms.iter().any(|(_, tt)| (tt / t - 1.0).abs() < 1e-6) {
+                for e in [
+                    &mut g.correlation_time,
+                    &mut g.sigma,
+                    &mut g.driving_density,
+                ] {
+                    e.ci_low = None;
+                    e.ci_high = None;
+                    e.status = EstimateStatus::Undetermined;
+                    e.source.push_str(
+                        "; its correlation time is not determined at this length (gmwm plan)",
+                    );
+                }
+            }
+        }
+        let dropped: Vec<usize> = terms.iter().map(|t| t.0).collect();
+        let model = super::effective::with_random_walk_for(&fit.model, &dropped, freq_hz)?;
+        let (fit, inference, canonical, _) = self.judged(model, selection, wv)?;
+        let readoff = Readoff::new(&fit, &canonical, &inference, kind, unit, freq_hz);
+        let mut scratch = Vec::new();
+        let effective = readoff.read(allan, ieee, &mut scratch).random_walk?;
+        if effective.status == EstimateStatus::UpperBound {
+            return None;
+        }
+        let (note, source) = super::effective::effective_random_walk_note(
+            &terms,
+            &fit.model,
+            read.random_walk.as_ref(),
+            &effective,
+            wv.n() as f64 / freq_hz,
+        );
+        notes.push(note);
+        read.random_walk = Some(Estimate {
+            source,
+            ..effective
+        });
+        Some(())
     }
 
     /// The identified fit (the canonical model's reduced model, fitted: a candidate of the

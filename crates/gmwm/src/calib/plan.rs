@@ -72,6 +72,9 @@ pub struct PlannedQuantity {
     pub source: String,
     /// Relative half-width at each length.
     pub half_width: Vec<Option<f64>>,
+    /// The index of the process (in `Model::processes` order) a correlation time belongs to.
+    #[serde(skip)]
+    pub(crate) process: Option<usize>,
 }
 
 /// The shortest length meeting a target.
@@ -158,6 +161,7 @@ impl Plan {
                 unit: q.unit.clone(),
                 source: q.source.clone(),
                 half_width: columns.iter().map(|c| c[i]).collect(),
+                process: q.process,
             })
             .collect();
         let mut out_targets = Vec::new();
@@ -222,6 +226,8 @@ struct Quantity {
     unit: String,
     source: String,
     of: Of,
+    /// The process a correlation time belongs to.
+    process: Option<usize>,
 }
 
 /// The model prepared once for every length.
@@ -264,6 +270,7 @@ impl Planner {
                     unit: "u*sqrt(Hz)".into(),
                     source: "RW term".into(),
                     of: Of::RandomWalk(offset),
+                    process: None,
                 }),
                 Process::Flicker(f) => quantities.push(Quantity {
                     name: "B".into(),
@@ -271,6 +278,7 @@ impl Planner {
                     unit: "u".into(),
                     source: "FN term".into(),
                     of: Of::Flicker(offset),
+                    process: None,
                 }),
                 Process::Ar1(_) | Process::Gm(_) => {
                     correlated += 1;
@@ -282,6 +290,7 @@ impl Planner {
                         unit: "s".into(),
                         source: format!("correlation time of {}[{component}]", p.name()),
                         of: Of::CorrelationTime { index: offset, gm },
+                        process: Some(component),
                     });
                 }
                 Process::Arma(_) => {
@@ -306,6 +315,7 @@ impl Planner {
                     unit: "u/sqrt(Hz)".into(),
                     source: "white-noise terms".into(),
                     of: Of::WhiteDensity(white),
+                    process: None,
                 },
             );
         }
@@ -317,6 +327,7 @@ impl Planner {
                     unit: "u".into(),
                     source: "IEEE 952 read-off: min Allan deviation / 0.664 (its spread)".into(),
                     of: Of::AllanMinimum,
+                    process: None,
                 });
             }
         }
