@@ -3,7 +3,7 @@
 
 use super::export::{NavNoise, SensorNoise};
 use super::horizon::HorizonBound;
-use super::pipeline::{AxisCalibration, CalibrationReport, Estimate};
+use super::pipeline::{AxisCalibration, CalibrationReport, Estimate, EstimateStatus};
 use crate::error::ParamError;
 use crate::units::{SignalKind, SignalUnit};
 use serde::Serialize;
@@ -342,8 +342,16 @@ fn triad(
     let (bias_correlation_time_s, bias_sigma, bias_driving_density) = match gm {
         Some((a, g)) => {
             comments.push(format!(
-                "{name} Gauss-Markov bias: {} (its slowest correlated term: T = {:.4e} s, sigma = {:.4e} {})",
-                a.column, g.correlation_time.value, g.sigma.value, g.sigma.unit
+                "{name} Gauss-Markov bias: {} (its slowest correlated term: T = {:.4e} s, sigma = {:.4e} {}){}",
+                a.column,
+                g.correlation_time.value,
+                g.sigma.value,
+                g.sigma.unit,
+                if g.correlation_time.status == EstimateStatus::Undetermined {
+                    "; T is not determined at this recording's length (gmwm plan): the random walk exported is the effective one, which counts this term, so a filter that also carries it counts it twice, on the safe side (docs/methods.md §20)"
+                } else {
+                    ""
+                }
             ));
             let pick = |e: &Estimate| match adjustment {
                 Adjustment::Conservative => e.ci_high.unwrap_or(e.value),
