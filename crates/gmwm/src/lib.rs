@@ -145,7 +145,7 @@ pub use imu::{
     RecordingOptions, RecordingSource, SampleAccount, Sensor, SensorInfo, SeriesWriter, Sidecar,
     SidecarColumn, TimeUnit, TimingReport,
 };
-pub use imu::{Axis, ColumnSummary, Gap, SidecarUnits, Tally, TimingWarning};
+pub use imu::{Axis, ColumnSummary, Gap, NotASidecar, SidecarUnits, Tally, TimingWarning};
 pub use units::{si_unit, NoiseTerm, SignalKind, SignalUnit};
 
 // The calibration: a recording to a navigation filter's parameters (§14).

@@ -55,7 +55,7 @@ pub(crate) use read::{
 pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use samples::{SampleAccount, Tally};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
-pub use sidecar::{find_sidecar, ColumnSummary, Sidecar, SidecarColumn, SidecarUnits};
+pub use sidecar::{find_sidecar, ColumnSummary, NotASidecar, Sidecar, SidecarColumn, SidecarUnits};
 #[cfg(test)]
 pub(crate) use timing::{check_times, UnitSource};
 pub use timing::{time_column_unit, Gap, TimeUnit, TimingReport, TimingWarning};

@@ -135,14 +135,92 @@ pub fn sidecar_candidates(data: &Path) -> Vec<PathBuf> {
 
 /// Finds and reads the sidecar of a data file, if one exists.
 ///
+/// A candidate that is empty, or is JSON without any of a sidecar's keys (the output of
+/// `gmwm wv x.csv --json > x.json`: a WV or calibration document at the sidecar's name), is
+/// not a sidecar and is passed over ([`locate_sidecar`] says which and why).
+///
 /// # Errors
-/// As [`Sidecar::read`], for the first candidate of [`sidecar_candidates`] that exists.
+/// As [`Sidecar::read`], for the first candidate of [`sidecar_candidates`] that exists and is
+/// not passed over.
 pub fn find_sidecar(data: &Path) -> Result<Option<Sidecar>, ReadError> {
-    match sidecar_candidates(data).into_iter().find(|p| p.is_file()) {
-        Some(p) => Sidecar::read(&p).map(Some),
-        None => Ok(None),
-    }
+    locate_sidecar(data).map(|(sidecar, _)| sidecar)
 }
+
+/// A file at a sidecar's name that is not one: its path and why.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct NotASidecar {
+    /// The file.
+    pub path: PathBuf,
+    /// Why it is not taken as a sidecar.
+    pub why: String,
+}
+
+/// The keys a sidecar may have ([`Sidecar`]'s fields).
+const SIDECAR_KEYS: &[&str] = &[
+    "name",
+    "sensor",
+    "sampling_frequency_hz",
+    "units",
+    "format",
+    "n_columns",
+    "columns",
+    "n_rows",
+    "summary",
+];
+
+/// [`find_sidecar`], with the files at a sidecar's name passed over, in candidate order.
+///
+/// # Errors
+/// As [`find_sidecar`].
+pub(crate) fn locate_sidecar(
+    data: &Path,
+) -> Result<(Option<Sidecar>, Vec<NotASidecar>), ReadError> {
+    let mut passed = Vec::new();
+    for path in sidecar_candidates(data).into_iter().filter(|p| p.is_file()) {
+        let text = std::fs::read_to_string(&path).map_err(|source| ReadError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        if let Some(why) = not_a_sidecar(&text) {
+            passed.push(NotASidecar { path, why });
+            continue;
+        }
+        return Ok((Some(Sidecar::from_json(&text, &path)?), passed));
+    }
+    Ok((None, passed))
+}
+
+/// Why `text` is not a sidecar, `None` when it may be one (text that is not JSON is left to
+/// [`Sidecar::from_json`] to report: a sidecar with a typo is an error, not ignored).
+fn not_a_sidecar(text: &str) -> Option<String> {
+    if text.trim().is_empty() {
+        return Some("it is empty".to_string());
+    }
+    let value: serde_json::Value = serde_json::from_str(text).ok()?;
+    let Some(object) = value.as_object() else {
+        return Some("it is JSON but not an object".to_string());
+    };
+    // gmwm's own documents first: a calibration has a `name` too
+    if let Some((_, what)) = DOCUMENT_KEYS.iter().find(|(k, _)| object.contains_key(*k)) {
+        return Some(format!("it is {what}, not a sidecar"));
+    }
+    if object.keys().any(|k| SIDECAR_KEYS.contains(&k.as_str())) {
+        return None;
+    }
+    Some("it has none of a sidecar's keys".to_string())
+}
+
+/// The top-level key of each JSON document gmwm writes, and what it is.
+const DOCUMENT_KEYS: &[(&str, &str)] = &[
+    (
+        "series",
+        "a wavelet or Allan variance document (gmwm wv/avar --json)",
+    ),
+    ("fits", "a fit document (gmwm fit --json)"),
+    ("selections", "a selection document (gmwm select --json)"),
+    ("axes", "a calibration document (gmwm calibrate --json)"),
+    ("processes", "an implied-WV document (gmwm implied --json)"),
+];
 
 #[cfg(test)]
 mod tests {

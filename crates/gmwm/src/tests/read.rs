@@ -383,6 +383,48 @@ fn read_error_sidecar_unreadable() {
     );
 }
 
+/// `gmwm wv s.csv --json > s.json`: the shell creates the empty `s.json` before the run, and
+/// afterwards it holds a WV document; neither is the recording's sidecar, the real one (at the
+/// writers' name) is read, and each file passed over is a warning.
+#[test]
+fn files_at_a_sidecar_name_that_are_not_sidecars_are_passed_over() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(&d, "s.csv", b"1\n2\n3\n");
+    let legacy = write(&d, "s.json", b"");
+    let table = read(&p).unwrap();
+    assert_eq!(table.facts.freq_hz, None);
+    let said: Vec<String> = table.facts.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        said,
+        vec![format!(
+            "{}: not read as the recording's sidecar: it is empty",
+            legacy.display()
+        )]
+    );
+    for (doc, what) in [
+        ("{\"series\": []}", "a wavelet or Allan variance document"),
+        ("{\"name\": \"x\", \"axes\": []}", "a calibration document"),
+        ("{\"fits\": []}", "a fit document"),
+        ("[1, 2]", "it is JSON but not an object"),
+        ("{\"hello\": 1}", "none of a sidecar's keys"),
+    ] {
+        std::fs::write(&legacy, doc).unwrap();
+        write(&d, "s.csv.json", b"{\"sampling_frequency_hz\": 50}");
+        let table = read(&p).unwrap();
+        assert_eq!(table.facts.freq_hz, Some(50.0), "{doc}");
+        // the writers' name comes first: the legacy one is not even looked at
+        assert!(table.facts.warnings.is_empty(), "{doc}");
+        std::fs::remove_file(d.path().join("s.csv.json")).unwrap();
+        let table = read(&p).unwrap();
+        assert_eq!(table.facts.freq_hz, None, "{doc}");
+        let said = table.facts.warnings[0].to_string();
+        assert!(said.contains(what), "{doc}: {said}");
+    }
+    // a sidecar with a typo stays an error, not passed over
+    std::fs::write(&legacy, b"{\"sampling_frequency_hz\": ").unwrap();
+    assert!(err(&p, &ReadOptions::default()).contains("sidecar JSON is unreadable"));
+}
+
 #[test]
 fn imu_from_table_without_freq_fails() {
     let d = tempfile::tempdir().unwrap();

@@ -380,6 +380,16 @@ pub enum ReadWarning {
         /// Its rate, in Hz (used).
         time_hz: f64,
     },
+    /// A file at a sidecar's name that is not a sidecar (empty, or a document gmwm wrote
+    /// there: `gmwm wv x.csv --json > x.json`), passed over.
+    NotASidecar(crate::imu::sidecar::NotASidecar),
+}
+
+/// The warnings for the files at `path`'s sidecar names passed over as not sidecars.
+pub(crate) fn passed_over_sidecars(path: &Path) -> Vec<ReadWarning> {
+    crate::imu::sidecar::locate_sidecar(path)
+        .map(|(_, passed)| passed.into_iter().map(ReadWarning::NotASidecar).collect())
+        .unwrap_or_default()
 }
 
 /// Relative difference between two rates above which they disagree: 1% (a time column and a
@@ -391,6 +401,12 @@ impl fmt::Display for ReadWarning {
         let pct = |a: f64, b: f64| 100.0 * (a - b).abs() / b;
         match self {
             Self::Timing { path, warning } => write!(f, "{}: {warning}", path.display()),
+            Self::NotASidecar(n) => write!(
+                f,
+                "{}: not read as the recording's sidecar: {}",
+                n.path.display(),
+                n.why
+            ),
             Self::FreqDisagrees {
                 path,
                 given_hz,
@@ -711,6 +727,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         sidecar.as_ref(),
         &mut warnings,
     )?;
+    warnings.extend(passed_over_sidecars(path));
     let samples = SampleAccount {
         missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
         ..SampleAccount::all_used(

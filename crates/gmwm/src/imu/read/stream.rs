@@ -601,6 +601,7 @@ fn finish(
         sidecar.as_ref(),
         &mut warnings,
     )?;
+    warnings.extend(super::passed_over_sidecars(path));
     let samples = SampleAccount {
         missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
         ..SampleAccount::all_used(names.clone(), "row", rows)
