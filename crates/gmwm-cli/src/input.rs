@@ -143,8 +143,15 @@ pub(crate) fn report_parts(
                 quote(column),
                 hz(*time_hz),
             ),
-            w => eprintln!("gmwm: warning: {}", crate::spool::shown(&w.to_string())),
+            w => warn_all(std::slice::from_ref(w)),
         }
+    }
+}
+
+/// Prints each reader warning on stderr (shown with `--quiet` too).
+pub(crate) fn warn_all(warnings: &[ReadWarning]) {
+    for w in warnings {
+        eprintln!("gmwm: warning: {}", crate::spool::shown(&w.to_string()));
     }
 }
 
@@ -315,6 +322,7 @@ pub fn streamed_recording(input: &InputConfig) -> Result<LoadedRecording> {
     // the columns left out, as the in-memory reader notes them
     let skipped = match gmwm::binary_layout(&input.file, &input.read)? {
         Some(layout) => {
+            warn_all(&gmwm::binary_warnings(&input.file, &layout));
             let sidecar = gmwm::find_sidecar(&input.file)?;
             layout
                 .selection(&input.file, &input.read, sidecar.as_ref())?

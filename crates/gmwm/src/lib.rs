@@ -128,6 +128,7 @@ pub use shared::{
 // Recordings: readers, writers, sidecars, ROS containers (docs/methods.md §10).
 pub use imu::plausible::{raw_floats, ImplausibleFloats};
 pub use imu::read::binary::ImuRecordType;
+pub use imu::read::binary_warnings;
 pub use imu::read::stream::{streams_from, StreamedTable};
 pub use imu::read::{
     binary_layout, read_table, BinaryLayout, Column, ColumnSelector, HeaderMode, InputFormat,

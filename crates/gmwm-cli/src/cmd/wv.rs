@@ -53,6 +53,7 @@ pub(crate) fn stream_columns(
     let sidecar = gmwm::find_sidecar(&input.file)?;
     let (columns, skipped) = layout.selection(&input.file, &input.read, sidecar.as_ref())?;
     crate::input::note_not_analysed(style, &input.file, &skipped);
+    crate::input::warn_all(&gmwm::binary_warnings(&input.file, layout));
     let freq_hz = match input.read.freq_hz {
         Some(f) => f,
         None => stream_freq(&input.file)?,

@@ -425,6 +425,43 @@ fn files_at_a_sidecar_name_that_are_not_sidecars_are_passed_over() {
     assert!(err(&p, &ReadOptions::default()).contains("sidecar JSON is unreadable"));
 }
 
+/// A truncated copy beside the sidecar of the whole recording: read, with a warning naming
+/// both counts; a sidecar stating a raw layout the file's name contradicts: refused.
+#[test]
+fn a_sidecar_is_held_against_the_file() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(&d, "s.csv", b"1\n2\n3\n");
+    write(
+        &d,
+        "s.csv.json",
+        b"{\"n_rows\": 5, \"sampling_frequency_hz\": 10}",
+    );
+    let table = read(&p).unwrap();
+    let said: Vec<String> = table.facts.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        said,
+        vec![format!(
+            "{}: its sidecar says n_rows = 5 but the file holds 3 rows (a truncated or partial copy?); the 3 rows are analysed",
+            p.display()
+        )]
+    );
+    let raw = write(&d, "r.f64", &[0u8; 64]);
+    write(&d, "r.f64.json", b"{\"format\": \"f32\", \"n_rows\": 8}");
+    let msg = err(&raw, &ReadOptions::default());
+    assert!(
+        msg.contains("invalid sidecar format = f32") && msg.contains("(f64)"),
+        "{msg}"
+    );
+    // the flag decides
+    let opts = ReadOptions {
+        format: InputFormat::F64,
+        ..ReadOptions::default()
+    };
+    let table = read_table(&raw, &opts).unwrap();
+    assert_eq!(table.columns[0].values.len(), 8);
+    assert_eq!(table.facts.warnings.len(), 0, "{:?}", table.facts.warnings);
+}
+
 #[test]
 fn imu_from_table_without_freq_fails() {
     let d = tempfile::tempdir().unwrap();

@@ -383,6 +383,30 @@ pub enum ReadWarning {
     /// A file at a sidecar's name that is not a sidecar (empty, or a document gmwm wrote
     /// there: `gmwm wv x.csv --json > x.json`), passed over.
     NotASidecar(crate::imu::sidecar::NotASidecar),
+    /// The sidecar's `n_rows` is not the number of rows read; the rows read are used.
+    SidecarRowsDisagree {
+        /// File.
+        path: PathBuf,
+        /// The sidecar's `n_rows`.
+        sidecar_rows: u64,
+        /// Rows read.
+        rows: u64,
+    },
+}
+
+/// The warning of a sidecar whose `n_rows` is not the number of rows the file holds (a
+/// truncated or partial copy of the recording, or the sidecar of another one).
+pub(crate) fn sidecar_rows_disagree(
+    path: &Path,
+    sidecar: Option<&Sidecar>,
+    rows: u64,
+) -> Option<ReadWarning> {
+    let stated = sidecar?.n_rows?;
+    (stated != rows).then(|| ReadWarning::SidecarRowsDisagree {
+        path: path.to_path_buf(),
+        sidecar_rows: stated,
+        rows,
+    })
 }
 
 /// The warnings for the files at `path`'s sidecar names passed over as not sidecars.
@@ -401,6 +425,20 @@ impl fmt::Display for ReadWarning {
         let pct = |a: f64, b: f64| 100.0 * (a - b).abs() / b;
         match self {
             Self::Timing { path, warning } => write!(f, "{}: {warning}", path.display()),
+            Self::SidecarRowsDisagree {
+                path,
+                sidecar_rows,
+                rows,
+            } => write!(
+                f,
+                "{}: its sidecar says n_rows = {sidecar_rows} but the file holds {rows} rows ({}); the {rows} rows are analysed",
+                path.display(),
+                if rows < sidecar_rows {
+                    "a truncated or partial copy?"
+                } else {
+                    "the sidecar of another recording?"
+                }
+            ),
             Self::NotASidecar(n) => write!(
                 f,
                 "{}: not read as the recording's sidecar: {}",
@@ -452,7 +490,27 @@ pub(crate) fn resolve_format(
     format: InputFormat,
     sidecar: Option<&Sidecar>,
 ) -> Result<InputFormat, ReadError> {
+    let given = format;
     let mut format = format.resolve(path);
+    // a raw layout named by the file and another by its sidecar: the values would be read
+    // with the wrong width, so neither is chosen silently (a --format flag decides)
+    if given == InputFormat::Auto && format.value_width().is_some() {
+        if let Some(other) = sidecar
+            .and_then(|s| s.format.as_deref())
+            .and_then(|f| f.parse::<InputFormat>().ok())
+            .filter(|f| f.value_width().is_some() && *f != format)
+        {
+            return Err(ParamError::new(
+                "sidecar format",
+                other,
+                format!(
+                    "the layout {}'s name says ({format}); fix the sidecar, rename the file, or say --format",
+                    path.display()
+                ),
+            )
+            .into());
+        }
+    }
     if format == InputFormat::Auto {
         if let Some(f) = sidecar
             .and_then(|s| s.format.as_deref())
@@ -581,6 +639,19 @@ pub fn binary_layout(path: &Path, opts: &ReadOptions) -> Result<Option<BinaryLay
         ncols,
         names: binary_names(sidecar.as_ref(), ncols),
     }))
+}
+
+/// The warnings of a raw binary file read in `layout` without [`read_table`] (streamed): the
+/// files at its sidecar's names passed over, and a sidecar `n_rows` the file does not hold.
+pub fn binary_warnings(path: &Path, layout: &BinaryLayout) -> Vec<ReadWarning> {
+    let (sidecar, passed) = crate::imu::sidecar::locate_sidecar(path).unwrap_or_default();
+    let record = layout.format.value_width().unwrap_or(8) * layout.ncols.max(1);
+    let rows = std::fs::metadata(path).map_or(0, |m| m.len() / record as u64);
+    passed
+        .into_iter()
+        .map(ReadWarning::NotASidecar)
+        .chain(sidecar_rows_disagree(path, sidecar.as_ref(), rows))
+        .collect()
 }
 
 /// Column names of a raw binary file: the sidecar's if it names exactly `ncols` columns.
@@ -728,6 +799,11 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         &mut warnings,
     )?;
     warnings.extend(passed_over_sidecars(path));
+    warnings.extend(sidecar_rows_disagree(
+        path,
+        sidecar.as_ref(),
+        raw.columns.first().map_or(0, |c| c.values.len() as u64),
+    ));
     let samples = SampleAccount {
         missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
         ..SampleAccount::all_used(

@@ -602,6 +602,7 @@ fn finish(
         &mut warnings,
     )?;
     warnings.extend(super::passed_over_sidecars(path));
+    warnings.extend(super::sidecar_rows_disagree(path, sidecar.as_ref(), rows));
     let samples = SampleAccount {
         missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
         ..SampleAccount::all_used(names.clone(), "row", rows)
