@@ -131,6 +131,7 @@ impl TryFrom<&InputArgs> for InputConfig {
             columns: a.columns.iter().map(|c| selector(c)).collect(),
             ncols: a.ncols,
             freq_hz: a.freq,
+            time_policy: a.time_policy,
         };
         Ok(Self {
             file: a.file.clone(),
@@ -1766,6 +1767,7 @@ mod tests {
                 ],
                 ncols: Some(6),
                 freq_hz: Some(200.0),
+                time_policy: gmwm::TimePolicy::Strict,
             }
         );
         assert_eq!(c.input.topic.as_deref(), Some("/imu0"));
@@ -1789,6 +1791,7 @@ mod tests {
             header: HeaderMode::Auto,
             time_column: None,
             time_unit: None,
+            time_policy: gmwm::TimePolicy::Strict,
             topic: None,
             stream_from: None,
         };

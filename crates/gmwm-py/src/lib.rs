@@ -543,6 +543,7 @@ fn read_options(
             .collect(),
         ncols,
         freq_hz: freq,
+        time_policy: gmwm::TimePolicy::Strict,
     })
 }
 

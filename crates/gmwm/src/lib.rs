@@ -128,12 +128,12 @@ pub use shared::{
 // Recordings: readers, writers, sidecars, ROS containers (docs/methods.md §10).
 pub use imu::plausible::{raw_floats, ImplausibleFloats};
 pub use imu::read::binary::ImuRecordType;
-pub use imu::read::binary_warnings;
 pub use imu::read::stream::{streams_from, StreamedTable};
 pub use imu::read::{
     binary_layout, read_table, BinaryLayout, Column, ColumnSelector, HeaderMode, InputFormat,
     ReadOptions, ReadWarning, Table, TableFacts, RATE_TOLERANCE,
 };
+pub use imu::read::{binary_warnings, TimePolicy};
 pub use imu::recording::{left_out_note, table_notes};
 pub use imu::ros::{
     choose_topic, list_topics, read_imu_messages, ImuMessages, RosContainer, TopicInfo,

@@ -10,8 +10,8 @@ pub use several::{Against, MonitorArgs, SameModelArgs, SharedArgs};
 use clap::{Args, Parser, Subcommand};
 use gmwm::{
     AllanKind, AvConvention, AxisPolicy, CovarianceMethod, HeaderMode, InputFormat,
-    OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimeUnit, Transform,
-    Weighting,
+    OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimePolicy, TimeUnit,
+    Transform, Weighting,
 };
 use std::path::PathBuf;
 use values::{
@@ -847,6 +847,9 @@ pub struct InputArgs {
     /// Unit of the time column [default: stated by its name, else inferred from the values].
     #[arg(long, value_parser = choice::<TimeUnit>(), value_name = "UNIT")]
     pub time_unit: Option<TimeUnit>,
+    /// What a text file's row whose time stamp is not after the previous one does.
+    #[arg(long, value_parser = choice::<TimePolicy>(), default_value_t = TimePolicy::Strict, value_name = "POLICY")]
+    pub time_policy: TimePolicy,
     /// The sensor_msgs/Imu topic of a ROS recording (ROS1 .bag, MCAP, rosbag2 .db3 or folder)
     /// [default: its only IMU topic; `gmwm topics FILE` lists them].
     #[arg(long, value_name = "TOPIC")]

@@ -5,8 +5,8 @@
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use gmwm::{
     AllanKind, AvConvention, AxisPolicy, CovarianceMethod, HeaderMode, ImuRecordType, InputFormat,
-    Named, OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimeUnit,
-    Transform, Weighting,
+    Named, OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimePolicy,
+    TimeUnit, Transform, Weighting,
 };
 use std::str::FromStr;
 
@@ -66,6 +66,16 @@ impl ValueHelp for HeaderMode {
             Self::Auto => "A header iff the first row has a non-numeric field",
             Self::Present => "The first row is a header",
             Self::Absent => "There is no header",
+        }
+    }
+}
+
+impl ValueHelp for TimePolicy {
+    fn help(self) -> &'static str {
+        match self {
+            Self::Strict => "An error naming the line (the default)",
+            Self::DropDuplicates => "Drop the row, counted in a warning",
+            Self::Sort => "Sort the rows by stamp, then drop repeats (read in memory only)",
         }
     }
 }

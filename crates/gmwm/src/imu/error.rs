@@ -362,7 +362,8 @@ pub enum ReadError {
     /// The time column is not strictly increasing.
     #[error(
         "{}:{line}: column {column}: time {value} is not greater than the previous time \
-         {previous}; the time column must be strictly increasing",
+         {previous}; the time column must be strictly increasing (--time-policy \
+         drop-duplicates drops such rows, --time-policy sort sorts them)",
         .path.display()
     )]
     TimeNotIncreasing {

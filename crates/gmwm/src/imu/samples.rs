@@ -129,6 +129,11 @@ impl fmt::Display for SampleAccount {
                  (analysed as contiguous)",
                 plural("sample", m)
             ),
+            (d, 0) => write!(
+                f,
+                "; {d} {} not used; nothing filled in",
+                plural(self.unit, d)
+            ),
             (d, m) => write!(
                 f,
                 "; {d} {} not used; {m} missing in the time stamps' gaps, not filled in",

@@ -170,10 +170,51 @@ fn read_time_not_increasing() {
         err(&p, &o),
         format!(
             "{}:4: column t: time 0.01 is not greater than the previous time 0.01; \
-             the time column must be strictly increasing",
+             the time column must be strictly increasing (--time-policy drop-duplicates drops \
+             such rows, --time-policy sort sorts them)",
             p.display()
         )
     );
+}
+
+/// A repeated stamp and a swapped pair: `drop-duplicates` drops both kinds, `sort` puts the
+/// pair in order and drops the repeat; each says what it did and the account counts it.
+#[test]
+fn time_policies_drop_or_sort_and_say_so() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(
+        &d,
+        "imu.csv",
+        b"time,x\n0,0\n0.01,1\n0.01,9\n0.03,3\n0.02,2\n0.04,4\n",
+    );
+    let with = |policy| ReadOptions {
+        time_policy: policy,
+        ..ReadOptions::default()
+    };
+    let t = read_table(&p, &with(gmwm::TimePolicy::DropDuplicates)).unwrap();
+    assert_eq!(t.columns[0].values, vec![0.0, 1.0, 3.0, 4.0]);
+    assert_eq!((t.facts.samples.read, t.facts.samples.used), (6, 4));
+    assert_eq!(
+        t.facts.warnings.last().unwrap().to_string(),
+        format!(
+            "{}: --time-policy drop-duplicates: 1 row repeating the previous stamp dropped, 1 row \
+             stamped before the previous one dropped",
+            p.display()
+        )
+    );
+    let t = read_table(&p, &with(gmwm::TimePolicy::Sort)).unwrap();
+    assert_eq!(t.columns[0].values, vec![0.0, 1.0, 2.0, 3.0, 4.0]);
+    assert_eq!(t.time.as_ref().unwrap().values.len(), 5);
+    assert_eq!((t.facts.samples.read, t.facts.samples.used), (6, 5));
+    assert!(t.facts.warnings.iter().any(|w| w.to_string().ends_with(
+        "--time-policy sort: 2 rows out of order sorted into place, 1 row repeating the previous \
+         stamp dropped"
+    )));
+    // a first row that is not the earliest: the stamps count from the earliest
+    let p = write(&d, "late.csv", b"time,x\n0.02,2\n0,0\n0.01,1\n0.03,3\n");
+    let t = read_table(&p, &with(gmwm::TimePolicy::Sort)).unwrap();
+    assert_eq!(t.columns[0].values, vec![0.0, 1.0, 2.0, 3.0]);
+    assert_eq!(t.time.as_ref().unwrap().values[0], 0.0);
 }
 
 #[test]
@@ -1093,7 +1134,8 @@ fn issue_time_columns_are_not_analysed() {
         err(&p, &ReadOptions::default()),
         format!(
             "{}:4: column time: time 0.005 is not greater than the previous time 0.01; the time \
-             column must be strictly increasing",
+             column must be strictly increasing (--time-policy drop-duplicates drops such rows, \
+             --time-policy sort sorts them)",
             p.display()
         )
     );

@@ -241,6 +241,7 @@ pub(crate) fn read_binary_table(
         })
         .collect::<Result<_, ReadError>>()?;
     Ok(RawTable {
+        dropped: super::DroppedRows::default(),
         columns,
         time,
         time_origin,
@@ -819,6 +820,7 @@ pub(crate) fn read_record_table(
     let time_origin = time[0];
     time.iter_mut().for_each(|t| *t -= time_origin);
     Ok(RawTable {
+        dropped: super::DroppedRows::default(),
         columns,
         time: Some(Column {
             name: "time".into(),

@@ -256,6 +256,27 @@ crate::names::named_values!(HeaderMode, "header", {
     Absent => "no",
 }, derive(FromStr, Display));
 
+/// What a text reader does with a row whose time stamp is not after the previous row's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TimePolicy {
+    /// An error naming the line (default): a repeated or reordered stamp is a logging fault
+    /// the user should see before any number is computed.
+    #[default]
+    Strict,
+    /// The rows are sorted by their stamps (stable), then a row whose stamp repeats the
+    /// previous one is dropped; in-memory reads only.
+    Sort,
+    /// A row whose stamp is not after the last kept row's is dropped.
+    DropDuplicates,
+}
+
+crate::names::named_values!(TimePolicy, "time policy", {
+    Strict => "strict",
+    Sort => "sort",
+    DropDuplicates => "drop-duplicates",
+}, derive(FromStr, Display));
+
 /// Options of [`read_table`]. The default reads every column of any supported file.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ReadOptions {
@@ -277,6 +298,9 @@ pub struct ReadOptions {
     pub ncols: Option<usize>,
     /// Sampling rate override in Hz (default `None`: from the time column, else the sidecar).
     pub freq_hz: Option<f64>,
+    /// What a text file's stamp that is not after the previous one does (default
+    /// [`TimePolicy::Strict`]: an error).
+    pub time_policy: TimePolicy,
 }
 
 /// One column.
@@ -383,6 +407,19 @@ pub enum ReadWarning {
     /// A file at a sidecar's name that is not a sidecar (empty, or a document gmwm wrote
     /// there: `gmwm wv x.csv --json > x.json`), passed over.
     NotASidecar(crate::imu::sidecar::NotASidecar),
+    /// Rows a [`TimePolicy`] other than strict dropped or moved.
+    TimePolicy {
+        /// File.
+        path: PathBuf,
+        /// The policy.
+        policy: TimePolicy,
+        /// Rows whose stamp repeated the previous one, dropped.
+        repeated: u64,
+        /// Rows whose stamp was before the previous one: dropped (`drop-duplicates`).
+        earlier: u64,
+        /// Rows sorted into place (`sort`).
+        moved: u64,
+    },
     /// The sidecar's `n_rows` is not the number of rows read; the rows read are used.
     SidecarRowsDisagree {
         /// File.
@@ -409,6 +446,21 @@ pub(crate) fn sidecar_rows_disagree(
     })
 }
 
+/// The warning of rows a time policy dropped or moved, `None` when it did neither.
+pub(crate) fn time_policy_warning(
+    path: &Path,
+    policy: TimePolicy,
+    dropped: DroppedRows,
+) -> Option<ReadWarning> {
+    (dropped.total() + dropped.moved > 0).then(|| ReadWarning::TimePolicy {
+        path: path.to_path_buf(),
+        policy,
+        repeated: dropped.repeated,
+        earlier: dropped.earlier,
+        moved: dropped.moved,
+    })
+}
+
 /// The warnings for the files at `path`'s sidecar names passed over as not sidecars.
 pub(crate) fn passed_over_sidecars(path: &Path) -> Vec<ReadWarning> {
     crate::imu::sidecar::locate_sidecar(path)
@@ -425,6 +477,26 @@ impl fmt::Display for ReadWarning {
         let pct = |a: f64, b: f64| 100.0 * (a - b).abs() / b;
         match self {
             Self::Timing { path, warning } => write!(f, "{}: {warning}", path.display()),
+            Self::TimePolicy {
+                path,
+                policy,
+                repeated,
+                earlier,
+                moved,
+            } => {
+                let rows = |k: u64| if k == 1 { "1 row".to_string() } else { format!("{k} rows") };
+                let mut parts = Vec::new();
+                if *moved > 0 {
+                    parts.push(format!("{} out of order sorted into place", rows(*moved)));
+                }
+                if *repeated > 0 {
+                    parts.push(format!("{} repeating the previous stamp dropped", rows(*repeated)));
+                }
+                if *earlier > 0 {
+                    parts.push(format!("{} stamped before the previous one dropped", rows(*earlier)));
+                }
+                write!(f, "{}: --time-policy {policy}: {}", path.display(), parts.join(", "))
+            }
             Self::SidecarRowsDisagree {
                 path,
                 sidecar_rows,
@@ -799,13 +871,17 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         &mut warnings,
     )?;
     warnings.extend(passed_over_sidecars(path));
+    let kept = raw.columns.first().map_or(0, |c| c.values.len() as u64);
+    let dropped = raw.dropped;
     warnings.extend(sidecar_rows_disagree(
         path,
         sidecar.as_ref(),
-        raw.columns.first().map_or(0, |c| c.values.len() as u64),
+        kept + dropped.total(),
     ));
+    warnings.extend(time_policy_warning(path, opts.time_policy, dropped));
     let samples = SampleAccount {
         missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
+        read: kept + dropped.total(),
         ..SampleAccount::all_used(
             raw.columns.iter().map(|c| c.name.clone()).collect(),
             if matches!(format, InputFormat::ImuRecord(_)) {
@@ -813,7 +889,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
             } else {
                 "row"
             },
-            raw.columns.first().map_or(0, |c| c.values.len() as u64),
+            kept,
         )
         .without(raw.header_lines, "header line")
         .without(raw.blank_lines, "blank line")
@@ -918,6 +994,25 @@ pub(crate) struct RawTable {
     pub(crate) header_lines: u64,
     /// Blank lines before the last data row (text files).
     pub(crate) blank_lines: u64,
+    /// Rows dropped by the time policy: stamps repeating the previous one, stamps before it.
+    pub(crate) dropped: DroppedRows,
+}
+
+/// Rows a [`TimePolicy`] dropped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct DroppedRows {
+    /// Stamp equal to the previous kept one.
+    pub(crate) repeated: u64,
+    /// Stamp before the previous kept one (`drop-duplicates`).
+    pub(crate) earlier: u64,
+    /// Rows moved into place (`sort`).
+    pub(crate) moved: u64,
+}
+
+impl DroppedRows {
+    pub(crate) fn total(&self) -> u64 {
+        self.repeated + self.earlier
+    }
 }
 
 /// Physical line of each data row of a text file, stored as the rows where the line stops

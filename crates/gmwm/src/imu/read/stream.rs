@@ -491,6 +491,17 @@ fn open_text_stream(
                 .collect(),
         });
     }
+    if pass.unsorted {
+        return Err(crate::error::ParamError::new(
+            "time-policy",
+            "sort",
+            format!(
+                "a recording read in memory ({} is streamed through a spool, in file order: --time-policy drop-duplicates drops the rows out of order, or sort the file, or raise --stream-from)",
+                path.display()
+            ),
+        )
+        .into());
+    }
     let mut notes = Vec::new();
     let timing = match check {
         None => None,
@@ -511,6 +522,12 @@ fn open_text_stream(
         .samples
         .without(pass.header_lines, "header line")
         .without(pass.blank_lines, "blank line");
+    table.facts.samples.read += pass.dropped.total();
+    table.facts.warnings.extend(super::time_policy_warning(
+        path,
+        opts.time_policy,
+        pass.dropped,
+    ));
     Ok(table)
 }
 

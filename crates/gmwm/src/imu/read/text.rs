@@ -160,6 +160,10 @@ pub(crate) struct TextPass {
     pub(crate) header_lines: u64,
     /// Blank lines before the last data row.
     pub(crate) blank_lines: u64,
+    /// Rows the time policy dropped, and whether a row came before the previous one (`sort`:
+    /// the rows must be sorted).
+    pub(crate) dropped: super::DroppedRows,
+    pub(crate) unsorted: bool,
 }
 
 /// Reads a delimited text file (see [`super::read_table`] for the options) into memory: the
@@ -196,6 +200,19 @@ pub(crate) fn read_text_table(
     if values.is_empty() {
         values = vec![Vec::new(); pass.sel.columns.len()];
     }
+    let mut dropped = pass.dropped;
+    let mut time_origin = pass.time_origin;
+    let mut lines = Some(lines);
+    if pass.unsorted {
+        let (moved, repeated) = sort_rows(&mut time, &mut values);
+        dropped.moved = moved;
+        dropped.repeated += repeated;
+        // stamps relative to the earliest one; the rows' lines no longer follow the file
+        let first = time.first().copied().unwrap_or(0.0);
+        time.iter_mut().for_each(|t| *t -= first);
+        time_origin += first;
+        lines = None;
+    }
     let names = &pass.names;
     let columns = pass
         .sel
@@ -214,14 +231,37 @@ pub(crate) fn read_text_table(
     Ok(RawTable {
         columns,
         time,
-        time_origin: pass.time_origin,
+        time_origin,
         time_unit: pass.sel.time_unit,
         freq_hz: None,
-        lines: pass.sel.time.map(|_| lines),
+        lines: pass.sel.time.and(lines),
         skipped: pass.sel.skipped,
         header_lines: pass.header_lines,
         blank_lines: pass.blank_lines,
+        dropped,
     })
+}
+
+/// `--time-policy sort`: the rows put in the order of their stamps (stable: rows with one
+/// stamp keep the file's order), then each row whose stamp repeats the previous one dropped.
+/// Returns the rows that moved and the rows dropped.
+fn sort_rows(time: &mut Vec<f64>, values: &mut [Vec<f64>]) -> (u64, u64) {
+    let mut order: Vec<usize> = (0..time.len()).collect();
+    order.sort_by(|&a, &b| time[a].total_cmp(&time[b]));
+    let moved = order.iter().enumerate().filter(|(i, &k)| *i != k).count() as u64;
+    let mut kept: Vec<usize> = Vec::with_capacity(order.len());
+    for k in order {
+        if kept.last().is_some_and(|&last| time[last] == time[k]) {
+            continue;
+        }
+        kept.push(k);
+    }
+    let repeated = (time.len() - kept.len()) as u64;
+    *time = kept.iter().map(|&k| time[k]).collect();
+    for v in values.iter_mut() {
+        *v = kept.iter().map(|&k| v[k]).collect();
+    }
+    (moved, repeated)
 }
 
 /// One pass over a delimited text file: `row` is called on each data row with the selected
@@ -343,6 +383,9 @@ pub(crate) fn for_each_text_row(
         origin: None,
         previous_abs: 0.0,
         n: 0,
+        policy: opts.time_policy,
+        dropped: super::DroppedRows::default(),
+        unsorted: false,
     };
     if !has_header {
         rows.push(&rec, first_line_no, &mut row)?;
@@ -364,6 +407,8 @@ pub(crate) fn for_each_text_row(
     }
     let time_origin = rows.origin.map_or(0.0, |o| o.0);
     Ok(TextPass {
+        dropped: rows.dropped,
+        unsorted: rows.unsorted,
         names,
         sel,
         time_origin,
@@ -391,6 +436,12 @@ struct Rows<'a> {
     origin: Option<(f64, Option<i64>)>,
     /// The previous stamp as read (for messages).
     previous_abs: f64,
+    /// What a stamp not after the previous one does.
+    policy: super::TimePolicy,
+    /// Rows dropped by the policy.
+    dropped: super::DroppedRows,
+    /// A row came before the previous one (`sort`).
+    unsorted: bool,
 }
 
 impl Rows<'_> {
@@ -423,13 +474,28 @@ impl Rows<'_> {
                 (Some(o), Some(v)) => v.checked_sub(o).map_or(t - origin.0, |d| d as f64),
                 _ => t - origin.0,
             };
-            if let Some(previous) = self.previous {
-                if rel <= previous {
-                    return Err(self.not_increasing(k, line, self.previous_abs, t));
+            match self.previous {
+                Some(previous) if rel <= previous => match self.policy {
+                    super::TimePolicy::Strict => {
+                        return Err(self.not_increasing(k, line, self.previous_abs, t))
+                    }
+                    super::TimePolicy::DropDuplicates => {
+                        if rel == previous {
+                            self.dropped.repeated += 1;
+                        } else {
+                            self.dropped.earlier += 1;
+                        }
+                        self.cells = cells;
+                        return Ok(());
+                    }
+                    // kept as read: sorted, and repeats dropped, once every row is in
+                    super::TimePolicy::Sort => self.unsorted = true,
+                },
+                _ => {
+                    self.previous_abs = t;
+                    self.previous = Some(rel);
                 }
             }
-            self.previous_abs = t;
-            self.previous = Some(rel);
             stamp = Some((rel, line, origin.0));
         }
         self.n += 1;
