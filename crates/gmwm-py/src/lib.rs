@@ -519,8 +519,7 @@ fn read_options(
     format: &str,
     ncols: Option<usize>,
     header: &str,
-    time_column: Option<String>,
-    time_unit: Option<&str>,
+    (time_column, time_unit, time_policy): (Option<String>, Option<&str>, &str),
 ) -> PyResult<ReadOptions> {
     if let Some(f) = freq {
         check_freq(f)?;
@@ -543,14 +542,14 @@ fn read_options(
             .collect(),
         ncols,
         freq_hz: freq,
-        time_policy: gmwm::TimePolicy::Strict,
+        time_policy: choice::<gmwm::TimePolicy>("time_policy", time_policy)?,
     })
 }
 
 /// Reads a recording as the CLI does (text, raw binary, binary IMU records, ROS): returns
 /// `(names, arrays, freq, units, notes)`; the arrays are handed to numpy without a copy.
 #[pyfunction]
-#[pyo3(signature = (path, columns=None, freq=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None))]
+#[pyo3(signature = (path, columns=None, freq=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, time_policy="strict", topic=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn read<'py>(
     py: Python<'py>,
@@ -562,6 +561,7 @@ fn read<'py>(
     header: &str,
     time_column: Option<String>,
     time_unit: Option<&str>,
+    time_policy: &str,
     topic: Option<String>,
 ) -> PyResult<(
     Vec<String>,
@@ -570,7 +570,14 @@ fn read<'py>(
     Vec<Option<String>>,
     Vec<String>,
 )> {
-    let opts = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+    let opts = read_options(
+        columns,
+        freq,
+        format,
+        ncols,
+        header,
+        (time_column, time_unit, time_policy),
+    )?;
     let probe = gmwm::Probe::of(&path, &opts);
     let read = py.detach(|| -> Result<_, gmwm::Error> {
         if probe.is_ros() {
@@ -626,7 +633,7 @@ fn read<'py>(
 /// `arrays` named `names` with `units` at `freq`, or of the recordings at `paths` calibrated as
 /// one sensor (`gmwm calibrate --pool`).
 #[pyfunction]
-#[pyo3(signature = (path=None, arrays=None, paths=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, horizon=None, rostopic=None, tolerance=0.1, force_units=false, datasheet=None, progress=None))]
+#[pyo3(signature = (path=None, arrays=None, paths=None, names=None, units=None, freq=None, columns=None, format="auto", ncols=None, header="auto", time_column=None, time_unit=None, time_policy="strict", topic=None, gyro_unit=None, accel_unit=None, model=None, rule="navigation", bootstrap=50, covariance="auto", draws=None, seed=1337, eff=0.6, robust_convention="exact", robust=false, alpha=0.05, axis_policy="worst", inflate=None, conservative=false, horizon=None, rostopic=None, tolerance=0.1, force_units=false, datasheet=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn calibrate(
     py: Python<'_>,
@@ -642,6 +649,7 @@ fn calibrate(
     header: &str,
     time_column: Option<String>,
     time_unit: Option<&str>,
+    time_policy: &str,
     topic: Option<String>,
     gyro_unit: Option<&str>,
     accel_unit: Option<&str>,
@@ -734,7 +742,14 @@ fn calibrate(
                 "give paths alone (a pooled calibration), or a path, or arrays",
             ));
         }
-        let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+        let read = read_options(
+            columns,
+            freq,
+            format,
+            ncols,
+            header,
+            (time_column, time_unit, time_policy),
+        )?;
         let opts = RecordingOptions { read, topic };
         let recordings = py
             .detach(|| {
@@ -781,7 +796,14 @@ fn calibrate(
         .as_ref()
         .filter(|p| arrays.is_none() && format == "auto" && gmwm::is_wv_json(p))
     {
-        let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+        let read = read_options(
+            columns,
+            freq,
+            format,
+            ncols,
+            header,
+            (time_column, time_unit, time_policy),
+        )?;
         let series = gmwm::read_wv_json(wv_path, read.freq_hz)
             .and_then(|all| gmwm::select_series(wv_path, all, &read.columns))
             .map_err(engine)?;
@@ -806,7 +828,14 @@ fn calibrate(
     // the recording: a file read as the CLI reads it, or the given columns
     let (imu, file, notes, topic_read, rows) = match (path, arrays) {
         (Some(path), None) => {
-            let read = read_options(columns, freq, format, ncols, header, time_column, time_unit)?;
+            let read = read_options(
+                columns,
+                freq,
+                format,
+                ncols,
+                header,
+                (time_column, time_unit, time_policy),
+            )?;
             let opts = RecordingOptions { read, topic };
             let rec = py
                 .detach(|| Recording::open(&path, &opts))

@@ -262,6 +262,19 @@ def test_implied_and_read():
     ), rec.notes
 
 
+def test_read_time_policy(tmp_path):
+    p = tmp_path / "imu.csv"
+    p.write_text("time,gyro_x\n0,0\n0.01,1\n0.01,9\n0.03,3\n0.02,2\n0.04,4\n")
+    with pytest.raises(gmwm.GmwmError, match="--time-policy"):
+        gmwm.read(str(p))
+    rec = gmwm.read(str(p), time_policy="sort")
+    np.testing.assert_array_equal(rec["gyro_x"], [0.0, 1.0, 2.0, 3.0, 4.0])
+    rec = gmwm.read(str(p), time_policy="drop-duplicates")
+    np.testing.assert_array_equal(rec["gyro_x"], [0.0, 1.0, 3.0, 4.0])
+    with pytest.raises(gmwm.GmwmError, match="time_policy"):
+        gmwm.read(str(p), time_policy="nope")
+
+
 # ---------------------------------------------------------------- bad input raises, never crashes
 
 

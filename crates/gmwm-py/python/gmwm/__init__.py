@@ -64,7 +64,16 @@ __version__ = _native.version()
 Data = Union[str, "os.PathLike[str]", np.ndarray, Mapping[str, Any], Sequence[float]]
 Progress = Optional[Callable[[int, int], Any]]
 
-_READ_KEYS = ("columns", "format", "ncols", "header", "time_column", "time_unit", "topic")
+_READ_KEYS = (
+    "columns",
+    "format",
+    "ncols",
+    "header",
+    "time_column",
+    "time_unit",
+    "time_policy",
+    "topic",
+)
 
 
 def _column(values: Any, name: str) -> np.ndarray:
@@ -86,7 +95,8 @@ def _is_path(data: Any) -> bool:
 def read(path: Union[str, "os.PathLike[str]"], *, freq: Optional[float] = None, **options) -> Recording:
     """Reads a recording as the CLI does: ``columns``, ``freq``, ``format`` (auto, csv, tsv,
     f64, f32, imar, ln200, ln200ig, ixsea, navchip-int, navchip-flt), ``ncols``, ``header``
-    (auto, yes, no), ``time_column``, ``time_unit`` (s, ms, us, ns), ``topic`` (ROS)."""
+    (auto, yes, no), ``time_column``, ``time_unit`` (s, ms, us, ns), ``time_policy`` (strict, sort,
+    drop-duplicates: what a repeated or reordered stamp does), ``topic`` (ROS)."""
     unknown = set(options) - set(_READ_KEYS)
     if unknown:
         raise TypeError(f"read() got unexpected keyword(s): {', '.join(sorted(unknown))}")

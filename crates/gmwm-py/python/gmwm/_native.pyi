@@ -43,7 +43,7 @@ def select(arrays: Sequence[F64], names: Sequence[str], freq: float, model: Opti
 
 def read(path: str, columns: Optional[Sequence[str]] = ..., freq: Optional[float] = ..., format: str = ...,
          ncols: Optional[int] = ..., header: str = ..., time_column: Optional[str] = ...,
-         time_unit: Optional[str] = ..., topic: Optional[str] = ...
+         time_unit: Optional[str] = ..., time_policy: str = ..., topic: Optional[str] = ...
          ) -> Tuple[List[str], List[F64], Optional[float], List[Optional[str]], List[str]]:
     """A recording's columns as the CLI reads them: names, arrays, rate, units, notes."""
 
@@ -51,7 +51,7 @@ def calibrate(path: Optional[str] = ..., arrays: Optional[Sequence[F64]] = ...,
               paths: Optional[Sequence[str]] = ..., names: Optional[Sequence[str]] = ...,
               units: Optional[Sequence[Optional[str]]] = ..., freq: Optional[float] = ...,
               columns: Optional[Sequence[str]] = ..., format: str = ..., ncols: Optional[int] = ...,
-              header: str = ..., time_column: Optional[str] = ..., time_unit: Optional[str] = ...,
+              header: str = ..., time_column: Optional[str] = ..., time_unit: Optional[str] = ..., time_policy: str = ...,
               topic: Optional[str] = ..., gyro_unit: Optional[str] = ..., accel_unit: Optional[str] = ...,
               model: Optional[str] = ..., rule: str = ..., bootstrap: int = ..., covariance: str = ...,
               draws: Optional[int] = ...,
