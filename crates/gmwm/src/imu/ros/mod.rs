@@ -439,6 +439,39 @@ fn metadata_files(text: &str) -> Option<Vec<String>> {
     Some(files)
 }
 
+/// The storage files a `metadata.yaml` lists: each inside the bag folder (a relative path
+/// without `..`) and listed once; a list that repeats a file would read its messages again,
+/// one that leaves the folder would read another recording.
+fn checked_storage_names(meta: &Path, names: &[String]) -> Result<(), ReadError> {
+    use std::path::Component;
+    let mut seen = std::collections::HashSet::new();
+    for name in names {
+        let inside = Path::new(name)
+            .components()
+            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir));
+        if !inside {
+            return Err(not_recording(
+                meta,
+                format!(
+                    "expected storage files inside the bag folder; relative_file_paths lists {}",
+                    super::quote(name)
+                ),
+            ));
+        }
+        if !seen.insert(name.as_str()) {
+            let times = names.iter().filter(|n| *n == name).count();
+            return Err(not_recording(
+                meta,
+                format!(
+                    "expected each storage file listed once; relative_file_paths lists {} {times} times",
+                    super::quote(name)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Sort key putting `bag_2.mcap` before `bag_10.mcap`.
 fn split_index(name: &str) -> (String, u64) {
     let stem = name.rsplit_once('.').map_or(name, |(s, _)| s);
@@ -454,7 +487,10 @@ fn folder(dir: &Path) -> Result<Source, ReadError> {
         Err(_) => None,
     };
     let files: Vec<PathBuf> = match listed {
-        Some(names) => names.iter().map(|n| dir.join(n)).collect(),
+        Some(names) => {
+            checked_storage_names(&meta, &names)?;
+            names.iter().map(|n| dir.join(n)).collect()
+        }
         None => {
             let mut names: Vec<String> = std::fs::read_dir(dir)
                 .map_err(|e| io_error(dir, e))?
@@ -850,6 +886,35 @@ pub(crate) fn imu_messages_count(path: &Path) -> Result<u64, ReadError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn metadata_lists_each_storage_file_once_inside_the_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let meta = d.path().join("metadata.yaml");
+        let cases = [
+            (
+                "  - a_0.mcap\n  - a_0.mcap\n  - a_0.mcap\n",
+                "lists a_0.mcap 3 times",
+            ),
+            ("  - /etc/passwd\n", "inside the bag folder"),
+            ("  - ../other/b_0.mcap\n", "inside the bag folder"),
+        ];
+        for (list, said) in cases {
+            std::fs::write(
+                &meta,
+                format!("rosbag2_bagfile_information:\n  relative_file_paths:\n{list}"),
+            )
+            .unwrap();
+            let e = source(d.path()).err().unwrap().to_string();
+            assert!(
+                e.starts_with(&format!(
+                    "{}: not a ROS recording: expected",
+                    meta.display()
+                )) && e.contains(said),
+                "{e}"
+            );
+        }
+    }
 
     #[test]
     fn metadata_files_reads_the_list() {
