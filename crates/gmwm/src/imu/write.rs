@@ -112,38 +112,72 @@ impl OutputFormat {
 /// ```
 pub struct AtomicFile {
     path: PathBuf,
-    tmp: PathBuf,
+    /// The temporary file renamed over `path` on commit; `None` when `path` is written in
+    /// place (a FIFO, a device: not a regular file, which a rename would replace).
+    tmp: Option<PathBuf>,
     file: Option<BufWriter<File>>,
 }
 
 impl AtomicFile {
-    /// Creates the temporary file for `path`.
+    /// Creates the temporary file for `path`: in `path`'s folder, under a name no other
+    /// process can predict, created exclusively (a file or symlink planted at that name
+    /// makes the creation fail, never redirects the write). A symlink at `path` is followed:
+    /// its target is the destination. An existing `path` that is not a regular file (a FIFO,
+    /// `/dev/null`, a terminal) is opened and written in place.
     ///
     /// # Errors
     /// [`ReadError::Io`] naming `path` when its folder cannot be written (or `path` has no
     /// file name).
     pub fn create(path: &Path) -> Result<Self, ReadError> {
-        static COUNTER: AtomicU64 = AtomicU64::new(0);
-        let name = path.file_name().ok_or_else(|| {
+        // what the path names, links followed by the system (`>(cmd)` is a link to a pipe)
+        if let Ok(meta) = std::fs::metadata(path) {
+            if !meta.is_file() && !meta.is_dir() {
+                let file = std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(path)
+                    .map_err(|e| io_error(path, e))?;
+                return Ok(Self {
+                    path: path.to_path_buf(),
+                    tmp: None,
+                    file: Some(BufWriter::with_capacity(BUF_CAPACITY, file)),
+                });
+            }
+        }
+        let target = followed(path);
+        let name = target.file_name().ok_or_else(|| {
             io_error(
                 path,
                 io::Error::new(io::ErrorKind::InvalidInput, "not a file name"),
             )
         })?;
-        let tmp = path.with_file_name(format!(
-            ".{}.{}.{}.tmp",
-            name.to_string_lossy(),
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
-        let file = File::create(&tmp).map_err(|e| io_error(path, e))?;
-        Ok(Self {
-            path: path.to_path_buf(),
-            tmp,
-            file: Some(BufWriter::with_capacity(BUF_CAPACITY, file)),
-        })
+        let mut last = None;
+        for _ in 0..8 {
+            let tmp = target.with_file_name(format!(
+                ".{}.{:016x}.tmp",
+                name.to_string_lossy(),
+                unpredictable()
+            ));
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&tmp)
+            {
+                Ok(file) => {
+                    return Ok(Self {
+                        path: target,
+                        tmp: Some(tmp),
+                        file: Some(BufWriter::with_capacity(BUF_CAPACITY, file)),
+                    })
+                }
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last = Some(e),
+                Err(e) => return Err(io_error(path, e)),
+            }
+        }
+        Err(io_error(
+            path,
+            last.unwrap_or_else(|| io::Error::other("no temporary name")),
+        ))
     }
-
     /// The destination.
     pub fn path(&self) -> &Path {
         &self.path
@@ -155,18 +189,25 @@ impl AtomicFile {
     /// [`ReadError::Io`] naming the destination when the last writes or the rename fail (the
     /// temporary file is then removed).
     pub fn commit(mut self) -> Result<(), ReadError> {
+        let tmp = self.tmp.clone();
         let result = match self.file.take() {
             Some(w) => w
                 .into_inner()
                 .map_err(io::IntoInnerError::into_error)
-                .and_then(|f| {
-                    drop(f);
-                    std::fs::rename(&self.tmp, &self.path)
+                .and_then(|f| match &tmp {
+                    // on disk before it takes the destination's name
+                    Some(tmp) => f.sync_all().and_then(|()| {
+                        drop(f);
+                        std::fs::rename(tmp, &self.path)
+                    }),
+                    None => Ok(()),
                 }),
             None => Ok(()),
         };
         result.map_err(|e| {
-            let _ = std::fs::remove_file(&self.tmp);
+            if let Some(tmp) = &tmp {
+                let _ = std::fs::remove_file(tmp);
+            }
             io_error(&self.path, e)
         })
     }
@@ -195,9 +236,44 @@ impl Write for AtomicFile {
 impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.file.take().is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
+            if let Some(tmp) = &self.tmp {
+                let _ = std::fs::remove_file(tmp);
+            }
         }
     }
+}
+
+/// `path`, or the file a symlink there points to (a relative target read from the link's
+/// folder; chains followed up to 16 links).
+fn followed(path: &Path) -> PathBuf {
+    let mut p = path.to_path_buf();
+    for _ in 0..16 {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => match std::fs::read_link(&p) {
+                Ok(t) if t.is_absolute() => p = t,
+                Ok(t) => p = p.parent().map_or(t.clone(), |d| d.join(&t)),
+                Err(_) => break,
+            },
+            _ => break,
+        }
+    }
+    p
+}
+
+/// 64 bits no other process can predict: std's per-process random hash keys, the clock, the
+/// process and a counter, hashed.
+fn unpredictable() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u64(COUNTER.fetch_add(1, Ordering::Relaxed));
+    h.write_u32(std::process::id());
+    h.write_u128(
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos()),
+    );
+    h.finish()
 }
 
 /// Writes `bytes` to `path` atomically ([`AtomicFile`]).
@@ -425,6 +501,59 @@ pub fn write_sidecar(data: &Path, sidecar: &Sidecar) -> Result<PathBuf, ReadErro
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A FIFO is written through (a rename would replace it), a symlinked output writes its
+    /// target and stays a link, and the temporary names differ from call to call and are
+    /// created exclusively.
+    #[cfg(unix)]
+    #[test]
+    fn outputs_that_are_not_plain_files_are_written_through() {
+        use std::io::Read;
+        use std::os::unix::fs::FileTypeExt;
+        let d = tempfile::tempdir().unwrap();
+        // a FIFO, read by a thread while the write goes through it
+        let fifo = d.path().join("out.fifo");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            let reader = {
+                let fifo = fifo.clone();
+                std::thread::spawn(move || {
+                    let mut text = String::new();
+                    File::open(&fifo)
+                        .unwrap()
+                        .read_to_string(&mut text)
+                        .unwrap();
+                    text
+                })
+            };
+            write_atomic(&fifo, b"through the pipe\n").unwrap();
+            assert_eq!(reader.join().unwrap(), "through the pipe\n");
+            assert!(std::fs::symlink_metadata(&fifo)
+                .unwrap()
+                .file_type()
+                .is_fifo());
+        }
+        // a symlinked output
+        let target = d.path().join("real.json");
+        let link = d.path().join("link.json");
+        std::os::unix::fs::symlink("real.json", &link).unwrap();
+        write_atomic(&link, b"{}").unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(&target).unwrap(), b"{}");
+        // unpredictable temporary names; nothing left behind
+        let a = AtomicFile::create(&target).unwrap();
+        let b = AtomicFile::create(&target).unwrap();
+        assert_ne!(a.tmp, b.tmp);
+        drop((a, b));
+        let left: Vec<_> = std::fs::read_dir(d.path()).unwrap().collect();
+        assert_eq!(left.len(), 3, "{left:?}");
+        // /dev/null is written to, not replaced
+        write_atomic(Path::new("/dev/null"), b"x").unwrap();
+        assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
+    }
 
     #[test]
     fn unequal_csv_columns_are_an_error() {
