@@ -137,7 +137,7 @@ pub fn sidecar_candidates(data: &Path) -> Vec<PathBuf> {
 ///
 /// A candidate that is empty, or is JSON without any of a sidecar's keys (the output of
 /// `gmwm wv x.csv --json > x.json`: a WV or calibration document at the sidecar's name), is
-/// not a sidecar and is passed over ([`locate_sidecar`] says which and why).
+/// not a sidecar and is passed over (the readers warn which and why).
 ///
 /// # Errors
 /// As [`Sidecar::read`], for the first candidate of [`sidecar_candidates`] that exists and is
