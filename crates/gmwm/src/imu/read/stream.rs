@@ -510,7 +510,7 @@ fn open_text_stream(
     let mut table = finish(
         path,
         opts,
-        (names, pass.rows as u64, None),
+        (names, pass.rows as u64, pass.dropped, None),
         timing,
         sidecar,
         pass.sel.skipped,
@@ -522,12 +522,6 @@ fn open_text_stream(
         .samples
         .without(pass.header_lines, "header line")
         .without(pass.blank_lines, "blank line");
-    table.facts.samples.read += pass.dropped.total();
-    table.facts.warnings.extend(super::time_policy_warning(
-        path,
-        opts.time_policy,
-        pass.dropped,
-    ));
     Ok(table)
 }
 
@@ -599,7 +593,7 @@ fn finish_check(
 fn finish(
     path: &Path,
     opts: &ReadOptions,
-    (names, rows, format_hz): (Vec<String>, u64, Option<f64>),
+    (names, rows, dropped, format_hz): (Vec<String>, u64, super::DroppedRows, Option<f64>),
     timing: Option<TimingReport>,
     sidecar: Option<Sidecar>,
     skipped: Vec<String>,
@@ -619,9 +613,15 @@ fn finish(
         &mut warnings,
     )?;
     warnings.extend(super::passed_over_sidecars(path));
-    warnings.extend(super::sidecar_rows_disagree(path, sidecar.as_ref(), rows));
+    warnings.extend(super::sidecar_rows_disagree(
+        path,
+        sidecar.as_ref(),
+        rows + dropped.total(),
+    ));
+    warnings.extend(super::time_policy_warning(path, opts.time_policy, dropped));
     let samples = SampleAccount {
         missing: timing.as_ref().map_or(0, |t| t.missing_samples() as u64),
+        read: rows + dropped.total(),
         ..SampleAccount::all_used(names.clone(), "row", rows)
     };
     Ok(StreamedTable {
@@ -807,7 +807,7 @@ fn open_records_stream(
     let mut table = finish(
         path,
         opts,
-        (selected, rows, Some(freq)),
+        (selected, rows, super::DroppedRows::default(), Some(freq)),
         Some(report),
         sidecar,
         Vec::new(),
