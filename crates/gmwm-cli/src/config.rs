@@ -138,6 +138,7 @@ impl TryFrom<&InputArgs> for InputConfig {
             read,
             topic: a.topic.clone(),
             stream_from: a.stream_from.unwrap_or(gmwm::STREAM_FROM),
+            gaps: a.gaps,
             probe: Default::default(),
         })
     }
@@ -629,6 +630,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             force_units: a.force_units,
             datasheet: a.datasheet.datasheet.clone(),
             horizon_s: a.horizon,
+            gaps: input.gaps,
         };
         let exports = exports(a)?;
         let adjustment = match (a.inflate, a.conservative, a.horizon) {
@@ -1274,6 +1276,7 @@ impl TryFrom<&SameModelArgs> for SameModelConfig {
             },
             topic: None,
             stream_from: gmwm::STREAM_FROM,
+            gaps: gmwm::GapPolicy::default(),
             probe: Default::default(),
         };
         Ok(Self {

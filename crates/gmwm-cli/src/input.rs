@@ -23,6 +23,8 @@ pub struct InputConfig {
     /// `--stream-from`: rows from which a text or IMU-record recording is streamed
     /// ([`gmwm::STREAM_FROM`] by default).
     pub stream_from: u64,
+    /// `--gaps`: how gaps in the time stamps enter the WV.
+    pub gaps: gmwm::GapPolicy,
     /// What FILE is, probed once ([`InputConfig::probe`]).
     pub probe: std::sync::OnceLock<gmwm::Probe>,
 }
@@ -253,6 +255,31 @@ pub fn analyse_columns<T: Send>(
         .zip(results)
         .map(|(col, r)| Ok((col.name.clone(), column_context(r, file, &col.name)?)))
         .collect()
+}
+
+/// The gaps in the loaded recording's time stamps when `--gaps aware` (empty otherwise, with
+/// a note for `--gaps contiguous` over gaps).
+pub fn gaps_of(loaded: &Loaded, input: &InputConfig, style: OutputStyle) -> Vec<gmwm::Gap> {
+    let Some(t) = &loaded.table.facts.timing else {
+        return Vec::new();
+    };
+    if t.gaps.is_empty() {
+        return Vec::new();
+    }
+    match input.gaps {
+        gmwm::GapPolicy::Aware => t.gaps.clone(),
+        gmwm::GapPolicy::Contiguous => {
+            style.note(
+                &input.file,
+                &format!(
+                    "{} {} in the time stamps analysed as one contiguous series (--gaps contiguous)",
+                    t.gaps.len(),
+                    if t.gaps.len() == 1 { "gap" } else { "gaps" }
+                ),
+            );
+            Vec::new()
+        }
+    }
 }
 
 /// Borrows `(name, result)` pairs as [`Named`](crate::render::Named) items.

@@ -143,8 +143,7 @@ fn issue_gap_is_warned_and_not_averaged() {
         warnings,
         [format!(
             "gmwm: warning: {}: time column \"#timestamp [ns]\": 1 gap (100 samples missing), \
-             largest 0.50 s at line 4012 (20.05 s after the start); the rows are analysed as if \
-             evenly spaced at 200 Hz",
+             largest 0.50 s at line 4012 (20.05 s after the start); 200 Hz between them",
             p.display()
         )]
     );

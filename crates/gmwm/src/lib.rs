@@ -86,8 +86,9 @@ pub use variance::robust::{RobustConvention, RobustOptions};
 pub(crate) use variance::wv::HaarWvAccumulator;
 pub use variance::wv::{wavelet_variance, WaveletVariance, WvOptions, WvWarning};
 pub use variance::{
-    allan_from_wv, binary_columns_wv, binary_wavelet_variance, default_levels, is_wv_json,
-    per_column, read_wv_json, select_series, StreamedColumn,
+    allan_from_wv, binary_columns_wv, binary_wavelet_variance, default_levels,
+    gap_aware_wavelet_variance, is_wv_json, per_column, read_wv_json, select_series, GapAccount,
+    GapLevel, GapPolicy, StreamedColumn,
 };
 pub use wavelet::{Transform, WaveletFilter};
 

@@ -9,7 +9,7 @@ pub use several::{Against, MonitorArgs, SameModelArgs, SharedArgs};
 
 use clap::{Args, Parser, Subcommand};
 use gmwm::{
-    AllanKind, AvConvention, AxisPolicy, CovarianceMethod, HeaderMode, InputFormat,
+    AllanKind, AvConvention, AxisPolicy, CovarianceMethod, GapPolicy, HeaderMode, InputFormat,
     OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimePolicy, TimeUnit,
     Transform, Weighting,
 };
@@ -850,6 +850,11 @@ pub struct InputArgs {
     /// What a text file's row whose time stamp is not after the previous one does.
     #[arg(long, value_parser = choice::<TimePolicy>(), default_value_t = TimePolicy::Strict, value_name = "POLICY")]
     pub time_policy: TimePolicy,
+    /// How gaps in the time stamps (packet loss) enter the wavelet and Allan variances:
+    /// `aware` uses only the coefficients whose windows hold no gap, `contiguous` analyses
+    /// the samples as one series.
+    #[arg(long, value_parser = choice::<GapPolicy>(), default_value_t = GapPolicy::Aware, value_name = "POLICY")]
+    pub gaps: GapPolicy,
     /// The sensor_msgs/Imu topic of a ROS recording (ROS1 .bag, MCAP, rosbag2 .db3 or folder)
     /// [default: its only IMU topic; `gmwm topics FILE` lists them].
     #[arg(long, value_name = "TOPIC")]

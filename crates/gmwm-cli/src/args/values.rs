@@ -4,9 +4,9 @@
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use gmwm::{
-    AllanKind, AvConvention, AxisPolicy, CovarianceMethod, HeaderMode, ImuRecordType, InputFormat,
-    Named, OptimismConvention, OptimismMethod, RobustConvention, SelectionRule, TimePolicy,
-    TimeUnit, Transform, Weighting,
+    AllanKind, AvConvention, AxisPolicy, CovarianceMethod, GapPolicy, HeaderMode, ImuRecordType,
+    InputFormat, Named, OptimismConvention, OptimismMethod, RobustConvention, SelectionRule,
+    TimePolicy, TimeUnit, Transform, Weighting,
 };
 use std::str::FromStr;
 
@@ -76,6 +76,15 @@ impl ValueHelp for TimePolicy {
             Self::Strict => "An error naming the line (the default)",
             Self::DropDuplicates => "Drop the row, counted in a warning",
             Self::Sort => "Sort the rows by stamp, then drop repeats (read in memory only)",
+        }
+    }
+}
+
+impl ValueHelp for GapPolicy {
+    fn help(self) -> &'static str {
+        match self {
+            Self::Aware => "Only coefficients whose windows hold no gap (the default)",
+            Self::Contiguous => "The samples as one series, the gaps ignored",
         }
     }
 }

@@ -2,7 +2,7 @@
 
 use super::Command;
 use crate::config::AvarConfig;
-use crate::input::{analyse_columns, column_context, is_wv, load, load_wv, named};
+use crate::input::{analyse_columns, column_context, gaps_of, is_wv, load, load_wv, named};
 use crate::prepare::Inputs;
 use crate::render;
 use crate::style::OutputStyle;
@@ -65,7 +65,32 @@ pub fn compute(config: &AvarConfig, style: OutputStyle) -> Result<Vec<(String, A
         return run_saved(config, style);
     }
     let loaded = load(&config.input, style)?;
-    analyse_columns(&loaded, &config.input.file, |x| {
-        Ok(allan_variance(x, loaded.freq_hz, &config.allan)?)
-    })
+    let gaps = gaps_of(&loaded, &config.input, style);
+    if gaps.is_empty() {
+        return analyse_columns(&loaded, &config.input.file, |x| {
+            Ok(allan_variance(x, loaded.freq_hz, &config.allan)?)
+        });
+    }
+    // the gap-aware estimator is the overlapping Allan variance, twice the gap-aware Haar WV
+    // (docs/methods.md §3.4, §1.14)
+    let file = &config.input.file;
+    anyhow::ensure!(
+        config.allan.kind == gmwm::AllanKind::Overlapping
+            && config.allan.convention == gmwm::AvConvention::Textbook,
+        "{}: the time stamps have {} gaps: the gap-aware estimator is the overlapping Allan \
+         variance (textbook convention); give --gaps contiguous for this kind or convention",
+        file.display(),
+        gaps.len()
+    );
+    let opts = gmwm::WvOptions {
+        alpha: config.allan.alpha,
+        ..gmwm::WvOptions::default()
+    };
+    let wvs = super::wv::gap_aware(&loaded, file, &gaps, &opts, style)?;
+    wvs.iter()
+        .map(|(name, wv)| {
+            let av = allan_from_wv(wv).map_err(gmwm::Error::from);
+            Ok((name.clone(), column_context(av, file, name)?))
+        })
+        .collect()
 }

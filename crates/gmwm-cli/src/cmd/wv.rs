@@ -3,7 +3,7 @@
 use super::Command;
 use crate::config::WvConfig;
 use crate::input::InputConfig;
-use crate::input::{analyse_columns, is_wv, load, load_wv, named};
+use crate::input::{analyse_columns, gaps_of, is_wv, load, load_wv, named, Loaded};
 use crate::prepare::Inputs;
 use crate::render;
 use crate::style::OutputStyle;
@@ -159,6 +159,29 @@ fn run_streamed_table(
     Ok(table.names.iter().cloned().zip(wvs).collect())
 }
 
+/// The gap-aware WV of every loaded column (docs/methods.md §1.14), the gaps' cost noted
+/// once (it is the same for every column).
+pub(crate) fn gap_aware(
+    loaded: &Loaded,
+    file: &Path,
+    gaps: &[gmwm::Gap],
+    opts: &WvOptions,
+    style: OutputStyle,
+) -> Result<Vec<(String, WaveletVariance)>> {
+    let items = analyse_columns(loaded, file, |x| {
+        Ok(gmwm::gap_aware_wavelet_variance(
+            x,
+            gaps,
+            loaded.freq_hz,
+            opts,
+        )?)
+    })?;
+    if let Some((_, (_, account))) = items.first() {
+        style.note(file, &account.to_string());
+    }
+    Ok(items.into_iter().map(|(n, (wv, _))| (n, wv)).collect())
+}
+
 /// A saved wavelet variance as it is (no recomputation).
 fn run_saved(config: &WvConfig, style: OutputStyle) -> Result<Vec<(String, WaveletVariance)>> {
     let file = &config.input.file;
@@ -218,9 +241,14 @@ pub fn compute(config: &WvConfig, style: OutputStyle) -> Result<Vec<(String, Wav
         return run_streamed_table(input, opts, style);
     }
     let loaded = load(input, style)?;
-    let items = analyse_columns(&loaded, &input.file, |x| {
-        Ok(wavelet_variance(x, loaded.freq_hz, opts)?)
-    })?;
+    let gaps = gaps_of(&loaded, input, style);
+    let items = if gaps.is_empty() {
+        analyse_columns(&loaded, &input.file, |x| {
+            Ok(wavelet_variance(x, loaded.freq_hz, opts)?)
+        })?
+    } else {
+        gap_aware(&loaded, &input.file, &gaps, opts, style)?
+    };
     for (name, wv) in &items {
         for w in wv.warnings() {
             eprintln!(

@@ -21,6 +21,7 @@ use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
 use crate::units::{forms, si_unit, NoiseTerm, SignalKind, SignalUnit, UnitForms};
 use crate::variance::allan::{allan_variance, AllanOptions, AllanVariance};
 use crate::variance::allan_from_wv;
+use crate::variance::gaps::{gap_aware_wavelet_variance, GapAccount, GapPolicy};
 use crate::variance::pooled::PooledWv;
 use crate::variance::psd::{welch_psd, Psd, BINNED_POINTS};
 use crate::variance::robust::RobustOptions;
@@ -90,6 +91,9 @@ pub struct CalibrationOptions {
     /// A mission horizon, s: each axis gets the white-noise + random-walk pair that bounds its
     /// model up to it ([`AxisCalibration::horizon_bound`]; default `None`).
     pub horizon_s: Option<f64>,
+    /// How gaps in the time stamps enter the WV (default [`GapPolicy::Aware`]: only the
+    /// coefficients whose windows hold no gap, docs/methods.md §1.14).
+    pub gaps: GapPolicy,
 }
 
 impl Default for CalibrationOptions {
@@ -112,6 +116,7 @@ impl Default for CalibrationOptions {
             force_units: false,
             datasheet: None,
             horizon_s: None,
+            gaps: GapPolicy::Aware,
         }
     }
 }
@@ -328,6 +333,10 @@ pub struct AxisCalibration {
     /// recording.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub recording_wvs: Vec<WaveletVariance>,
+    /// What the gaps in the time stamps cost the WV, when the recording has gaps and they
+    /// are analysed as such ([`CalibrationOptions::gaps`]; left out of the JSON otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gaps: Option<GapAccount>,
 }
 
 /// The calibration of a recording: one [`AxisCalibration`] per gyroscope and accelerometer
@@ -420,23 +429,38 @@ impl Calibration {
         imu: &Imu,
         progress: &dyn Progress,
     ) -> Result<CalibrationReport, CalibError> {
+        // gaps in the stamps: the samples on their time grid (§1.14)
+        let gaps: &[crate::imu::Gap] = match (self.options.gaps, imu.timing()) {
+            (GapPolicy::Aware, Some(t)) => &t.gaps,
+            _ => &[],
+        };
         let axes: Vec<InputAxis<'_>> = imu
             .axes()
             .iter()
             .map(|a| InputAxis {
                 column: &a.column.name,
                 info: &a.info,
-                data: AxisData::Series(a.values()),
+                data: if gaps.is_empty() {
+                    AxisData::Series(a.values())
+                } else {
+                    AxisData::Gapped {
+                        series: a.values(),
+                        gaps,
+                    }
+                },
             })
             .collect();
-        self.run_axes(
-            imu.name(),
-            imu.freq_hz(),
-            imu.len(),
-            axes,
-            Vec::new(),
-            progress,
-        )
+        let mut checks = Vec::new();
+        if let (GapPolicy::Contiguous, Some(t)) = (self.options.gaps, imu.timing()) {
+            if !t.gaps.is_empty() {
+                checks.push(format!(
+                    "{} {} in the time stamps analysed as one contiguous series (gaps: contiguous): the scales are mislabelled by the missing samples",
+                    t.gaps.len(),
+                    if t.gaps.len() == 1 { "gap" } else { "gaps" }
+                ));
+            }
+        }
+        self.run_axes(imu.name(), imu.freq_hz(), imu.len(), axes, checks, progress)
     }
 
     /// A static accelerometer measures gravity: the magnitude of its axes' means, under the
@@ -453,7 +477,7 @@ impl Calibration {
             .iter()
             .filter(|a| a.info.sensor == Sensor::Accelerometer)
         {
-            let AxisData::Series(x) = &a.data else {
+            let (AxisData::Series(x) | AxisData::Gapped { series: x, .. }) = &a.data else {
                 return None;
             };
             let unit = self
@@ -662,6 +686,7 @@ impl Calibration {
         // statistic
         let si_values = in_si(&data, unit);
         let data = match (&si_values, data) {
+            (Some(x), AxisData::Gapped { gaps, .. }) => AxisData::Gapped { series: x, gaps },
             (Some(x), _) => AxisData::Series(x),
             (None, d) => d.scaled(unit.map_or(1.0, |u| u.to_si())),
         };
@@ -675,6 +700,18 @@ impl Calibration {
             _ => "u".to_string(),
         };
         let errors = AxisErrors { column };
+        let mut gaps = None;
+        let data = match data {
+            AxisData::Gapped { series, gaps: g } => {
+                let (pooled, account) = self
+                    .gap_aware(series, g, freq_hz, &mut notes)
+                    .map_err(|e| errors.engine(e))?;
+                notes.push(account.to_string());
+                gaps = Some(account);
+                pooled
+            }
+            d => d,
+        };
         let selection = self.select(&data, freq_hz, progress, &errors)?;
         let wv = selection.fit.empirical.clone().ok_or_else(|| {
             errors.fit(FitError::Length {
@@ -793,6 +830,7 @@ impl Calibration {
             plan,
             audit: None,
             recording_wvs: Vec::new(),
+            gaps,
         };
         if let Some(t) = self.options.horizon_s {
             axis.horizon = Some(axis.horizon_bound(t).map_err(|e| errors.engine(e))?);
@@ -821,7 +859,9 @@ impl Calibration {
         match data {
             AxisData::Series(x) => wic.select_with_progress(x, freq_hz, progress),
             AxisData::Streamed { wv, .. } => wic.select_wv_with_progress(wv, progress),
-            AxisData::Pooled { classical, robust } => match (self.options.wv.robust, robust) {
+            AxisData::Pooled {
+                classical, robust, ..
+            } => match (self.options.wv.robust, robust) {
                 (None, _) => wic.select_pooled_wv_with_progress(classical, progress),
                 (Some(_), Some(Ok(r))) => wic.select_pooled_wv_with_progress(r, progress),
                 (Some(_), Some(Err(e))) => {
@@ -831,6 +871,9 @@ impl Calibration {
                 }
                 (Some(_), None) => unreachable!("run_pooled computes the robust WV it fits"),
             },
+            AxisData::Gapped { .. } => {
+                unreachable!("Calibration::axis pools a gapped series first")
+            }
         }
         .map_err(|source| errors.selection(source))
     }
@@ -1252,6 +1295,42 @@ impl Calibration {
     /// The classical WV of the axis against the robust one ([`compare_classical_robust`]);
     /// `wv` is the axis' WV, classical or robust as the options ask, so only the other is
     /// computed (a streamed axis brings its robust WV).
+    /// A gapped axis' WV (docs/methods.md §1.14): the gap-aware classical WV, calibrated as a
+    /// streamed recording's, with the spectrum of the longest gap-free stretch; no robust WV
+    /// (the gap-aware estimator is the classical one's), said in a note.
+    fn gap_aware<'a>(
+        &self,
+        series: &'a [f64],
+        gaps: &[crate::imu::Gap],
+        freq_hz: f64,
+        notes: &mut Vec<String>,
+    ) -> Result<(AxisData<'a>, GapAccount), crate::InputError> {
+        let (wv, account) = gap_aware_wavelet_variance(series, gaps, freq_hz, &self.options.wv)?;
+        let rows: Vec<usize> = gaps.iter().map(|g| g.row).collect();
+        let psd = crate::variance::gaps::segments(series.len(), &rows)
+            .into_iter()
+            .max_by_key(|s| s.len())
+            .map(|s| {
+                welch_psd(&series[s], freq_hz)
+                    .map(Box::new)
+                    .map_err(|e| format!("the longest gap-free stretch: {e}"))
+            });
+        if self.options.robust_check.is_some() {
+            notes.push(
+                "no contamination check: the gap-aware estimator is the classical wavelet variance's (--gaps contiguous compares it with the robust one over the samples as one series)"
+                    .to_string(),
+            );
+        }
+        Ok((
+            AxisData::Streamed {
+                wv: Box::new(wv),
+                robust: None,
+                psd,
+            },
+            account,
+        ))
+    }
+
     fn contamination(
         &self,
         data: &AxisData<'_>,
@@ -1263,7 +1342,9 @@ impl Calibration {
         let alpha = self.options.wv.alpha;
         let x = match data {
             AxisData::Series(x) => *x,
-            AxisData::Pooled { classical, robust } => {
+            AxisData::Pooled {
+                classical, robust, ..
+            } => {
                 let uses = match self.options.wv.robust {
                     Some(_) => FitUses::Robust,
                     None => FitUses::Classical,
@@ -1277,6 +1358,9 @@ impl Calibration {
                     self.options.tolerance,
                     notes,
                 );
+            }
+            AxisData::Gapped { .. } => {
+                unreachable!("Calibration::axis pools a gapped series first")
             }
             AxisData::Streamed { robust, .. } => {
                 let robust = robust.as_ref().map(|r| r.as_ref().map(|w| &**w));
@@ -1383,7 +1467,7 @@ impl AxisErrors<'_> {
 fn in_si(data: &AxisData<'_>, unit: Option<SignalUnit>) -> Option<Vec<f64>> {
     let to_si = unit.map_or(1.0, |u| u.to_si());
     match data {
-        AxisData::Series(values) if to_si != 1.0 => {
+        AxisData::Series(values) | AxisData::Gapped { series: values, .. } if to_si != 1.0 => {
             Some(values.iter().map(|v| v * to_si).collect())
         }
         _ => None,
@@ -1408,6 +1492,7 @@ fn allan_of(
         )?,
         AxisData::Streamed { wv, .. } => allan_from_wv(wv)?,
         AxisData::Pooled { classical, .. } => allan_from_wv(classical.wv())?,
+        AxisData::Gapped { .. } => unreachable!("Calibration::axis pools a gapped series first"),
     })
 }
 
@@ -1424,6 +1509,7 @@ fn psd_of(data: &AxisData<'_>, freq_hz: f64, unit: &str, notes: &mut Vec<String>
         AxisData::Pooled { .. } => {
             Err("a pooled calibration has no single series to take it from".to_string())
         }
+        AxisData::Gapped { .. } => unreachable!("Calibration::axis pools a gapped series first"),
     };
     match psd {
         Ok(p) => Some(p.binned(BINNED_POINTS).in_unit(unit)),
@@ -1493,6 +1579,12 @@ pub(crate) enum AxisData<'a> {
         classical: Box<PooledWv>,
         robust: Option<Result<Box<PooledWv>, String>>,
     },
+    /// The samples of a recording with gaps in its time stamps, and the gaps (docs/methods.md
+    /// §1.14): turned into the gap-aware WV by [`Calibration::axis`], as a streamed one.
+    Gapped {
+        series: &'a [f64],
+        gaps: &'a [crate::imu::Gap],
+    },
 }
 
 impl AxisData<'_> {
@@ -1514,6 +1606,7 @@ impl AxisData<'_> {
             AxisData::Series(x) => x.len(),
             AxisData::Streamed { wv, .. } => wv.n,
             AxisData::Pooled { classical, .. } => classical.wv().n(),
+            AxisData::Gapped { series, .. } => series.len(),
         }
     }
 }

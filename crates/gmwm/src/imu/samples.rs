@@ -63,7 +63,8 @@ pub struct SampleAccount {
     /// Parts of the file that held no sample, with their counts.
     pub without_samples: Vec<Tally>,
     /// Samples the time stamps say are missing (the gaps' missing samples), not filled in:
-    /// the series is analysed as contiguous.
+    /// the wavelet variance skips the windows that span a gap unless asked to analyse the
+    /// samples as contiguous (`GapPolicy`).
     pub missing: u64,
 }
 
@@ -125,8 +126,7 @@ impl fmt::Display for SampleAccount {
             (0, 0) => write!(f, "; nothing dropped or filled in"),
             (0, m) => write!(
                 f,
-                "; nothing dropped; {m} {} missing in the time stamps' gaps, not filled in \
-                 (analysed as contiguous)",
+                "; nothing dropped; {m} {} missing in the time stamps' gaps, not filled in",
                 plural("sample", m)
             ),
             (d, 0) => write!(
@@ -182,9 +182,9 @@ mod tests {
              lines; nothing dropped or filled in"
         );
         let gaps = SampleAccount { missing: 5, ..a };
-        assert!(gaps
-            .to_string()
-            .ends_with("nothing dropped; 5 samples missing in the time stamps' gaps, not filled in (analysed as contiguous)"));
+        assert!(gaps.to_string().ends_with(
+            "nothing dropped; 5 samples missing in the time stamps' gaps, not filled in"
+        ));
         let names: Vec<String> = (1..=8).map(|k| format!("c{k}")).collect();
         let many = SampleAccount::all_used(names, "row", 1);
         assert!(many

@@ -311,6 +311,13 @@ impl Imu {
         })
     }
 
+    /// This IMU with `timing` as what its time stamps say (a simulated recording with gaps).
+    #[cfg(test)]
+    pub(crate) fn with_timing(mut self, timing: TimingReport) -> Self {
+        self.timing = Some(timing);
+        self
+    }
+
     /// Builds an IMU from a table, inferring sensor and axis of each column from its name, else
     /// from the sidecar's meaning ([`SensorInfo::infer`]); columns that match neither become
     /// [`Sensor::Other`] with the column name as label. Units: the one the column name states

@@ -833,7 +833,7 @@ impl fmt::Display for TimingWarning {
             } => write!(
                 f,
                 "time column \"{}\": {count} gap{} ({missing} sample{} missing), largest {} s at \
-                 {} ({} s after the start); the rows are analysed as if evenly spaced at {} Hz",
+                 {} ({} s after the start); {} Hz between them",
                 quote(column),
                 if *count == 1 { "" } else { "s" },
                 if *missing == 1 { "" } else { "s" },
@@ -1089,8 +1089,7 @@ mod tests {
         assert_eq!(
             w[0].to_string(),
             "time column \"t\": 1 gap (100 samples missing), largest 0.50 s at sample 400 \
-             (0-based) (2.00 s after the start); the rows are analysed as if evenly spaced at \
-             200 Hz"
+             (0-based) (2.00 s after the start); 200 Hz between them"
         );
         // duplicates and reordering are counted, not refused
         let r = check_times(

@@ -18,6 +18,7 @@ mod fit_ref;
 mod fit_start;
 mod flicker;
 mod fuzz_props;
+mod gaps;
 mod horizon;
 mod ieee;
 mod inference;

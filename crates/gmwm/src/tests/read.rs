@@ -1052,7 +1052,7 @@ fn issue_gap_is_not_averaged_into_the_rate() {
         t.facts.warnings[0].to_string(),
         format!(
             "{}: time column \"time\": 1 gap (100 samples missing), largest 0.50 s at line 1002 \
-             (5.00 s after the start); the rows are analysed as if evenly spaced at 200 Hz",
+             (5.00 s after the start); 200 Hz between them",
             p.display()
         )
     );
@@ -1609,7 +1609,7 @@ fn read_accounts_for_every_row() {
         s.to_string(),
         "7 rows read, 7 samples used in each of 2 columns (gx, gy); no samples in 1 header \
          line, 4 blank lines; nothing dropped; 3 samples missing in the time stamps' gaps, not \
-         filled in (analysed as contiguous)"
+         filled in"
     );
     // gzip: the same account
     let gz = write(&d, "gaps.csv.gz", &gzip(text.as_bytes()));

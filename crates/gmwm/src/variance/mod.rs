@@ -7,6 +7,7 @@ pub(crate) mod ci;
 pub(crate) mod cov;
 pub(crate) mod cross;
 mod file;
+pub(crate) mod gaps;
 pub(crate) mod growth;
 pub(crate) mod haar;
 pub(crate) mod haar_robust;
@@ -19,6 +20,7 @@ pub(crate) mod stream;
 pub(crate) mod wv;
 
 pub use file::{allan_from_wv, is_wv_json, read_wv_json, select_series};
+pub use gaps::{gap_aware_wavelet_variance, GapAccount, GapLevel, GapPolicy};
 pub use stream::{binary_columns_wv, binary_wavelet_variance, StreamedColumn};
 pub use wv::default_levels;
 
