@@ -413,3 +413,101 @@ fn calibrate_a_saved_wavelet_variance_as_its_recording() {
     let checks = b["checks"].to_string();
     assert!(checks.contains("saved wavelet variances"), "{checks}");
 }
+
+/// Packet loss (issue 30): a rosbag2 MCAP written by `rosbags` with 5% of its messages
+/// dropped in bursts of mean 50 messages calibrated end to end. The gaps are found in the
+/// header stamps, the WV is gap-aware (docs/methods.md §1.11) with its account in the JSON
+/// and the report, and N and K hold the truth at the nominal rate; `--gaps contiguous`
+/// keeps the samples as one series and says so.
+#[test]
+fn calibrate_a_ros2_mcap_with_dropped_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let values = dir.path().join("values.csv");
+    let mut extra = vec!["--drop", "0.05:50", "--values-out"];
+    let values_arg = values.to_str().unwrap().to_string();
+    extra.push(&values_arg);
+    let bag = write_bag(dir.path(), "lossy", "mcap", 1 << 16, &extra);
+    // the bursts as written: jumps in the message index of the values file
+    let written: Vec<u64> = std::fs::read_to_string(&values)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    let bursts = written.windows(2).filter(|w| w[1] != w[0] + 1).count();
+    let lost = (1 << 16) - written.len();
+    assert!(bursts > 20 && lost > 2000, "{bursts} bursts, {lost} lost");
+
+    let json = dir.path().join("out.json");
+    let report = dir.path().join("out.html");
+    let out = gmwm()
+        .arg("calibrate")
+        .arg(&bag)
+        .args(["--audit", "0", "--json"])
+        .arg(&json)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        summary.contains(&format!("{bursts} gaps ({lost} samples missing)")),
+        "{summary}"
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for axis in doc["axes"].as_array().unwrap() {
+        let column = axis["column"].as_str().unwrap();
+        assert_eq!(axis["gaps"]["gaps"], bursts, "{column}");
+        assert_eq!(axis["gaps"]["missing"], lost, "{column}");
+        assert_eq!(axis["samples"], written.len(), "{column}");
+        let (n, k) = if column.starts_with("gyro") {
+            (GYRO_N, GYRO_K)
+        } else {
+            (ACCEL_N, ACCEL_K)
+        };
+        for (key, truth) in [("noise_density", n), ("random_walk", k)] {
+            let e = &axis[key];
+            let (lo, hi) = (
+                e["ci_low"].as_f64().unwrap(),
+                e["ci_high"].as_f64().unwrap(),
+            );
+            // 95% intervals: with twelve numbers one miss in a run is chance; the slack covers it
+            assert!(
+                lo * 0.9 <= truth && truth <= hi * 1.1,
+                "{column} {key}: [{lo}, {hi}] against {truth}"
+            );
+        }
+    }
+    let html = std::fs::read_to_string(&report).unwrap();
+    assert!(
+        html.contains("gap-aware wavelet variance over"),
+        "no gap account in the report"
+    );
+
+    let contiguous = gmwm()
+        .arg("calibrate")
+        .arg(&bag)
+        .args(["--audit", "0", "--gaps", "contiguous", "--json", "-"])
+        .output()
+        .unwrap();
+    assert!(
+        contiguous.status.success(),
+        "{}",
+        String::from_utf8_lossy(&contiguous.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&contiguous.stdout).unwrap();
+    assert!(doc["axes"][0].get("gaps").is_none());
+    assert!(
+        doc["checks"]
+            .to_string()
+            .contains("analysed as one contiguous series"),
+        "{}",
+        doc["checks"]
+    );
+}

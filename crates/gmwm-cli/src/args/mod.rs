@@ -851,8 +851,8 @@ pub struct InputArgs {
     #[arg(long, value_parser = choice::<TimePolicy>(), default_value_t = TimePolicy::Strict, value_name = "POLICY")]
     pub time_policy: TimePolicy,
     /// How gaps in the time stamps (packet loss) enter the wavelet and Allan variances:
-    /// `aware` uses only the coefficients whose windows hold no gap, `contiguous` analyses
-    /// the samples as one series.
+    /// `aware` uses the observed samples on their time grid (docs/methods.md §1.11),
+    /// `contiguous` analyses the samples as one series.
     #[arg(long, value_parser = choice::<GapPolicy>(), default_value_t = GapPolicy::Aware, value_name = "POLICY")]
     pub gaps: GapPolicy,
     /// The sensor_msgs/Imu topic of a ROS recording (ROS1 .bag, MCAP, rosbag2 .db3 or folder)

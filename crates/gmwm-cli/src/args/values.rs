@@ -83,7 +83,7 @@ impl ValueHelp for TimePolicy {
 impl ValueHelp for GapPolicy {
     fn help(self) -> &'static str {
         match self {
-            Self::Aware => "Only coefficients whose windows hold no gap (the default)",
+            Self::Aware => "The observed samples on their time grid (the default)",
             Self::Contiguous => "The samples as one series, the gaps ignored",
         }
     }

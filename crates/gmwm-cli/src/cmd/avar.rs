@@ -72,7 +72,7 @@ pub fn compute(config: &AvarConfig, style: OutputStyle) -> Result<Vec<(String, A
         });
     }
     // the gap-aware estimator is the overlapping Allan variance, twice the gap-aware Haar WV
-    // (docs/methods.md §3.4, §1.14)
+    // (docs/methods.md §3.4, §1.11)
     let file = &config.input.file;
     anyhow::ensure!(
         config.allan.kind == gmwm::AllanKind::Overlapping

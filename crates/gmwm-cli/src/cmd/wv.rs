@@ -159,7 +159,7 @@ fn run_streamed_table(
     Ok(table.names.iter().cloned().zip(wvs).collect())
 }
 
-/// The gap-aware WV of every loaded column (docs/methods.md §1.14), the gaps' cost noted
+/// The gap-aware WV of every loaded column (docs/methods.md §1.11), the gaps' cost noted
 /// once (it is the same for every column).
 pub(crate) fn gap_aware(
     loaded: &Loaded,

@@ -91,8 +91,8 @@ pub struct CalibrationOptions {
     /// A mission horizon, s: each axis gets the white-noise + random-walk pair that bounds its
     /// model up to it ([`AxisCalibration::horizon_bound`]; default `None`).
     pub horizon_s: Option<f64>,
-    /// How gaps in the time stamps enter the WV (default [`GapPolicy::Aware`]: only the
-    /// coefficients whose windows hold no gap, docs/methods.md §1.14).
+    /// How gaps in the time stamps enter the WV (default [`GapPolicy::Aware`]: the observed
+    /// samples on their time grid, docs/methods.md §1.11).
     pub gaps: GapPolicy,
 }
 
@@ -429,8 +429,19 @@ impl Calibration {
         imu: &Imu,
         progress: &dyn Progress,
     ) -> Result<CalibrationReport, CalibError> {
-        // gaps in the stamps: the samples on their time grid (§1.14)
-        let gaps: &[crate::imu::Gap] = match (self.options.gaps, imu.timing()) {
+        self.run_timed(imu, imu.timing(), progress)
+    }
+
+    /// [`Calibration::run_with_progress`] with `timing` as what the samples' stamps say (a
+    /// ROS recording's are the [`Recording`](crate::imu::Recording)'s, not its IMU's).
+    pub(crate) fn run_timed(
+        &self,
+        imu: &Imu,
+        timing: Option<&crate::imu::TimingReport>,
+        progress: &dyn Progress,
+    ) -> Result<CalibrationReport, CalibError> {
+        // gaps in the stamps: the samples on their time grid (§1.11)
+        let gaps: &[crate::imu::Gap] = match (self.options.gaps, timing) {
             (GapPolicy::Aware, Some(t)) => &t.gaps,
             _ => &[],
         };
@@ -451,7 +462,7 @@ impl Calibration {
             })
             .collect();
         let mut checks = Vec::new();
-        if let (GapPolicy::Contiguous, Some(t)) = (self.options.gaps, imu.timing()) {
+        if let (GapPolicy::Contiguous, Some(t)) = (self.options.gaps, timing) {
             if !t.gaps.is_empty() {
                 checks.push(format!(
                     "{} {} in the time stamps analysed as one contiguous series (gaps: contiguous): the scales are mislabelled by the missing samples",
@@ -1295,7 +1306,7 @@ impl Calibration {
     /// The classical WV of the axis against the robust one ([`compare_classical_robust`]);
     /// `wv` is the axis' WV, classical or robust as the options ask, so only the other is
     /// computed (a streamed axis brings its robust WV).
-    /// A gapped axis' WV (docs/methods.md §1.14): the gap-aware classical WV, calibrated as a
+    /// A gapped axis' WV (docs/methods.md §1.11): the gap-aware classical WV, calibrated as a
     /// streamed recording's, with the spectrum of the longest gap-free stretch; no robust WV
     /// (the gap-aware estimator is the classical one's), said in a note.
     fn gap_aware<'a>(
@@ -1580,7 +1591,7 @@ pub(crate) enum AxisData<'a> {
         robust: Option<Result<Box<PooledWv>, String>>,
     },
     /// The samples of a recording with gaps in its time stamps, and the gaps (docs/methods.md
-    /// §1.14): turned into the gap-aware WV by [`Calibration::axis`], as a streamed one.
+    /// §1.11): turned into the gap-aware WV by [`Calibration::axis`], as a streamed one.
     Gapped {
         series: &'a [f64],
         gaps: &'a [crate::imu::Gap],

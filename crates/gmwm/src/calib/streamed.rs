@@ -539,9 +539,11 @@ impl Calibration {
         progress: &dyn Progress,
     ) -> Result<CalibrationReport, Error> {
         match source {
-            CalibrationSource::Memory(recording) => {
-                self.run_with_progress(&recording.imu, progress)
-            }
+            CalibrationSource::Memory(recording) => self.run_timed(
+                &recording.imu,
+                recording.timing.as_ref().or(recording.imu.timing()),
+                progress,
+            ),
             CalibrationSource::Spooled(table) => self.run_table(table, progress),
             CalibrationSource::Raw { probe, read } => self.run_probed(probe, read, progress),
             CalibrationSource::Pooled(recordings) => {

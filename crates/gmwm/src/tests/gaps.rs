@@ -1,4 +1,4 @@
-//! Packet loss against Monte Carlo (docs/methods.md §1.14): a gyroscope's WN + RW + GM truth
+//! Packet loss against Monte Carlo (docs/methods.md §1.11): a gyroscope's WN + RW + GM truth
 //! simulated at 200 Hz, 5% of its samples then lost in bursts. Per replicate, the gap-aware WV
 //! of what is left is held against the interval of the WV of the whole series (before the
 //! loss), scale by scale; the WV of what is left analysed as contiguous is set beside it as
@@ -179,8 +179,8 @@ fn calibration_study(replicates: u64, seed: u64) -> [[(f64, f64); 2]; 2] {
 /// The CI version: 60 replicates of the WV check, each level's gap-aware WV inside the whole
 /// series' interval in at least 90% of them (true share ~0.99: a binomial count of 60 falls
 /// below 54 with probability under 1%), and the gap-aware mean within 3% of the whole
-/// series' at the levels below 10 s (the contiguous one's is 5% high there: the time axis
-/// shrunk by the loss); 16 calibrations, N and K covering in at least 12.
+/// series' at the levels up to 5 s (the windows without a gap); 16 calibrations, N and K
+/// covering in at least 12.
 #[test]
 fn packet_loss_leaves_the_wavelet_variance_and_the_calibration_right() {
     let (inside, aware, contiguous, _) = wv_study(60, 91_000);
@@ -195,9 +195,12 @@ fn packet_loss_leaves_the_wavelet_variance_and_the_calibration_right() {
             aware[j]
         );
     }
-    // the contiguous treatment is biased at the random walk's scales: there its WV rises with
-    // tau, and the loss compresses the time axis
-    assert!(contiguous[14] > aware[14], "{contiguous:?} {aware:?}");
+    // the contiguous treatment: unbiased at the white noise's scales, a few percent high at the
+    // random walk's (printed above; the gap-aware WV splices there too, module docs)
+    assert!(
+        contiguous[..8].iter().all(|c| (c - 1.0).abs() < 0.01),
+        "{contiguous:?}"
+    );
     let c = calibration_study(16, 92_000);
     for k in 0..2 {
         assert!(
