@@ -8,8 +8,9 @@
 #
 # Each run starts from the committed seeds (fuzz/corpus/<target>) and writes what it finds to a
 # scratch corpus outside the repository ($GMWM_FUZZ_DIR, default ${TMPDIR:-/tmp}/gmwm-fuzz),
-# with its crash/timeout/OOM inputs and its log. A crash, a timeout (> 10 s) or an allocation
-# beyond 2 GiB fails the script; the final libFuzzer figures of each target are printed as one
+# with its crash/timeout/OOM inputs and its log. A crash, a timeout (> 10 s), a single
+# allocation beyond 512 MiB (-malloc_limit_mb: a small input must never ask for more) or a
+# resident size beyond 2 GiB fails the script; the final libFuzzer figures of each target are printed as one
 # line: target, executions, exec/s, cov, ft, corpus, crashes.
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -44,7 +45,7 @@ for t in "${targets[@]}"; do
   max_len=$(( $(find "corpus/$t" -type f -printf '%s\n' | sort -n | tail -1) * 2 ))
   if [ "$max_len" -lt 4096 ]; then max_len=4096; fi
   if cargo +nightly fuzz run -s none "$t" "$scratch/$t/corpus" "corpus/$t" -- \
-      "${args[@]}" -max_len="$max_len" -rss_limit_mb=2048 -timeout=10 \
+      "${args[@]}" -max_len="$max_len" -rss_limit_mb=2048 -malloc_limit_mb=512 -timeout=10 \
       -artifact_prefix="$scratch/$t/artifacts/" -print_final_stats=1 >"$log" 2>&1; then
     result=ok
   else

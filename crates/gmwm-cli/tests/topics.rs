@@ -144,3 +144,86 @@ fn topics_truncated_recording_is_a_one_line_error() {
         &["cut.bag: corrupt or truncated ROS1 bag: ", "cut short"],
     );
 }
+
+/// A 70 000-character topic name (issue 30): `gmwm topics` panicked ("Formatting argument out
+/// of range"); the table now shows the name cut and escaped, under a memory and time bound.
+#[test]
+fn topics_with_a_huge_topic_name_is_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = format!("/{}", "a".repeat(70_000));
+    let bag = write(dir.path(), "long.bag", "ros1", &["--topic", &name]);
+    let out = common::gmwm_bounded()
+        .arg("topics")
+        .arg(&bag)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains(&format!("/{}...", "a".repeat(199))),
+        "{table}"
+    );
+    assert!(table.lines().all(|l| l.chars().count() < 400), "{table}");
+}
+
+/// The records of an MCAP summary section: `(opcode, position, body length)`.
+fn summary_records(bytes: &[u8]) -> Vec<(u8, usize, usize)> {
+    let footer = bytes.len() - 8 - 29;
+    assert_eq!(bytes[footer], 0x02, "footer record");
+    let u64_at = |p: usize| u64::from_le_bytes(bytes[p..p + 8].try_into().unwrap()) as usize;
+    let mut pos = u64_at(footer + 9);
+    let mut out = Vec::new();
+    while pos < footer {
+        let len = u64_at(pos + 1);
+        out.push((bytes[pos], pos, len));
+        pos += 9 + len;
+    }
+    out
+}
+
+/// Hostile MCAP summaries (issue 30), each from a small file under a 1.5 GB address-space
+/// limit: a channel's topic claiming 0xFFFFFFFF bytes (the `mcap` crate reserved 4 GiB and
+/// aborted), a schema record claiming 4 GiB and 2^48 bytes. One error line, no abort.
+#[test]
+fn topics_hostile_mcap_summaries_are_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = write(dir.path(), "small", "mcap", &[]);
+    let file = bag.join("small.mcap");
+    let bytes = std::fs::read(&file).unwrap();
+    let records = summary_records(&bytes);
+    let channel = records
+        .iter()
+        .find(|r| r.0 == 0x04)
+        .expect("a channel record");
+    let schema = records
+        .iter()
+        .find(|r| r.0 == 0x03)
+        .expect("a schema record");
+    let mut cases = Vec::new();
+    // channel: id u16, schema id u16, then the topic's u32 length
+    let mut topic = bytes.clone();
+    topic[channel.1 + 9 + 4..channel.1 + 9 + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+    cases.push(("topic length", topic, "claims 4294967295 bytes"));
+    for claim in [u32::MAX as u64, 1u64 << 48] {
+        let mut long = bytes.clone();
+        long[schema.1 + 1..schema.1 + 9].copy_from_slice(&claim.to_le_bytes());
+        cases.push(("record length", long, "where the summary holds"));
+    }
+    for (what, content, needle) in cases {
+        let path = dir.path().join("hostile.mcap");
+        std::fs::write(&path, content).unwrap();
+        let out = common::gmwm_bounded()
+            .arg("topics")
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
+        let lines: Vec<&str> = stderr.lines().collect();
+        assert_eq!(lines.len(), 1, "{what}: {stderr}");
+        assert!(
+            lines[0].starts_with("gmwm: error: ") && lines[0].contains(needle),
+            "{what}: {stderr}"
+        );
+    }
+}

@@ -71,15 +71,21 @@ fn table(
     if topics.is_empty() {
         return Ok(());
     }
-    let wt = topics
+    // names from the file: control characters escaped and cut, so that a hostile name can
+    // neither reach the terminal raw nor widen the table past what formatting allows
+    let shown: Vec<(String, String)> = topics
         .iter()
-        .map(|t| t.topic.len())
+        .map(|t| (shown_name(&t.topic), shown_name(&t.message_type)))
+        .collect();
+    let wt = shown
+        .iter()
+        .map(|t| t.0.chars().count())
         .max()
         .unwrap_or(0)
         .max(5);
-    let wy = topics
+    let wy = shown
         .iter()
-        .map(|t| t.message_type.len())
+        .map(|t| t.1.chars().count())
         .max()
         .unwrap_or(0)
         .max(4);
@@ -88,7 +94,7 @@ fn table(
         "  {:<wt$}  {:<wy$}  {:>10}  imu",
         "topic", "type", "messages"
     )?;
-    for t in topics {
+    for (t, (topic, message_type)) in topics.iter().zip(&shown) {
         let mark = match (t.is_imu(), Some(t.topic.as_str()) == default) {
             (true, true) => "IMU (default)",
             (true, false) => "IMU",
@@ -96,7 +102,7 @@ fn table(
         };
         let line = format!(
             "  {:<wt$}  {:<wy$}  {:>10}  {mark}",
-            t.topic, t.message_type, t.messages
+            topic, message_type, t.messages
         );
         writeln!(out, "{}", line.trim_end())?;
     }
@@ -126,4 +132,25 @@ impl Command for TopicsConfig {
     fn run(&self, _: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
         run(self, &mut out)
     }
+}
+
+/// Longest topic or type name shown whole, in characters; a longer one (no real topic is) is
+/// cut with `...`.
+const NAME_SHOWN: usize = 200;
+
+/// A name from the file for the table: control characters escaped, cut to [`NAME_SHOWN`].
+fn shown_name(name: &str) -> String {
+    let mut out = String::new();
+    for (k, c) in name.chars().enumerate() {
+        if k == NAME_SHOWN {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }

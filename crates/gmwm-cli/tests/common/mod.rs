@@ -9,6 +9,25 @@ pub fn gmwm() -> Command {
     Command::cargo_bin("gmwm").expect("binary built")
 }
 
+/// Address space a hostile-input run may use: 1.5 GB, as in a small container.
+pub const MEMORY_LIMIT_KB: u64 = 1_536_000;
+/// Wall-clock bound of a hostile-input run, s: a hang fails the test instead of the CI job.
+pub const TIME_LIMIT_S: u64 = 120;
+
+/// `gmwm` run by bash under `ulimit -v` [`MEMORY_LIMIT_KB`] and `timeout` [`TIME_LIMIT_S`]:
+/// arguments added to the command go to `gmwm`. An allocation past the limit aborts the run
+/// (exit 134), a hang ends with exit 124: either fails an assertion on the exit code.
+pub fn gmwm_bounded() -> Command {
+    let bin = assert_cmd::cargo::cargo_bin("gmwm");
+    let mut cmd = Command::new("bash");
+    cmd.args([
+        "-c",
+        &format!("ulimit -v {MEMORY_LIMIT_KB} && exec timeout {TIME_LIMIT_S} \"$0\" \"$@\""),
+    ])
+    .arg(bin);
+    cmd
+}
+
 /// `gmwm simulate --model MODEL --n N --freq F --seed S -o DIR/NAME` (with its sidecar).
 pub fn simulate(dir: &Path, name: &str, model: &str, n: usize, freq: f64, seed: u64) -> PathBuf {
     let path = dir.join(name);

@@ -195,14 +195,25 @@ impl Calibration {
                     .file_name()
                     .map(|f| f.to_string_lossy().into_owned())
             });
-        self.run_streamed(
+        let mut report = self.run_streamed(
             spool,
             &layout,
             (&columns, &infos),
             (freq_hz, table.rows),
             name.as_deref(),
             progress,
-        )
+        )?;
+        // the streamed pass computes the WV as the rows come: the gap-aware estimator needs
+        // the segments first (docs/methods.md §1.11)
+        if let Some(t) = table.facts.timing.as_ref().filter(|t| !t.gaps.is_empty()) {
+            report.checks.push(format!(
+                "{} {} in the time stamps analysed as one contiguous series: a streamed recording \
+                 is not gap-aware (give a larger --stream-from to read it in memory)",
+                t.gaps.len(),
+                if t.gaps.len() == 1 { "gap" } else { "gaps" }
+            ));
+        }
+        Ok(report)
     }
 
     /// The streamed calibration of the 1-based `columns` of the raw binary `path` (a

@@ -112,14 +112,17 @@ fn wv_study(replicates: u64, seed: u64) -> (Vec<f64>, Vec<f64>, Vec<f64>, f64) {
 
 /// N and K from the calibration of the replicates after the loss, gap-aware and contiguous:
 /// per number the share of intervals holding the truth and the median ratio to it.
-fn calibration_study(replicates: u64, seed: u64) -> [[(f64, f64); 2]; 2] {
+fn calibration_study(replicates: u64, seed: u64) -> [[(f64, f64); 2]; 3] {
     let truth: Model = TRUTH.parse().unwrap();
     let targets = [(6e-6 / FREQ).sqrt(), (2e-12 * FREQ).sqrt()];
-    let mut out = [[(0.0, 0.0); 2]; 2];
-    for (p, policy) in [GapPolicy::Aware, GapPolicy::Contiguous]
+    let mut out = [[(0.0, 0.0); 2]; 3];
+    // the third run calibrates the whole series, before the loss: the calibration's own
+    // coverage on this truth and length, which the gaps should not lower
+    for (p, policy) in [GapPolicy::Aware, GapPolicy::Contiguous, GapPolicy::Aware]
         .into_iter()
         .enumerate()
     {
+        let whole = p == 2;
         let calibration = Calibration::new(CalibrationOptions {
             gaps: policy,
             robust_check: None,
@@ -129,7 +132,11 @@ fn calibration_study(replicates: u64, seed: u64) -> [[(f64, f64); 2]; 2] {
             .into_par_iter()
             .map(|r| {
                 let x = simulate_model(&truth, SAMPLES, FREQ, seed + r).unwrap();
-                let kept = lose_bursts(SAMPLES, (seed + r) ^ 0x9e37);
+                let kept = if whole {
+                    (0..SAMPLES).collect()
+                } else {
+                    lose_bursts(SAMPLES, (seed + r) ^ 0x9e37)
+                };
                 let y: Vec<f64> = kept.iter().map(|&i| x[i]).collect();
                 let times: Vec<f64> = kept.iter().map(|&i| i as f64 / FREQ).collect();
                 let timing = check_times("time", &times, TimeUnit::Seconds, UnitSource::Flag);
@@ -167,7 +174,12 @@ fn calibration_study(replicates: u64, seed: u64) -> [[(f64, f64); 2]; 2] {
             ratios.sort_by(f64::total_cmp);
             out[p][k] = (covered, ratios[ratios.len() / 2]);
             eprintln!(
-                "{policy}: {} coverage {covered:.3}, median ratio to the truth {:.4}",
+                "{}: {} coverage {covered:.3}, median ratio to the truth {:.4}",
+                if whole {
+                    "no loss".to_string()
+                } else {
+                    policy.to_string()
+                },
                 ["N", "K"][k],
                 ratios[ratios.len() / 2]
             );
@@ -216,8 +228,17 @@ fn packet_loss_leaves_the_wavelet_variance_and_the_calibration_right() {
 #[ignore = "Monte Carlo study: cargo test --release -- --ignored packet_loss_study"]
 fn packet_loss_study() {
     let reps = std::env::var("GMWM_GAP_REPS").map_or(200, |v| v.parse().unwrap());
-    let (inside, ..) = wv_study(reps, 1_000);
+    let wv_reps = if std::env::var("GMWM_GAP_SKIP_WV").is_ok() {
+        2
+    } else {
+        reps
+    };
+    let (inside, ..) = wv_study(wv_reps, 1_000);
     let c = calibration_study(reps.min(100), 2_000);
     assert!(inside.iter().all(|s| *s >= 0.95), "{inside:?}");
-    assert!(c[0].iter().all(|(cov, _)| *cov >= 0.9), "{c:?}");
+    // the gaps cost no coverage against the whole series' calibration (binomial sd ~0.035
+    // at 100 replicates)
+    for k in 0..2 {
+        assert!(c[0][k].0 >= c[2][k].0 - 0.07, "{c:?}");
+    }
 }

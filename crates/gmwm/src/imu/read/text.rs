@@ -37,12 +37,63 @@ fn open(path: &Path) -> Result<Source, ReadError> {
     let reader: Box<dyn BufRead> = if gzip {
         Box::new(BufReader::with_capacity(
             BUF_CAPACITY,
-            MultiGzDecoder::new(buffered),
+            LineCapped::new(MultiGzDecoder::new(buffered)),
         ))
     } else {
-        Box::new(buffered)
+        Box::new(BufReader::with_capacity(
+            BUF_CAPACITY,
+            LineCapped::new(buffered),
+        ))
     };
     Ok(Source { reader, gzip })
+}
+
+/// Longest line a text recording may hold: 1 MiB (a row of an IMU log is under a kilobyte; a
+/// header of 10^5 column names fits). A longer one (a gzip bomb's single 1 GiB line) is an
+/// error once this many bytes have passed without a newline, before the line is held.
+pub(crate) const MAX_LINE: usize = 1 << 20;
+
+/// The error of [`LineCapped`].
+#[derive(Debug)]
+struct LineTooLong;
+
+impl std::fmt::Display for LineTooLong {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "a line longer than {} MiB: not a text recording (its rows are short)",
+            MAX_LINE >> 20
+        )
+    }
+}
+
+impl std::error::Error for LineTooLong {}
+
+/// A byte stream that fails once a line runs past [`MAX_LINE`] bytes.
+struct LineCapped<R> {
+    inner: R,
+    /// Bytes since the last newline.
+    run: usize,
+}
+
+impl<R> LineCapped<R> {
+    fn new(inner: R) -> Self {
+        Self { inner, run: 0 }
+    }
+}
+
+impl<R: Read> Read for LineCapped<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        match buf[..n].iter().rposition(|&b| b == b'\n') {
+            Some(i) => self.run = n - 1 - i,
+            None => self.run += n,
+        }
+        if self.run > MAX_LINE {
+            return Err(io::Error::new(io::ErrorKind::InvalidData, LineTooLong));
+        }
+        Ok(n)
+    }
 }
 
 /// Chooses the delimiter: fixed for [`InputFormat::Csv`]/[`InputFormat::Tsv`], else the most
@@ -281,7 +332,8 @@ pub(crate) fn for_each_text_row(
 ) -> Result<TextPass, ReadError> {
     let Source { mut reader, gzip } = open(path)?;
     let stream_error = |e: io::Error| {
-        if gzip {
+        let too_long = e.get_ref().is_some_and(|r| r.is::<LineTooLong>());
+        if gzip && !too_long {
             ReadError::Gzip {
                 path: path.to_path_buf(),
                 source: e,

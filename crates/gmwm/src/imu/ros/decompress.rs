@@ -3,9 +3,14 @@
 
 use std::io::Read;
 
-/// Output reserved up front even for a tiny input (a 64 MiB chunk is ten times the usual
-/// recorder's chunk size); Zstandard decodes into reserved capacity only.
-const MIN_RESERVE: usize = 1 << 26;
+/// Largest decompressed chunk accepted: 256 MiB (recorders write chunks of 768 KiB to a few
+/// MiB); a larger declared size is refused before anything is allocated, so that a small
+/// hostile file cannot make the reader hold gigabytes (a bz2 bomb declaring 4 GiB).
+pub(crate) const MAX_CHUNK: usize = 1 << 28;
+
+/// Output reserved up front for lz4 and bzip2 beyond 16 times the input: 1 MiB; the buffer
+/// grows as the data come (Zstandard decodes into reserved capacity only: it gets `size`).
+const MIN_RESERVE: usize = 1 << 20;
 
 /// A chunk compression.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,8 +42,18 @@ impl Decompressor {
         dst: &mut Vec<u8>,
     ) -> Result<(), String> {
         dst.clear();
-        // the declared size is data: never reserve more than a generous ratio of the input
-        dst.reserve(size.min(src.len().saturating_mul(1024).max(MIN_RESERVE)));
+        if size > MAX_CHUNK {
+            return Err(format!(
+                "the chunk declares {size} bytes decompressed, more than the {} MiB accepted \
+                 (recorders write chunks of a few MiB)",
+                MAX_CHUNK >> 20
+            ));
+        }
+        // the declared size is data: reserve what the input can plausibly give, then grow
+        dst.reserve(match codec {
+            Codec::Zstd => size,
+            _ => size.min(src.len().saturating_mul(16).max(MIN_RESERVE)),
+        });
         // one byte beyond the declared size shows a stream that is longer (a declared size of
         // u64::MAX from the file reads to the end of the stream)
         let limit = (size as u64).saturating_add(1);
@@ -92,6 +107,46 @@ pub(crate) fn zstd_frame(src: &[u8], dst: &mut Vec<u8>) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn declared_sizes_are_capped_before_anything_is_allocated() {
+        let mut d = Decompressor::new();
+        let mut out = Vec::new();
+        // a bz2 bomb: 300 MB of zeros in a few hundred bytes, declaring what it holds
+        let mut enc = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::best());
+        let block = vec![0u8; 1 << 20];
+        for _ in 0..300 {
+            std::io::Write::write_all(&mut enc, &block).unwrap();
+        }
+        let bomb = enc.finish().unwrap();
+        assert!(bomb.len() < 4096, "{}", bomb.len());
+        for (codec, size) in [
+            (Codec::Bz2, 300 << 20),
+            (Codec::Bz2, u32::MAX as usize),
+            (Codec::Zstd, usize::MAX),
+        ] {
+            let e = d.decompress(codec, &bomb, size, &mut out).unwrap_err();
+            assert!(e.contains("more than the 256 MiB accepted"), "{e}");
+            assert!(out.capacity() < 1 << 20, "{}", out.capacity());
+        }
+        // 1.6 MB of garbage declaring 1.6 GB: refused; declaring 200 MB: at most 16x the
+        // input reserved, then the decoder's error
+        let garbage: Vec<u8> = (0..1_600_000u32)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
+            .collect();
+        assert!(d
+            .decompress(Codec::Lz4, &garbage, 1_600_000_000, &mut out)
+            .is_err());
+        let e = d
+            .decompress(Codec::Lz4, &garbage, 200 << 20, &mut out)
+            .unwrap_err();
+        assert!(e.starts_with("lz4"), "{e}");
+        assert!(
+            out.capacity() <= 16 * garbage.len() + (1 << 20),
+            "{}",
+            out.capacity()
+        );
+    }
 
     #[test]
     fn lz4_round_trip_and_size_check() {

@@ -83,10 +83,108 @@ fn parse<'a>(
     body: &'a [u8],
     at: &dyn Fn() -> String,
 ) -> Result<Record<'a>, ReadError> {
+    if let Err(why) = check_lengths(opcode, body) {
+        return Err(corrupt(path, format!("{}: {why}", at())).into());
+    }
     guarded(path, at, || {
         mcap::parse_record(opcode, body)
             .map_err(|e| corrupt(path, format!("{}: {}", at(), describe(&e))).into())
     })
+}
+
+/// A field of a record body, as the MCAP specification lays them out.
+#[derive(Clone, Copy)]
+enum Field {
+    /// Fixed-width bytes.
+    Fixed(usize),
+    /// A string or byte array: u32 length, then the bytes.
+    Prefixed,
+    /// A map or array of fixed-width entries: u32 byte length, then the entries.
+    Block,
+    /// A map of strings to strings: u32 byte length, then prefixed keys and values.
+    StringMap,
+    /// The rest of the body as the record's data, or a u64 length then the data.
+    Rest,
+    Long,
+}
+
+/// The fields of the records whose lengths the `mcap` crate trusts (the other opcodes are
+/// fixed-size or ours to read).
+fn layout(opcode: u8) -> &'static [Field] {
+    use Field::*;
+    match opcode {
+        op::HEADER => &[Prefixed, Prefixed],
+        op::SCHEMA => &[Fixed(2), Prefixed, Prefixed, Prefixed],
+        op::CHANNEL => &[Fixed(4), Prefixed, Prefixed, StringMap],
+        op::MESSAGE => &[Fixed(22), Rest],
+        op::CHUNK => &[Fixed(28), Prefixed, Long],
+        op::MESSAGE_INDEX => &[Fixed(2), Block],
+        op::CHUNK_INDEX => &[Fixed(32), Block, Fixed(8), Prefixed, Fixed(16)],
+        op::ATTACHMENT => &[Fixed(16), Prefixed, Prefixed, Long],
+        op::ATTACHMENT_INDEX => &[Fixed(40), Prefixed, Prefixed],
+        op::STATISTICS => &[Fixed(42), Block],
+        op::METADATA => &[Prefixed, StringMap],
+        op::METADATA_INDEX => &[Fixed(16), Prefixed],
+        _ => &[Rest],
+    }
+}
+
+/// Every length inside a record body held against the bytes left in it, before the `mcap`
+/// crate sees the body: the crate reserves what a string's length prefix says (`mcap` 0.26,
+/// through `binrw`), so a 4 KiB summary with a topic of length 0xFFFFFFFF asked for 4 GiB.
+fn check_lengths(opcode: u8, body: &[u8]) -> Result<(), String> {
+    fn prefixed(b: &[u8], at: &mut usize, wide: bool) -> Result<usize, String> {
+        let w = if wide { 8 } else { 4 };
+        let head = b
+            .get(*at..*at + w)
+            .ok_or_else(|| format!("a length field at byte {at} runs past the record's end"))?;
+        let n = if wide {
+            u64::from_le_bytes(head.try_into().expect("8 bytes"))
+        } else {
+            u64::from(u32::from_le_bytes(head.try_into().expect("4 bytes")))
+        };
+        *at += w;
+        let left = (b.len() - *at) as u64;
+        if n > left {
+            return Err(format!(
+                "a field at byte {} claims {n} bytes where the record holds {left} more",
+                *at - w
+            ));
+        }
+        let start = *at;
+        *at += n as usize;
+        Ok(start)
+    }
+    let mut at = 0usize;
+    for field in layout(opcode) {
+        match *field {
+            Field::Fixed(n) => {
+                if body.len() - at < n {
+                    return Err(format!(
+                        "the record ends before its {n}-byte field at byte {at}"
+                    ));
+                }
+                at += n;
+            }
+            Field::Prefixed | Field::Block => {
+                prefixed(body, &mut at, false)?;
+            }
+            Field::Long => {
+                prefixed(body, &mut at, true)?;
+            }
+            Field::StringMap => {
+                let start = prefixed(body, &mut at, false)?;
+                let map = &body[start..at];
+                let mut k = 0;
+                while k < map.len() {
+                    prefixed(map, &mut k, false)?;
+                    prefixed(map, &mut k, false)?;
+                }
+            }
+            Field::Rest => return Ok(()),
+        }
+    }
+    Ok(())
 }
 
 /// Checks both magics (a file without the end magic was cut short or never closed).
@@ -319,6 +417,28 @@ fn check_summary_records(file: &StorageFile) -> Result<(), ReadError> {
             op::ATTACHMENT => Some("an attachment"),
             _ => None,
         };
+        let claimed = u64_at(&header[1..9]);
+        if !matches!(layout(header[0]), [Field::Rest]) {
+            // the body is read (its length held against the summary first) and its own
+            // lengths checked before the crate parses it
+            let room = (footer - pos - header.len()) as u64;
+            if claimed > room {
+                return Err(corrupt(
+                    file.path(),
+                    format!("summary section: record at byte {pos} claims {claimed} bytes where the summary holds {room} more"),
+                )
+                .into());
+            }
+            let mut body = vec![0u8; claimed as usize];
+            file.read_into(pos + header.len(), &mut body)?;
+            if let Err(why) = check_lengths(header[0], &body) {
+                return Err(corrupt(
+                    file.path(),
+                    format!("summary section: record at byte {pos}: {why}"),
+                )
+                .into());
+            }
+        }
         if let Some(record) = misplaced {
             return Err(corrupt(
                 file.path(),
@@ -362,8 +482,10 @@ fn crate_summary(file: &StorageFile) -> Result<Option<mcap::Summary>, ReadError>
     while let Some(event) = reader.next_event() {
         match event.map_err(fail)? {
             SummaryReadEvent::ReadRequest(n) => {
+                // what the file holds from here, never the length a record claims: a
+                // summary record declaring 4 GiB in a 4 KiB file costs nothing
                 let k = usize::try_from(len.saturating_sub(pos)).map_or(n, |left| left.min(n));
-                let into = &mut reader.insert(n)[..k];
+                let into = reader.insert(k);
                 file.read_into(pos as usize, into)?;
                 reader.notify_read(k);
                 pos += k as u64;
