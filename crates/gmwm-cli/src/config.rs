@@ -1795,6 +1795,7 @@ mod tests {
             time_column: None,
             time_unit: None,
             time_policy: gmwm::TimePolicy::Strict,
+            gaps: gmwm::GapPolicy::Aware,
             topic: None,
             stream_from: None,
         };
