@@ -417,6 +417,15 @@ fn check_summary_records(file: &StorageFile) -> Result<(), ReadError> {
             op::ATTACHMENT => Some("an attachment"),
             _ => None,
         };
+        if let Some(record) = misplaced {
+            return Err(corrupt(
+                file.path(),
+                format!(
+                    "summary section: {record} record at byte {pos} (the format keeps it in the data section; the summary holds only schemas, channels, indexes and statistics)"
+                ),
+            )
+            .into());
+        }
         let claimed = u64_at(&header[1..9]);
         if !matches!(layout(header[0]), [Field::Rest]) {
             // the body is read (its length held against the summary first) and its own
@@ -438,15 +447,6 @@ fn check_summary_records(file: &StorageFile) -> Result<(), ReadError> {
                 )
                 .into());
             }
-        }
-        if let Some(record) = misplaced {
-            return Err(corrupt(
-                file.path(),
-                format!(
-                    "summary section: {record} record at byte {pos} (the format keeps it in the data section; the summary holds only schemas, channels, indexes and statistics)"
-                ),
-            )
-            .into());
         }
         match usize::try_from(u64_at(&header[1..9]))
             .ok()
