@@ -269,17 +269,24 @@ pub fn gaps_of(loaded: &Loaded, input: &InputConfig, style: OutputStyle) -> Vec<
     match input.gaps {
         gmwm::GapPolicy::Aware => t.gaps.clone(),
         gmwm::GapPolicy::Contiguous => {
-            style.note(
-                &input.file,
-                &format!(
-                    "{} {} in the time stamps analysed as one contiguous series (--gaps contiguous)",
-                    t.gaps.len(),
-                    if t.gaps.len() == 1 { "gap" } else { "gaps" }
-                ),
-            );
+            style.note(&input.file, &contiguous_gaps_note(t.gaps.len(), false));
             Vec::new()
         }
     }
+}
+
+/// The note of `count` gaps analysed as one contiguous series: asked for (`--gaps
+/// contiguous`), or because the recording was streamed.
+pub fn contiguous_gaps_note(count: usize, streamed: bool) -> String {
+    format!(
+        "{count} {} in the time stamps analysed as one contiguous series ({})",
+        if count == 1 { "gap" } else { "gaps" },
+        if streamed {
+            "a streamed recording is not gap-aware; a larger --stream-from reads it in memory"
+        } else {
+            "--gaps contiguous"
+        }
+    )
 }
 
 /// Borrows `(name, result)` pairs as [`Named`](crate::render::Named) items.

@@ -145,6 +145,14 @@ fn run_streamed_table(
     for n in &table.notes {
         style.note(&input.file, n);
     }
+    // the streamed pass sums the windows as the rows come: every scale spliced across gaps
+    if let Some(t) = table.facts.timing.as_ref().filter(|t| !t.gaps.is_empty()) {
+        let streamed = input.gaps == gmwm::GapPolicy::Aware;
+        style.note(
+            &input.file,
+            &crate::input::contiguous_gaps_note(t.gaps.len(), streamed),
+        );
+    }
     let freq_hz = match table.facts.freq_hz {
         Some(f) => f,
         None => {
