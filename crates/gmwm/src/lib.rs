@@ -143,9 +143,9 @@ pub use imu::ros::{MessageError, RosError};
 pub use imu::sidecar::sidecar_candidates;
 pub use imu::write::{write_atomic, write_csv_header, write_csv_rows, write_sidecar, AtomicFile};
 pub use imu::{
-    find_sidecar, quote, time_column_unit, Imu, OutputFormat, Probe, ReadError, Recording,
-    RecordingOptions, RecordingSource, SampleAccount, Sensor, SensorInfo, SeriesWriter, Sidecar,
-    SidecarColumn, TimeUnit, TimingReport,
+    find_sidecar, quote, quote_up_to, time_column_unit, Imu, OutputFormat, Probe, ReadError,
+    Recording, RecordingOptions, RecordingSource, SampleAccount, Sensor, SensorInfo, SeriesWriter,
+    Sidecar, SidecarColumn, TimeUnit, TimingReport,
 };
 pub use imu::{Axis, ColumnSummary, Gap, NotASidecar, SidecarUnits, Tally, TimingWarning};
 pub use units::{si_unit, NoiseTerm, SignalKind, SignalUnit};

@@ -140,17 +140,5 @@ const NAME_SHOWN: usize = 200;
 
 /// A name from the file for the table: control characters escaped, cut to [`NAME_SHOWN`].
 fn shown_name(name: &str) -> String {
-    let mut out = String::new();
-    for (k, c) in name.chars().enumerate() {
-        if k == NAME_SHOWN {
-            out.push_str("...");
-            break;
-        }
-        if c.is_control() {
-            out.extend(c.escape_debug());
-        } else {
-            out.push(c);
-        }
-    }
-    out
+    gmwm::quote_up_to(name, NAME_SHOWN)
 }

@@ -18,6 +18,17 @@ pub fn quote(text: &str) -> String {
     escaped(text, QUOTE_MAX)
 }
 
+/// [`quote`] cut at `max` characters instead: for a table that shows names whole up to a
+/// bound (a ROS topic).
+///
+/// ```
+/// assert_eq!(gmwm::quote_up_to("/imu\n0", 3), "/im...");
+/// assert_eq!(gmwm::quote_up_to("/imu\n0", 10), "/imu\\n0");
+/// ```
+pub fn quote_up_to(text: &str, max: usize) -> String {
+    escaped(text, max)
+}
+
 /// `text` with control characters (and U+FFFD) escaped, whole: for a message of the engine's
 /// own that may hold text from a file.
 pub(crate) fn escape_control(text: &str) -> String {

@@ -40,7 +40,7 @@ pub(crate) mod timing;
 pub(crate) mod write;
 
 pub(crate) use error::escape_name;
-pub use error::{quote, ReadError};
+pub use error::{quote, quote_up_to, ReadError};
 pub use probe::Probe;
 #[cfg(test)]
 pub(crate) use read::sniff;

@@ -131,7 +131,7 @@ impl GapLevel {
 
 impl fmt::Display for GapAccount {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let sig = crate::fit::report::significant;
+        let sig = crate::math::significant;
         let plural = |n: usize, one: &'static str, many: &'static str| {
             if n == 1 {
                 one
