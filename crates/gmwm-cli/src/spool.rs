@@ -4,7 +4,7 @@
 //! end. Messages name it as the user did (`<stdin>`, or the FIFO's path), not the copy.
 
 use anyhow::{Context, Result};
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -68,6 +68,19 @@ pub fn spool(path: &Path) -> Result<(PathBuf, Spool)> {
     } else {
         path.display().to_string()
     };
+    // a character device (/dev/zero, /dev/urandom, a terminal) never ends: refused before a
+    // byte is copied, where the copy would fill the disk
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let probe = if stdin { Path::new("/dev/stdin") } else { path };
+        if std::fs::metadata(probe).is_ok_and(|m| m.file_type().is_char_device()) {
+            anyhow::bail!(
+                "{shown_name}: is a character device (a terminal, /dev/zero), not a recording: \
+                 give a file, or pipe the data in (cmd | gmwm ... -)"
+            );
+        }
+    }
     let dir = std::env::temp_dir().join(format!("gmwm-input-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir)
@@ -80,14 +93,35 @@ pub fn spool(path: &Path) -> Result<(PathBuf, Spool)> {
     let copy = dir.join(name);
     let mut file = std::fs::File::create(&copy)
         .with_context(|| format!("{shown_name}: cannot create its temporary copy"))?;
-    let copied = if stdin {
-        std::io::copy(&mut std::io::stdin().lock(), &mut file)
+    let mut source: Box<dyn std::io::Read> = if stdin {
+        Box::new(std::io::stdin().lock())
     } else {
-        std::fs::File::open(path).and_then(|mut f| std::io::copy(&mut f, &mut file))
+        Box::new(
+            std::fs::File::open(path).with_context(|| format!("{shown_name}: cannot read it"))?,
+        )
     };
-    copied
-        .and_then(|_| file.flush())
-        .with_context(|| format!("{shown_name}: cannot read it"))?;
+    // a failed read is the input's; a failed write (a full disk) is the temporary folder's
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = match source.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e).with_context(|| format!("{shown_name}: cannot read it")),
+        };
+        file.write_all(&buf[..n]).with_context(|| {
+            format!(
+                "{shown_name}: cannot write its temporary copy in {} (free space there or set TMPDIR)",
+                dir.display()
+            )
+        })?;
+    }
+    file.flush().with_context(|| {
+        format!(
+            "{shown_name}: cannot write its temporary copy in {} (free space there or set TMPDIR)",
+            dir.display()
+        )
+    })?;
     if !stdin {
         for candidate in gmwm::sidecar_candidates(path) {
             if candidate.is_file() {

@@ -77,3 +77,30 @@ fn a_million_columns_is_refused() {
         assert_one_error(&path, &[command], "a line longer than 1 MiB");
     }
 }
+
+/// `gmwm wv /dev/zero` (also `topics`, `calibrate`, and `-` fed from it) copied the device into
+/// TMPDIR until the disk was full: a character device is refused before anything is copied.
+#[test]
+fn a_character_device_is_refused() {
+    for command in ["wv", "topics", "calibrate"] {
+        assert_one_error(Path::new("/dev/zero"), &[command], "is a character device");
+    }
+    let out = std::process::Command::new("bash")
+        .args([
+            "-c",
+            &format!(
+                "ulimit -v {} && exec timeout {} \"$0\" wv - --freq 100 < /dev/zero",
+                common::MEMORY_LIMIT_KB,
+                common::TIME_LIMIT_S
+            ),
+        ])
+        .arg(assert_cmd::cargo::cargo_bin("gmwm"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("<stdin>: is a character device"),
+        "{stderr}"
+    );
+}
