@@ -15,6 +15,7 @@ mod panic;
 mod prepare;
 mod recordings;
 mod render;
+mod signals;
 mod spool;
 mod style;
 
@@ -153,6 +154,7 @@ fn parse() -> Result<Cli, ExitCode> {
 
 fn main() -> ExitCode {
     panic::install();
+    signals::install();
     let cli = match parse() {
         Ok(cli) => cli,
         Err(code) => return code,

@@ -81,6 +81,7 @@ fn scan_folder(dir: &Path, format: InputFormat) -> Result<Vec<PathBuf>> {
         .filter(|p| is_recording(p, format))
         .collect();
     found.sort();
+    found.retain(|p| readable_entry(p));
     anyhow::ensure!(
         !found.is_empty(),
         "{}: no recording in this folder (.csv, .tsv, .txt, .gz, .bag, .mcap, .db3, .f64, .f32, \
@@ -88,6 +89,25 @@ fn scan_folder(dir: &Path, format: InputFormat) -> Result<Vec<PathBuf>> {
         dir.display()
     );
     Ok(found)
+}
+
+/// Whether a folder's or glob's entry is a regular file (links followed) or a folder: a FIFO,
+/// socket or device named like a recording would block or never end the batch, and is
+/// skipped with a warning.
+fn readable_entry(path: &Path) -> bool {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() || m.is_dir() => true,
+        Ok(_) => {
+            eprintln!(
+                "gmwm: warning: {}: not a regular file (a FIFO, socket or device): skipped; \
+                 name it alone to read it as a stream",
+                path.display()
+            );
+            false
+        }
+        // a broken link: left to the reader, which names it
+        Err(_) => true,
+    }
 }
 
 /// The recordings among a glob's matches, sorted.
@@ -99,6 +119,7 @@ fn expand_glob(pattern: &Path, format: InputFormat) -> Result<Vec<PathBuf>> {
         .filter(|p| is_recording(p, format));
     let mut found: Vec<PathBuf> = paths.collect();
     found.sort();
+    found.retain(|p| readable_entry(p));
     anyhow::ensure!(!found.is_empty(), "no recording matches {text:?}");
     Ok(found)
 }

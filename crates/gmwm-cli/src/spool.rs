@@ -21,6 +21,7 @@ pub struct Spool {
 
 impl Drop for Spool {
     fn drop(&mut self) {
+        gmwm::untrack_temporary(&self.dir);
         let _ = std::fs::remove_dir_all(&self.dir);
     }
 }
@@ -85,6 +86,7 @@ pub fn spool(path: &Path) -> Result<(PathBuf, Spool)> {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("{shown_name}: cannot create a temporary folder to read it"))?;
+    gmwm::track_temporary(&dir);
     let guard = Spool { dir: dir.clone() };
     let name = match path.file_name() {
         Some(n) if !stdin => n.to_os_string(),

@@ -104,3 +104,178 @@ fn a_character_device_is_refused() {
         "{stderr}"
     );
 }
+
+/// A rosbag2 sqlite3 file whose schema is `schema` (the bag's real tables, views or crafted
+/// columns), written by SQLite itself: a few KB.
+fn sqlite_bag(path: &Path, schema: &str) {
+    let db = rusqlite::Connection::open(path).unwrap();
+    db.execute_batch(schema).unwrap();
+}
+
+/// Views in place of rosbag2's tables: one without end (`topics` hung), one of 10^9 rows
+/// (sorted), one naming a topic with 900 MB; and a generated column of 900 MB in a table.
+#[test]
+fn sqlite_views_and_huge_values_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let topics = "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT, type TEXT, \
+                  serialization_format TEXT, offered_qos_profiles TEXT); \
+                  INSERT INTO topics VALUES (1, '/imu', 'sensor_msgs/msg/Imu', 'cdr', '');";
+    let messages = "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER, \
+                    timestamp INTEGER, data BLOB);";
+    let cases = [
+        (
+            "endless",
+            format!(
+                "{topics} CREATE VIEW messages AS WITH RECURSIVE r(i) AS (SELECT 1 UNION ALL \
+                 SELECT i + 1 FROM r) SELECT i AS id, 1 AS topic_id, i AS timestamp, \
+                 x'00' AS data FROM r;"
+            ),
+            "`messages` is a view, not a table",
+        ),
+        (
+            "billion",
+            format!(
+                "{topics} CREATE VIEW messages AS WITH RECURSIVE r(i) AS (SELECT 1 UNION ALL \
+                 SELECT i + 1 FROM r WHERE i < 1000000000) SELECT i AS id, 1 AS topic_id, \
+                 -i AS timestamp, x'00' AS data FROM r;"
+            ),
+            "`messages` is a view, not a table",
+        ),
+        (
+            "name_view",
+            format!(
+                "{messages} CREATE VIEW topics AS SELECT 1 AS id, \
+                 printf('%.*c', 900000000, 'x') AS name, 'sensor_msgs/msg/Imu' AS type, \
+                 'cdr' AS serialization_format;"
+            ),
+            "`topics` is a view, not a table",
+        ),
+        (
+            "name_column",
+            format!(
+                "{messages} CREATE TABLE topics(id INTEGER PRIMARY KEY, type TEXT, \
+                 serialization_format TEXT, name TEXT GENERATED ALWAYS AS \
+                 (printf('%.*c', 900000000, 'x')) VIRTUAL); \
+                 INSERT INTO topics(id, type, serialization_format) \
+                 VALUES (1, 'sensor_msgs/msg/Imu', 'cdr');"
+            ),
+            "longer than 16 MiB",
+        ),
+    ];
+    for (name, schema, needle) in &cases {
+        let path = dir.path().join(format!("{name}.db3"));
+        sqlite_bag(&path, schema);
+        for cmd in ["topics", "wv"] {
+            assert_one_error(&path, &[cmd], needle);
+        }
+    }
+}
+
+/// Runs `gmwm ARGS` under the memory and time bounds and asserts it succeeds.
+fn assert_bounded_success(args: &[&str]) -> String {
+    let out = common::gmwm_bounded().args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A 3 KB saved WV claiming n = 2^40 over 40 levels: an ARMA fit summed 2^40 autocovariances
+/// (4 TB); `implied` at 30 levels took 8.4 GB. Both now run in memory linear in the levels.
+#[test]
+fn arma_at_forty_levels_is_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("wv40.json");
+    let tau: Vec<f64> = (1..=40).map(|j| 2f64.powi(j)).collect();
+    let wv: Vec<f64> = tau.iter().map(|t| 1.0 / t).collect();
+    let doc = serde_json::json!({
+        "freq_hz": 100.0,
+        "series": [{
+            "name": "x", "n": 2f64.powi(40), "tau": tau, "wv": wv,
+            "ci_low": wv.iter().map(|w| 0.9 * w).collect::<Vec<_>>(),
+            "ci_high": wv.iter().map(|w| 1.1 * w).collect::<Vec<_>>(),
+        }]
+    });
+    std::fs::write(&path, doc.to_string()).unwrap();
+    assert!(std::fs::metadata(&path).unwrap().len() < 4096);
+    let file = path.to_str().unwrap();
+    for model in ["ARMA(2,1)", "AR(2)", "MA(2)"] {
+        let out = assert_bounded_success(&["fit", file, "--model", model, "--json"]);
+        let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let sigma2 = doc["fits"][0]["parameters"]
+            .as_array()
+            .and_then(|p| {
+                p.iter()
+                    .find(|p| p["name"].as_str().is_some_and(|n| n.ends_with("sigma2")))
+            })
+            .map(|p| p["value"].as_f64().unwrap());
+        // the WV is white noise's (1/tau): the fitted innovation variance is about 1
+        assert!(
+            sigma2.is_some_and(|s| (s - 1.0).abs() < 0.05),
+            "{model}: {out}"
+        );
+    }
+    let out = assert_bounded_success(&[
+        "implied",
+        "--model",
+        "ARMA(2,1)(ar1=0.5, ar2=-0.3, ma1=0.4, sigma2=1)",
+        "--levels",
+        "30",
+        "--json",
+    ]);
+    assert!(out.contains("1073741824"), "{out}");
+}
+
+/// `gmwm shared` over 50 columns grew with the fourth power of the count (89 s, then an
+/// abort): more than 16 series is refused before any work.
+#[test]
+fn shared_over_too_many_columns_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("wide.csv");
+    let mut text: String = (0..50).map(|k| format!("c{k},")).collect();
+    text.pop();
+    text.push('\n');
+    for r in 0..2000u64 {
+        let row: Vec<String> = (0..50u64)
+            .map(|k| ((r * 31 + k * 17) % 101).to_string())
+            .collect();
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    std::fs::write(&path, text).unwrap();
+    assert_one_error(
+        &path,
+        &[
+            "shared", "--freq", "100", "--shared", "GM()", "--model", "WN()",
+        ],
+        "at most 16 series for a shared process",
+    );
+}
+
+/// A 0.5 MB gzip of 2^28 valid rows: the streaming switch took its rows from the compressed
+/// size and read it into memory (abort). Now its lines are counted as they decompress: `wv`
+/// streams it in bounded memory, and `fit`, which holds the recording, stops with one line.
+#[test]
+fn a_gzip_of_2_pow_28_rows_streams_or_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rows.csv.gz");
+    // "1" and "2" alternate: not constant, so the WV is computed to the end
+    gzip_bomb(&path, b"x\n", b"1\n2\n", 1 << 27);
+    assert!(std::fs::metadata(&path).unwrap().len() < 8 << 20);
+    assert_one_error(
+        &path,
+        &["fit", "--freq", "100", "--model", "WN()"],
+        "in memory failed",
+    );
+    // 2^27 rows for `wv` (a 1 GB spool), twice what an in-memory WV could hold here
+    let half = dir.path().join("half.csv.gz");
+    gzip_bomb(&half, b"x\n", b"1\n2\n", 1 << 26);
+    let out = common::gmwm_bounded()
+        .args(["wv", "--freq", "100"])
+        .arg(&half)
+        .env("TMPDIR", dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("134217728 rows read"), "{stderr}");
+}

@@ -218,6 +218,11 @@ fn union_model(shared: &Model, specific: &Model) -> Model {
     Model::new(comps).unwrap_or_else(|_| specific.without_values())
 }
 
+/// Most series one shared-process fit takes: `P + P(P-1)/2` moment blocks, an exact
+/// covariance of their fourth power in size and time (16 axes: 136 blocks; an IMU array of
+/// four triads is 12).
+pub(crate) const MAX_SERIES: usize = 16;
+
 /// Fits the shared-process model `x_i = V + U_i` (module docs, docs/methods.md §15) to the
 /// `axes` (name, samples) at `freq_hz`.
 ///
@@ -239,7 +244,7 @@ fn union_model(shared: &Model, specific: &Model) -> Model {
 /// ```
 ///
 /// # Errors
-/// [`ParamError`] for fewer than two axes, axes of different lengths, a DR term or a rate that
+/// [`ParamError`] for fewer than two axes or more than 16, axes of different lengths, a DR term or a rate that
 /// is not positive; as [`wavelet_variance`] for a series with non-finite values or too short
 /// for the levels; [`FitError`](crate::FitError) (e.g. `TooFewLevels`) when the series is too short for the
 /// model; a [`ParamError`] from the exact covariance for a term it does not cover.
@@ -256,6 +261,18 @@ pub fn fit_shared(
             "axes",
             p,
             "at least 2 series for a shared process (e.g. --columns gyro_x,gyro_y,gyro_z)",
+        )
+        .into());
+    }
+    if p > MAX_SERIES {
+        return Err(ParamError::new(
+            "axes",
+            p,
+            format!(
+                "at most {MAX_SERIES} series for a shared process: the stacked moments grow \
+                 as the square of the count and their covariance as its fourth power \
+                 (choose the axes with --columns)"
+            ),
         )
         .into());
     }

@@ -53,6 +53,13 @@ fn escaped(text: &str, max: usize) -> String {
     out
 }
 
+/// `text` with its control characters escaped (`\u{8}` for a backspace, `\n`, `\t`): a column
+/// name from a file's header as every output shows it, so that no terminal, CSV or YAML file
+/// receives raw control bytes.
+pub(crate) fn printable(text: &str) -> String {
+    escaped(text, usize::MAX)
+}
+
 /// Longest message of another library (e.g. SQLite's, which may quote SQL from the file)
 /// kept in an error, in characters.
 pub(crate) const CAUSE_MAX: usize = 200;
@@ -361,6 +368,22 @@ pub enum ReadError {
         path: PathBuf,
         /// Cause reported by the decoder.
         source: std::io::Error,
+    },
+    /// The recording's rows do not fit in the memory this process can allocate (a command
+    /// that holds the recording; `wv` and `calibrate` stream long recordings).
+    #[error(
+        "{}: holding more than {rows} rows of {columns} column(s) in memory failed (the \
+         recording decompresses to more than this process may allocate); `wv` and \
+         `calibrate` stream recordings this long",
+        .path.display()
+    )]
+    TooLarge {
+        /// File.
+        path: PathBuf,
+        /// Rows held when the allocation failed.
+        rows: u64,
+        /// Columns per row.
+        columns: usize,
     },
     /// The JSON sidecar exists but cannot be parsed.
     #[error("{}: sidecar JSON is unreadable: {source}", .path.display())]

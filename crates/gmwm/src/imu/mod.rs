@@ -36,10 +36,11 @@ pub(crate) mod ros;
 mod samples;
 mod sensor;
 pub(crate) mod sidecar;
+mod temporary;
 pub(crate) mod timing;
 pub(crate) mod write;
 
-pub(crate) use error::escape_name;
+pub(crate) use error::{escape_name, printable};
 pub use error::{quote, quote_up_to, ReadError};
 pub use probe::Probe;
 #[cfg(test)]
@@ -56,6 +57,7 @@ pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use samples::{SampleAccount, Tally};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
 pub use sidecar::{find_sidecar, ColumnSummary, NotASidecar, Sidecar, SidecarColumn, SidecarUnits};
+pub use temporary::{remove_temporary_files, track_temporary, untrack_temporary};
 #[cfg(test)]
 pub(crate) use timing::{check_times, UnitSource};
 pub use timing::{time_column_unit, Gap, TimeUnit, TimingReport, TimingWarning};

@@ -168,6 +168,70 @@ const SIDECAR_KEYS: &[&str] = &[
     "summary",
 ];
 
+/// Keys a sidecar may carry to describe the data, not read and not warned about (those of the
+/// shared recordings' sidecars and of common dataset descriptions).
+const DESCRIPTIVE_KEYS: &[&str] = &[
+    "file",
+    "source",
+    "license",
+    "authors",
+    "citation",
+    "url",
+    "description",
+    "notes",
+    "comment",
+    "date",
+    "data_origin",
+    "duration_s",
+    "truncated",
+    "r_object",
+    "r_column",
+];
+
+/// The keys of the sidecar `text` that gmwm neither reads nor takes as a description
+/// (`DESCRIPTIVE_KEYS`), as paths (`gyro_unit`, `columns[2].unit`, `units.temperature`).
+fn unread_keys(text: &str) -> Vec<String> {
+    let Ok(serde_json::Value::Object(top)) = serde_json::from_str::<serde_json::Value>(text) else {
+        return Vec::new();
+    };
+    let unknown = |k: &str, known: &[&str]| !known.contains(&k) && !DESCRIPTIVE_KEYS.contains(&k);
+    let mut out: Vec<String> = top
+        .keys()
+        .filter(|k| unknown(k, SIDECAR_KEYS))
+        .map(|k| k.to_string())
+        .collect();
+    if let Some(serde_json::Value::Object(units)) = top.get("units") {
+        out.extend(
+            units
+                .keys()
+                .filter(|k| unknown(k, &["gyro", "accel"]))
+                .map(|k| format!("units.{k}")),
+        );
+    }
+    if let Some(serde_json::Value::Array(columns)) = top.get("columns") {
+        for (i, c) in columns.iter().enumerate() {
+            if let serde_json::Value::Object(c) = c {
+                out.extend(
+                    c.keys()
+                        .filter(|k| unknown(k, &["name", "meaning"]))
+                        .map(|k| format!("columns[{i}].{k}")),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// The sidecar of `data` and its keys gmwm does not read ([`unread_keys`]), `None` when there
+/// is no sidecar or it has none.
+pub(crate) fn unread_sidecar_keys(data: &Path) -> Option<(PathBuf, Vec<String>)> {
+    let path = sidecar_candidates(data).into_iter().find(|p| {
+        p.is_file() && std::fs::read_to_string(p).is_ok_and(|text| not_a_sidecar(&text).is_none())
+    })?;
+    let keys = unread_keys(&std::fs::read_to_string(&path).ok()?);
+    (!keys.is_empty()).then_some((path, keys))
+}
+
 /// [`find_sidecar`], with the files at a sidecar's name passed over, in candidate order.
 ///
 /// # Errors
@@ -225,6 +289,26 @@ const DOCUMENT_KEYS: &[(&str, &str)] = &[
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unread_keys_name_typos_and_per_column_units_not_descriptions() {
+        let text = r#"{"name": "x", "sampling_frequncy_hz": 100, "license": "CC",
+            "units": {"gyro": "rad/s", "temperature": "C"},
+            "columns": [{"name": "gyro_x", "unit": "rad/s", "r_column": "X"}, "odd"]}"#;
+        assert_eq!(
+            unread_keys(text),
+            [
+                "sampling_frequncy_hz",
+                "units.temperature",
+                "columns[0].unit"
+            ]
+        );
+        // the shared recordings' descriptive keys, and what is not JSON, say nothing
+        assert!(
+            unread_keys(r#"{"file": "a.csv.gz", "duration_s": 3, "truncated": false}"#).is_empty()
+        );
+        assert!(unread_keys("not json").is_empty());
+    }
 
     #[test]
     fn sidecar_candidates_strip_data_extensions() {

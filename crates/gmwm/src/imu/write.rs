@@ -163,11 +163,12 @@ impl AtomicFile {
                 .open(&tmp)
             {
                 Ok(file) => {
+                    super::temporary::track_temporary(&tmp);
                     return Ok(Self {
                         path: target,
                         tmp: Some(tmp),
                         file: Some(BufWriter::with_capacity(BUF_CAPACITY, file)),
-                    })
+                    });
                 }
                 Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last = Some(e),
                 Err(e) => return Err(io_error(path, e)),
@@ -190,6 +191,9 @@ impl AtomicFile {
     /// temporary file is then removed).
     pub fn commit(mut self) -> Result<(), ReadError> {
         let tmp = self.tmp.clone();
+        if let Some(tmp) = &tmp {
+            super::temporary::untrack_temporary(tmp);
+        }
         let result = match self.file.take() {
             Some(w) => w
                 .into_inner()
@@ -237,6 +241,7 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.file.take().is_some() {
             if let Some(tmp) = &self.tmp {
+                super::temporary::untrack_temporary(tmp);
                 let _ = std::fs::remove_file(tmp);
             }
         }

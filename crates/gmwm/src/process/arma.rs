@@ -441,13 +441,105 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     Some(x)
 }
 
+/// Levels whose WV is summed lag by lag (§4.1 over `2^16` autocovariances); deeper levels
+/// come from the recurrence of [`deep_levels`], in memory and time linear in the levels.
+const DIRECT_LEVELS: usize = 16;
+
+/// Deepest level computed: `m = 2^61` is far beyond any recording (and keeps `2m` finite).
+const MAX_LEVELS: usize = 62;
+
 /// docs/methods.md §4.4: WV through §4.1 from the exact autocovariances (no validation).
 fn arma_wv(ar: &[f64], ma: &[f64], sigma2: f64, levels: usize) -> Vec<f64> {
     if levels == 0 {
         return Vec::new();
     }
-    let max_lag = (1usize << levels.min(40)) - 1;
-    autocovariance_wv(&autocovariance(ar, ma, sigma2, max_lag), levels)
+    let r = ar.len().max(ma.len() + 1);
+    // the recurrence starts from lag 2^direct - 1, which must reach past the ARMA orders
+    let floor = usize::BITS as usize - r.leading_zeros() as usize;
+    let direct = levels.min(DIRECT_LEVELS.max(floor));
+    let gamma = autocovariance(ar, ma, sigma2, (1usize << direct) - 1);
+    let mut out = autocovariance_wv(&gamma, direct);
+    if levels > direct {
+        out.extend(deep_levels(ar, ma.len(), &gamma, levels.min(MAX_LEVELS)));
+    }
+    out
+}
+
+/// docs/methods.md §4.4, deep levels: the WV at levels `direct+1..=levels` (where `gamma`
+/// holds lags `0..2^direct`) without storing `2^levels` autocovariances.
+///
+/// With `A(n) = sum_{h=1..n} gamma_h` and `B(n) = sum_{h=1..n} h gamma_h`, the §4.1 sum at
+/// half-width `m` is `m gamma_0 + 2m A(m-1) - 2B(m-1) - 2B(m) - 2m (A(2m-1) - A(m))
+/// + B(2m-1)`, over `2m^2`. Beyond the MA order the autocovariances follow the AR
+/// recursion, so the state `(gamma_h.., h gamma_h.., A(h), B(h))` (the last `r` lags of
+/// each) advances by a constant matrix `M`, and `2^k` lags at once by `M^(2^k)`, one
+/// squaring per level. `B` is carried, not formed as a difference, so nothing cancels.
+fn deep_levels(ar: &[f64], q: usize, gamma: &[f64], levels: usize) -> Vec<f64> {
+    let r = ar.len().max(q + 1);
+    let phi = |i: usize| ar.get(i).copied().unwrap_or(0.0);
+    let d = 2 * r + 2;
+    let (ia, ib) = (2 * r, 2 * r + 1);
+    let mut step = vec![vec![0.0; d]; d];
+    for i in 0..r {
+        // gamma_{h+1} = sum phi_i gamma_{h+1-i}; (h+1) gamma_{h+1} = sum phi_i ((h+1-i) gamma.. + i gamma..)
+        let (gi, ei) = (i, r + i);
+        step[0][gi] = phi(i);
+        step[r][ei] = phi(i);
+        step[r][gi] = (i + 1) as f64 * phi(i);
+        step[ia][gi] = phi(i);
+        step[ib][ei] = phi(i);
+        step[ib][gi] = (i + 1) as f64 * phi(i);
+        if i + 1 < r {
+            step[gi + 1][gi] = 1.0;
+            step[ei + 1][ei] = 1.0;
+        }
+    }
+    step[ia][ia] = 1.0;
+    step[ib][ib] = 1.0;
+    let h0 = gamma.len() - 1;
+    let mut state = vec![0.0; d];
+    for i in 0..r {
+        state[i] = gamma[h0 - i];
+        state[r + i] = (h0 - i) as f64 * gamma[h0 - i];
+    }
+    state[ia] = gamma[1..].iter().sum();
+    state[ib] = gamma.iter().enumerate().map(|(h, g)| h as f64 * g).sum();
+    // jump = M^(2^k), from M^(2^direct)
+    let mut jump = step.clone();
+    let direct = h0.trailing_ones() as usize;
+    for _ in 0..direct {
+        jump = mat_mul(&jump, &jump);
+    }
+    let mut out = Vec::with_capacity(levels.saturating_sub(direct));
+    for k in direct..levels {
+        let m = 2f64.powi(k as i32);
+        let (a_m1, b_m1) = (state[ia], state[ib]);
+        let next = mat_vec(&step, &state);
+        let (a_m, b_m) = (next[ia], next[ib]);
+        state = mat_vec(&jump, &state);
+        let (a_2m1, b_2m1) = (state[ia], state[ib]);
+        let s = m * gamma[0] + 2.0 * m * a_m1 - 2.0 * b_m1 - 2.0 * b_m - 2.0 * m * (a_2m1 - a_m)
+            + b_2m1;
+        out.push(s / (2.0 * m * m));
+        jump = mat_mul(&jump, &jump);
+    }
+    out
+}
+
+fn mat_mul(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    a.iter()
+        .map(|row| {
+            (0..b.len())
+                .map(|j| row.iter().zip(b).map(|(x, bk)| x * bk[j]).sum())
+                .collect()
+        })
+        .collect()
+}
+
+fn mat_vec(a: &[Vec<f64>], x: &[f64]) -> Vec<f64> {
+    a.iter()
+        .map(|row| row.iter().zip(x).map(|(a, x)| a * x).sum())
+        .collect()
 }
 
 /// Largest half-width `m = 2^{levels-1}` (1 for no levels).

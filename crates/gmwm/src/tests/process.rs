@@ -436,6 +436,55 @@ fn arma_autocovariance_is_exact_near_unit_root() {
     assert!(rel_diff(g[2], phi * phi / (1.0 - phi * phi)) < 1e-12);
 }
 
+#[test]
+fn arma_deep_levels_match_the_lag_sum_and_closed_forms() {
+    // §4.4 deep levels: past 2^16 lags the ARMA WV comes from the state recurrence. Against
+    // the §4.1 lag sum at 20 levels (both exact; the sum's rounding grows with 2^j, hence
+    // ACF_SUM scaled) and against the AR1 / ARMA(1,1) closed forms at 45 levels, where the
+    // lag sum would need 2^45 autocovariances.
+    let cases = [
+        Arma::new(vec![0.5, -0.3], vec![0.4], 2.0).unwrap(),
+        Arma::new(vec![0.999], vec![], 1.0).unwrap(),
+        Arma::new(vec![0.9999, -0.0001], vec![-0.5, 0.2], 1e-6).unwrap(),
+        Arma::new(vec![], vec![0.7, 0.1], 3.0).unwrap(),
+        Arma::new(vec![-0.6], vec![], 1.0).unwrap(),
+    ];
+    for arma in &cases {
+        let deep = Process::from(arma.clone()).wv(20);
+        let sum = autocovariance_wv(&arma.autocovariance((1 << 20) - 1), 20);
+        assert_eq!(deep.len(), 20);
+        for (j, (a, b)) in deep.iter().zip(&sum).enumerate() {
+            assert!(
+                rel_diff(*a, *b) < 1e-9,
+                "{arma:?} level {}: {a} vs {b}",
+                j + 1
+            );
+        }
+    }
+    for (phi, theta) in [
+        (0.999, 0.0),
+        (0.3, 0.0),
+        (-0.6, 0.0),
+        (0.99, -0.4),
+        (0.5, 0.5),
+    ] {
+        let arma = Process::from(Arma::new(vec![phi], vec![theta], 2.0).unwrap()).wv(45);
+        let closed = if theta == 0.0 {
+            Process::from(Ar1::new(phi, 2.0).unwrap()).wv(45)
+        } else {
+            Process::from(Arma11::new(phi, theta, 2.0).unwrap()).wv(45)
+        };
+        assert_eq!(arma.len(), 45);
+        for (j, (a, b)) in arma.iter().zip(&closed).enumerate() {
+            assert!(
+                rel_diff(*a, *b) < 1e-9,
+                "phi {phi} theta {theta} level {}: {a} vs {b}",
+                j + 1
+            );
+        }
+    }
+}
+
 // ---------------------------------------------------------------- derivatives
 
 /// Richardson-extrapolated central difference of `f` at `x` with step `h` (error O(h^4)).

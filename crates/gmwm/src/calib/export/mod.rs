@@ -294,7 +294,8 @@ pub(super) const fn key(
 /// A `# ` comment block of the caller's lines, then the format's own lines.
 pub(super) fn hash_comments(out: &mut String, noise: &NavNoise, own: &[String]) {
     for line in noise.comments.iter().chain(own).flat_map(|c| c.lines()) {
-        let _ = writeln!(out, "# {line}");
+        // YAML allows no control characters but tab, even in a comment
+        let _ = writeln!(out, "# {}", crate::imu::printable(line));
     }
 }
 
@@ -318,7 +319,7 @@ pub(super) fn yaml_line(
 /// The topic, or a marked placeholder.
 pub(super) fn topic(noise: &NavNoise, placeholder: &'static str) -> (String, Option<String>) {
     match &noise.rostopic {
-        Some(t) => (t.clone(), None),
+        Some(t) => (yaml_scalar(t), None),
         None => (
             placeholder.to_string(),
             Some(format!(
@@ -326,6 +327,31 @@ pub(super) fn topic(noise: &NavNoise, placeholder: &'static str) -> (String, Opt
             )),
         ),
     }
+}
+
+/// `text` as a YAML scalar: as is when it is a plain ROS name (letters, digits, `/_-.~`),
+/// else double-quoted with `"`, `\\` and control characters escaped (a topic read from a bag
+/// may hold anything).
+fn yaml_scalar(text: &str) -> String {
+    let plain = !text.is_empty()
+        && text
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/_-.~".contains(c))
+        && !text.starts_with(['-', '~', '.']);
+    if plain {
+        return text.to_string();
+    }
+    let mut out = String::from("\"");
+    for c in text.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => out.push_str(&format!("\\u{:04x}", u32::from(c))),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
 }
 
 pub(super) fn check_rate(format: ExportFormat, noise: &NavNoise) -> Result<f64, ExportError> {

@@ -407,6 +407,13 @@ pub enum ReadWarning {
     /// A file at a sidecar's name that is not a sidecar (empty, or a document gmwm wrote
     /// there: `gmwm wv x.csv --json > x.json`), passed over.
     NotASidecar(crate::imu::sidecar::NotASidecar),
+    /// The sidecar has keys gmwm does not read (a typo, or a per-column unit).
+    SidecarKeysUnread {
+        /// The sidecar.
+        path: PathBuf,
+        /// The keys, as paths (`columns[2].unit`).
+        keys: Vec<String>,
+    },
     /// Rows a [`TimePolicy`] other than strict dropped or moved.
     TimePolicy {
         /// File.
@@ -461,11 +468,16 @@ pub(crate) fn time_policy_warning(
     })
 }
 
-/// The warnings for the files at `path`'s sidecar names passed over as not sidecars.
+/// The warnings for the files at `path`'s sidecar names passed over as not sidecars, and for
+/// the keys of its sidecar that are not read.
 pub(crate) fn passed_over_sidecars(path: &Path) -> Vec<ReadWarning> {
-    crate::imu::sidecar::locate_sidecar(path)
+    let mut out: Vec<ReadWarning> = crate::imu::sidecar::locate_sidecar(path)
         .map(|(_, passed)| passed.into_iter().map(ReadWarning::NotASidecar).collect())
-        .unwrap_or_default()
+        .unwrap_or_default();
+    if let Some((path, keys)) = crate::imu::sidecar::unread_sidecar_keys(path) {
+        out.push(ReadWarning::SidecarKeysUnread { path, keys });
+    }
+    out
 }
 
 /// Relative difference between two rates above which they disagree: 1% (a time column and a
@@ -511,6 +523,23 @@ impl fmt::Display for ReadWarning {
                     "the sidecar of another recording?"
                 }
             ),
+            Self::SidecarKeysUnread { path, keys } => {
+                let units = keys.iter().any(|k| k.ends_with(".unit") || k.ends_with(".units"));
+                write!(
+                    f,
+                    "{}: key{} not read: {}{}",
+                    path.display(),
+                    if keys.len() == 1 { "" } else { "s" },
+                    crate::imu::error::name_list(keys),
+                    if units {
+                        " (a column's unit is not read: the sidecar's units.gyro and \
+                         units.accel, or --gyro-unit and --accel-unit, give the units)"
+                    } else {
+                        " (a typo? the keys read are name, sensor, sampling_frequency_hz, \
+                         units, format, n_columns, columns, n_rows, summary)"
+                    }
+                )
+            }
             Self::NotASidecar(n) => write!(
                 f,
                 "{}: not read as the recording's sidecar: {}",

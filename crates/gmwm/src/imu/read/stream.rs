@@ -119,7 +119,8 @@ pub(crate) fn streamed_size(probe: &Probe, opts: &ReadOptions) -> Result<Option<
 /// records the exact count (the size over the record's), for text, whose rows are known only
 /// once read, the file's size in bytes over 8 (a text row of numbers takes more than 8 bytes
 /// a column, so this is never below what the rule means for raw f64: a text file of
-/// `stream_from` rows streams); for a ROS recording, the messages of its largest IMU topic
+/// `stream_from` rows streams), and for a gzip file its lines counted as they decompress, up
+/// to `stream_from`; for a ROS recording, the messages of its largest IMU topic
 /// (`imu_messages_count`, from the index or the
 /// statistics).
 ///
@@ -142,6 +143,11 @@ pub fn streams_from(
     let sidecar = find_sidecar(path)?;
     let rows = match resolve_format(path, opts.format, sidecar.as_ref())? {
         InputFormat::ImuRecord(t) => size / t.record_size() as u64,
+        // a gzip's size says nothing of its rows (a 0.5 MB file can hold 2^28): its lines
+        // are counted as they decompress, up to the switch
+        _ if super::text::is_gzip(path)? => {
+            super::text::count_lines_up_to(path, stream_from.max(1))?
+        }
         _ => size / 8,
     };
     Ok(rows >= stream_from.max(1))
@@ -318,7 +324,10 @@ impl Spool {
                 .create_new(true)
                 .open(&path)
             {
-                Ok(f) => return Ok((Self { path, ncols }, BufWriter::with_capacity(1 << 20, f))),
+                Ok(f) => {
+                    crate::imu::track_temporary(&path);
+                    return Ok((Self { path, ncols }, BufWriter::with_capacity(1 << 20, f)));
+                }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
                 Err(e) => return Err(io(&path, e)),
             }
@@ -339,6 +348,7 @@ impl Spool {
 
 impl Drop for Spool {
     fn drop(&mut self) {
+        crate::imu::untrack_temporary(&self.path);
         let _ = std::fs::remove_file(&self.path);
     }
 }

@@ -48,6 +48,37 @@ fn open(path: &Path) -> Result<Source, ReadError> {
     Ok(Source { reader, gzip })
 }
 
+/// Whether the file starts with the gzip magic bytes.
+pub(crate) fn is_gzip(path: &Path) -> Result<bool, ReadError> {
+    let mut head = [0u8; 2];
+    let mut file = File::open(path).map_err(|e| io_error(path, e))?;
+    let n = io::Read::read(&mut file, &mut head).map_err(|e| io_error(path, e))?;
+    Ok(n == 2 && head == GZIP_MAGIC)
+}
+
+/// Lines of a (gzip) text file, counted as they decompress and no further than `cap`: the
+/// streaming switch's count for a file whose size says nothing of its rows.
+pub(crate) fn count_lines_up_to(path: &Path, cap: u64) -> Result<u64, ReadError> {
+    let mut source = open(path)?;
+    let mut lines = 0u64;
+    loop {
+        let gzip = source.gzip;
+        let buf = source
+            .reader
+            .fill_buf()
+            .map_err(|e| stream_error(path, gzip, e))?;
+        if buf.is_empty() {
+            return Ok(lines);
+        }
+        lines += buf.iter().filter(|&&b| b == b'\n').count() as u64;
+        let n = buf.len();
+        source.reader.consume(n);
+        if lines >= cap {
+            return Ok(lines);
+        }
+    }
+}
+
 /// Longest line a text recording may hold: 1 MiB (a row of an IMU log is under a kilobyte; a
 /// header of 10^5 column names fits). A longer one (a gzip bomb's single 1 GiB line) is an
 /// error once this many bytes have passed without a newline, before the line is held.
@@ -238,6 +269,22 @@ pub(crate) fn read_text_table(
             if values.is_empty() {
                 values = vec![Vec::new(); row.len()];
             }
+            // columns grow by fallible reservations: a gzip of 10^8 rows is refused with a
+            // line, not an abort, where the process may not allocate that much
+            if values[0].len() == values[0].capacity() {
+                let grow = values[0].len().max(4096);
+                let failed = values
+                    .iter_mut()
+                    .chain(stamp.is_some().then_some(&mut time))
+                    .any(|v| v.try_reserve_exact(grow).is_err());
+                if failed {
+                    return Err(ReadError::TooLarge {
+                        path: path.to_path_buf(),
+                        rows: values[0].len() as u64,
+                        columns: row.len(),
+                    });
+                }
+            }
             for (v, &x) in values.iter_mut().zip(row) {
                 v.push(x);
             }
@@ -331,17 +378,7 @@ pub(crate) fn for_each_text_row(
     mut row: impl FnMut(&[f64], Option<(f64, u64, f64)>) -> Result<(), ReadError>,
 ) -> Result<TextPass, ReadError> {
     let Source { mut reader, gzip } = open(path)?;
-    let stream_error = |e: io::Error| {
-        let too_long = e.get_ref().is_some_and(|r| r.is::<LineTooLong>());
-        if gzip && !too_long {
-            ReadError::Gzip {
-                path: path.to_path_buf(),
-                source: e,
-            }
-        } else {
-            io_error(path, e)
-        }
-    };
+    let stream_error = |e: io::Error| stream_error(path, gzip, e);
     let mut first_line = Vec::new();
     reader
         .read_until(b'\n', &mut first_line)
@@ -409,7 +446,8 @@ pub(crate) fn for_each_text_row(
         rec.iter()
             .enumerate()
             .map(|(k, f)| {
-                let n = String::from_utf8_lossy(f).trim().to_string();
+                // control characters escaped once here: every output shows the name so
+                let n = crate::imu::printable(String::from_utf8_lossy(f).trim());
                 if n.is_empty() {
                     default_name(k)
                 } else {
@@ -612,6 +650,20 @@ impl Rows<'_> {
 }
 
 #[cold]
+/// A read error of the text source: a gzip stream's own as [`ReadError::Gzip`], the line
+/// cap's and the file's as I/O.
+fn stream_error(path: &Path, gzip: bool, e: io::Error) -> ReadError {
+    let too_long = e.get_ref().is_some_and(|r| r.is::<LineTooLong>());
+    if gzip && !too_long {
+        ReadError::Gzip {
+            path: path.to_path_buf(),
+            source: e,
+        }
+    } else {
+        io_error(path, e)
+    }
+}
+
 fn io_error(path: &Path, source: io::Error) -> ReadError {
     ReadError::Io {
         path: path.to_path_buf(),

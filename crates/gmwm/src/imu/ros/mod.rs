@@ -670,29 +670,24 @@ fn open(source: &Source) -> Result<Vec<Opened>, ReadError> {
     Ok(out)
 }
 
-/// Topics of all files, merged by (topic, type), sorted by topic.
+/// Topics of all files, merged by (topic, type), sorted by topic (a map: a file may list a
+/// million topics).
 fn merged_topics(opened: &[Opened]) -> Vec<TopicInfo> {
-    let mut topics: Vec<TopicInfo> = Vec::new();
+    let mut merged: std::collections::BTreeMap<(&str, &str), u64> = Default::default();
     for o in opened {
         for (topic, message_type, messages) in o.entries() {
-            match topics
-                .iter_mut()
-                .find(|t| t.topic == topic && t.message_type == message_type)
-            {
-                Some(t) => t.messages = t.messages.saturating_add(messages),
-                None => topics.push(TopicInfo {
-                    topic: topic.to_owned(),
-                    message_type: message_type.to_owned(),
-                    messages,
-                }),
-            }
+            let count = merged.entry((topic, message_type)).or_insert(0);
+            *count = count.saturating_add(messages);
         }
     }
-    topics.sort_by(|a, b| {
-        (a.topic.as_str(), a.message_type.as_str())
-            .cmp(&(b.topic.as_str(), b.message_type.as_str()))
-    });
-    topics
+    merged
+        .into_iter()
+        .map(|((topic, message_type), messages)| TopicInfo {
+            topic: topic.to_owned(),
+            message_type: message_type.to_owned(),
+            messages,
+        })
+        .collect()
 }
 
 /// Lists the topics of a recording (a file or a rosbag2 folder) with their message types and

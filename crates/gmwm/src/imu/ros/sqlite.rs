@@ -9,6 +9,7 @@ use super::error::RosError;
 use super::{Collector, Encoding, RosContainer};
 use crate::imu::error::one_line;
 use crate::imu::ReadError;
+use rusqlite::limits::Limit;
 use rusqlite::{Connection, OpenFlags};
 use std::collections::HashMap;
 use std::path::Path;
@@ -25,6 +26,28 @@ pub(crate) struct Topic {
 }
 
 fn sql_error(path: &Path, e: rusqlite::Error) -> RosError {
+    use rusqlite::ErrorCode::{OperationInterrupted, TooBig};
+    match e.sqlite_error_code() {
+        Some(OperationInterrupted) => {
+            return corrupt(
+                path,
+                "reading it takes more work than a database of its size can need (a crafted \
+                 view, index or generated column?); stopped"
+                    .into(),
+            )
+        }
+        Some(TooBig) => {
+            return corrupt(
+                path,
+                format!(
+                    "it holds or computes a value longer than {} MiB, more than any topic \
+                     name or IMU message",
+                    MAX_VALUE_BYTES >> 20
+                ),
+            )
+        }
+        _ => {}
+    }
     RosError::Sqlite {
         path: path.to_path_buf(),
         // SQLite's messages may quote the file's schema, newlines and all
@@ -87,7 +110,25 @@ fn check_size(path: &Path, head: &[u8], len: u64) -> Result<(), RosError> {
     Ok(())
 }
 
-/// Opens the database read-only, after checking its size against its header.
+/// Longest string or blob SQLite may make (its `SQLITE_LIMIT_LENGTH`): an IMU message is a
+/// few hundred bytes and a topic name a few dozen; a generated column or function asked for
+/// more fails with "string or blob too big" instead of allocating it.
+const MAX_VALUE_BYTES: i32 = 16 << 20;
+
+/// Virtual-machine steps between two calls of the progress handler.
+const STEPS_PER_CALL: i32 = 100_000;
+
+/// Work SQLite may do on a file, in virtual-machine steps: a floor for small files plus a
+/// share per byte. Reading a rosbag2 table costs a few dozen steps per row and a row takes
+/// at least a dozen bytes, so a real bag stays far below this; a crafted file (an expensive
+/// expression in a generated column, say) is stopped instead of running for hours.
+fn step_budget(len: u64) -> u64 {
+    1_000_000_000u64.saturating_add(len.saturating_mul(1_000))
+}
+
+/// Opens the database read-only, after checking its size against its header: values capped
+/// at [`MAX_VALUE_BYTES`], work at [`step_budget`], and `topics` and `messages` required to
+/// be ordinary tables (a view can compute any number of rows from nothing).
 pub(crate) fn open(path: &Path) -> Result<Connection, ReadError> {
     let io = |source| ReadError::Io {
         path: path.to_path_buf(),
@@ -98,11 +139,74 @@ pub(crate) fn open(path: &Path) -> Result<Connection, ReadError> {
     let mut head = Vec::with_capacity(100);
     std::io::Read::read_to_end(&mut std::io::Read::take(&mut file, 100), &mut head).map_err(io)?;
     check_size(path, &head, len)?;
-    Connection::open_with_flags(
+    let mut db = Connection::open_with_flags(
         path,
         OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
     )
-    .map_err(|e| sql_error(path, e).into())
+    .map_err(|e| sql_error(path, e))?;
+    let err = |e| ReadError::from(sql_error(path, e));
+    db.set_limit(Limit::SQLITE_LIMIT_LENGTH, MAX_VALUE_BYTES)
+        .map_err(err)?;
+    let calls = step_budget(len) / STEPS_PER_CALL as u64;
+    let mut made = 0u64;
+    db.progress_handler(
+        STEPS_PER_CALL,
+        Some(move || {
+            made += 1;
+            made > calls
+        }),
+    )
+    .map_err(err)?;
+    check_tables(path, &db)?;
+    Ok(db)
+}
+
+/// `topics` and `messages` must be ordinary tables of the database.
+fn check_tables(path: &Path, db: &Connection) -> Result<(), RosError> {
+    let err = |e| sql_error(path, e);
+    for name in ["topics", "messages"] {
+        let kind: Option<(String, String)> = db
+            .query_row(
+                "SELECT type, coalesce(sql, '') FROM sqlite_schema WHERE name = ?1",
+                [name],
+                |row| Ok((row.get(0)?, row.get(1)?)),
+            )
+            .map(Some)
+            .or_else(|e| match e {
+                rusqlite::Error::QueryReturnedNoRows => Ok(None),
+                e => Err(err(e)),
+            })?;
+        let virtual_table = |sql: &str| {
+            sql.split_whitespace()
+                .take(2)
+                .any(|w| w.eq_ignore_ascii_case("virtual"))
+        };
+        match kind {
+            None => {
+                return Err(corrupt(
+                    path,
+                    format!("the database has no `{name}` table: it is not a rosbag2 bag"),
+                ))
+            }
+            Some((kind, sql)) if kind != "table" || virtual_table(&sql) => {
+                let what = match kind.as_str() {
+                    "table" => "a virtual table",
+                    "index" => "an index",
+                    "trigger" => "a trigger",
+                    _ => "a view",
+                };
+                return Err(corrupt(
+                    path,
+                    format!(
+                        "`{name}` is {what}, not a table: rosbag2 stores its {name} in a \
+                         table, and a view can compute rows without end"
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(())
 }
 
 /// Lists the topics with their message counts (one pass over `messages`).
