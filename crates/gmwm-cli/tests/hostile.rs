@@ -279,3 +279,136 @@ fn a_gzip_of_2_pow_28_rows_streams_or_is_refused() {
     assert_eq!(out.status.code(), Some(0), "{stderr}");
     assert!(stderr.contains("134217728 rows read"), "{stderr}");
 }
+
+/// A small IMU-like CSV: `header`, then white noise in two columns plus a slow walk.
+fn small_csv(path: &Path, header: &str, rows: usize) {
+    let mut text = format!("{header}\n");
+    let (mut s, mut walk) = (0x9e37_79b9_7f4a_7c15u64, 0.0);
+    let mut next = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for _ in 0..rows {
+        walk += 1e-3 * next();
+        text.push_str(&format!("{:.6},{:.6}\n", next() + walk, next()));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+const FAST: [&str; 8] = [
+    "--freq",
+    "100",
+    "--model",
+    "WN()+RW()",
+    "--bootstrap",
+    "2",
+    "--G",
+    "200",
+];
+
+/// A FIFO named like a recording in a batch folder hung the batch (opened, never written):
+/// it is skipped with a warning, the other recordings are calibrated.
+#[test]
+fn a_fifo_in_a_batch_folder_is_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    small_csv(&dir.path().join("a.csv"), "gyro_x,gyro_y", 4096);
+    small_csv(&dir.path().join("c.csv"), "gyro_x,gyro_y", 4096);
+    let fifo = dir.path().join("b.csv");
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let out = common::gmwm_bounded()
+        .arg("calibrate")
+        .arg(dir.path())
+        .args(FAST)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("b.csv: not a regular file (a FIFO, socket or device): skipped"),
+        "{stderr}"
+    );
+    assert!(
+        stdout.contains("a.csv") && stdout.contains("c.csv"),
+        "{stdout}"
+    );
+}
+
+/// Control characters in a header's names (a backspace, an escape sequence) reached the
+/// terminal raw and made the Kalibr YAML unparseable: they are escaped in every output.
+#[test]
+fn control_characters_in_names_are_escaped_in_every_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("imu.csv");
+    small_csv(&csv, "gyro\u{8}_x,accel\u{1b}[31m_x", 4096);
+    let yaml = dir.path().join("imu.yaml");
+    let json = dir.path().join("cal.json");
+    let out = common::gmwm_bounded()
+        .arg("calibrate")
+        .arg(&csv)
+        .args(FAST)
+        .args([
+            "--gyro-unit",
+            "rad/s",
+            "--accel-unit",
+            "m/s^2",
+            "--export",
+            "kalibr",
+        ])
+        .arg(&yaml)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let raw = |bytes: &[u8]| bytes.iter().any(|&b| b < 0x20 && b != b'\n' || b == 0x7f);
+    assert!(
+        !raw(&out.stdout),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(!raw(&out.stderr), "{stderr}");
+    let yaml = std::fs::read(&yaml).unwrap();
+    assert!(!raw(&yaml), "{}", String::from_utf8_lossy(&yaml));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains(r"gyro\u{8}_x"), "{text}");
+    // the JSON names the column as shown, JSON-escaped as JSON is
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(doc["axes"][0]["column"], r"gyro\u{8}_x", "{doc}");
+}
+
+/// A sidecar's keys that are not read (a typo, a per-column unit) are named in a warning.
+#[test]
+fn unread_sidecar_keys_are_warned() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("imu.csv");
+    small_csv(&csv, "gyro_x,gyro_y", 2048);
+    std::fs::write(
+        dir.path().join("imu.json"),
+        r#"{"sampling_frequency_hz": 100, "sampling_rate": 100, "license": "CC0",
+            "columns": [{"name": "gyro_x", "unit": "rad/s"}, {"name": "gyro_y"}]}"#,
+    )
+    .unwrap();
+    let out = common::gmwm_bounded().arg("wv").arg(&csv).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let warning = stderr
+        .lines()
+        .find(|l| l.contains("not read"))
+        .unwrap_or_else(|| panic!("{stderr}"));
+    assert!(
+        warning.starts_with("gmwm: warning: ")
+            && warning.contains("imu.json: keys not read: sampling_rate, columns[0].unit")
+            && warning.contains("a column's unit is not read"),
+        "{warning}"
+    );
+}

@@ -130,6 +130,11 @@ fn step_budget(len: u64) -> u64 {
 /// at [`MAX_VALUE_BYTES`], work at [`step_budget`], and `topics` and `messages` required to
 /// be ordinary tables (a view can compute any number of rows from nothing).
 pub(crate) fn open(path: &Path) -> Result<Connection, ReadError> {
+    open_within(path, None)
+}
+
+/// [`open`] with a work budget of `steps` (default [`step_budget`] of the file's size).
+fn open_within(path: &Path, steps: Option<u64>) -> Result<Connection, ReadError> {
     let io = |source| ReadError::Io {
         path: path.to_path_buf(),
         source,
@@ -147,7 +152,7 @@ pub(crate) fn open(path: &Path) -> Result<Connection, ReadError> {
     let err = |e| ReadError::from(sql_error(path, e));
     db.set_limit(Limit::SQLITE_LIMIT_LENGTH, MAX_VALUE_BYTES)
         .map_err(err)?;
-    let calls = step_budget(len) / STEPS_PER_CALL as u64;
+    let calls = steps.unwrap_or_else(|| step_budget(len)) / STEPS_PER_CALL as u64;
     let mut made = 0u64;
     db.progress_handler(
         STEPS_PER_CALL,
@@ -267,4 +272,43 @@ pub(crate) fn read(
         out.push(encoding, t, bytes)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rosbag2 database of `rows` messages on one topic.
+    fn bag(path: &Path, rows: i64) {
+        let db = Connection::open(path).unwrap();
+        db.execute_batch(
+            "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT, type TEXT, \
+             serialization_format TEXT, offered_qos_profiles TEXT); \
+             INSERT INTO topics VALUES (1, '/imu', 'sensor_msgs/msg/Imu', 'cdr', ''); \
+             CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER, \
+             timestamp INTEGER, data BLOB); \
+             CREATE INDEX timestamp_idx ON messages (timestamp ASC);",
+        )
+        .unwrap();
+        let mut insert = db
+            .prepare("INSERT INTO messages(topic_id, timestamp, data) VALUES (1, ?1, x'00')")
+            .unwrap();
+        for t in 0..rows {
+            insert.execute([t]).unwrap();
+        }
+    }
+
+    #[test]
+    fn work_past_the_budget_is_stopped_with_a_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.db3");
+        bag(&path, 20_000);
+        // the default budget reads it; a budget of one handler call does not
+        let db = open(&path).unwrap();
+        assert_eq!(catalog(&path, &db).unwrap()[0].messages, 20_000);
+        let db = open_within(&path, Some(STEPS_PER_CALL as u64)).unwrap();
+        let e = catalog(&path, &db).unwrap_err().to_string();
+        assert!(e.contains("more work than a database of its size"), "{e}");
+        assert!(!e.contains('\n'));
+    }
 }
