@@ -144,6 +144,14 @@ def wv_seeds():
                  "n_coefficients": [511, 509, 505, 497, 481], "eta": [255, 127, 63, 31, 15]})
     full["wv"][2] = None
     put("wv_json", "full_with_null", json.dumps({"freq_hz": 50, "series": [full]}))
+    # wv_fit: a model's text, a newline, a saved WV (one claims n = 2^40 over 40 levels)
+    for i, (model, s) in enumerate([
+        ("WN()+RW()", series("gyro_x", 4096, 8)),
+        ("ARMA(2,1)", series("x", 2.0 ** 40, 40)),
+        ("GM()+WN()+QN()", series("gyro_z", 2 ** 20, 16, 200.0)),
+        ("AR(2)(0.5, -0.2, 1e-4)+MA(1)", series("y", 1e6, 12)),
+    ]):
+        put("wv_fit", f"fit{i}", model + "\n" + json.dumps({"freq_hz": 100.0, "series": [s]}))
 
 
 def sidecar_seeds():

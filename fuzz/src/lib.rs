@@ -18,8 +18,8 @@
 
 use gmwm::{
     allan_from_wv, is_wv_json, list_topics, read_imu_messages, read_table, read_wv_json,
-    ColumnSelector, HeaderMode, Imu, ImuMessages, ImuRecordType, InputFormat, Model, ReadError,
-    ReadOptions, Recording, RecordingOptions, Sidecar, Table,
+    ColumnSelector, Gmwm, HeaderMode, Imu, ImuMessages, ImuRecordType, InputFormat, Model,
+    ReadError, ReadOptions, Recording, RecordingOptions, Sidecar, StartInputs, Table,
 };
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -38,6 +38,7 @@ pub const TARGETS: &[(&str, Body)] = &[
     ("wv_json", wv_json),
     ("sidecar", sidecar),
     ("model_text", model_text),
+    ("wv_fit", wv_fit),
 ];
 
 thread_local! {
@@ -325,6 +326,42 @@ pub fn mcap(data: &[u8]) {
 /// A rosbag2 sqlite3 storage file (`x.db3`).
 pub fn db3(data: &[u8]) {
     ros("db3", data);
+}
+
+/// A model's text on the first line, a saved WV (JSON) after it: the WV read, the model's
+/// implied WV at the WV's levels and the model fitted to it (`gmwm fit WV.json --model M`).
+/// Any `n` and level count a file claims must cost no more than the levels: a 3 KB file
+/// claiming `n = 2^40` over 40 levels made an ARMA fit allocate 4 TB.
+pub fn wv_fit(data: &[u8]) {
+    let Some(split) = data.iter().position(|&b| b == b'\n') else {
+        return;
+    };
+    let Ok(text) = std::str::from_utf8(&data[..split]) else {
+        return;
+    };
+    // a fit's cost grows with the parameters: a dozen is past any IMU model
+    let Ok(model) = Model::parse(text) else {
+        return;
+    };
+    if model.n_params() > 12 {
+        return;
+    }
+    let path = scratch("wv_fit", &[("x.json", &data[split + 1..])]);
+    let Ok(series) = read_wv_json(&path, None) else {
+        return;
+    };
+    for (_, wv) in series.iter().take(2) {
+        let levels = wv.tau().len();
+        match model.implied_wv(levels, wv.freq_hz()) {
+            Ok(implied) => assert_eq!(implied.wv.len(), levels),
+            Err(e) => check_error(&e),
+        }
+        let gmwm = Gmwm::new(model.clone());
+        match gmwm.fit_from_wv(wv, StartInputs::from_wv(wv)) {
+            Ok(fit) => assert_eq!(fit.implied_wv().wv.len(), levels),
+            Err(e) => check_error(&e),
+        }
+    }
 }
 
 /// A WV JSON (`gmwm wv --json`) through [`read_wv_json`], then [`allan_from_wv`] on each

@@ -883,7 +883,7 @@ impl Calibration {
                 (Some(_), None) => unreachable!("run_pooled computes the robust WV it fits"),
             },
             AxisData::Gapped { .. } => {
-                unreachable!("Calibration::axis pools a gapped series first")
+                unreachable!("Calibration::axis turns a gapped series into its gap-aware WV first")
             }
         }
         .map_err(|source| errors.selection(source))
@@ -1371,7 +1371,7 @@ impl Calibration {
                 );
             }
             AxisData::Gapped { .. } => {
-                unreachable!("Calibration::axis pools a gapped series first")
+                unreachable!("Calibration::axis turns a gapped series into its gap-aware WV first")
             }
             AxisData::Streamed { robust, .. } => {
                 let robust = robust.as_ref().map(|r| r.as_ref().map(|w| &**w));
@@ -1503,7 +1503,9 @@ fn allan_of(
         )?,
         AxisData::Streamed { wv, .. } => allan_from_wv(wv)?,
         AxisData::Pooled { classical, .. } => allan_from_wv(classical.wv())?,
-        AxisData::Gapped { .. } => unreachable!("Calibration::axis pools a gapped series first"),
+        AxisData::Gapped { .. } => {
+            unreachable!("Calibration::axis turns a gapped series into its gap-aware WV first")
+        }
     })
 }
 
@@ -1520,7 +1522,7 @@ fn psd_of(data: &AxisData<'_>, freq_hz: f64, unit: &str, notes: &mut Vec<String>
         AxisData::Pooled { .. } => {
             Err("a pooled calibration has no single series to take it from".to_string())
         }
-        AxisData::Gapped { .. } => unreachable!("Calibration::axis pools a gapped series first"),
+        AxisData::Gapped { .. } => unreachable!("Calibration::axis turns a gapped series into its gap-aware WV first"),
     };
     match psd {
         Ok(p) => Some(p.binned(BINNED_POINTS).in_unit(unit)),

@@ -101,11 +101,12 @@ impl Sidecar {
         Self::from_json(&text, path)
     }
 
-    /// The meaning of the column named `name`, if the sidecar gives one.
+    /// The meaning of the column named `name` (as the readers show it: control characters
+    /// escaped), if the sidecar gives one.
     pub fn meaning(&self, name: &str) -> Option<&str> {
         self.columns
             .iter()
-            .find(|c| c.name == name)
+            .find(|c| c.name == name || super::printable(&c.name) == name)
             .and_then(|c| c.meaning.as_deref())
     }
 }

@@ -441,9 +441,9 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     Some(x)
 }
 
-/// Levels whose WV is summed lag by lag (§4.1 over `2^16` autocovariances); deeper levels
+/// Levels whose WV is summed lag by lag (§4.1 over `2^10` autocovariances); deeper levels
 /// come from the recurrence of [`deep_levels`], in memory and time linear in the levels.
-const DIRECT_LEVELS: usize = 16;
+const DIRECT_LEVELS: usize = 10;
 
 /// Deepest level computed: `m = 2^61` is far beyond any recording (and keeps `2m` finite).
 const MAX_LEVELS: usize = 62;

@@ -759,7 +759,7 @@ pub fn binary_warnings(path: &Path, layout: &BinaryLayout) -> Vec<ReadWarning> {
 pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<String> {
     match sidecar {
         Some(s) if s.columns.len() == ncols && s.columns.iter().all(|c| !c.name.is_empty()) => {
-            s.columns.iter().map(|c| c.name.clone()).collect()
+            s.columns.iter().map(|c| crate::imu::printable(&c.name)).collect()
         }
         _ => (0..ncols).map(default_name).collect(),
     }

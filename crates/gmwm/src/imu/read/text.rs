@@ -259,6 +259,7 @@ pub(crate) fn read_text_table(
     let mut values: Vec<Vec<f64>> = Vec::new();
     let mut time = Vec::new();
     let mut lines = LineMap::default();
+    let (mut held, mut room) = (0usize, 0usize);
     let pass = for_each_text_row(
         path,
         format,
@@ -270,9 +271,10 @@ pub(crate) fn read_text_table(
                 values = vec![Vec::new(); row.len()];
             }
             // columns grow by fallible reservations: a gzip of 10^8 rows is refused with a
-            // line, not an abort, where the process may not allocate that much
-            if values[0].len() == values[0].capacity() {
-                let grow = values[0].len().max(4096);
+            // line, not an abort, where the process may not allocate that much (a row may
+            // hold no value column: a time column alone)
+            if room == 0 {
+                let grow = held.max(4096);
                 let failed = values
                     .iter_mut()
                     .chain(stamp.is_some().then_some(&mut time))
@@ -280,11 +282,14 @@ pub(crate) fn read_text_table(
                 if failed {
                     return Err(ReadError::TooLarge {
                         path: path.to_path_buf(),
-                        rows: values[0].len() as u64,
+                        rows: held as u64,
                         columns: row.len(),
                     });
                 }
+                room = grow;
             }
+            room -= 1;
+            held += 1;
             for (v, &x) in values.iter_mut().zip(row) {
                 v.push(x);
             }
