@@ -758,9 +758,11 @@ pub fn binary_warnings(path: &Path, layout: &BinaryLayout) -> Vec<ReadWarning> {
 /// Column names of a raw binary file: the sidecar's if it names exactly `ncols` columns.
 pub(crate) fn binary_names(sidecar: Option<&Sidecar>, ncols: usize) -> Vec<String> {
     match sidecar {
-        Some(s) if s.columns.len() == ncols && s.columns.iter().all(|c| !c.name.is_empty()) => {
-            s.columns.iter().map(|c| crate::imu::printable(&c.name)).collect()
-        }
+        Some(s) if s.columns.len() == ncols && s.columns.iter().all(|c| !c.name.is_empty()) => s
+            .columns
+            .iter()
+            .map(|c| crate::imu::printable(&c.name))
+            .collect(),
         _ => (0..ncols).map(default_name).collect(),
     }
 }
