@@ -269,6 +269,12 @@ fn a_gzip_of_2_pow_28_rows_streams_or_is_refused() {
     // 2^27 rows for `wv` (a 1 GB spool), twice what an in-memory WV could hold here
     let half = dir.path().join("half.csv.gz");
     gzip_bomb(&half, b"x\n", b"1\n2\n", 1 << 26);
+    // 2^27 rows fit once in the limit but not twice, as an in-memory WV holds them
+    assert_one_error(
+        &half,
+        &["fit", "--freq", "100", "--model", "WN()"],
+        "in memory failed",
+    );
     let out = common::gmwm_bounded()
         .args(["wv", "--freq", "100"])
         .arg(&half)

@@ -303,6 +303,16 @@ pub(crate) fn read_text_table(
     if values.is_empty() {
         values = vec![Vec::new(); pass.sel.columns.len()];
     }
+    // an in-memory WV holds a second copy of a column (the Haar pyramid's stage A): room for
+    // it is asked for now (reserved, never touched), so that a decompressed recording too
+    // large for this process stops here with a line instead of aborting there
+    if held > 0 && Vec::<f64>::new().try_reserve_exact(held).is_err() {
+        return Err(ReadError::TooLarge {
+            path: path.to_path_buf(),
+            rows: held as u64,
+            columns: values.len(),
+        });
+    }
     let mut dropped = pass.dropped;
     let mut time_origin = pass.time_origin;
     let mut lines = Some(lines);
