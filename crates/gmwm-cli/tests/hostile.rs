@@ -392,66 +392,45 @@ fn control_characters_in_names_are_escaped_in_every_output() {
     assert_eq!(doc["axes"][0]["column"], r"gyro\u{8}_x", "{doc}");
 }
 
-/// A sidecar's keys that are not read (a typo, a per-column unit) are named in a warning.
+/// A sidecar's keys that are not read (a typo, a misspelt unit key) are named in a warning;
+/// a column's `unit` is read.
 #[test]
-fn unread_sidecar_keys_are_warned() {
+fn unread_sidecar_keys_are_warned_and_column_units_read() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("imu.csv");
-    small_csv(&csv, "gyro_x,gyro_y", 2048);
+    small_csv(&csv, "gyro_x,accel_x", 2048);
     std::fs::write(
         dir.path().join("imu.json"),
         r#"{"sampling_frequency_hz": 100, "sampling_rate": 100, "license": "CC0",
-            "columns": [{"name": "gyro_x", "unit": "rad/s"}, {"name": "gyro_y"}]}"#,
+            "columns": [{"name": "gyro_x", "unit": "deg/s"},
+                        {"name": "accel_x", "unit": "g", "units": "g"}]}"#,
     )
     .unwrap();
-    let out = common::gmwm_bounded().arg("wv").arg(&csv).output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{stderr}");
-    let warning = stderr
-        .lines()
-        .find(|l| l.contains("not read"))
-        .unwrap_or_else(|| panic!("{stderr}"));
-    assert!(
-        warning.starts_with("gmwm: warning: ")
-            && warning.contains("imu.json: keys not read: sampling_rate, columns[0].unit")
-            && warning.contains("a column's unit is not read"),
-        "{warning}"
-    );
-}
-
-/// A rosbag2 database listing 10^6 topics: merging them searched the list for every topic
-/// (10^12 comparisons). They are merged through a map: `gmwm topics` lists them in seconds.
-#[test]
-fn a_million_topics_merge_in_n_log_n() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("topics.db3");
-    let mut db = rusqlite::Connection::open(&path).unwrap();
-    db.execute_batch(
-        "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT, type TEXT, \
-         serialization_format TEXT, offered_qos_profiles TEXT); \
-         CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER, \
-         timestamp INTEGER, data BLOB);",
-    )
-    .unwrap();
-    let tx = db.transaction().unwrap();
-    {
-        let mut insert = tx
-            .prepare("INSERT INTO topics VALUES (?1, '/t' || ?1, 'std_msgs/msg/Empty', 'cdr', '')")
-            .unwrap();
-        for k in 1..=1_000_000i64 {
-            insert.execute([k]).unwrap();
-        }
-    }
-    tx.commit().unwrap();
-    drop(db);
     let out = common::gmwm_bounded()
-        .args(["topics", "--json"])
-        .arg(&path)
+        .arg("calibrate")
+        .arg(&csv)
+        .args(&FAST[2..])
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
     assert_eq!(out.status.code(), Some(0), "{stderr}");
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let topics = doc["topics"].as_array().expect("topics listed");
-    assert_eq!(topics.len(), 1_000_000);
+    // calibrate's summary carries the reader's warnings (other commands print them on stderr)
+    let warning = stdout
+        .lines()
+        .find(|l| l.contains("not read"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(
+        warning.contains("imu.json: keys not read: sampling_rate, columns[1].units")
+            && warning.contains("a column's unit: columns[k].unit"),
+        "{warning}"
+    );
+    // the columns' units, read from the sidecar, convert the data to SI
+    assert!(
+        stdout.contains("data in deg/s converted to rad/s"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("data in g converted to m/s^2"), "{stdout}");
 }

@@ -205,6 +205,7 @@ pub fn run(config: &SimulateConfig, stdout: &mut impl Write) -> Result<()> {
                     .map(|n| SidecarColumn {
                         name: n.clone(),
                         meaning: None,
+                        unit: None,
                     })
                     .collect(),
                 ..Sidecar::default()

@@ -132,8 +132,9 @@ impl SensorInfo {
         SensorInfo { sensor, axis, unit }
     }
 
-    /// The unit of a column, as text: the one its name states, else the sidecar's for its
-    /// sensor, else rad/s and m/s^2 for binary IMU records (`record`, docs/methods.md §9.3).
+    /// The unit of a column, as text: the one its name states, else the sidecar's for the
+    /// column (`columns[k].unit`), else the sidecar's for its sensor, else rad/s and m/s^2
+    /// for binary IMU records (`record`, docs/methods.md §9.3).
     pub fn column_unit(
         name: &str,
         sensor: Sensor,
@@ -141,15 +142,18 @@ impl SensorInfo {
         record: bool,
     ) -> Option<String> {
         let units = sidecar.and_then(|s| s.units.as_ref());
-        SensorInfo::unit_from_name(name).or_else(|| match sensor {
-            Sensor::Gyroscope => units
-                .and_then(|u| u.gyro.clone())
-                .or_else(|| record.then(|| "rad/s".to_string())),
-            Sensor::Accelerometer => units
-                .and_then(|u| u.accel.clone())
-                .or_else(|| record.then(|| "m/s^2".to_string())),
-            Sensor::Other => None,
-        })
+        let column = sidecar.and_then(|s| s.unit_of(name)).map(str::to_string);
+        SensorInfo::unit_from_name(name)
+            .or(column)
+            .or_else(|| match sensor {
+                Sensor::Gyroscope => units
+                    .and_then(|u| u.gyro.clone())
+                    .or_else(|| record.then(|| "rad/s".to_string())),
+                Sensor::Accelerometer => units
+                    .and_then(|u| u.accel.clone())
+                    .or_else(|| record.then(|| "m/s^2".to_string())),
+                Sensor::Other => None,
+            })
     }
 
     /// The unit a column name states in a trailing `[..]` or `(..)`, as text:

@@ -61,6 +61,10 @@ pub struct SidecarColumn {
     pub name: String,
     /// Free-text meaning, e.g. `"gyroscope X axis, ..."`.
     pub meaning: Option<String>,
+    /// The column's unit, e.g. `"deg/s"` (read as `units.gyro`/`units.accel` are; a unit the
+    /// column's name states comes first, this one before the sensor's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unit: Option<String>,
 }
 
 /// Summary statistics of a column given by a sidecar.
@@ -104,10 +108,18 @@ impl Sidecar {
     /// The meaning of the column named `name` (as the readers show it: control characters
     /// escaped), if the sidecar gives one.
     pub fn meaning(&self, name: &str) -> Option<&str> {
+        self.column(name).and_then(|c| c.meaning.as_deref())
+    }
+
+    /// The unit of the column named `name`, if the sidecar gives one (`columns[k].unit`).
+    pub fn unit_of(&self, name: &str) -> Option<&str> {
+        self.column(name).and_then(|c| c.unit.as_deref())
+    }
+
+    fn column(&self, name: &str) -> Option<&SidecarColumn> {
         self.columns
             .iter()
             .find(|c| c.name == name || super::printable(&c.name) == name)
-            .and_then(|c| c.meaning.as_deref())
     }
 }
 
@@ -214,7 +226,7 @@ fn unread_keys(text: &str) -> Vec<String> {
             if let serde_json::Value::Object(c) = c {
                 out.extend(
                     c.keys()
-                        .filter(|k| unknown(k, &["name", "meaning"]))
+                        .filter(|k| unknown(k, &["name", "meaning", "unit"]))
                         .map(|k| format!("columns[{i}].{k}")),
                 );
             }
@@ -292,16 +304,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn unread_keys_name_typos_and_per_column_units_not_descriptions() {
+    fn unread_keys_name_typos_not_descriptions_nor_column_units() {
         let text = r#"{"name": "x", "sampling_frequncy_hz": 100, "license": "CC",
             "units": {"gyro": "rad/s", "temperature": "C"},
-            "columns": [{"name": "gyro_x", "unit": "rad/s", "r_column": "X"}, "odd"]}"#;
+            "columns": [{"name": "gyro_x", "unit": "rad/s", "r_column": "X", "units": "x"},
+                        "odd"]}"#;
         assert_eq!(
             unread_keys(text),
             [
                 "sampling_frequncy_hz",
                 "units.temperature",
-                "columns[0].unit"
+                "columns[0].units"
             ]
         );
         // the shared recordings' descriptive keys, and what is not JSON, say nothing

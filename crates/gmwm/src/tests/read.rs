@@ -1339,6 +1339,7 @@ fn issue_series_files_follow_their_extension_and_sidecars_do_not_collide() {
                 .map(|n| SidecarColumn {
                     name: n.to_string(),
                     meaning: None,
+                    unit: None,
                 })
                 .collect(),
             ..Sidecar::default()

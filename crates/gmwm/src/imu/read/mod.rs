@@ -524,7 +524,9 @@ impl fmt::Display for ReadWarning {
                 }
             ),
             Self::SidecarKeysUnread { path, keys } => {
-                let units = keys.iter().any(|k| k.ends_with(".unit") || k.ends_with(".units"));
+                let units = keys
+                    .iter()
+                    .any(|k| k.starts_with("units.") || k.ends_with(".units"));
                 write!(
                     f,
                     "{}: key{} not read: {}{}",
@@ -532,8 +534,8 @@ impl fmt::Display for ReadWarning {
                     if keys.len() == 1 { "" } else { "s" },
                     crate::imu::error::name_list(keys),
                     if units {
-                        " (a column's unit is not read: the sidecar's units.gyro and \
-                         units.accel, or --gyro-unit and --accel-unit, give the units)"
+                        " (the units read are units.gyro, units.accel and a column's \
+                         unit: columns[k].unit)"
                     } else {
                         " (a typo? the keys read are name, sensor, sampling_frequency_hz, \
                          units, format, n_columns, columns, n_rows, summary)"
