@@ -479,23 +479,25 @@ fn deep_levels(ar: &[f64], q: usize, gamma: &[f64], levels: usize) -> Vec<f64> {
     let phi = |i: usize| ar.get(i).copied().unwrap_or(0.0);
     let d = 2 * r + 2;
     let (ia, ib) = (2 * r, 2 * r + 1);
-    let mut step = vec![vec![0.0; d]; d];
+    // M, row-major d x d
+    let mut step = vec![0.0; d * d];
+    let at = |row: usize, col: usize| row * d + col;
     for i in 0..r {
         // gamma_{h+1} = sum phi_i gamma_{h+1-i}; (h+1) gamma_{h+1} = sum phi_i ((h+1-i) gamma.. + i gamma..)
         let (gi, ei) = (i, r + i);
-        step[0][gi] = phi(i);
-        step[r][ei] = phi(i);
-        step[r][gi] = (i + 1) as f64 * phi(i);
-        step[ia][gi] = phi(i);
-        step[ib][ei] = phi(i);
-        step[ib][gi] = (i + 1) as f64 * phi(i);
+        step[at(0, gi)] = phi(i);
+        step[at(r, ei)] = phi(i);
+        step[at(r, gi)] = (i + 1) as f64 * phi(i);
+        step[at(ia, gi)] = phi(i);
+        step[at(ib, ei)] = phi(i);
+        step[at(ib, gi)] = (i + 1) as f64 * phi(i);
         if i + 1 < r {
-            step[gi + 1][gi] = 1.0;
-            step[ei + 1][ei] = 1.0;
+            step[at(gi + 1, gi)] = 1.0;
+            step[at(ei + 1, ei)] = 1.0;
         }
     }
-    step[ia][ia] = 1.0;
-    step[ib][ib] = 1.0;
+    step[at(ia, ia)] = 1.0;
+    step[at(ib, ib)] = 1.0;
     let h0 = gamma.len() - 1;
     let mut state = vec![0.0; d];
     for i in 0..r {
@@ -504,42 +506,68 @@ fn deep_levels(ar: &[f64], q: usize, gamma: &[f64], levels: usize) -> Vec<f64> {
     }
     state[ia] = gamma[1..].iter().sum();
     state[ib] = gamma.iter().enumerate().map(|(h, g)| h as f64 * g).sum();
-    // jump = M^(2^k), from M^(2^direct)
+    // jump = M^(2^k), from M^(2^direct); squared in place through one scratch matrix. Once
+    // the AR part has decayed to nothing, M^(2n) = M^n to rounding (the accumulators take the
+    // whole sums): a fixed point, squared no more.
     let mut jump = step.clone();
+    let mut scratch = vec![0.0; d * d];
+    let mut fixed = false;
+    let mut square = |jump: &mut Vec<f64>| {
+        if fixed {
+            return;
+        }
+        mat_mul(jump, jump, &mut scratch, d);
+        let size = scratch.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        fixed = scratch
+            .iter()
+            .zip(jump.iter())
+            .all(|(a, b)| (a - b).abs() <= f64::EPSILON * size);
+        std::mem::swap(jump, &mut scratch);
+    };
     let direct = h0.trailing_ones() as usize;
     for _ in 0..direct {
-        jump = mat_mul(&jump, &jump);
+        square(&mut jump);
     }
+    let mut next = vec![0.0; d];
     let mut out = Vec::with_capacity(levels.saturating_sub(direct));
     for k in direct..levels {
         let m = 2f64.powi(k as i32);
         let (a_m1, b_m1) = (state[ia], state[ib]);
-        let next = mat_vec(&step, &state);
+        mat_vec(&step, &state, &mut next);
         let (a_m, b_m) = (next[ia], next[ib]);
-        state = mat_vec(&jump, &state);
+        mat_vec(&jump, &state, &mut next);
+        std::mem::swap(&mut state, &mut next);
         let (a_2m1, b_2m1) = (state[ia], state[ib]);
         let s = m * gamma[0] + 2.0 * m * a_m1 - 2.0 * b_m1 - 2.0 * b_m - 2.0 * m * (a_2m1 - a_m)
             + b_2m1;
         out.push(s / (2.0 * m * m));
-        jump = mat_mul(&jump, &jump);
+        if k + 1 < levels {
+            square(&mut jump);
+        }
     }
     out
 }
 
-fn mat_mul(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    a.iter()
-        .map(|row| {
-            (0..b.len())
-                .map(|j| row.iter().zip(b).map(|(x, bk)| x * bk[j]).sum())
-                .collect()
-        })
-        .collect()
+/// `out = a b` for row-major `d x d` matrices (zero entries of `a` skipped: the early
+/// powers of the companion matrix are sparse).
+fn mat_mul(a: &[f64], b: &[f64], out: &mut [f64], d: usize) {
+    out.fill(0.0);
+    for (row, o) in a.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
+        for (&x, bk) in row.iter().zip(b.chunks_exact(d)) {
+            if x != 0.0 {
+                for (o, &b) in o.iter_mut().zip(bk) {
+                    *o += x * b;
+                }
+            }
+        }
+    }
 }
 
-fn mat_vec(a: &[Vec<f64>], x: &[f64]) -> Vec<f64> {
-    a.iter()
-        .map(|row| row.iter().zip(x).map(|(a, x)| a * x).sum())
-        .collect()
+/// `out = a x` for a row-major `d x d` matrix.
+fn mat_vec(a: &[f64], x: &[f64], out: &mut [f64]) {
+    for (o, row) in out.iter_mut().zip(a.chunks_exact(x.len())) {
+        *o = row.iter().zip(x).map(|(a, x)| a * x).sum();
+    }
 }
 
 /// Largest half-width `m = 2^{levels-1}` (1 for no levels).
