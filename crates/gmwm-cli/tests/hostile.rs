@@ -434,3 +434,40 @@ fn unread_sidecar_keys_are_warned_and_column_units_read() {
     );
     assert!(stdout.contains("data in g converted to m/s^2"), "{stdout}");
 }
+
+/// A rosbag2 database listing 10^6 topics: merging them searched the list for every topic
+/// (10^12 comparisons). They are merged through a map: `gmwm topics` lists them in seconds.
+#[test]
+fn a_million_topics_merge_in_n_log_n() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("topics.db3");
+    let mut db = rusqlite::Connection::open(&path).unwrap();
+    db.execute_batch(
+        "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT, type TEXT, \
+         serialization_format TEXT, offered_qos_profiles TEXT); \
+         CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER, \
+         timestamp INTEGER, data BLOB);",
+    )
+    .unwrap();
+    let tx = db.transaction().unwrap();
+    {
+        let mut insert = tx
+            .prepare("INSERT INTO topics VALUES (?1, '/t' || ?1, 'std_msgs/msg/Empty', 'cdr', '')")
+            .unwrap();
+        for k in 1..=1_000_000i64 {
+            insert.execute([k]).unwrap();
+        }
+    }
+    tx.commit().unwrap();
+    drop(db);
+    let out = common::gmwm_bounded()
+        .args(["topics", "--json"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let topics = doc["topics"].as_array().expect("topics listed");
+    assert_eq!(topics.len(), 1_000_000);
+}

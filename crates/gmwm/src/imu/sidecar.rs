@@ -156,7 +156,7 @@ pub fn sidecar_candidates(data: &Path) -> Vec<PathBuf> {
 /// As [`Sidecar::read`], for the first candidate of [`sidecar_candidates`] that exists and is
 /// not passed over.
 pub fn find_sidecar(data: &Path) -> Result<Option<Sidecar>, ReadError> {
-    locate_sidecar(data).map(|(sidecar, _)| sidecar)
+    locate_sidecar(data).map(|located| located.sidecar)
 }
 
 /// A file at a sidecar's name that is not one: its path and why.
@@ -235,23 +235,23 @@ fn unread_keys(text: &str) -> Vec<String> {
     out
 }
 
-/// The sidecar of `data` and its keys gmwm does not read ([`unread_keys`]), `None` when there
-/// is no sidecar or it has none.
-pub(crate) fn unread_sidecar_keys(data: &Path) -> Option<(PathBuf, Vec<String>)> {
-    let path = sidecar_candidates(data).into_iter().find(|p| {
-        p.is_file() && std::fs::read_to_string(p).is_ok_and(|text| not_a_sidecar(&text).is_none())
-    })?;
-    let keys = unread_keys(&std::fs::read_to_string(&path).ok()?);
-    (!keys.is_empty()).then_some((path, keys))
+/// What [`locate_sidecar`] found beside a data file.
+#[derive(Debug, Default)]
+pub(crate) struct Located {
+    /// The sidecar, if one is there.
+    pub(crate) sidecar: Option<Sidecar>,
+    /// The files at a sidecar's name passed over, in candidate order.
+    pub(crate) passed: Vec<NotASidecar>,
+    /// The sidecar's path and its keys gmwm does not read ([`unread_keys`]), when it has any.
+    pub(crate) unread: Option<(PathBuf, Vec<String>)>,
 }
 
-/// [`find_sidecar`], with the files at a sidecar's name passed over, in candidate order.
+/// [`find_sidecar`], with the files at a sidecar's name passed over and the sidecar's unread
+/// keys, each candidate read once.
 ///
 /// # Errors
 /// As [`find_sidecar`].
-pub(crate) fn locate_sidecar(
-    data: &Path,
-) -> Result<(Option<Sidecar>, Vec<NotASidecar>), ReadError> {
+pub(crate) fn locate_sidecar(data: &Path) -> Result<Located, ReadError> {
     let mut passed = Vec::new();
     for path in sidecar_candidates(data).into_iter().filter(|p| p.is_file()) {
         let text = std::fs::read_to_string(&path).map_err(|source| ReadError::Io {
@@ -262,9 +262,18 @@ pub(crate) fn locate_sidecar(
             passed.push(NotASidecar { path, why });
             continue;
         }
-        return Ok((Some(Sidecar::from_json(&text, &path)?), passed));
+        let sidecar = Sidecar::from_json(&text, &path)?;
+        let keys = unread_keys(&text);
+        return Ok(Located {
+            sidecar: Some(sidecar),
+            passed,
+            unread: (!keys.is_empty()).then_some((path, keys)),
+        });
     }
-    Ok((None, passed))
+    Ok(Located {
+        passed,
+        ..Located::default()
+    })
 }
 
 /// Why `text` is not a sidecar, `None` when it may be one (text that is not JSON is left to

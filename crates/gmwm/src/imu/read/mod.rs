@@ -470,14 +470,19 @@ pub(crate) fn time_policy_warning(
 
 /// The warnings for the files at `path`'s sidecar names passed over as not sidecars, and for
 /// the keys of its sidecar that are not read.
-pub(crate) fn passed_over_sidecars(path: &Path) -> Vec<ReadWarning> {
-    let mut out: Vec<ReadWarning> = crate::imu::sidecar::locate_sidecar(path)
-        .map(|(_, passed)| passed.into_iter().map(ReadWarning::NotASidecar).collect())
-        .unwrap_or_default();
-    if let Some((path, keys)) = crate::imu::sidecar::unread_sidecar_keys(path) {
-        out.push(ReadWarning::SidecarKeysUnread { path, keys });
-    }
-    out
+pub(crate) fn sidecar_warnings(path: &Path) -> Vec<ReadWarning> {
+    located_warnings(crate::imu::sidecar::locate_sidecar(path).unwrap_or_default()).collect()
+}
+
+fn located_warnings(located: crate::imu::sidecar::Located) -> impl Iterator<Item = ReadWarning> {
+    let unread = located
+        .unread
+        .map(|(path, keys)| ReadWarning::SidecarKeysUnread { path, keys });
+    located
+        .passed
+        .into_iter()
+        .map(ReadWarning::NotASidecar)
+        .chain(unread)
 }
 
 /// Relative difference between two rates above which they disagree: 1% (a time column and a
@@ -745,16 +750,14 @@ pub fn binary_layout(path: &Path, opts: &ReadOptions) -> Result<Option<BinaryLay
 }
 
 /// The warnings of a raw binary file read in `layout` without [`read_table`] (streamed): the
-/// files at its sidecar's names passed over, and a sidecar `n_rows` the file does not hold.
+/// files at its sidecar's names passed over, its unread keys, and a sidecar `n_rows` the file
+/// does not hold.
 pub fn binary_warnings(path: &Path, layout: &BinaryLayout) -> Vec<ReadWarning> {
-    let (sidecar, passed) = crate::imu::sidecar::locate_sidecar(path).unwrap_or_default();
+    let mut located = crate::imu::sidecar::locate_sidecar(path).unwrap_or_default();
     let record = layout.format.value_width().unwrap_or(8) * layout.ncols.max(1);
     let rows = std::fs::metadata(path).map_or(0, |m| m.len() / record as u64);
-    passed
-        .into_iter()
-        .map(ReadWarning::NotASidecar)
-        .chain(sidecar_rows_disagree(path, sidecar.as_ref(), rows))
-        .collect()
+    let disagree = sidecar_rows_disagree(path, located.sidecar.take().as_ref(), rows);
+    located_warnings(located).chain(disagree).collect()
 }
 
 /// Column names of a raw binary file: the sidecar's if it names exactly `ncols` columns.
@@ -903,7 +906,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<Table, ReadError> {
         sidecar.as_ref(),
         &mut warnings,
     )?;
-    warnings.extend(passed_over_sidecars(path));
+    warnings.extend(sidecar_warnings(path));
     let kept = raw.columns.first().map_or(0, |c| c.values.len() as u64);
     let dropped = raw.dropped;
     warnings.extend(sidecar_rows_disagree(

@@ -622,7 +622,7 @@ fn finish(
         sidecar.as_ref(),
         &mut warnings,
     )?;
-    warnings.extend(super::passed_over_sidecars(path));
+    warnings.extend(super::sidecar_warnings(path));
     warnings.extend(super::sidecar_rows_disagree(
         path,
         sidecar.as_ref(),
