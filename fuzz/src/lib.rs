@@ -358,7 +358,9 @@ pub fn wv_fit(data: &[u8]) {
             Ok(implied) => assert_eq!(implied.wv.len(), levels),
             Err(e) => check_error(&e),
         }
-        let gmwm = Gmwm::new(model.clone());
+        // the starting-value search's draws (20000 by default) repeat one computation: a few
+        // cover its paths, and leave the executions to the inputs
+        let gmwm = Gmwm::new(model.clone()).with_draws(64);
         match gmwm.fit_from_wv(wv, StartInputs::from_wv(wv)) {
             Ok(fit) => assert_eq!(fit.implied_wv().wv.len(), levels),
             Err(e) => check_error(&e),
