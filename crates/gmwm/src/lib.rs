@@ -104,13 +104,15 @@ pub use sim::{simulate_model, DemoSensor, Simulator};
 pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
 pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{
-    Convergence, FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter,
+    Convergence, CovariateFit, CovariateRecording, Dependence, FitError, FitEstimates,
+    FitRecording, Gmwm, GmwmFit, NavParameter,
     ParameterEstimate, PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
 };
 pub use inference::same_model::{
     compare_wvs, same_model_test_of, SameModelOptions, SameModelTest, ScaleContribution,
 };
 pub use inference::{
+    CoefficientInference, CovariateInference, DependenceTest,
     infer, infer_with_progress, CovarianceMethod, Inference, InferenceOptions, ParameterInference,
     WvComparison,
 };

@@ -12,6 +12,7 @@
 pub(crate) mod active;
 pub(crate) mod auto;
 pub(crate) mod canonical;
+pub(crate) mod covariate;
 mod estimates;
 pub(crate) mod gmwm;
 pub(crate) mod objective;
@@ -28,6 +29,7 @@ mod tests_groundwork;
 
 pub(crate) use canonical::Reading;
 pub(crate) use canonical::{CanonicalModel, CanonicalTerm, SEPARATION_LIMIT};
+pub use covariate::{CovariateFit, CovariateRecording, Dependence};
 pub use estimates::FitEstimates;
 pub use gmwm::{Gmwm, GmwmFit};
 pub(crate) use objective::Objective;

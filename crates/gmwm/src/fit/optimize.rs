@@ -151,9 +151,63 @@ pub(crate) const STALL_COSINE: f64 = 1e-4;
 /// soon as the gradient points back inside.
 pub(crate) const COLLAPSE_INFLUENCE: f64 = 1e-7;
 
+/// A least-squares problem [`minimize`] solves: whitened residuals and their Jacobian in the
+/// unconstrained parameters `u`. The GMWM objective ([`Objective`]) is one; the fit whose
+/// parameters are functions of a covariate (`super::covariate`) is another, on the
+/// coefficients of those functions.
+pub(crate) trait LeastSquares {
+    /// Number of parameters p.
+    fn n_params(&self) -> usize;
+    /// Number of residuals.
+    fn levels(&self) -> usize;
+    /// A fresh evaluation buffer.
+    fn buffer(&self) -> Eval;
+    /// Residuals at `u` (and their Jacobian when `with_jacobian`) into `ev`.
+    fn evaluate(
+        &self,
+        u: &[f64],
+        ev: &mut Eval,
+        with_jacobian: bool,
+    ) -> Result<(), crate::InputError>;
+    /// The sum of squares at a zero model: the scale of `Q`.
+    fn scale(&self) -> f64;
+    /// Where each parameter's boundary lies in `u`.
+    fn edges(&self) -> Vec<Edge>;
+}
+
+impl LeastSquares for Objective {
+    fn n_params(&self) -> usize {
+        Objective::n_params(self)
+    }
+    fn levels(&self) -> usize {
+        Objective::levels(self)
+    }
+    fn buffer(&self) -> Eval {
+        Objective::buffer(self)
+    }
+    fn evaluate(
+        &self,
+        u: &[f64],
+        ev: &mut Eval,
+        with_jacobian: bool,
+    ) -> Result<(), crate::InputError> {
+        Objective::evaluate(self, u, ev, with_jacobian)
+    }
+    fn scale(&self) -> f64 {
+        Objective::scale(self)
+    }
+    fn edges(&self) -> Vec<Edge> {
+        self.parametrisation()
+            .transforms()
+            .iter()
+            .map(|t| Edge::of(*t))
+            .collect()
+    }
+}
+
 /// Where a parameter's boundary lies in `u` (see [`COLLAPSE_INFLUENCE`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Edge {
+pub(crate) enum Edge {
     /// Unbounded (identity transform): never collapses.
     Free,
     /// Log scale: the boundary theta = 0 is u -> -inf.
@@ -161,6 +215,18 @@ enum Edge {
     /// A bounded coefficient (logit-type, or a link of the ordered phi chain): u -> -inf and
     /// u -> +inf are both edges (e.g. phi -> 0 and phi -> 1).
     Both,
+}
+
+impl Edge {
+    /// The edge of a parameter with transform `t` (`None`: a link of the ordered phi chain).
+    pub(crate) fn of(t: Option<ParamTransform>) -> Self {
+        match t {
+            Some(ParamTransform::Log | ParamTransform::LogAbs) => Edge::Zero,
+            Some(ParamTransform::Identity) => Edge::Free,
+            // logit-type transforms, and None: a link of the ordered phi chain
+            _ => Edge::Both,
+        }
+    }
 }
 
 /// Indices of the collapsed parameters (see [`COLLAPSE_INFLUENCE`]) at `ev` (`u` its point):
@@ -247,7 +313,7 @@ fn sum_sq(r: &[f64]) -> f64 {
 /// [`FitError::Length`] if `u0` has the wrong length; [`FitError::BadStart`] if theta(u0) is not
 /// a valid model; [`FitError::NonFiniteStart`] if its implied WV overflows.
 pub(crate) fn minimize(
-    objective: &Objective,
+    objective: &impl LeastSquares,
     u0: &[f64],
     opts: &LmOptions,
 ) -> Result<Minimum, FitError> {
@@ -286,17 +352,7 @@ pub(crate) fn minimize(
     let mut mu = f64::NAN;
     let mut nu = 2.0;
     let mut restarts = 0;
-    let edge: Vec<Edge> = objective
-        .parametrisation()
-        .transforms()
-        .iter()
-        .map(|t| match t {
-            Some(ParamTransform::Log | ParamTransform::LogAbs) => Edge::Zero,
-            Some(ParamTransform::Identity) => Edge::Free,
-            // logit-type transforms, and None: a link of the ordered phi chain
-            _ => Edge::Both,
-        })
-        .collect();
+    let edge = objective.edges();
     let finish =
         |reason: StopReason, u: Vec<f64>, ev: &Eval, q: f64, it: usize, evals: usize| Minimum {
             u,

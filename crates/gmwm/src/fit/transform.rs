@@ -234,7 +234,6 @@ impl Parametrisation {
     ///
     /// # Errors
     /// [`FitError::Length`].
-    #[cfg(test)]
     pub(crate) fn to_theta(&self, u: &[f64]) -> Result<Vec<f64>, FitError> {
         self.check_len("u", u.len())?;
         let mut theta = vec![0.0; u.len()];

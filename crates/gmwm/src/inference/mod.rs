@@ -7,6 +7,7 @@
 
 pub(crate) mod asymptotic;
 pub(crate) mod bootstrap;
+pub(crate) mod covariate;
 pub(crate) mod gof;
 mod pooled;
 pub(crate) mod same_model;
@@ -24,6 +25,7 @@ pub(crate) use asymptotic::{sandwich, wald_interval};
 pub use asymptotic::{IntervalScale, ZConvention};
 #[cfg(test)]
 pub(crate) use bootstrap::wv_bootstrap;
+pub use covariate::{CoefficientInference, CovariateInference, DependenceTest};
 pub use gof::JTest;
 pub use same_model::WvComparison;
 pub(crate) use summary::infer_with_covariance;

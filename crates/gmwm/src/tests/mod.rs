@@ -9,6 +9,7 @@ mod calib;
 mod canonical;
 mod common;
 mod contamination;
+mod covariate;
 mod coverage;
 mod datasheet;
 mod examples;
