@@ -64,6 +64,8 @@ pub enum Config {
     SameModel(SameModelConfig),
     /// `gmwm fit FILE... --pool`.
     PooledFit(PooledFitConfig),
+    /// `gmwm fit FILE... --covariate COL` or `--covariate-values LIST`.
+    CovariateFit(CovariateFitConfig),
     /// `gmwm select FILE... --pool`.
     PooledSelect(PooledSelectConfig),
 }
@@ -85,6 +87,18 @@ impl TryFrom<&Command> for Config {
             Command::Report(a) => Self::Report(a.try_into()?),
             Command::SameModel(a) => Self::SameModel(a.try_into()?),
             Command::Fit(a) if a.pool => Self::PooledFit(a.try_into()?),
+            Command::Fit(a) if a.covariate.is_some() || !a.covariate_values.is_empty() => {
+                Self::CovariateFit(a.try_into()?)
+            }
+            Command::Fit(a) if !a.depends.is_empty() || !a.at.is_empty() => anyhow::bail!(
+                "--{} describes a covariate fit: give the covariate with --covariate COL or \
+                 --covariate-values LIST",
+                if a.depends.is_empty() {
+                    "at"
+                } else {
+                    "depends"
+                }
+            ),
             Command::Select(a) if a.pool => Self::PooledSelect(a.try_into()?),
             Command::Fit(a) => Self::Fit(a.try_into()?),
             Command::Select(a) => Self::Select(a.try_into()?),
@@ -1171,6 +1185,84 @@ impl TryFrom<&FitArgs> for PooledFitConfig {
             fit,
             seed: a.seed,
             files,
+        })
+    }
+}
+
+/// Where a covariate fit's levels come from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CovariateSource {
+    /// `--covariate COL`: the mean of column COL of each FILE.
+    Column(String),
+    /// `--covariate-values LIST`: one level per FILE.
+    Values(Vec<f64>),
+}
+
+/// `gmwm fit FILE... --covariate COL | --covariate-values LIST`: the parameters as functions of
+/// a covariate (docs/methods.md §5.13).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CovariateFitConfig {
+    /// The fit's reading, estimator and output, as `gmwm fit`.
+    pub fit: FitConfig,
+    /// `--seed`: of the searches and of the inference.
+    pub seed: u64,
+    /// FILE and the more FILEs, in order.
+    pub files: Vec<PathBuf>,
+    /// The covariate's levels.
+    pub covariate: CovariateSource,
+    /// `--depends`, resolved per parameter.
+    pub dependence: Vec<gmwm::Dependence>,
+    /// `--at`: levels at which the parameters are reported (empty: each FILE's).
+    pub at: Vec<f64>,
+}
+
+impl TryFrom<&FitArgs> for CovariateFitConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &FitArgs) -> Result<Self> {
+        let fit = FitConfig::try_from(a)?;
+        anyhow::ensure!(
+            a.bootstrap.is_none(),
+            "invalid --bootstrap with a covariate: a covariate fit's intervals are the sandwich's \
+             (docs/methods.md §5.13)"
+        );
+        let files: Vec<PathBuf> = std::iter::once(fit.input.file.clone())
+            .chain(a.more.iter().cloned())
+            .collect();
+        anyhow::ensure!(
+            files.len() >= 2,
+            "a covariate fit needs at least two FILEs at different covariate levels (one FILE \
+             was given)"
+        );
+        let covariate = match &a.covariate {
+            Some(col) => CovariateSource::Column(col.clone()),
+            None => {
+                let v = &a.covariate_values;
+                anyhow::ensure!(
+                    v.len() == files.len(),
+                    "invalid --covariate-values: {} value(s) for {} FILEs; give one level per FILE, \
+                     in order",
+                    v.len(),
+                    files.len()
+                );
+                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                    anyhow::bail!("invalid --covariate-values: {x} is not a finite number");
+                }
+                CovariateSource::Values(v.clone())
+            }
+        };
+        if let Some(x) = a.at.iter().find(|x| !x.is_finite()) {
+            anyhow::bail!("invalid --at: {x} is not a finite number");
+        }
+        let dependence = gmwm::dependences(fit.gmwm.model(), &a.depends)
+            .map_err(|e| anyhow::anyhow!("invalid --depends {}: {}", e.value, e.expected))?;
+        Ok(Self {
+            fit,
+            seed: a.seed,
+            files,
+            covariate,
+            dependence,
+            at: a.at.clone(),
         })
     }
 }

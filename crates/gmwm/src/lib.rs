@@ -104,17 +104,16 @@ pub use sim::{simulate_model, DemoSensor, Simulator};
 pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
 pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{
-    Convergence, CovariateFit, CovariateRecording, Dependence, FitError, FitEstimates,
-    FitRecording, Gmwm, GmwmFit, NavParameter,
-    ParameterEstimate, PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
+    covariate_level, dependences, Convergence, CovariateFit, CovariateRecording, Dependence,
+    FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter, ParameterEstimate,
+    PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
 };
 pub use inference::same_model::{
     compare_wvs, same_model_test_of, SameModelOptions, SameModelTest, ScaleContribution,
 };
 pub use inference::{
-    CoefficientInference, CovariateInference, DependenceTest,
-    infer, infer_with_progress, CovarianceMethod, Inference, InferenceOptions, ParameterInference,
-    WvComparison,
+    infer, infer_with_progress, CoefficientInference, CovarianceMethod, CovariateInference,
+    DependenceTest, Inference, InferenceOptions, ParameterInference, WvComparison,
 };
 pub use inference::{
     BootstrapGof, InferenceMethod, InferenceWarning, IntervalScale, JTest, VShape, ZConvention,

@@ -94,7 +94,7 @@ pub enum Command {
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
         allow_negative_numbers = true,
-        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three"
+        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three\n  gmwm fit t5.csv t15.csv t25.csv t35.csv --covariate-values 5,15,25,35 --model \"GM()+WN()\"   parameters as functions of temperature\n  gmwm fit a.csv b.csv c.csv --covariate temperature --model \"GM()+WN()\" --depends variances=quadratic --at 0,40 --json"
     )]
     Fit(FitArgs),
     /// Select a model by the Wavelet Information Criterion on each selected column (docs/methods.md
@@ -628,9 +628,37 @@ pub struct SelectArgs {
     /// one rate, docs/methods.md §5.11): `gmwm select a.csv b.csv --pool --model M`.
     #[arg(long)]
     pub pool: bool,
-    /// More recordings, with --pool.
-    #[arg(value_name = "FILE", requires = "pool")]
+    /// More recordings, with --pool, --covariate or --covariate-values.
+    #[arg(value_name = "FILE", requires = "several")]
     pub more: Vec<PathBuf>,
+    /// Fit the parameters as functions of a covariate over all FILEs (docs/methods.md §5.13):
+    /// each FILE's level is the mean of its column COL (e.g. temperature); COL is not fitted.
+    #[arg(long, value_name = "COL", conflicts_with_all = ["pool", "covariate_values"])]
+    pub covariate: Option<String>,
+    /// The covariate's level of each FILE, in order (e.g. 5,15,25,35 for recordings at those
+    /// temperatures), instead of --covariate.
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        conflicts_with = "pool",
+        allow_hyphen_values = true
+    )]
+    pub covariate_values: Vec<f64>,
+    /// With a covariate: how each parameter depends on it, NAME=constant|affine|quadratic
+    /// (comma-separated, later entries win; NAME a label such as WN[0].sigma2, `variances` or
+    /// `all`), on the parameter's log/logit scale [default: variances affine, the rest constant].
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub depends: Vec<String>,
+    /// With a covariate: report the parameters and their pointwise bands at these levels
+    /// [default: each FILE's].
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub at: Vec<f64>,
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,
@@ -638,6 +666,7 @@ pub struct SelectArgs {
 
 /// `gmwm fit`.
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("several").args(["pool", "covariate", "covariate_values"]).multiple(true)))]
 pub struct FitArgs {
     /// Input.
     #[command(flatten)]
@@ -677,9 +706,37 @@ pub struct FitArgs {
     /// §5.11): `gmwm fit a.csv b.csv c.csv --pool --model M`.
     #[arg(long)]
     pub pool: bool,
-    /// More recordings, with --pool.
-    #[arg(value_name = "FILE", requires = "pool")]
+    /// More recordings, with --pool, --covariate or --covariate-values.
+    #[arg(value_name = "FILE", requires = "several")]
     pub more: Vec<PathBuf>,
+    /// Fit the parameters as functions of a covariate over all FILEs (docs/methods.md §5.13):
+    /// each FILE's level is the mean of its column COL (e.g. temperature); COL is not fitted.
+    #[arg(long, value_name = "COL", conflicts_with_all = ["pool", "covariate_values"])]
+    pub covariate: Option<String>,
+    /// The covariate's level of each FILE, in order (e.g. 5,15,25,35 for recordings at those
+    /// temperatures), instead of --covariate.
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        conflicts_with = "pool",
+        allow_hyphen_values = true
+    )]
+    pub covariate_values: Vec<f64>,
+    /// With a covariate: how each parameter depends on it, NAME=constant|affine|quadratic
+    /// (comma-separated, later entries win; NAME a label such as WN[0].sigma2, `variances` or
+    /// `all`), on the parameter's log/logit scale [default: variances affine, the rest constant].
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub depends: Vec<String>,
+    /// With a covariate: report the parameters and their pointwise bands at these levels
+    /// [default: each FILE's].
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub at: Vec<f64>,
     /// Output format.
     #[command(flatten)]
     pub output: OutputArgs,

@@ -6,6 +6,7 @@
 pub mod avar;
 pub mod batch;
 pub mod calibrate;
+pub mod covariate;
 pub mod demo;
 pub mod fit;
 pub mod implied;
@@ -59,6 +60,7 @@ pub fn of(config: &mut Config) -> &mut dyn Command {
         Config::Monitor(c) => c,
         Config::SameModel(c) => c,
         Config::PooledFit(c) => c,
+        Config::CovariateFit(c) => c,
         Config::PooledSelect(c) => c,
     }
 }

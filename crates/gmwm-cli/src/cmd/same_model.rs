@@ -51,7 +51,7 @@ pooled_command!(SameModelConfig, run);
 
 /// One input of a pooled computation, as reported (`recordings[]`).
 #[derive(Debug, Clone, Serialize)]
-struct RecordingInfo {
+pub(super) struct RecordingInfo {
     path: String,
     freq_hz: f64,
     n: usize,
@@ -59,10 +59,10 @@ struct RecordingInfo {
 }
 
 /// The files read and, per column, the recordings (input order).
-struct Pool {
-    files: Vec<PathBuf>,
-    info: Vec<RecordingInfo>,
-    columns: Vec<(String, Vec<FitRecording>)>,
+pub(super) struct Pool {
+    pub(super) files: Vec<PathBuf>,
+    pub(super) info: Vec<RecordingInfo>,
+    pub(super) columns: Vec<(String, Vec<FitRecording>)>,
     /// Each column's unit for figures (`u` when the first file's sidecar names none).
     units: Vec<String>,
 }
@@ -75,7 +75,7 @@ fn unit_of(s: &Option<String>) -> Option<String> {
 
 /// Reads every file with `base`'s read options, checks that they can be pooled and computes
 /// each column's WV and weights (docs/methods.md §5.11).
-fn read_pool(
+pub(super) fn read_pool(
     files: &[PathBuf],
     base: &InputConfig,
     wv: &WvOptions,
@@ -177,7 +177,7 @@ fn read_pool(
 }
 
 /// The engine's pooled-input errors, with the recording named by its file.
-fn named(e: FitError, files: &[PathBuf], column: &str) -> anyhow::Error {
+pub(super) fn named(e: FitError, files: &[PathBuf], column: &str) -> anyhow::Error {
     let file = |k: usize| files[k - 1].display().to_string();
     match &e {
         FitError::RecordingTooShort {
@@ -465,7 +465,7 @@ fn run_pooled_select(
     Ok(())
 }
 
-fn write_recordings(info: &[RecordingInfo], out: &mut impl Write) -> Result<()> {
+pub(super) fn write_recordings(info: &[RecordingInfo], out: &mut impl Write) -> Result<()> {
     writeln!(
         out,
         "{:<44} {:>10} {:>10} {:>6}",

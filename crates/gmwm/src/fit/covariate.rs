@@ -117,6 +117,120 @@ impl FromStr for Dependence {
     }
 }
 
+/// docs/methods.md §5.13: each parameter's dependence from a list of `NAME=FORM` entries,
+/// later entries overriding earlier ones. NAME is a parameter label (`WN[0].sigma2`,
+/// `GM[1].beta`; case-insensitive), `variances` (every variance: `sigma2`, `sigma2_gm`, `q2`,
+/// `gamma2`) or `all`; FORM is `constant`, `affine` or `quadratic`. Without entries, every
+/// variance is affine and the rest constant (a sensor's noise levels drift with temperature,
+/// its correlation times much less).
+///
+/// ```
+/// use gmwm::{dependences, Dependence, Model};
+/// let m = Model::parse("WN()+GM()").unwrap();
+/// let d = dependences(&m, &["GM[1].beta=affine".to_string()]).unwrap();
+/// assert_eq!(d, [Dependence::Affine, Dependence::Affine, Dependence::Affine]);
+/// ```
+///
+/// # Errors
+/// [`ParamError`] naming the entry: no `=`, an unknown name (the labels listed) or form.
+pub fn dependences(model: &Model, entries: &[String]) -> Result<Vec<Dependence>, ParamError> {
+    let labels: Vec<(String, bool)> = model
+        .components()
+        .iter()
+        .enumerate()
+        .flat_map(|(ci, c)| {
+            let kind = c.kind;
+            kind.param_names()
+                .iter()
+                .enumerate()
+                .map(move |(i, name)| {
+                    (
+                        format!("{}[{ci}].{name}", kind.base_name()),
+                        kind.param_domain(i) == Some(crate::process::ParamDomain::Variance),
+                    )
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut out: Vec<Dependence> = labels
+        .iter()
+        .map(|(_, var)| {
+            if *var {
+                Dependence::Affine
+            } else {
+                Dependence::Constant
+            }
+        })
+        .collect();
+    for entry in entries {
+        let Some((name, form)) = entry.split_once('=') else {
+            return Err(ParamError::new(
+                "dependence",
+                entry,
+                "NAME=FORM, e.g. WN[0].sigma2=affine",
+            ));
+        };
+        let form: Dependence = form.parse()?;
+        let name = name.trim();
+        let hit: Vec<usize> = match name.to_ascii_lowercase().as_str() {
+            "all" => (0..labels.len()).collect(),
+            "variances" => (0..labels.len()).filter(|&i| labels[i].1).collect(),
+            _ => labels
+                .iter()
+                .position(|(l, _)| l.eq_ignore_ascii_case(name))
+                .into_iter()
+                .collect(),
+        };
+        if hit.is_empty() {
+            let names: Vec<&str> = labels.iter().map(|(l, _)| l.as_str()).collect();
+            return Err(ParamError::new(
+                "dependence",
+                entry,
+                format!(
+                    "a parameter of the model ({}), `variances` or `all`",
+                    names.join(", ")
+                ),
+            ));
+        }
+        for i in hit {
+            out[i] = form;
+        }
+    }
+    Ok(out)
+}
+
+/// docs/methods.md §5.13: the covariate level of a recording or window, the mean of its
+/// covariate samples `values` (a temperature channel).
+///
+/// # Errors
+/// [`ParamError`] for no sample or a non-finite one (named by its 1-based row).
+pub fn covariate_level(values: &[f64]) -> Result<f64, ParamError> {
+    if values.is_empty() {
+        return Err(ParamError::new(
+            "covariate",
+            "no sample",
+            "at least one sample",
+        ));
+    }
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(ParamError::new(
+            "covariate",
+            format!("{} at sample {}", values[i], i + 1),
+            "finite values: the covariate is averaged over the recording",
+        ));
+    }
+    // a compensated mean: temperatures of 10^8 samples keep their last digits
+    let mut sum = 0.0f64;
+    let mut c = 0.0f64;
+    for &v in values {
+        let y = v - c;
+        let t = sum + y;
+        c = (t - sum) - y;
+        sum = t;
+    }
+    Ok(sum / values.len() as f64)
+}
+
 /// The coefficients' layout: parameter `i` holds `terms[i]` coefficients from `offset[i]`.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Layout {
@@ -248,7 +362,13 @@ impl LeastSquares for CovariateObjective<'_> {
                 let pw = self.layout.powers(x);
                 for j in 0..levels {
                     let row = &mut ev.jac[(at + j) * q..(at + j + 1) * q];
-                    for (i, (d, &o)) in self.layout.dependence.iter().zip(&self.layout.offset).enumerate() {
+                    for (i, (d, &o)) in self
+                        .layout
+                        .dependence
+                        .iter()
+                        .zip(&self.layout.offset)
+                        .enumerate()
+                    {
                         let dr_du = part.jac[j * p + i];
                         for t in 0..d.terms() {
                             row[o + t] = dr_du * pw[t];
@@ -421,7 +541,9 @@ fn polyfit(xs: &[f64], y: &[f64], layout: &Layout, degree: usize) -> Option<Vec<
     }
     let a = nalgebra::DMatrix::from_row_slice(n, n, &m);
     let sol = a.lu().solve(&nalgebra::DVector::from_vec(b))?;
-    sol.iter().all(|v| v.is_finite()).then(|| sol.iter().copied().collect())
+    sol.iter()
+        .all(|v| v.is_finite())
+        .then(|| sol.iter().copied().collect())
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -504,12 +626,16 @@ impl Gmwm {
             let names = Parametrisation::new(self.model(), self.settings().0, PhiOrder::Free, 1.0)
                 .map(|p| p.names()[i].clone())
                 .unwrap_or_else(|_| format!("parameter {}", i + 1));
+            let why = if distinct.len() == 1 {
+                "a covariate that does not vary cannot explain a dependence"
+            } else {
+                "add recordings at other levels or choose a lower degree"
+            };
             return Err(ParamError::new(
-                "covariate values",
-                format!("{} distinct value(s)", distinct.len()),
+                "covariate levels",
+                format!("{} distinct value(s) over the recordings", distinct.len()),
                 format!(
-                    "at least {} distinct values for a {d} dependence of {names}: a covariate \
-                     that does not vary cannot explain a dependence",
+                    "the {d} dependence of {names} needs at least {} distinct levels: {why}",
                     d.terms()
                 ),
             )
@@ -529,7 +655,9 @@ impl Gmwm {
             .iter()
             .map(|f| {
                 let u = param.to_u_restart(&f.theta)?;
-                Ok(u.iter().map(|v| v.clamp(-START_CLAMP, START_CLAMP)).collect())
+                Ok(u.iter()
+                    .map(|v| v.clamp(-START_CLAMP, START_CLAMP))
+                    .collect())
             })
             .collect::<Result<_, FitError>>()?;
         let mut regression = Vec::with_capacity(layout.len());
@@ -573,7 +701,9 @@ impl Gmwm {
         };
         let step1 = best(&objectives(recordings)?, &starts)?;
         let at = |c: &[f64], x: f64| -> Result<Model, FitError> {
-            Ok(self.model().with_values(&param.to_theta(&layout.u_at(c, x))?)?)
+            Ok(self
+                .model()
+                .with_values(&param.to_theta(&layout.u_at(c, x))?)?)
         };
         let step2: Result<Vec<FitRecording>, FitError> = recordings
             .iter()
@@ -613,19 +743,22 @@ impl Gmwm {
         for ((r, &x), s) in inputs.iter().zip(covariates).zip(&separate) {
             let model = at(&c, x)?;
             let implied = model.implied_wv(r.levels(), freq_hz)?.wv;
-            let qk = r
-                .wv
-                .wv
-                .iter()
-                .zip(&implied)
-                .zip(&r.weights.omega)
-                .map(|((h, n), w)| w * (h - n) * (h - n))
-                .sum();
+            let qk =
+                r.wv.wv
+                    .iter()
+                    .zip(&implied)
+                    .zip(&r.weights.omega)
+                    .map(|((h, n), w)| w * (h - n) * (h - n))
+                    .sum();
             parts.push(CovariateRecording {
                 covariate: x,
                 n: r.n(),
                 levels: r.levels(),
-                theta: model.values().into_iter().map(|v| v.unwrap_or(f64::NAN)).collect(),
+                theta: model
+                    .values()
+                    .into_iter()
+                    .map(|v| v.unwrap_or(f64::NAN))
+                    .collect(),
                 objective: qk,
                 nu_hat: r.wv.wv.clone(),
                 implied_wv: implied,

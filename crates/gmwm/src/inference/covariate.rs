@@ -58,7 +58,8 @@ pub struct CovariateInference {
     pub no_dependence: Option<DependenceTest>,
     /// The same test per parameter that has a dependence.
     pub per_parameter: Vec<DependenceTest>,
-    #[serde(skip)]
+    /// The sandwich covariance of the coefficients (their order), as rows.
+    #[serde(rename = "covariance", serialize_with = "rows")]
     pub(crate) psi: DMatrix<f64>,
     #[serde(skip)]
     z: f64,
@@ -165,6 +166,15 @@ impl CovariateFit {
     }
 }
 
+fn rows<S: serde::Serializer>(m: &DMatrix<f64>, s: S) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeSeq;
+    let mut seq = s.serialize_seq(Some(m.nrows()))?;
+    for r in m.row_iter() {
+        seq.serialize_element(&r.iter().copied().collect::<Vec<f64>>())?;
+    }
+    seq.end()
+}
+
 /// The Wald statistic of `c[idx] = 0` under the covariance `psi` and its chi-squared p-value;
 /// `None` when the block is singular.
 fn wald(c: &[f64], psi: &DMatrix<f64>, idx: &[usize]) -> Option<(f64, f64)> {
@@ -177,10 +187,13 @@ fn wald(c: &[f64], psi: &DMatrix<f64>, idx: &[usize]) -> Option<(f64, f64)> {
 }
 
 impl CovariateInference {
-    /// The `1 - alpha` covariance of the coefficients (parameter by parameter, ascending
-    /// power), as rows.
+    /// The sandwich covariance of the coefficients (parameter by parameter, ascending power),
+    /// as rows.
     pub fn covariance(&self) -> Vec<Vec<f64>> {
-        self.psi.row_iter().map(|r| r.iter().copied().collect()).collect()
+        self.psi
+            .row_iter()
+            .map(|r| r.iter().copied().collect())
+            .collect()
     }
 
     /// docs/methods.md §5.13: each parameter at covariate value `x` with its pointwise

@@ -103,7 +103,11 @@ fn a_log_affine_sensor_is_recovered_with_its_bands() {
         let band = inf.band(&fit, t).unwrap();
         let s2 = truth_at(t, WN_SLOPE, GM_SLOPE).values()[0].unwrap();
         let wn = &band[0];
-        assert!((wn.estimate / s2 - 1.0).abs() < 0.05, "{t} °C: {} vs {s2}", wn.estimate);
+        assert!(
+            (wn.estimate / s2 - 1.0).abs() < 0.05,
+            "{t} °C: {} vs {s2}",
+            wn.estimate
+        );
         assert!(wn.ci_low.unwrap() < s2 && s2 < wn.ci_high.unwrap());
         // N = sqrt(sigma2 / f) within 2.5% is the same statement on N
         assert!(((wn.estimate / s2).sqrt() - 1.0).abs() < 0.025);
@@ -118,7 +122,10 @@ fn a_constant_covariate_or_a_bad_value_is_one_clear_error() {
     let e = gmwm.fit_covariate(&recs, &same, &AFFINE).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, FitError::Input(_)), "{e:?}");
-    assert!(msg.contains("1 distinct value") && msg.contains("WN[0].sigma2"), "{msg}");
+    assert!(
+        msg.contains("1 distinct value") && msg.contains("WN[0].sigma2"),
+        "{msg}"
+    );
     assert!(msg.contains("does not vary"), "{msg}");
     let e = gmwm
         .fit_covariate(&recs, &[5.0, f64::NAN, 25.0, 35.0], &AFFINE)
@@ -126,19 +133,22 @@ fn a_constant_covariate_or_a_bad_value_is_one_clear_error() {
     assert!(e.to_string().contains("NaN"), "{e}");
     let e = gmwm.fit_covariate(&recs, &TEMPS[..3], &AFFINE).unwrap_err();
     assert!(e.to_string().contains("covariate values"), "{e}");
-    let e = gmwm
-        .fit_covariate(&recs, &TEMPS, &AFFINE[..2])
-        .unwrap_err();
+    let e = gmwm.fit_covariate(&recs, &TEMPS, &AFFINE[..2]).unwrap_err();
     assert!(e.to_string().contains("dependences"), "{e}");
     // a quadratic needs three distinct values
     let e = gmwm
         .fit_covariate(
             &recs,
             &[5.0, 5.0, 35.0, 35.0],
-            &[Dependence::Quadratic, Dependence::Constant, Dependence::Constant],
+            &[
+                Dependence::Quadratic,
+                Dependence::Constant,
+                Dependence::Constant,
+            ],
         )
         .unwrap_err();
     assert!(e.to_string().contains("at least 3 distinct"), "{e}");
+    assert!(e.to_string().contains("lower degree"), "{e}");
     assert_eq!("Affine".parse::<Dependence>().unwrap(), Dependence::Affine);
     assert!("cubic".parse::<Dependence>().is_err());
 }
@@ -181,7 +191,10 @@ fn slopes_cover_and_the_no_dependence_test_holds_its_size() {
     let size = without.iter().filter(|r| r.2 < 0.05).count();
     // size 5%: more than 9 of 60 rejections is p < 0.01 under binomial(60, 0.05)
     assert!(size <= 9, "size: {size}/{R} rejected without a dependence");
-    assert!(power >= 54, "power: {power}/{R} rejected with the dependence");
+    assert!(
+        power >= 54,
+        "power: {power}/{R} rejected with the dependence"
+    );
 }
 
 /// The study of docs/methods.md §5.13 (200 replicates at each of two lengths).
@@ -199,9 +212,8 @@ fn covariate_study() {
                 .collect();
             let k = r.len() as f64;
             let mean = |s: usize| r.iter().map(|x| x.0[s]).sum::<f64>() / k;
-            let rmse = |s: usize, t: f64| {
-                (r.iter().map(|x| (x.0[s] - t).powi(2)).sum::<f64>() / k).sqrt()
-            };
+            let rmse =
+                |s: usize, t: f64| (r.iter().map(|x| (x.0[s] - t).powi(2)).sum::<f64>() / k).sqrt();
             let cov = |s: usize| r.iter().filter(|x| x.1[s]).count() as f64 / k;
             let rej = r.iter().filter(|x| x.2 < 0.05).count() as f64 / k;
             println!(
