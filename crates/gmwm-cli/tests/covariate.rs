@@ -182,7 +182,7 @@ fn covariates_that_cannot_carry_a_dependence_are_one_line() {
     );
     assert_one_line_error(&mut fit(&["--covariate", "pressure"]), &["pressure"]);
     assert_one_line_error(
-        &mut gmwm().args(["fit", "a.csv", "--model", "WN()", "--depends", "all=affine"]),
+        gmwm().args(["fit", "a.csv", "--model", "WN()", "--depends", "all=affine"]),
         &["--depends", "--covariate"],
     );
     // a NaN in the covariate column names the file

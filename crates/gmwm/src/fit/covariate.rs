@@ -285,7 +285,7 @@ impl Layout {
             .iter()
             .zip(&self.offset)
             .enumerate()
-            .filter(|(i, _)| only.is_none_or(|o| o == *i))
+            .filter(|(i, _)| only.map_or(true, |o| o == *i))
             .flat_map(|(_, (d, &o))| (1..d.terms()).map(move |t| o + t))
             .collect()
     }
@@ -517,7 +517,7 @@ impl CovariateFit {
     /// The model with its values at covariate value `x`.
     ///
     /// # Errors
-    /// As [`CovariateFit::theta_at`]; [`FitError::Model`] when the parameters at `x` are not a
+    /// As [`CovariateFit::theta_at`]; [`FitError::Input`] when the parameters at `x` are not a
     /// valid model (a variance overflowing far outside the recordings' range).
     pub fn model_at(&self, x: f64) -> Result<Model, FitError> {
         Ok(self.model.with_values(&self.theta_at(x)?)?)
@@ -672,7 +672,7 @@ impl Gmwm {
                 c
             }));
             constant.push(m);
-            constant.extend(std::iter::repeat_n(0.0, d.degree()));
+            constant.extend(std::iter::repeat(0.0).take(d.degree()));
         }
         let starts = [regression, constant];
 
