@@ -1214,7 +1214,15 @@ pub struct CovariateFitConfig {
     pub dependence: Vec<gmwm::Dependence>,
     /// `--at`: levels at which the parameters are reported (empty: each FILE's).
     pub at: Vec<f64>,
+    /// `--windows K` of one FILE ([`DEFAULT_WINDOWS`] when not given); `None` with several.
+    pub windows: Option<usize>,
 }
+
+/// Windows one drifting recording is cut into without `--windows`: enough levels for an
+/// affine or quadratic dependence with a few to spare, each window 1/8 of the recording.
+pub const DEFAULT_WINDOWS: usize = 8;
+/// Most windows `--windows` cuts one recording into.
+pub const MAX_WINDOWS: usize = 64;
 
 impl TryFrom<&FitArgs> for CovariateFitConfig {
     type Error = anyhow::Error;
@@ -1229,11 +1237,21 @@ impl TryFrom<&FitArgs> for CovariateFitConfig {
         let files: Vec<PathBuf> = std::iter::once(fit.input.file.clone())
             .chain(a.more.iter().cloned())
             .collect();
-        anyhow::ensure!(
-            files.len() >= 2,
-            "a covariate fit needs at least two FILEs at different covariate levels (one FILE \
-             was given)"
-        );
+        let windows = match (files.len(), &a.covariate, a.windows) {
+            (1, Some(_), Some(k)) if k > MAX_WINDOWS => anyhow::bail!(
+                "invalid --windows {k}: at most {MAX_WINDOWS}; each window loses the recording's \
+                 longest scales, and a polynomial of degree 2 needs only a few levels"
+            ),
+            (1, Some(_), k) => Some(k.unwrap_or(DEFAULT_WINDOWS)),
+            (1, None, _) => anyhow::bail!(
+                "a covariate fit of one FILE cuts it into windows at their mean levels of \
+                 --covariate COL; --covariate-values needs a FILE per level"
+            ),
+            (n, _, Some(k)) => anyhow::bail!(
+                "invalid --windows {k}: it cuts one FILE into windows, and {n} FILEs were given"
+            ),
+            _ => None,
+        };
         let covariate = match &a.covariate {
             Some(col) => CovariateSource::Column(col.clone()),
             None => {
@@ -1263,6 +1281,7 @@ impl TryFrom<&FitArgs> for CovariateFitConfig {
             covariate,
             dependence,
             at: a.at.clone(),
+            windows,
         })
     }
 }

@@ -197,3 +197,89 @@ fn covariates_that_cannot_carry_a_dependence_are_one_line() {
         .args(["--model", "WN()+GM()", "--covariate", "temperature"]);
     assert_one_line_error(&mut cmd, &["t1.csv"]);
 }
+
+#[test]
+fn one_recording_on_a_ramp_is_cut_into_windows() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 1 << 16;
+    let raw = simulate(dir.path(), "unit.csv", "WN(sigma2=1)", n, 100.0, 9);
+    let text = std::fs::read_to_string(&raw).unwrap();
+    let mut out = String::from("time,gyro_x,temperature\n");
+    for (i, line) in text.lines().skip(1).enumerate() {
+        let t = 40.0 * i as f64 / n as f64;
+        let z: f64 = line.parse().unwrap();
+        let x = z * truth_at(t).0.sqrt();
+        out.push_str(&format!("{:.2},{x:.9e},{t:.4}\n", i as f64 / 100.0));
+    }
+    let ramp = dir.path().join("ramp.csv");
+    std::fs::write(&ramp, out).unwrap();
+    let doc = run_json(gmwm().arg("fit").arg(&ramp).args([
+        "--covariate",
+        "temperature",
+        "--windows",
+        "8",
+        "--model",
+        "WN()",
+        "--json",
+    ]));
+    let recs = doc["recordings"].as_array().unwrap();
+    assert_eq!(recs.len(), 8);
+    assert!(recs[2]["path"]
+        .as_str()
+        .unwrap()
+        .ends_with("ramp.csv [window 3/8]"));
+    assert_eq!(recs[2]["n"], n / 8);
+    assert!((recs[2]["covariate"].as_f64().unwrap() - 12.5).abs() < 1e-3);
+    // a ramp's bands at its ends and its centre
+    let bands = doc["fits"][0]["bands"].as_array().unwrap();
+    assert_eq!(bands.len(), 3);
+    let slope = &doc["fits"][0]["inference"]["coefficients"][1];
+    let (est, se) = (
+        slope["estimate"].as_f64().unwrap(),
+        slope["se"].as_f64().unwrap(),
+    );
+    assert!((est - 0.03).abs() < 4.0 * se, "{slope}");
+    // --windows cuts one FILE; --covariate-values needs a FILE per level
+    let mut cmd = gmwm();
+    cmd.arg("fit").arg(&ramp).arg(&ramp);
+    cmd.args([
+        "--covariate",
+        "temperature",
+        "--windows",
+        "4",
+        "--model",
+        "WN()",
+    ]);
+    assert_one_line_error(&mut cmd, &["--windows 4", "2 FILEs"]);
+    let mut cmd = gmwm();
+    cmd.arg("fit").arg(&ramp);
+    cmd.args(["--covariate-values", "5", "--model", "WN()"]);
+    assert_one_line_error(&mut cmd, &["one FILE", "--covariate COL"]);
+    let mut cmd = gmwm();
+    cmd.arg("fit").arg(&ramp);
+    cmd.args([
+        "--covariate",
+        "temperature",
+        "--windows",
+        "400",
+        "--model",
+        "WN()",
+    ]);
+    assert_one_line_error(&mut cmd, &["--windows 400", "at most 64"]);
+    // 64 windows of 1024 samples: each still fits
+    let mut cmd = gmwm();
+    cmd.arg("fit").arg(&ramp);
+    cmd.args([
+        "--covariate",
+        "temperature",
+        "--windows",
+        "64",
+        "--model",
+        "WN()",
+        "--json",
+    ]);
+    assert_eq!(
+        run_json(&mut cmd)["recordings"].as_array().unwrap().len(),
+        64
+    );
+}

@@ -104,9 +104,9 @@ pub use sim::{simulate_model, DemoSensor, Simulator};
 pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
 pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{
-    covariate_level, dependences, Convergence, CovariateFit, CovariateRecording, Dependence,
-    FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter, ParameterEstimate,
-    PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
+    covariate_level, covariate_windows, dependences, Convergence, CovariateFit, CovariateRecording,
+    Dependence, FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter,
+    ParameterEstimate, PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
 };
 pub use inference::same_model::{
     compare_wvs, same_model_test_of, SameModelOptions, SameModelTest, ScaleContribution,

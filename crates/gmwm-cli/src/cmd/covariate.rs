@@ -3,7 +3,7 @@
 //! (`Gmwm::fit_covariate`, `CovariateFit::inference`, `CovariateInference::band`,
 //! `gmwm::covariate_level`); this module reads the files and their levels and renders.
 
-use super::same_model::{named, read_pool, write_recordings};
+use super::same_model::{named, read_pool, write_recordings, RecordingInfo};
 use super::Command;
 use crate::config::{CovariateFitConfig, CovariateSource};
 use crate::input::load;
@@ -11,10 +11,13 @@ use crate::prepare::Inputs;
 use crate::render::Style;
 use crate::style::OutputStyle;
 use anyhow::Result;
-use gmwm::{covariate_level, ColumnSelector, CovariateFit, CovariateInference, ParameterInference};
+use gmwm::{
+    covariate_level, ColumnSelector, CovariateFit, CovariateInference, FitRecording,
+    ParameterInference,
+};
 use serde::Serialize;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 impl Command for CovariateFitConfig {
     fn inputs(&mut self) -> Inputs<'_> {
@@ -51,28 +54,48 @@ struct ColumnFit<'a> {
     bands: Vec<Band>,
 }
 
-/// Each FILE's covariate level: given, or the mean of its column COL.
-fn levels(config: &CovariateFitConfig, style: OutputStyle) -> Result<Vec<f64>> {
-    match &config.covariate {
-        CovariateSource::Values(v) => Ok(v.clone()),
+/// The values of column `col` of `file`, read without notes (the recording's notes come
+/// once, from the read of its sensor columns).
+fn covariate_column(
+    config: &CovariateFitConfig,
+    file: &Path,
+    col: &str,
+    style: OutputStyle,
+) -> Result<Vec<f64>> {
+    let mut input = config.fit.input.with_file(file);
+    input.read.columns = vec![col
+        .parse::<ColumnSelector>()
+        .map_err(|e| anyhow::anyhow!("invalid --covariate {col}: {}", e.expected))?];
+    let quiet = OutputStyle {
+        notes: false,
+        progress: false,
+        ..style
+    };
+    // the reader's errors name the file, the line and the column
+    let mut loaded = load(&input, quiet)?;
+    Ok(std::mem::take(&mut loaded.table.columns[0].values))
+}
+
+/// What a covariate fit runs on: the recordings (or windows) as reported, their names in
+/// errors, their covariate levels and, per column, their WVs.
+struct FitInputs {
+    info: Vec<RecordingInfo>,
+    names: Vec<PathBuf>,
+    covariates: Vec<f64>,
+    columns: Vec<(String, Vec<FitRecording>)>,
+}
+
+/// Several FILEs, each at its level: given, or the mean of its column COL.
+fn files_at_levels(config: &CovariateFitConfig, style: OutputStyle) -> Result<FitInputs> {
+    let fit_config = &config.fit;
+    let covariates = match &config.covariate {
+        CovariateSource::Values(v) => v.clone(),
         CovariateSource::Column(col) => config
             .files
             .iter()
             .map(|f| {
-                let mut input = config.fit.input.with_file(f);
-                input.read.columns = vec![col
-                    .parse::<ColumnSelector>()
-                    .map_err(|e| anyhow::anyhow!("invalid --covariate {col}: {}", e.expected))?];
-                // the recording's notes come once, from the read of its sensor columns
-                let quiet = OutputStyle {
-                    notes: false,
-                    progress: false,
-                    ..style
-                };
-                // the reader's errors name the file, the line and the column
-                let loaded = load(&input, quiet)?;
-                let values = &loaded.table.columns[0].values;
-                covariate_level(values).map_err(|e| {
+                let values = covariate_column(config, f, col, style)?;
+                covariate_level(&values).map_err(|e| {
                     anyhow::anyhow!(
                         "{}: covariate column {col}: {} is not a usable level ({})",
                         f.display(),
@@ -81,43 +104,113 @@ fn levels(config: &CovariateFitConfig, style: OutputStyle) -> Result<Vec<f64>> {
                     )
                 })
             })
-            .collect(),
-    }
-}
-
-fn run(config: &CovariateFitConfig, style: OutputStyle, out: &mut impl Write) -> Result<()> {
-    let fit_config = &config.fit;
-    let covariates = levels(config, style)?;
-    let mut pool = read_pool(
+            .collect::<Result<_>>()?,
+    };
+    let pool = read_pool(
         &config.files,
         &fit_config.input,
         &fit_config.wv,
         fit_config.gmwm.weighting(),
         style,
     )?;
+    Ok(FitInputs {
+        info: pool.info,
+        names: pool.files,
+        covariates,
+        columns: pool.columns,
+    })
+}
+
+/// One FILE whose covariate drifts, cut into `windows` windows at their mean levels.
+fn windows_of_one(
+    config: &CovariateFitConfig,
+    col: &str,
+    windows: usize,
+    style: OutputStyle,
+) -> Result<FitInputs> {
+    let fit_config = &config.fit;
+    let file = &config.files[0];
+    let covariate = covariate_column(config, file, col, style)?;
+    let loaded = load(&fit_config.input, style)?;
+    let mut columns = Vec::new();
+    let mut levels = Vec::new();
+    for c in &loaded.table.columns {
+        if c.name == col {
+            continue;
+        }
+        let (recs, l) = gmwm::covariate_windows(
+            &c.values,
+            &covariate,
+            loaded.freq_hz,
+            windows,
+            &fit_config.wv,
+            fit_config.gmwm.weighting(),
+        )
+        .map_err(|e| anyhow::anyhow!("{}: column {}: {e}", file.display(), c.name))?;
+        levels = l;
+        columns.push((c.name.clone(), recs));
+    }
+    let Some((_, first)) = columns.first() else {
+        anyhow::bail!(
+            "--covariate {col} is the only column selected: name the sensor columns with --columns"
+        );
+    };
+    let names: Vec<PathBuf> = (1..=windows)
+        .map(|k| PathBuf::from(format!("{} [window {k}/{windows}]", file.display())))
+        .collect();
+    let info = names
+        .iter()
+        .zip(first)
+        .map(|(name, r)| RecordingInfo {
+            path: name.display().to_string(),
+            freq_hz: loaded.freq_hz,
+            n: r.n(),
+            levels: r.levels(),
+        })
+        .collect();
+    Ok(FitInputs {
+        info,
+        names,
+        covariates: levels,
+        columns,
+    })
+}
+
+fn run(config: &CovariateFitConfig, style: OutputStyle, out: &mut impl Write) -> Result<()> {
+    let fit_config = &config.fit;
+    let mut inputs = match (&config.covariate, config.windows) {
+        (CovariateSource::Column(col), Some(k)) => windows_of_one(config, col, k, style)?,
+        _ => files_at_levels(config, style)?,
+    };
     // the covariate column is the regressor, not a series to fit
     if let CovariateSource::Column(col) = &config.covariate {
-        pool.columns.retain(|(name, _)| name != col);
+        inputs.columns.retain(|(name, _)| name != col);
         anyhow::ensure!(
-            !pool.columns.is_empty(),
+            !inputs.columns.is_empty(),
             "--covariate {col} is the only column selected: name the sensor columns with --columns"
         );
     }
+    let covariates = &inputs.covariates;
     let alpha = fit_config
         .inference
         .as_ref()
         .map_or(gmwm::InferenceOptions::default().alpha, |o| o.alpha);
-    let at = if config.at.is_empty() {
-        covariates.clone()
-    } else {
+    let at = if !config.at.is_empty() {
         config.at.clone()
+    } else if config.windows.is_some() {
+        // a ramp's windows are many: its ends and its centre
+        let lo = covariates.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = covariates.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        vec![lo, 0.5 * (lo + hi), hi]
+    } else {
+        covariates.to_vec()
     };
-    let mut fits = Vec::with_capacity(pool.columns.len());
-    for (column, recs) in &pool.columns {
+    let mut fits = Vec::with_capacity(inputs.columns.len());
+    for (column, recs) in &inputs.columns {
         let fit = fit_config
             .gmwm
-            .fit_covariate(recs, &covariates, &config.dependence)
-            .map_err(|e| named(e, &pool.files, column))?;
+            .fit_covariate(recs, covariates, &config.dependence)
+            .map_err(|e| named(e, &inputs.names, column))?;
         if !fit.convergence().converged {
             eprintln!(
                 "gmwm: warning: column {column}: the covariate fit did not converge ({})",
@@ -126,7 +219,7 @@ fn run(config: &CovariateFitConfig, style: OutputStyle, out: &mut impl Write) ->
         }
         let inference = fit
             .inference(alpha, config.seed)
-            .map_err(|e| named(e, &pool.files, column))?;
+            .map_err(|e| named(e, &inputs.names, column))?;
         let bands = at
             .iter()
             .map(|&x| {
@@ -136,7 +229,7 @@ fn run(config: &CovariateFitConfig, style: OutputStyle, out: &mut impl Write) ->
                 })
             })
             .collect::<Result<Vec<_>, gmwm::FitError>>()
-            .map_err(|e| named(e, &pool.files, column))?;
+            .map_err(|e| named(e, &inputs.names, column))?;
         fits.push(ColumnFit {
             column,
             fit,
@@ -152,7 +245,7 @@ fn run(config: &CovariateFitConfig, style: OutputStyle, out: &mut impl Write) ->
         #[derive(Serialize)]
         struct Recording<'a> {
             #[serde(flatten)]
-            info: &'a super::same_model::RecordingInfo,
+            info: &'a RecordingInfo,
             covariate: f64,
         }
         #[derive(Serialize)]
@@ -161,10 +254,10 @@ fn run(config: &CovariateFitConfig, style: OutputStyle, out: &mut impl Write) ->
             recordings: Vec<Recording<'a>>,
             fits: &'a [ColumnFit<'a>],
         }
-        let recordings = pool
+        let recordings = inputs
             .info
             .iter()
-            .zip(&covariates)
+            .zip(covariates)
             .map(|(info, &covariate)| Recording { info, covariate })
             .collect();
         serde_json::to_writer_pretty(
@@ -178,7 +271,7 @@ fn run(config: &CovariateFitConfig, style: OutputStyle, out: &mut impl Write) ->
         writeln!(out)?;
         return Ok(());
     }
-    write_recordings(&pool.info, out)?;
+    write_recordings(&inputs.info, out)?;
     writeln!(
         out,
         "{what} levels: {}",

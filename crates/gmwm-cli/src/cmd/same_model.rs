@@ -52,10 +52,10 @@ pooled_command!(SameModelConfig, run);
 /// One input of a pooled computation, as reported (`recordings[]`).
 #[derive(Debug, Clone, Serialize)]
 pub(super) struct RecordingInfo {
-    path: String,
-    freq_hz: f64,
-    n: usize,
-    levels: usize,
+    pub(super) path: String,
+    pub(super) freq_hz: f64,
+    pub(super) n: usize,
+    pub(super) levels: usize,
 }
 
 /// The files read and, per column, the recordings (input order).

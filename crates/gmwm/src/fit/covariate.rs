@@ -231,6 +231,62 @@ pub fn covariate_level(values: &[f64]) -> Result<f64, ParamError> {
     Ok(sum / values.len() as f64)
 }
 
+/// docs/methods.md §5.13: one recording whose covariate drifts (a temperature ramp), cut into
+/// `windows` contiguous windows of equal length (the last `N mod windows` samples left out):
+/// each window's WV and weights, as [`FitRecording::from_series`], and its covariate level,
+/// the mean of `covariate` over the window. The windows' WVs are treated as independent: the
+/// Haar filter's differences see a random walk's increments, which are, and short-memory
+/// processes decorrelate within a few of their correlation times, short beside a window.
+///
+/// # Errors
+/// [`FitError::Length`] when `covariate` and `x` differ in length; [`FitError::Input`] for
+/// fewer than 2 windows, a window of fewer than 2 samples, or a non-finite covariate sample;
+/// as [`FitRecording::from_series`].
+pub fn covariate_windows(
+    x: &[f64],
+    covariate: &[f64],
+    freq_hz: f64,
+    windows: usize,
+    wv_opts: &crate::variance::wv::WvOptions,
+    weighting: super::Weighting,
+) -> Result<(Vec<FitRecording>, Vec<f64>), FitError> {
+    if covariate.len() != x.len() {
+        return Err(FitError::Length {
+            what: "covariate samples",
+            expected: x.len(),
+            found: covariate.len(),
+        });
+    }
+    if windows < 2 {
+        return Err(ParamError::new("windows", windows, "at least 2").into());
+    }
+    let len = x.len() / windows;
+    if len < 2 {
+        return Err(ParamError::new(
+            "windows",
+            windows,
+            format!("at most {} for {} samples", x.len() / 2, x.len()),
+        )
+        .into());
+    }
+    let mut recs = Vec::with_capacity(windows);
+    let mut levels = Vec::with_capacity(windows);
+    for k in 0..windows {
+        let range = k * len..(k + 1) * len;
+        levels.push(covariate_level(&covariate[range.clone()]).map_err(|e| {
+            ParamError::new(
+                "covariate",
+                e.value,
+                format!("{} (window {})", e.expected, k + 1),
+            )
+        })?);
+        recs.push(FitRecording::from_series(
+            &x[range], freq_hz, wv_opts, weighting,
+        )?);
+    }
+    Ok((recs, levels))
+}
+
 /// The coefficients' layout: parameter `i` holds `terms[i]` coefficients from `offset[i]`.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Layout {

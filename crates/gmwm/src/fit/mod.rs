@@ -29,7 +29,9 @@ mod tests_groundwork;
 
 pub(crate) use canonical::Reading;
 pub(crate) use canonical::{CanonicalModel, CanonicalTerm, SEPARATION_LIMIT};
-pub use covariate::{covariate_level, dependences, CovariateFit, CovariateRecording, Dependence};
+pub use covariate::{
+    covariate_level, covariate_windows, dependences, CovariateFit, CovariateRecording, Dependence,
+};
 pub use estimates::FitEstimates;
 pub use gmwm::{Gmwm, GmwmFit};
 pub(crate) use objective::Objective;

@@ -153,6 +153,96 @@ fn a_constant_covariate_or_a_bad_value_is_one_clear_error() {
     assert!("cubic".parse::<Dependence>().is_err());
 }
 
+/// One recording whose temperature ramps from 0 to 40 °C, the sensor following it sample by
+/// sample: white noise `sigma(T_t) z_t`, a GM whose innovation variance is
+/// `sigma2_gm(T_t) (1 - phi^2)`.
+fn ramp(n: usize, seed: u64) -> (Vec<f64>, Vec<f64>) {
+    use rand::SeedableRng;
+    use rand_distr::Distribution;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let phi = (-BETA / FREQ).exp();
+    let temps: Vec<f64> = (0..n).map(|i| 40.0 * i as f64 / n as f64).collect();
+    let z0: f64 = rand_distr::StandardNormal.sample(&mut rng);
+    let mut gm = 1e-5f64.sqrt() * z0;
+    let x = temps
+        .iter()
+        .map(|&t| {
+            let (s2, g2) = {
+                let m = truth_at(t, WN_SLOPE, GM_SLOPE).values();
+                (m[0].unwrap(), m[2].unwrap())
+            };
+            let z: f64 = rand_distr::StandardNormal.sample(&mut rng);
+            let e: f64 = rand_distr::StandardNormal.sample(&mut rng);
+            gm = phi * gm + (g2 * (1.0 - phi * phi)).sqrt() * e;
+            s2.sqrt() * z + gm
+        })
+        .collect();
+    (x, temps)
+}
+
+#[test]
+fn one_recording_on_a_temperature_ramp_cut_into_windows() {
+    let (x, temps) = ramp(1 << 19, 17);
+    let (recs, levels) =
+        gmwm::fit::covariate_windows(&x, &temps, FREQ, 8, &WvOptions::default(), Weighting::Fast)
+            .unwrap();
+    assert_eq!(recs.len(), 8);
+    // window k covers 5k to 5(k + 1) °C
+    for (k, l) in levels.iter().enumerate() {
+        assert!((l - (5.0 * k as f64 + 2.5)).abs() < 1e-3, "window {k}: {l}");
+        assert_eq!(recs[k].n(), 1 << 16);
+    }
+    let fit = estimator().fit_covariate(&recs, &levels, &AFFINE).unwrap();
+    let inf = fit.inference(0.05, 1).unwrap();
+    for (c, t) in [
+        (&inf.coefficients[1], WN_SLOPE),
+        (&inf.coefficients[4], GM_SLOPE),
+    ] {
+        assert!(
+            (c.estimate - t).abs() < 4.5 * c.se,
+            "{}: {} vs {t} (se {})",
+            c.parameter,
+            c.estimate,
+            c.se
+        );
+    }
+    for t in [5.0, 35.0] {
+        let wn = &inf.band(&fit, t).unwrap()[0];
+        let s2 = truth_at(t, WN_SLOPE, GM_SLOPE).values()[0].unwrap();
+        assert!(
+            (wn.estimate / s2 - 1.0).abs() < 0.05,
+            "{t} °C: {} vs {s2}",
+            wn.estimate
+        );
+    }
+    // bad windows: one line each
+    let e = gmwm::fit::covariate_windows(
+        &x,
+        &temps[1..],
+        FREQ,
+        8,
+        &WvOptions::default(),
+        Weighting::Fast,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("covariate samples"), "{e}");
+    let e = gmwm::fit::covariate_windows(
+        &x[..10],
+        &temps[..10],
+        FREQ,
+        6,
+        &WvOptions::default(),
+        Weighting::Fast,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("at most 5 for 10 samples"), "{e}");
+    let mut bad = temps.clone();
+    bad[1 << 17] = f64::NAN;
+    let e = gmwm::fit::covariate_windows(&x, &bad, FREQ, 8, &WvOptions::default(), Weighting::Fast)
+        .unwrap_err();
+    assert!(e.to_string().contains("window 3"), "{e}");
+}
+
 /// One replicate: (slope estimates, their 95% interval covers the truth, no-dependence p).
 fn replicate(n: usize, slopes: (f64, f64), seed: u64) -> ([f64; 2], [bool; 2], f64) {
     let recs = recordings(n, &TEMPS, slopes, seed);
