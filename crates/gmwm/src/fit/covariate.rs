@@ -47,15 +47,11 @@
 
 use super::objective::Eval;
 use super::optimize::{Edge, LeastSquares};
-use super::pooled::{check_recordings, POOLED_V_REPLICATES};
+use super::pooled::{check_recordings, model_variance_weights, recording_objective};
 use super::{
     minimize, Convergence, FitError, FitRecording, Gmwm, Objective, Parametrisation, PhiOrder,
-    Weights,
 };
 use crate::model::Model;
-use crate::progress::NoProgress;
-use crate::sim::covariance::{wv_covariance, CovarianceMethod};
-use crate::sim::replicate_seed;
 use crate::ParamError;
 
 use rayon::prelude::*;
@@ -766,21 +762,13 @@ impl Gmwm {
             .zip(covariates)
             .enumerate()
             .map(|(k, (r, &x))| {
-                let v = wv_covariance(
+                model_variance_weights(
+                    r,
                     &at(&step1.theta, x)?,
-                    r.n(),
                     freq_hz,
-                    &r.wv.options(),
-                    CovarianceMethod::Auto,
-                    POOLED_V_REPLICATES,
-                    replicate_seed(self.start_options.seed, k as u64),
-                    &NoProgress,
-                )?;
-                let diag = (0..r.levels()).map(|l| v.v[(l, l)]).collect();
-                Ok(FitRecording {
-                    weights: Weights::from_v(diag, "model variance of the WV")?,
-                    ..r.clone()
-                })
+                    k,
+                    self.start_options.seed,
+                )
             })
             .collect();
         let (inputs, minimum, reweighted) = match step2 {
@@ -799,13 +787,7 @@ impl Gmwm {
         for ((r, &x), s) in inputs.iter().zip(covariates).zip(&separate) {
             let model = at(&c, x)?;
             let implied = model.implied_wv(r.levels(), freq_hz)?.wv;
-            let qk =
-                r.wv.wv
-                    .iter()
-                    .zip(&implied)
-                    .zip(&r.weights.omega)
-                    .map(|((h, n), w)| w * (h - n) * (h - n))
-                    .sum();
+            let qk = recording_objective(r, &implied);
             parts.push(CovariateRecording {
                 covariate: x,
                 n: r.n(),

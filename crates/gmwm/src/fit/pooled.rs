@@ -180,6 +180,44 @@ pub(crate) fn check_recordings(
     Ok(())
 }
 
+/// Step 2 of the two-step weights (module doc): recording `r` (the `k`-th) weighted by the
+/// diagonal of `model`'s covariance (at the fit's rate `freq_hz`) of its WV at its length (exact, or a bootstrap of
+/// [`POOLED_V_REPLICATES`] seeded from `seed` and `k`).
+pub(crate) fn model_variance_weights(
+    r: &FitRecording,
+    model: &Model,
+    freq_hz: f64,
+    k: usize,
+    seed: u64,
+) -> Result<FitRecording, FitError> {
+    let v = wv_covariance(
+        model,
+        r.n(),
+        freq_hz,
+        &r.wv.options(),
+        CovarianceMethod::Auto,
+        POOLED_V_REPLICATES,
+        replicate_seed(seed, k as u64),
+        &NoProgress,
+    )?;
+    let diag = (0..r.levels()).map(|l| v.v[(l, l)]).collect();
+    Ok(FitRecording {
+        weights: Weights::from_v(diag, "model variance of the WV")?,
+        ..r.clone()
+    })
+}
+
+/// `Q_k = sum_j omega_kj (nu2_hat_kj - nu_j)^2`, recording `r`'s own objective at the implied
+/// WV `nu` (its levels).
+pub(crate) fn recording_objective(r: &FitRecording, nu: &[f64]) -> f64 {
+    r.wv.wv
+        .iter()
+        .zip(nu)
+        .zip(&r.weights.omega)
+        .map(|((h, n), w)| w * (h - n) * (h - n))
+        .sum()
+}
+
 /// The stacked objective of `model` over `recordings` with each one's diagonal weights, or
 /// with the full weights `full[k]` when given.
 pub(crate) fn pooled_objective(
@@ -364,23 +402,7 @@ impl Gmwm {
         let step2: Result<Vec<FitRecording>, FitError> = recordings
             .iter()
             .enumerate()
-            .map(|(k, r)| {
-                let v = wv_covariance(
-                    &model1,
-                    r.n(),
-                    freq_hz,
-                    &r.wv.options(),
-                    CovarianceMethod::Auto,
-                    POOLED_V_REPLICATES,
-                    replicate_seed(self.start_options.seed, k as u64),
-                    &NoProgress,
-                )?;
-                let diag = (0..r.levels()).map(|l| v.v[(l, l)]).collect();
-                Ok(FitRecording {
-                    weights: Weights::from_v(diag, "model variance of the WV")?,
-                    ..r.clone()
-                })
-            })
+            .map(|(k, r)| model_variance_weights(r, &model1, freq_hz, k, self.start_options.seed))
             .collect();
         // a step-1 model whose WV variance is not usable (a component at the edge of its
         // domain, e.g. a collapsed AR1) keeps the step-1 weights: `reweighted` says which
@@ -412,13 +434,7 @@ impl Gmwm {
                 let s = separate.map(|s| &s[k]);
                 let j = r.levels();
                 let nu = implied.wv[..j].to_vec();
-                let qk =
-                    r.wv.wv
-                        .iter()
-                        .zip(&nu)
-                        .zip(&r.weights.omega)
-                        .map(|((h, n), w)| w * (h - n) * (h - n))
-                        .sum();
+                let qk = recording_objective(r, &nu);
                 PooledRecording {
                     n: r.n(),
                     levels: j,
