@@ -138,7 +138,8 @@ pub use imu::read::{
 pub use imu::read::{binary_warnings, TimePolicy};
 pub use imu::recording::{left_out_note, table_notes};
 pub use imu::ros::{
-    choose_topic, list_topics, read_imu_messages, ImuMessages, RosContainer, TopicInfo,
+    choose_topic, list_topics, read_imu_messages, read_ros_covariate, ImuMessages, RosContainer,
+    RosCovariate, TopicInfo,
 };
 pub use imu::ros::{MessageError, RosError};
 pub use imu::sidecar::sidecar_candidates;

@@ -94,7 +94,7 @@ pub enum Command {
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
         allow_negative_numbers = true,
-        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three\n  gmwm fit t5.csv t15.csv t25.csv t35.csv --covariate-values 5,15,25,35 --model \"GM()+WN()\"   parameters as functions of temperature\n  gmwm fit a.csv b.csv c.csv --covariate temperature --model \"GM()+WN()\" --depends variances=quadratic --at 0,40 --json\n  gmwm fit ramp.csv --covariate temperature --windows 12 --model \"GM()+WN()+RW()\"   one recording whose temperature drifts"
+        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three\n  gmwm fit t5.csv t15.csv t25.csv t35.csv --covariate-values 5,15,25,35 --model \"GM()+WN()\"   parameters as functions of temperature\n  gmwm fit a.csv b.csv c.csv --covariate temperature --model \"GM()+WN()\" --depends variances=quadratic --at 0,40 --json\n  gmwm fit ramp.csv --covariate temperature --windows 12 --model \"GM()+WN()+RW()\"   one recording whose temperature drifts\n  gmwm fit run.mcap --covariate temperature --windows 8 --model \"WN()+RW()\"   a ROS bag with a sensor_msgs/Temperature topic"
     )]
     Fit(FitArgs),
     /// Select a model by the Wavelet Information Criterion on each selected column (docs/methods.md
@@ -633,6 +633,10 @@ pub struct SelectArgs {
     pub more: Vec<PathBuf>,
     /// Fit the parameters as functions of a covariate over all FILEs (docs/methods.md §5.13):
     /// each FILE's level is the mean of its column COL (e.g. temperature); COL is not fitted.
+    /// Of a ROS recording, COL is a topic (sensor_msgs/Temperature or FluidPressure,
+    /// std_msgs/Float64 or Float32; `temperature` finds the only Temperature topic)
+    /// interpolated to the IMU messages in log time, or angular_rate / specific_force (the
+    /// magnitudes of the IMU messages' angular_velocity / linear_acceleration).
     #[arg(long, value_name = "COL", conflicts_with_all = ["pool", "covariate_values"])]
     pub covariate: Option<String>,
     /// The covariate's level of each FILE, in order (e.g. 5,15,25,35 for recordings at those
@@ -715,6 +719,10 @@ pub struct FitArgs {
     pub more: Vec<PathBuf>,
     /// Fit the parameters as functions of a covariate over all FILEs (docs/methods.md §5.13):
     /// each FILE's level is the mean of its column COL (e.g. temperature); COL is not fitted.
+    /// Of a ROS recording, COL is a topic (sensor_msgs/Temperature or FluidPressure,
+    /// std_msgs/Float64 or Float32; `temperature` finds the only Temperature topic)
+    /// interpolated to the IMU messages in log time, or angular_rate / specific_force (the
+    /// magnitudes of the IMU messages' angular_velocity / linear_acceleration).
     #[arg(long, value_name = "COL", conflicts_with_all = ["pool", "covariate_values"])]
     pub covariate: Option<String>,
     /// The covariate's level of each FILE, in order (e.g. 5,15,25,35 for recordings at those

@@ -55,7 +55,9 @@ struct ColumnFit<'a> {
 }
 
 /// The values of column `col` of `file`, read without notes (the recording's notes come
-/// once, from the read of its sensor columns).
+/// once, from the read of its sensor columns); of a ROS recording, the covariate `col` one
+/// value per IMU message (a scalar topic or a magnitude, `gmwm::read_ros_covariate`), with
+/// its notes.
 fn covariate_column(
     config: &CovariateFitConfig,
     file: &Path,
@@ -63,6 +65,14 @@ fn covariate_column(
     style: OutputStyle,
 ) -> Result<Vec<f64>> {
     let mut input = config.fit.input.with_file(file);
+    if input.probe().is_ros() {
+        // a scalar topic interpolated to the IMU messages, or a magnitude of their fields
+        let covariate = gmwm::read_ros_covariate(file, input.topic.as_deref(), col)?;
+        for n in &covariate.notes {
+            style.note(file, n);
+        }
+        return Ok(covariate.values);
+    }
     input.read.columns = vec![col
         .parse::<ColumnSelector>()
         .map_err(|e| anyhow::anyhow!("invalid --covariate {col}: {}", e.expected))?];

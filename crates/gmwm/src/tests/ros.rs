@@ -898,3 +898,69 @@ fn ros_streamed_log_times_out_of_order() {
         }
     }
 }
+
+/// A temperature topic at 1 Hz carrying a linear ramp from 5 to 35 °C over the IMU topic's
+/// 20 s: read as a covariate, every IMU sample gets the ramp's value at its time (linear
+/// interpolation of a linear function is exact), in every container; a topic shifted away in
+/// time is one clear line.
+#[test]
+fn ros_temperature_topic_is_aligned_to_the_imu_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 4001; // 20 s at 200 Hz: the last temperature message is at the last IMU sample
+    let ramp = [
+        "--temperature-topic",
+        "/imu/temperature",
+        "--temperature-ramp",
+        "5:35",
+        "--log-delay-ns",
+        "1000",
+    ];
+    for (name, container) in [("t.bag", "ros1"), ("t_mcap", "mcap"), ("t_db3", "sqlite3")] {
+        let fx = make(dir.path(), name, container, n, 11, &ramp);
+        for asked in ["temperature", "/imu/temperature", "imu/temperature"] {
+            let c = gmwm::read_ros_covariate(&fx.path, None, asked).unwrap();
+            assert_eq!(c.topic.as_deref(), Some("/imu/temperature"));
+            assert_eq!(c.unit, Some("degC"));
+            assert_eq!(c.values.len(), n);
+            for (k, v) in c.values.iter().enumerate() {
+                let truth = 5.0 + 30.0 * k as f64 / (n - 1) as f64;
+                // the stamps are whole ns of k / 200 s: the ramp's value to 1e-9 °C
+                assert!(
+                    (v - truth).abs() < 1e-9,
+                    "{container} sample {k}: {v} vs {truth}"
+                );
+            }
+            assert!(
+                c.notes[0].contains("21 messages over 20.00 s"),
+                "{:?}",
+                c.notes
+            );
+        }
+        // the magnitude of the IMU messages' own fields
+        let f = gmwm::read_ros_covariate(&fx.path, None, "specific_force").unwrap();
+        let rows = &fx.values["/imu0"];
+        for (k, r) in rows.iter().enumerate() {
+            let norm = (r.v[3].powi(2) + r.v[4].powi(2) + r.v[5].powi(2)).sqrt();
+            assert!((f.values[k] - norm).abs() <= 1e-15 * norm, "{k}");
+        }
+    }
+    // no overlap in time: one line naming both topics and how far apart they are
+    let fx = make(
+        dir.path(),
+        "late.bag",
+        "ros1",
+        400,
+        12,
+        &["--temperature-topic", "/t", "--temperature-offset-s", "100"],
+    );
+    let e = gmwm::read_ros_covariate(&fx.path, None, "temperature")
+        .unwrap_err()
+        .to_string();
+    assert!(!e.contains('\n'), "{e}");
+    assert!(
+        e.contains("covariate topic /t (2 messages")
+            && e.contains("does not overlap the IMU topic /imu0")
+            && e.contains("it begins 98.005000000 s after the IMU topic ends"),
+        "{e}"
+    );
+}

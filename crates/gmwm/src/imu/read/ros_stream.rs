@@ -153,7 +153,13 @@ impl Reorder {
 }
 
 impl MessageSink for Reorder {
-    fn message(&mut self, header_ns: i64, log_ns: i64, values: [f64; 6]) -> Result<(), ReadError> {
+    fn message(&mut self, header_ns: i64, log_ns: i64, values: &[f64]) -> Result<(), ReadError> {
+        // an IMU message: six values (the collector of IMU topics hands over no other)
+        let mut six = [0.0; 6];
+        for (d, v) in six.iter_mut().zip(values) {
+            *d = *v;
+        }
+        let values = six;
         if self.disordered {
             // still decoded and checked: the errors are those of the in-memory read
             return Ok(());
@@ -274,7 +280,7 @@ mod tests {
     fn released(input: &[(i64, u64)], capacity: usize) -> (Vec<(i64, f64)>, bool) {
         let mut r = Reorder::new(capacity, Released::new((0..6).collect()).unwrap());
         for &(log, tag) in input {
-            r.message(0, log, [tag as f64, 0.0, 0.0, 0.0, 0.0, 0.0])
+            r.message(0, log, &[tag as f64, 0.0, 0.0, 0.0, 0.0, 0.0])
                 .unwrap();
         }
         let disordered = r.disordered;

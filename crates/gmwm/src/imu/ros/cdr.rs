@@ -161,6 +161,172 @@ pub(crate) fn decode_cdr(msg: &[u8]) -> Result<ImuFields<'_>, MessageError> {
     })
 }
 
+/// A scalar message type read as a covariate: a measurement with a header (its stamp kept),
+/// or a bare `std_msgs` number (no stamp: the log time stands for it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ScalarType {
+    /// `sensor_msgs/Temperature`: header, float64 temperature (°C), float64 variance.
+    Temperature,
+    /// `sensor_msgs/FluidPressure`: header, float64 fluid_pressure (Pa), float64 variance.
+    FluidPressure,
+    /// `std_msgs/Float64`: float64 data.
+    Float64,
+    /// `std_msgs/Float32`: float32 data.
+    Float32,
+}
+
+impl ScalarType {
+    /// The type a container's type name stands for (ROS1 or ROS2 spelling).
+    pub(crate) fn of(message_type: &str) -> Option<Self> {
+        let (package, name) = message_type.split_once('/')?;
+        let name = name.strip_prefix("msg/").unwrap_or(name);
+        Some(match (package, name) {
+            ("sensor_msgs", "Temperature") => ScalarType::Temperature,
+            ("sensor_msgs", "FluidPressure") => ScalarType::FluidPressure,
+            ("std_msgs", "Float64") => ScalarType::Float64,
+            ("std_msgs", "Float32") => ScalarType::Float32,
+            _ => return None,
+        })
+    }
+
+    /// The ROS1 spelling, `sensor_msgs/Temperature`.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            ScalarType::Temperature => "sensor_msgs/Temperature",
+            ScalarType::FluidPressure => "sensor_msgs/FluidPressure",
+            ScalarType::Float64 => "std_msgs/Float64",
+            ScalarType::Float32 => "std_msgs/Float32",
+        }
+    }
+
+    /// The field read.
+    pub(crate) fn field(self) -> &'static str {
+        match self {
+            ScalarType::Temperature => "temperature",
+            ScalarType::FluidPressure => "fluid_pressure",
+            ScalarType::Float64 | ScalarType::Float32 => "data",
+        }
+    }
+
+    /// The unit the message definition gives the field (`None` for a bare number).
+    pub(crate) fn unit(self) -> Option<&'static str> {
+        match self {
+            ScalarType::Temperature => Some("degC"),
+            ScalarType::FluidPressure => Some("Pa"),
+            ScalarType::Float64 | ScalarType::Float32 => None,
+        }
+    }
+
+    fn has_header(self) -> bool {
+        matches!(self, ScalarType::Temperature | ScalarType::FluidPressure)
+    }
+}
+
+/// One scalar message: its header stamp (`None` without a header) and its value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ScalarFields {
+    pub(crate) stamp_ns: Option<i64>,
+    pub(crate) value: f64,
+}
+
+/// The value of a scalar message whose body (after any header) starts at `at` of `b` (`shift`
+/// bytes of encapsulation before `b`); ROS1 packs it, CDR aligns a float64 to 8 and a
+/// float32 to 4.
+fn scalar_body(
+    b: &[u8],
+    at: usize,
+    shift: usize,
+    order: Order,
+    ty: ScalarType,
+    cdr: bool,
+) -> Result<f64, MessageError> {
+    let align = |a: usize, to: usize| if cdr { a.div_ceil(to) * to } else { a };
+    let field = ty.field();
+    if ty == ScalarType::Float32 {
+        let at = align(at, 4);
+        if b.len() < at + 4 {
+            return Err(short(b.len() + shift, field, at + 4 + shift));
+        }
+        let mut a = [0u8; 4];
+        a.copy_from_slice(&b[at..at + 4]);
+        return Ok(f64::from(match order {
+            Order::Little => f32::from_le_bytes(a),
+            Order::Big => f32::from_be_bytes(a),
+        }));
+    }
+    let at = align(at, 8);
+    // a header-bearing measurement also holds its variance: the whole message is checked
+    let needed = at + if ty.has_header() { 16 } else { 8 };
+    if b.len() < needed {
+        let field = if b.len() < at + 8 { field } else { "variance" };
+        let needed = if b.len() < at + 8 { at + 8 } else { needed };
+        return Err(short(b.len() + shift, field, needed + shift));
+    }
+    Ok(f64_at(b, at, order))
+}
+
+/// Decodes a ROS1-serialized scalar message of type `ty`.
+pub(crate) fn decode_scalar_ros1(msg: &[u8], ty: ScalarType) -> Result<ScalarFields, MessageError> {
+    if !ty.has_header() {
+        let value = scalar_body(msg, 0, 0, Order::Little, ty, false)?;
+        return Ok(ScalarFields {
+            stamp_ns: None,
+            value,
+        });
+    }
+    if msg.len() < 16 {
+        return Err(short(msg.len(), "header", 16));
+    }
+    let sec = u32_at(msg, 4, Order::Little);
+    let nsec = u32_at(msg, 8, Order::Little);
+    let len = u32_at(msg, 12, Order::Little) as usize;
+    let end = 16usize.saturating_add(len);
+    if end > msg.len() {
+        return Err(short(msg.len(), "header.frame_id", end));
+    }
+    let value = scalar_body(msg, end, 0, Order::Little, ty, false)?;
+    Ok(ScalarFields {
+        stamp_ns: Some(i64::from(sec) * 1_000_000_000 + i64::from(nsec)),
+        value,
+    })
+}
+
+/// Decodes a CDR-serialized ROS2 scalar message of type `ty` (encapsulation as
+/// [`decode_cdr`]).
+pub(crate) fn decode_scalar_cdr(msg: &[u8], ty: ScalarType) -> Result<ScalarFields, MessageError> {
+    if msg.len() < 4 {
+        return Err(short(msg.len(), "CDR encapsulation header", 4));
+    }
+    let order = match (msg[0], msg[1]) {
+        (0x00, 0x01) => Order::Little,
+        (0x00, 0x00) => Order::Big,
+        (a, b) => return Err(MessageError::Encapsulation(a, b)),
+    };
+    let b = &msg[4..];
+    if !ty.has_header() {
+        let value = scalar_body(b, 0, 4, order, ty, true)?;
+        return Ok(ScalarFields {
+            stamp_ns: None,
+            value,
+        });
+    }
+    if b.len() < 12 {
+        return Err(short(msg.len(), "header", 16));
+    }
+    let sec = u32_at(b, 0, order) as i32;
+    let nanosec = u32_at(b, 4, order);
+    let len = u32_at(b, 8, order) as usize;
+    let end = 12usize.saturating_add(len);
+    if end > b.len() {
+        return Err(short(msg.len(), "header.frame_id", end.saturating_add(4)));
+    }
+    let value = scalar_body(b, end, 4, order, ty, true)?;
+    Ok(ScalarFields {
+        stamp_ns: Some(i64::from(sec) * 1_000_000_000 + i64::from(nanosec)),
+        value,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -292,5 +458,86 @@ mod tests {
             }
         );
         assert!(decode_ros1(&m[..10]).is_err());
+    }
+
+    #[test]
+    fn scalar_messages_decode_in_both_serializations() {
+        // CDR Temperature: encapsulation, stamp (7, 9), frame "t\0" (len 2), pad to 8, value, variance
+        let mut m = vec![0, 1, 0, 0];
+        m.extend(7u32.to_le_bytes());
+        m.extend(9u32.to_le_bytes());
+        m.extend(2u32.to_le_bytes());
+        m.extend(b"t\0");
+        while (m.len() - 4) % 8 != 0 {
+            m.push(0);
+        }
+        m.extend(21.5f64.to_le_bytes());
+        m.extend(0.01f64.to_le_bytes());
+        let d = decode_scalar_cdr(&m, ScalarType::Temperature).unwrap();
+        assert_eq!(d.stamp_ns, Some(7_000_000_009));
+        assert_eq!(d.value, 21.5);
+        assert_eq!(
+            decode_scalar_cdr(&m[..m.len() - 8], ScalarType::Temperature).unwrap_err(),
+            MessageError::Short {
+                len: m.len() - 8,
+                field: "variance",
+                needed: m.len()
+            }
+        );
+        assert_eq!(
+            decode_scalar_cdr(&m[..m.len() - 12], ScalarType::Temperature).unwrap_err(),
+            MessageError::Short {
+                len: m.len() - 12,
+                field: "temperature",
+                needed: m.len() - 8
+            }
+        );
+        // CDR Float64 and Float32: no header
+        let mut f = vec![0, 1, 0, 0];
+        f.extend(3.25f64.to_le_bytes());
+        let d = decode_scalar_cdr(&f, ScalarType::Float64).unwrap();
+        assert_eq!((d.stamp_ns, d.value), (None, 3.25));
+        let mut g = vec![0, 0, 0, 0];
+        g.extend(1.5f32.to_be_bytes());
+        assert_eq!(
+            decode_scalar_cdr(&g, ScalarType::Float32).unwrap().value,
+            1.5
+        );
+        assert!(decode_scalar_cdr(&g[..6], ScalarType::Float32).is_err());
+        // ROS1 FluidPressure: seq, stamp, frame "p" (len 1), packed value and variance
+        let mut r = Vec::new();
+        for v in [1u32, 7, 9, 1] {
+            r.extend(v.to_le_bytes());
+        }
+        r.push(b'p');
+        r.extend(101325.0f64.to_le_bytes());
+        r.extend(4.0f64.to_le_bytes());
+        let d = decode_scalar_ros1(&r, ScalarType::FluidPressure).unwrap();
+        assert_eq!((d.stamp_ns, d.value), (Some(7_000_000_009), 101325.0));
+        assert!(decode_scalar_ros1(&r[..20], ScalarType::FluidPressure).is_err());
+        assert_eq!(
+            decode_scalar_ros1(&2.5f64.to_le_bytes(), ScalarType::Float64)
+                .unwrap()
+                .value,
+            2.5
+        );
+    }
+
+    #[test]
+    fn scalar_types_by_name() {
+        assert_eq!(
+            ScalarType::of("sensor_msgs/msg/Temperature"),
+            Some(ScalarType::Temperature)
+        );
+        assert_eq!(
+            ScalarType::of("sensor_msgs/Temperature"),
+            Some(ScalarType::Temperature)
+        );
+        assert_eq!(
+            ScalarType::of("std_msgs/msg/Float32"),
+            Some(ScalarType::Float32)
+        );
+        assert_eq!(ScalarType::of("sensor_msgs/msg/Imu"), None);
+        assert_eq!(ScalarType::of("Temperature"), None);
     }
 }

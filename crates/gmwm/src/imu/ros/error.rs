@@ -115,6 +115,86 @@ pub enum RosError {
         /// The topic(s) without messages.
         topics: Vec<String>,
     },
+    /// No topic of the recording answers to a covariate's name (`--covariate NAME`).
+    #[error(
+        "{}: no covariate {}: expected a topic of that name (or ending in /{}) carrying \
+         sensor_msgs/Temperature, sensor_msgs/FluidPressure, std_msgs/Float64 or \
+         std_msgs/Float32, or angular_rate or specific_force of the IMU messages; {}",
+        .path.display(),
+        escape_name(.name),
+        escape_name(.name.trim_start_matches('/')),
+        topic_list(.available)
+    )]
+    NoCovariate {
+        /// Path as given.
+        path: PathBuf,
+        /// The covariate asked for.
+        name: String,
+        /// Every topic present, as `name (type)`.
+        available: Vec<String>,
+    },
+    /// The topic named as a covariate carries a type that is not a scalar measurement.
+    #[error(
+        "{}: topic {} carries {}, not a scalar covariate (sensor_msgs/Temperature, \
+         sensor_msgs/FluidPressure, std_msgs/Float64, std_msgs/Float32)",
+        .path.display(),
+        escape_name(.topic),
+        escape_name(.message_type)
+    )]
+    NotScalar {
+        /// Path as given.
+        path: PathBuf,
+        /// The topic.
+        topic: String,
+        /// Its message type.
+        message_type: String,
+    },
+    /// Several scalar topics answer to a covariate's name.
+    #[error(
+        "{}: several topics answer to covariate {}: {}; name one with --covariate TOPIC",
+        .path.display(),
+        escape_name(.name),
+        topic_names(.topics)
+    )]
+    AmbiguousCovariate {
+        /// Path as given.
+        path: PathBuf,
+        /// The covariate asked for.
+        name: String,
+        /// The topics answering to it.
+        topics: Vec<String>,
+    },
+    /// A covariate topic's messages and the IMU topic's do not overlap in time.
+    #[error(
+        "{}: covariate topic {} ({messages} messages, log times {} to {}) does not overlap \
+         the IMU topic {} ({} to {}) in time ({}): nothing to align",
+        .path.display(),
+        escape_name(.topic),
+        format_ns(*.from_ns),
+        format_ns(*.to_ns),
+        escape_name(.imu_topic),
+        format_ns(*.imu_from_ns),
+        format_ns(*.imu_to_ns),
+        apart(*.from_ns, *.to_ns, *.imu_from_ns, *.imu_to_ns)
+    )]
+    NoOverlap {
+        /// Path as given.
+        path: PathBuf,
+        /// The covariate topic.
+        topic: String,
+        /// Its messages.
+        messages: usize,
+        /// Its first and last log times, ns since the epoch.
+        from_ns: i64,
+        /// See `from_ns`.
+        to_ns: i64,
+        /// The IMU topic.
+        imu_topic: String,
+        /// Its first and last log times.
+        imu_from_ns: i64,
+        /// See `imu_from_ns`.
+        imu_to_ns: i64,
+    },
     /// The topic's messages use a serialization this reader does not decode.
     #[error(
         "{}: topic {}: message encoding \"{}\" is not supported (expected cdr or ros1)",
@@ -151,7 +231,7 @@ pub enum RosError {
     },
 }
 
-/// What is wrong with one serialized `sensor_msgs/Imu` message.
+/// What is wrong with one serialized `sensor_msgs/Imu` (or scalar covariate) message.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum MessageError {
@@ -180,7 +260,8 @@ pub enum MessageError {
     /// A measurement is NaN or infinite.
     #[error("{field} = {value} is not a finite number")]
     NonFinite {
-        /// `angular_velocity.x` ... `linear_acceleration.z`.
+        /// `angular_velocity.x` ... `linear_acceleration.z`, or a covariate's field
+        /// (`temperature`).
         field: &'static str,
         /// The value read.
         value: f64,
@@ -206,6 +287,22 @@ fn empty_topics(topics: &[String]) -> String {
     match topics {
         [one] => format!("topic {} holds", escape_name(one)),
         more => format!("IMU topics {} hold", topic_names(more)),
+    }
+}
+
+/// How far apart two time spans that do not overlap are: `it begins 9990.005000000 s after the IMU
+/// topic ends` (or `ends ... before ... begins`).
+fn apart(from_ns: i64, to_ns: i64, imu_from_ns: i64, imu_to_ns: i64) -> String {
+    if from_ns > imu_to_ns {
+        format!(
+            "it begins {} after the IMU topic ends",
+            format_ns(from_ns.saturating_sub(imu_to_ns))
+        )
+    } else {
+        format!(
+            "it ends {} before the IMU topic begins",
+            format_ns(imu_from_ns.saturating_sub(to_ns))
+        )
     }
 }
 

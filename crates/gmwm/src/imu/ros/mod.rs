@@ -33,6 +33,7 @@
 //! ```
 
 mod cdr;
+mod covariate;
 mod decompress;
 mod error;
 mod file;
@@ -40,6 +41,7 @@ mod mcap;
 mod ros1;
 mod sqlite;
 
+pub use covariate::{read_ros_covariate, RosCovariate};
 pub use error::{MessageError, RosError};
 
 use crate::imu::ReadError;
@@ -170,12 +172,32 @@ fn encoding(path: &Path, topic: &str, name: &str) -> Result<Encoding, RosError> 
 /// (`compression_mode: message`); a CDR message starts with 0x00.
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
 
+/// What a topic's messages are decoded as.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum MessageKind {
+    /// `sensor_msgs/Imu`: six values.
+    Imu,
+    /// A scalar measurement read as a covariate: one value.
+    Scalar(cdr::ScalarType),
+}
+
+impl MessageKind {
+    /// Whether a topic of `message_type` is decoded as this kind.
+    fn accepts(self, message_type: &str) -> bool {
+        match self {
+            MessageKind::Imu => is_imu_type(message_type),
+            MessageKind::Scalar(t) => cdr::ScalarType::of(message_type) == Some(t),
+        }
+    }
+}
+
 /// Where [`Collector`] puts each decoded, checked message, in file order: the in-memory
 /// vectors ([`Gathered`]) or a streamed reader's reorder buffer.
 pub(crate) trait MessageSink {
-    /// One message: its header stamp and log time (ns), and its six values (angular velocity
-    /// x, y, z then linear acceleration x, y, z, all finite).
-    fn message(&mut self, header_ns: i64, log_ns: i64, values: [f64; 6]) -> Result<(), ReadError>;
+    /// One message: its header stamp and log time (ns; a message without a header gives its
+    /// log time twice), and its values, all finite: for an IMU message six (angular velocity
+    /// x, y, z then linear acceleration x, y, z), for a scalar one.
+    fn message(&mut self, header_ns: i64, log_ns: i64, values: &[f64]) -> Result<(), ReadError>;
 }
 
 /// The one decoder of IMU messages: decodes and checks each message and hands it to a
@@ -186,6 +208,7 @@ pub(crate) struct Collector<'a> {
     /// A decompressed message (rosbag2 per-message compression).
     scratch: Vec<u8>,
     topic: &'a str,
+    kind: MessageKind,
     frame_id: Option<String>,
     /// Messages decoded so far.
     count: u64,
@@ -193,11 +216,18 @@ pub(crate) struct Collector<'a> {
 }
 
 impl<'a> Collector<'a> {
+    /// A collector of `sensor_msgs/Imu` messages.
+    #[cfg(test)]
     pub(crate) fn new(topic: &'a str, sink: &'a mut dyn MessageSink) -> Self {
+        Self::of_kind(topic, MessageKind::Imu, sink)
+    }
+
+    fn of_kind(topic: &'a str, kind: MessageKind, sink: &'a mut dyn MessageSink) -> Self {
         Self {
             file: PathBuf::new(),
             scratch: Vec::new(),
             topic,
+            kind,
             frame_id: None,
             count: 0,
             sink,
@@ -231,6 +261,25 @@ impl<'a> Collector<'a> {
         } else {
             data
         };
+        if let MessageKind::Scalar(ty) = self.kind {
+            let decoded = match encoding {
+                Encoding::Ros1 => cdr::decode_scalar_ros1(data, ty),
+                Encoding::Cdr => cdr::decode_scalar_cdr(data, ty),
+            };
+            let m = decoded.map_err(|r| self.error(log_time_ns, r))?;
+            if !m.value.is_finite() {
+                let reason = MessageError::NonFinite {
+                    field: ty.field(),
+                    value: m.value,
+                };
+                return Err(self.error(log_time_ns, reason).into());
+            }
+            let stamp = m.stamp_ns.unwrap_or(log_time_ns);
+            self.sink.message(stamp, log_time_ns, &[m.value])?;
+            self.count += 1;
+            self.scratch = scratch;
+            return Ok(());
+        }
         let decoded = match encoding {
             Encoding::Ros1 => cdr::decode_ros1(data),
             Encoding::Cdr => cdr::decode_cdr(data),
@@ -253,7 +302,7 @@ impl<'a> Collector<'a> {
         if self.count == 0 && !m.frame_id.is_empty() {
             self.frame_id = Some(String::from_utf8_lossy(m.frame_id).into_owned());
         }
-        self.sink.message(m.stamp_ns, log_time_ns, values)?;
+        self.sink.message(m.stamp_ns, log_time_ns, &values)?;
         self.count += 1;
         self.scratch = scratch;
         Ok(())
@@ -270,7 +319,7 @@ struct Gathered {
 }
 
 impl MessageSink for Gathered {
-    fn message(&mut self, header_ns: i64, log_ns: i64, values: [f64; 6]) -> Result<(), ReadError> {
+    fn message(&mut self, header_ns: i64, log_ns: i64, values: &[f64]) -> Result<(), ReadError> {
         self.header_stamp_ns.push(header_ns);
         self.log_time_ns.push(log_ns);
         for a in 0..3 {
@@ -589,7 +638,7 @@ impl Opened {
         }
     }
 
-    /// Reads the IMU messages of `topic` into `out`.
+    /// Reads the messages of `topic` of the collector's kind into `out`.
     fn read(&mut self, topic: &str, out: &mut Collector<'_>) -> Result<(), ReadError> {
         match self {
             Opened::Ros1(file, cat) => {
@@ -597,7 +646,7 @@ impl Opened {
                 let wanted: HashSet<u32> = cat
                     .connections
                     .iter()
-                    .filter(|c| c.topic == topic && is_imu_type(&c.message_type))
+                    .filter(|c| c.topic == topic && out.kind.accepts(&c.message_type))
                     .map(|c| c.id)
                     .collect();
                 if wanted.is_empty() {
@@ -611,7 +660,7 @@ impl Opened {
                 out.file = file.path().to_path_buf();
                 let mut wanted = HashMap::new();
                 for c in &cat.channels {
-                    if c.topic == topic && is_imu_type(&c.message_type) {
+                    if c.topic == topic && out.kind.accepts(&c.message_type) {
                         wanted.insert(c.id, encoding(file.path(), topic, &c.encoding)?);
                     }
                 }
@@ -626,7 +675,7 @@ impl Opened {
                 out.file.clone_from(path);
                 let mut wanted = HashMap::new();
                 for t in topics {
-                    if t.name == topic && is_imu_type(&t.message_type) {
+                    if t.name == topic && out.kind.accepts(&t.message_type) {
                         wanted.insert(t.id, encoding(path, topic, &t.encoding)?);
                     }
                 }
@@ -826,12 +875,28 @@ pub(crate) fn read_topic<'s>(
     topic: Option<&str>,
     sink: impl FnOnce(&TopicInfo, u64) -> &'s mut dyn MessageSink,
 ) -> Result<TopicRead, ReadError> {
+    read_messages(
+        path,
+        |topics| Ok((choose_topic(path, topics, topic)?.clone(), MessageKind::Imu)),
+        sink,
+    )
+}
+
+/// Reads the messages of the topic `choose` picks from the recording's topics (with the kind
+/// its messages are decoded as) in file order into the sink `sink` gives, checking the count
+/// against the index.
+pub(crate) fn read_messages<'s>(
+    path: &Path,
+    choose: impl FnOnce(&[TopicInfo]) -> Result<(TopicInfo, MessageKind), ReadError>,
+    sink: impl FnOnce(&TopicInfo, u64) -> &'s mut dyn MessageSink,
+) -> Result<TopicRead, ReadError> {
     let source = source(path)?;
     let mut opened = open(&source)?;
     let topics = merged_topics(&opened);
-    let chosen = choose_topic(path, &topics, topic)?;
+    let (chosen, kind) = choose(&topics)?;
+    let chosen = &chosen;
     let bytes: u64 = opened.iter().map(Opened::size).sum();
-    let mut out = Collector::new(&chosen.topic, sink(chosen, bytes));
+    let mut out = Collector::of_kind(&chosen.topic, kind, sink(chosen, bytes));
     for o in &mut opened {
         o.read(&chosen.topic, &mut out)?;
     }
