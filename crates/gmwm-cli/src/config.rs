@@ -596,6 +596,72 @@ pub struct CalibrateConfig {
     pub pool: Vec<PathBuf>,
     /// `--audit R`: replicates of the self-audit per axis (0: none).
     pub audit: usize,
+    /// `--covariate COL` and its options: N, B, K against a covariate.
+    pub covariate: Option<CovariateCalibrationConfig>,
+}
+
+/// Which N, B, K a calibration against a covariate exports.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CovariateExport {
+    /// The estimates of the whole recording.
+    Whole,
+    /// `--at X`.
+    At(f64),
+    /// `--over LO:HI`: each at its largest over the range.
+    Over(f64, f64),
+}
+
+/// `gmwm calibrate --covariate COL [--windows K] [--at X | --over LO:HI]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CovariateCalibrationConfig {
+    /// The covariate: a column, or a ROS recording's topic or IMU magnitude.
+    pub column: String,
+    /// Windows the recording is cut into.
+    pub windows: usize,
+    /// What is exported.
+    pub export: CovariateExport,
+}
+
+impl CovariateCalibrationConfig {
+    fn of(a: &CalibrateArgs) -> Result<Option<Self>> {
+        let Some(column) = &a.covariate else {
+            return Ok(None);
+        };
+        let windows = a.windows.unwrap_or(DEFAULT_WINDOWS);
+        anyhow::ensure!(
+            windows <= MAX_WINDOWS,
+            UsageError(format!(
+                "invalid --windows {windows}: at most {MAX_WINDOWS}; each window loses the \
+                 recording's longest scales"
+            ))
+        );
+        let export = match (a.at, &a.over) {
+            (Some(x), _) if !x.is_finite() => {
+                return Err(UsageError(format!("invalid --at {x}: not a finite number")).into())
+            }
+            (Some(x), _) => CovariateExport::At(x),
+            (None, Some(range)) => {
+                let bad = || {
+                    UsageError(format!(
+                        "invalid --over {range}: expected LO:HI with finite LO <= HI, e.g. 0:40"
+                    ))
+                };
+                let (lo, hi) = range.split_once(':').ok_or_else(bad)?;
+                let lo: f64 = lo.trim().parse().map_err(|_| bad())?;
+                let hi: f64 = hi.trim().parse().map_err(|_| bad())?;
+                if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                    return Err(bad().into());
+                }
+                CovariateExport::Over(lo, hi)
+            }
+            (None, None) => CovariateExport::Whole,
+        };
+        Ok(Some(Self {
+            column: column.clone(),
+            windows,
+            export,
+        }))
+    }
 }
 
 /// The files of `--kalibr` and `--export STACK FILE`, Kalibr first.
@@ -663,6 +729,7 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             rostopic: a.rostopic.clone(),
             report: a.report.clone(),
             pool: Vec::new(),
+            covariate: CovariateCalibrationConfig::of(a)?,
             audit: a.audit.unwrap_or(if a.report.is_some() {
                 DEFAULT_REPORT_AUDIT
             } else {

@@ -133,6 +133,9 @@ pub struct Bars {
 pub enum PanelKind {
     /// Series on log-log axes.
     LogLog(Vec<Series>),
+    /// Series against a linear abscissa (a covariate such as temperature, which may be zero
+    /// or negative) on a log ordinate; lines and bands only.
+    LinLog(Vec<Series>),
     /// A stacked bar chart.
     Bars(Bars),
 }
@@ -155,10 +158,12 @@ impl Panel {
     /// where a series has no point inside the panel's range).
     pub fn legend(&self) -> Vec<String> {
         match &self.kind {
-            PanelKind::LogLog(series) => legend_entries(series, ranges(series).1)
-                .into_iter()
-                .map(|(label, _, _)| label)
-                .collect(),
+            PanelKind::LogLog(series) | PanelKind::LinLog(series) => {
+                legend_entries(series, ranges(series).1)
+                    .into_iter()
+                    .map(|(label, _, _)| label)
+                    .collect()
+            }
             PanelKind::Bars(b) => b.segment_labels.to_vec(),
         }
     }
@@ -563,6 +568,130 @@ fn draw_loglog<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Draws a panel with a linear abscissa and a log ordinate: lines (broken at missing values)
+/// and bands (a polygon per run of points with both ends); the abscissa spans every series'
+/// finite abscissae.
+fn draw_linlog<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    series: &[Series],
+) -> Result<(), PlotError> {
+    let (_, yr) = ranges(series);
+    let (x0, x1) = series
+        .iter()
+        .flat_map(|s| s.x.iter().copied())
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    let (x0, x1) = if x0 < x1 {
+        let pad = 0.02 * (x1 - x0);
+        (x0 - pad, x1 + pad)
+    } else if x0.is_finite() {
+        (x0 - 1.0, x0 + 1.0)
+    } else {
+        (0.0, 1.0)
+    };
+    let entries = legend_entries(series, yr);
+    let (w, _) = area.dim_in_pixel();
+    let (plot, legend) = if entries.is_empty() {
+        (area.clone(), None)
+    } else {
+        let lw = legend_width(area, &entries);
+        let (p, l) = area.split_horizontally(w - lw);
+        (p, Some(l))
+    };
+    let (yb, yl) = log_ticks(yr);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(&panel.title, (FONT, TITLE_SIZE))
+        .margin(12)
+        .x_label_area_size(52)
+        .y_label_area_size(84)
+        .build_cartesian_2d(
+            x0..x1,
+            (yr.0..yr.1)
+                .log_scale()
+                .with_key_points(yb)
+                .with_light_points(yl),
+        )
+        .map_err(draw_error)?;
+    chart
+        .configure_mesh()
+        .x_desc(&panel.x_label)
+        .y_desc(&panel.y_label)
+        .x_label_formatter(&|v| number(*v))
+        .y_label_formatter(&|v| pow10_label(*v))
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, LABEL_SIZE))
+        .bold_line_style(RGBColor(200, 200, 200).stroke_width(1))
+        .light_line_style(RGBColor(236, 236, 236).stroke_width(1))
+        .draw()
+        .map_err(draw_error)?;
+    let ok = |y: f64| y.is_finite() && y >= yr.0 && y <= yr.1;
+    for s in series {
+        let rgb = s.rgb();
+        let upper = s.upper.as_deref();
+        // runs of consecutive drawable points
+        let mut runs: Vec<Vec<usize>> = vec![Vec::new()];
+        for k in 0..s.x.len() {
+            // a band is drawn clamped to the range; a line only inside it
+            let drawable = match (s.mark, upper) {
+                (Mark::Band, Some(u)) => {
+                    s.y[k].is_finite() && u[k].is_finite() && s.y[k] > 0.0 && u[k] > 0.0
+                }
+                _ => ok(s.y[k]),
+            };
+            if drawable {
+                if let Some(r) = runs.last_mut() {
+                    r.push(k);
+                }
+            } else if runs.last().is_some_and(|r| !r.is_empty()) {
+                runs.push(Vec::new());
+            }
+        }
+        for run in runs.iter().filter(|r| !r.is_empty()) {
+            match (s.mark, upper) {
+                (Mark::Band, Some(u)) => {
+                    let clamp = |v: f64| v.clamp(yr.0, yr.1);
+                    let poly: Vec<(f64, f64)> = run
+                        .iter()
+                        .map(|&k| (s.x[k], clamp(s.y[k])))
+                        .chain(run.iter().rev().map(|&k| (s.x[k], clamp(u[k]))))
+                        .collect();
+                    chart
+                        .draw_series(std::iter::once(Polygon::new(poly, rgb.mix(0.2).filled())))
+                        .map_err(draw_error)?;
+                }
+                (Mark::Line { width, dashed }, _) => {
+                    let pts: Vec<(f64, f64)> = run.iter().map(|&k| (s.x[k], s.y[k])).collect();
+                    if dashed {
+                        chart
+                            .draw_series(DashedLineSeries::new(pts, 7, 5, rgb.stroke_width(width)))
+                            .map_err(draw_error)?;
+                    } else {
+                        chart
+                            .draw_series(LineSeries::new(pts, rgb.stroke_width(width)))
+                            .map_err(draw_error)?;
+                    }
+                }
+                (Mark::Points | Mark::LinePoints, _) => {
+                    chart
+                        .draw_series(
+                            run.iter()
+                                .map(|&k| Circle::new((s.x[k], s.y[k]), 4, rgb.filled())),
+                        )
+                        .map_err(draw_error)?;
+                }
+                _ => {}
+            }
+        }
+    }
+    if let Some(l) = legend {
+        draw_legend(&l, &entries)?;
+    }
+    Ok(())
+}
+
 /// Draws a horizontal stacked bar chart on an axis up to 12.5 times the smallest total (1.25
 /// times a cap at ten times it); longer bars are cut at the edge with their value written, so
 /// the margin between the best rows stays visible.
@@ -689,6 +818,7 @@ pub(crate) fn draw<DB: DrawingBackend>(
     for (panel, area) in panels.iter().zip(areas.iter()) {
         match &panel.kind {
             PanelKind::LogLog(series) => draw_loglog(area, panel, series)?,
+            PanelKind::LinLog(series) => draw_linlog(area, panel, series)?,
             PanelKind::Bars(bars) => draw_bars(area, panel, bars)?,
         }
     }

@@ -25,9 +25,9 @@ pub mod style;
 pub use chart::{BarRow, Bars, Mark, Panel, PanelKind, Series};
 pub use figure::{within_limits, Figure, ImageFormat, MAX_PIXELS, MAX_SIDE};
 pub use figures::{
-    allan_figure, compare_figure, fit_figure, ieee_figure, plan_figure, pooled_figure, psd_figure,
-    recordings_figure, selection_figure, shared_figure, wv_figure, Column, Layout, AV_SCALE,
-    PSD_FREQUENCY, WIC_ROWS, WV_SCALE,
+    allan_figure, compare_figure, covariate_figure, fit_figure, ieee_figure, plan_figure,
+    pooled_figure, psd_figure, recordings_figure, selection_figure, shared_figure, wv_figure,
+    Column, Layout, AV_SCALE, PSD_FREQUENCY, WIC_ROWS, WV_SCALE,
 };
 
 /// What can go wrong while drawing or writing a figure or a report.

@@ -6,8 +6,8 @@
 //! `gmwm calibrate --json` writes it) is embedded in the page.
 
 use crate::figures::{
-    compare_figure, fit_figure, ieee_figure, psd_figure, recordings_figure, selection_figure,
-    wv_figure, Column, Layout, WIC_ROWS,
+    compare_figure, covariate_figure, fit_figure, ieee_figure, psd_figure, recordings_figure,
+    selection_figure, wv_figure, Column, Layout, WIC_ROWS,
 };
 use crate::style::number;
 use crate::{Figure, PlotError};
@@ -38,6 +38,8 @@ pub struct ReportContext {
     pub json: String,
     /// The program and version that made the report.
     pub generator: String,
+    /// N, B, K against a covariate (`gmwm calibrate --covariate`), when asked for.
+    pub covariate: Option<gmwm::CovariateCalibration>,
 }
 
 /// A sentence with its first letter upper-case.
@@ -717,6 +719,62 @@ ul.notes{font-size:14px}nav a{margin-right:10px}.meta{color:#555;font-size:13px}
 @media print{body{max-width:none;margin:0}section.axis{break-before:page}figure,table,pre,.verdict{break-inside:avoid}h2,h3{break-after:avoid}nav{display:none}a{color:inherit;text-decoration:none}}
 ";
 
+/// The section on N, B, K against a covariate: the figure, then per axis the chosen form and
+/// the no-dependence test.
+fn covariate_section(out: &mut String, c: &gmwm::CovariateCalibration) -> Result<(), PlotError> {
+    let unit = c
+        .unit
+        .as_deref()
+        .map(|u| format!(" {u}"))
+        .unwrap_or_default();
+    let _ = write!(
+        out,
+        "<section id=\"covariate\"><h2>Against {}</h2>\n<p>The recording was cut into {} windows at {} levels from {} to {}{unit}; each axis' identified model was fitted with its variances depending on {} (log-affine, the form chosen by WIC) — docs/methods.md §5.14. Bands are {:.0}% pointwise.</p>\n",
+        esc(&c.covariate),
+        c.windows,
+        esc(&c.covariate),
+        crate::style::number(c.range[0]),
+        crate::style::number(c.range[1]),
+        esc(&c.covariate),
+        100.0 * (1.0 - c.alpha)
+    );
+    out.push_str(&figure_html(
+        &covariate_figure(c),
+        &format!(
+            "N, B, K of every axis against {}: lines are the estimates, shaded the pointwise bands; dashed where the chosen form keeps the quantity constant.",
+            esc(&c.covariate)
+        ),
+    )?);
+    out.push_str(
+        "<table><tr><th>axis</th><th>model</th><th>no dependence (Wald)</th><th>notes</th></tr>\n",
+    );
+    for a in &c.axes {
+        let test = a
+            .inference
+            .as_ref()
+            .and_then(|i| i.no_dependence.as_ref())
+            .map_or_else(
+                || "—".to_string(),
+                |t| {
+                    format!(
+                        "W = {:.1}, df = {}, p = {:.3e}",
+                        t.statistic, t.df, t.p_value
+                    )
+                },
+            );
+        let _ = writeln!(
+            out,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            esc(&a.column),
+            esc(&a.fit.model().without_values().to_string()),
+            esc(&test),
+            esc(&a.notes.join("; "))
+        );
+    }
+    out.push_str("</table></section>\n");
+    Ok(())
+}
+
 /// Renders the page.
 ///
 /// # Errors
@@ -789,6 +847,9 @@ pub fn render(report: &CalibrationReport, ctx: &ReportContext) -> Result<String,
             ),
         )?);
         out.push_str("</section>\n");
+    }
+    if let Some(c) = &ctx.covariate {
+        covariate_section(&mut out, c)?;
     }
     for a in &report.axes {
         axis_section(&mut out, a, report.alpha)?;

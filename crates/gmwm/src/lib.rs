@@ -161,7 +161,8 @@ pub use calib::export::{render_export, ExportError, ExportFormat, NavNoise, Sens
 pub use calib::ieee::{ieee_readoff, term_avar, CoefficientReadoff, IeeeReadoff};
 pub use calib::streamed::{binary_file_columns, wv_account, wv_columns};
 pub use calib::{
-    spread_across, Audit, AuditQuantity, AuditStats, Contamination, FitUses, FitVerdict,
+    spread_across, Audit, AuditQuantity, AuditStats, AxisCurves, BandValue, Contamination,
+    CovariateCalibration, CovariateCalibrationOptions, CurvePoint, FitUses, FitVerdict,
     GaussMarkovBias, HorizonBound, Plan, PlanTarget, PlannedQuantity, PooledInput, RecordedAxis,
     ScaleFit, ScaleMiss, SpreadAcross, SpreadRow, PLAN_LENGTHS_S,
 };

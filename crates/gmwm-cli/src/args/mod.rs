@@ -321,6 +321,36 @@ pub struct CalibrateArgs {
     /// Also write the HTML report (as `gmwm report`) to FILE.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
+    /// Calibrate against a covariate (docs/methods.md §5.14): each axis' identified model is
+    /// fitted over windows of the recording with its variances depending on COL, and N, B, K
+    /// are reported as curves against it. COL is a column (e.g. temperature), or of a ROS
+    /// recording a topic (sensor_msgs/Temperature, ...; `temperature` finds the only one)
+    /// interpolated to the IMU messages, or angular_rate / specific_force.
+    #[arg(long, value_name = "COL")]
+    pub covariate: Option<String>,
+    /// With --covariate: cut the recording into K windows of equal length, each at its mean
+    /// level [default: 8, at most 64].
+    #[arg(long, value_name = "K", value_parser = at_least_2, requires = "covariate")]
+    pub windows: Option<usize>,
+    /// With --covariate: export (and report as the axes' N, B, K) the values at covariate
+    /// value X, e.g. --at 5 for 5 degC [default: the estimates of the whole recording].
+    #[arg(
+        long,
+        value_name = "X",
+        requires = "covariate",
+        conflicts_with = "over",
+        allow_hyphen_values = true
+    )]
+    pub at: Option<f64>,
+    /// With --covariate: export the worst case over covariate values LO:HI, each of N, B, K
+    /// at its largest (e.g. --over 0:40 for a filter that must hold from 0 to 40 degC).
+    #[arg(
+        long,
+        value_name = "LO:HI",
+        requires = "covariate",
+        allow_hyphen_values = true
+    )]
+    pub over: Option<String>,
 }
 
 /// `--gyro-unit`, `--accel-unit`: the unit of the samples, as `gmwm calibrate` and

@@ -94,11 +94,23 @@ pub fn execute_in(
 ) -> Result<Calibrated> {
     let print_summary = mode.print_summary;
     let exports = &config.exports;
-    let (recording, mut report) = if config.pool.is_empty() {
+    let (recording, mut report, samples) = if config.pool.is_empty() {
         check_outputs(config, report_path)?;
         calibrate_one(config, mode)?
     } else {
-        calibrate_pooled(config, report_path, mode)?
+        let (recording, report) = calibrate_pooled(config, report_path, mode)?;
+        (recording, report, None)
+    };
+    let curves = match &config.covariate {
+        Some(c) => Some(against_covariate(
+            config,
+            c,
+            &recording,
+            samples,
+            &mut report,
+            mode,
+        )?),
+        None => None,
     };
     let audited = audit(config, &mut report, mode)?;
     // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
@@ -126,7 +138,7 @@ pub fn execute_in(
         }
     }
     let json_to_stdout = config.json.as_deref() == Some(Path::new("-"));
-    let doc = gmwm::document::calibration(
+    let mut doc = gmwm::document::calibration(
         &recording.path,
         &recording.notes,
         // a pooled calibration's accounts are its recordings' (their notes)
@@ -134,8 +146,19 @@ pub fn execute_in(
         &report,
         &sets,
     );
+    if let Some(c) = &curves {
+        doc["covariate"] = serde_json::to_value(c)?;
+    }
     if let Some(path) = report_path {
-        match write_report(config, path, &recording, &report, &sets, &doc) {
+        match write_report(
+            config,
+            path,
+            &recording,
+            &report,
+            &sets,
+            &doc,
+            curves.as_ref(),
+        ) {
             Ok(figures) => {
                 written.push(format!(
                     "{} (HTML report, {figures} figures)",
@@ -159,6 +182,9 @@ pub fn execute_in(
     if !json_to_stdout {
         if print_summary {
             summary(&recording, &report, out)?;
+            if let Some(c) = &curves {
+                covariate_summary(c, out)?;
+            }
             if let Some(seconds) = audited {
                 writeln!(
                     out,
@@ -206,15 +232,86 @@ fn audit(
     Ok(Some(started.elapsed().as_secs_f64()))
 }
 
-/// One recording read (streamed when long) and calibrated.
+/// `--covariate`: N, B, K of every axis against the covariate (the engine's
+/// `Calibration::covariate_curves` over the recording's samples, `samples` when the
+/// calibration held them, else read again), and the report's N, B, K replaced for `--at` or
+/// `--over`.
+fn against_covariate(
+    config: &CalibrateConfig,
+    c: &crate::config::CovariateCalibrationConfig,
+    recording: &crate::input::LoadedRecording,
+    samples: Option<gmwm::Imu>,
+    report: &mut CalibrationReport,
+    mode: Mode,
+) -> Result<gmwm::CovariateCalibration> {
+    use crate::config::CovariateExport;
+    let file = &config.input.file;
+    if !config.pool.is_empty() {
+        return Err(UsageError(
+            "--covariate calibrates one recording cut into windows; for several recordings at \
+             different levels use gmwm fit FILE... --covariate COL"
+                .into(),
+        )
+        .into());
+    }
+    if matches!(recording.source, gmwm::RecordingSource::SavedWv) {
+        return Err(UsageError(format!(
+            "{}: --covariate needs the samples; a saved wavelet variance has none",
+            file.display()
+        ))
+        .into());
+    }
+    let imu = match samples {
+        Some(imu) => imu,
+        None => crate::input::load_recording(&config.input)?
+            .imu
+            .context("the recording's samples")?,
+    };
+    let (values, unit) =
+        super::covariate::covariate_values(&config.input, file, &c.column, mode.style)?;
+    let options = gmwm::CovariateCalibrationOptions {
+        unit,
+        windows: c.windows,
+        at: match c.export {
+            CovariateExport::At(x) => vec![x],
+            _ => Vec::new(),
+        },
+        ..gmwm::CovariateCalibrationOptions::new(c.column.clone())
+    };
+    let calibration = Calibration::new(config.options.clone());
+    let spinner = mode.style.bar(
+        1,
+        &format!("fitting against {} over {} windows", c.column, c.windows),
+        "steps",
+    );
+    spinner.enable_steady_tick(std::time::Duration::from_millis(250));
+    let curves = calibration
+        .covariate_curves(&imu, report, &values, &options)
+        .with_context(|| format!("{}: --covariate {}", file.display(), c.column))?;
+    spinner.finish_and_clear();
+    match c.export {
+        CovariateExport::At(x) => report.at_covariate(&curves, x)?,
+        CovariateExport::Over(lo, hi) => report.worst_over(&curves, lo, hi)?,
+        CovariateExport::Whole => {}
+    }
+    Ok(curves)
+}
+
+/// One recording read (streamed when long) and calibrated; its samples too when they were
+/// read into memory.
 fn calibrate_one(
     config: &CalibrateConfig,
     mode: Mode,
-) -> Result<(crate::input::LoadedRecording, CalibrationReport)> {
+) -> Result<(
+    crate::input::LoadedRecording,
+    CalibrationReport,
+    Option<gmwm::Imu>,
+)> {
     let exports = &config.exports;
     let calibration = Calibration::new(config.options.clone());
     if crate::input::is_wv(&config.input) {
-        return calibrate_saved_wv(config, &calibration, exports, mode);
+        let (recording, report) = calibrate_saved_wv(config, &calibration, exports, mode)?;
+        return Ok((recording, report, None));
     }
     // the engine reads the recording the way its kind and length ask (memory, one spooled
     // pass, or a raw binary file streamed), from the probe the configuration carries
@@ -246,7 +343,11 @@ fn calibrate_one(
         .run_source(&source, &Ticks(&progress))
         .with_context(|| recording.path.display().to_string())?;
     progress.finish_and_clear();
-    Ok((recording, report))
+    let samples = match source {
+        CalibrationSource::Memory(r) => Some(r.imu),
+        _ => None,
+    };
+    Ok((recording, report, samples))
 }
 
 /// A wavelet variance saved by `gmwm wv --json` (or computed elsewhere in that shape, such as
@@ -374,6 +475,7 @@ fn write_report(
     report: &CalibrationReport,
     sets: &[NavSet],
     doc: &serde_json::Value,
+    curves: Option<&gmwm::CovariateCalibration>,
 ) -> Result<usize> {
     let mut formats: Vec<(ExportFormat, Option<&Path>)> = config
         .exports
@@ -428,6 +530,7 @@ fn write_report(
         exports: files,
         json: serde_json::to_string(doc)?,
         generator: format!("gmwm {}", env!("CARGO_PKG_VERSION")),
+        covariate: curves.cloned(),
     };
     let html = gmwm_plot::report::render(report, &ctx)?;
     let figures = html.matches("<figure>").count();
@@ -504,6 +607,92 @@ pub fn per_axis_path(path: &Path, label: &str) -> PathBuf {
 }
 
 /// Four significant digits.
+/// N, B, K against the covariate: per axis the no-dependence test and the three at five
+/// levels across the recorded range (and `--at`), with their bands.
+fn covariate_summary(c: &gmwm::CovariateCalibration, out: &mut impl Write) -> Result<()> {
+    let unit = c
+        .unit
+        .as_deref()
+        .map(|u| format!(" {u}"))
+        .unwrap_or_default();
+    writeln!(
+        out,
+        "\nN, B, K against {} ({} windows at {}..{}{unit}; {:.0}% pointwise bands; docs/methods.md §5.14):",
+        c.covariate,
+        c.windows,
+        num(c.range[0]),
+        num(c.range[1]),
+        100.0 * (1.0 - c.alpha)
+    )?;
+    for a in &c.axes {
+        let test = a
+            .inference
+            .as_ref()
+            .and_then(|i| i.no_dependence.as_ref())
+            .map_or_else(
+                || "no test".to_string(),
+                |t| {
+                    format!(
+                        "no dependence: W = {:.1}, df = {}, p = {}",
+                        t.statistic,
+                        t.df,
+                        if t.p_value < 1e-16 {
+                            "< 1e-16".to_string()
+                        } else {
+                            format!("{:.3}", t.p_value)
+                        }
+                    )
+                },
+            );
+        writeln!(
+            out,
+            "  {}: {}; {test}",
+            a.column,
+            a.fit.model().without_values()
+        )?;
+        writeln!(
+            out,
+            "    {:>10}  {:<36} {:<36} {:<36}",
+            c.covariate,
+            format!("N ({})", a.noise_density_unit),
+            format!("B ({})", a.bias_instability_unit),
+            format!("K ({})", a.random_walk_unit)
+        )?;
+        let n = a.points.len();
+        let picks: Vec<usize> = (0..n)
+            .filter(|&k| {
+                let x = a.points[k].covariate;
+                [0, n / 4, n / 2, (3 * n) / 4, n.saturating_sub(1)].contains(&k)
+                    || !(c.range[0]..=c.range[1]).contains(&x)
+            })
+            .collect();
+        for k in picks {
+            let p = &a.points[k];
+            let cell = |k: usize, v: &Option<gmwm::BandValue>| match v {
+                // a quantity that does not depend on the covariate: the calibration's own
+                _ if !a.depends[k] && v.is_some() => "as the whole recording".to_string(),
+                Some(b) => match (b.low, b.high) {
+                    (Some(l), Some(h)) => format!("{:.3e} [{:.3e}, {:.3e}]", b.value, l, h),
+                    _ => format!("{:.3e}", b.value),
+                },
+                None => "-".to_string(),
+            };
+            writeln!(
+                out,
+                "    {:>10}  {:<36} {:<36} {:<36}",
+                num(p.covariate),
+                cell(0, &p.noise_density),
+                cell(1, &p.bias_instability),
+                cell(2, &p.random_walk)
+            )?;
+        }
+        for note in &a.notes {
+            writeln!(out, "    note: {note}")?;
+        }
+    }
+    Ok(())
+}
+
 fn num(v: f64) -> String {
     let a = v.abs();
     if a != 0.0 && !(1e-3..1e5).contains(&a) {

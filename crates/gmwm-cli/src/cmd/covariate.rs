@@ -54,24 +54,24 @@ struct ColumnFit<'a> {
     bands: Vec<Band>,
 }
 
-/// The values of column `col` of `file`, read without notes (the recording's notes come
-/// once, from the read of its sensor columns); of a ROS recording, the covariate `col` one
-/// value per IMU message (a scalar topic or a magnitude, `gmwm::read_ros_covariate`), with
-/// its notes.
-fn covariate_column(
-    config: &CovariateFitConfig,
+/// The values of column `col` of `file` (read as `base` reads recordings), without notes
+/// (the recording's notes come once, from the read of its sensor columns); of a ROS
+/// recording, the covariate `col` one value per IMU message (a scalar topic or a magnitude,
+/// `gmwm::read_ros_covariate`), with its notes. Also its unit, when the recording says it.
+pub(super) fn covariate_values(
+    base: &crate::input::InputConfig,
     file: &Path,
     col: &str,
     style: OutputStyle,
-) -> Result<Vec<f64>> {
-    let mut input = config.fit.input.with_file(file);
+) -> Result<(Vec<f64>, Option<String>)> {
+    let mut input = base.with_file(file);
     if input.probe().is_ros() {
         // a scalar topic interpolated to the IMU messages, or a magnitude of their fields
         let covariate = gmwm::read_ros_covariate(file, input.topic.as_deref(), col)?;
         for n in &covariate.notes {
             style.note(file, n);
         }
-        return Ok(covariate.values);
+        return Ok((covariate.values, covariate.unit.map(str::to_owned)));
     }
     input.read.columns = vec![col
         .parse::<ColumnSelector>()
@@ -83,7 +83,16 @@ fn covariate_column(
     };
     // the reader's errors name the file, the line and the column
     let mut loaded = load(&input, quiet)?;
-    Ok(std::mem::take(&mut loaded.table.columns[0].values))
+    Ok((std::mem::take(&mut loaded.table.columns[0].values), None))
+}
+
+fn covariate_column(
+    config: &CovariateFitConfig,
+    file: &Path,
+    col: &str,
+    style: OutputStyle,
+) -> Result<Vec<f64>> {
+    Ok(covariate_values(&config.fit.input, file, col, style)?.0)
 }
 
 /// What a covariate fit runs on: the recordings (or windows) as reported, their names in

@@ -12,6 +12,7 @@ use gmwm::{
 
 mod allan;
 mod compare;
+mod covariate;
 mod fit;
 mod ieee;
 mod plan;
@@ -24,6 +25,7 @@ mod wv;
 
 pub use allan::allan_figure;
 pub use compare::compare_figure;
+pub use covariate::covariate_figure;
 pub use fit::fit_figure;
 pub use ieee::ieee_figure;
 pub use plan::plan_figure;

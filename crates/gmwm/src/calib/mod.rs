@@ -1,6 +1,7 @@
 //! Calibration: from a recording to navigation-filter parameters.
 pub(crate) mod audit;
 pub(crate) mod contamination;
+pub(crate) mod covariate;
 pub(crate) mod datasheet;
 pub(crate) mod effective;
 pub(crate) mod export;
@@ -16,6 +17,9 @@ pub(crate) mod verdict;
 
 pub use audit::{Audit, AuditQuantity, AuditStats};
 pub use contamination::{Contamination, FitUses};
+pub use covariate::{
+    AxisCurves, BandValue, CovariateCalibration, CovariateCalibrationOptions, CurvePoint,
+};
 pub use datasheet::{Datasheet, DatasheetComparison};
 pub use horizon::HorizonBound;
 

@@ -574,6 +574,13 @@ impl CovariateFit {
     pub fn model_at(&self, x: f64) -> Result<Model, FitError> {
         Ok(self.model.with_values(&self.theta_at(x)?)?)
     }
+
+    /// The parameters at `x` with the coefficients `c` (flat, as [`Self::flat_coefficients`])
+    /// in place of the estimate's: a draw of them, for bands of functions of the parameters.
+    pub(crate) fn theta_with(&self, c: &[f64], x: f64) -> Result<Vec<f64>, FitError> {
+        let u = self.layout().u_at(c, x);
+        self.param.to_theta(&u)
+    }
 }
 
 /// Least-squares coefficients of `y` on `(x - x0)^0..=degree` (normal equations, at most 3x3);

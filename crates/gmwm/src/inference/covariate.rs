@@ -63,6 +63,10 @@ pub struct CovariateInference {
     pub(crate) psi: DMatrix<f64>,
     #[serde(skip)]
     z: f64,
+    /// The WIC's optimism of the stacked fit, `2 tr((A' Omega A)^-1 A' Omega V Omega A)`: the
+    /// fit's objective plus it is the Wavelet Information Criterion that chooses among
+    /// dependence forms ([`CovariateInference::wic`]).
+    pub optimism: f64,
 }
 
 impl CovariateFit {
@@ -117,6 +121,16 @@ impl CovariateFit {
             at += j;
         }
         let psi = sandwich(&a, &DMatrix::from_diagonal(&omega), &v)?.psi;
+        // the WIC's optimism (docs/methods.md §8.1) on the stacked problem:
+        // 2 tr((A' Omega A)^-1 A' Omega V Omega A)
+        let oa = DMatrix::from_fn(total, q, |l, j| omega[l] * a[(l, j)]);
+        let bread = a.transpose() * &oa;
+        let meat = oa.transpose() * &v * &oa;
+        let tiny = 1e-12 * bread.amax();
+        let optimism = bread
+            .pseudo_inverse(tiny)
+            .map(|b| 2.0 * (b * meat).trace())
+            .unwrap_or(f64::NAN);
         let mut coefficients = Vec::with_capacity(q);
         for (i, (d, &o)) in layout.dependence.iter().zip(&layout.offset).enumerate() {
             for t in 0..d.terms() {
@@ -162,6 +176,7 @@ impl CovariateFit {
             per_parameter,
             psi,
             z,
+            optimism,
         })
     }
 }
@@ -187,6 +202,12 @@ fn wald(c: &[f64], psi: &DMatrix<f64>, idx: &[usize]) -> Option<(f64, f64)> {
 }
 
 impl CovariateInference {
+    /// The Wavelet Information Criterion of `fit` (the fit this inference is of): its stacked
+    /// objective plus [`Self::optimism`]; the dependence form with the smallest is chosen.
+    pub fn wic(&self, fit: &CovariateFit) -> f64 {
+        fit.objective + self.optimism
+    }
+
     /// The sandwich covariance of the coefficients (parameter by parameter, ascending power),
     /// as rows.
     pub fn covariance(&self) -> Vec<Vec<f64>> {
