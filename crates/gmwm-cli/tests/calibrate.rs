@@ -511,3 +511,124 @@ fn calibrate_a_ros2_mcap_with_dropped_messages() {
         doc["checks"]
     );
 }
+
+/// Issue 31 items 1 and 4: an MCAP written by `rosbags` with an IMU topic and a
+/// sensor_msgs/Temperature topic ramping 5 -> 35 °C, the white noise's variance x exp(0.03
+/// (T - 25)): `--covariate temperature` reads the topic, the curves and the report section
+/// come out, `--at 5` and `--over 0:40` export N at 5 °C and at 40 °C within 5% of the truth;
+/// a temperature topic that does not overlap the IMU topic, and a constant temperature
+/// column, are one line each.
+#[test]
+fn calibrate_against_a_temperature_topic_exports_at_and_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let ramp = [
+        "--temperature-topic",
+        "/imu/temperature",
+        "--temperature-ramp",
+        "5:35",
+        "--gyro-wn-log-slope",
+        "0.03",
+        "--accel-wn-log-slope",
+        "0.03",
+    ];
+    let bag = write_bag(dir.path(), "ramp", "mcap", 1 << 16, &ramp);
+    let n_at = |base: f64, t: f64| base * (0.015 * (t - 25.0)).exp();
+    let kalibr = dir.path().join("k5.yaml");
+    let report = dir.path().join("r.html");
+    let doc = run_json(
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--covariate", "temperature", "--at", "5", "--audit", "0"])
+            .arg("--kalibr")
+            .arg(&kalibr)
+            .arg("--report")
+            .arg(&report)
+            .args(["--json", "-"]),
+    );
+    let c = &doc["covariate"];
+    assert_eq!(c["covariate"], "temperature");
+    assert_eq!(c["unit"], "degC");
+    assert_eq!(c["windows"], 8);
+    let axes = c["axes"].as_array().unwrap();
+    assert_eq!(axes.len(), 6);
+    for a in axes {
+        assert_eq!(a["depends"][0], true, "{}", a["column"]);
+        assert!(a["points"].as_array().unwrap().len() >= 21);
+    }
+    let k = yaml(&kalibr);
+    let gyro: f64 = k["gyroscope_noise_density"].parse().unwrap();
+    let accel: f64 = k["accelerometer_noise_density"].parse().unwrap();
+    for (got, truth) in [(gyro, n_at(GYRO_N, 5.0)), (accel, n_at(ACCEL_N, 5.0))] {
+        assert!(
+            (got / truth - 1.0).abs() < 0.05,
+            "N at 5 degC: {got} vs {truth}"
+        );
+    }
+    let html = std::fs::read_to_string(&report).unwrap();
+    assert!(html.contains("id=\"covariate\"") && html.contains("Against temperature"));
+    // the worst case over 0..40 °C: N grows with T, so its largest is at 40 °C
+    let worst = dir.path().join("kw.yaml");
+    let out = gmwm()
+        .arg("calibrate")
+        .arg(&bag)
+        .args(["--covariate", "temperature", "--over", "0:40", "-q"])
+        .arg("--kalibr")
+        .arg(&worst)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("N, B, K against temperature"), "{text}");
+    let k = yaml(&worst);
+    let gyro: f64 = k["gyroscope_noise_density"].parse().unwrap();
+    assert!((gyro / n_at(GYRO_N, 40.0) - 1.0).abs() < 0.05, "{gyro}");
+    // a temperature topic 100 s after the IMU topic ends: nothing to align
+    let late = write_bag(
+        dir.path(),
+        "late",
+        "mcap",
+        2000,
+        &[
+            "--temperature-topic",
+            "/imu/temperature",
+            "--temperature-offset-s",
+            "120",
+        ],
+    );
+    assert_one_line_error(
+        gmwm()
+            .arg("calibrate")
+            .arg(&late)
+            .args(["--covariate", "temperature"]),
+        &[
+            "covariate topic /imu/temperature",
+            "does not overlap the IMU topic /imu0",
+        ],
+    );
+    // a constant temperature column cannot explain a dependence
+    let csv = dir.path().join("flat.csv");
+    let mut text = String::from("time,gyro_x,temperature\n");
+    let mut state = 12345u64;
+    for i in 0..20000 {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        text.push_str(&format!("{:.2},{:.6e},20.0\n", i as f64 / 100.0, 1e-2 * u));
+    }
+    std::fs::write(&csv, text).unwrap();
+    assert_one_line_error(
+        gmwm().arg("calibrate").arg(&csv).args([
+            "--covariate",
+            "temperature",
+            "--gyro-unit",
+            "rad/s",
+        ]),
+        &["--covariate temperature", "cannot explain a dependence"],
+    );
+}

@@ -319,3 +319,106 @@ fn covariate_study() {
         }
     }
 }
+
+/// docs/methods.md §5.14: a calibration against the temperature of one drifting recording
+/// (two gyroscope axes on the 0–40 °C ramp of [`ramp`]) gives N within 5% of the truth along
+/// the range, with bands that contain it; `--at` and `--over` put the curve's values into the
+/// report; a constant covariate is one clear error.
+#[test]
+fn calibration_against_temperature_gives_n_curves_and_exports() {
+    use gmwm::imu::{Column, Sensor, SensorInfo};
+    let n = 1 << 18;
+    let (x0, temps) = ramp(n, 23);
+    let (x1, _) = ramp(n, 24);
+    let info = |axis: &str| SensorInfo {
+        sensor: Sensor::Gyroscope,
+        axis: axis.into(),
+        unit: Some("rad/s".into()),
+    };
+    let imu = gmwm::Imu::new(
+        vec![
+            Column {
+                name: "gyro_x".into(),
+                values: x0,
+            },
+            Column {
+                name: "gyro_y".into(),
+                values: x1,
+            },
+        ],
+        vec![info("X"), info("Y")],
+        FREQ,
+    )
+    .unwrap();
+    let options = gmwm::CalibrationOptions {
+        full_model: "AR1()+WN()+RW()".parse().unwrap(),
+        robust_check: None,
+        ..gmwm::CalibrationOptions::default()
+    };
+    let calibration = gmwm::Calibration::new(options);
+    let report = calibration.run(&imu).unwrap();
+    let mut opts = gmwm::CovariateCalibrationOptions::new("temperature");
+    opts.unit = Some("degC".into());
+    opts.at = vec![5.0];
+    let curves = calibration
+        .covariate_curves(&imu, &report, &temps, &opts)
+        .unwrap();
+    assert_eq!(curves.axes.len(), 2);
+    assert!((curves.range[0] - 2.5).abs() < 1e-3 && (curves.range[1] - 37.5).abs() < 1e-3);
+    let n_truth = |t: f64| (truth_at(t, WN_SLOPE, GM_SLOPE).values()[0].unwrap() / FREQ).sqrt();
+    for a in &curves.axes {
+        assert!(a.depends[0], "{}: {:?}", a.column, a.notes);
+        assert!(a.points.iter().any(|p| p.covariate == 5.0));
+        for t in [5.0, 20.0, 35.0] {
+            let p = a.at(t).unwrap();
+            let nd = p.noise_density.unwrap();
+            let truth = n_truth(t);
+            assert!(
+                (nd.value / truth - 1.0).abs() < 0.05,
+                "{} at {t}: N {} vs {truth}",
+                a.column,
+                nd.value
+            );
+            let (lo, hi) = (nd.low.unwrap(), nd.high.unwrap());
+            assert!(lo < nd.value && nd.value < hi, "{lo} {} {hi}", nd.value);
+            // the GM term makes an Allan floor: B is read off the model at every T
+            assert!(p.bias_instability.is_some_and(|b| b.value > 0.0));
+        }
+    }
+    // --at 5: the report's N is the curve's at 5 °C, said so
+    let mut at5 = report.clone();
+    at5.at_covariate(&curves, 5.0).unwrap();
+    for (axis, a) in at5.axes.iter().zip(&curves.axes) {
+        let nd = axis.noise_density.as_ref().unwrap();
+        let want = a.at(5.0).unwrap().noise_density.unwrap();
+        assert_eq!(nd.value, want.value);
+        assert_eq!((nd.ci_low, nd.ci_high), (want.low, want.high));
+        assert!(
+            nd.source.starts_with("at temperature 5 degC"),
+            "{}",
+            nd.source
+        );
+        assert!(axis
+            .notes
+            .iter()
+            .any(|n| n.contains("N, B, K at temperature 5 degC")));
+    }
+    // --over 0:40: N grows with T here, so its worst case is at 40 °C (extrapolated, said so)
+    let mut worst = report.clone();
+    worst.worst_over(&curves, 0.0, 40.0).unwrap();
+    for (axis, a) in worst.axes.iter().zip(&curves.axes) {
+        let nd = axis.noise_density.as_ref().unwrap();
+        assert_eq!(nd.value, a.at(40.0).unwrap().noise_density.unwrap().value);
+        assert!(nd.source.contains("at 40 degC"), "{}", nd.source);
+        assert!(axis.notes.iter().any(|n| n.contains("extrapolated")));
+    }
+    assert!(worst.worst_over(&curves, 40.0, 0.0).is_err());
+    // a constant covariate cannot explain a dependence: one line naming it
+    let flat = vec![21.0; n];
+    let e = calibration
+        .covariate_curves(&imu, &report, &flat, &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(!e.contains('\n'), "{e}");
+    assert!(e.contains("cannot explain a dependence"), "{e}");
+}
