@@ -311,6 +311,21 @@ fn ros(ext: &str, data: &[u8]) {
             Err(e) => check_error(&e),
         }
     }
+    // a covariate (docs/methods.md §5.13): a scalar topic aligned to the IMU messages, and a
+    // magnitude of their fields; one value per IMU message, all finite
+    for name in ["temperature", "angular_rate"] {
+        match gmwm::read_ros_covariate(&path, None, name) {
+            Ok(c) => {
+                assert!(c.values.iter().all(|v| v.is_finite()));
+                let n = read_imu_messages(&path, None).map(|m| m.len()).unwrap_or(0);
+                assert_eq!(c.values.len(), n, "one covariate value per IMU message");
+                for note in &c.notes {
+                    assert!(!note.contains('\n'), "multi-line note: {note:?}");
+                }
+            }
+            Err(e) => check_error(&e),
+        }
+    }
 }
 
 /// A ROS1 bag (`x.bag`).
