@@ -16,7 +16,7 @@ use gmwm::{
 use std::path::PathBuf;
 use values::{
     alpha, at_least_1, at_least_2, choice, datasheet, efficiency, horizon_seconds, inflation,
-    positive_hz, seed, signal_unit, tolerance, whole,
+    positive_hz, seed, signal_unit, tolerance, whole, window_count,
 };
 
 const EXAMPLES: &str = "\
@@ -163,7 +163,11 @@ Examples:
   gmwm calibrate runs/ --out-dir calib/ --kalibr imu.yaml      every recording in runs/
   gmwm calibrate 'runs/*.csv.gz' a.bag --json summary.json      a glob (quoted) and a file
   gmwm calibrate imu1.csv.gz imu2.csv.gz imu3.csv.gz --pool --kalibr imu.yaml
-      one calibration of three recordings of one sensor (their pooled wavelet variance)";
+      one calibration of three recordings of one sensor (their pooled wavelet variance)
+  gmwm calibrate warmup.mcap --covariate temperature --at 5 --kalibr imu.yaml
+      N, B, K against the bag's sensor_msgs/Temperature topic; the filter file at 5 degC
+  gmwm calibrate ramp.csv --covariate temperature --over 0:40 --report r.html
+      the worst case over 0..40 degC of a recording whose temperature column drifts";
 
 const WV_EXAMPLES: &str = "\
 Many recordings (batch mode: several FILEs, a folder, a quoted glob, or --out-dir/--force):
@@ -330,7 +334,7 @@ pub struct CalibrateArgs {
     pub covariate: Option<String>,
     /// With --covariate: cut the recording into K windows of equal length, each at its mean
     /// level [default: 8, at most 64].
-    #[arg(long, value_name = "K", value_parser = at_least_2, requires = "covariate")]
+    #[arg(long, value_name = "K", value_parser = window_count, requires = "covariate")]
     pub windows: Option<usize>,
     /// With --covariate: export (and report as the axes' N, B, K) the values at covariate
     /// value X, e.g. --at 5 for 5 degC [default: the estimates of the whole recording].
@@ -686,7 +690,7 @@ pub struct SelectArgs {
     pub depends: Vec<String>,
     /// With --covariate and one FILE whose covariate drifts (a temperature ramp): cut it into K
     /// windows of equal length, each at its mean level [default: 8].
-    #[arg(long, value_name = "K", value_parser = at_least_2)]
+    #[arg(long, value_name = "K", value_parser = window_count)]
     pub windows: Option<usize>,
     /// With a covariate: report the parameters and their pointwise bands at these levels
     /// [default: each FILE's; with --windows the lowest, middle and highest level].
@@ -772,7 +776,7 @@ pub struct FitArgs {
     pub depends: Vec<String>,
     /// With --covariate and one FILE whose covariate drifts (a temperature ramp): cut it into K
     /// windows of equal length, each at its mean level [default: 8].
-    #[arg(long, value_name = "K", value_parser = at_least_2)]
+    #[arg(long, value_name = "K", value_parser = window_count)]
     pub windows: Option<usize>,
     /// With a covariate: report the parameters and their pointwise bands at these levels
     /// [default: each FILE's; with --windows the lowest, middle and highest level].

@@ -300,6 +300,12 @@ pub fn at_least_2(s: &str) -> Result<usize, String> {
     count_at_least(s, 2).map_err(|e| format!("{e} (a covariance needs two replicates)"))
 }
 
+/// A number of windows (`--windows`): a whole number >= 2 (a dependence needs two levels).
+pub fn window_count(s: &str) -> Result<usize, String> {
+    count_at_least(s, 2)
+        .map_err(|e| format!("{e} (a dependence needs windows at two levels at least)"))
+}
+
 /// A whole number >= 0 (`--top`).
 pub fn whole(s: &str) -> Result<usize, String> {
     count_at_least(s, 0)
