@@ -80,7 +80,15 @@ struct ImuTimes {
 impl MessageSink for ImuTimes {
     fn message(&mut self, _header_ns: i64, log_ns: i64, values: &[f64]) -> Result<(), ReadError> {
         self.log_ns.push(log_ns);
-        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // scaled, so that finite values of any size give a finite magnitude
+        let norm = |v: &[f64]| {
+            let m = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            if m == 0.0 {
+                0.0
+            } else {
+                m * v.iter().map(|x| (x / m) * (x / m)).sum::<f64>().sqrt()
+            }
+        };
         match self.derived {
             Some(Derived::AngularRate) => self.values.push(norm(&values[..3])),
             Some(Derived::SpecificForce) => self.values.push(norm(&values[3..6])),
@@ -369,7 +377,9 @@ fn align(imu_ns: &[i64], msgs: &[(i64, f64)]) -> Option<Aligned> {
         let (tb, vb) = msgs[j + 1];
         // ta <= t < tb here (tb > ta as t is strictly inside)
         let w = (t - ta) as f64 / (tb - ta) as f64;
-        values.push(va + w * (vb - va));
+        // a convex combination: finite for any finite ends (va + w (vb - va) overflows when
+        // they are near the largest f64 of opposite signs)
+        values.push((1.0 - w) * va + w * vb);
     }
     let seconds = |ns: i64| ns as f64 * 1e-9;
     Some(Aligned {
@@ -399,6 +409,9 @@ mod tests {
         assert!(align(&[0, 10], &msgs).is_some());
         assert_eq!(align(&[], &msgs), None);
         assert_eq!(align(&imu, &[]), None);
+        // ends near the largest f64, of opposite signs: still finite
+        let huge = align(&[0, 5, 10], &[(0, -1e308), (10, 1e308)]).unwrap();
+        assert!(huge.values.iter().all(|v| v.is_finite()), "{:?}", huge.values);
         // one message inside the span: a constant
         let one = align(&imu, &[(12, 7.0)]).unwrap();
         assert!(one.values.iter().all(|&v| v == 7.0));
