@@ -320,9 +320,10 @@ impl Calibration {
     /// plus `options.at`.
     ///
     /// # Errors
-    /// [`CalibError::Fit`] when the covariate's length differs from the recording's, a window
-    /// is too short for the model, or the fit fails; [`CalibError::Input`] for a covariate
-    /// that is constant (it cannot explain a dependence) or not finite.
+    /// [`CalibError::Fit`], naming the column, when the covariate's length differs from the
+    /// recording's, a window is too short for the model, a covariate value is not finite, the
+    /// covariate is the same in every window (it cannot explain a dependence), or the fit
+    /// fails.
     pub fn covariate_curves(
         &self,
         imu: &Imu,
@@ -684,7 +685,8 @@ impl CalibrationReport {
     /// hold over the whole range; a note on each axis says where each maximum is.
     ///
     /// # Errors
-    /// [`CalibError::Fit`] for a non-finite or empty range.
+    /// [`CalibError::Input`] for a non-finite or empty range; [`CalibError::Fit`] when a curve
+    /// cannot be evaluated.
     pub fn worst_over(
         &mut self,
         curves: &CovariateCalibration,

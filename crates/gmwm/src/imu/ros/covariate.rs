@@ -411,7 +411,11 @@ mod tests {
         assert_eq!(align(&imu, &[]), None);
         // ends near the largest f64, of opposite signs: still finite
         let huge = align(&[0, 5, 10], &[(0, -1e308), (10, 1e308)]).unwrap();
-        assert!(huge.values.iter().all(|v| v.is_finite()), "{:?}", huge.values);
+        assert!(
+            huge.values.iter().all(|v| v.is_finite()),
+            "{:?}",
+            huge.values
+        );
         // one message inside the span: a constant
         let one = align(&imu, &[(12, 7.0)]).unwrap();
         assert!(one.values.iter().all(|&v| v == 7.0));
