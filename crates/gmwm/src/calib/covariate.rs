@@ -161,7 +161,8 @@ fn quantities(model: &Model, freq_hz: f64, levels: usize) -> [Option<f64>; 3] {
 /// random-walk variances alone (so a draw whose other parameters are out of range still
 /// gives them), B from the implied WV, and only when the model has a term that makes an
 /// Allan-deviation floor (a Gauss–Markov or flicker term: without one the minimum is where
-/// the white noise meets the random walk, or the longest scale).
+/// the white noise meets the random walk) and the minimum lies inside the scales (a floor
+/// reached; at the longest scale the deviation is still falling).
 fn quantities_at(model: &Model, theta: &[f64], freq_hz: f64, levels: usize) -> [Option<f64>; 3] {
     let (mut wn, mut rw, mut floor) = (None::<f64>, None::<f64>, false);
     let mut at = 0;
@@ -180,12 +181,19 @@ fn quantities_at(model: &Model, theta: &[f64], freq_hz: f64, levels: usize) -> [
         let m = model.with_values(theta).ok()?;
         m.implied_wv(levels, freq_hz).ok()
     };
+    // a floor: the minimum inside the scales, not at the longest (where an Allan deviation
+    // still falling would put it: no floor reached, no bias instability to read off)
     let b = floor.then(implied).flatten().and_then(|w| {
-        w.wv.iter()
-            .map(|&nu| (2.0 * nu).sqrt())
-            .filter(|a| a.is_finite() && *a > 0.0)
-            .reduce(f64::min)
-            .map(|a| a / FLICKER_FLOOR)
+        let ad: Vec<f64> = w.wv.iter().map(|&nu| (2.0 * nu).sqrt()).collect();
+        if ad.iter().any(|a| !(a.is_finite() && *a > 0.0)) {
+            return None;
+        }
+        let (at, min) = ad
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        (at + 1 < ad.len()).then_some(min / FLICKER_FLOOR)
     });
     let finite = |v: f64| v.is_finite().then_some(v);
     [
@@ -872,7 +880,8 @@ mod tests {
         // no Gauss–Markov or flicker term: no floor, no B
         assert!(b.is_none());
         // the Allan deviation's minimum over the dyadic scales, / 0.664
-        let m: Model = "GM(beta=0.5, sigma2_gm=1e-6)+WN(sigma2=4e-4)+RW(gamma2=1e-10)"
+        // (the random walk meets the white noise at 3.5 s: a floor inside the 41 s of scales)
+        let m: Model = "GM(beta=0.5, sigma2_gm=1e-6)+WN(sigma2=4e-4)+RW(gamma2=1e-8)"
             .parse()
             .unwrap();
         let [_, b, _] = quantities(&m, 100.0, 12);
@@ -882,9 +891,10 @@ mod tests {
                 .map(|v| (2.0 * v).sqrt())
                 .fold(f64::INFINITY, f64::min);
         assert!((b.unwrap() - min / 0.664).abs() < 1e-15);
+        // an AR1 alone: its Allan deviation still falls at the longest scale, no floor
         let only: Model = "AR1(phi=0.9, sigma2=1e-4)".parse().unwrap();
         let [n, b, k] = quantities(&only, 100.0, 12);
-        assert!(n.is_none() && k.is_none() && b.is_some());
+        assert!(n.is_none() && k.is_none() && b.is_none());
     }
 
     #[test]
