@@ -633,13 +633,13 @@ fn covariate_summary(c: &gmwm::CovariateCalibration, out: &mut impl Write) -> Re
                 || "no test".to_string(),
                 |t| {
                     format!(
-                        "no dependence: W = {:.1}, df = {}, p = {}",
+                        "no dependence: W = {:.1}, df = {}, p {}",
                         t.statistic,
                         t.df,
                         if t.p_value < 1e-16 {
                             "< 1e-16".to_string()
                         } else {
-                            format!("{:.3}", t.p_value)
+                            format!("= {:.3}", t.p_value)
                         }
                     )
                 },
