@@ -19,7 +19,7 @@ use crate::recordings::{is_glob, is_rosbag2_folder};
 use crate::render::Style;
 use anyhow::{Context, Result};
 use gmwm::{
-    Adjustment, AllanKind, AllanOptions, AvConvention, AxisPolicy, CalibrationOptions,
+    Adjustment, AugmentOptions, AllanKind, AllanOptions, AvConvention, AxisPolicy, CalibrationOptions,
     ColumnSelector, Datasheet, ExportFormat, Gmwm, InferenceOptions, Model, MonitorOptions,
     ReadOptions, RobustOptions, SameModelOptions, SharedOptions, SignalUnit, Transform,
     WaveletFilter, Weighting, Wic, WvOptions, DEFAULT_FULL_MODEL,
@@ -448,6 +448,8 @@ pub struct FitConfig {
     pub wv: WvOptions,
     /// `--inference` (and `--bootstrap B`): docs/methods.md §7 on each fit; `None` without.
     pub inference: Option<InferenceOptions>,
+    /// `--augment`: GMWM+ beside each fit (docs/methods.md §5.15); `None` without.
+    pub augment: Option<AugmentOptions>,
     /// Flags a saved wavelet variance cannot honour (`--robust`, `--filter`/`--transform`,
     /// `--weights diag`).
     pub saved_wv: SavedWvCheck,
@@ -488,11 +490,17 @@ impl TryFrom<&FitArgs> for FitConfig {
                     .to_string()
             })
         });
+        let augment = a.augment.map(|augment| AugmentOptions {
+            seed: a.seed,
+            alpha: a.estimator.alpha,
+            ..AugmentOptions::new(augment)
+        });
         Ok(Self {
             input,
             gmwm,
             wv,
             inference,
+            augment,
             saved_wv,
             output: (&a.output).into(),
         })
@@ -598,6 +606,8 @@ pub struct CalibrateConfig {
     pub audit: usize,
     /// `--covariate COL` and its options: N, B, K against a covariate.
     pub covariate: Option<CovariateCalibrationConfig>,
+    /// `--augment`: GMWM+ of every axis' identified model (docs/methods.md §5.15).
+    pub augment: Option<AugmentOptions>,
 }
 
 /// Which N, B, K a calibration against a covariate exports.
@@ -730,6 +740,11 @@ impl TryFrom<&CalibrateArgs> for CalibrateConfig {
             report: a.report.clone(),
             pool: Vec::new(),
             covariate: CovariateCalibrationConfig::of(a)?,
+            augment: a.augment.map(|augment| AugmentOptions {
+                seed: a.seed,
+                alpha: a.estimator.alpha,
+                ..AugmentOptions::new(augment)
+            }),
             audit: a.audit.unwrap_or(if a.report.is_some() {
                 DEFAULT_REPORT_AUDIT
             } else {

@@ -409,6 +409,7 @@ fn fit(
                 fit,
                 canonical,
                 inference: inferences.get(k),
+                augmented: None,
             })
             .collect();
         Ok(json(&gmwm::document::fits(&items)))

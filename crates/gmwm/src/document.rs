@@ -2,6 +2,7 @@
 //! print and what the Python package's `to_dict()` returns, built in one place so that the two
 //! agree field for field.
 
+use crate::augmented::AugmentedFit;
 use crate::calib::{CalibrationReport, NavSet};
 use crate::fit::{
     Ar1GmForms, CanonicalModel, CanonicalTerm, NavParameter, ParameterEstimate, Reading,
@@ -94,6 +95,8 @@ struct FitReport<'a> {
     reduced_model: String,
     canonical: &'a [CanonicalTerm],
     canonical_notes: Vec<CanonicalNote<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    augmented: Option<&'a AugmentedFit>,
     fit: &'a GmwmFit,
 }
 
@@ -108,12 +111,15 @@ pub struct FitItem<'a> {
     pub canonical: &'a CanonicalModel,
     /// Its inference, when asked.
     pub inference: Option<&'a Inference>,
+    /// Its GMWM+ fit, when asked (`--augment`).
+    pub augmented: Option<&'a AugmentedFit>,
 }
 
 /// `{"fits": [...]}`: the document of `gmwm fit --json`. Per column: `column`, `model`,
 /// `objective`, `converged`, `parameters` (`{process, index, name, value, start[, se, ci_low,
 /// ci_high]}`), `gof` and `inference` (with inference), `ar1_gm`, `navigation`,
-/// `canonical_model`, `reduced_model`, `canonical`, `canonical_notes`, `fit`.
+/// `canonical_model`, `reduced_model`, `canonical`, `canonical_notes`, `augmented` (with
+/// `--augment`: [`AugmentedFit`]'s wire format), `fit`.
 pub fn fits(items: &[FitItem<'_>]) -> Value {
     #[derive(Serialize)]
     struct Doc<'a> {
@@ -152,6 +158,7 @@ pub fn fits(items: &[FitItem<'_>]) -> Value {
                 reduced_model: it.canonical.reduced.to_string(),
                 canonical: &it.canonical.terms,
                 canonical_notes: canonical_notes(it.canonical),
+                augmented: it.augmented,
                 fit,
             }
         })

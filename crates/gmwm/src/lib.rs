@@ -42,6 +42,7 @@
 #[cfg(test)]
 extern crate self as gmwm;
 
+mod augmented;
 mod calib;
 pub mod document;
 mod error;
@@ -101,11 +102,16 @@ pub use process::{
 pub use sim::{simulate_model, DemoSensor, Simulator};
 
 // GMWM fits, their inference and model selection (§5-§8).
+pub use augmented::{
+    augment_fit, fit_augmented, AugmentOptions, AugmentedFit, AugmentedJTest, AugmentedMoment,
+    AugmentedPhysical,
+    AugmentedParameter, DEFAULT_AUGMENT_REPLICATES,
+};
 pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
 pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{
     covariate_level, covariate_windows, dependences, Convergence, CovariateFit, CovariateRecording,
-    Dependence, FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter,
+    Augment, Dependence, FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter,
     ParameterEstimate, PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
 };
 pub use inference::same_model::{
@@ -161,7 +167,7 @@ pub use calib::export::{render_export, ExportError, ExportFormat, NavNoise, Sens
 pub use calib::ieee::{ieee_readoff, term_avar, CoefficientReadoff, IeeeReadoff};
 pub use calib::streamed::{binary_file_columns, wv_account, wv_columns};
 pub use calib::{
-    spread_across, Audit, AuditQuantity, AuditStats, AxisCurves, BandValue, Contamination,
+    spread_across, Audit, AuditQuantity, AuditStats, AxisAugmented, AxisCurves, BandValue, Contamination,
     CovariateCalibration, CovariateCalibrationOptions, CurvePoint, FitUses, FitVerdict,
     GaussMarkovBias, HorizonBound, Plan, PlanTarget, PlannedQuantity, PooledInput, RecordedAxis,
     ScaleFit, ScaleMiss, SpreadAcross, SpreadRow, PLAN_LENGTHS_S,

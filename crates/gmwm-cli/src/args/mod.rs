@@ -15,7 +15,7 @@ use gmwm::{
 };
 use std::path::PathBuf;
 use values::{
-    alpha, at_least_1, at_least_2, choice, datasheet, efficiency, horizon_seconds, inflation,
+    alpha, at_least_1, augment, at_least_2, choice, datasheet, efficiency, horizon_seconds, inflation,
     positive_hz, seed, signal_unit, tolerance, whole, window_count,
 };
 
@@ -94,7 +94,7 @@ pub enum Command {
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
         allow_negative_numbers = true,
-        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three\n  gmwm fit t5.csv t15.csv t25.csv t35.csv --covariate-values 5,15,25,35 --model \"GM()+WN()\"   parameters as functions of temperature\n  gmwm fit a.csv b.csv c.csv --covariate temperature --model \"GM()+WN()\" --depends variances=quadratic --at 0,40 --json\n  gmwm fit ramp.csv --covariate temperature --windows 12 --model \"GM()+WN()+RW()\"   one recording whose temperature drifts\n  gmwm fit run.mcap --covariate temperature --windows 8 --model \"WN()+RW()\"   a ROS bag with a sensor_msgs/Temperature topic"
+        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit imu.csv.gz --columns gyro_x --model \"GM()+WN()+RW()\" --augment acf:3   GMWM+ beside GMWM\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three\n  gmwm fit t5.csv t15.csv t25.csv t35.csv --covariate-values 5,15,25,35 --model \"GM()+WN()\"   parameters as functions of temperature\n  gmwm fit a.csv b.csv c.csv --covariate temperature --model \"GM()+WN()\" --depends variances=quadratic --at 0,40 --json\n  gmwm fit ramp.csv --covariate temperature --windows 12 --model \"GM()+WN()+RW()\"   one recording whose temperature drifts\n  gmwm fit run.mcap --covariate temperature --windows 8 --model \"WN()+RW()\"   a ROS bag with a sensor_msgs/Temperature topic"
     )]
     Fit(FitArgs),
     /// Select a model by the Wavelet Information Criterion on each selected column (docs/methods.md
@@ -332,6 +332,12 @@ pub struct CalibrateArgs {
     /// interpolated to the IMU messages, or angular_rate / specific_force.
     #[arg(long, value_name = "COL")]
     pub covariate: Option<String>,
+    /// GMWM+ (docs/methods.md §5.15) of each axis' identified model: the WV stacked with
+    /// extra moments of the samples' first differences, `mean` (a DR term's slope), `acf:K`
+    /// (their autocovariances at lags 1..K) or both; reported beside the calibration's
+    /// estimates with intervals and a J-test (the exports stay the calibration's).
+    #[arg(long, value_name = "LIST", value_parser = augment)]
+    pub augment: Option<gmwm::Augment>,
     /// With --covariate: cut the recording into K windows of equal length, each at its mean
     /// level [default: 8, at most 64].
     #[arg(long, value_name = "K", value_parser = window_count, requires = "covariate")]
@@ -744,6 +750,13 @@ pub struct FitArgs {
     /// sandwich (bootstrap SE/CI and the bootstrap goodness-of-fit p-value).
     #[arg(long, value_name = "B", requires = "inference", value_parser = at_least_2)]
     pub bootstrap: Option<usize>,
+    /// GMWM+ (docs/methods.md §5.15): also fit the model to the WV stacked with extra moments
+    /// of the series' first differences, `mean` (the slope of a DR term), `acf:K` (their
+    /// autocovariances at lags 1..K) or both (`mean,acf:3`), weighted by their joint covariance
+    /// from 200 bootstrap series at the GMWM fit; shown beside the GMWM estimates with
+    /// intervals and a J-test.
+    #[arg(long, value_name = "LIST", value_parser = augment, conflicts_with_all = ["pool", "covariate", "covariate_values"])]
+    pub augment: Option<gmwm::Augment>,
     /// Fit one model to all FILEs (recordings of one sensor at one rate, docs/methods.md
     /// §5.11): `gmwm fit a.csv b.csv c.csv --pool --model M`.
     #[arg(long)]

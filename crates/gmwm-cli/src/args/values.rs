@@ -306,6 +306,13 @@ pub fn window_count(s: &str) -> Result<usize, String> {
         .map_err(|e| format!("{e} (a dependence needs windows at two levels at least)"))
 }
 
+/// `--augment`: `mean`, `acf:K` or both (docs/methods.md §5.15).
+pub fn augment(s: &str) -> Result<gmwm::Augment, String> {
+    s.parse().map_err(|_| {
+        "expected mean, acf:K (K from 1 to 16) or both, comma-separated, e.g. mean,acf:3".into()
+    })
+}
+
 /// A whole number >= 0 (`--top`).
 pub fn whole(s: &str) -> Result<usize, String> {
     count_at_least(s, 0)

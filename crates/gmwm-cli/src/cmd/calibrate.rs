@@ -101,16 +101,18 @@ pub fn execute_in(
         let (recording, report) = calibrate_pooled(config, report_path, mode)?;
         (recording, report, None)
     };
-    let curves = match &config.covariate {
-        Some(c) => Some(against_covariate(
-            config,
-            c,
-            &recording,
-            samples,
-            &mut report,
-            mode,
-        )?),
-        None => None,
+    let samples = if config.covariate.is_some() || config.augment.is_some() {
+        Some(samples_of(config, &recording, samples)?)
+    } else {
+        None
+    };
+    let curves = match (&config.covariate, &samples) {
+        (Some(c), Some(imu)) => Some(against_covariate(config, c, imu, &mut report, mode)?),
+        _ => None,
+    };
+    let augmented = match (&config.augment, &samples) {
+        (Some(opts), Some(imu)) => Some(augmented(config, opts, imu, &report, mode)?),
+        _ => None,
     };
     let audited = audit(config, &mut report, mode)?;
     // unknown for a file that is not a ROS recording: the exporter writes its placeholder and
@@ -149,6 +151,9 @@ pub fn execute_in(
     if let Some(c) = &curves {
         doc["covariate"] = serde_json::to_value(c)?;
     }
+    if let Some(a) = &augmented {
+        doc["augmented"] = serde_json::to_value(a)?;
+    }
     if let Some(path) = report_path {
         match write_report(
             config,
@@ -184,6 +189,9 @@ pub fn execute_in(
             summary(&recording, &report, out)?;
             if let Some(c) = &curves {
                 covariate_summary(c, out)?;
+            }
+            if let Some(a) = &augmented {
+                augmented_summary(a, out)?;
             }
             if let Some(seconds) = audited {
                 writeln!(
@@ -239,34 +247,12 @@ fn audit(
 fn against_covariate(
     config: &CalibrateConfig,
     c: &crate::config::CovariateCalibrationConfig,
-    recording: &crate::input::LoadedRecording,
-    samples: Option<gmwm::Imu>,
+    imu: &gmwm::Imu,
     report: &mut CalibrationReport,
     mode: Mode,
 ) -> Result<gmwm::CovariateCalibration> {
     use crate::config::CovariateExport;
     let file = &config.input.file;
-    if !config.pool.is_empty() {
-        return Err(UsageError(
-            "--covariate calibrates one recording cut into windows; for several recordings at \
-             different levels use gmwm fit FILE... --covariate COL"
-                .into(),
-        )
-        .into());
-    }
-    if matches!(recording.source, gmwm::RecordingSource::SavedWv) {
-        return Err(UsageError(format!(
-            "{}: --covariate needs the samples; a saved wavelet variance has none",
-            file.display()
-        ))
-        .into());
-    }
-    let imu = match samples {
-        Some(imu) => imu,
-        None => crate::input::load_recording(&config.input)?
-            .imu
-            .context("the recording's samples")?,
-    };
     let (values, unit) =
         super::covariate::covariate_values(&config.input, file, &c.column, mode.style)?;
     let options = gmwm::CovariateCalibrationOptions {
@@ -286,7 +272,7 @@ fn against_covariate(
     );
     spinner.enable_steady_tick(std::time::Duration::from_millis(250));
     let curves = calibration
-        .covariate_curves(&imu, report, &values, &options)
+        .covariate_curves(imu, report, &values, &options)
         .with_context(|| format!("{}: --covariate {}", file.display(), c.column))?;
     spinner.finish_and_clear();
     match c.export {
@@ -295,6 +281,145 @@ fn against_covariate(
         CovariateExport::Whole => {}
     }
     Ok(curves)
+}
+
+/// The samples `--covariate` and `--augment` work on: those the calibration held, else the
+/// recording read again (a streamed one); refused for a pooled calibration and a saved WV.
+fn samples_of(
+    config: &CalibrateConfig,
+    recording: &crate::input::LoadedRecording,
+    samples: Option<gmwm::Imu>,
+) -> Result<gmwm::Imu> {
+    let flag = if config.covariate.is_some() {
+        "--covariate"
+    } else {
+        "--augment"
+    };
+    if !config.pool.is_empty() {
+        return Err(UsageError(if config.covariate.is_some() {
+            "--covariate calibrates one recording cut into windows; for several recordings at \
+             different levels use gmwm fit FILE... --covariate COL"
+                .to_string()
+        } else {
+            "--augment works on one recording's samples; calibrate the recordings one by one"
+                .to_string()
+        })
+        .into());
+    }
+    if matches!(recording.source, gmwm::RecordingSource::SavedWv) {
+        return Err(UsageError(format!(
+            "{}: {flag} needs the samples; a saved wavelet variance has none",
+            config.input.file.display()
+        ))
+        .into());
+    }
+    match samples {
+        Some(imu) => Ok(imu),
+        None => crate::input::load_recording(&config.input)?
+            .imu
+            .context("the recording's samples"),
+    }
+}
+
+/// `--augment`: GMWM+ of every axis' identified model (the engine's `Calibration::augmented`).
+fn augmented(
+    config: &CalibrateConfig,
+    opts: &gmwm::AugmentOptions,
+    imu: &gmwm::Imu,
+    report: &CalibrationReport,
+    mode: Mode,
+) -> Result<Vec<gmwm::AxisAugmented>> {
+    let spinner = mode.style.bar(
+        1,
+        &format!(
+            "GMWM+ ({}) with {} bootstrap series per axis",
+            opts.augment, opts.replicates
+        ),
+        "steps",
+    );
+    spinner.enable_steady_tick(std::time::Duration::from_millis(250));
+    let out = Calibration::new(config.options.clone())
+        .augmented(imu, report, opts)
+        .with_context(|| format!("{}: --augment {}", config.input.file.display(), opts.augment))?;
+    spinner.finish_and_clear();
+    Ok(out)
+}
+
+/// The `--augment` table: per axis the physical quantities of GMWM and GMWM+ and the J-test.
+fn augmented_summary(axes: &[gmwm::AxisAugmented], out: &mut impl Write) -> Result<()> {
+    let Some(first) = axes.iter().find_map(|a| a.fit.as_ref()) else {
+        writeln!(out, "\nGMWM+:")?;
+        for a in axes {
+            if let Some(n) = &a.note {
+                writeln!(out, "  {n}")?;
+            }
+        }
+        return Ok(());
+    };
+    writeln!(
+        out,
+        "\nGMWM+ (augment {}; the exports above stay GMWM's)",
+        first.augment()
+    )?;
+    writeln!(
+        out,
+        "  {:<9} {:<34} {:>12} {:>12} {:>27}  {}",
+        "axis", "quantity", "GMWM", "GMWM+", "95% interval", "unit"
+    )?;
+    for a in axes {
+        let Some(fit) = &a.fit else {
+            if let Some(n) = &a.note {
+                writeln!(out, "  {:<9} {n}", a.column)?;
+            }
+            continue;
+        };
+        for q in &a.physical {
+            let ci = match (q.ci_low, q.ci_high) {
+                // an interval from 0 to infinity: the stacked moments cannot place it
+                (Some(lo), Some(hi)) if lo > 0.0 && hi.is_finite() => {
+                    format!("[{lo:.4e}, {hi:.4e}]")
+                }
+                (Some(_), Some(_)) => "not determined".to_string(),
+                _ => "-".to_string(),
+            };
+            writeln!(
+                out,
+                "  {:<9} {:<34} {:>12.4e} {:>12.4e} {:>27}  {}",
+                a.column,
+                format!("{}[{}].{}", q.process, q.index, q.name),
+                q.gmwm,
+                q.value,
+                ci,
+                q.unit
+            )?;
+        }
+        let j = fit.j_test();
+        let p = match j.p_value {
+            Some(p) if p < 1e-16 => "p < 1e-16".to_string(),
+            Some(p) => format!("p = {p:.3}"),
+            None => "no degrees of freedom".to_string(),
+        };
+        writeln!(
+            out,
+            "  {:<9} J-test of the stacked moments: Q = {:.1} on {} df, {p}",
+            a.column, j.statistic, j.df
+        )?;
+        if j.p_value.is_some_and(|p| p < 0.001) {
+            writeln!(
+                out,
+                "  {:<9} the model does not reproduce the differences' first autocovariances \
+                 (observed against implied: {}): the sensor's own filter shapes them; read \
+                 GMWM+ here as a check of the model, not as better estimates",
+                a.column,
+                fit.moments()[fit.moments().len() - fit.augment().len()..]
+                    .iter()
+                    .map(|m| format!("{} {:.3e} vs {:.3e}", m.name, m.observed, m.implied))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// One recording read (streamed when long) and calibrated; its samples too when they were

@@ -10,7 +10,7 @@ use crate::render::Style;
 use crate::style::OutputStyle;
 use anyhow::Result;
 use gmwm::{
-    infer_with_progress, CanonicalModel, GmwmFit, Inference, InferenceOptions, StartInputs,
+    fit_augmented, infer_with_progress, AugmentedFit, CanonicalModel, GmwmFit, Inference, InferenceOptions, StartInputs,
     WaveletVariance, Weighting,
 };
 use rayon::prelude::*;
@@ -118,8 +118,17 @@ impl Command for FitConfig {
     }
 
     fn run(&self, style: OutputStyle, mut out: &mut dyn Write) -> Result<()> {
+        if self.augment.is_some() {
+            let augmented = compute_augmented(self, style)?;
+            let fits: Vec<(String, GmwmFit)> = augmented
+                .iter()
+                .map(|(c, a)| (c.clone(), a.gmwm().clone()))
+                .collect();
+            let plus: Vec<&AugmentedFit> = augmented.iter().map(|(_, a)| a).collect();
+            return render_fits(self, style, &fits, Some(&plus), &mut out);
+        }
         let fits = compute(self, style)?;
-        render_fits(self, style, &fits, &mut out)
+        render_fits(self, style, &fits, None, &mut out)
     }
 }
 
@@ -152,12 +161,59 @@ pub fn compute(config: &FitConfig, style: OutputStyle) -> Result<Vec<(String, Gm
     Ok(fits)
 }
 
+/// GMWM+ (`--augment`, docs/methods.md §5.15) on every selected column of a recording: the
+/// series are needed (the extra moments and the bootstrap), so a saved WV is refused.
+fn compute_augmented(
+    config: &FitConfig,
+    style: OutputStyle,
+) -> Result<Vec<(String, AugmentedFit)>> {
+    let file = &config.input.file;
+    let Some(opts) = &config.augment else {
+        anyhow::bail!("no --augment given");
+    };
+    anyhow::ensure!(
+        !is_wv(&config.input),
+        "{}: --augment needs the series (its differences' moments and the bootstrap), and this \
+         file is a saved wavelet variance: give the recording instead",
+        file.display()
+    );
+    let loaded = load(&config.input, style)?;
+    let bar = style.bar(
+        loaded.table.columns.len() as u64,
+        "GMWM+ fits",
+        "columns",
+    );
+    let fits = analyse_columns(&loaded, file, |x| {
+        let r = fit_augmented(&config.gmwm, x, loaded.freq_hz, &config.wv, opts)
+            .map_err(gmwm::Error::from);
+        bar.inc(1);
+        r
+    })?;
+    bar.finish_and_clear();
+    for (name, fit) in &fits {
+        for (what, c) in [
+            ("GMWM", fit.gmwm().convergence()),
+            ("GMWM+", fit.estimates().convergence()),
+        ] {
+            if !c.converged {
+                eprintln!(
+                    "gmwm: warning: {}: column {name}: the {what} optimiser did not converge ({c})",
+                    file.display()
+                );
+            }
+        }
+    }
+    Ok(fits)
+}
+
 fn render_fits(
     config: &FitConfig,
     style: OutputStyle,
     fits: &[(String, GmwmFit)],
+    augmented: Option<&[&AugmentedFit]>,
     out: &mut impl Write,
 ) -> Result<()> {
+    let plus = |i: usize| augmented.map(|a| a[i]);
     let canonicals: Vec<CanonicalModel> = fits
         .par_iter()
         .map(|(column, fit)| {
@@ -181,12 +237,14 @@ fn render_fits(
                 .iter()
                 .zip(&inferences)
                 .zip(&canonicals)
+                .enumerate()
                 .map(
-                    |(((column, fit), inf), canonical)| gmwm::document::FitItem {
+                    |(i, (((column, fit), inf), canonical))| gmwm::document::FitItem {
                         column,
                         fit,
                         canonical,
                         inference: inf.as_ref(),
+                        augmented: plus(i),
                     },
                 )
                 .collect();
@@ -231,6 +289,26 @@ fn render_fits(
                     )?;
                 }
             }
+            if let Some(augmented) = augmented {
+                // GMWM+ rows: process `GMWM+`, the label as name, its own objective
+                for ((column, _), a) in fits.iter().zip(augmented) {
+                    let objective = a.estimates().objective();
+                    for p in a.parameters() {
+                        let cell = |x: Option<f64>| x.map(|x| format!("{x:e}")).unwrap_or_default();
+                        let short = p.name.rsplit('.').next().unwrap_or(&p.name);
+                        writeln!(
+                            out,
+                            "{column},GMWM+,,{},{:e},{},{},{},{},{objective:e}",
+                            p.name,
+                            p.value,
+                            cell(p.se),
+                            cell(p.ci_low),
+                            cell(p.ci_high),
+                            parameter_unit(short)
+                        )?;
+                    }
+                }
+            }
         }
         Style::Table => {
             for (i, (((column, fit), inf), canonical)) in
@@ -245,6 +323,9 @@ fn render_fits(
                     writeln!(out, "{inf}")?;
                 }
                 writeln!(out, "{canonical}")?;
+                if let Some(a) = plus(i) {
+                    writeln!(out, "{a}")?;
+                }
                 if canonical.reduced != fit.model().without_values() {
                     writeln!(
                         out,

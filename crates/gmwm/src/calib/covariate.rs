@@ -383,19 +383,11 @@ impl Calibration {
         options: &CovariateCalibrationOptions,
     ) -> Result<(AxisCurves, Vec<f64>), CalibError> {
         let mut notes = Vec::new();
-        let unit = self.unit_of(
-            &axis.column,
-            axis.kind,
-            axis.data_unit.as_deref(),
-            &mut notes,
-        )?;
-        notes.clear();
         let fit_error = |source: FitError| CalibError::Fit {
             column: axis.column.clone(),
             source,
         };
-        let to_si = unit.map_or(1.0, |u| u.to_si());
-        let si: Vec<f64> = values.iter().map(|v| v * to_si).collect();
+        let si = self.samples_in_si(axis, values)?;
         let (recs, levels): (Vec<FitRecording>, Vec<f64>) = crate::fit::covariate_windows(
             &si,
             covariate,

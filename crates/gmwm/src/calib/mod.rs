@@ -1,5 +1,6 @@
 //! Calibration: from a recording to navigation-filter parameters.
 pub(crate) mod audit;
+pub(crate) mod augmented;
 pub(crate) mod contamination;
 pub(crate) mod covariate;
 pub(crate) mod datasheet;
@@ -16,6 +17,7 @@ pub(crate) mod streamed;
 pub(crate) mod verdict;
 
 pub use audit::{Audit, AuditQuantity, AuditStats};
+pub use augmented::AxisAugmented;
 pub use contamination::{Contamination, FitUses};
 pub use covariate::{
     AxisCurves, BandValue, CovariateCalibration, CovariateCalibrationOptions, CurvePoint,

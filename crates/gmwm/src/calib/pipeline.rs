@@ -1473,6 +1473,27 @@ impl AxisErrors<'_> {
     }
 }
 
+impl Calibration {
+    /// An axis' samples (`values`, in the recording's unit) in the unit its calibration
+    /// reports (SI when the unit is known): what a later analysis of the same axis
+    /// (`--covariate`, `--augment`) fits beside the calibration's WV.
+    pub(crate) fn samples_in_si(
+        &self,
+        axis: &AxisCalibration,
+        values: &[f64],
+    ) -> Result<Vec<f64>, CalibError> {
+        let mut notes = Vec::new();
+        let unit = self.unit_of(
+            &axis.column,
+            axis.kind,
+            axis.data_unit.as_deref(),
+            &mut notes,
+        )?;
+        let to_si = unit.map_or(1.0, |u| u.to_si());
+        Ok(values.iter().map(|v| v * to_si).collect())
+    }
+}
+
 /// The samples in SI when the unit converts them (`None` when they are SI already or are not
 /// in memory).
 fn in_si(data: &AxisData<'_>, unit: Option<SignalUnit>) -> Option<Vec<f64>> {

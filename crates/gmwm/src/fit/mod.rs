@@ -10,6 +10,7 @@
 //! [`Convergence`], never hidden.
 
 pub(crate) mod active;
+pub(crate) mod augment;
 pub(crate) mod auto;
 pub(crate) mod canonical;
 pub(crate) mod covariate;
@@ -50,6 +51,8 @@ pub(crate) use transform::{Parametrisation, PhiOrder, TransformPreset};
 
 pub(crate) use transform::ParamTransform;
 pub use weights::{Weighting, Weights};
+pub(crate) use weights::FullWeights;
+pub use augment::Augment;
 
 use crate::wavelet::WaveletFilter;
 use thiserror::Error;

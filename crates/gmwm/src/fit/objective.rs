@@ -10,6 +10,7 @@
 //! §7.3) whitens by a lower-triangular matrix instead: `r = W (nu2_hat - nu2)`, `W'W = Omega`.
 //! The diagonal path is unchanged.
 
+use super::augment::Augment;
 use super::weights::FullWeights;
 use super::{FitError, Parametrisation, Weights};
 use crate::model::Model;
@@ -29,6 +30,8 @@ pub(crate) struct Objective {
     /// A stacked layout of several WVs or moments ([`Stack`]); `model` is then the first
     /// block's template.
     stack: Option<Stack>,
+    /// GMWM+: extra moments after the WV levels (`super::augment`, docs/methods.md §5.15).
+    augment: Option<Augment>,
 }
 
 /// The stacked moments of a multi-series fit: `rows.len()` blocks of moments, block `r`
@@ -167,6 +170,7 @@ impl Objective {
             whitening: None,
             freq_hz,
             stack: Some(stack),
+            augment: None,
         })
     }
 
@@ -235,7 +239,57 @@ impl Objective {
             whitening,
             freq_hz,
             stack: None,
+            augment: None,
         })
+    }
+
+    /// The GMWM+ objective (docs/methods.md §5.15): the WV (its first levels of `moments`)
+    /// followed by the `augment` moments, with a full weighting over all of them.
+    ///
+    /// # Errors
+    /// As [`Objective::with_full_weights`]; [`FitError::Length`] when `moments` does not hold
+    /// more than the extra moments or the weights are of another size.
+    pub(crate) fn augmented(
+        model: &Model,
+        param: Parametrisation,
+        moments: &[f64],
+        augment: Augment,
+        weights: &FullWeights,
+        freq_hz: f64,
+    ) -> Result<Self, FitError> {
+        let total = moments.len();
+        let levels = total.checked_sub(augment.len()).filter(|&j| j > 0);
+        let (Some(levels), true) = (levels, weights.levels() == total) else {
+            return Err(FitError::Length {
+                what: "augmented moments",
+                expected: weights.levels(),
+                found: total,
+            });
+        };
+        if let Some((i, &value)) = moments[levels..]
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite())
+        {
+            return Err(FitError::BadWv {
+                level: levels + i + 1,
+                value,
+            });
+        }
+        let mut obj = Self::build(
+            model,
+            param,
+            &moments[..levels],
+            vec![1.0; levels],
+            None,
+            freq_hz,
+        )?;
+        let w = weights.whitening();
+        obj.whitening = Some((0..total * total).map(|k| w[(k / total, k % total)]).collect());
+        obj.nu_hat.extend_from_slice(&moments[levels..]);
+        obj.sqrt_omega.resize(total, 1.0);
+        obj.augment = Some(augment);
+        Ok(obj)
     }
 
     /// The pooled objective of several WVs of the same model (docs/methods.md §5.11):
@@ -410,15 +464,30 @@ impl Objective {
             }
             return Ok(());
         }
-        let levels = self.levels();
+        let extra = self.augment.map_or(0, |g| g.len());
+        let levels = self.levels() - extra;
         self.model.for_each_process(theta, self.freq_hz, |p, col| {
-            p.add_wv(nu);
+            p.add_wv(&mut nu[..levels]);
             if let Some(a) = a.as_deref_mut() {
                 for (j, row) in p.jacobian(levels).iter().enumerate() {
                     a[j * np + col..j * np + col + row.len()].copy_from_slice(row);
                 }
             }
-        })
+        })?;
+        if let Some(augment) = &self.augment {
+            let (model, freq) = (&self.model, self.freq_hz);
+            match a {
+                Some(a) => augment.implied_with_jacobian(
+                    model,
+                    theta,
+                    freq,
+                    &mut nu[levels..],
+                    &mut a[levels * np..],
+                )?,
+                None => augment.implied(model, theta, freq, &mut nu[levels..])?,
+            }
+        }
+        Ok(())
     }
 
     /// Whitened residuals at theta (original parametrisation): `sqrt(omega_j) (nu2_hat_j -

@@ -237,7 +237,6 @@ impl Sin {
     }
 
     /// Autocovariance `gamma_h = (amplitude^2 / 2) cos(2 pi omega h)` at lags `0..lags`.
-    #[cfg(test)]
     pub(crate) fn autocovariance(&self, lags: usize) -> Vec<f64> {
         let p = 0.5 * self.amplitude * self.amplitude;
         (0..lags)

@@ -5,6 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod allan;
+mod augmented;
 mod calib;
 mod canonical;
 mod common;
