@@ -632,3 +632,61 @@ fn calibrate_against_a_temperature_topic_exports_at_and_over() {
         &["--covariate temperature", "cannot explain a dependence"],
     );
 }
+
+/// `calibrate --augment acf:3`: GMWM+ of every axis' identified model beside the calibration
+/// (JSON `augmented`, one entry per axis; the table's section), the exports unchanged.
+#[test]
+fn calibrate_augment_reports_gmwm_plus_per_axis() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = write_bag(dir.path(), "aug", "mcap", 1 << 15, &[]);
+    let plain = run_json(
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--audit", "0", "--json", "-"]),
+    );
+    let doc = run_json(
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--augment", "acf:3", "--audit", "0", "--json", "-"]),
+    );
+    let axes = doc["augmented"].as_array().unwrap();
+    assert_eq!(axes.len(), 6);
+    for a in axes {
+        let fit = &a["fit"];
+        assert_eq!(fit["augment"], "acf:3", "{a}");
+        // WN + RW truths: the white-noise density of GMWM+ within 5% of the truth
+        let n = a["physical"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|q| q["name"] == "white_noise_density")
+            .unwrap_or_else(|| panic!("{a}"));
+        let truth = if a["column"].as_str().unwrap().starts_with("gyro") {
+            GYRO_N
+        } else {
+            ACCEL_N
+        };
+        let v = n["value"].as_f64().unwrap();
+        assert!((v / truth - 1.0).abs() < 0.05, "{n} vs {truth}");
+    }
+    // the calibration's own estimates are GMWM's, with or without --augment
+    for (a, b) in plain["axes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(doc["axes"].as_array().unwrap())
+    {
+        assert_eq!(a["noise_density"], b["noise_density"]);
+    }
+    let out = gmwm()
+        .arg("calibrate")
+        .arg(&bag)
+        .args(["--augment", "acf:2", "--audit", "0"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("GMWM+ (augment acf:2"), "{table}");
+}
