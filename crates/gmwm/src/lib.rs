@@ -45,6 +45,7 @@ extern crate self as gmwm;
 mod augmented;
 mod calib;
 pub mod document;
+mod dynamics;
 mod error;
 mod fit;
 mod imu;
@@ -107,6 +108,7 @@ pub use augmented::{
     AugmentedPhysical,
     AugmentedParameter, DEFAULT_AUGMENT_REPLICATES,
 };
+pub use dynamics::{fit_ns_ar1, NsAr1, NsAr1Fit, NsAr1Options};
 pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
 pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{

@@ -13,6 +13,7 @@ mod contamination;
 mod covariate;
 mod coverage;
 mod datasheet;
+mod dynamics;
 mod examples;
 mod export;
 mod fit_mc;
