@@ -66,6 +66,8 @@ pub enum Config {
     PooledFit(PooledFitConfig),
     /// `gmwm fit FILE... --covariate COL` or `--covariate-values LIST`.
     CovariateFit(CovariateFitConfig),
+    /// `gmwm fit FILE --covariate COL --dynamic`.
+    DynamicFit(DynamicFitConfig),
     /// `gmwm select FILE... --pool`.
     PooledSelect(PooledSelectConfig),
 }
@@ -87,6 +89,7 @@ impl TryFrom<&Command> for Config {
             Command::Report(a) => Self::Report(a.try_into()?),
             Command::SameModel(a) => Self::SameModel(a.try_into()?),
             Command::Fit(a) if a.pool => Self::PooledFit(a.try_into()?),
+            Command::Fit(a) if a.dynamic => Self::DynamicFit(a.try_into()?),
             Command::Fit(a) if a.covariate.is_some() || !a.covariate_values.is_empty() => {
                 Self::CovariateFit(a.try_into()?)
             }
@@ -1298,6 +1301,65 @@ pub struct CovariateFitConfig {
     pub at: Vec<f64>,
     /// `--windows K` of one FILE ([`DEFAULT_WINDOWS`] when not given); `None` with several.
     pub windows: Option<usize>,
+}
+
+/// `gmwm fit FILE --covariate COL --dynamic [--windows K]`: the non-stationary AR1 of the
+/// paper's §IV-B (docs/methods.md §5.16) on each sensor column.
+#[derive(Debug, Clone)]
+pub struct DynamicFitConfig {
+    /// The reading and output, as `gmwm fit`.
+    pub fit: FitConfig,
+    /// `--covariate COL`.
+    pub covariate: String,
+    /// The estimator's settings (windows, white noise).
+    pub options: gmwm::NsAr1Options,
+}
+
+impl TryFrom<&FitArgs> for DynamicFitConfig {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &FitArgs) -> Result<Self> {
+        let fit = FitConfig::try_from(a)?;
+        let Some(covariate) = a.covariate.clone() else {
+            return Err(UsageError(
+                "--dynamic needs the dynamics: give them with --covariate COL (a column, or a \
+                 ROS recording's topic or angular_rate / specific_force)"
+                    .into(),
+            )
+            .into());
+        };
+        anyhow::ensure!(
+            a.more.is_empty(),
+            "--dynamic fits one recording along its covariate; {} more FILEs were given",
+            a.more.len()
+        );
+        let canonical = fit.gmwm.model().without_values().to_string();
+        let white_noise = match canonical.as_str() {
+            "AR1()" | "GM()" => false,
+            "AR1()+WN()" | "GM()+WN()" | "WN()+AR1()" | "WN()+GM()" => true,
+            other => {
+                return Err(UsageError(format!(
+                    "invalid --model {other} with --dynamic: the non-stationary model is AR1() or \
+                     AR1()+WN() (docs/methods.md §5.16)"
+                ))
+                .into())
+            }
+        };
+        let windows = a.windows.unwrap_or(DEFAULT_WINDOWS);
+        anyhow::ensure!(
+            windows <= MAX_WINDOWS,
+            "invalid --windows {windows}: at most {MAX_WINDOWS}"
+        );
+        Ok(Self {
+            fit,
+            covariate,
+            options: gmwm::NsAr1Options {
+                windows,
+                white_noise,
+                ..gmwm::NsAr1Options::default()
+            },
+        })
+    }
 }
 
 /// Windows one drifting recording is cut into without `--windows`: enough levels for an

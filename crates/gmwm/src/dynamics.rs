@@ -43,10 +43,13 @@
 //! `nu2_k(theta | z)` is the exact implied WV of window `k` given the whole covariate path (the
 //! AR state carries across windows). Levenberg–Marquardt from the stationary AR1 + WN GMWM fit
 //! (`beta0 = atanh(phi)`, `alpha0 = ln sigma2`, `gamma0 = ln sigma2_wn`, slopes 0), with the
-//! Jacobian by central differences (step 1e-6). Standard errors from the sandwich with the
-//! windows' WVs treated as independent, each with its exact `V` at its own mean
-//! parameters (the stationary AR1 + WN at the window's mean `rho`, variances), an
-//! approximation the study checks.
+//! Jacobian by central differences (step 1e-6), first with each window's fast weights, then
+//! (step 2) with `Omega_k = diag(V_k)^{-1}` from the model's own covariance at the first
+//! estimate and a refit: weights computed from the windows' noisy WVs correlate with the
+//! moments' errors and bias the estimate (in the study, `beta0` by two standard errors). `V_k`
+//! is the mean, over eight parts of the window, of the exact WV covariance of the stationary
+//! AR1 + WN at the part's mean `rho` and variances (an approximation the study checks);
+//! standard errors from the sandwich with the windows' WVs taken as independent.
 
 use crate::fit::objective::Eval;
 use crate::fit::optimize::{Edge, LeastSquares};
@@ -275,10 +278,10 @@ impl Default for NsAr1Options {
 
 /// The result of [`fit_ns_ar1`].
 ///
-/// Wire format: `model` (text), `theta`, `names`, `se` (null where not available),
-/// `covariate_mean` (the centring `z_bar`: the model is in `z - z_bar`), `objective`,
-/// `converged`, `windows`, `levels`, `stationary` (the AR1 + WN fit that ignores the covariate:
-/// `model`, `objective`).
+/// Wire format: `model` (`beta`, `alpha`, `gamma`), `theta`, `names`, `se` (null for a fixed
+/// parameter), `covariate_mean` (the centring `z_bar`: the model is in `z - z_bar`),
+/// `covariate_range`, `objective`, `converged`, `windows`, `levels`, `stationary_objective` (the
+/// same windowed objective at the stationary AR1 (+ WN) fit that ignores the covariate).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct NsAr1Fit {
     /// The estimate (in the centred covariate).
@@ -291,6 +294,8 @@ pub struct NsAr1Fit {
     pub se: Vec<Option<f64>>,
     /// `z_bar`.
     pub covariate_mean: f64,
+    /// Smallest and largest centred covariate value (`z - z_bar`) of the recording.
+    pub covariate_range: [f64; 2],
     /// The stacked objective at the estimate.
     pub objective: f64,
     /// Whether the optimiser converged.
@@ -493,14 +498,42 @@ pub fn fit_ns_ar1(
         fixed: fixed.clone(),
     };
     let u0: Vec<f64> = free.iter().map(|&i| fixed[i]).collect();
+    let first = minimize(&objective, &u0, &LmOptions::default())?;
+    // step 2: weights from the model's own V at the first estimate, not from the windows'
+    // noisy WVs (fast weights correlate with the moments' errors and bias the estimate), then
+    // the refit; the SEs use the same V
+    let blocks = window_covariances(
+        &objective.model(&first.theta),
+        &zc,
+        &windows,
+        levels,
+        freq_hz,
+    );
+    let (objective, min) = match &blocks {
+        Some(blocks) => {
+            let sqrt_omega = blocks
+                .iter()
+                .flat_map(|b| (0..levels).map(move |j| 1.0 / b[(j, j)].sqrt()))
+                .collect();
+            let reweighted = NsObjective {
+                sqrt_omega,
+                ..objective
+            };
+            let min = minimize(&reweighted, &first.theta, &LmOptions::default())?;
+            (reweighted, min)
+        }
+        None => (objective, first),
+    };
     let stationary_objective = {
         let mut ev = objective.buffer();
         objective.evaluate(&u0, &mut ev, false)?;
         ev.r.iter().map(|r| r * r).sum()
     };
-    let min = minimize(&objective, &u0, &LmOptions::default())?;
     let model = objective.model(&min.theta);
-    let se = standard_errors(&objective, &min.theta, freq_hz);
+    let se = match &blocks {
+        Some(b) => standard_errors(&objective, &min.theta, b),
+        None => vec![None; min.theta.len()],
+    };
     let mut se_all = vec![None; fixed.len()];
     for (&i, s) in free.iter().zip(se) {
         se_all[i] = s;
@@ -511,6 +544,10 @@ pub fn fit_ns_ar1(
         model,
         se: se_all,
         covariate_mean: mean,
+        covariate_range: [
+            zc.iter().copied().fold(f64::INFINITY, f64::min),
+            zc.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        ],
         objective: min.objective,
         converged: min.convergence.converged,
         windows: k,
@@ -520,10 +557,59 @@ pub fn fit_ns_ar1(
     })
 }
 
-/// Sandwich standard errors of the free parameters (module docs): `V` block-diagonal over the
-/// windows, each the exact WV covariance of the stationary AR1 (+ WN) at the window's mean
-/// `rho` and variances.
-fn standard_errors(obj: &NsObjective<'_>, u: &[f64], freq_hz: f64) -> Vec<Option<f64>> {
+/// Each window's WV covariance `V_k` (`levels x levels`): the mean over [`SUB_WINDOWS`] parts of
+/// the window of the exact `V` of a series of the window's length from the stationary AR1
+/// (+ WN) at the part's mean `rho` and variances under `model` (module docs); `None` when a
+/// part's stationary model is outside the exact formulas' cover (a negative `rho`).
+fn window_covariances(
+    model: &NsAr1,
+    z: &[f64],
+    windows: &[Range<usize>],
+    levels: usize,
+    freq_hz: f64,
+) -> Option<Vec<nalgebra::DMatrix<f64>>> {
+    let (rho, s, v) = model.paths(z).ok()?;
+    windows
+        .iter()
+        .map(|range| {
+            let n = range.end - range.start;
+            let part = n / SUB_WINDOWS;
+            let mut sum = nalgebra::DMatrix::zeros(levels, levels);
+            for i in 0..SUB_WINDOWS {
+                let sub = range.start + i * part..range.start + (i + 1) * part;
+                let mean = |x: &[f64]| x[sub.clone()].iter().sum::<f64>() / part as f64;
+                let (r, s2, v2) = (mean(&rho), mean(&s), mean(&v));
+                let text = if model.gamma.is_some() {
+                    format!("AR1(phi={r}, sigma2={s2})+WN(sigma2={v2})")
+                } else {
+                    format!("AR1(phi={r}, sigma2={s2})")
+                };
+                let stationary = crate::model::Model::parse(&text).ok()?;
+                sum += crate::variance::implied_cov::exact_wv_covariance(
+                    &stationary,
+                    n,
+                    freq_hz,
+                    levels,
+                )
+                .ok()?;
+            }
+            Some(sum / SUB_WINDOWS as f64)
+        })
+        .collect()
+}
+
+/// Parts of a window over which [`window_covariances`] averages the stationary `V`: the
+/// covariance of a WV is convex in `rho` near 1, so the `V` at the window's mean `rho`
+/// understates it when `rho` moves within the window (by half in the study).
+const SUB_WINDOWS: usize = 8;
+
+/// Sandwich standard errors of the free parameters with the windows' covariances `blocks`
+/// (block-diagonal `V`, the windows taken as independent).
+fn standard_errors(
+    obj: &NsObjective<'_>,
+    u: &[f64],
+    blocks: &[nalgebra::DMatrix<f64>],
+) -> Vec<Option<f64>> {
     use nalgebra::DMatrix;
     let p = u.len();
     let m = obj.nu_hat.len();
@@ -540,35 +626,12 @@ fn standard_errors(obj: &NsObjective<'_>, u: &[f64], freq_hz: f64) -> Vec<Option
             0.0
         }
     });
-    let model = obj.model(u);
-    let Ok((rho, s, v)) = model.paths(obj.z) else {
-        return vec![None; p];
-    };
     let mut big_v = DMatrix::zeros(m, m);
-    for (w, range) in obj.windows.iter().enumerate() {
-        let len = (range.end - range.start) as f64;
-        let mean = |x: &[f64]| x[range.clone()].iter().sum::<f64>() / len;
-        let (r, s2, v2) = (mean(&rho), mean(&s), mean(&v));
-        let text = if model.gamma.is_some() {
-            format!("AR1(phi={r}, sigma2={s2})+WN(sigma2={v2})")
-        } else {
-            format!("AR1(phi={r}, sigma2={s2})")
-        };
-        let Ok(stationary) = crate::model::Model::parse(&text) else {
-            return vec![None; p];
-        };
-        let Ok(block) = crate::variance::implied_cov::exact_wv_covariance(
-            &stationary,
-            range.end - range.start,
-            freq_hz,
-            obj.levels,
-        ) else {
-            return vec![None; p];
-        };
+    for (w, block) in blocks.iter().enumerate() {
         let at = w * obj.levels;
         big_v
             .view_mut((at, at), (obj.levels, obj.levels))
-            .copy_from(&block);
+            .copy_from(block);
     }
     match crate::inference::asymptotic::sandwich(&a, &omega, &big_v) {
         Ok(s) => (0..p)

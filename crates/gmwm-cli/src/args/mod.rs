@@ -94,7 +94,7 @@ pub enum Command {
     /// recording or from a wavelet variance saved by `gmwm wv --json`.
     #[command(
         allow_negative_numbers = true,
-        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit imu.csv.gz --columns gyro_x --model \"GM()+WN()+RW()\" --augment acf:3   GMWM+ beside GMWM\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three\n  gmwm fit t5.csv t15.csv t25.csv t35.csv --covariate-values 5,15,25,35 --model \"GM()+WN()\"   parameters as functions of temperature\n  gmwm fit a.csv b.csv c.csv --covariate temperature --model \"GM()+WN()\" --depends variances=quadratic --at 0,40 --json\n  gmwm fit ramp.csv --covariate temperature --windows 12 --model \"GM()+WN()+RW()\"   one recording whose temperature drifts\n  gmwm fit run.mcap --covariate temperature --windows 8 --model \"WN()+RW()\"   a ROS bag with a sensor_msgs/Temperature topic"
+        after_long_help = "FILE may also be the JSON of `gmwm wv --json` (or any JSON with series[].{name, n, tau, wv, ci_low, ci_high} and a top-level freq_hz or --freq): the WV is fitted without recomputing it.\n\nExamples:\n  gmwm fit imu.csv.gz --model \"3*GM()+WN()+QN()+RW()\" --columns gyro_x\n  gmwm fit imu.csv.gz --model \"AR1(phi=0.99, sigma2=1e-6)+WN(sigma2=1e-4)\" --json\n  gmwm fit sim.csv.gz --model \"AR1()+WN()+RW()\" --robust --eff 0.6 --G 20000 --seed 7\n  gmwm wv imu.csv.gz --json > wv.json && gmwm fit wv.json --model \"2*GM()+WN()+RW()\"\n  gmwm fit imu.csv.gz --model \"GM()+WN()+RW()\" --weights bootstrap\n  gmwm fit imu.csv.gz --columns gyro_x --model \"2*GM()+WN()+RW()\" --inference --json\n  gmwm fit sim.csv --model \"AR1()+WN()\" --inference --bootstrap 200\n  gmwm fit imu.csv.gz --columns gyro_x --model \"GM()+WN()+RW()\" --augment acf:3   GMWM+ beside GMWM\n  gmwm fit a.csv b.csv c.csv --pool --model \"AR1()+WN()+RW()\" --inference   one model for all three\n  gmwm fit t5.csv t15.csv t25.csv t35.csv --covariate-values 5,15,25,35 --model \"GM()+WN()\"   parameters as functions of temperature\n  gmwm fit a.csv b.csv c.csv --covariate temperature --model \"GM()+WN()\" --depends variances=quadratic --at 0,40 --json\n  gmwm fit ramp.csv --covariate temperature --windows 12 --model \"GM()+WN()+RW()\"   one recording whose temperature drifts\n  gmwm fit run.mcap --covariate temperature --windows 8 --model \"WN()+RW()\"   a ROS bag with a sensor_msgs/Temperature topic\n  gmwm fit drive.mcap --covariate angular_rate --dynamic --model \"AR1()+WN()\"   rho_t following the dynamics (paper IV-B)"
     )]
     Fit(FitArgs),
     /// Select a model by the Wavelet Information Criterion on each selected column (docs/methods.md
@@ -787,6 +787,12 @@ pub struct FitArgs {
     /// `all`), on the parameter's log/logit scale [default: variances affine, the rest constant].
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub depends: Vec<String>,
+    /// With --covariate: the paper's non-stationary AR1 (§IV-B, docs/methods.md §5.16),
+    /// rho_t = tanh(beta0 + beta1 z_{t-1}) and log sigma2_t affine in z_{t-1}, sample by
+    /// sample along the covariate z (e.g. angular_rate), fitted over --windows K windows with
+    /// the exact implied WV given z; --model AR1() or AR1()+WN().
+    #[arg(long, conflicts_with_all = ["pool", "covariate_values", "depends", "at", "augment"])]
+    pub dynamic: bool,
     /// With --covariate and one FILE whose covariate drifts (a temperature ramp): cut it into K
     /// windows of equal length, each at its mean level [default: 8].
     #[arg(long, value_name = "K", value_parser = window_count)]

@@ -8,6 +8,7 @@ pub mod batch;
 pub mod calibrate;
 pub mod covariate;
 pub mod demo;
+pub mod dynamic;
 pub mod fit;
 pub mod implied;
 pub mod monitor;
@@ -61,6 +62,7 @@ pub fn of(config: &mut Config) -> &mut dyn Command {
         Config::SameModel(c) => c,
         Config::PooledFit(c) => c,
         Config::CovariateFit(c) => c,
+        Config::DynamicFit(c) => c,
         Config::PooledSelect(c) => c,
     }
 }
