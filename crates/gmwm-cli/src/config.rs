@@ -19,10 +19,10 @@ use crate::recordings::{is_glob, is_rosbag2_folder};
 use crate::render::Style;
 use anyhow::{Context, Result};
 use gmwm::{
-    Adjustment, AugmentOptions, AllanKind, AllanOptions, AvConvention, AxisPolicy, CalibrationOptions,
-    ColumnSelector, Datasheet, ExportFormat, Gmwm, InferenceOptions, Model, MonitorOptions,
-    ReadOptions, RobustOptions, SameModelOptions, SharedOptions, SignalUnit, Transform,
-    WaveletFilter, Weighting, Wic, WvOptions, DEFAULT_FULL_MODEL,
+    Adjustment, AllanKind, AllanOptions, AugmentOptions, AvConvention, AxisPolicy,
+    CalibrationOptions, ColumnSelector, Datasheet, ExportFormat, Gmwm, InferenceOptions, Model,
+    MonitorOptions, ReadOptions, RobustOptions, SameModelOptions, SharedOptions, SignalUnit,
+    Transform, WaveletFilter, Weighting, Wic, WvOptions, DEFAULT_FULL_MODEL,
 };
 use gmwm_plot::{ImageFormat, Layout};
 use std::path::{Path, PathBuf};

@@ -11,12 +11,13 @@ const TRUTH: &str = "AR1(phi=0.9, sigma2=1e-6)+WN(sigma2=1e-4)";
 fn fit_augment_reports_gmwm_plus_beside_gmwm() {
     let dir = tempfile::tempdir().unwrap();
     let csv = simulate(dir.path(), "sim.csv", TRUTH, 1 << 14, 100.0, 3);
-    let doc = run_json(
-        gmwm()
-            .arg("fit")
-            .arg(&csv)
-            .args(["--model", "AR1()+WN()", "--augment", "acf:3", "--json"]),
-    );
+    let doc = run_json(gmwm().arg("fit").arg(&csv).args([
+        "--model",
+        "AR1()+WN()",
+        "--augment",
+        "acf:3",
+        "--json",
+    ]));
     let a = &doc["fits"][0]["augmented"];
     assert_eq!(a["augment"], "acf:3");
     assert_eq!(a["replicates"], 200);
@@ -28,9 +29,18 @@ fn fit_augment_reports_gmwm_plus_beside_gmwm() {
         assert!(p["ci_low"].as_f64().unwrap() < v && v < p["ci_high"].as_f64().unwrap());
     }
     assert_eq!(a["moments"].as_array().unwrap().len(), 13 + 3);
-    assert!(a["j_test"]["p_value"].as_f64().unwrap() > 1e-4, "{}", a["j_test"]);
+    assert!(
+        a["j_test"]["p_value"].as_f64().unwrap() > 1e-4,
+        "{}",
+        a["j_test"]
+    );
     // without --augment the document has no such field
-    let plain = run_json(gmwm().arg("fit").arg(&csv).args(["--model", "AR1()+WN()", "--json"]));
+    let plain = run_json(
+        gmwm()
+            .arg("fit")
+            .arg(&csv)
+            .args(["--model", "AR1()+WN()", "--json"]),
+    );
     assert!(plain["fits"][0].get("augmented").is_none());
     let out = gmwm()
         .arg("fit")
@@ -50,7 +60,10 @@ fn fit_augment_reports_gmwm_plus_beside_gmwm() {
         .output()
         .unwrap();
     let csv_text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(csv_text.lines().filter(|l| l.contains(",GMWM+,")).count(), 3);
+    assert_eq!(
+        csv_text.lines().filter(|l| l.contains(",GMWM+,")).count(),
+        3
+    );
 }
 
 #[test]
@@ -77,7 +90,12 @@ fn fit_augment_bad_inputs_are_one_line_each() {
     }
     // a saved WV has no series
     let wv = dir.path().join("wv.json");
-    let out = gmwm().arg("wv").arg(&csv).args(["--json"]).output().unwrap();
+    let out = gmwm()
+        .arg("wv")
+        .arg(&csv)
+        .args(["--json"])
+        .output()
+        .unwrap();
     std::fs::write(&wv, &out.stdout).unwrap();
     assert_one_line_error(
         gmwm()

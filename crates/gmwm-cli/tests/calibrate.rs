@@ -645,12 +645,14 @@ fn calibrate_augment_reports_gmwm_plus_per_axis() {
             .arg(&bag)
             .args(["--audit", "0", "--json", "-"]),
     );
-    let doc = run_json(
-        gmwm()
-            .arg("calibrate")
-            .arg(&bag)
-            .args(["--augment", "acf:3", "--audit", "0", "--json", "-"]),
-    );
+    let doc = run_json(gmwm().arg("calibrate").arg(&bag).args([
+        "--augment",
+        "acf:3",
+        "--audit",
+        "0",
+        "--json",
+        "-",
+    ]));
     let axes = doc["augmented"].as_array().unwrap();
     assert_eq!(axes.len(), 6);
     for a in axes {

@@ -48,18 +48,34 @@ fn dynamic_fit_recovers_rho_following_the_covariate() {
     let f = &fits[0];
     assert_eq!(f["column"], "gyro");
     assert_eq!(f["names"][1], "beta1");
-    let (b1, se) = (f["theta"][1].as_f64().unwrap(), f["se"][1].as_f64().unwrap());
+    let (b1, se) = (
+        f["theta"][1].as_f64().unwrap(),
+        f["se"][1].as_f64().unwrap(),
+    );
     assert!((b1 - 0.6).abs() < 4.0 * se, "beta1 {b1} +- {se}");
     assert!(f["stationary_objective"].as_f64().unwrap() > 5.0 * f["objective"].as_f64().unwrap());
     let out = gmwm()
         .arg("fit")
         .arg(&csv)
-        .args(["--freq", "100", "--covariate", "speed", "--dynamic", "--model", "AR1()+WN()"])
+        .args([
+            "--freq",
+            "100",
+            "--covariate",
+            "speed",
+            "--dynamic",
+            "--model",
+            "AR1()+WN()",
+        ])
         .output()
         .unwrap();
     assert!(out.status.success());
     let table = String::from_utf8_lossy(&out.stdout);
-    for needle in ["non-stationary AR1 along speed", "beta1", "rejected at 5%", "ignoring speed"] {
+    for needle in [
+        "non-stationary AR1 along speed",
+        "beta1",
+        "rejected at 5%",
+        "ignoring speed",
+    ] {
         assert!(table.contains(needle), "{needle} not in {table}");
     }
 }
@@ -68,7 +84,13 @@ fn dynamic_fit_recovers_rho_following_the_covariate() {
 fn dynamic_fit_bad_inputs_are_one_line_each() {
     let dir = tempfile::tempdir().unwrap();
     let base = ["--freq", "100", "--covariate", "speed", "--dynamic"];
-    let nan = recording(dir.path(), "nan.csv", 0.6, |t, z| if t == 70 { f64::NAN } else { z });
+    let nan = recording(dir.path(), "nan.csv", 0.6, |t, z| {
+        if t == 70 {
+            f64::NAN
+        } else {
+            z
+        }
+    });
     assert_one_line_error(
         gmwm()
             .arg("fit")

@@ -36,6 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             fit: &fit,
             canonical: &canonical,
             inference: None,
+            augmented: None,
         }])
         .to_string();
         with_document.push(t.elapsed().as_secs_f64());

@@ -19,8 +19,8 @@
 //! `V` of the WV alone: comparing the two on the same replicates isolates what the extra moments
 //! add (the study `tests::augmented::gmwm_plus_efficiency_study`).
 
-use crate::fit::{minimize, Augment, FitError, FitEstimates, FullWeights, Gmwm, GmwmFit};
 use crate::fit::report::physical_parameters;
+use crate::fit::{minimize, Augment, FitError, FitEstimates, FullWeights, Gmwm, GmwmFit};
 use crate::fit::{Objective, Parametrisation};
 use crate::inference::asymptotic::{sandwich, scales, z_value};
 use crate::inference::{IntervalScale, ZConvention};
@@ -290,7 +290,10 @@ impl fmt::Display for AugmentedFit {
                     format!("= {p:.3}")
                 }
             ),
-            None => write!(f, "  J-test: no degrees of freedom (as many moments as parameters)"),
+            None => write!(
+                f,
+                "  J-test: no degrees of freedom (as many moments as parameters)"
+            ),
         }
     }
 }
@@ -385,7 +388,10 @@ pub(crate) fn stacked_fit(
         return Err(ParamError::new(
             "replicates",
             h,
-            format!("more than the moment count plus 2 ({}) for the joint covariance", m + 2),
+            format!(
+                "more than the moment count plus 2 ({}) for the joint covariance",
+                m + 2
+            ),
         )
         .into());
     }

@@ -75,6 +75,9 @@ pub struct NsAr1 {
     pub gamma: Option<[f64; 2]>,
 }
 
+/// `rho_t`, the innovation variances `s_t` and the white variances `v_t` along a path.
+type Paths = (Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// Parameter labels in [`NsAr1::theta`] order.
 const NAMES: [&str; 6] = ["beta0", "beta1", "alpha0", "alpha1", "gamma0", "gamma1"];
 
@@ -104,7 +107,7 @@ impl NsAr1 {
 
     /// `rho_t` (index 0: the stationary start's, at `z_0`), innovation variances `s_t`, white
     /// variances `v_t` (zeros without white noise), after checking them.
-    fn paths(&self, z: &[f64]) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>), ParamError> {
+    fn paths(&self, z: &[f64]) -> Result<Paths, ParamError> {
         let n = z.len();
         let at = |t: usize| z[t.saturating_sub(1)];
         let rho: Vec<f64> = (0..n)
@@ -117,9 +120,9 @@ impl NsAr1 {
             Some(g) => z.iter().map(|&x| (g[0] + g[1] * x).exp()).collect(),
             None => vec![0.0; n],
         };
-        if let Some(t) = (0..n).find(|&t| {
-            !(rho[t].abs() < 1.0 && s[t].is_finite() && s[t] > 0.0 && v[t].is_finite())
-        }) {
+        if let Some(t) = (0..n)
+            .find(|&t| !(rho[t].abs() < 1.0 && s[t].is_finite() && s[t] > 0.0 && v[t].is_finite()))
+        {
             return Err(ParamError::new(
                 "theta",
                 format!("{:?}", self.theta()),
@@ -195,7 +198,9 @@ impl NsAr1 {
         // valid for s + D <= n - 1
         let mut big_v = p.clone();
         let mut c = p;
-        let mut g: Vec<f64> = (0..n).map(|s| rho.get(s + 1).copied().unwrap_or(0.0)).collect();
+        let mut g: Vec<f64> = (0..n)
+            .map(|s| rho.get(s + 1).copied().unwrap_or(0.0))
+            .collect();
         let mut pi = g.clone();
         let mut out = vec![vec![0.0; levels]; windows.len()];
         let mut var_w = vec![0.0; n];
@@ -418,25 +423,19 @@ pub fn fit_ns_ar1(
 ) -> Result<NsAr1Fit, FitError> {
     let n = x.len();
     if z.len() != n {
-        return Err(ParamError::new(
-            "covariate",
-            z.len(),
-            format!("one value per sample ({n})"),
-        )
-        .into());
+        return Err(
+            ParamError::new("covariate", z.len(), format!("one value per sample ({n})")).into(),
+        );
     }
     if let Some(t) = z.iter().position(|v| !v.is_finite()) {
-        return Err(ParamError::new(
-            "covariate",
-            z[t],
-            format!("finite values (sample {t})"),
-        )
-        .into());
+        return Err(
+            ParamError::new("covariate", z[t], format!("finite values (sample {t})")).into(),
+        );
     }
     let mean = z.iter().sum::<f64>() / n.max(1) as f64;
     let zc: Vec<f64> = z.iter().map(|v| v - mean).collect();
     let spread = zc.iter().map(|v| v * v).sum::<f64>() / n.max(1) as f64;
-    if !(spread > 0.0) {
+    if spread.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return Err(ParamError::new(
             "covariate",
             mean,
@@ -470,7 +469,11 @@ pub fn fit_ns_ar1(
         sqrt_omega.extend(weights.omega.iter().map(|o| o.sqrt()));
     }
     // start: the stationary AR1 (+ WN) fit of the whole series
-    let template = if opts.white_noise { "AR1()+WN()" } else { "AR1()" };
+    let template = if opts.white_noise {
+        "AR1()+WN()"
+    } else {
+        "AR1()"
+    };
     let stationary = Gmwm::parse(template)
         .map_err(|e| ParamError::new("model", template, e.to_string()))?
         .fit(x, freq_hz, &WvOptions::default())?;
@@ -656,10 +659,7 @@ mod tests {
         }
         let cov = |u: usize, w: usize| {
             let (a, b) = (u.min(w), u.max(w));
-            let mut c = p[a];
-            for k in a + 1..=b {
-                c *= rho[k];
-            }
+            let c = p[a] * rho[a + 1..=b].iter().product::<f64>();
             c + if a == b { v[a] } else { 0.0 }
         };
         (1..=levels)
@@ -720,7 +720,13 @@ mod tests {
         .unwrap();
         let levels = 8;
         let want = stationary.implied_wv(levels, 1.0).unwrap().wv;
-        let got = m.implied_wv(&z, &[0..4096], levels).unwrap();
+        let whole = Range {
+            start: 0,
+            end: 4096,
+        };
+        let got = m
+            .implied_wv(&z, std::slice::from_ref(&whole), levels)
+            .unwrap();
         for (g, w) in got[0].iter().zip(&want) {
             assert!((g / w - 1.0).abs() < 1e-10, "{got:?} vs {want:?}");
         }
@@ -747,10 +753,10 @@ mod tests {
         let mut mean = vec![vec![0.0; 6]; 2];
         for r in 0..reps {
             let x = m.simulate(&z, 100 + r).unwrap();
-            for (k, w) in windows.iter().enumerate() {
+            for (row, w) in mean.iter_mut().zip(&windows) {
                 let wv = wavelet_variance(&x[w.clone()], 1.0, &opts).unwrap();
-                for j in 0..6 {
-                    mean[k][j] += wv.wv[j] / reps as f64;
+                for (m, v) in row.iter_mut().zip(&wv.wv) {
+                    *m += v / reps as f64;
                 }
             }
         }
@@ -772,9 +778,13 @@ mod tests {
     fn refuses_what_it_cannot_fit() {
         let x = vec![0.0; 4096];
         let opts = NsAr1Options::default();
-        let e = fit_ns_ar1(&x, &[1.0; 4096], 1.0, &opts).unwrap_err().to_string();
+        let e = fit_ns_ar1(&x, &[1.0; 4096], 1.0, &opts)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("constant"), "{e}");
-        let e = fit_ns_ar1(&x, &[1.0; 100], 1.0, &opts).unwrap_err().to_string();
+        let e = fit_ns_ar1(&x, &[1.0; 100], 1.0, &opts)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("one value per sample"), "{e}");
         let mut z = vec![0.0; 4096];
         z[7] = f64::NAN;

@@ -105,16 +105,16 @@ pub use sim::{simulate_model, DemoSensor, Simulator};
 // GMWM fits, their inference and model selection (§5-§8).
 pub use augmented::{
     augment_fit, fit_augmented, AugmentOptions, AugmentedFit, AugmentedJTest, AugmentedMoment,
-    AugmentedPhysical,
-    AugmentedParameter, DEFAULT_AUGMENT_REPLICATES,
+    AugmentedParameter, AugmentedPhysical, DEFAULT_AUGMENT_REPLICATES,
 };
 pub use dynamics::{fit_ns_ar1, NsAr1, NsAr1Fit, NsAr1Options};
 pub use fit::canonical::{CanonicalModel, CanonicalTerm, TermParameter};
 pub use fit::transform::{Parametrisation, PhiOrder};
 pub use fit::{
-    covariate_level, covariate_windows, dependences, Convergence, CovariateFit, CovariateRecording,
-    Augment, Dependence, FitError, FitEstimates, FitRecording, Gmwm, GmwmFit, NavParameter,
-    ParameterEstimate, PooledFit, PooledRecording, StartInputs, StopReason, Weighting, Weights,
+    covariate_level, covariate_windows, dependences, Augment, Convergence, CovariateFit,
+    CovariateRecording, Dependence, FitError, FitEstimates, FitRecording, Gmwm, GmwmFit,
+    NavParameter, ParameterEstimate, PooledFit, PooledRecording, StartInputs, StopReason,
+    Weighting, Weights,
 };
 pub use inference::same_model::{
     compare_wvs, same_model_test_of, SameModelOptions, SameModelTest, ScaleContribution,
@@ -169,10 +169,10 @@ pub use calib::export::{render_export, ExportError, ExportFormat, NavNoise, Sens
 pub use calib::ieee::{ieee_readoff, term_avar, CoefficientReadoff, IeeeReadoff};
 pub use calib::streamed::{binary_file_columns, wv_account, wv_columns};
 pub use calib::{
-    spread_across, Audit, AuditQuantity, AuditStats, AxisAugmented, AxisCurves, BandValue, Contamination,
-    CovariateCalibration, CovariateCalibrationOptions, CurvePoint, FitUses, FitVerdict,
-    GaussMarkovBias, HorizonBound, Plan, PlanTarget, PlannedQuantity, PooledInput, RecordedAxis,
-    ScaleFit, ScaleMiss, SpreadAcross, SpreadRow, PLAN_LENGTHS_S,
+    spread_across, Audit, AuditQuantity, AuditStats, AxisAugmented, AxisCurves, BandValue,
+    Contamination, CovariateCalibration, CovariateCalibrationOptions, CurvePoint, FitUses,
+    FitVerdict, GaussMarkovBias, HorizonBound, Plan, PlanTarget, PlannedQuantity, PooledInput,
+    RecordedAxis, ScaleFit, ScaleMiss, SpreadAcross, SpreadRow, PLAN_LENGTHS_S,
 };
 pub use calib::{
     Adjustment, AxisCalibration, AxisPolicy, CalibError, Calibration, CalibrationOptions,

@@ -15,8 +15,8 @@ use gmwm::{
 };
 use std::path::PathBuf;
 use values::{
-    alpha, at_least_1, augment, at_least_2, choice, datasheet, efficiency, horizon_seconds, inflation,
-    positive_hz, seed, signal_unit, tolerance, whole, window_count,
+    alpha, at_least_1, at_least_2, augment, choice, datasheet, efficiency, horizon_seconds,
+    inflation, positive_hz, seed, signal_unit, tolerance, whole, window_count,
 };
 
 const EXAMPLES: &str = "\

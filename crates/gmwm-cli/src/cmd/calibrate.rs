@@ -340,7 +340,13 @@ fn augmented(
     spinner.enable_steady_tick(std::time::Duration::from_millis(250));
     let out = Calibration::new(config.options.clone())
         .augmented(imu, report, opts)
-        .with_context(|| format!("{}: --augment {}", config.input.file.display(), opts.augment))?;
+        .with_context(|| {
+            format!(
+                "{}: --augment {}",
+                config.input.file.display(),
+                opts.augment
+            )
+        })?;
     spinner.finish_and_clear();
     Ok(out)
 }
@@ -363,8 +369,8 @@ fn augmented_summary(axes: &[gmwm::AxisAugmented], out: &mut impl Write) -> Resu
     )?;
     writeln!(
         out,
-        "  {:<9} {:<34} {:>12} {:>12} {:>27}  {}",
-        "axis", "quantity", "GMWM", "GMWM+", "95% interval", "unit"
+        "  {:<9} {:<34} {:>12} {:>12} {:>27}  unit",
+        "axis", "quantity", "GMWM", "GMWM+", "95% interval"
     )?;
     for a in axes {
         let Some(fit) = &a.fit else {

@@ -92,7 +92,10 @@ fn run(config: &DynamicFitConfig, style: OutputStyle, out: &mut impl Write) -> R
             writeln!(out)?;
         }
         Style::Csv => {
-            writeln!(out, "column,covariate,name,value,se,covariate_mean,objective")?;
+            writeln!(
+                out,
+                "column,covariate,name,value,se,covariate_mean,objective"
+            )?;
             for it in &items {
                 for ((name, v), se) in it.fit.names.iter().zip(&it.fit.theta).zip(&it.fit.se) {
                     writeln!(
@@ -126,7 +129,11 @@ fn table(it: &ColumnFit<'_>, col: &str, out: &mut impl Write) -> Result<()> {
         it.column, f.covariate_mean, f.windows, f.levels
     )?;
     writeln!(out, "  {}", f.model)?;
-    writeln!(out, "  {:<8} {:>13} {:>11} {:>8}", "param", "estimate", "SE", "z")?;
+    writeln!(
+        out,
+        "  {:<8} {:>13} {:>11} {:>8}",
+        "param", "estimate", "SE", "z"
+    )?;
     for ((name, v), se) in f.names.iter().zip(&f.theta).zip(&f.se) {
         match se {
             Some(s) => writeln!(out, "  {name:<8} {v:>13.6} {s:>11.4e} {:>8.2}", v / s)?,
@@ -147,7 +154,10 @@ fn table(it: &ColumnFit<'_>, col: &str, out: &mut impl Write) -> Result<()> {
         rho(hi),
         [lo, 0.0, hi]
             .iter()
-            .map(|&zv| format!("{:.4}", -1.0 / (rho(zv).abs().ln() * f.stationary.freq_hz())))
+            .map(|&zv| format!(
+                "{:.4}",
+                -1.0 / (rho(zv).abs().ln() * f.stationary.freq_hz())
+            ))
             .collect::<Vec<_>>()
             .join(", ")
     )?;

@@ -10,8 +10,8 @@ use crate::render::Style;
 use crate::style::OutputStyle;
 use anyhow::Result;
 use gmwm::{
-    fit_augmented, infer_with_progress, AugmentedFit, CanonicalModel, GmwmFit, Inference, InferenceOptions, StartInputs,
-    WaveletVariance, Weighting,
+    fit_augmented, infer_with_progress, AugmentedFit, CanonicalModel, GmwmFit, Inference,
+    InferenceOptions, StartInputs, WaveletVariance, Weighting,
 };
 use rayon::prelude::*;
 use std::io::Write;
@@ -178,11 +178,7 @@ fn compute_augmented(
         file.display()
     );
     let loaded = load(&config.input, style)?;
-    let bar = style.bar(
-        loaded.table.columns.len() as u64,
-        "GMWM+ fits",
-        "columns",
-    );
+    let bar = style.bar(loaded.table.columns.len() as u64, "GMWM+ fits", "columns");
     let fits = analyse_columns(&loaded, file, |x| {
         let r = fit_augmented(&config.gmwm, x, loaded.freq_hz, &config.wv, opts)
             .map_err(gmwm::Error::from);

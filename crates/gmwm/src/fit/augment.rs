@@ -32,8 +32,8 @@
 //! relative) is far below what the optimiser and the sandwich need.
 
 use crate::error::{InputError, ParamError};
-use crate::process::flicker::odd_harmonic;
 use crate::model::Model;
+use crate::process::flicker::odd_harmonic;
 use crate::process::{CovariancePart, Process};
 use std::fmt;
 use std::str::FromStr;
@@ -226,7 +226,9 @@ fn variogram(p: &Process, lags: usize) -> Result<Vec<f64>, ParamError> {
         }
         _ => match p.covariance_part()? {
             CovariancePart::White(sigma2) => from_gamma(&|h| if h == 0 { sigma2 } else { 0.0 }),
-            CovariancePart::RandomWalk(gamma2) => (0..=lags).map(|h| gamma2 * h as f64 / 2.0).collect(),
+            CovariancePart::RandomWalk(gamma2) => {
+                (0..=lags).map(|h| gamma2 * h as f64 / 2.0).collect()
+            }
             // x_t = sqrt(q2) (u_{t+1} - u_t): gamma(0) = 2 q2, gamma(1) = -q2
             CovariancePart::Quantization(q2) => from_gamma(&|h| match h {
                 0 => 2.0 * q2,
@@ -264,7 +266,7 @@ impl fmt::Display for Augment {
 impl FromStr for Augment {
     type Err = ParamError;
 
-    /// `mean`, `acf:K` (`1 <= K <=` [`MAX_AUGMENT_LAGS`]) or both, comma-separated.
+    /// `mean`, `acf:K` (`1 <= K <= 16`) or both, comma-separated.
     fn from_str(s: &str) -> Result<Self, ParamError> {
         let expected = "mean, acf:K (K from 1 to 16) or both, comma-separated, e.g. mean,acf:3";
         let mut out = Augment::default();
@@ -306,8 +308,19 @@ mod tests {
             }
         );
         assert_eq!(a.to_string(), "mean,acf:3");
-        assert_eq!(a.names(), ["mean_diff", "acf_diff[1]", "acf_diff[2]", "acf_diff[3]"]);
-        for bad in ["", "acf", "acf:0", "acf:17", "mean,mean", "acf:2,acf:3", "var"] {
+        assert_eq!(
+            a.names(),
+            ["mean_diff", "acf_diff[1]", "acf_diff[2]", "acf_diff[3]"]
+        );
+        for bad in [
+            "",
+            "acf",
+            "acf:0",
+            "acf:17",
+            "mean,mean",
+            "acf:2,acf:3",
+            "var",
+        ] {
             let e = bad.parse::<Augment>().unwrap_err().to_string();
             assert!(e.contains("augment"), "{bad}: {e}");
         }

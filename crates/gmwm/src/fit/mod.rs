@@ -49,10 +49,10 @@ pub(crate) use start::StartOptions;
 
 pub(crate) use transform::{Parametrisation, PhiOrder, TransformPreset};
 
-pub(crate) use transform::ParamTransform;
-pub use weights::{Weighting, Weights};
-pub(crate) use weights::FullWeights;
 pub use augment::Augment;
+pub(crate) use transform::ParamTransform;
+pub(crate) use weights::FullWeights;
+pub use weights::{Weighting, Weights};
 
 use crate::wavelet::WaveletFilter;
 use thiserror::Error;

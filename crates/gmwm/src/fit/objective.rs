@@ -285,7 +285,11 @@ impl Objective {
             freq_hz,
         )?;
         let w = weights.whitening();
-        obj.whitening = Some((0..total * total).map(|k| w[(k / total, k % total)]).collect());
+        obj.whitening = Some(
+            (0..total * total)
+                .map(|k| w[(k / total, k % total)])
+                .collect(),
+        );
         obj.nu_hat.extend_from_slice(&moments[levels..]);
         obj.sqrt_omega.resize(total, 1.0);
         obj.augment = Some(augment);

@@ -38,7 +38,10 @@ fn gmwm_plus_fits_a_known_truth_with_intervals_and_a_j_test() {
     assert_eq!(json["augment"], "acf:3");
     assert_eq!(json["moments"][13]["name"], "acf_diff[1]");
     let table = fit.to_string();
-    assert!(table.contains("GMWM+") && table.contains("acf_diff[3]"), "{table}");
+    assert!(
+        table.contains("GMWM+") && table.contains("acf_diff[3]"),
+        "{table}"
+    );
 }
 
 #[test]
@@ -129,12 +132,42 @@ fn replicate(
 fn gmwm_plus_efficiency_study() {
     const REPLICATES: u64 = 200;
     let cases = [
-        ("AR1(phi=0.9, sigma2=1)+WN(sigma2=2)", "AR1()+WN()", "acf:3", 1 << 14),
-        ("AR1(phi=0.5, sigma2=1)+WN(sigma2=1)", "AR1()+WN()", "acf:3", 1 << 14),
-        ("WN(sigma2=1)+RW(gamma2=1e-4)+DR(omega=1e-3)", "WN()+RW()+DR()", "mean,acf:2", 1 << 14),
-        ("WN(sigma2=1)+QN(q2=0.5)+RW(gamma2=1e-5)", "WN()+QN()+RW()", "acf:2", 1 << 14),
-        ("AR1(phi=0.5, sigma2=1)+WN(sigma2=1)", "AR1()+WN()", "acf:3", 1 << 10),
-        ("ARMA11(phi=0.8, theta=-0.5, sigma2=1)", "ARMA11()", "acf:3", 1 << 12),
+        (
+            "AR1(phi=0.9, sigma2=1)+WN(sigma2=2)",
+            "AR1()+WN()",
+            "acf:3",
+            1 << 14,
+        ),
+        (
+            "AR1(phi=0.5, sigma2=1)+WN(sigma2=1)",
+            "AR1()+WN()",
+            "acf:3",
+            1 << 14,
+        ),
+        (
+            "WN(sigma2=1)+RW(gamma2=1e-4)+DR(omega=1e-3)",
+            "WN()+RW()+DR()",
+            "mean,acf:2",
+            1 << 14,
+        ),
+        (
+            "WN(sigma2=1)+QN(q2=0.5)+RW(gamma2=1e-5)",
+            "WN()+QN()+RW()",
+            "acf:2",
+            1 << 14,
+        ),
+        (
+            "AR1(phi=0.5, sigma2=1)+WN(sigma2=1)",
+            "AR1()+WN()",
+            "acf:3",
+            1 << 10,
+        ),
+        (
+            "ARMA11(phi=0.8, theta=-0.5, sigma2=1)",
+            "ARMA11()",
+            "acf:3",
+            1 << 12,
+        ),
     ];
     for (truth, template, augment, n) in cases {
         let truth = Model::parse(truth).unwrap();
@@ -157,8 +190,7 @@ fn gmwm_plus_efficiency_study() {
         let names: Vec<String> = truth.param_names().into_iter().map(|(_, s)| s).collect();
         for k in 0..t.len() {
             let rmse = |f: &dyn Fn(&Replicate) -> f64| {
-                (reps.iter().map(|r| (f(r) - t[k]).powi(2)).sum::<f64>() / reps.len() as f64)
-                    .sqrt()
+                (reps.iter().map(|r| (f(r) - t[k]).powi(2)).sum::<f64>() / reps.len() as f64).sqrt()
             };
             let (g, e, p) = (
                 rmse(&|r| r.gmwm[k]),
@@ -166,8 +198,7 @@ fn gmwm_plus_efficiency_study() {
                 rmse(&|r| r.plus[k]),
             );
             let bias = reps.iter().map(|r| r.plus[k] - t[k]).sum::<f64>() / reps.len() as f64;
-            let cover =
-                reps.iter().filter(|r| r.covered[k]).count() as f64 / reps.len() as f64;
+            let cover = reps.iter().filter(|r| r.covered[k]).count() as f64 / reps.len() as f64;
             println!(
                 "| {} | {:.3e} | {g:.3e} | {e:.3e} | {p:.3e} | {:.3} | {:.3} | {bias:.2e} | {cover:.3} |",
                 names[k],
