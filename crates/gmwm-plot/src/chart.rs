@@ -6,6 +6,7 @@ use crate::style::{
     colour, ensure_fonts, number, pow10_label, FONT, LABEL_SIZE, TICK_SIZE, TITLE_SIZE,
 };
 use crate::PlotError;
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -460,6 +461,45 @@ fn legend_entries(series: &[Series], yr: (f64, f64)) -> Vec<(String, RGBColor, M
         .collect()
 }
 
+/// The plot area and, when there are `entries`, the legend column on its right.
+fn split_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, RGBColor, Mark)],
+) -> (DrawingArea<DB, Shift>, Option<DrawingArea<DB, Shift>>) {
+    if entries.is_empty() {
+        return (area.clone(), None);
+    }
+    let (w, _) = area.dim_in_pixel();
+    let (p, l) = area.split_horizontally(w - legend_width(area, entries));
+    (p, Some(l))
+}
+
+/// The grid, axis labels and tick labels of a panel with a log ordinate (powers of ten) and
+/// abscissa ticks written by `x_label`.
+fn draw_mesh<DB, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    panel: &Panel,
+    x_label: &dyn Fn(&f64) -> String,
+) -> Result<(), PlotError>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(&panel.x_label)
+        .y_desc(&panel.y_label)
+        .x_label_formatter(x_label)
+        .y_label_formatter(&|v| pow10_label(*v))
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, LABEL_SIZE))
+        .bold_line_style(RGBColor(200, 200, 200).stroke_width(1))
+        .light_line_style(RGBColor(236, 236, 236).stroke_width(1))
+        .draw()
+        .map_err(draw_error)
+}
+
 /// Draws a log-log panel.
 fn draw_loglog<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -468,14 +508,7 @@ fn draw_loglog<DB: DrawingBackend>(
 ) -> Result<(), PlotError> {
     let (xr, yr) = ranges(series);
     let entries = legend_entries(series, yr);
-    let (w, _) = area.dim_in_pixel();
-    let (plot, legend) = if entries.is_empty() {
-        (area.clone(), None)
-    } else {
-        let lw = legend_width(area, &entries);
-        let (p, l) = area.split_horizontally(w - lw);
-        (p, Some(l))
-    };
+    let (plot, legend) = split_legend(area, &entries);
     let (xb, xl) = log_ticks(xr);
     let (yb, yl) = log_ticks(yr);
     let mut chart = ChartBuilder::on(&plot)
@@ -494,18 +527,7 @@ fn draw_loglog<DB: DrawingBackend>(
                 .with_light_points(yl),
         )
         .map_err(draw_error)?;
-    chart
-        .configure_mesh()
-        .x_desc(&panel.x_label)
-        .y_desc(&panel.y_label)
-        .x_label_formatter(&|v| pow10_label(*v))
-        .y_label_formatter(&|v| pow10_label(*v))
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, LABEL_SIZE))
-        .bold_line_style(RGBColor(200, 200, 200).stroke_width(1))
-        .light_line_style(RGBColor(236, 236, 236).stroke_width(1))
-        .draw()
-        .map_err(draw_error)?;
+    draw_mesh(&mut chart, panel, &|v| pow10_label(*v))?;
     let inside = |&(x, y): &(f64, f64)| x >= xr.0 && x <= xr.1 && y >= yr.0 && y <= yr.1;
     for s in series {
         let rgb = s.rgb();
@@ -593,14 +615,7 @@ fn draw_linlog<DB: DrawingBackend>(
         (0.0, 1.0)
     };
     let entries = legend_entries(series, yr);
-    let (w, _) = area.dim_in_pixel();
-    let (plot, legend) = if entries.is_empty() {
-        (area.clone(), None)
-    } else {
-        let lw = legend_width(area, &entries);
-        let (p, l) = area.split_horizontally(w - lw);
-        (p, Some(l))
-    };
+    let (plot, legend) = split_legend(area, &entries);
     let (yb, yl) = log_ticks(yr);
     let mut chart = ChartBuilder::on(&plot)
         .caption(&panel.title, (FONT, TITLE_SIZE))
@@ -615,18 +630,7 @@ fn draw_linlog<DB: DrawingBackend>(
                 .with_light_points(yl),
         )
         .map_err(draw_error)?;
-    chart
-        .configure_mesh()
-        .x_desc(&panel.x_label)
-        .y_desc(&panel.y_label)
-        .x_label_formatter(&|v| number(*v))
-        .y_label_formatter(&|v| pow10_label(*v))
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, LABEL_SIZE))
-        .bold_line_style(RGBColor(200, 200, 200).stroke_width(1))
-        .light_line_style(RGBColor(236, 236, 236).stroke_width(1))
-        .draw()
-        .map_err(draw_error)?;
+    draw_mesh(&mut chart, panel, &|v| number(*v))?;
     let ok = |y: f64| y.is_finite() && y >= yr.0 && y <= yr.1;
     for s in series {
         let rgb = s.rgb();

@@ -658,24 +658,49 @@ impl CalibrationReport {
         curves: &CovariateCalibration,
         x: f64,
     ) -> Result<(), CalibError> {
-        let unit = curves
-            .unit
-            .as_deref()
-            .map(|u| format!(" {u}"))
-            .unwrap_or_default();
-        let name = &curves.covariate;
-        let outside = outside_note(curves, x, x);
-        for axis in &mut self.axes {
-            let Some(c) = curves.axes.iter().find(|c| c.column == axis.column) else {
-                continue;
-            };
+        self.for_each_curve(curves, x, x, |axis, c, r, freq_hz| {
             let p = c.at(x).map_err(|e| axis_error(axis, e))?;
+            let (name, unit, outside) = (r.name, &r.unit, &r.outside);
             let at = format!("at {name} {}{unit}", fmt_level(x));
-            let kept = replace(axis, &p, c.depends, [&at, &at, &at], self.freq_hz);
+            let kept = replace(axis, &p, c.depends, [&at, &at, &at], freq_hz);
             axis.notes.push(format!(
                 "N, B, K {at}, from the fit of its parameters against {name} (docs/methods.md §5.14){outside}{}",
                 kept_note(&kept, name)
             ));
+            Ok(())
+        })
+    }
+
+    /// Calls `f` with each axis that has a curve in `curves`, the curve, how the covariate
+    /// reads (over `[lo, hi]`) and the rate: the walk [`Self::at_covariate`] and
+    /// [`Self::worst_over`] share.
+    fn for_each_curve(
+        &mut self,
+        curves: &CovariateCalibration,
+        lo: f64,
+        hi: f64,
+        mut f: impl FnMut(
+            &mut AxisCalibration,
+            &AxisCurves,
+            &CovariateReading<'_>,
+            f64,
+        ) -> Result<(), CalibError>,
+    ) -> Result<(), CalibError> {
+        let reading = CovariateReading {
+            name: &curves.covariate,
+            unit: curves
+                .unit
+                .as_deref()
+                .map(|u| format!(" {u}"))
+                .unwrap_or_default(),
+            outside: outside_note(curves, lo, hi),
+        };
+        let freq_hz = self.freq_hz;
+        for axis in &mut self.axes {
+            let Some(c) = curves.axes.iter().find(|c| c.column == axis.column) else {
+                continue;
+            };
+            f(axis, c, &reading, freq_hz)?;
         }
         Ok(())
     }
@@ -701,17 +726,8 @@ impl CalibrationReport {
             ))
             .into());
         }
-        let unit = curves
-            .unit
-            .as_deref()
-            .map(|u| format!(" {u}"))
-            .unwrap_or_default();
-        let name = &curves.covariate;
-        let outside = outside_note(curves, lo, hi);
-        for axis in &mut self.axes {
-            let Some(c) = curves.axes.iter().find(|c| c.column == axis.column) else {
-                continue;
-            };
+        self.for_each_curve(curves, lo, hi, |axis, c, r, freq_hz| {
+            let (name, unit, outside) = (r.name, &r.unit, &r.outside);
             // the point estimates on a fine grid: the worst x of each quantity
             let mut worst: [Option<(f64, f64)>; 3] = [None; 3];
             for k in 0..WORST_POINTS {
@@ -754,7 +770,7 @@ impl CalibrationReport {
                 &point,
                 c.depends,
                 [&sources[0], &sources[1], &sources[2]],
-                self.freq_hz,
+                freq_hz,
             );
             axis.notes.push(format!(
                 "N, B, K are the largest over {name} {}..{}{unit}, from the fit of its parameters against {name} (docs/methods.md §5.14){outside}{}",
@@ -762,8 +778,8 @@ impl CalibrationReport {
                 fmt_level(hi),
                 kept_note(&kept, name)
             ));
-        }
-        Ok(())
+            Ok(())
+        })
     }
 }
 
@@ -772,6 +788,14 @@ fn axis_error(axis: &AxisCalibration, source: FitError) -> CalibError {
         column: axis.column.clone(),
         source,
     }
+}
+
+/// How a covariate reads in the notes: its name, its unit as a suffix (` degC`, or empty) and
+/// the note on covariate values outside the recorded range.
+struct CovariateReading<'a> {
+    name: &'a str,
+    unit: String,
+    outside: String,
 }
 
 /// `; X is outside the recorded range A..B: extrapolated` when `[lo, hi]` leaves it.

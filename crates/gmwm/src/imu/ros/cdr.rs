@@ -103,6 +103,20 @@ fn body(
 /// Decodes a ROS1-serialized `sensor_msgs/Imu` (little-endian, packed): `header` = seq u32,
 /// stamp (sec u32, nsec u32), frame_id (u32 length + bytes), then the 37 float64.
 pub(crate) fn decode_ros1(msg: &[u8]) -> Result<ImuFields<'_>, MessageError> {
+    let (stamp_ns, end) = ros1_header(msg)?;
+    let (angular_velocity, linear_acceleration) = body(msg, end, 0, Order::Little)?;
+    Ok(ImuFields {
+        stamp_ns,
+        frame_id: &msg[16..end],
+        angular_velocity,
+        linear_acceleration,
+    })
+}
+
+/// A ROS1 `std_msgs/Header` at the start of `msg` (seq u32, stamp sec u32 and nsec u32,
+/// frame_id u32 length + bytes): the stamp in ns and the offset of the byte after it, its
+/// lengths checked.
+fn ros1_header(msg: &[u8]) -> Result<(i64, usize), MessageError> {
     if msg.len() < 16 {
         return Err(short(msg.len(), "header", 16));
     }
@@ -113,20 +127,11 @@ pub(crate) fn decode_ros1(msg: &[u8]) -> Result<ImuFields<'_>, MessageError> {
     if end > msg.len() {
         return Err(short(msg.len(), "header.frame_id", end));
     }
-    let (angular_velocity, linear_acceleration) = body(msg, end, 0, Order::Little)?;
-    Ok(ImuFields {
-        stamp_ns: i64::from(sec) * 1_000_000_000 + i64::from(nsec),
-        frame_id: &msg[16..end],
-        angular_velocity,
-        linear_acceleration,
-    })
+    Ok((i64::from(sec) * 1_000_000_000 + i64::from(nsec), end))
 }
 
-/// Decodes a CDR-serialized ROS2 `sensor_msgs/msg/Imu`: a 4-byte encapsulation header
-/// (0x00 0x01 little-endian, 0x00 0x00 big-endian CDR; the two option bytes are ignored), then,
-/// with alignment counted from the byte after that header, stamp (sec int32, nanosec uint32),
-/// frame_id (uint32 length including the NUL, bytes), and the 37 float64 aligned to 8 bytes.
-pub(crate) fn decode_cdr(msg: &[u8]) -> Result<ImuFields<'_>, MessageError> {
+/// The CDR encapsulation header of `msg` (4 bytes): the byte order and the body after it.
+fn cdr_encapsulation(msg: &[u8]) -> Result<(Order, &[u8]), MessageError> {
     if msg.len() < 4 {
         return Err(short(msg.len(), "CDR encapsulation header", 4));
     }
@@ -135,17 +140,33 @@ pub(crate) fn decode_cdr(msg: &[u8]) -> Result<ImuFields<'_>, MessageError> {
         (0x00, 0x00) => Order::Big,
         (a, b) => return Err(MessageError::Encapsulation(a, b)),
     };
-    let b = &msg[4..];
+    Ok((order, &msg[4..]))
+}
+
+/// A CDR `std_msgs/Header` at the start of the body `b` (stamp sec int32 and nanosec uint32,
+/// frame_id uint32 length + bytes; lengths reported against `msg_len`, the message with its
+/// 4-byte encapsulation): the stamp in ns and the offset of the byte after the string.
+fn cdr_header(b: &[u8], order: Order, msg_len: usize) -> Result<(i64, usize), MessageError> {
     if b.len() < 12 {
-        return Err(short(msg.len(), "header", 16));
+        return Err(short(msg_len, "header", 16));
     }
     let sec = u32_at(b, 0, order) as i32;
     let nanosec = u32_at(b, 4, order);
     let len = u32_at(b, 8, order) as usize;
     let end = 12usize.saturating_add(len);
     if end > b.len() {
-        return Err(short(msg.len(), "header.frame_id", end.saturating_add(4)));
+        return Err(short(msg_len, "header.frame_id", end.saturating_add(4)));
     }
+    Ok((i64::from(sec) * 1_000_000_000 + i64::from(nanosec), end))
+}
+
+/// Decodes a CDR-serialized ROS2 `sensor_msgs/msg/Imu`: a 4-byte encapsulation header
+/// (0x00 0x01 little-endian, 0x00 0x00 big-endian CDR; the two option bytes are ignored), then,
+/// with alignment counted from the byte after that header, stamp (sec int32, nanosec uint32),
+/// frame_id (uint32 length including the NUL, bytes), and the 37 float64 aligned to 8 bytes.
+pub(crate) fn decode_cdr(msg: &[u8]) -> Result<ImuFields<'_>, MessageError> {
+    let (order, b) = cdr_encapsulation(msg)?;
+    let (stamp_ns, end) = cdr_header(b, order, msg.len())?;
     // the string's length counts its terminating NUL (an empty string may be written as 0)
     let frame_id = match b[12..end].split_last() {
         Some((0, text)) => text,
@@ -154,7 +175,7 @@ pub(crate) fn decode_cdr(msg: &[u8]) -> Result<ImuFields<'_>, MessageError> {
     let aligned = end.div_ceil(8) * 8;
     let (angular_velocity, linear_acceleration) = body(b, aligned, 4, order)?;
     Ok(ImuFields {
-        stamp_ns: i64::from(sec) * 1_000_000_000 + i64::from(nanosec),
+        stamp_ns,
         frame_id,
         angular_velocity,
         linear_acceleration,
@@ -274,19 +295,10 @@ pub(crate) fn decode_scalar_ros1(msg: &[u8], ty: ScalarType) -> Result<ScalarFie
             value,
         });
     }
-    if msg.len() < 16 {
-        return Err(short(msg.len(), "header", 16));
-    }
-    let sec = u32_at(msg, 4, Order::Little);
-    let nsec = u32_at(msg, 8, Order::Little);
-    let len = u32_at(msg, 12, Order::Little) as usize;
-    let end = 16usize.saturating_add(len);
-    if end > msg.len() {
-        return Err(short(msg.len(), "header.frame_id", end));
-    }
+    let (stamp_ns, end) = ros1_header(msg)?;
     let value = scalar_body(msg, end, 0, Order::Little, ty, false)?;
     Ok(ScalarFields {
-        stamp_ns: Some(i64::from(sec) * 1_000_000_000 + i64::from(nsec)),
+        stamp_ns: Some(stamp_ns),
         value,
     })
 }
@@ -294,15 +306,7 @@ pub(crate) fn decode_scalar_ros1(msg: &[u8], ty: ScalarType) -> Result<ScalarFie
 /// Decodes a CDR-serialized ROS2 scalar message of type `ty` (encapsulation as
 /// [`decode_cdr`]).
 pub(crate) fn decode_scalar_cdr(msg: &[u8], ty: ScalarType) -> Result<ScalarFields, MessageError> {
-    if msg.len() < 4 {
-        return Err(short(msg.len(), "CDR encapsulation header", 4));
-    }
-    let order = match (msg[0], msg[1]) {
-        (0x00, 0x01) => Order::Little,
-        (0x00, 0x00) => Order::Big,
-        (a, b) => return Err(MessageError::Encapsulation(a, b)),
-    };
-    let b = &msg[4..];
+    let (order, b) = cdr_encapsulation(msg)?;
     if !ty.has_header() {
         let value = scalar_body(b, 0, 4, order, ty, true)?;
         return Ok(ScalarFields {
@@ -310,19 +314,10 @@ pub(crate) fn decode_scalar_cdr(msg: &[u8], ty: ScalarType) -> Result<ScalarFiel
             value,
         });
     }
-    if b.len() < 12 {
-        return Err(short(msg.len(), "header", 16));
-    }
-    let sec = u32_at(b, 0, order) as i32;
-    let nanosec = u32_at(b, 4, order);
-    let len = u32_at(b, 8, order) as usize;
-    let end = 12usize.saturating_add(len);
-    if end > b.len() {
-        return Err(short(msg.len(), "header.frame_id", end.saturating_add(4)));
-    }
+    let (stamp_ns, end) = cdr_header(b, order, msg.len())?;
     let value = scalar_body(b, end, 4, order, ty, true)?;
     Ok(ScalarFields {
-        stamp_ns: Some(i64::from(sec) * 1_000_000_000 + i64::from(nanosec)),
+        stamp_ns: Some(stamp_ns),
         value,
     })
 }

@@ -421,13 +421,7 @@ mod tests {
         assert!(one.values.iter().all(|&v| v == 7.0));
     }
 
-    fn t(topic: &str, ty: &str, n: u64) -> TopicInfo {
-        TopicInfo {
-            topic: topic.into(),
-            message_type: ty.into(),
-            messages: n,
-        }
-    }
+    use crate::imu::ros::tests::t;
 
     #[test]
     fn covariate_names_resolve_to_topics() {

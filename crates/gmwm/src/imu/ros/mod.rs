@@ -994,7 +994,8 @@ mod tests {
         assert_eq!(names, ["b_0.mcap", "b_2.mcap", "b_10.mcap"]);
     }
 
-    fn t(topic: &str, ty: &str, n: u64) -> TopicInfo {
+    /// A topic of `n` messages of type `ty` (also for the covariate tests).
+    pub(super) fn t(topic: &str, ty: &str, n: u64) -> TopicInfo {
         TopicInfo {
             topic: topic.into(),
             message_type: ty.into(),
