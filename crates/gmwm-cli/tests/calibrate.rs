@@ -645,14 +645,21 @@ fn calibrate_augment_reports_gmwm_plus_per_axis() {
             .arg(&bag)
             .args(["--audit", "0", "--json", "-"]),
     );
-    let doc = run_json(gmwm().arg("calibrate").arg(&bag).args([
-        "--augment",
-        "acf:3",
-        "--audit",
-        "0",
-        "--json",
-        "-",
-    ]));
+    let report = dir.path().join("aug.html");
+    let doc = run_json(
+        gmwm()
+            .arg("calibrate")
+            .arg(&bag)
+            .args(["--augment", "acf:3", "--audit", "0", "--json", "-"])
+            .arg("--report")
+            .arg(&report),
+    );
+    let html = std::fs::read_to_string(&report).unwrap();
+    assert!(
+        html.contains("GMWM+ (augment acf:3)"),
+        "the report's GMWM+ section"
+    );
+    assert_eq!(html.matches("J-test of the stacked moments").count(), 6);
     let axes = doc["augmented"].as_array().unwrap();
     assert_eq!(axes.len(), 6);
     for a in axes {

@@ -40,6 +40,8 @@ pub struct ReportContext {
     pub generator: String,
     /// N, B, K against a covariate (`gmwm calibrate --covariate`), when asked for.
     pub covariate: Option<gmwm::CovariateCalibration>,
+    /// GMWM+ of every axis (`gmwm calibrate --augment`); empty when not asked for.
+    pub augmented: Vec<gmwm::AxisAugmented>,
 }
 
 /// A sentence with its first letter upper-case.
@@ -775,6 +777,66 @@ fn covariate_section(out: &mut String, c: &gmwm::CovariateCalibration) -> Result
     Ok(())
 }
 
+/// The GMWM+ section (`gmwm calibrate --augment`): per axis the physical quantities of GMWM
+/// and GMWM+ with GMWM+'s interval, and the J-test of the stacked moments.
+fn augmented_section(out: &mut String, axes: &[gmwm::AxisAugmented]) {
+    let augment = axes
+        .iter()
+        .find_map(|a| a.fit.as_ref())
+        .map_or_else(String::new, |f| f.augment().to_string());
+    let _ = write!(
+        out,
+        "<section id=\"augmented\"><h2>GMWM+ (augment {})</h2>\n<p>Each axis' identified model refitted to its wavelet variance stacked with moments of the samples' first differences, weighted by their joint bootstrap covariance (docs/methods.md §5.15). The filter files keep the calibration's (GMWM) values; a J-test that rejects says the model does not reproduce the differences' first autocovariances (the sensor's own filter shapes them).</p>\n<table><tr><th>axis</th><th>quantity</th><th>GMWM</th><th>GMWM+</th><th>interval</th><th>unit</th></tr>\n",
+        esc(&augment)
+    );
+    let num = |v: f64| esc(&crate::style::number(v));
+    for a in axes {
+        let Some(fit) = &a.fit else {
+            let _ = writeln!(
+                out,
+                "<tr><td>{}</td><td colspan=\"5\">{}</td></tr>",
+                esc(&a.column),
+                esc(a.note.as_deref().unwrap_or("not run"))
+            );
+            continue;
+        };
+        for q in &a.physical {
+            let ci = match (q.ci_low, q.ci_high) {
+                (Some(lo), Some(hi)) if lo > 0.0 && hi.is_finite() => {
+                    format!("[{}, {}]", num(lo), num(hi))
+                }
+                (Some(_), Some(_)) => "not determined".to_string(),
+                _ => "—".to_string(),
+            };
+            let _ = writeln!(
+                out,
+                "<tr><td>{}</td><td>{}[{}].{}</td><td>{}</td><td>{}</td><td>{ci}</td><td>{}</td></tr>",
+                esc(&a.column),
+                esc(&q.process),
+                q.index,
+                esc(q.name),
+                num(q.gmwm),
+                num(q.value),
+                esc(&q.unit)
+            );
+        }
+        let j = fit.j_test();
+        let p = match j.p_value {
+            Some(p) if p < 1e-16 => "p &lt; 1e-16".to_string(),
+            Some(p) => format!("p = {p:.3}"),
+            None => "no degrees of freedom".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "<tr><td>{}</td><td colspan=\"5\">J-test of the stacked moments: Q = {:.1} on {} degrees of freedom, {p}</td></tr>",
+            esc(&a.column),
+            j.statistic,
+            j.df
+        );
+    }
+    out.push_str("</table></section>\n");
+}
+
 /// Renders the page.
 ///
 /// # Errors
@@ -850,6 +912,9 @@ pub fn render(report: &CalibrationReport, ctx: &ReportContext) -> Result<String,
     }
     if let Some(c) = &ctx.covariate {
         covariate_section(&mut out, c)?;
+    }
+    if !ctx.augmented.is_empty() {
+        augmented_section(&mut out, &ctx.augmented);
     }
     for a in &report.axes {
         axis_section(&mut out, a, report.alpha)?;

@@ -319,7 +319,7 @@ impl Progress for PyProgress {
 /// GMWM fit of a model on each column (docs/methods.md §5, §7 with `inference`): the
 /// `gmwm fit --json` document.
 #[pyfunction]
-#[pyo3(signature = (arrays, names, freq, model, weights="fast", draws=None, seed=1337, inference=false, bootstrap=None, covariance="auto", robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None))]
+#[pyo3(signature = (arrays, names, freq, model, weights="fast", draws=None, seed=1337, inference=false, bootstrap=None, covariance="auto", robust=false, eff=0.6, robust_convention="exact", levels=None, alpha=0.05, progress=None, augment=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -339,6 +339,7 @@ fn fit(
     levels: Option<usize>,
     alpha: f64,
     progress: Option<Py<PyAny>>,
+    augment: Option<&str>,
 ) -> PyResult<String> {
     check_columns(&arrays, &names)?;
     check_freq(freq)?;
@@ -351,6 +352,18 @@ fn fit(
         levels,
         alpha,
     )?;
+    // GMWM+ (docs/methods.md §5.15), as `gmwm fit --augment` with the same seed and level
+    let augment = augment
+        .map(|a| {
+            a.parse::<gmwm::Augment>()
+                .map(|augment| gmwm::AugmentOptions {
+                    seed,
+                    alpha,
+                    ..gmwm::AugmentOptions::new(augment)
+                })
+        })
+        .transpose()
+        .map_err(|e| err(format!("invalid augment: {e}")))?;
     let model: Model = model.parse().map_err(engine)?;
     let mut gmwm = Gmwm::new(model)
         .with_seed(seed)
@@ -399,6 +412,14 @@ fn fit(
                 inferences.push(i);
             }
         }
+        let mut augmented = Vec::new();
+        if let Some(opts) = &augment {
+            for ((f, n), x) in fits.iter().zip(&names).zip(&cols) {
+                let a =
+                    gmwm::augment_fit(&gmwm, f, x, opts).map_err(|e| format!("column {n}: {e}"))?;
+                augmented.push(a);
+            }
+        }
         let items: Vec<gmwm::document::FitItem<'_>> = names
             .iter()
             .zip(&fits)
@@ -409,7 +430,7 @@ fn fit(
                 fit,
                 canonical,
                 inference: inferences.get(k),
-                augmented: None,
+                augmented: augmented.get(k),
             })
             .collect();
         Ok(json(&gmwm::document::fits(&items)))

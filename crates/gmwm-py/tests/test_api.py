@@ -59,6 +59,19 @@ def test_fit_to_dict_is_the_cli_json():
     assert py == cli
 
 
+def test_fit_augment_is_the_cli_json():
+    # GMWM+ (docs/methods.md §5.15) beside the fit, as `gmwm fit --augment`
+    model = "AR1()+WN()+RW()"
+    py = gmwm.fit(str(ADIS), columns=["gyro_y"], model=model, G=2000, seed=7, augment="acf:2").to_dict()
+    cli = cli_json(
+        "fit", str(ADIS), "--columns", "gyro_y", "--model", model, "--G", "2000", "--seed", "7", "--augment", "acf:2"
+    )
+    assert py == cli
+    assert py["fits"][0]["augmented"]["augment"] == "acf:2"
+    with pytest.raises(gmwm.GmwmError, match="augment"):
+        gmwm.fit(str(ADIS), columns=["gyro_y"], model=model, augment="acf:0")
+
+
 def test_select_to_dict_is_the_cli_json():
     model = "AR1()+WN()+RW()+QN()"
     py = gmwm.select(str(ADIS), columns=["gyro_z"], model=model, bootstrap=10, G=2000).to_dict()

@@ -162,7 +162,10 @@ pub fn execute_in(
             &report,
             &sets,
             &doc,
-            curves.as_ref(),
+            Extra {
+                curves: curves.as_ref(),
+                augmented: augmented.as_deref(),
+            },
         ) {
             Ok(figures) => {
                 written.push(format!(
@@ -606,7 +609,7 @@ fn write_report(
     report: &CalibrationReport,
     sets: &[NavSet],
     doc: &serde_json::Value,
-    curves: Option<&gmwm::CovariateCalibration>,
+    extra: Extra<'_>,
 ) -> Result<usize> {
     let mut formats: Vec<(ExportFormat, Option<&Path>)> = config
         .exports
@@ -661,13 +664,22 @@ fn write_report(
         exports: files,
         json: serde_json::to_string(doc)?,
         generator: format!("gmwm {}", env!("CARGO_PKG_VERSION")),
-        covariate: curves.cloned(),
+        covariate: extra.curves.cloned(),
+        augmented: extra.augmented.map(<[_]>::to_vec).unwrap_or_default(),
     };
     let html = gmwm_plot::report::render(report, &ctx)?;
     let figures = html.matches("<figure>").count();
     // the caller names the file
     crate::output::write_io(path, html.as_bytes())?;
     Ok(figures)
+}
+
+/// The analyses beyond the calibration that the report shows when they were asked for.
+struct Extra<'a> {
+    /// `--covariate`: N, B, K against the covariate.
+    curves: Option<&'a gmwm::CovariateCalibration>,
+    /// `--augment`: GMWM+ per axis.
+    augmented: Option<&'a [gmwm::AxisAugmented]>,
 }
 
 /// The command as typed, to paste back into a shell: `gmwm` and the arguments, each quoted

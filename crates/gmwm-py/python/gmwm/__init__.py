@@ -202,7 +202,9 @@ def fit(
     """GMWM estimate of ``model`` on each column (docs/methods.md §5): ``weights`` (fast, diag,
     bootstrap), ``G`` (starting-value draws), ``seed``, ``inference``, ``bootstrap`` and
     ``covariance`` (docs/methods.md §7; "auto", "exact" or "bootstrap": how V is obtained),
-    ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``."""
+    ``robust``, ``eff``, ``robust_convention``, ``levels``, ``alpha``, and ``augment``
+    ("mean", "acf:K" or "mean,acf:K": GMWM+ beside each fit, docs/methods.md §5.15, in
+    ``to_dict()["fits"][k]["augmented"]``)."""
     read_options, options = _split(options)
     arrays, cols, rate = _columns(data, freq, names, read_options)
     doc = _native.fit(arrays, cols, rate, model, draws=G, progress=progress, **options)

@@ -30,8 +30,8 @@ def simulate(model: str, n: int, freq: float = ..., seed: int = ..., components:
 def fit(arrays: Sequence[F64], names: Sequence[str], freq: float, model: str, weights: str = ...,
         draws: Optional[int] = ..., seed: int = ..., inference: bool = ..., bootstrap: Optional[int] = ...,
         covariance: str = ..., robust: bool = ..., eff: float = ..., robust_convention: str = ..., levels: Optional[int] = ...,
-        alpha: float = ..., progress: Progress = ...) -> str:
-    """GMWM fit of `model` on each column (docs/methods.md §5, §7)."""
+        alpha: float = ..., progress: Progress = ..., augment: Optional[str] = ...) -> str:
+    """GMWM fit of `model` on each column (docs/methods.md §5, §7; GMWM+ with `augment`, §5.15)."""
 
 def select(arrays: Sequence[F64], names: Sequence[str], freq: float, model: Optional[str] = ...,
            candidates: Optional[Sequence[str]] = ..., bootstrap: int = ..., covariance: str = ...,
