@@ -15,7 +15,8 @@
 //!   V is the exact covariance ([`crate::variance::implied_cov`]), which needs no series;
 //! - **the power spectral density**: Welch's estimator takes the samples chunk by chunk
 //!   (`Welch`), so the robust check's pass below feeds it its blocks, in order, and the PSD
-//!   is that of the whole series (without the robust check, no PSD, with a note);
+//!   is that of those blocks, no segment straddling two blocks that do not follow each other
+//!   (without the robust check, no PSD, with a note);
 //! - **the contamination check**: the robust WV is a root per level over all the level's
 //!   coefficients, which an exact streamed computation would need several passes and the
 //!   coefficients near the root for. Here it is estimated on consecutive blocks of
@@ -25,7 +26,12 @@
 //!   windows). The interval is the robust one (docs/methods.md §2.5) for the pooled count. The
 //!   error of this approximation against the robust WV of the whole series is measured in the
 //!   tests (`streamed_robust_matches_whole_series`); contamination (spikes, steps) shows at
-//!   the fine scales, which the check covers.
+//!   the fine scales, which the check covers. A recording of more than `ROBUST_BLOCKS` blocks
+//!   (2^24 samples) is checked on that many blocks spread evenly over it, the others skipped
+//!   unread: 2^24 samples already pin the fine scales' robust WV to a fraction of a percent,
+//!   and the whole-series pass cost a third of a 10^8-sample calibration's CPU time. The
+//!   comparison stays honest: the classical WV of every sample against a robust one whose
+//!   interval is that of the samples it saw.
 //!
 //! Memory: that of [`binary_wavelet_variance`] (the rings up to level 20, 8 MiB an axis, and a
 //! few chunks of rows per thread) and one block per axis for the robust check: tens of MB an
@@ -58,6 +64,9 @@ use std::path::Path;
 pub const STREAM_FROM: u64 = 1 << 24;
 /// Samples per block of the streamed robust check (2^21).
 pub(crate) const ROBUST_BLOCK: usize = 1 << 21;
+/// Blocks the streamed robust check (and the PSD) takes at most: `2^24` samples an axis,
+/// spread evenly over a longer recording ([`robust_blocks`]).
+pub(crate) const ROBUST_BLOCKS: usize = 8;
 /// Levels of the streamed robust check: scales up to `2^15` samples, at least 64 windows a
 /// block.
 pub(crate) const ROBUST_LEVELS: usize = 15;
@@ -269,7 +278,7 @@ impl Calibration {
             );
             (c?, r?)
         };
-        let left_out = pooled.as_ref().map_or(0, |(_, left_out, _)| *left_out);
+        let coverage = pooled.as_ref().map(|(_, c, _)| *c);
         let (pooled, psds) = match pooled {
             Some((p, _, psds)) => (Some(p), Some(psds)),
             None => (None, None),
@@ -325,11 +334,16 @@ impl Calibration {
             "streamed from the file ({n} samples per axis, at least {}): the Allan variance from the WV (exact), starting values from the WV; the contamination check compares the scales up to {} samples with a robust WV estimated on blocks of {ROBUST_BLOCK} samples{}",
             self.options().stream_from,
             1usize << levels.min(ROBUST_LEVELS),
-            match left_out {
-                0 => String::new(),
-                k => format!(
-                    " (the last {k} samples, too few for 64 windows of its coarsest scale, are left out of it; the WV uses them)"
+            match coverage {
+                Some(c) if c.samples < n && c.blocks < c.of_blocks.saturating_sub(1) => format!(
+                    " ({} of the {} blocks, spread evenly over the recording: {} of its samples; the PSD is Welch's on the same blocks; the WV uses every sample)",
+                    c.blocks, c.of_blocks, c.samples
                 ),
+                Some(c) if c.samples < n => format!(
+                    " (the last {} samples, too few for 64 windows of its coarsest scale, are left out of it; the WV uses them)",
+                    n - c.samples
+                ),
+                _ => String::new(),
             }
         ));
         self.run_axes(name, freq_hz, n, axes, checks, progress)
@@ -670,24 +684,55 @@ type Pooled = Vec<Vec<Option<(f64, usize)>>>;
 /// Each column's Welch PSD from the streamed pass (an error as text: too short, say).
 type StreamedPsds = Vec<Result<Box<Psd>, String>>;
 
-/// The blocks' robust WVs of each column, pooled (module docs), the samples of the short last
-/// block left out of them, and each column's Welch PSD of all its `n` samples at `freq_hz`,
-/// fed block by block.
+/// Which of the series' blocks of [`ROBUST_BLOCK`] samples the robust check takes, in order
+/// (0-based), and whether it takes the short last block: every block when there are at most
+/// [`ROBUST_BLOCKS`] full ones (the short last one when it holds `min_rows` samples, or is the
+/// only one); otherwise [`ROBUST_BLOCKS`] full blocks spread evenly, block `k` the one holding
+/// the point `(2k + 1) / (2 · ROBUST_BLOCKS)` of the full blocks' span.
+fn robust_blocks(n: usize, min_rows: usize) -> (Vec<usize>, bool) {
+    let full = n / ROBUST_BLOCK;
+    let short = n % ROBUST_BLOCK;
+    if full <= ROBUST_BLOCKS {
+        let with_short = short > 0 && (short >= min_rows || full == 0);
+        return ((0..full).collect(), with_short);
+    }
+    let picked = (0..ROBUST_BLOCKS)
+        .map(|k| (2 * k + 1) * full / (2 * ROBUST_BLOCKS))
+        .collect();
+    (picked, false)
+}
+
+/// What the streamed robust check took: `blocks` of the series' `of_blocks` blocks
+/// ([`robust_blocks`]), `samples` samples an axis in all.
+#[derive(Debug, Clone, Copy)]
+struct RobustCoverage {
+    blocks: usize,
+    of_blocks: usize,
+    samples: usize,
+}
+
+/// The blocks' robust WVs of each column, pooled (module docs), what they covered, and each
+/// column's Welch PSD of the same blocks at `freq_hz` (segments never straddle two blocks that
+/// are not consecutive). On a recording of at most [`ROBUST_BLOCKS`] blocks that is every
+/// sample but a short last block too short for 64 windows of the coarsest level; on a longer
+/// one, [`ROBUST_BLOCKS`] blocks spread over it, the others skipped unread.
 fn robust_pass(
     path: &Path,
     layout: &BinaryLayout,
     columns: &[usize],
     opts: &WvOptions,
     (n, freq_hz): (usize, f64),
-) -> Result<(Pooled, usize, StreamedPsds), Error> {
+) -> Result<(Pooled, RobustCoverage, StreamedPsds), Error> {
     let levels = opts.levels.unwrap_or(ROBUST_LEVELS);
+    let (picked, with_short) = robust_blocks(n, 64 << levels);
     let mut chunks = BinaryChunks::open(path, layout.format, layout.ncols, 1, ROBUST_BLOCK)?;
     // per column and level: sum of count x estimate, sum of counts; None once undefined
     let mut pooled: Pooled = vec![vec![Some((0.0, 0)); levels]; columns.len()];
     let mut buffers = vec![Vec::with_capacity(ROBUST_BLOCK); columns.len()];
+    let analysed = picked.len() * ROBUST_BLOCK + if with_short { n % ROBUST_BLOCK } else { 0 };
     let too_short = || {
         crate::error::SeriesError::TooShort {
-            n,
+            n: analysed,
             needed: MIN_SEGMENT,
             what: "a Welch PSD (one segment)".into(),
         }
@@ -695,19 +740,32 @@ fn robust_pass(
     };
     let mut welch: Vec<Result<Welch, String>> = (0..columns.len())
         .map(|_| {
-            let l = segment_length(n).ok_or_else(too_short)?;
+            let l = segment_length(analysed).ok_or_else(too_short)?;
             Welch::new(l, freq_hz).map_err(|e| e.to_string())
         })
         .collect();
-    let finish = |welch: Vec<Result<Welch, String>>| -> StreamedPsds {
-        welch
-            .into_iter()
-            .map(|w| Ok(Box::new(w?.finish().map_err(|e| e.to_string())?)))
-            .collect()
+    let mut coverage = RobustCoverage {
+        blocks: 0,
+        of_blocks: n.div_ceil(ROBUST_BLOCK),
+        samples: 0,
     };
-    let mut blocks = 0usize;
-    while let Some(rows) = chunks.next_chunk_of(columns, &mut buffers)? {
-        // every sample goes to the PSD; a column whose samples fail keeps its error
+    let mut at = 0usize;
+    let blocks = picked
+        .iter()
+        .copied()
+        .chain(with_short.then_some(n / ROBUST_BLOCK));
+    for block in blocks {
+        if block > at {
+            chunks.skip_rows(((block - at) * ROBUST_BLOCK) as u64)?;
+            welch.iter_mut().flatten().for_each(Welch::discontinue);
+        }
+        at = block + 1;
+        let Some(rows) = chunks.next_chunk_of(columns, &mut buffers)? else {
+            break;
+        };
+        coverage.blocks += 1;
+        coverage.samples += rows;
+        // a column whose samples fail keeps its error
         welch.par_iter_mut().zip(&buffers).for_each(|(w, x)| {
             if let Ok(acc) = w {
                 if let Err(e) = acc.push(x) {
@@ -715,11 +773,6 @@ fn robust_pass(
                 }
             }
         });
-        // a short last block holding fewer than 64 windows of the coarsest level is left out
-        if rows < 64 << levels && blocks > 0 {
-            return Ok((pooled, rows, finish(welch)));
-        }
-        blocks += 1;
         let block_levels = levels.min(default_levels(rows, Transform::Modwt, WaveletFilter::Haar));
         let results: Vec<Option<WaveletVariance>> = buffers
             .par_iter()
@@ -749,7 +802,11 @@ fn robust_pass(
             }
         }
     }
-    Ok((pooled, 0, finish(welch)))
+    let psds = welch
+        .into_iter()
+        .map(|w| Ok(Box::new(w?.finish().map_err(|e| e.to_string())?)))
+        .collect();
+    Ok((pooled, coverage, psds))
 }
 
 /// The pooled robust WV of each column (module docs); `classical` gives the intervals'
@@ -787,4 +844,35 @@ fn robust_wvs(
             )))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{robust_blocks, ROBUST_BLOCK, ROBUST_BLOCKS};
+
+    /// Up to `ROBUST_BLOCKS` full blocks: all of them, and the short last one when it is long
+    /// enough or the only one; beyond: `ROBUST_BLOCKS` distinct full blocks spread evenly.
+    #[test]
+    fn robust_blocks_take_all_or_spread_evenly() {
+        let b = ROBUST_BLOCK;
+        assert_eq!(robust_blocks(3 * b + 100, 1000), (vec![0, 1, 2], false));
+        assert_eq!(robust_blocks(3 * b + 1000, 1000), (vec![0, 1, 2], true));
+        assert_eq!(robust_blocks(100, 1000), (vec![], true));
+        assert_eq!(robust_blocks(8 * b, 1000), ((0..8).collect(), false));
+        // 10^8 samples: 47 full blocks, the short one left out
+        let (picked, short) = robust_blocks(100_000_000, 1000);
+        assert!(!short);
+        assert_eq!(picked, vec![2, 8, 14, 20, 26, 32, 38, 44]);
+        for full in [9, 10, 16, 17, 100, 4097] {
+            let (picked, short) = robust_blocks(full * b + 7, 1);
+            assert!(!short);
+            assert_eq!(picked.len(), ROBUST_BLOCKS);
+            assert!(picked.windows(2).all(|w| w[0] < w[1]), "{full}: {picked:?}");
+            assert!(*picked.last().unwrap() < full);
+            // as many blocks before the first as after the last, within one
+            let before = picked[0];
+            let after = full - 1 - picked.last().unwrap();
+            assert!(before.abs_diff(after) <= 1, "{full}: {picked:?}");
+        }
+    }
 }

@@ -319,3 +319,38 @@ fn spectral_line_is_found_where_a_sinusoid_is_and_nowhere_in_white_noise() {
         );
     }
 }
+
+/// A break (`Welch::discontinue`) between two pieces: the PSD averages the pieces' own
+/// segments, none across the break, so its power is the segment-weighted sum of the pieces'
+/// (to rounding).
+#[test]
+fn welch_break_averages_the_pieces_segments() {
+    let (l, f) = (256, 50.0);
+    let a = white_noise(4 * l + 100, 1.0, SEED);
+    let b: Vec<f64> = white_noise(6 * l, 1.0, SEED + 1)
+        .iter()
+        .map(|v| 3.0 * v + 100.0)
+        .collect();
+    let piece = |x: &[f64]| {
+        let mut w = Welch::new(l, f).unwrap();
+        w.push(x).unwrap();
+        w.finish().unwrap()
+    };
+    let (pa, pb) = (piece(&a), piece(&b));
+    let mut w = Welch::new(l, f).unwrap();
+    w.push(&a).unwrap();
+    w.discontinue();
+    w.push(&b).unwrap();
+    let both = w.finish().unwrap();
+    assert_eq!(both.segments(), pa.segments() + pb.segments());
+    for k in 0..both.density().len() {
+        let want = (pa.density()[k] * pa.segments() as f64
+            + pb.density()[k] * pb.segments() as f64)
+            / both.segments() as f64;
+        let got = both.density()[k];
+        assert!(
+            (got - want).abs() <= 1e-12 * want,
+            "bin {k}: {got} vs {want}"
+        );
+    }
+}

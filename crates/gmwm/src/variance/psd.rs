@@ -284,6 +284,13 @@ impl Welch {
         Ok(())
     }
 
+    /// Marks a break in the series: the next samples pushed do not follow the previous ones,
+    /// so no segment straddles the break (the samples since the last full segment are
+    /// dropped).
+    pub(crate) fn discontinue(&mut self) {
+        self.pending.clear();
+    }
+
     /// One full segment in `pending`: mean removed, windowed, transformed, accumulated.
     fn segment(&mut self) {
         let l = self.pending.len();

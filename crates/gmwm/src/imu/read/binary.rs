@@ -351,6 +351,22 @@ impl BinaryChunks {
         Ok(Some(&self.values))
     }
 
+    /// Skips the next `rows` rows (at most those left) without reading them.
+    ///
+    /// # Errors
+    /// [`ReadError::Io`].
+    pub(crate) fn skip_rows(&mut self, rows: u64) -> Result<(), ReadError> {
+        let rows = rows.min(self.rows - self.row);
+        let record = (self.width * self.ncols) as u64;
+        let bytes = i64::try_from(rows * record)
+            .map_err(|_| ParamError::new("rows", rows, "a skip within the file"))?;
+        self.reader
+            .seek_relative(bytes)
+            .map_err(|e| io_error(&self.path, e))?;
+        self.row += rows;
+        Ok(())
+    }
+
     /// Reads the bytes of the next chunk of rows into `self.bytes`: the number of rows, `None`
     /// after the last one (`self.row` is advanced by the caller once the values are checked).
     fn read_rows(&mut self) -> Result<Option<usize>, ReadError> {
