@@ -1,5 +1,5 @@
 //! Determinism (issue 15): every randomised command gives the same bits for the same seed at
-//! 1, 2 and 3 threads (`RAYON_NUM_THREADS`): simulate, fit in guess mode, fit with the
+//! 1, 2, 3 and 16 threads (`RAYON_NUM_THREADS`): simulate, fit in guess mode, fit with the
 //! simulated weights, bootstrap inference, selection with a simulated V and with the bootstrap
 //! optimism, and calibrate. The engine's own tests cover the chunkings (the simulator's fill,
 //! the WV accumulator's blocks, the streamed WV's read sizes).
@@ -30,9 +30,9 @@ fn stdout_at(threads: usize, args: &[&str], dir: &Path) -> Vec<u8> {
     out.stdout
 }
 
-fn same_bits_at_1_2_3_threads(args: &[&str], dir: &Path) {
+fn same_bits_at_1_2_3_16_threads(args: &[&str], dir: &Path) {
     let one = stdout_at(1, args, dir);
-    for threads in [2, 3] {
+    for threads in [2, 3, 16] {
         let other = stdout_at(threads, args, dir);
         assert!(
             one == other,
@@ -49,7 +49,7 @@ fn randomised_commands_give_the_same_bits_at_any_thread_count() {
     let d = dir.path();
     let model = "AR1(phi=0.95, sigma2=1e-6)+WN(sigma2=1e-4)+RW(gamma2=1e-10)";
     // simulate: the series itself, as CSV on standard output
-    same_bits_at_1_2_3_threads(
+    same_bits_at_1_2_3_16_threads(
         &["simulate", "--model", model, "--n", "16384", "--seed", "5"],
         d,
     );
@@ -57,14 +57,14 @@ fn randomised_commands_give_the_same_bits_at_any_thread_count() {
     let file = file.to_str().unwrap();
     let fit = ["fit", file, "--model", "AR1()+WN()+RW()", "--json"];
     // guess mode (the G draws run in parallel batches)
-    same_bits_at_1_2_3_threads(&[&fit[..], &["--G", "3000", "--seed", "9"]].concat(), d);
+    same_bits_at_1_2_3_16_threads(&[&fit[..], &["--G", "3000", "--seed", "9"]].concat(), d);
     // simulated weights (replicates in parallel, then a refit)
-    same_bits_at_1_2_3_threads(
+    same_bits_at_1_2_3_16_threads(
         &[&fit[..], &["--G", "500", "--weights", "bootstrap"]].concat(),
         d,
     );
     // bootstrap inference (replicates refitted in parallel)
-    same_bits_at_1_2_3_threads(
+    same_bits_at_1_2_3_16_threads(
         &[
             &fit[..],
             &[
@@ -90,7 +90,7 @@ fn randomised_commands_give_the_same_bits_at_any_thread_count() {
         "--G",
         "500",
     ];
-    same_bits_at_1_2_3_threads(
+    same_bits_at_1_2_3_16_threads(
         &[
             &select[..],
             &["--covariance", "bootstrap", "--bootstrap", "20"],
@@ -98,7 +98,7 @@ fn randomised_commands_give_the_same_bits_at_any_thread_count() {
         .concat(),
         d,
     );
-    same_bits_at_1_2_3_threads(
+    same_bits_at_1_2_3_16_threads(
         &[
             &select[..],
             &["--optimism", "bootstrap", "--bootstrap", "10"],
@@ -128,5 +128,5 @@ fn calibrate_gives_the_same_bits_at_any_thread_count() {
         r#"{"sampling_frequency_hz": 100, "units": {"gyro": "rad/s"}}"#,
     )
     .unwrap();
-    same_bits_at_1_2_3_threads(&["calibrate", "imu.csv", "--json", "-", "--G", "500"], d);
+    same_bits_at_1_2_3_16_threads(&["calibrate", "imu.csv", "--json", "-", "--G", "500"], d);
 }
