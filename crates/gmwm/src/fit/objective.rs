@@ -473,9 +473,7 @@ impl Objective {
         self.model.for_each_process(theta, self.freq_hz, |p, col| {
             p.add_wv(&mut nu[..levels]);
             if let Some(a) = a.as_deref_mut() {
-                for (j, row) in p.jacobian(levels).iter().enumerate() {
-                    a[j * np + col..j * np + col + row.len()].copy_from_slice(row);
-                }
+                p.write_jacobian(levels, a, np, col);
             }
         })?;
         if let Some(augment) = &self.augment {

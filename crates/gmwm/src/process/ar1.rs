@@ -324,12 +324,12 @@ impl Gm {
 ///
 /// `lag` is `L = -ln(phi)` when known exactly (GM); otherwise it is computed from `phi` when
 /// `phi > 0`. For `phi <= 0` the closed form has no cancellation and is used as written.
-pub(crate) fn ar1_wv_jet<const N: usize>(
-    phi: Jet<N>,
-    lag: Option<Jet<N>>,
-    sigma2: Jet<N>,
+pub(crate) fn ar1_wv_jet<const N: usize, const H: bool>(
+    phi: Jet<N, H>,
+    lag: Option<Jet<N, H>>,
+    sigma2: Jet<N, H>,
     m: f64,
-) -> Jet<N> {
+) -> Jet<N, H> {
     let lag = match lag {
         Some(l) => Some(l),
         None if phi.v > 0.0 => Some(-phi.ln()),
@@ -360,7 +360,7 @@ pub(crate) fn ar1_wv_jet<const N: usize>(
 /// power overflows: `G = sum_k d_k t^{k-3}`,
 /// `d_k = (-1)^k (1+2m)^3 / k! * (4 r1^k - 1 - m r2^k - 3 r0^k)` with `r1 = (1+m)/(1+2m)`,
 /// `r2 = 2/(1+2m)`, `r0 = 1/(1+2m)`.
-fn series_g<const N: usize>(l: Jet<N>, m: f64) -> Jet<N> {
+fn series_g<const N: usize, const H: bool>(l: Jet<N, H>, m: f64) -> Jet<N, H> {
     let q = 1.0 + 2.0 * m;
     let mut d = [0.0; G_TERMS];
     for (dk, c) in d.iter_mut().zip(g_coefficients(m)) {
@@ -407,7 +407,7 @@ fn g_coefficients(m: f64) -> impl Iterator<Item = f64> {
 }
 
 /// `R(L) = 1 / (E(L)^3 (1 + e^{-L}))`, `E(L) = (1 - e^{-L})/L = sum_k (-L)^k/(k+1)!`.
-fn series_r<const N: usize>(l: Jet<N>) -> Jet<N> {
+fn series_r<const N: usize, const H: bool>(l: Jet<N, H>) -> Jet<N, H> {
     let mut coef = [0.0; E_TERMS];
     let mut fact = 1.0;
     for (k, c) in coef.iter_mut().enumerate() {
@@ -476,7 +476,7 @@ pub(crate) fn ar1_spectrum(one_m_phi: f64, phi: f64, sigma2: f64, f: f64) -> f64
 }
 
 impl Ar1 {
-    fn jets(&self, levels: usize) -> Vec<Jet<2>> {
+    fn jets<const H: bool>(&self, levels: usize) -> Vec<Jet<2, H>> {
         jet_levels([self.phi, self.sigma2], levels, |v, m| {
             ar1_wv_jet(v[0], None, v[1], m)
         })
@@ -502,7 +502,7 @@ impl LatentProcess for Ar1 {
         if self.phi > 0.0 {
             ar1_add_wv(self.phi, None, self.sigma2, out);
         } else {
-            let jets = jet_levels::<0>([], out.len(), |_, m| {
+            let jets = jet_levels::<0, false>([], out.len(), |_, m| {
                 ar1_wv_jet(Jet::c(self.phi), None, Jet::c(self.sigma2), m)
             });
             for (o, j) in out.iter_mut().zip(jets) {
@@ -511,10 +511,13 @@ impl LatentProcess for Ar1 {
         }
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
-        jets_jacobian(&self.jets(levels))
+        jets_jacobian(&self.jets::<false>(levels))
+    }
+    fn write_jacobian(&self, levels: usize, a: &mut [f64], stride: usize, col: usize) {
+        super::write_jets_jacobian(&self.jets::<false>(levels), a, stride, col);
     }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
-        jets_hessian(&self.jets(levels))
+        jets_hessian(&self.jets::<true>(levels))
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
         Some(ar1_spectrum(1.0 - self.phi, self.phi, self.sigma2, f))
@@ -523,7 +526,7 @@ impl LatentProcess for Ar1 {
 
 impl Gm {
     /// Jets in `(beta, sigma2_gm)` through the exact conversion of §4.3 (chain rule included).
-    fn jets(&self, levels: usize) -> Vec<Jet<2>> {
+    fn jets<const H: bool>(&self, levels: usize) -> Vec<Jet<2, H>> {
         let dt = 1.0 / self.freq_hz;
         jet_levels([self.beta, self.sigma2_gm], levels, |v, m| {
             let l = v[0] * dt;
@@ -555,10 +558,13 @@ impl LatentProcess for Gm {
         ar1_add_wv((-l).exp(), Some(l), sigma2, out);
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
-        jets_jacobian(&self.jets(levels))
+        jets_jacobian(&self.jets::<false>(levels))
+    }
+    fn write_jacobian(&self, levels: usize, a: &mut [f64], stride: usize, col: usize) {
+        super::write_jets_jacobian(&self.jets::<false>(levels), a, stride, col);
     }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
-        jets_hessian(&self.jets(levels))
+        jets_hessian(&self.jets::<true>(levels))
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let l = self.beta / self.freq_hz;
@@ -765,7 +771,7 @@ mod tests {
         ] {
             for &sigma2 in &[1e-12, 1.0] {
                 let levels = 40;
-                let jets = jet_levels::<0>([], levels, |_, m| {
+                let jets = jet_levels::<0, false>([], levels, |_, m| {
                     ar1_wv_jet(Jet::c(phi), None, Jet::c(sigma2), m)
                 });
                 let mut out = vec![0.0; levels];
@@ -779,7 +785,7 @@ mod tests {
         // GM: through the exact lag
         let gm = Gm::new(0.25, 7.08e-9, 250.0).unwrap();
         let fast = gm.wv(22);
-        let slow: Vec<f64> = gm.jets(22).iter().map(|j| j.v).collect();
+        let slow: Vec<f64> = gm.jets::<true>(22).iter().map(|j| j.v).collect();
         for (a, b) in fast.iter().zip(&slow) {
             assert!((a / b - 1.0).abs() < 1e-13, "{a} vs {b}");
         }

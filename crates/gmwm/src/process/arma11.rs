@@ -89,7 +89,7 @@ impl Arma11 {
         Ok(Self { phi, theta, sigma2 })
     }
 
-    fn jets(&self, levels: usize) -> Vec<Jet<3>> {
+    fn jets<const H: bool>(&self, levels: usize) -> Vec<Jet<3, H>> {
         jet_levels([self.phi, self.theta, self.sigma2], levels, |v, m| {
             arma11_wv_jet(v[0], v[1], v[2], m)
         })
@@ -99,12 +99,12 @@ impl Arma11 {
 /// docs/methods.md §4.2 (ARMA11 row):
 /// `nu2 = sigma2 [(1+theta)^2 (1-phi^2) tau - 2 (theta+phi)(1+theta phi) K] / [tau^2 (1-phi)^3 (1+phi)]`,
 /// `K = 3 - 4 phi^{tau/2} + phi^tau`; for `phi > 1/2` through the decomposition of the module doc.
-pub(crate) fn arma11_wv_jet<const N: usize>(
-    phi: Jet<N>,
-    theta: Jet<N>,
-    sigma2: Jet<N>,
+pub(crate) fn arma11_wv_jet<const N: usize, const H: bool>(
+    phi: Jet<N, H>,
+    theta: Jet<N, H>,
+    sigma2: Jet<N, H>,
     m: f64,
-) -> Jet<N> {
+) -> Jet<N, H> {
     let tau = 2.0 * m;
     if phi.v > DECOMPOSE_FROM_PHI {
         let wn = -(sigma2 * theta / phi) / tau;
@@ -131,13 +131,13 @@ impl LatentProcess for Arma11 {
         vec![self.phi, self.theta, self.sigma2]
     }
     fn wv(&self, levels: usize) -> Vec<f64> {
-        self.jets(levels).iter().map(|j| j.v).collect()
+        self.jets::<false>(levels).iter().map(|j| j.v).collect()
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
-        jets_jacobian(&self.jets(levels))
+        jets_jacobian(&self.jets::<false>(levels))
     }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
-        jets_hessian(&self.jets(levels))
+        jets_hessian(&self.jets::<true>(levels))
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let s = (std::f64::consts::PI * f).sin();

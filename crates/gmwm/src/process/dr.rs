@@ -86,6 +86,9 @@ impl LatentProcess for Dr {
             .map(|m| vec![2.0 * self.omega * unit_wv(m)])
             .collect()
     }
+    fn write_jacobian(&self, levels: usize, a: &mut [f64], stride: usize, col: usize) {
+        super::write_scalar_jacobian(levels, a, stride, col, |m| 2.0 * self.omega * unit_wv(m));
+    }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
         half_widths(levels)
             .map(|m| vec![vec![2.0 * unit_wv(m)]])

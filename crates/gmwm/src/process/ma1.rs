@@ -70,7 +70,7 @@ impl Ma1 {
         Ok(Self { theta, sigma2 })
     }
 
-    fn jets(&self, levels: usize) -> Vec<Jet<2>> {
+    fn jets<const H: bool>(&self, levels: usize) -> Vec<Jet<2, H>> {
         jet_levels([self.theta, self.sigma2], levels, |v, m| {
             ma1_wv_jet(v[0], v[1], m)
         })
@@ -79,7 +79,11 @@ impl Ma1 {
 
 /// docs/methods.md §4.2 (MA1 row): `nu2 = sigma2 [(1 + theta)^2 tau - 6 theta] / tau^2`, `tau =
 /// 2m`.
-pub(crate) fn ma1_wv_jet<const N: usize>(theta: Jet<N>, sigma2: Jet<N>, m: f64) -> Jet<N> {
+pub(crate) fn ma1_wv_jet<const N: usize, const H: bool>(
+    theta: Jet<N, H>,
+    sigma2: Jet<N, H>,
+    m: f64,
+) -> Jet<N, H> {
     let tau = 2.0 * m;
     sigma2 * ((theta + 1.0).powi(2) * tau - theta * 6.0) / (tau * tau)
 }
@@ -95,13 +99,13 @@ impl LatentProcess for Ma1 {
         vec![self.theta, self.sigma2]
     }
     fn wv(&self, levels: usize) -> Vec<f64> {
-        self.jets(levels).iter().map(|j| j.v).collect()
+        self.jets::<false>(levels).iter().map(|j| j.v).collect()
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
-        jets_jacobian(&self.jets(levels))
+        jets_jacobian(&self.jets::<false>(levels))
     }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
-        jets_hessian(&self.jets(levels))
+        jets_hessian(&self.jets::<true>(levels))
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let s = (std::f64::consts::PI * f).sin();

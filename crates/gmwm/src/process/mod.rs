@@ -87,6 +87,14 @@ pub trait LatentProcess {
     }
     /// docs/methods.md §4.5: Jacobian `d nu2_j / d theta_k`, indexed `[level][param]`.
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>>;
+    /// [`jacobian`](Self::jacobian) written into a row-major matrix: level `j`'s row at
+    /// `a[j * stride + col..]` (the same values, without a vector per level; the fit's hot
+    /// path).
+    fn write_jacobian(&self, levels: usize, a: &mut [f64], stride: usize, col: usize) {
+        for (j, row) in self.jacobian(levels).iter().enumerate() {
+            a[j * stride + col..j * stride + col + row.len()].copy_from_slice(row);
+        }
+    }
     /// docs/methods.md §4.6: second derivatives, indexed `[level][param][param]` (symmetric).
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>>;
     /// docs/methods.md §1.9: spectral density `S(f)` on `|f| <= 1/2` (cycles per sample); the RW
@@ -277,6 +285,9 @@ impl LatentProcess for Process {
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         self.inner().jacobian(levels)
     }
+    fn write_jacobian(&self, levels: usize, a: &mut [f64], stride: usize, col: usize) {
+        self.inner().write_jacobian(levels, a, stride, col)
+    }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
         self.inner().hessian(levels)
     }
@@ -344,18 +355,44 @@ pub(crate) fn check_unit(name: &'static str, v: f64, expected: &str) -> Result<(
 
 /// Evaluates a function of `N` parameters in jets and splits value, gradient and Hessian per
 /// level. `f(params, m)` returns the level's jet.
-pub(crate) fn jet_levels<const N: usize>(
+pub(crate) fn jet_levels<const N: usize, const H: bool>(
     params: [f64; N],
     levels: usize,
-    f: impl Fn(&[Jet<N>; N], f64) -> Jet<N>,
-) -> Vec<Jet<N>> {
-    let vars: [Jet<N>; N] = std::array::from_fn(|k| Jet::var(params[k], k));
+    f: impl Fn(&[Jet<N, H>; N], f64) -> Jet<N, H>,
+) -> Vec<Jet<N, H>> {
+    let vars: [Jet<N, H>; N] = std::array::from_fn(|k| Jet::var(params[k], k));
     half_widths(levels).map(|m| f(&vars, m)).collect()
 }
 
 /// Jacobian rows from jets.
-pub(crate) fn jets_jacobian<const N: usize>(jets: &[Jet<N>]) -> Vec<Vec<f64>> {
+pub(crate) fn jets_jacobian<const N: usize, const H: bool>(jets: &[Jet<N, H>]) -> Vec<Vec<f64>> {
     jets.iter().map(|j| j.g.to_vec()).collect()
+}
+
+/// [`jets_jacobian`] written into rows of `a` (see [`LatentProcess::write_jacobian`]).
+pub(crate) fn write_jets_jacobian<const N: usize, const H: bool>(
+    jets: &[Jet<N, H>],
+    a: &mut [f64],
+    stride: usize,
+    col: usize,
+) {
+    for (j, jet) in jets.iter().enumerate() {
+        a[j * stride + col..j * stride + col + N].copy_from_slice(&jet.g);
+    }
+}
+
+/// A one-parameter process's Jacobian `d(m)` at the half-widths, written into column `col` of
+/// `a` (see [`LatentProcess::write_jacobian`]).
+pub(crate) fn write_scalar_jacobian(
+    levels: usize,
+    a: &mut [f64],
+    stride: usize,
+    col: usize,
+    d: impl Fn(f64) -> f64,
+) {
+    for (j, m) in half_widths(levels).enumerate() {
+        a[j * stride + col] = d(m);
+    }
 }
 
 /// Hessian blocks from jets.
@@ -367,8 +404,11 @@ pub(crate) fn jets_hessian<const N: usize>(jets: &[Jet<N>]) -> Vec<Vec<Vec<f64>>
 
 /// A second-order forward-mode jet: value, gradient and Hessian with respect to `N` parameters.
 /// Arithmetic on jets gives exact derivatives of whatever formula is evaluated (no differencing).
+/// With `H = false` the Hessian is not propagated (it stays zero): a Jacobian costs less than
+/// half as much, and the value and gradient are computed by the very same operations, so they
+/// are the same bits.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Jet<const N: usize> {
+pub(crate) struct Jet<const N: usize, const H: bool = true> {
     /// Value.
     pub(crate) v: f64,
     /// Gradient.
@@ -377,7 +417,7 @@ pub(crate) struct Jet<const N: usize> {
     pub(crate) h: [[f64; N]; N],
 }
 
-impl<const N: usize> Jet<N> {
+impl<const N: usize, const H: bool> Jet<N, H> {
     /// A constant.
     pub(crate) fn c(v: f64) -> Self {
         Self {
@@ -399,8 +439,10 @@ impl<const N: usize> Jet<N> {
         let mut out = Self::c(f0);
         for a in 0..N {
             out.g[a] = f1 * self.g[a];
-            for b in 0..N {
-                out.h[a][b] = f1 * self.h[a][b] + f2 * self.g[a] * self.g[b];
+            if H {
+                for b in 0..N {
+                    out.h[a][b] = f1 * self.h[a][b] + f2 * self.g[a] * self.g[b];
+                }
             }
         }
         out
@@ -443,30 +485,34 @@ impl<const N: usize> Jet<N> {
         out.v *= s;
         for a in 0..N {
             out.g[a] *= s;
-            for b in 0..N {
-                out.h[a][b] *= s;
+            if H {
+                for b in 0..N {
+                    out.h[a][b] *= s;
+                }
             }
         }
         out
     }
 }
 
-impl<const N: usize> std::ops::Add for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Add for Jet<N, H> {
     type Output = Self;
     fn add(self, o: Self) -> Self {
         let mut out = self;
         out.v += o.v;
         for a in 0..N {
             out.g[a] += o.g[a];
-            for b in 0..N {
-                out.h[a][b] += o.h[a][b];
+            if H {
+                for b in 0..N {
+                    out.h[a][b] += o.h[a][b];
+                }
             }
         }
         out
     }
 }
 
-impl<const N: usize> std::ops::Add<f64> for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Add<f64> for Jet<N, H> {
     type Output = Self;
     fn add(self, o: f64) -> Self {
         let mut out = self;
@@ -475,52 +521,54 @@ impl<const N: usize> std::ops::Add<f64> for Jet<N> {
     }
 }
 
-impl<const N: usize> std::ops::Neg for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Neg for Jet<N, H> {
     type Output = Self;
     fn neg(self) -> Self {
         self.scale(-1.0)
     }
 }
 
-impl<const N: usize> std::ops::Sub for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Sub for Jet<N, H> {
     type Output = Self;
     fn sub(self, o: Self) -> Self {
         self + (-o)
     }
 }
 
-impl<const N: usize> std::ops::Sub<f64> for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Sub<f64> for Jet<N, H> {
     type Output = Self;
     fn sub(self, o: f64) -> Self {
         self + (-o)
     }
 }
 
-impl<const N: usize> std::ops::Mul for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Mul for Jet<N, H> {
     type Output = Self;
     fn mul(self, o: Self) -> Self {
         let mut out = Self::c(self.v * o.v);
         for a in 0..N {
             out.g[a] = self.g[a] * o.v + self.v * o.g[a];
-            for b in 0..N {
-                out.h[a][b] = self.h[a][b] * o.v
-                    + self.v * o.h[a][b]
-                    + self.g[a] * o.g[b]
-                    + self.g[b] * o.g[a];
+            if H {
+                for b in 0..N {
+                    out.h[a][b] = self.h[a][b] * o.v
+                        + self.v * o.h[a][b]
+                        + self.g[a] * o.g[b]
+                        + self.g[b] * o.g[a];
+                }
             }
         }
         out
     }
 }
 
-impl<const N: usize> std::ops::Mul<f64> for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Mul<f64> for Jet<N, H> {
     type Output = Self;
     fn mul(self, o: f64) -> Self {
         self.scale(o)
     }
 }
 
-impl<const N: usize> std::ops::Div for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Div for Jet<N, H> {
     type Output = Self;
     #[allow(clippy::suspicious_arithmetic_impl)]
     fn div(self, o: Self) -> Self {
@@ -528,7 +576,7 @@ impl<const N: usize> std::ops::Div for Jet<N> {
     }
 }
 
-impl<const N: usize> std::ops::Div<f64> for Jet<N> {
+impl<const N: usize, const H: bool> std::ops::Div<f64> for Jet<N, H> {
     type Output = Self;
     fn div(self, o: f64) -> Self {
         self.scale(1.0 / o)
@@ -536,7 +584,7 @@ impl<const N: usize> std::ops::Div<f64> for Jet<N> {
 }
 
 /// `1 - x` for a jet.
-pub(crate) fn one_minus<const N: usize>(x: Jet<N>) -> Jet<N> {
+pub(crate) fn one_minus<const N: usize, const H: bool>(x: Jet<N, H>) -> Jet<N, H> {
     -x + 1.0
 }
 
@@ -570,6 +618,54 @@ mod add_wv_tests {
                     j + 1
                 );
             }
+        }
+    }
+
+    /// `write_jacobian` (the fit's hot path, first-order jets) writes the very bits of
+    /// `jacobian`, and those are the gradients of the second-order jets the Hessian uses.
+    #[test]
+    fn write_jacobian_writes_the_jacobian_bit_for_bit() {
+        let processes: Vec<Process> = vec![
+            Wn::new(2.0).unwrap().into(),
+            Qn::new(0.5).unwrap().into(),
+            Rw::new(1e-3).unwrap().into(),
+            Dr::new(0.01).unwrap().into(),
+            Ar1::new(0.97, 0.2).unwrap().into(),
+            Ar1::new(0.999_99, 0.2).unwrap().into(),
+            Ar1::new(-0.4, 0.2).unwrap().into(),
+            Gm::new(0.25, 7e-9, 250.0).unwrap().into(),
+            Arma::new(vec![0.5], vec![0.3], 1.0).unwrap().into(),
+        ];
+        let levels = 22;
+        for p in &processes {
+            let jac = p.jacobian(levels);
+            let k = jac[0].len();
+            // two columns either side, to see that nothing else is written
+            let stride = k + 4;
+            let mut a = vec![f64::NAN; levels * stride];
+            p.write_jacobian(levels, &mut a, stride, 2);
+            for (j, row) in jac.iter().enumerate() {
+                for c in 0..stride {
+                    let got = a[j * stride + c];
+                    if (2..2 + k).contains(&c) {
+                        assert_eq!(got.to_bits(), row[c - 2].to_bits(), "{p:?} level {}", j + 1);
+                    } else {
+                        assert!(got.is_nan(), "{p:?} wrote column {c}");
+                    }
+                }
+            }
+        }
+        // first-order jets: the value and gradient of the second-order ones, bit for bit
+        let first = jet_levels::<2, false>([0.97, 0.2], levels, |v, m| {
+            ar1::ar1_wv_jet(v[0], None, v[1], m)
+        });
+        let second = jet_levels::<2, true>([0.97, 0.2], levels, |v, m| {
+            ar1::ar1_wv_jet(v[0], None, v[1], m)
+        });
+        for (f, s) in first.iter().zip(&second) {
+            assert_eq!(f.v.to_bits(), s.v.to_bits());
+            assert_eq!(f.g.map(f64::to_bits), s.g.map(f64::to_bits));
+            assert_eq!(f.h, [[0.0; 2]; 2]);
         }
     }
 }

@@ -247,7 +247,7 @@ impl Sin {
             .collect()
     }
 
-    fn jets(&self, levels: usize) -> Vec<Jet<2>> {
+    fn jets<const H: bool>(&self, levels: usize) -> Vec<Jet<2, H>> {
         jet_levels([self.amplitude, self.omega], levels, |v, m| {
             sin_wv_jet(v[0], v[1], m)
         })
@@ -255,7 +255,7 @@ impl Sin {
 }
 
 /// `sin(x)` of a jet.
-fn jet_sin<const N: usize>(x: Jet<N>) -> Jet<N> {
+fn jet_sin<const N: usize, const H: bool>(x: Jet<N, H>) -> Jet<N, H> {
     let (s, c) = x.v.sin_cos();
     x.chain(s, c, -s)
 }
@@ -263,7 +263,11 @@ fn jet_sin<const N: usize>(x: Jet<N>) -> Jet<N> {
 /// Implied WV at half-width `m` (module doc):
 /// `nu2 = (amplitude^2 / 2) sin^4(pi (omega m - k)) / (m^2 sin^2(pi omega))`, `k` the integer
 /// nearest `omega m`.
-fn sin_wv_jet<const N: usize>(amplitude: Jet<N>, omega: Jet<N>, m: f64) -> Jet<N> {
+fn sin_wv_jet<const N: usize, const H: bool>(
+    amplitude: Jet<N, H>,
+    omega: Jet<N, H>,
+    m: f64,
+) -> Jet<N, H> {
     let k = (omega.v * m).round();
     let num = jet_sin((omega.scale(m) - k).scale(PI)).powi(4);
     let den = jet_sin(omega.scale(PI)).powi(2).scale(m * m);
@@ -299,10 +303,10 @@ impl LatentProcess for Sin {
         }
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
-        jets_jacobian(&self.jets(levels))
+        jets_jacobian(&self.jets::<false>(levels))
     }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
-        jets_hessian(&self.jets(levels))
+        jets_hessian(&self.jets::<true>(levels))
     }
     /// A line spectrum has no density: `None` (the §1.9 quadrature does not apply; the tests
     /// check the WV against the §4.1 sum of `Sin::autocovariance`).
@@ -394,7 +398,7 @@ mod tests {
         let wv = s.wv(16);
         let mut out = vec![0.0; 16];
         s.add_wv(&mut out);
-        for (j, jet) in s.jets(16).iter().enumerate() {
+        for (j, jet) in s.jets::<true>(16).iter().enumerate() {
             assert!((jet.v - wv[j]).abs() <= 1e-14 * wv[j], "level {}", j + 1);
             assert_eq!(out[j], wv[j]);
         }

@@ -105,6 +105,9 @@ impl LatentProcess for Wn {
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         half_widths(levels).map(|m| vec![unit_wv(m)]).collect()
     }
+    fn write_jacobian(&self, levels: usize, a: &mut [f64], stride: usize, col: usize) {
+        super::write_scalar_jacobian(levels, a, stride, col, unit_wv);
+    }
     fn hessian(&self, levels: usize) -> Vec<Vec<Vec<f64>>> {
         half_widths(levels).map(|_| vec![vec![0.0]]).collect()
     }

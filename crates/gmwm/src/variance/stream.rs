@@ -29,7 +29,7 @@ use std::path::Path;
 use std::sync::Mutex;
 
 /// Samples per part of a split pass: `2^22`.
-pub(crate) const PART: usize = 1 << 22;
+pub(crate) const PART: usize = 1 << 20;
 
 /// Rows per read: 16 Ki (128 KiB a column of f64): the chunk, its demeaned copy and the
 /// samples read back for the top levels stay in the L2 cache.
