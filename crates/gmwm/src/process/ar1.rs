@@ -362,10 +362,8 @@ pub(crate) fn ar1_wv_jet<const N: usize, const H: bool>(
 /// `r2 = 2/(1+2m)`, `r0 = 1/(1+2m)`.
 fn series_g<const N: usize, const H: bool>(l: Jet<N, H>, m: f64) -> Jet<N, H> {
     let q = 1.0 + 2.0 * m;
-    let mut d = [0.0; G_TERMS];
-    for (dk, c) in d.iter_mut().zip(g_coefficients(m)) {
-        *dk = c;
-    }
+    let d = g_coefficients_at(m);
+    let d = &*d;
     let t = l * q;
     // Truncate where the terms, divided by t^2, fall below 1e-17 of the leading one: the value,
     // first and second derivatives then all keep their full precision (each derivative in t
@@ -386,6 +384,42 @@ fn series_g<const N: usize, const H: bool>(l: Jet<N, H>, m: f64) -> Jet<N, H> {
         acc = acc * t + d[k];
     }
     acc
+}
+
+/// Levels whose coefficients [`g_coefficients_at`] keeps: half-widths `m = 2^0 .. 2^63`.
+const G_TABLE_LEVELS: usize = 64;
+
+/// The coefficients of [`g_coefficients`] at every level's half-width, computed once: the
+/// same operations, so the same bits, without their dozens of multiplications and a division
+/// per term on every evaluation (the series branch was most of an AR1's implied WV in the
+/// starting-value search).
+static G_TABLE: std::sync::OnceLock<Vec<[f64; G_TERMS]>> = std::sync::OnceLock::new();
+
+/// The [`G_TERMS`] coefficients of [`g_coefficients`] at `m`: from [`G_TABLE`] when `m` is a
+/// level's half-width `2^e`, `e < G_TABLE_LEVELS`, else computed.
+fn g_coefficients_at(m: f64) -> std::borrow::Cow<'static, [f64; G_TERMS]> {
+    let bits = m.to_bits();
+    let exponent = (bits >> 52) as i64 - 1023;
+    let power_of_two = m > 0.0 && bits & ((1u64 << 52) - 1) == 0;
+    if power_of_two && (0..G_TABLE_LEVELS as i64).contains(&exponent) {
+        let table = G_TABLE.get_or_init(|| {
+            (0..G_TABLE_LEVELS)
+                .map(|e| computed_g_coefficients(f64::from_bits((e as u64 + 1023) << 52)))
+                .collect()
+        });
+        std::borrow::Cow::Borrowed(&table[exponent as usize])
+    } else {
+        std::borrow::Cow::Owned(computed_g_coefficients(m))
+    }
+}
+
+/// [`g_coefficients`] collected.
+fn computed_g_coefficients(m: f64) -> [f64; G_TERMS] {
+    let mut d = [0.0; G_TERMS];
+    for (dk, c) in d.iter_mut().zip(g_coefficients(m)) {
+        *dk = c;
+    }
+    d
 }
 
 /// The coefficients `d_0, d_1, ...` ([`G_TERMS`] of them) of the series of [`series_g`].
@@ -457,7 +491,7 @@ fn series_g_f64(l: f64, m: f64) -> f64 {
     let t = l * (1.0 + 2.0 * m);
     let mut tp = 1.0;
     let mut acc = 0.0;
-    for (k, d) in g_coefficients(m).enumerate() {
+    for (k, &d) in g_coefficients_at(m).iter().enumerate() {
         let term = d * tp;
         acc += term;
         if k > 2 && term.abs() <= 1e-17 * acc.abs() {
@@ -711,6 +745,32 @@ impl Simulate for Gm {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cached coefficients are the computed ones, bit for bit, at every level's half-width;
+    /// another `m` is computed.
+    #[test]
+    fn g_table_is_the_computed_coefficients() {
+        for e in 0..G_TABLE_LEVELS {
+            let m = f64::from_bits((e as u64 + 1023) << 52);
+            assert_eq!(m, 2f64.powi(e as i32));
+            let cached = g_coefficients_at(m);
+            assert!(matches!(cached, std::borrow::Cow::Borrowed(_)));
+            let computed = computed_g_coefficients(m);
+            assert_eq!(
+                cached.map(f64::to_bits),
+                computed.map(f64::to_bits),
+                "m = 2^{e}"
+            );
+        }
+        for m in [3.0, 0.5, 2f64.powi(64), 1.5] {
+            let at = g_coefficients_at(m);
+            assert!(matches!(at, std::borrow::Cow::Owned(_)), "{m}");
+            assert_eq!(
+                at.map(f64::to_bits),
+                computed_g_coefficients(m).map(f64::to_bits)
+            );
+        }
+    }
 
     #[test]
     fn condition_phi_ranges() {
