@@ -194,10 +194,17 @@ impl Autoregressive {
         -0.5 * self.increment_variance(n.abs())
     }
 
-    /// `K(m) - 2 K(m + half) + K(m + 2 half)` for `m >= 0`: the linear part of `K` drops out,
-    /// leaving `-(r1 / (1 - phi)^2) phi^m (1 - phi^half)^2`, without cancellation.
-    fn second_difference(&self, half: f64, m: f64) -> f64 {
-        let e = (half * self.ln_phi).exp_m1() / self.eps;
+    /// `(phi^half - 1) / (1 - phi)`: the factor of
+    /// [`second_difference_with`](Self::second_difference_with) that depends on the level
+    /// only, computed once per pair of levels.
+    fn half_factor(&self, half: f64) -> f64 {
+        (half * self.ln_phi).exp_m1() / self.eps
+    }
+
+    /// `K(m) - 2 K(m + half) + K(m + 2 half)` for `m >= 0` given `e =`
+    /// [`half_factor`](Self::half_factor)`(half)`: the linear part of `K` drops out, leaving
+    /// `-(r1 / (1 - phi)^2) phi^m (1 - phi^half)^2`, without cancellation.
+    fn second_difference_with(&self, e: f64, m: f64) -> f64 {
         -self.r1 * self.phi.powf(m) * e * e
     }
 }
@@ -262,7 +269,9 @@ impl Parts {
     /// of values of `K` as large as `L_k^3` would otherwise lose every digit of a result of
     /// order `half^2 L_k` (a fine level paired with a coarse one). Across 0 the points are
     /// within `2 half` of it and the values of `K` are small enough to difference directly.
-    fn second_difference(&self, half: f64, y: f64) -> f64 {
+    ///
+    /// `factors` holds each autoregressive part's [`Autoregressive::half_factor`] at `half`.
+    fn second_difference(&self, half: f64, y: f64, factors: &[f64]) -> f64 {
         let (lo, hi) = (y, y + 2.0 * half);
         if lo < 0.0 && hi > 0.0 {
             return self.k(lo) - 2.0 * self.k(y + half) + self.k(hi);
@@ -275,8 +284,8 @@ impl Parts {
         };
         // WN: linear, so 0; RW: (n^3 - n) / 12 differences to 6 half^2 centre / 12
         let mut d = self.rw * half * half * centre / 2.0;
-        for p in &self.autoregressive {
-            d += p.second_difference(half, near);
+        for (p, &e) in self.autoregressive.iter().zip(factors) {
+            d += p.second_difference_with(e, near);
         }
         d
     }
@@ -291,6 +300,8 @@ struct Pair<'a> {
     n: i64,
     lj: i64,
     lk: i64,
+    /// Each autoregressive part's [`Autoregressive::half_factor`] at level j's half-width.
+    factors: Vec<f64>,
 }
 
 impl Pair<'_> {
@@ -298,7 +309,7 @@ impl Pair<'_> {
     fn gamma(&self, h: f64) -> f64 {
         let half = (self.lj / 2) as f64;
         let hk = (self.lk / 2) as f64;
-        let d = |b: f64| self.parts.second_difference(half, h - b);
+        let d = |b: f64| self.parts.second_difference(half, h - b, &self.factors);
         (d(0.0) - 2.0 * d(hk) + d(2.0 * hk)) * self.scale
     }
 
@@ -378,6 +389,11 @@ impl<'a> Pair<'a> {
             n: n as i64,
             lj,
             lk,
+            factors: parts
+                .autoregressive
+                .iter()
+                .map(|p| p.half_factor((lj / 2) as f64))
+                .collect(),
         }
     }
 
