@@ -29,7 +29,7 @@ use std::path::Path;
 use std::sync::Mutex;
 
 /// Samples per part of a split pass: `2^22`.
-pub(crate) const PART: usize = 1 << 20;
+pub(crate) const PART: usize = 1 << 22;
 
 /// Rows per read: 16 Ki (128 KiB a column of f64): the chunk, its demeaned copy and the
 /// samples read back for the top levels stay in the L2 cache.
@@ -749,6 +749,9 @@ fn run_part<S: Source>(
             s.acc.append_upper(up);
         }
         part.accs.push(s.acc);
+        for top in &mut s.tops {
+            top.scratch = Vec::new();
+        }
         part.tops.push(s.tops);
         part.block_sums.push(s.block_sums);
         part.extremes.push(s.extremes);

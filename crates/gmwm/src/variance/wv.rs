@@ -985,6 +985,11 @@ impl HaarWvAccumulator {
     pub(crate) fn close_part(&mut self) -> Result<Vec<f64>, SeriesError> {
         self.flush()?;
         self.priming = Vec::new();
+        // a closed part keeps its sums only: a 10^9-sample pass holds 239 of them until they
+        // are added in order
+        self.pending = Vec::new();
+        self.scratch_in = Vec::new();
+        self.scratch_out = Vec::new();
         Ok(std::mem::take(&mut self.rings))
     }
 

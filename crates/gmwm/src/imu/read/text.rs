@@ -37,7 +37,7 @@ fn open(path: &Path) -> Result<Source, ReadError> {
     let reader: Box<dyn BufRead> = if gzip {
         Box::new(BufReader::with_capacity(
             BUF_CAPACITY,
-            LineCapped::new(MultiGzDecoder::new(buffered)),
+            LineCapped::new(ReadAhead::spawn(MultiGzDecoder::new(buffered))),
         ))
     } else {
         Box::new(BufReader::with_capacity(
@@ -83,6 +83,126 @@ pub(crate) fn count_lines_up_to(path: &Path, cap: u64) -> Result<u64, ReadError>
 /// header of 10^5 column names fits). A longer one (a gzip bomb's single 1 GiB line) is an
 /// error once this many bytes have passed without a newline, before the line is held.
 pub(crate) const MAX_LINE: usize = 1 << 20;
+
+/// Bytes per buffer of [`ReadAhead`].
+const AHEAD_CHUNK: usize = 1 << 18;
+/// Buffers [`ReadAhead`]'s thread may fill before the reader takes them.
+const AHEAD_BUFFERS: usize = 4;
+
+/// A byte stream read on a thread of its own, at most [`AHEAD_BUFFERS`] buffers of
+/// [`AHEAD_CHUNK`] bytes ahead of the reader: a gzip file's decompression runs beside the
+/// parsing of what it has already given (a third of a CSV.gz read), with the same bytes in the
+/// same order, and its memory stays bounded whatever the stream. Read errors arrive in order,
+/// after the bytes before them; a thread that cannot be started leaves the stream read in
+/// place.
+enum ReadAhead<R> {
+    Thread {
+        rx: std::sync::mpsc::Receiver<io::Result<Vec<u8>>>,
+        current: Vec<u8>,
+        pos: usize,
+        done: bool,
+    },
+    Direct(R),
+}
+
+impl<R: Read + Send + 'static> ReadAhead<R> {
+    fn spawn(inner: R) -> Self {
+        let (tx, rx) = std::sync::mpsc::sync_channel(AHEAD_BUFFERS);
+        let slot = std::sync::Arc::new(std::sync::Mutex::new(Some(inner)));
+        let theirs = std::sync::Arc::clone(&slot);
+        let started = std::thread::Builder::new()
+            .name("gmwm-read-ahead".into())
+            .spawn(move || {
+                let Some(mut inner) = theirs.lock().ok().and_then(|mut s| s.take()) else {
+                    return;
+                };
+                loop {
+                    let mut buf = vec![0u8; AHEAD_CHUNK];
+                    let mut filled = 0;
+                    let mut failed = None;
+                    while filled < buf.len() {
+                        match inner.read(&mut buf[filled..]) {
+                            Ok(0) => break,
+                            Ok(n) => filled += n,
+                            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                            Err(e) => {
+                                failed = Some(e);
+                                break;
+                            }
+                        }
+                    }
+                    buf.truncate(filled);
+                    let end = filled == 0 || failed.is_some();
+                    if filled > 0 && tx.send(Ok(buf)).is_err() {
+                        return; // the reader is gone
+                    }
+                    if let Some(e) = failed {
+                        let _ = tx.send(Err(e));
+                    }
+                    if end {
+                        return;
+                    }
+                }
+            });
+        match started {
+            Ok(_) => ReadAhead::Thread {
+                rx,
+                current: Vec::new(),
+                pos: 0,
+                done: false,
+            },
+            // the closure never ran: the stream is still in its slot
+            Err(_) => match slot.lock().ok().and_then(|mut s| s.take()) {
+                Some(inner) => ReadAhead::Direct(inner),
+                None => ReadAhead::Thread {
+                    rx,
+                    current: Vec::new(),
+                    pos: 0,
+                    done: false,
+                },
+            },
+        }
+    }
+}
+
+impl<R: Read> Read for ReadAhead<R> {
+    fn read(&mut self, out: &mut [u8]) -> io::Result<usize> {
+        match self {
+            ReadAhead::Direct(inner) => inner.read(out),
+            ReadAhead::Thread {
+                rx,
+                current,
+                pos,
+                done,
+            } => {
+                while *pos == current.len() {
+                    if *done {
+                        return Ok(0);
+                    }
+                    match rx.recv() {
+                        Ok(Ok(buf)) => {
+                            *current = buf;
+                            *pos = 0;
+                        }
+                        Ok(Err(e)) => {
+                            *done = true;
+                            return Err(e);
+                        }
+                        // the thread ended after the last bytes
+                        Err(_) => {
+                            *done = true;
+                            return Ok(0);
+                        }
+                    }
+                }
+                let n = out.len().min(current.len() - *pos);
+                out[..n].copy_from_slice(&current[*pos..*pos + n]);
+                *pos += n;
+                Ok(n)
+            }
+        }
+    }
+}
 
 /// The error of [`LineCapped`].
 #[derive(Debug)]
