@@ -810,6 +810,57 @@ fn io_error(path: &Path, source: io::Error) -> ReadError {
 mod tests {
     use super::*;
 
+    /// A stream read ahead on its own thread gives the same bytes in the same order, then the
+    /// stream's error, then the end.
+    #[test]
+    fn read_ahead_gives_the_bytes_then_the_error() {
+        struct Uneven {
+            data: Vec<u8>,
+            at: usize,
+            step: usize,
+        }
+        impl Read for Uneven {
+            fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+                if self.at == self.data.len() {
+                    return Err(io::Error::new(
+                        io::ErrorKind::InvalidData,
+                        "corrupt deflate",
+                    ));
+                }
+                self.step = self.step * 7 % 1013 + 1;
+                let n = self.step.min(buf.len()).min(self.data.len() - self.at);
+                buf[..n].copy_from_slice(&self.data[self.at..self.at + n]);
+                self.at += n;
+                Ok(n)
+            }
+        }
+        let data: Vec<u8> = (0..3 * AHEAD_CHUNK + 12345)
+            .map(|i| (i * 31 % 251) as u8)
+            .collect();
+        let mut ahead = ReadAhead::spawn(Uneven {
+            data: data.clone(),
+            at: 0,
+            step: 1,
+        });
+        let mut got = Vec::new();
+        let mut buf = [0u8; 4097];
+        let err = loop {
+            match ahead.read(&mut buf) {
+                Ok(0) => panic!("ended without the error"),
+                Ok(n) => got.extend_from_slice(&buf[..n]),
+                Err(e) => break e,
+            }
+        };
+        assert_eq!(got, data);
+        assert_eq!(err.to_string(), "corrupt deflate");
+        assert_eq!(ahead.read(&mut buf).unwrap(), 0);
+        // a clean end: the bytes, then 0
+        let mut ahead = ReadAhead::spawn(io::Cursor::new(data.clone()));
+        let mut all = Vec::new();
+        ahead.read_to_end(&mut all).unwrap();
+        assert_eq!(all, data);
+    }
+
     #[test]
     fn delimiter_sniffing() {
         let p = Path::new("x.txt");
