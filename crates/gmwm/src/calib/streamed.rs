@@ -335,7 +335,8 @@ impl Calibration {
             self.options().stream_from,
             1usize << levels.min(ROBUST_LEVELS),
             match coverage {
-                Some(c) if c.samples < n && c.blocks < c.of_blocks.saturating_sub(1) => format!(
+                // more full blocks than the check takes: it spread its blocks
+                Some(c) if n / ROBUST_BLOCK > ROBUST_BLOCKS => format!(
                     " ({} of the {} blocks, spread evenly over the recording: {} of its samples; the PSD is Welch's on the same blocks; the WV uses every sample)",
                     c.blocks, c.of_blocks, c.samples
                 ),

@@ -98,6 +98,8 @@ const AHEAD_BUFFERS: usize = 4;
 enum ReadAhead<R> {
     Thread {
         rx: std::sync::mpsc::Receiver<io::Result<Vec<u8>>>,
+        /// Buffers read through, handed back to the thread to fill again.
+        spent: std::sync::mpsc::Sender<Vec<u8>>,
         current: Vec<u8>,
         pos: usize,
         done: bool,
@@ -108,6 +110,7 @@ enum ReadAhead<R> {
 impl<R: Read + Send + 'static> ReadAhead<R> {
     fn spawn(inner: R) -> Self {
         let (tx, rx) = std::sync::mpsc::sync_channel(AHEAD_BUFFERS);
+        let (spent, reuse) = std::sync::mpsc::channel::<Vec<u8>>();
         let slot = std::sync::Arc::new(std::sync::Mutex::new(Some(inner)));
         let theirs = std::sync::Arc::clone(&slot);
         let started = std::thread::Builder::new()
@@ -117,7 +120,8 @@ impl<R: Read + Send + 'static> ReadAhead<R> {
                     return;
                 };
                 loop {
-                    let mut buf = vec![0u8; AHEAD_CHUNK];
+                    let mut buf = reuse.try_recv().unwrap_or_default();
+                    buf.resize(AHEAD_CHUNK, 0);
                     let mut filled = 0;
                     let mut failed = None;
                     while filled < buf.len() {
@@ -147,6 +151,7 @@ impl<R: Read + Send + 'static> ReadAhead<R> {
         match started {
             Ok(_) => ReadAhead::Thread {
                 rx,
+                spent,
                 current: Vec::new(),
                 pos: 0,
                 done: false,
@@ -156,6 +161,7 @@ impl<R: Read + Send + 'static> ReadAhead<R> {
                 Some(inner) => ReadAhead::Direct(inner),
                 None => ReadAhead::Thread {
                     rx,
+                    spent,
                     current: Vec::new(),
                     pos: 0,
                     done: false,
@@ -171,6 +177,7 @@ impl<R: Read> Read for ReadAhead<R> {
             ReadAhead::Direct(inner) => inner.read(out),
             ReadAhead::Thread {
                 rx,
+                spent,
                 current,
                 pos,
                 done,
@@ -181,7 +188,8 @@ impl<R: Read> Read for ReadAhead<R> {
                     }
                     match rx.recv() {
                         Ok(Ok(buf)) => {
-                            *current = buf;
+                            // the thread may be gone already: then the buffer is dropped
+                            let _ = spent.send(std::mem::replace(current, buf));
                             *pos = 0;
                         }
                         Ok(Err(e)) => {
