@@ -625,8 +625,8 @@ fn write_report(
             let name = match target {
                 Some(p) => per_axis_path(p, &set.label).display().to_string(),
                 // one set (no per-axis split) has no label to name
-                None if set.label.is_empty() => "not written (add --kalibr FILE)".to_string(),
-                None => format!("not written (add --kalibr FILE); {}", set.label),
+                None if set.label.is_empty() => "not written: add --kalibr FILE".to_string(),
+                None => format!("{}: not written, add --kalibr FILE", set.label),
             };
             let content = match render_export(*format, &set.noise) {
                 Ok(text) => text,
