@@ -82,7 +82,7 @@ pub fn spool(path: &Path) -> Result<(PathBuf, Spool)> {
             );
         }
     }
-    let dir = std::env::temp_dir().join(format!("gmwm-input-{}", std::process::id()));
+    let dir = gmwm::temporary_dir().join(format!("gmwm-input-{}", gmwm::process_tag()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("{shown_name}: cannot create a temporary folder to read it"))?;

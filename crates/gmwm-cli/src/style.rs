@@ -3,10 +3,13 @@
 //! terminal, without `--quiet` and not on a `TERM=dumb` one; notes (what the reader found, the
 //! files written) unless `--quiet`; colour (clap's messages) unless `NO_COLOR` or `TERM=dumb`.
 //! Warnings and errors are always printed; standard output carries the results alone, the same
-//! whatever the style.
+//! whatever the style. `GMWM_PROGRESS=lines` draws the bars as plain lines on standard error,
+//! `gmwm: progress: calibrating: 12/60 candidate fits`, at most four a second and whether or not
+//! it is a terminal: for a program that runs gmwm and shows its progress (the browser page's
+//! worker, web/).
 
 use gmwm::Progress;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, TermLike};
 use std::io::IsTerminal;
 use std::path::Path;
 
@@ -25,7 +28,9 @@ impl OutputStyle {
     /// The style of this run: `--quiet`, the environment (`NO_COLOR`, `TERM`) and whether
     /// standard error is a terminal.
     pub fn detect(quiet: bool) -> Self {
-        Self::of(quiet, std::io::stderr().is_terminal(), no_color(), dumb())
+        let mut style = Self::of(quiet, std::io::stderr().is_terminal(), no_color(), dumb());
+        style.progress |= progress_lines() && !quiet;
+        style
     }
 
     /// The style for `--quiet`, a terminal on stderr, `NO_COLOR` set (non-empty, as
@@ -51,6 +56,19 @@ impl OutputStyle {
     pub fn bar(&self, total: u64, message: &str, unit: &str) -> ProgressBar {
         if !self.progress {
             return ProgressBar::hidden();
+        }
+        if progress_lines() {
+            let bar = ProgressBar::with_draw_target(
+                Some(total),
+                ProgressDrawTarget::term_like_with_hz(Box::new(ProgressLines), 4),
+            );
+            let template = format!("{{msg}}: {{pos}}/{{len}} {unit}");
+            bar.set_style(
+                ProgressStyle::with_template(&template)
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            bar.set_message(message.to_string());
+            return bar;
         }
         let bar = ProgressBar::new(total);
         let template =
@@ -95,6 +113,51 @@ fn no_color() -> bool {
 /// `TERM=dumb`: a terminal that cannot redraw a line or show colour.
 fn dumb() -> bool {
     std::env::var_os("TERM").is_some_and(|t| t == "dumb")
+}
+
+/// `GMWM_PROGRESS=lines` in the environment.
+fn progress_lines() -> bool {
+    static LINES: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *LINES.get_or_init(|| std::env::var_os("GMWM_PROGRESS").is_some_and(|v| v == "lines"))
+}
+
+/// A bar's draw target that writes each drawn state as one line on standard error, with no
+/// cursor movement: `gmwm: progress: MESSAGE: POS/LEN UNIT`.
+#[derive(Debug)]
+struct ProgressLines;
+
+impl TermLike for ProgressLines {
+    fn width(&self) -> u16 {
+        200
+    }
+    fn move_cursor_up(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn move_cursor_down(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn move_cursor_right(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn move_cursor_left(&self, _: usize) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn write_line(&self, s: &str) -> std::io::Result<()> {
+        self.write_str(s)
+    }
+    fn write_str(&self, s: &str) -> std::io::Result<()> {
+        if !s.trim().is_empty() {
+            use std::io::Write;
+            writeln!(std::io::stderr().lock(), "gmwm: progress: {}", s.trim_end())?;
+        }
+        Ok(())
+    }
+    fn clear_line(&self) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn flush(&self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 /// Advances a bar by one step per engine report, whichever computation (or thread) reports.

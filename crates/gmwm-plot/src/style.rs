@@ -1,8 +1,7 @@
 //! The look shared by every figure: the colour-blind-safe palette, the embedded font, text
 //! sizes and tick labels written as powers of ten.
 
-use plotters::style::{FontStyle, RGBColor};
-use std::sync::Once;
+use plotters::style::RGBColor;
 
 /// Okabe & Ito's palette (Color Universal Design, 2008), distinguishable under every common
 /// colour-vision deficiency: black, orange, sky blue, bluish green, blue, vermillion, reddish
@@ -35,7 +34,10 @@ pub const LABEL_SIZE: u32 = 19;
 pub const TICK_SIZE: u32 = 17;
 
 /// Registers the embedded font once per process (plotters keeps a global font table).
+#[cfg(not(target_family = "wasm"))]
 pub(crate) fn ensure_fonts() {
+    use plotters::style::FontStyle;
+    use std::sync::Once;
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // the bytes are a TrueType font shipped inside the dejavu crate: registration cannot
@@ -44,6 +46,10 @@ pub(crate) fn ensure_fonts() {
         let _ = plotters::style::register_font(FONT, FontStyle::Bold, dejavu::sans::bold());
     });
 }
+
+/// No font table on WebAssembly: SVG text is laid out by estimate and drawn by the browser.
+#[cfg(target_family = "wasm")]
+pub(crate) fn ensure_fonts() {}
 
 /// A palette colour by index (wrapping).
 pub(crate) fn colour(i: usize) -> RGBColor {

@@ -157,7 +157,9 @@ pub use imu::{
     Recording, RecordingOptions, RecordingSource, SampleAccount, Sensor, SensorInfo, SeriesWriter,
     Sidecar, SidecarColumn, TimeUnit, TimingReport,
 };
-pub use imu::{remove_temporary_files, track_temporary, untrack_temporary};
+pub use imu::{
+    process_tag, remove_temporary_files, temporary_dir, track_temporary, untrack_temporary,
+};
 pub use imu::{Axis, ColumnSummary, Gap, NotASidecar, SidecarUnits, Tally, TimingWarning};
 pub use units::{si_unit, NoiseTerm, SignalKind, SignalUnit};
 

@@ -67,6 +67,7 @@ pub(crate) const CAUSE_MAX: usize = 200;
 /// A message of another library made one line: runs of whitespace (newlines included) become
 /// one space, other control characters are escaped, cut to [`CAUSE_MAX`] characters with
 /// `...` appended.
+#[cfg_attr(not(any(feature = "sqlite", test)), allow(dead_code))]
 pub(crate) fn one_line(text: &str) -> String {
     let mut out = String::new();
     for (count, c) in text

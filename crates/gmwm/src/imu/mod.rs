@@ -57,7 +57,9 @@ pub use recording::{Recording, RecordingOptions, RecordingSource};
 pub use samples::{SampleAccount, Tally};
 pub use sensor::{Axis, Imu, Sensor, SensorInfo};
 pub use sidecar::{find_sidecar, ColumnSummary, NotASidecar, Sidecar, SidecarColumn, SidecarUnits};
-pub use temporary::{remove_temporary_files, track_temporary, untrack_temporary};
+pub use temporary::{
+    process_tag, remove_temporary_files, temporary_dir, track_temporary, untrack_temporary,
+};
 #[cfg(test)]
 pub(crate) use timing::{check_times, UnitSource};
 pub use timing::{time_column_unit, Gap, TimeUnit, TimingReport, TimingWarning};

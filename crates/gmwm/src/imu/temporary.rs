@@ -14,6 +14,33 @@ fn live() -> MutexGuard<'static, Vec<PathBuf>> {
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
+/// The folder for temporary files: the system's (`TMPDIR`, else `/tmp`). Under WASI, whose
+/// standard library has none, `TMPDIR` or `/tmp` as the host maps it (the browser page's
+/// in-memory file system).
+pub fn temporary_dir() -> PathBuf {
+    #[cfg(target_os = "wasi")]
+    {
+        std::env::var_os("TMPDIR").map_or_else(|| PathBuf::from("/tmp"), PathBuf::from)
+    }
+    #[cfg(not(target_os = "wasi"))]
+    {
+        std::env::temp_dir()
+    }
+}
+
+/// A number that tells this process's temporary names from another's: the process id, or 0
+/// under WASI (one program per sandbox, and no process ids).
+pub fn process_tag() -> u32 {
+    #[cfg(target_os = "wasi")]
+    {
+        0
+    }
+    #[cfg(not(target_os = "wasi"))]
+    {
+        std::process::id()
+    }
+}
+
 /// Lists `path` (a file or a folder) as a temporary of this process, until
 /// [`untrack_temporary`].
 pub fn track_temporary(path: &Path) {

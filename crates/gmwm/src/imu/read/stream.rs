@@ -308,7 +308,7 @@ impl Spool {
     pub(super) fn create(ncols: usize) -> Result<(Self, BufWriter<File>), ReadError> {
         use std::sync::atomic::{AtomicU64, Ordering};
         static NEXT: AtomicU64 = AtomicU64::new(0);
-        let dir = std::env::temp_dir();
+        let dir = crate::imu::temporary::temporary_dir();
         let io = |path: &Path, source| ReadError::Io {
             path: path.to_path_buf(),
             source,
@@ -316,7 +316,7 @@ impl Spool {
         loop {
             let path = dir.join(format!(
                 "gmwm-spool-{}-{}.f64",
-                std::process::id(),
+                crate::imu::temporary::process_tag(),
                 NEXT.fetch_add(1, Ordering::Relaxed)
             ));
             match std::fs::OpenOptions::new()

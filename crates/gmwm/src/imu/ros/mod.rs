@@ -39,6 +39,10 @@ mod error;
 mod file;
 mod mcap;
 mod ros1;
+#[cfg(feature = "sqlite")]
+mod sqlite;
+#[cfg(not(feature = "sqlite"))]
+#[path = "sqlite_absent.rs"]
 mod sqlite;
 
 pub use covariate::{read_ros_covariate, RosCovariate};
@@ -607,7 +611,7 @@ pub(crate) fn container_of(path: &Path) -> Option<RosContainer> {
 enum Opened {
     Ros1(StorageFile, ros1::Catalog),
     Mcap(StorageFile, mcap::Catalog),
-    Sqlite(PathBuf, rusqlite::Connection, Vec<sqlite::Topic>),
+    Sqlite(PathBuf, sqlite::Connection, Vec<sqlite::Topic>),
 }
 
 impl Opened {

@@ -10,7 +10,8 @@ use super::{Collector, Encoding, RosContainer};
 use crate::imu::error::one_line;
 use crate::imu::ReadError;
 use rusqlite::limits::Limit;
-use rusqlite::{Connection, OpenFlags};
+pub(crate) use rusqlite::Connection;
+use rusqlite::OpenFlags;
 use std::collections::HashMap;
 use std::path::Path;
 
