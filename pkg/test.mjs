@@ -71,3 +71,15 @@ test("a corrupt file is one line of gmwm's", async () => {
     return true;
   });
 });
+
+test("ROS recordings are read from bytes (ROS1 bag and MCAP, the fuzz seeds)", async () => {
+  for (const [seed, name] of [["ros1_bag/two_topics_extra", "r.bag"], ["mcap/temperature", "m.mcap"]]) {
+    const bytes = readFileSync(new URL(`../fuzz/corpus/${seed}`, import.meta.url));
+    const got = await run(["topics", name], { files: { [name]: bytes } });
+    assert.equal(got.code, 0, got.stderr);
+    const dir = mkdtempSync(join(tmpdir(), "gmwm-pkg-"));
+    writeFileSync(join(dir, name), bytes);
+    const native = execFileSync(GMWM, ["topics", name], { cwd: dir, encoding: "utf8" });
+    assert.equal(got.stdout, native);
+  }
+});

@@ -36,8 +36,19 @@ pub(crate) fn read_exact_at(file: &File, buf: &mut [u8], offset: u64) -> std::io
     std::os::unix::fs::FileExt::read_exact_at(file, buf, offset)
 }
 
+/// A seek and a read under WASI (the WebAssembly build, web/), whose positioned reads are not
+/// in stable std: a WASI program has one thread, so nothing moves the file's cursor between
+/// the two.
+#[cfg(target_os = "wasi")]
+pub(crate) fn read_exact_at(file: &File, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut cursor = file;
+    cursor.seek(SeekFrom::Start(offset))?;
+    cursor.read_exact(buf)
+}
+
 /// Positioned reads are not available on this platform.
-#[cfg(not(any(unix, windows)))]
+#[cfg(not(any(unix, windows, target_os = "wasi")))]
 pub(crate) fn read_exact_at(_: &File, _: &mut [u8], _: u64) -> std::io::Result<()> {
     Err(std::io::Error::new(
         ErrorKind::Unsupported,
