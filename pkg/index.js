@@ -16,6 +16,9 @@ import {
   PreopenDirectory,
   Directory,
 } from "./vendor/browser_wasi_shim/index.js";
+import { controlBlock, threadSpawn, progressCell, recordProgress, parseProgress } from "./shared.js";
+
+export { progressCell, readProgress } from "./shared.js";
 
 /** The error of a run that failed: `message` is gmwm's one line (without `gmwm: error: `). */
 export class GmwmError extends Error {
@@ -38,17 +41,31 @@ export const EXPORTS = {
   px4: "px4_imu.params",
 };
 
-let compiled = null;
+const compiled = new Map();
+
+/**
+ * Threads this context can run the engine on: `navigator.hardwareConcurrency` where
+ * SharedArrayBuffer and Web Workers are available (a page served cross-origin isolated:
+ * `Cross-Origin-Opener-Policy: same-origin` and `Cross-Origin-Embedder-Policy: require-corp`),
+ * else 1. Node.js runs one thread (its workers are not Web Workers).
+ */
+export function availableThreads() {
+  if (typeof SharedArrayBuffer === "undefined" || typeof Worker === "undefined") return 1;
+  if (globalThis.crossOriginIsolated !== true) return 1;
+  return Math.max(1, Math.min(16, globalThis.navigator?.hardwareConcurrency ?? 1));
+}
 
 /**
  * The compiled module (compiled once per realm): `options.module` (a WebAssembly.Module),
- * else `gmwm.wasm` beside this file, fetched in a browser or read from disk in Node.js.
+ * else `gmwm.wasm` (one thread) or `gmwm-threads.wasm` (`options.threads` > 1) beside this
+ * file, fetched in a browser or read from disk in Node.js.
  */
 export async function loadModule(options = {}) {
   if (options.module) return options.module;
-  if (!compiled) {
-    compiled = (async () => {
-      const url = new URL("./gmwm.wasm", import.meta.url);
+  const file = (options.threads ?? 1) > 1 ? "gmwm-threads.wasm" : "gmwm.wasm";
+  if (!compiled.has(file)) {
+    compiled.set(file, (async () => {
+      const url = new URL(`./${file}`, import.meta.url);
       if (url.protocol === "file:" && typeof process !== "undefined" && process.versions?.node) {
         const { readFile } = await import("node:fs/promises");
         return WebAssembly.compile(await readFile(url));
@@ -61,9 +78,9 @@ export async function loadModule(options = {}) {
       } catch {
         return WebAssembly.compile(await response.arrayBuffer());
       }
-    })();
+    })());
   }
-  return compiled;
+  return compiled.get(file);
 }
 
 function bytesOf(data) {
@@ -92,12 +109,20 @@ function baseName(name) {
  * @param {(p: {message: string, done: number, total: number, unit: string}) => void} [options.onProgress]
  * @param {(line: string) => void} [options.onStderr]  every other line of standard error
  * @param {WebAssembly.Module} [options.module]
+ * @param {number} [options.threads]  engine threads (default {@link availableThreads}); more
+ *   than one runs `gmwm-threads.wasm` on Web Workers sharing its memory
+ * @param {SharedArrayBuffer} [options.progressCell]  a {@link progressCell} that every
+ *   thread's progress updates (read it with `readProgress` from another thread)
  * @returns {Promise<{code: number, stdout: string, stderr: string, files: Map<string, Uint8Array>, memoryBytes: number, seconds: number}>}
  *   `files`: every file in `/work` after the run (inputs included), `memoryBytes`: the
  *   module's memory at the end (its peak: WebAssembly memory only grows)
  */
 export async function run(args, options = {}) {
-  const module = await loadModule(options);
+  const threads = Math.max(1, Math.floor(options.threads ?? availableThreads()));
+  if (threads > 1 && availableThreads() === 1) {
+    throw new GmwmError(`${threads} threads need SharedArrayBuffer and Web Workers (a page served with the cross-origin isolation headers); this context has none`);
+  }
+  const module = await loadModule({ ...options, threads });
   const contents = new Map();
   for (const [name, data] of Object.entries(options.files ?? {})) {
     contents.set(baseName(name), new File(bytesOf(data), { readonly: true }));
@@ -107,10 +132,12 @@ export async function run(args, options = {}) {
   const out = [];
   const err = [];
   const stdout = ConsoleStdout.lineBuffered((line) => out.push(line));
+  const cell = options.progressCell ?? (threads > 1 ? progressCell() : null);
   const stderr = ConsoleStdout.lineBuffered((line) => {
-    const m = /^gmwm: progress: (.*): (\d+)\/(\d+) ?(.*)$/.exec(line);
-    if (m) {
-      options.onProgress?.({ message: m[1], done: Number(m[2]), total: Number(m[3]), unit: m[4] });
+    const progress = parseProgress(line);
+    if (progress) {
+      if (cell) recordProgress(cell, line);
+      options.onProgress?.(progress);
       return;
     }
     err.push(line);
@@ -118,8 +145,24 @@ export async function run(args, options = {}) {
   });
   const stdin = new OpenFile(new File(new Uint8Array(0), { readonly: true }));
   const env = ["GMWM_PROGRESS=lines", "TMPDIR=/tmp", "NO_COLOR=1", "TERM=dumb"];
+  if (threads > 1) env.push(`RAYON_NUM_THREADS=${threads}`);
   const wasi = new WASI(["gmwm", ...args], env, [stdin, stdout, stderr, work, tmp], { debug: false });
-  const instance = await WebAssembly.instantiate(module, { wasi_snapshot_preview1: wasi.wasiImport });
+  const imports = { wasi_snapshot_preview1: wasi.wasiImport };
+  let pool = null;
+  let memory = null;
+  let control = null;
+  if (threads > 1) {
+    memory = new WebAssembly.Memory({ ...SHARED_PAGES, shared: true });
+    // two more workers than the pool's threads, for threads the program starts besides it
+    control = controlBlock(threads + 2);
+    imports.env = { memory };
+    imports.wasi = { "thread-spawn": (arg) => threadSpawn(control, arg) };
+  }
+  // the main instance first: the first instance on a shared memory initialises it and the
+  // main thread's thread-local storage (an instance made before would leave the main thread's
+  // TLS uninitialised: "cannot access a Thread Local Storage value")
+  const instance = await WebAssembly.instantiate(module, imports);
+  if (threads > 1) pool = await threadPool(module, memory, control, cell, env);
   const started = performance.now();
   let code;
   try {
@@ -129,6 +172,8 @@ export async function run(args, options = {}) {
     // err; the trap's message otherwise
     code = 101;
     err.push(`gmwm: error: the WebAssembly module stopped: ${e?.message ?? e}`);
+  } finally {
+    pool?.workers.forEach((w) => w.terminate());
   }
   const seconds = (performance.now() - started) / 1000;
   const files = new Map();
@@ -143,6 +188,37 @@ export async function run(args, options = {}) {
   };
 }
 
+/** Pages of the threaded module's shared memory: its declared maximum (4 GiB, web/build.sh). */
+const SHARED_PAGES = { initial: 256, maximum: 65536 };
+
+/**
+ * One Web Worker per slot of `control`, each with the module instantiated on the shared
+ * `memory` and waiting for a thread.
+ */
+async function threadPool(module, memory, control, cell, env) {
+  const slots = control[0];
+  const workers = [];
+  const ready = [];
+  for (let slot = 0; slot < slots; slot++) {
+    const worker = new Worker(new URL("./thread.js", import.meta.url), { type: "module" });
+    ready.push(new Promise((resolve, reject) => {
+      worker.onmessage = ({ data }) => {
+        if (data.kind === "ready") resolve();
+      };
+      worker.onerror = (e) => reject(new GmwmError(`a thread of the engine could not start: ${e.message ?? e}`));
+    }));
+    worker.postMessage({ module, memory, control: control.buffer, progress: cell, slot, env });
+    workers.push(worker);
+  }
+  try {
+    await Promise.all(ready);
+  } catch (e) {
+    workers.forEach((w) => w.terminate());
+    throw e;
+  }
+  return { workers };
+}
+
 function collect(dir, prefix, files) {
   for (const [name, entry] of dir.contents) {
     if (entry instanceof Directory) collect(entry, `${prefix}${name}/`, files);
@@ -153,8 +229,10 @@ function collect(dir, prefix, files) {
 /** gmwm's error line of a failed run (`gmwm: error: ...` without the prefix), else its last line. */
 export function errorLine(stderr) {
   const lines = stderr.split("\n").filter((l) => l.trim() !== "");
-  const error = lines.find((l) => l.startsWith("gmwm: error: ")) ?? lines.find((l) => l.startsWith("error: "));
-  if (error) return error.replace(/^gmwm: error: |^error: /, "");
+  const error = lines.find((l) => l.startsWith("gmwm: error: ")) ??
+    lines.find((l) => l.startsWith("gmwm: internal error: ")) ??
+    lines.find((l) => l.startsWith("error: "));
+  if (error) return error.replace(/^gmwm: error: |^gmwm: |^error: /, "");
   return lines.at(-1) ?? "gmwm failed without a message";
 }
 

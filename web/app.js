@@ -1,7 +1,21 @@
 // The page: choose a recording (and its sidecar), set what it does not say, calibrate in a Web
 // Worker (worker.js, the gmwm command in WebAssembly), show N, B, K, the report and the files.
+import { readProgress } from "./pkg/shared.js";
+
 const $ = (id) => document.getElementById(id);
-const state = { recording: null, sidecar: null, worker: null, urls: [] };
+const state = { recording: null, sidecar: null, worker: null, urls: [], poll: null };
+
+// threads need SharedArrayBuffer, which browsers give a cross-origin isolated page only
+{
+  const cores = Math.min(16, navigator.hardwareConcurrency || 1);
+  const auto = $("threads").options[0];
+  if (self.crossOriginIsolated && typeof SharedArrayBuffer !== "undefined") {
+    auto.textContent = `every core (${cores})`;
+  } else {
+    auto.textContent = "one (this page is not served cross-origin isolated)";
+    $("threads").disabled = true;
+  }
+}
 
 const SIDECAR_SUFFIX = /(\.(csv|tsv|txt|f64|f32|f64le|f32le|bin|dat|raw))?(\.gz)?$/i;
 const isBag = (name) => /\.(bag|mcap)$/i.test(name);
@@ -74,6 +88,7 @@ function options() {
     rule: value("rule") || undefined,
     topic: value("topic") || undefined,
     audit: value("audit") || undefined,
+    threads: $("threads").value,
     report: true,
     exports: [...document.querySelectorAll("input[name=export]:checked")].map((c) => c.value),
   };
@@ -97,6 +112,18 @@ function quantity(q) {
   const ci = q.ci_low != null && q.ci_high != null ? ` [${fmt(q.ci_low)}, ${fmt(q.ci_high)}]` : "";
   const bound = q.status === "upper-bound" ? "≤ " : "";
   return { text: `${bound}${fmt(q.value)}${ci}`, value: String(q.value) };
+}
+
+function showProgress(p) {
+  if (!p || p.total <= 0) return;
+  $("progress").max = p.total;
+  $("progress").value = p.done;
+  $("status").textContent = `${p.message}: ${p.done} of ${p.total} ${p.unit}`;
+}
+
+function stopPolling() {
+  clearInterval(state.poll);
+  state.poll = null;
 }
 
 function show(result, started) {
@@ -129,7 +156,9 @@ function show(result, started) {
   const wall = (performance.now() - started) / 1000;
   $("timing").textContent =
     `Calibrated in ${wall.toFixed(1)} s in this browser (the engine ${result.seconds.toFixed(1)} s, ` +
-    `single-threaded WebAssembly in a Web Worker), WebAssembly memory ${(result.memoryBytes / 2 ** 20).toFixed(0)} MiB.`;
+    `WebAssembly on ${result.threads === 1 ? "one thread" : `${result.threads} threads`} in Web Workers), ` +
+    `WebAssembly memory ${(result.memoryBytes / 2 ** 20).toFixed(0)} MiB.`;
+  $("timing").dataset.threads = result.threads;
   $("timing").dataset.engineSeconds = result.seconds;
   $("timing").dataset.memoryBytes = result.memoryBytes;
   state.urls.forEach((u) => URL.revokeObjectURL(u));
@@ -158,6 +187,7 @@ async function calibrate() {
   const bytes = new Uint8Array(await state.recording.arrayBuffer());
   const sidecar = state.sidecar ? new Uint8Array(await state.sidecar.arrayBuffer()) : undefined;
   state.worker?.terminate();
+  stopPolling();
   let worker;
   try {
     worker = new Worker(new URL("./worker.js", import.meta.url), { type: "module" });
@@ -169,13 +199,30 @@ async function calibrate() {
   }
   state.worker = worker;
   worker.onmessage = ({ data }) => {
-    if (data.kind === "progress") {
-      const p = data.progress;
-      $("progress").max = p.total;
-      $("progress").value = p.done;
-      $("status").textContent = `${p.message}: ${p.done} of ${p.total} ${p.unit}`;
+    if (data.kind === "started") {
+      // the engine's other threads report here, while the worker itself is busy
+      if (data.cell) {
+        state.poll = setInterval(() => {
+          const p = readProgress(data.cell);
+          if (p?.trap) {
+            // the worker waits for a thread that will not come back
+            stopPolling();
+            worker.terminate();
+            $("run").disabled = false;
+            $("progress-section").hidden = true;
+            showError(p.trap);
+            return;
+          }
+          showProgress(p);
+        }, 250);
+      }
       return;
     }
+    if (data.kind === "progress") {
+      showProgress(data.progress);
+      return;
+    }
+    stopPolling();
     worker.terminate();
     state.worker = null;
     $("run").disabled = false;
@@ -187,6 +234,7 @@ async function calibrate() {
     show(data.result, started);
   };
   worker.onerror = (e) => {
+    stopPolling();
     $("run").disabled = false;
     $("progress-section").hidden = true;
     showError(`the calibration worker failed: ${e.message ?? "it could not be loaded"}`);

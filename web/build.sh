@@ -8,6 +8,7 @@
 #    one line) -> pkg/gmwm.wasm
 # 2. the WASI shim that runs it in a browser or Node.js (@bjorn3/browser_wasi_shim from the npm
 #    registry, pinned, MIT/Apache-2.0) -> pkg/vendor/browser_wasi_shim/
+#    and the same with threads (wasm32-wasip1-threads) -> pkg/gmwm-threads.wasm
 # 3. the static page: web/index.html, app.js, worker.js and the package -> web/dist/, servable
 #    from any static host (python3 -m http.server -d web/dist 8000, then http://localhost:8000)
 set -euo pipefail
@@ -17,6 +18,12 @@ SHIM_VERSION=0.4.2
 rustup target add wasm32-wasip1 >/dev/null 2>&1 || true
 cargo build --release --locked --target wasm32-wasip1 -p gmwm-cli --no-default-features
 cp target/wasm32-wasip1/release/gmwm.wasm pkg/gmwm.wasm
+# the threaded module (wasi-threads: the engine's rayon pool on Web Workers sharing its memory,
+# where the page is cross-origin isolated), its shared memory allowed to grow to 4 GiB
+rustup target add wasm32-wasip1-threads >/dev/null 2>&1 || true
+CARGO_TARGET_WASM32_WASIP1_THREADS_RUSTFLAGS="-C link-arg=--max-memory=4294967296" \
+  cargo build --release --locked --target wasm32-wasip1-threads -p gmwm-cli --no-default-features
+cp target/wasm32-wasip1-threads/release/gmwm.wasm pkg/gmwm-threads.wasm
 
 npm_dir=target/web-npm
 if [ ! -f "$npm_dir/node_modules/@bjorn3/browser_wasi_shim/package.json" ] ||
@@ -33,5 +40,6 @@ cp "$shim"/LICENSE* pkg/vendor/browser_wasi_shim/ 2>/dev/null || true
 rm -rf web/dist
 mkdir -p web/dist/pkg
 cp web/index.html web/app.js web/worker.js web/dist/
-cp -r pkg/index.js pkg/package.json pkg/gmwm.wasm pkg/vendor web/dist/pkg/
-echo "web/dist: $(du -sh web/dist | cut -f1) (gmwm.wasm $(( $(stat -c %s pkg/gmwm.wasm) / 1024 )) KiB); pkg/ ready"
+cp -r pkg/index.js pkg/shared.js pkg/thread.js pkg/package.json pkg/gmwm.wasm pkg/gmwm-threads.wasm \
+  pkg/vendor web/dist/pkg/
+echo "web/dist: $(du -sh web/dist | cut -f1) (gmwm.wasm $(( $(stat -c %s pkg/gmwm.wasm) / 1024 )) KiB, gmwm-threads.wasm $(( $(stat -c %s pkg/gmwm-threads.wasm) / 1024 )) KiB); pkg/ ready"

@@ -109,6 +109,11 @@ enum ReadAhead<R> {
 
 impl<R: Read + Send + 'static> ReadAhead<R> {
     fn spawn(inner: R) -> Self {
+        // under WASI a thread is another WebAssembly instance (a Web Worker in the browser)
+        // that shares the memory but not the host's file descriptors: read in place
+        if cfg!(target_os = "wasi") {
+            return ReadAhead::Direct(inner);
+        }
         let (tx, rx) = std::sync::mpsc::sync_channel(AHEAD_BUFFERS);
         let (spent, reuse) = std::sync::mpsc::channel::<Vec<u8>>();
         let slot = std::sync::Arc::new(std::sync::Mutex::new(Some(inner)));
