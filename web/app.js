@@ -67,8 +67,14 @@ function choose(files) {
     showError(`${data.length} recordings dropped: drop one recording (and its .json sidecar)`);
     return;
   }
-  state.recording = data[0] ?? state.recording;
-  if (jsons.length) state.sidecar = jsons[0];
+  if (data.length) {
+    // a new recording: the sidecar dropped with it, none otherwise (an earlier recording's
+    // sidecar says nothing about this one)
+    state.recording = data[0];
+    state.sidecar = jsons[0] ?? null;
+  } else if (jsons.length) {
+    state.sidecar = jsons[0];
+  }
   // the sidecar goes to the command as NAME.json beside the recording, whatever its own name
   const parts = [];
   if (state.recording) parts.push(`recording ${describe(state.recording)}`);
