@@ -54,6 +54,7 @@
 use crate::fit::objective::Eval;
 use crate::fit::optimize::{Edge, LeastSquares};
 use crate::fit::{minimize, FitError, Gmwm, GmwmFit, LmOptions, Weights};
+use crate::math::elementary;
 use crate::process::sampler::{normal, SimRng};
 use crate::variance::wv::{wavelet_variance, WvOptions};
 use crate::{InputError, ParamError};
@@ -111,13 +112,16 @@ impl NsAr1 {
         let n = z.len();
         let at = |t: usize| z[t.saturating_sub(1)];
         let rho: Vec<f64> = (0..n)
-            .map(|t| (self.beta[0] + self.beta[1] * at(t)).tanh())
+            .map(|t| elementary::tanh(self.beta[0] + self.beta[1] * at(t)))
             .collect();
         let s: Vec<f64> = (0..n)
-            .map(|t| (self.alpha[0] + self.alpha[1] * at(t)).exp())
+            .map(|t| elementary::exp(self.alpha[0] + self.alpha[1] * at(t)))
             .collect();
         let v: Vec<f64> = match self.gamma {
-            Some(g) => z.iter().map(|&x| (g[0] + g[1] * x).exp()).collect(),
+            Some(g) => z
+                .iter()
+                .map(|&x| elementary::exp(g[0] + g[1] * x))
+                .collect(),
             None => vec![0.0; n],
         };
         if let Some(t) = (0..n)
@@ -479,13 +483,18 @@ pub fn fit_ns_ar1(
         .fit(x, freq_hz, &WvOptions::default())?;
     let th = stationary.theta();
     let phi = th[0].clamp(-0.999_999, 0.999_999);
-    let mut fixed = vec![phi.atanh(), 0.0, th[1].max(1e-300).ln(), 0.0];
+    let mut fixed = vec![
+        elementary::atanh(phi),
+        0.0,
+        elementary::log(th[1].max(1e-300)),
+        0.0,
+    ];
     let mut free = vec![0, 1, 2];
     if opts.variance_depends {
         free.push(3);
     }
     if opts.white_noise {
-        fixed.extend([th[2].max(1e-300).ln(), 0.0]);
+        fixed.extend([elementary::log(th[2].max(1e-300)), 0.0]);
         free.push(4);
         if opts.white_depends {
             free.push(5);

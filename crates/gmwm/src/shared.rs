@@ -65,6 +65,7 @@ use crate::fit::{
 };
 use crate::inference::asymptotic::{sandwich, wald_interval, z_value, IntervalScale, ZConvention};
 use crate::inference::ParameterInference;
+use crate::math::elementary;
 use crate::model::{Component, Model};
 use crate::process::{spec, Process, Role};
 use crate::variance::cross::{axis_pairs, stacked_moment_covariance, wavelet_cross_covariance};
@@ -575,8 +576,8 @@ pub fn fit_shared(
         let rel = var.max(0.0).sqrt() / nu;
         shared_wv.push(nu);
         let ok = rel.is_finite() && var.is_finite();
-        band_lo.push(ok.then(|| nu * (-z * rel).exp()));
-        band_hi.push(ok.then(|| nu * (z * rel).exp()));
+        band_lo.push(ok.then(|| nu * elementary::exp(-z * rel)));
+        band_hi.push(ok.then(|| nu * elementary::exp(z * rel)));
     }
     let implied_wv = (0..p)
         .map(|i| implied[i * levels..(i + 1) * levels].to_vec())

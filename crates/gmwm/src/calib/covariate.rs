@@ -17,6 +17,7 @@ use crate::fit::covariate::{dependences, CovariateFit, Dependence};
 use crate::fit::{FitError, FitRecording, Gmwm, Weighting};
 use crate::imu::Imu;
 use crate::inference::covariate::CovariateInference;
+use crate::math::elementary;
 use crate::model::Model;
 use crate::process::sampler::{normal, SimRng};
 use crate::process::{spec, Role};
@@ -526,7 +527,7 @@ impl Calibration {
         let plausible = |f: &CovariateFit| {
             f.coefficients.iter().all(|c| {
                 c.get(1)
-                    .is_none_or_compat(|s| s.abs() * (hi - lo) <= MAX_CHANGE.ln())
+                    .is_none_or_compat(|s| s.abs() * (hi - lo) <= elementary::log(MAX_CHANGE))
             })
         };
         let mut implausible = 0;

@@ -37,6 +37,7 @@
 //! `ci_high` alone, with no value.
 
 use crate::error::ParamError;
+use crate::math::elementary;
 use crate::units::{si_unit, NoiseTerm};
 use crate::variance::allan::{AllanKind, AllanVariance};
 use nalgebra::{DMatrix, DVector};
@@ -325,10 +326,10 @@ fn line(s: &Scales, j: usize, idx: &[usize], values: &[f64]) -> Option<f64> {
         if !(coef.is_finite() && coef > 0.0) {
             return None;
         }
-        num += s.edf[i] * coef.ln();
+        num += s.edf[i] * elementary::log(coef);
         den += s.edf[i];
     }
-    let v = (num / den).exp();
+    let v = elementary::exp(num / den);
     v.is_finite().then_some(v)
 }
 
@@ -346,7 +347,9 @@ fn near_read_off(s: &Scales, idx: Vec<usize>, at_tau_s: f64) -> Vec<usize> {
     let near: Vec<usize> = idx
         .iter()
         .copied()
-        .filter(|&i| (s.tau_s[i] / at_tau_s).ln().abs() <= READ_OFF_WINDOW.ln() + 1e-12)
+        .filter(|&i| {
+            elementary::log(s.tau_s[i] / at_tau_s).abs() <= elementary::log(READ_OFF_WINDOW) + 1e-12
+        })
         .collect();
     if near.len() >= 2 {
         near

@@ -15,6 +15,7 @@ use crate::imu::{Imu, Sensor, SensorInfo};
 use crate::inference::{
     infer_with_covariance, CovarianceMethod, Inference, InferenceOptions, Progress,
 };
+use crate::math::elementary;
 use crate::model::Model;
 use crate::process::{spec, Role};
 use crate::selection::{ModelSelection, SelectionError, SelectionRule, Wic};
@@ -1817,7 +1818,11 @@ impl<'a> Readoff<'a> {
             return (value, None, None);
         }
         let rel = self.z * se_rel;
-        (value, Some(value * (-rel).exp()), Some(value * rel.exp()))
+        (
+            value,
+            Some(value * elementary::exp(-rel)),
+            Some(value * elementary::exp(rel)),
+        )
     }
 
     /// Parameter indices of the components `from`.

@@ -35,6 +35,7 @@ use super::ieee::RELIABLE_SPAN;
 use super::pipeline::CalibError;
 use crate::error::{InputError, ParamError};
 use crate::inference::asymptotic::{sandwich, z_value, ZConvention};
+use crate::math::elementary;
 use crate::model::Model;
 use crate::process::{Gm, LatentProcess, Process};
 use crate::variance::ci::{eta3, interval_unchecked};
@@ -409,7 +410,7 @@ impl Planner {
                         Some(var.max(0.0).sqrt())
                     }
                 };
-                se_log.map(|s| (self.z * s).sinh())
+                se_log.map(|s| elementary::sinh(self.z * s))
             })
             .collect())
     }
@@ -442,7 +443,7 @@ impl Planner {
                 } else {
                     // T = -1 / (f ln phi): d ln T / d phi = -1 / (phi ln phi)
                     let phi = self.theta[*index];
-                    g[*index] = -1.0 / (phi * phi.ln());
+                    g[*index] = -1.0 / (phi * elementary::log(phi));
                 }
             }
             Of::AllanMinimum => {}
@@ -469,8 +470,11 @@ impl Planner {
             if w <= goal {
                 return Ok(Some(match previous {
                     Some((l0, w0)) if w0 > goal => {
-                        let t = (w0.ln() - goal.ln()) / (w0.ln() - w.ln());
-                        (l0.ln() + t * (l.ln() - l0.ln())).exp()
+                        let t = (elementary::log(w0) - elementary::log(goal))
+                            / (elementary::log(w0) - elementary::log(w));
+                        elementary::exp(
+                            elementary::log(l0) + t * (elementary::log(l) - elementary::log(l0)),
+                        )
                     }
                     _ => l,
                 }));
@@ -494,7 +498,7 @@ fn long_run_variance(theta: &[f64], (i, ar1): (usize, bool)) -> f64 {
 fn correlation_time(p: &Process, freq_hz: f64) -> f64 {
     match p {
         Process::Gm(g) => 1.0 / g.beta(),
-        Process::Ar1(a) => -1.0 / (freq_hz * a.phi().ln()),
+        Process::Ar1(a) => -1.0 / (freq_hz * elementary::log(a.phi())),
         _ => f64::NAN,
     }
 }
@@ -543,7 +547,7 @@ fn minimum_spread(nu: &[f64], v: &DMatrix<f64>, reliable: &[bool]) -> Option<f64
             }
             let min = (0..j)
                 .filter(|&r| reliable[r])
-                .map(|r| nu[r].ln() + (0..=r).map(|c| l[(r, c)] * z[c]).sum::<f64>())
+                .map(|r| elementary::log(nu[r]) + (0..=r).map(|c| l[(r, c)] * z[c]).sum::<f64>())
                 .fold(f64::INFINITY, f64::min);
             min.is_finite().then_some(min)
         })

@@ -23,6 +23,7 @@ use crate::error::ParamError;
 use crate::imu::{Imu, Sensor, SensorInfo};
 use crate::inference::same_model::{compare_wvs, WvComparison};
 use crate::inference::Progress;
+use crate::math::elementary;
 use crate::units::{SignalKind, SignalUnit};
 use crate::variance::pooled::PooledWv;
 use crate::variance::wv::{wavelet_variance, WaveletVariance, WvOptions};
@@ -402,7 +403,7 @@ fn recording_agreement(
                     "recording {name}: its WV {verdict} at {} of {} scales ({level} level), the largest difference {:+.0}% at {} s (z = {:.1})",
                     outside.len(),
                     scales.len(),
-                    100.0 * worst.log_ratio.exp_m1(),
+                    100.0 * elementary::expm1(worst.log_ratio),
                     crate::fit::report::significant(worst.tau_s, 3),
                     worst.z
                 )

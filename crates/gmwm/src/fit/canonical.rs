@@ -85,6 +85,7 @@
 use super::active::active_components;
 use super::report::{physical_parameters, significant, NavParameter};
 use super::{FitError, Gmwm, GmwmFit, PhiOrder};
+use crate::math::elementary;
 use crate::model::{Component, ImpliedWv, Model, ProcessKind};
 use crate::process::{kind_of, spec, Ar1, Role};
 use serde::Serialize;
@@ -115,7 +116,7 @@ fn contributing(implied: &ImpliedWv, log_variance: &[f64]) -> Vec<bool> {
                 for ((t, x), v) in implied.wv.iter().zip(&c.wv).zip(log_variance) {
                     let rest = t - x;
                     if rest > 0.0 && *t > 0.0 && *v > 0.0 {
-                        sum += (t / rest).ln().powi(2) / v;
+                        sum += elementary::log(t / rest).powi(2) / v;
                     } else if x.abs() > 0.0 {
                         empties = true;
                     }
@@ -135,7 +136,7 @@ pub(crate) fn wv_separation(a: &[f64], b: &[f64], log_variance: &[f64]) -> f64 {
         .zip(b)
         .zip(log_variance)
         .filter(|((x, y), v)| x.is_finite() && y.is_finite() && **x > 0.0 && **y > 0.0 && **v > 0.0)
-        .map(|((x, y), v)| (x / y).ln().powi(2) / v)
+        .map(|((x, y), v)| elementary::log(x / y).powi(2) / v)
         .sum::<f64>()
         .sqrt()
 }
@@ -808,7 +809,7 @@ impl GmwmFit {
 
     /// The longest observed scale `2^J / f` in seconds.
     fn longest_scale_s(&self) -> f64 {
-        (self.nu_hat.len() as f64).exp2() / self.freq_hz
+        elementary::exp2(self.nu_hat.len() as f64) / self.freq_hz
     }
 
     /// The reductions of rule 2 that apply to `state` (module doc).
@@ -904,7 +905,7 @@ impl GmwmFit {
         }
         if let Some(k) = parts.iter().position(|p| p.role() == Role::Drift) {
             let omega = parts[k].values()[0];
-            let tau_last = (self.nu_hat.len() as f64).exp2();
+            let tau_last = elementary::exp2(self.nu_hat.len() as f64);
             let mut next = parts.clone();
             let from = next.remove(k).from;
             let has_rw = next.iter().any(|p| p.role() == Role::RandomWalk);

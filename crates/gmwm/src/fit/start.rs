@@ -18,6 +18,7 @@
 //! given in every draw; only the missing (`None`) values are drawn.
 
 use super::{FitError, Objective, Parametrisation, PhiOrder, TransformPreset, Weights};
+use crate::math::elementary;
 use crate::model::Model;
 use crate::process::draw::{Draw, DrawContext};
 pub(crate) use crate::process::Dominance;
@@ -97,7 +98,7 @@ impl StartInputs {
 /// `(lo2, hi2)`: both below -1/2 gives [`Dominance::Qn`], both above [`Dominance::Ar1`],
 /// otherwise [`Dominance::Wn`] (also for non-finite inputs).
 pub(crate) fn dominance(nu1: f64, lo2: f64, hi2: f64) -> Dominance {
-    let s = |b: f64| (b / nu1).ln() / 4f64.ln();
+    let s = |b: f64| elementary::log(b / nu1) / elementary::log(4f64);
     let (a, b) = (s(lo2), s(hi2));
     if !(a.is_finite() && b.is_finite()) {
         return Dominance::Wn;

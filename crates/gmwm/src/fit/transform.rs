@@ -12,6 +12,7 @@
 //! `beta = -freq ln(1 - c)`. Label switching then cannot happen and §5.6 needs no reordering.
 
 use super::FitError;
+use crate::math::elementary;
 use crate::model::Model;
 pub(crate) use crate::process::TransformPreset;
 pub(crate) use crate::process::{logistic, ParamTransform, RESTART_EDGE};
@@ -215,7 +216,7 @@ impl Parametrisation {
                 });
             }
             // c = upper * logistic(-u)  =>  u = ln((upper - c) / c)
-            u[i] = ((upper - c) / c).ln();
+            u[i] = elementary::log((upper - c) / c);
             upper = c;
         }
         Ok(u)

@@ -20,6 +20,7 @@
 
 use crate::error::ParamError;
 use crate::fit::FitError;
+use crate::math::elementary;
 use crate::model::{Model, ParamDomain};
 use crate::variance::ci::check_alpha;
 use nalgebra::DMatrix;
@@ -166,8 +167,8 @@ impl Scale {
     pub(crate) fn forward(self, x: f64) -> f64 {
         match self {
             Scale::Identity => x,
-            Scale::Log => x.ln(),
-            Scale::Atanh => x.atanh(),
+            Scale::Log => elementary::log(x),
+            Scale::Atanh => elementary::atanh(x),
         }
     }
 
@@ -175,8 +176,8 @@ impl Scale {
     pub(crate) fn inverse(self, y: f64) -> f64 {
         match self {
             Scale::Identity => y,
-            Scale::Log => y.exp(),
-            Scale::Atanh => y.tanh(),
+            Scale::Log => elementary::exp(y),
+            Scale::Atanh => elementary::tanh(y),
         }
     }
 

@@ -2,6 +2,7 @@
 //! finding, special functions; the display of a number to so many significant digits.
 
 pub(crate) mod brent;
+pub(crate) mod elementary;
 pub(crate) mod special;
 pub(crate) mod sum;
 
@@ -15,7 +16,7 @@ pub(crate) fn significant(v: f64, digits: usize) -> String {
     } else if !(1e-3..1e5).contains(&a) {
         format!("{v:.*e}", digits - 1)
     } else {
-        let decimals = (digits as i32 - 1 - a.log10().floor() as i32).max(0) as usize;
+        let decimals = (digits as i32 - 1 - elementary::log10(a).floor() as i32).max(0) as usize;
         format!("{v:.decimals$}")
     }
 }

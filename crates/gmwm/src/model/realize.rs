@@ -3,6 +3,7 @@
 
 use super::{Component, Model};
 use crate::error::{check_freq, InputError, ParamError};
+use crate::math::elementary;
 use crate::process::{spec, LatentProcess, Process};
 use serde::Serialize;
 use std::fmt;
@@ -101,7 +102,7 @@ impl Model {
         let wv = (0..levels)
             .map(|j| per.iter().map(|c| c.wv[j]).sum())
             .collect();
-        let tau: Vec<f64> = (1..=levels).map(|j| (j as f64).exp2()).collect();
+        let tau: Vec<f64> = (1..=levels).map(|j| elementary::exp2(j as f64)).collect();
         Ok(ImpliedWv {
             model: self.to_string(),
             freq_hz,

@@ -17,6 +17,7 @@ use super::{
     ChainSlot, CovariancePart, Markov, MarkovForms, ParamTransform, Physical, ProcessKind, Role,
     UnitShape, BASE,
 };
+use crate::math::elementary;
 use crate::process::sampler::SimRng;
 use serde::Serialize;
 
@@ -57,7 +58,7 @@ pub(crate) const AR1_SPEC: Spec = Spec {
         correlation_time_s: |v, freq_hz| {
             let phi = v[0];
             if phi > 0.0 {
-                -1.0 / (phi.ln() * freq_hz)
+                -1.0 / (elementary::log(phi) * freq_hz)
             } else {
                 0.0
             }
@@ -88,7 +89,7 @@ pub(crate) const GM_SPEC: Spec = Spec {
     transforms: |_, _| vec![ParamTransform::Log, ParamTransform::Log],
     chain: Some(ChainSlot::Beta),
     draw: |d, _, given, out| draw_markov(d, true, given, out),
-    unit_shapes: |levels, freq_hz| unit_shapes(levels, |phi| -phi.ln() * freq_hz),
+    unit_shapes: |levels, freq_hz| unit_shapes(levels, |phi| -elementary::log(phi) * freq_hz),
     markov: Some(Markov {
         ar1: |v, freq_hz| {
             Gm {
@@ -113,14 +114,19 @@ pub(crate) const GM_SPEC: Spec = Spec {
 fn ar1_forms(v: &[f64], freq_hz: f64) -> (f64, f64, f64, f64) {
     let dt = 1.0 / freq_hz;
     let (a, b) = (v[0], v[1]);
-    (a, b, -a.ln() / dt, b / (1.0 - a * a))
+    (a, b, -elementary::log(a) / dt, b / (1.0 - a * a))
 }
 
 /// docs/methods.md §4.3: `(phi, sigma2, beta, sigma2_gm)` of a GM `[beta, sigma2_gm]`.
 fn gm_forms(v: &[f64], freq_hz: f64) -> (f64, f64, f64, f64) {
     let dt = 1.0 / freq_hz;
     let (a, b) = (v[0], v[1]);
-    ((-a * dt).exp(), -b * (-2.0 * a * dt).exp_m1(), a, b)
+    (
+        elementary::exp(-a * dt),
+        -b * elementary::expm1(-2.0 * a * dt),
+        a,
+        b,
+    )
 }
 
 /// The physical read-off of an AR1 or GM (docs/methods.md §14) from its two forms
@@ -147,8 +153,8 @@ fn markov_physical(v: &[f64], freq_hz: f64, u: &str, forms: MarkovForms) -> Vec<
 fn unit_shapes(levels: usize, first: impl Fn(f64) -> f64) -> Vec<UnitShape> {
     (0..=2 * levels + 4)
         .map(|m| {
-            let length = 2f64.powf((m as f64 - 2.0) / 2.0);
-            let phi = (-1.0 / length).exp();
+            let length = elementary::pow(2f64, (m as f64 - 2.0) / 2.0);
+            let phi = elementary::exp(-1.0 / length);
             (vec![first(phi), 1.0], (|t| t) as fn(f64) -> f64)
         })
         .collect()
@@ -173,7 +179,7 @@ pub(crate) fn condition3_phi(u: f64, last_phi: f64) -> f64 {
 fn draw_markov(d: &mut Draw<'_>, gm: bool, g: &[Option<f64>], theta: &mut Vec<f64>) {
     d.condition += 1;
     let freq_hz = d.ctx.freq_hz;
-    let given_phi = g[0].map(|v| if gm { (-v / freq_hz).exp() } else { v });
+    let given_phi = g[0].map(|v| if gm { elementary::exp(-v / freq_hz) } else { v });
     let phi = given_phi.unwrap_or_else(|| match d.condition {
         1 => condition1_phi(d.unif(0.0, 1.0 / 3.0)),
         2 => {
@@ -194,7 +200,7 @@ fn draw_markov(d: &mut Draw<'_>, gm: bool, g: &[Option<f64>], theta: &mut Vec<f6
     };
     d.last_phi = phi;
     if gm {
-        theta.push(g[0].unwrap_or(-phi.ln() * freq_hz));
+        theta.push(g[0].unwrap_or(-elementary::log(phi) * freq_hz));
         theta.push(g[1].unwrap_or(sigma2 / v));
     } else {
         theta.push(phi);
@@ -287,7 +293,7 @@ impl Ar1 {
                 "0 < phi < 1 for a Gauss-Markov process",
             ));
         }
-        let beta = -self.phi.ln() * freq_hz;
+        let beta = -elementary::log(self.phi) * freq_hz;
         let sigma2_gm = self.sigma2 / ((1.0 - self.phi) * (1.0 + self.phi));
         Gm::new(beta, sigma2_gm, freq_hz)
     }
@@ -314,8 +320,8 @@ impl Gm {
     pub(crate) fn to_ar1(self) -> Ar1 {
         let l = self.beta / self.freq_hz;
         Ar1 {
-            phi: (-l).exp(),
-            sigma2: self.sigma2_gm * -(-2.0 * l).exp_m1(),
+            phi: elementary::exp(-l),
+            sigma2: self.sigma2_gm * -elementary::expm1(-2.0 * l),
         }
     }
 }
@@ -461,10 +467,10 @@ fn series_r<const N: usize, const H: bool>(l: Jet<N, H>) -> Jet<N, H> {
 /// (no cancellation, a few ulps over 60 levels), so a level costs a handful of flops; the
 /// series of `G` stops at its first term below `1e-17` of the sum. Needs `phi > 0`.
 pub(crate) fn ar1_add_wv(phi: f64, lag: Option<f64>, sigma2: f64, out: &mut [f64]) {
-    let l = lag.unwrap_or_else(|| -phi.ln());
-    let phi_e = (-l).exp();
-    let one_m_phi = -(-l).exp_m1();
-    let one_m_phi2 = -(-2.0 * l).exp_m1();
+    let l = lag.unwrap_or_else(|| -elementary::log(phi));
+    let phi_e = elementary::exp(-l);
+    let one_m_phi = -elementary::expm1(-l);
+    let one_m_phi2 = -elementary::expm1(-2.0 * l);
     let d0 = one_m_phi * one_m_phi * one_m_phi * (phi_e + 1.0) * 2.0;
     let mut r_series = f64::NAN;
     let mut one_m_a = one_m_phi;
@@ -505,7 +511,7 @@ fn series_g_f64(l: f64, m: f64) -> f64 {
 /// AR1 spectral density `sigma2 / ((1-phi)^2 + 4 phi sin^2(pi f))` (docs/methods.md §1.9), the same
 /// as `sigma2 / (1 - 2 phi cos 2 pi f + phi^2)` without its cancellation at `f = 0`.
 pub(crate) fn ar1_spectrum(one_m_phi: f64, phi: f64, sigma2: f64, f: f64) -> f64 {
-    let s = (std::f64::consts::PI * f).sin();
+    let s = elementary::sin(std::f64::consts::PI * f);
     sigma2 / (one_m_phi * one_m_phi + 4.0 * phi * s * s)
 }
 
@@ -588,8 +594,8 @@ impl LatentProcess for Gm {
     }
     fn add_wv(&self, out: &mut [f64]) {
         let l = self.beta / self.freq_hz;
-        let sigma2 = self.sigma2_gm * -(-2.0 * l).exp_m1();
-        ar1_add_wv((-l).exp(), Some(l), sigma2, out);
+        let sigma2 = self.sigma2_gm * -elementary::expm1(-2.0 * l);
+        ar1_add_wv(elementary::exp(-l), Some(l), sigma2, out);
     }
     fn jacobian(&self, levels: usize) -> Vec<Vec<f64>> {
         jets_jacobian(&self.jets::<false>(levels))
@@ -603,7 +609,7 @@ impl LatentProcess for Gm {
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let l = self.beta / self.freq_hz;
         let ar = self.to_ar1();
-        Some(ar1_spectrum(-(-l).exp_m1(), ar.phi, ar.sigma2, f))
+        Some(ar1_spectrum(-elementary::expm1(-l), ar.phi, ar.sigma2, f))
     }
 }
 

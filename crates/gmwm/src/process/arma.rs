@@ -4,6 +4,7 @@
 
 use super::draw::{unif, Draw};
 use super::{CovariancePart, ParamTransform, Role, TransformPreset, BASE};
+use crate::math::elementary;
 use crate::process::sampler::SimRng;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -314,7 +315,7 @@ impl C64 {
         }
     }
     fn abs(self) -> f64 {
-        self.re.hypot(self.im)
+        elementary::hypot(self.re, self.im)
     }
 }
 
@@ -327,8 +328,8 @@ fn monic_roots(a: &[f64]) -> Vec<C64> {
         .map(|k| {
             let ang = 2.0 * std::f64::consts::PI * k as f64 / n as f64 + 0.4;
             C64 {
-                re: radius * ang.cos(),
-                im: radius * ang.sin(),
+                re: radius * elementary::cos(ang),
+                im: radius * elementary::sin(ang),
             }
         })
         .collect();
@@ -729,8 +730,8 @@ impl LatentProcess for Arma {
             let (mut re, mut im) = (1.0, 0.0);
             for (k, v) in c.iter().enumerate() {
                 let a = w * (k + 1) as f64;
-                re += s * v * a.cos();
-                im -= s * v * a.sin();
+                re += s * v * elementary::cos(a);
+                im -= s * v * elementary::sin(a);
             }
             re * re + im * im
         };
@@ -818,14 +819,14 @@ fn arma_burn_in(ar: &[f64], q: usize, mode: StartMode) -> Result<usize, ParamErr
     let p = ar.len();
     let rho = inverse_root_radius(ar);
     let log_len = match mode {
-        StartMode::Stationary => -STATIONARY_BURN_IN_TOL.ln(),
+        StartMode::Stationary => -elementary::log(STATIONARY_BURN_IN_TOL),
         StartMode::Zero => R_BURN_IN_LOG,
     };
     let extra = if p == 0 || rho == 0.0 {
         0.0
     } else {
         // ln(min root modulus) = -ln(rho).
-        (log_len / -rho.ln()).ceil()
+        (log_len / -elementary::log(rho)).ceil()
     };
     if !(extra.is_finite() && extra >= 0.0 && extra <= MAX_BURN_IN as f64) {
         return Err(ParamError::new(

@@ -9,6 +9,7 @@
 //! `phi > 1/2`; below, the closed form is used as written.
 
 use super::{CovariancePart, ParamTransform, Role, BASE};
+use crate::math::elementary;
 use crate::process::sampler::SimRng;
 use serde::Serialize;
 
@@ -140,7 +141,7 @@ impl LatentProcess for Arma11 {
         jets_hessian(&self.jets::<true>(levels))
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
-        let s = (std::f64::consts::PI * f).sin();
+        let s = elementary::sin(std::f64::consts::PI * f);
         let s2 = s * s;
         let (p, t) = (self.phi, self.theta);
         let num = (1.0 + t) * (1.0 + t) - 4.0 * t * s2;

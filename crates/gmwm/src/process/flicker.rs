@@ -56,6 +56,7 @@ use super::{
     ProcessKind, Role, Simulate, Spec, BASE,
 };
 use crate::error::ParamError;
+use crate::math::elementary;
 use crate::process::sampler::{normal, Sampler, SimRng, Step};
 use crate::process::ParamDomain;
 use crate::process::StartMode;
@@ -95,7 +96,7 @@ pub(crate) const ALLAN_FLOOR_PER_B2: f64 = 2.0 * LN_2 / PI;
 /// empirical WV, so `b2` is drawn log-uniformly in `[1e-3, 1]` times `pi min_j nu2_j / ln 2`.
 fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f64>) {
     let floor = PI * d.ctx.wv_min / LN_2;
-    out.push(given[0].unwrap_or_else(|| floor * 10f64.powf(-3.0 * d.unif(0.0, 1.0))));
+    out.push(given[0].unwrap_or_else(|| floor * elementary::pow(10f64, -3.0 * d.unif(0.0, 1.0))));
 }
 
 /// Flicker noise: white noise of variance `b2` fractionally integrated with `d = 1/2`; its
@@ -143,7 +144,7 @@ pub(crate) fn odd_harmonic(n: f64) -> f64 {
         (1..=n as u64).map(|k| 1.0 / (2 * k - 1) as f64).sum()
     } else {
         // psi(1/2) = -gamma - 2 ln 2
-        0.5 * (n.ln() + digamma_half_rest(n) + EULER_GAMMA + 2.0 * LN_2)
+        0.5 * (elementary::log(n) + digamma_half_rest(n) + EULER_GAMMA + 2.0 * LN_2)
     }
 }
 
@@ -203,7 +204,7 @@ impl LatentProcess for Flicker {
         half_widths(levels).map(|_| vec![vec![0.0]]).collect()
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
-        Some(self.b2 / (2.0 * (PI * f).sin().abs()))
+        Some(self.b2 / (2.0 * elementary::sin(PI * f).abs()))
     }
 }
 
@@ -218,21 +219,21 @@ const BANK_S_MAX: f64 = 36.0;
 /// The bank of the module doc: `(s_i, c_i)` for every node, the lumped tail first.
 pub(crate) fn bank() -> Vec<(f64, f64)> {
     let h = BANK_STEP;
-    let lo = (BANK_S_MIN.ln() / h).floor() as i64;
-    let hi = (BANK_S_MAX.ln() / h).ceil() as i64;
+    let lo = (elementary::log(BANK_S_MIN) / h).floor() as i64;
+    let hi = (elementary::log(BANK_S_MAX) / h).ceil() as i64;
     // nodes s_k = s_lo e^{-k h}, k >= 1, where c = (h / pi) sqrt(s) to 1e-14: total weight
     // (h / pi) sqrt(s_lo) / (e^{h/2} - 1) at the weighted mean pole
     // s_lo (e^{h/2} - 1) / (e^{3h/2} - 1)
-    let s_lo = (lo as f64 * h).exp();
+    let s_lo = elementary::exp(lo as f64 * h);
     let tail = (
-        s_lo * (0.5 * h).exp_m1() / (1.5 * h).exp_m1(),
-        h / PI * s_lo.sqrt() / (0.5 * h).exp_m1(),
+        s_lo * elementary::expm1(0.5 * h) / elementary::expm1(1.5 * h),
+        h / PI * s_lo.sqrt() / elementary::expm1(0.5 * h),
     );
     std::iter::once(tail)
         .chain((lo..=hi).map(|i| {
-            let s = (i as f64 * h).exp();
+            let s = elementary::exp(i as f64 * h);
             // (h / pi) s e^{-s/2} (1 - e^{-s})^{-1/2}
-            let c = h / PI * s * (-0.5 * s).exp() / (-(-s).exp_m1()).sqrt();
+            let c = h / PI * s * elementary::exp(-0.5 * s) / (-elementary::expm1(-s)).sqrt();
             (s, c)
         }))
         .collect()
@@ -287,7 +288,7 @@ impl Simulate for Flicker {
         let nodes = bank();
         let n = nodes.len();
         let sd = self.b2.sqrt();
-        let decay: Vec<f64> = nodes.iter().map(|&(s, _)| -(-s).exp_m1()).collect();
+        let decay: Vec<f64> = nodes.iter().map(|&(s, _)| -elementary::expm1(-s)).collect();
         let c: Vec<f64> = nodes.iter().map(|&(_, c)| c).collect();
         let a0 = 1.0 - c.iter().sum::<f64>();
         let v = match start {
@@ -296,7 +297,7 @@ impl Simulate for Flicker {
                 let mut cov = vec![0.0; n * n];
                 for i in 0..n {
                     for j in 0..n {
-                        let q = -(-(nodes[i].0 + nodes[j].0)).exp_m1();
+                        let q = -elementary::expm1(-(nodes[i].0 + nodes[j].0));
                         cov[i * n + j] = c[i] * c[j] / q;
                     }
                 }

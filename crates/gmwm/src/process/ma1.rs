@@ -1,6 +1,7 @@
 //! First-order moving average (docs/methods.md §0.2, §4.2, §4.5, §4.6, §10.1).
 
 use super::{CovariancePart, ParamTransform, Role, BASE};
+use crate::math::elementary;
 use crate::process::sampler::SimRng;
 use serde::Serialize;
 
@@ -108,7 +109,7 @@ impl LatentProcess for Ma1 {
         jets_hessian(&self.jets::<true>(levels))
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
-        let s = (std::f64::consts::PI * f).sin();
+        let s = elementary::sin(std::f64::consts::PI * f);
         let t = self.theta;
         Some(self.sigma2 * ((1.0 + t) * (1.0 + t) - 4.0 * t * s * s))
     }

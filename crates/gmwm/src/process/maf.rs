@@ -37,6 +37,7 @@ use super::{
     Simulate, Spec, BASE,
 };
 use crate::error::ParamError;
+use crate::math::elementary;
 use crate::process::sampler::{normal, Sampler, SimRng, Step};
 use crate::process::ParamDomain;
 use crate::process::StartMode;
@@ -172,11 +173,11 @@ impl LatentProcess for Maf {
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
         let l = self.length as f64;
-        let s = (std::f64::consts::PI * f).sin();
+        let s = elementary::sin(std::f64::consts::PI * f);
         if s.abs() < 1e-300 {
             return Some(self.sigma2);
         }
-        let r = (std::f64::consts::PI * f * l).sin() / (l * s);
+        let r = elementary::sin(std::f64::consts::PI * f * l) / (l * s);
         Some(self.sigma2 * r * r)
     }
 }

@@ -3,14 +3,15 @@
 //! (`crate::fit::transform`'s module doc). Each process declares which of them its parameters
 //! use ([`Spec`](super::Spec)); the fit reads them from there.
 
+use crate::math::elementary;
 use serde::{Deserialize, Serialize};
 
 /// Logistic function `1 / (1 + e^{-u})`, evaluated without overflow for either sign of `u`.
 pub(crate) fn logistic(u: f64) -> f64 {
     if u >= 0.0 {
-        1.0 / (1.0 + (-u).exp())
+        1.0 / (1.0 + elementary::exp(-u))
     } else {
-        let e = u.exp();
+        let e = elementary::exp(u);
         e / (1.0 + e)
     }
 }
@@ -58,12 +59,18 @@ impl ParamTransform {
         }
         let u = match self {
             ParamTransform::Identity => theta,
-            ParamTransform::Log if theta > 0.0 => theta.ln(),
-            ParamTransform::Logit if theta > 0.0 && theta < 1.0 => (theta / (1.0 - theta)).ln(),
-            ParamTransform::PseudoLogit if theta.abs() < 1.0 => 2.0 * theta.atanh(),
-            ParamTransform::Logit2 if theta.abs() < 2.0 => ((theta + 2.0) / (2.0 - theta)).ln(),
-            ParamTransform::LogAbs if theta != 0.0 => theta.abs().ln(),
-            ParamTransform::LogitHalf if theta > 0.0 && theta < 0.5 => (theta / (0.5 - theta)).ln(),
+            ParamTransform::Log if theta > 0.0 => elementary::log(theta),
+            ParamTransform::Logit if theta > 0.0 && theta < 1.0 => {
+                elementary::log(theta / (1.0 - theta))
+            }
+            ParamTransform::PseudoLogit if theta.abs() < 1.0 => 2.0 * elementary::atanh(theta),
+            ParamTransform::Logit2 if theta.abs() < 2.0 => {
+                elementary::log((theta + 2.0) / (2.0 - theta))
+            }
+            ParamTransform::LogAbs if theta != 0.0 => elementary::log(theta.abs()),
+            ParamTransform::LogitHalf if theta > 0.0 && theta < 0.5 => {
+                elementary::log(theta / (0.5 - theta))
+            }
             _ => return None,
         };
         u.is_finite().then_some(u)
@@ -90,11 +97,11 @@ impl ParamTransform {
     pub(crate) fn to_theta(self, u: f64) -> f64 {
         match self {
             ParamTransform::Identity => u,
-            ParamTransform::Log | ParamTransform::LogAbs => u.exp(),
+            ParamTransform::Log | ParamTransform::LogAbs => elementary::exp(u),
             ParamTransform::Logit => logistic(u),
             // 2 logistic(u) - 1 = tanh(u / 2), without the cancellation near u = 0
-            ParamTransform::PseudoLogit => (0.5 * u).tanh(),
-            ParamTransform::Logit2 => 2.0 * (0.5 * u).tanh(),
+            ParamTransform::PseudoLogit => elementary::tanh(0.5 * u),
+            ParamTransform::Logit2 => 2.0 * elementary::tanh(0.5 * u),
             ParamTransform::LogitHalf => 0.5 * logistic(u),
         }
     }
@@ -104,7 +111,7 @@ impl ParamTransform {
         let s = || logistic(u) * logistic(-u);
         match self {
             ParamTransform::Identity => 1.0,
-            ParamTransform::Log | ParamTransform::LogAbs => u.exp(),
+            ParamTransform::Log | ParamTransform::LogAbs => elementary::exp(u),
             ParamTransform::Logit => s(),
             ParamTransform::PseudoLogit => 2.0 * s(),
             ParamTransform::Logit2 => 4.0 * s(),
@@ -154,7 +161,7 @@ impl ChainSlot {
     pub(crate) fn complement(self, v: f64) -> f64 {
         match self {
             ChainSlot::Phi => 1.0 - v,
-            ChainSlot::Beta(freq) => -(-v / freq).exp_m1(),
+            ChainSlot::Beta(freq) => -elementary::expm1(-v / freq),
         }
     }
 
@@ -162,7 +169,7 @@ impl ChainSlot {
     pub(crate) fn value(self, c: f64) -> (f64, f64) {
         match self {
             ChainSlot::Phi => (1.0 - c, -1.0),
-            ChainSlot::Beta(freq) => (-freq * (-c).ln_1p(), freq / (1.0 - c)),
+            ChainSlot::Beta(freq) => (-freq * elementary::log1p(-c), freq / (1.0 - c)),
         }
     }
 
@@ -170,7 +177,7 @@ impl ChainSlot {
     pub(crate) fn phi(self, v: f64) -> f64 {
         match self {
             ChainSlot::Phi => v,
-            ChainSlot::Beta(freq) => (-v / freq).exp(),
+            ChainSlot::Beta(freq) => elementary::exp(-v / freq),
         }
     }
 

@@ -2,6 +2,7 @@
 
 use super::draw::{Dominance, Draw};
 use super::{CovariancePart, ParamTransform, ProcessKind, Role, BASE};
+use crate::math::elementary;
 use crate::process::sampler::SimRng;
 use serde::Serialize;
 
@@ -108,7 +109,7 @@ impl LatentProcess for Qn {
         half_widths(levels).map(|_| vec![vec![0.0]]).collect()
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
-        let s = (std::f64::consts::PI * f).sin();
+        let s = elementary::sin(std::f64::consts::PI * f);
         Some(4.0 * self.q2 * s * s)
     }
 }

@@ -1,6 +1,7 @@
 //! Random walk (docs/methods.md §0.2, §4.2, §10.1).
 
 use super::{CovariancePart, ParamTransform, Role, BASE};
+use crate::math::elementary;
 use crate::process::sampler::SimRng;
 use serde::Serialize;
 
@@ -98,7 +99,7 @@ impl LatentProcess for Rw {
         half_widths(levels).map(|_| vec![vec![0.0]]).collect()
     }
     fn spectral_density(&self, f: f64) -> Option<f64> {
-        let s = (std::f64::consts::PI * f).sin();
+        let s = elementary::sin(std::f64::consts::PI * f);
         Some(self.gamma2 / (4.0 * s * s))
     }
 }

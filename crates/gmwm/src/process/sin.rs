@@ -37,6 +37,7 @@ use super::{
     ParamTransform, Params, Physical, ProcessKind, Role, Simulate, Spec, BASE,
 };
 use crate::error::ParamError;
+use crate::math::elementary;
 use crate::process::sampler::{uniform, Sampler, SimRng, Step};
 use crate::process::ParamDomain;
 use crate::process::StartMode;
@@ -133,10 +134,11 @@ fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f
             // the hump where the given line's WV peaks
             Some(omega) => {
                 let peak = 2.0 * HUMP_X / (PI * omega);
-                humps
-                    .iter()
-                    .copied()
-                    .min_by(|a, b| (a.0 / peak).ln().abs().total_cmp(&(b.0 / peak).ln().abs()))
+                humps.iter().copied().min_by(|a, b| {
+                    elementary::log(a.0 / peak)
+                        .abs()
+                        .total_cmp(&elementary::log(b.0 / peak).abs())
+                })
             }
             // one of the two largest humps, at random
             None => {
@@ -151,14 +153,23 @@ fn draw(d: &mut Draw<'_>, _: ProcessKind, given: &[Option<f64>], out: &mut Vec<f
     let (power, omega) = match hump {
         Some((tau, excess)) => {
             let peak = 2.0 * HUMP_X / (PI * tau);
-            let omega = (peak * d.unif(-(2f64.ln()), 2f64.ln()).exp()).min(OMEGA_MAX);
-            let power = excess / HUMP_HEIGHT * d.unif(-(3f64.ln()), 3f64.ln()).exp();
+            let omega = (peak
+                * elementary::exp(d.unif(-(elementary::log(2f64)), elementary::log(2f64))))
+            .min(OMEGA_MAX);
+            let power = excess / HUMP_HEIGHT
+                * elementary::exp(d.unif(-(elementary::log(3f64)), elementary::log(3f64)));
             (power, omega)
         }
         None => {
-            let share = d.unif(POWER_SHARE_MIN.ln(), POWER_SHARE_MAX.ln()).exp();
+            let share = elementary::exp(d.unif(
+                elementary::log(POWER_SHARE_MIN),
+                elementary::log(POWER_SHARE_MAX),
+            ));
             let lo = (2.0 / d.ctx.n).min(0.25 * OMEGA_MAX);
-            (share * st, d.unif(lo.ln(), OMEGA_MAX.ln()).exp())
+            (
+                share * st,
+                elementary::exp(d.unif(elementary::log(lo), elementary::log(OMEGA_MAX))),
+            )
         }
     };
     out.push(given[0].unwrap_or((2.0 * power).sqrt()));
@@ -232,7 +243,7 @@ impl Sin {
         let p = 0.5 * self.amplitude * self.amplitude;
         // reduce omega n modulo 1 before the sine: n reaches 1e9
         let c = self.omega * n;
-        let r = (PI * (c - c.floor())).sin() / (PI * self.omega).sin();
+        let r = elementary::sin(PI * (c - c.floor())) / elementary::sin(PI * self.omega);
         p * r * r
     }
 
@@ -242,7 +253,7 @@ impl Sin {
         (0..lags)
             .map(|h| {
                 let c = self.omega * h as f64;
-                p * (2.0 * PI * (c - c.round())).cos()
+                p * elementary::cos(2.0 * PI * (c - c.round()))
             })
             .collect()
     }
@@ -256,7 +267,7 @@ impl Sin {
 
 /// `sin(x)` of a jet.
 fn jet_sin<const N: usize, const H: bool>(x: Jet<N, H>) -> Jet<N, H> {
-    let (s, c) = x.v.sin_cos();
+    let (s, c) = elementary::sincos(x.v);
     x.chain(s, c, -s)
 }
 
@@ -277,8 +288,8 @@ fn sin_wv_jet<const N: usize, const H: bool>(
 /// [`sin_wv_jet`] in `f64` (the objective's hot path).
 fn sin_wv(amplitude: f64, omega: f64, m: f64) -> f64 {
     let k = (omega * m).round();
-    let num = (PI * (omega * m - k)).sin().powi(4);
-    let s = (PI * omega).sin();
+    let num = elementary::sin(PI * (omega * m - k)).powi(4);
+    let s = elementary::sin(PI * omega);
     0.5 * amplitude * amplitude * num / (m * m * s * s)
 }
 
@@ -332,7 +343,7 @@ impl Step for SinSampler {
     fn step(&mut self) -> f64 {
         let c = self.omega * self.t as f64 + self.phase;
         self.t += 1;
-        self.amplitude * (2.0 * PI * (c - c.floor())).sin()
+        self.amplitude * elementary::sin(2.0 * PI * (c - c.floor()))
     }
 }
 

@@ -13,6 +13,7 @@
 //! Cost: `O(2^j)` lobes per level, tens of evaluations each: about 0.1 s at level 20.
 
 use super::LatentProcess;
+use crate::math::elementary;
 
 /// Gauss–Legendre order.
 const GL_N: usize = 20;
@@ -32,7 +33,7 @@ fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     for i in 0..n {
-        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut z = elementary::cos(std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5));
         let mut dp = 1.0;
         for _ in 0..100 {
             let (mut p0, mut p1) = (1.0, z);
@@ -114,8 +115,8 @@ pub(crate) fn spectral_wv_level(density: &dyn Fn(f64) -> f64, j: usize) -> f64 {
             let s_max = (m / 2.0 - kf).min(1.0);
             let g = move |s: f64| {
                 let f = (kf + s) / m;
-                let ss = (std::f64::consts::PI * s).sin();
-                let sf = (std::f64::consts::PI * f).sin();
+                let ss = elementary::sin(std::f64::consts::PI * s);
+                let sf = elementary::sin(std::f64::consts::PI * f);
                 let gain = ss * ss * ss * ss / (m * m * sf * sf);
                 gain * density(f) / m
             };

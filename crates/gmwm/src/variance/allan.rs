@@ -29,6 +29,7 @@
 //! AV), O(N log N) for all octaves; cluster lengths are computed in parallel with rayon.
 
 use crate::error::{check_series, InputError, ParamError, SeriesError};
+use crate::math::elementary;
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, interval_unchecked};
 use rayon::prelude::*;
@@ -736,7 +737,7 @@ fn package_levels(
     base_int: usize,
     fits: impl Fn(usize) -> bool,
 ) -> Vec<usize> {
-    let levels = ((n as f64).log10() / base.log10()).floor() as i64 - drop;
+    let levels = (elementary::log10(n as f64) / elementary::log10(base)).floor() as i64 - drop;
     (1..=levels.max(0))
         .map(|i| base_int.pow(i as u32))
         .take_while(|&m| fits(m))

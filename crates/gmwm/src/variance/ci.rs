@@ -1,6 +1,7 @@
 //! Chi-square ("eta3") confidence intervals of a variance estimate (docs/methods.md §1.7).
 
 use crate::error::ParamError;
+use crate::math::elementary;
 use statrs::distribution::{ChiSquared, Continuous, ContinuousCDF, Normal};
 use statrs::function::gamma::{gamma_lr, gamma_ur};
 
@@ -23,7 +24,7 @@ pub fn check_alpha(alpha: f64) -> Result<(), ParamError> {
 /// Equivalent degrees of freedom of the level-j WV, docs/methods.md §1.7, paper eq. (1) CI:
 /// `eta_j = max(M_j / 2^j, 1)` with `M_j` the number of kept coefficients.
 pub(crate) fn eta3(kept: usize, j: usize) -> f64 {
-    (kept as f64 / (j as f64).exp2()).max(1.0)
+    (kept as f64 / elementary::exp2(j as f64)).max(1.0)
 }
 
 /// Why `alpha` is not a significance level the front ends accept, or `None` when it is one:

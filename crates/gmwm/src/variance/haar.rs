@@ -17,6 +17,7 @@
 //! thread count) and the per-level sums are added in that fixed order: the result is the same on
 //! any number of threads.
 
+use crate::math::elementary;
 use crate::math::sum::NeumaierSum;
 
 /// Samples per block of stage A: the block's input and output (2 x 16 KiB) and the rings of the
@@ -100,7 +101,7 @@ pub(crate) fn haar_square_sums(x: &[f64], levels: usize, offset: f64) -> Vec<f64
         .iter()
         .zip(1..)
         // the kernels square 2^j W: scale by 4^-j (exact)
-        .map(|(s, j)| s.total() * (-2.0 * j as f64).exp2())
+        .map(|(s, j)| s.total() * elementary::exp2(-2.0 * j as f64))
         .collect()
 }
 

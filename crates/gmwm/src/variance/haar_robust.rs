@@ -14,6 +14,7 @@
 //!    and [`robust_scale`] decides — the direct route, same root.
 
 use crate::error::{InputError, SeriesError};
+use crate::math::elementary;
 use crate::math::sum::NeumaierSum;
 use crate::variance::haar::{haar_pass, LevelSink};
 use crate::variance::robust::{
@@ -47,7 +48,7 @@ impl LevelSink for RobustSink {
             LevelState::Idle => {}
             LevelState::Window(acc, _, _) => acc.push(w),
             LevelState::Collect(all) => {
-                let scale = (-(j as f64)).exp2();
+                let scale = elementary::exp2(-(j as f64));
                 all.extend(w.iter().map(|v| v * scale));
             }
         }
@@ -100,7 +101,7 @@ pub(crate) fn haar_robust_levels(
         .map(|(start, j)| match start {
             Some(s) => {
                 let (lo, hi) = window_around(*s);
-                let scale2 = (-2.0 * j as f64).exp2();
+                let scale2 = elementary::exp2(-2.0 * j as f64);
                 LevelState::Window(PowerAccumulator::new(c, lo, hi, scale2), lo, hi)
             }
             None => LevelState::Collect(Vec::new()),
@@ -133,7 +134,7 @@ pub(crate) fn haar_robust_levels(
                     LevelState::Idle
                 }
                 LevelState::Window(acc, lo, hi) => {
-                    let scale2 = (-2.0 * j as f64).exp2();
+                    let scale2 = elementary::exp2(-2.0 * j as f64);
                     match acc.finish() {
                         None => LevelState::Collect(Vec::new()),
                         Some(window) => {
@@ -202,7 +203,7 @@ fn prefix_sums(x: &[f64], offset: f64) -> Vec<f64> {
 fn subsample(prefix: &[f64], j: usize, stride: usize) -> Vec<f64> {
     let n = prefix.len() - 1;
     let h = 1usize << (j - 1);
-    let scale = (-(j as f64)).exp2();
+    let scale = elementary::exp2(-(j as f64));
     ((2 * h - 1)..n)
         .step_by(stride.max(1))
         .map(|t| {

@@ -60,6 +60,7 @@
 //! callers simulate instead.
 
 use crate::error::{InputError, ParamError};
+use crate::math::elementary;
 use crate::model::Model;
 use crate::process::{CovariancePart, Process};
 use nalgebra::DMatrix;
@@ -102,7 +103,7 @@ impl Autoregressive {
     pub(crate) fn new(phi: f64, r0: f64, r1: f64) -> Self {
         let eps = 1.0 - phi;
         let ln_phi = if phi > 0.0 {
-            (-eps).ln_1p()
+            elementary::log1p(-eps)
         } else {
             f64::NEG_INFINITY
         };
@@ -143,9 +144,9 @@ impl Autoregressive {
                 }
             } else if self.phi < 0.0 {
                 // an integer power of a negative base (n is a whole number of samples)
-                self.phi.powf(n)
+                elementary::pow(self.phi, n)
             } else {
-                (n * self.ln_phi).exp()
+                elementary::exp(n * self.ln_phi)
             };
             return (n * self.eps - (1.0 - pn)) / (self.eps * self.eps);
         }
@@ -165,7 +166,7 @@ impl Autoregressive {
             }
             s
         } else {
-            y.exp_m1() - y
+            elementary::expm1(y) - y
         };
         (e + n * self.d) / (self.eps * self.eps)
     }
@@ -182,9 +183,9 @@ impl Autoregressive {
     /// samples.
     pub(crate) fn held_sum_variance(&self, n: f64) -> f64 {
         let geometric = if self.phi > 0.0 {
-            -(n * self.ln_phi).exp_m1() / self.eps
+            -elementary::expm1(n * self.ln_phi) / self.eps
         } else {
-            (1.0 - self.phi.powf(n)) / self.eps
+            (1.0 - elementary::pow(self.phi, n)) / self.eps
         };
         self.increment_variance(n) + n * n * self.r0 - 2.0 * n * self.r1 * geometric
     }
@@ -198,14 +199,14 @@ impl Autoregressive {
     /// [`second_difference_with`](Self::second_difference_with) that depends on the level
     /// only, computed once per pair of levels.
     fn half_factor(&self, half: f64) -> f64 {
-        (half * self.ln_phi).exp_m1() / self.eps
+        elementary::expm1(half * self.ln_phi) / self.eps
     }
 
     /// `K(m) - 2 K(m + half) + K(m + 2 half)` for `m >= 0` given `e =`
     /// [`half_factor`](Self::half_factor)`(half)`: the linear part of `K` drops out, leaving
     /// `-(r1 / (1 - phi)^2) phi^m (1 - phi^half)^2`, without cancellation.
     fn second_difference_with(&self, e: f64, m: f64) -> f64 {
-        -self.r1 * self.phi.powf(m) * e * e
+        -self.r1 * elementary::pow(self.phi, m) * e * e
     }
 }
 

@@ -20,6 +20,7 @@
 //! [`welch_psd`] runs it over a slice without copying it.
 
 use crate::error::{check_finite, check_freq, InputError, ParamError, SeriesError};
+use crate::math::elementary;
 use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlanner};
 use serde::Serialize;
@@ -152,11 +153,11 @@ impl Psd {
             .collect();
         let (mut frequency_hz, mut density) = (Vec::new(), Vec::new());
         if let (Some(first), Some(last)) = (members.first(), members.last()) {
-            let (lo, hi) = (first.0.ln(), last.0.ln());
+            let (lo, hi) = (elementary::log(first.0), elementary::log(last.0));
             let span = (hi - lo).max(f64::MIN_POSITIVE);
             let mut sums = vec![(0.0, 0.0, 0usize); points];
             for &(f, d) in &members {
-                let b = (((f.ln() - lo) / span) * points as f64) as usize;
+                let b = (((elementary::log(f) - lo) / span) * points as f64) as usize;
                 let s = &mut sums[b.min(points - 1)];
                 s.0 += f;
                 s.1 += d;
@@ -237,7 +238,7 @@ impl Welch {
         let l = segment_length;
         // periodic Hann: w_n = sin²(π n / L), whose 50%-overlapped copies sum to 1
         let window: Vec<f64> = (0..l)
-            .map(|n| (std::f64::consts::PI * n as f64 / l as f64).sin().powi(2))
+            .map(|n| elementary::sin(std::f64::consts::PI * n as f64 / l as f64).powi(2))
             .collect();
         let window_power = window.iter().map(|w| w * w).sum();
         let fft = FftPlanner::new().plan_fft_forward(l);

@@ -17,6 +17,7 @@
 
 use crate::error::{InputError, ParamError, SeriesError};
 use crate::math::brent::{find_root, minimize, OPTIMIZE_TOL};
+use crate::math::elementary;
 use crate::math::sum::NeumaierSum;
 use serde::{Deserialize, Serialize};
 use std::str::FromStr;
@@ -187,7 +188,7 @@ const INV_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
 /// relative. For non-finite or non-positive `c` the result is NaN/garbage: callers validate.
 pub(crate) fn truncated_normal_moments(c: f64) -> [f64; 11] {
     let mut mu = [0.0; 11];
-    let two_phi = 2.0 * INV_SQRT_2PI * (-0.5 * c * c).exp();
+    let two_phi = 2.0 * INV_SQRT_2PI * elementary::exp(-0.5 * c * c);
     mu[0] = central_normal_mass(c, two_phi);
     let mut c_pow = c; // c^{2k-1}
     for k in 1..11 {

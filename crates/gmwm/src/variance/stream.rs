@@ -17,6 +17,7 @@ use crate::error::{check_freq, InputError, ParamError, SeriesError};
 use crate::imu::read::binary::RawRows;
 use crate::imu::read::stream::StreamedTable;
 use crate::imu::{BinaryLayout, ReadError};
+use crate::math::elementary;
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::check_alpha;
 use crate::variance::wv::{
@@ -877,7 +878,7 @@ impl TopLevel {
         let n = self.count as f64;
         let (s1, s2) = (self.s1.total(), self.s2.total());
         // W = E / 2^j: scale by 4^-j (exact)
-        (n * e * e + 2.0 * e * s1 + s2) * (-2.0 * self.j as f64).exp2()
+        (n * e * e + 2.0 * e * s1 + s2) * elementary::exp2(-2.0 * self.j as f64)
     }
 }
 

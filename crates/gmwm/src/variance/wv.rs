@@ -6,6 +6,7 @@
 //! consume its input in chunks.
 
 use crate::error::{check_finite, check_freq, check_series, InputError, ParamError, SeriesError};
+use crate::math::elementary;
 use crate::math::special::trigamma;
 use crate::math::sum::NeumaierSum;
 use crate::variance::ci::{check_alpha, eta3, interval_unchecked};
@@ -276,7 +277,7 @@ impl WaveletVariance {
         eta: Vec<f64>,
     ) -> Self {
         let levels = classical.len();
-        let tau: Vec<f64> = (1..=levels).map(|j| (j as f64).exp2()).collect();
+        let tau: Vec<f64> = (1..=levels).map(|j| elementary::exp2(j as f64)).collect();
         let tau_s = tau.iter().map(|t| t / freq_hz).collect();
         let mut wv = Vec::with_capacity(levels);
         let mut ci_low = Vec::with_capacity(levels);
@@ -513,7 +514,7 @@ pub fn wavelet_variance(
             let kept = coefs.kept(j);
             let scale = match opts.transform {
                 Transform::Modwt => 1.0,
-                Transform::Dwt => (j as f64).exp2(),
+                Transform::Dwt => elementary::exp2(j as f64),
             };
             let robust = match (c, opts.robust) {
                 (Some(c), Some(r)) => match robust_scale(kept, c, r.convention()) {
