@@ -48,15 +48,9 @@ REL_TOL = 1e-9
 # command's, 8 with a report, which is most of the time: CI's test runs none)
 AUDIT = 0
 ROOT = Path(__file__).resolve().parents[2]
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
+# the report test's Chromium flags (headless as root, no background network on a closed machine)
+sys.path.insert(0, str(ROOT / "crates" / "gmwm-cli" / "tests" / "browser"))
+from check_report import CHROMIUM_ARGS  # noqa: E402
 
 
 class Fatal(Exception):

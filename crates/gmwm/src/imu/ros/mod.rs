@@ -607,6 +607,18 @@ pub(crate) fn container_of(path: &Path) -> Option<RosContainer> {
     source(path).ok().map(|s| s.container)
 }
 
+/// One row of a rosbag2 sqlite3 file's `topics`, with its message count (`sqlite`; never built
+/// in a build without SQLite).
+#[derive(Debug, Clone)]
+pub(crate) struct SqliteTopic {
+    pub(crate) id: i64,
+    pub(crate) name: String,
+    pub(crate) message_type: String,
+    /// `serialization_format`, `cdr` for ROS 2.
+    pub(crate) encoding: String,
+    pub(crate) messages: u64,
+}
+
 /// One storage file, opened and catalogued.
 enum Opened {
     Ros1(StorageFile, ros1::Catalog),

@@ -15,16 +15,7 @@ use rusqlite::OpenFlags;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// One row of `topics`, with its message count.
-#[derive(Debug, Clone)]
-pub(crate) struct Topic {
-    pub(crate) id: i64,
-    pub(crate) name: String,
-    pub(crate) message_type: String,
-    /// `serialization_format`, `cdr` for ROS 2.
-    pub(crate) encoding: String,
-    pub(crate) messages: u64,
-}
+pub(crate) use super::SqliteTopic as Topic;
 
 fn sql_error(path: &Path, e: rusqlite::Error) -> RosError {
     use rusqlite::ErrorCode::{OperationInterrupted, TooBig};

@@ -11,15 +11,7 @@ use std::path::Path;
 /// No database can be opened in this build: the type has no value.
 pub(crate) enum Connection {}
 
-/// One row of `topics` (never built here; the catalog of a refused file is empty).
-#[derive(Debug, Clone)]
-pub(crate) struct Topic {
-    pub(crate) id: i64,
-    pub(crate) name: String,
-    pub(crate) message_type: String,
-    pub(crate) encoding: String,
-    pub(crate) messages: u64,
-}
+pub(crate) use super::SqliteTopic as Topic;
 
 /// Refuses the file: this build has no SQLite.
 pub(crate) fn open(path: &Path) -> Result<Connection, ReadError> {
