@@ -45,12 +45,21 @@ EXIT_FAIL, EXIT_MISSING = 1, 3
 # recording's N, B, K by 1.5e-10 (by 1.4e-9 before that module).
 REL_TOL = 1e-9
 # self-audit recordings per axis in the page and the command (the page's default is the
-# command's, 8 with a report, which is most of the time: CI's test runs none)
+# command's, 8 with a report, which is most of the time: CI's test runs none; --audit 8 times
+# what a user gets by default)
 AUDIT = 0
 ROOT = Path(__file__).resolve().parents[2]
-# the report test's Chromium flags (headless as root, no background network on a closed machine)
-sys.path.insert(0, str(ROOT / "crates" / "gmwm-cli" / "tests" / "browser"))
-from check_report import CHROMIUM_ARGS  # noqa: E402
+# headless as root, no background network on a closed machine; unlike the report's test
+# (check_report.py), which maps every host name nowhere, this page loads from a local server
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 
 class Fatal(Exception):
@@ -104,14 +113,14 @@ DROP = """async (names) => {
 HEARTBEAT = """() => { window.__beats = 0; window.__beat = setInterval(() => window.__beats++, 100); }"""
 
 
-def native(gmwm: Path, recording: Path, out: Path, threads: int | None = None):
+def native(gmwm: Path, recording: Path, out: Path, audit: int, threads: int | None = None):
     """The native command's document and Kalibr file, and its wall time, with what the page
-    asks (the report, with AUDIT self-audit recordings per axis); on `threads` threads."""
+    asks (the report, with `audit` self-audit recordings per axis); on `threads` threads."""
     env = dict(os.environ, **({"RAYON_NUM_THREADS": str(threads)} if threads else {}))
     started = time.perf_counter()
     subprocess.run([str(gmwm), "calibrate", str(recording), "--json", str(out / "native.json"),
                     "--kalibr", str(out / "native_kalibr.yaml"), "--report",
-                    str(out / "native.html"), "--audit", str(AUDIT), "--quiet"],
+                    str(out / "native.html"), "--audit", str(audit), "--quiet"],
                    check=True, stdout=subprocess.DEVNULL, env=env)
     seconds = time.perf_counter() - started
     return (json.loads((out / "native.json").read_text()),
@@ -151,8 +160,8 @@ def check(args: argparse.Namespace) -> list[str]:
     problems: list[str] = []
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        doc, kalibr, native_s = native(Path(args.gmwm), recording, tmp)
-        native_one_s = (native(Path(args.gmwm), recording, tmp, threads=1)[2]
+        doc, kalibr, native_s = native(Path(args.gmwm), recording, tmp, args.audit)
+        native_one_s = (native(Path(args.gmwm), recording, tmp, args.audit, threads=1)[2]
                         if args.native_one_thread else None)
         corrupt = tmp / "corrupt.csv.gz"
         # a gzip header, then bytes that are no deflate stream
@@ -176,7 +185,7 @@ def check(args: argparse.Namespace) -> list[str]:
                     page.screenshot(path=str(shots / "1-before.png"), full_page=True)
                     page.evaluate(DROP, [n for n in data if n != corrupt.name])
                     page.wait_for_function("!document.getElementById('run').disabled")
-                    page.fill("#audit", str(AUDIT))
+                    page.fill("#audit", str(args.audit))
                     if not page.evaluate("self.crossOriginIsolated"):
                         problems.append("the page is not cross-origin isolated: no threads")
                     page.evaluate(HEARTBEAT)
@@ -292,6 +301,8 @@ def main(argv: list[str]) -> int:
                                                    "adis_16405_imu1.csv.gz"))
     parser.add_argument("--shots", default=str(ROOT / "target" / "web-shots"))
     parser.add_argument("--timeout", type=float, default=300)
+    parser.add_argument("--audit", type=int, default=AUDIT,
+                        help="self-audit recordings per axis, in the page and the command")
     parser.add_argument("--native-one-thread", action="store_true",
                         help="also time the native command on one thread")
     args = parser.parse_args(argv)
