@@ -10,7 +10,7 @@
 #    registry, pinned, MIT/Apache-2.0) -> pkg/vendor/browser_wasi_shim/
 #    and the same with threads (wasm32-wasip1-threads) -> pkg/gmwm-threads.wasm
 # 3. the static page: web/index.html, app.js, worker.js and the package -> web/dist/, servable
-#    from any static host (python3 -m http.server -d web/dist 8000, then http://localhost:8000)
+#    from any static host; web/serve.py serves it cross-origin isolated (threads)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHIM_VERSION=0.4.2

@@ -26,7 +26,6 @@ Exit status: 0 passed, 1 failed, 3 a dependency missing (playwright, chromium, w
 from __future__ import annotations
 
 import argparse
-import functools
 import http.server
 import json
 import os
@@ -36,6 +35,9 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from serve import handler  # noqa: E402  (web/serve.py)
 
 PREFIX = "check_web: "
 EXIT_FAIL, EXIT_MISSING = 1, 3
@@ -69,31 +71,10 @@ class Fatal(Exception):
 
 
 def serve(dist: Path, data: dict[str, Path]) -> tuple[http.server.ThreadingHTTPServer, str]:
-    """A static server of `dist` on a free loopback port; `/__test/NAME` serves the test's
-    input files (the page fetches them into File objects for the drop)."""
-
-    class Handler(http.server.SimpleHTTPRequestHandler):
-        extensions_map = {**http.server.SimpleHTTPRequestHandler.extensions_map,
-                          ".wasm": "application/wasm", ".js": "text/javascript"}
-
-        def end_headers(self) -> None:
-            # cross-origin isolation: SharedArrayBuffer, so the threaded module can run
-            self.send_header("Cross-Origin-Opener-Policy", "same-origin")
-            self.send_header("Cross-Origin-Embedder-Policy", "require-corp")
-            super().end_headers()
-
-        def translate_path(self, path: str) -> str:
-            if path.startswith("/__test/"):
-                name = path.split("/", 2)[2].split("?", 1)[0]
-                if name in data:
-                    return str(data[name])
-            return super().translate_path(path)
-
-        def log_message(self, *args) -> None:
-            pass
-
-    server = http.server.ThreadingHTTPServer(
-        ("127.0.0.1", 0), functools.partial(Handler, directory=str(dist)))
+    """The page's server (web/serve.py: cross-origin isolated, so with threads) of `dist` on a
+    free loopback port; `/__test/NAME` serves the test's input files (the page fetches them
+    into File objects for the drop)."""
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler(dist, data))
     threading.Thread(target=server.serve_forever, daemon=True).start()
     return server, f"http://127.0.0.1:{server.server_address[1]}/"
 
