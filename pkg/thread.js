@@ -2,7 +2,7 @@
 // that instantiates the module on the shared memory and runs, one after another, the threads
 // that `wasi.thread-spawn` hands to its slot (index.js: threadSpawn). Such a thread computes
 // (the engine's rayon pool); it has no file descriptors but standard output and error, whose
-// progress lines go to the shared progress cell and other lines to the parent.
+// progress lines go to the shared progress cell and other lines to the console.
 import { WASI, OpenFile, File, ConsoleStdout } from "./vendor/browser_wasi_shim/index.js";
 import { threadSpawn, slotState, recordProgress, recordTrap } from "./shared.js";
 
@@ -10,7 +10,9 @@ self.onmessage = async ({ data }) => {
   const { module, memory, control, progress, slot, env } = data;
   const ctl = new Int32Array(control);
   const forward = (line) => {
-    if (!recordProgress(progress, line)) self.postMessage({ kind: "stderr", line });
+    // the main worker is busy until the run ends: other lines (a thread's panic message) go to
+    // the console
+    if (!recordProgress(progress, line)) console.error(line);
   };
   const wasi = new WASI(["gmwm"], env, [
     new OpenFile(new File(new Uint8Array(0), { readonly: true })),
@@ -37,7 +39,6 @@ self.onmessage = async ({ data }) => {
       // a trap (a panic's abort): the process is over; the page stops it
       const message = `a thread of the WebAssembly module stopped: ${e?.message ?? e}`;
       recordTrap(progress, message);
-      self.postMessage({ kind: "trap", message });
       return;
     }
     Atomics.store(ctl, state, 0);

@@ -1,6 +1,7 @@
 // The page: choose a recording (and its sidecar), set what it does not say, calibrate in a Web
 // Worker (worker.js, the gmwm command in WebAssembly), show N, B, K, the report and the files.
 import { readProgress } from "./pkg/shared.js";
+import { EXPORTS } from "./pkg/index.js";
 
 const $ = (id) => document.getElementById(id);
 const state = { recording: null, sidecar: null, worker: null, urls: [], poll: null };
@@ -174,7 +175,8 @@ function show(result, started) {
   download(`${stem}.report.html`, result.report, "text/html");
   download(`${stem}.calibration.json`, JSON.stringify(doc, null, 2) + "\n", "application/json");
   for (const [stack, text] of Object.entries(result.exports)) {
-    const name = stack.includes(":") ? stack.split(":")[1] : stack === "px4" ? "px4_imu.params" : `${stack}_imu.yaml`;
+    // a per-axis file arrives as "stack:file name", one file per stack as the stack's name
+    const name = stack.includes(":") ? stack.split(":")[1] : EXPORTS[stack];
     download(`${stem}.${name}`, text, "text/plain");
   }
   $("report").srcdoc = result.report;
