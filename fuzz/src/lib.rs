@@ -373,9 +373,14 @@ pub fn wv_fit(data: &[u8]) {
             Ok(implied) => assert_eq!(implied.wv.len(), levels),
             Err(e) => check_error(&e),
         }
-        // the starting-value search's draws (20000 by default) repeat one computation: a few
-        // cover its paths, and leave the executions to the inputs
-        let gmwm = Gmwm::new(model.clone()).with_draws(64);
+        // the starting-value search's draws (20000 by default) repeat one computation, and so
+        // do the optimiser's steps past the first hundred (2000 by default: a deep-level ARMA
+        // fit that never converges ran them all, 1.4 s natively and 4 s in this build): a few
+        // cover their paths (100 steps include two refreshes of the scaling, every 50) and
+        // leave the executions to the inputs
+        let gmwm = Gmwm::new(model.clone())
+            .with_draws(64)
+            .with_max_iterations(100);
         match gmwm.fit_from_wv(wv, StartInputs::from_wv(wv)) {
             Ok(fit) => assert_eq!(fit.implied_wv().wv.len(), levels),
             Err(e) => check_error(&e),

@@ -134,6 +134,20 @@ impl Gmwm {
         self
     }
 
+    /// Caps the optimiser's accepted steps (default 2000). A fit that reaches the cap ends
+    /// "not converged" (the fit's `convergence()` says so): for callers that bound
+    /// the time of a fit whatever the data (the fuzz targets), not for estimates.
+    ///
+    /// ```
+    /// use gmwm::{Gmwm, Model};
+    /// let gmwm = Gmwm::new("AR1()+WN()".parse::<Model>().unwrap()).with_max_iterations(100);
+    /// # let _ = gmwm;
+    /// ```
+    pub fn with_max_iterations(mut self, iterations: usize) -> Self {
+        self.options.max_iterations = iterations.max(1);
+        self
+    }
+
     /// The weighting (docs/methods.md §5.2).
     pub fn weighting(&self) -> Weighting {
         self.weighting

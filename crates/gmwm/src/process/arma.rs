@@ -10,6 +10,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
+use super::scalar::{sum, Dual, Scalar};
 use super::{
     autocovariance_wv, check_positive, LatentProcess, Occurs, Orders, Params, Process, Simulate,
     Spec,
@@ -366,13 +367,17 @@ fn monic_roots(a: &[f64]) -> Vec<C64> {
 
 /// docs/methods.md §4.4: `psi_i = ma_i (0 if i > q) + sum_{l=1}^{min(i,p)} ar_l psi_{i-l}`,
 /// `psi_0 = 1`.
-fn psi(ar: &[f64], ma: &[f64], n: usize) -> Vec<f64> {
-    let mut out = vec![0.0; n.max(1)];
-    out[0] = 1.0;
+fn psi<T: Scalar>(ar: &[T], ma: &[T], n: usize) -> Vec<T> {
+    let mut out = vec![T::lift(0.0); n.max(1)];
+    out[0] = T::lift(1.0);
     for i in 1..n {
-        let mut v = if i <= ma.len() { ma[i - 1] } else { 0.0 };
+        let mut v = if i <= ma.len() {
+            ma[i - 1]
+        } else {
+            T::lift(0.0)
+        };
         for l in 1..=i.min(ar.len()) {
-            v += ar[l - 1] * out[i - l];
+            v = v + ar[l - 1] * out[i - l];
         }
         out[i] = v;
     }
@@ -381,47 +386,51 @@ fn psi(ar: &[f64], ma: &[f64], n: usize) -> Vec<f64> {
 }
 
 /// docs/methods.md §4.4 linear system plus recursion; see [`Arma::autocovariance`].
-fn autocovariance(ar: &[f64], ma: &[f64], sigma2: f64, max_lag: usize) -> Vec<f64> {
+fn autocovariance<T: Scalar>(ar: &[T], ma: &[T], sigma2: f64, max_lag: usize) -> Vec<T> {
     let (p, q) = (ar.len(), ma.len());
     let r = p.max(q + 1);
-    let phi: Vec<f64> = (0..r).map(|i| ar.get(i).copied().unwrap_or(0.0)).collect();
+    let zero = T::lift(0.0);
+    let phi: Vec<T> = (0..r).map(|i| ar.get(i).copied().unwrap_or(zero)).collect();
     let ps = psi(ar, ma, q + 1);
-    let ma0 = |l: usize| if l == 0 { 1.0 } else { ma[l - 1] };
+    let ma0 = |l: usize| if l == 0 { T::lift(1.0) } else { ma[l - 1] };
     // A gamma = rhs, unknowns gamma_0..gamma_r
     let n = r + 1;
-    let mut a = vec![vec![0.0; n]; n];
-    let mut rhs = vec![0.0; n];
+    let mut a = vec![vec![zero; n]; n];
+    let mut rhs = vec![zero; n];
     for k in 0..n {
-        a[k][k] += 1.0;
+        a[k][k] = a[k][k] + T::lift(1.0);
         for i in 1..=r {
-            a[k][k.abs_diff(i)] -= phi[i - 1];
+            let c = k.abs_diff(i);
+            a[k][c] = a[k][c] - phi[i - 1];
         }
         rhs[k] = if k <= q {
-            sigma2 * (k..=q).map(|l| ma0(l) * ps[l - k]).sum::<f64>()
+            sum((k..=q).map(|l| ma0(l) * ps[l - k])) * sigma2
         } else {
-            0.0
+            zero
         };
     }
     let Some(g) = solve(a, rhs) else {
-        return vec![f64::NAN; max_lag + 1];
+        return vec![T::lift(f64::NAN); max_lag + 1];
     };
     let mut gamma = g;
-    gamma.resize(max_lag.max(r) + 1, 0.0);
+    gamma.resize(max_lag.max(r) + 1, zero);
     for h in r + 1..=max_lag {
-        gamma[h] = (1..=r).map(|i| phi[i - 1] * gamma[h - i]).sum();
+        gamma[h] = sum((1..=r).map(|i| phi[i - 1] * gamma[h - i]));
     }
     gamma.truncate(max_lag + 1);
     gamma
 }
 
-/// Gaussian elimination with partial pivoting; `None` when singular.
+/// Gaussian elimination with partial pivoting (on the values); `None` when singular.
 // Row operations read two rows of one matrix by index; iterators would obscure that.
 #[allow(clippy::needless_range_loop)]
-fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+fn solve<T: Scalar>(mut a: Vec<Vec<T>>, mut b: Vec<T>) -> Option<Vec<T>> {
     let n = b.len();
     for col in 0..n {
-        let piv = (col..n).max_by(|&i, &k| a[i][col].abs().total_cmp(&a[k][col].abs()))?;
-        if a[piv][col] == 0.0 || !a[piv][col].is_finite() {
+        let piv = (col..n)
+            .max_by(|&i, &k| a[i][col].value().abs().total_cmp(&a[k][col].value().abs()))?;
+        let pivot = a[piv][col].value();
+        if pivot == 0.0 || !pivot.is_finite() {
             return None;
         }
         a.swap(col, piv);
@@ -429,14 +438,14 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
         for row in col + 1..n {
             let f = a[row][col] / a[col][col];
             for k in col..n {
-                a[row][k] -= f * a[col][k];
+                a[row][k] = a[row][k] - f * a[col][k];
             }
-            b[row] -= f * b[col];
+            b[row] = b[row] - f * b[col];
         }
     }
-    let mut x = vec![0.0; n];
+    let mut x = vec![T::lift(0.0); n];
     for row in (0..n).rev() {
-        let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
+        let s = sum((row + 1..n).map(|k| a[row][k] * x[k]));
         x[row] = (b[row] - s) / a[row][row];
     }
     Some(x)
@@ -449,8 +458,9 @@ const DIRECT_LEVELS: usize = 10;
 /// Deepest level computed: `m = 2^61` is far beyond any recording (and keeps `2m` finite).
 const MAX_LEVELS: usize = 62;
 
-/// docs/methods.md §4.4: WV through §4.1 from the exact autocovariances (no validation).
-fn arma_wv(ar: &[f64], ma: &[f64], sigma2: f64, levels: usize) -> Vec<f64> {
+/// docs/methods.md §4.4: WV through §4.1 from the exact autocovariances (no validation). In
+/// [`Dual`] numbers (one variable per coefficient of `ar ++ ma`) it gives the exact Jacobian.
+fn arma_wv<T: Scalar>(ar: &[T], ma: &[T], sigma2: f64, levels: usize) -> Vec<T> {
     if levels == 0 {
         return Vec::new();
     }
@@ -475,61 +485,58 @@ fn arma_wv(ar: &[f64], ma: &[f64], sigma2: f64, levels: usize) -> Vec<f64> {
 /// recursion, so the state `(gamma_h.., h gamma_h.., A(h), B(h))` (the last `r` lags of
 /// each) advances by a constant matrix `M`, and `2^k` lags at once by `M^(2^k)`, one
 /// squaring per level. `B` is carried, not formed as a difference, so nothing cancels.
-fn deep_levels(ar: &[f64], q: usize, gamma: &[f64], levels: usize) -> Vec<f64> {
+fn deep_levels<T: Scalar>(ar: &[T], q: usize, gamma: &[T], levels: usize) -> Vec<T> {
     let r = ar.len().max(q + 1);
-    let phi = |i: usize| ar.get(i).copied().unwrap_or(0.0);
+    let zero = T::lift(0.0);
+    let phi = |i: usize| ar.get(i).copied().unwrap_or(zero);
     let d = 2 * r + 2;
     let (ia, ib) = (2 * r, 2 * r + 1);
     // M, row-major d x d
-    let mut step = vec![0.0; d * d];
+    let mut step = vec![zero; d * d];
     let at = |row: usize, col: usize| row * d + col;
     for i in 0..r {
         // gamma_{h+1} = sum phi_i gamma_{h+1-i}; (h+1) gamma_{h+1} = sum phi_i ((h+1-i) gamma.. + i gamma..)
         let (gi, ei) = (i, r + i);
         step[at(0, gi)] = phi(i);
         step[at(r, ei)] = phi(i);
-        step[at(r, gi)] = (i + 1) as f64 * phi(i);
+        step[at(r, gi)] = phi(i) * (i + 1) as f64;
         step[at(ia, gi)] = phi(i);
         step[at(ib, ei)] = phi(i);
-        step[at(ib, gi)] = (i + 1) as f64 * phi(i);
+        step[at(ib, gi)] = phi(i) * (i + 1) as f64;
         if i + 1 < r {
-            step[at(gi + 1, gi)] = 1.0;
-            step[at(ei + 1, ei)] = 1.0;
+            step[at(gi + 1, gi)] = T::lift(1.0);
+            step[at(ei + 1, ei)] = T::lift(1.0);
         }
     }
-    step[at(ia, ia)] = 1.0;
-    step[at(ib, ib)] = 1.0;
+    step[at(ia, ia)] = T::lift(1.0);
+    step[at(ib, ib)] = T::lift(1.0);
     let h0 = gamma.len() - 1;
-    let mut state = vec![0.0; d];
+    let mut state = vec![zero; d];
     for i in 0..r {
         state[i] = gamma[h0 - i];
-        state[r + i] = (h0 - i) as f64 * gamma[h0 - i];
+        state[r + i] = gamma[h0 - i] * (h0 - i) as f64;
     }
-    state[ia] = gamma[1..].iter().sum();
-    state[ib] = gamma.iter().enumerate().map(|(h, g)| h as f64 * g).sum();
+    state[ia] = sum(gamma[1..].iter().copied());
+    state[ib] = sum(gamma.iter().enumerate().map(|(h, &g)| g * h as f64));
     // jump = M^(2^k), from M^(2^direct); squared in place through one scratch matrix. Once
     // the AR part has decayed to nothing, M^(2n) = M^n to rounding (the accumulators take the
     // whole sums): a fixed point, squared no more.
     let mut jump = step.clone();
-    let mut scratch = vec![0.0; d * d];
+    let mut scratch = vec![zero; d * d];
     let mut fixed = false;
-    let mut square = |jump: &mut Vec<f64>| {
+    let mut square = |jump: &mut Vec<T>| {
         if fixed {
             return;
         }
         mat_mul(jump, jump, &mut scratch, d);
-        let size = scratch.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        fixed = scratch
-            .iter()
-            .zip(jump.iter())
-            .all(|(a, b)| (a - b).abs() <= f64::EPSILON * size);
+        fixed = T::settled(&scratch, jump);
         std::mem::swap(jump, &mut scratch);
     };
     let direct = h0.trailing_ones() as usize;
     for _ in 0..direct {
         square(&mut jump);
     }
-    let mut next = vec![0.0; d];
+    let mut next = vec![zero; d];
     let mut out = Vec::with_capacity(levels.saturating_sub(direct));
     for k in direct..levels {
         let m = 2f64.powi(k as i32);
@@ -539,8 +546,9 @@ fn deep_levels(ar: &[f64], q: usize, gamma: &[f64], levels: usize) -> Vec<f64> {
         mat_vec(&jump, &state, &mut next);
         std::mem::swap(&mut state, &mut next);
         let (a_2m1, b_2m1) = (state[ia], state[ib]);
-        let s = m * gamma[0] + 2.0 * m * a_m1 - 2.0 * b_m1 - 2.0 * b_m - 2.0 * m * (a_2m1 - a_m)
-            + b_2m1;
+        let s =
+            gamma[0] * m + a_m1 * (2.0 * m) - b_m1 * 2.0 - b_m * 2.0 - (a_2m1 - a_m) * (2.0 * m)
+                + b_2m1;
         out.push(s / (2.0 * m * m));
         if k + 1 < levels {
             square(&mut jump);
@@ -551,13 +559,13 @@ fn deep_levels(ar: &[f64], q: usize, gamma: &[f64], levels: usize) -> Vec<f64> {
 
 /// `out = a b` for row-major `d x d` matrices (zero entries of `a` skipped: the early
 /// powers of the companion matrix are sparse).
-fn mat_mul(a: &[f64], b: &[f64], out: &mut [f64], d: usize) {
-    out.fill(0.0);
+fn mat_mul<T: Scalar>(a: &[T], b: &[T], out: &mut [T], d: usize) {
+    out.fill(T::lift(0.0));
     for (row, o) in a.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
         for (&x, bk) in row.iter().zip(b.chunks_exact(d)) {
-            if x != 0.0 {
+            if !x.is_zero() {
                 for (o, &b) in o.iter_mut().zip(bk) {
-                    *o += x * b;
+                    *o = *o + x * b;
                 }
             }
         }
@@ -565,9 +573,9 @@ fn mat_mul(a: &[f64], b: &[f64], out: &mut [f64], d: usize) {
 }
 
 /// `out = a x` for a row-major `d x d` matrix.
-fn mat_vec(a: &[f64], x: &[f64], out: &mut [f64]) {
+fn mat_vec<T: Scalar>(a: &[T], x: &[T], out: &mut [T]) {
     for (o, row) in out.iter_mut().zip(a.chunks_exact(x.len())) {
-        *o = row.iter().zip(x).map(|(a, x)| a * x).sum();
+        *o = sum(row.iter().zip(x).map(|(&a, &x)| a * x));
     }
 }
 
@@ -575,9 +583,6 @@ fn mat_vec(a: &[f64], x: &[f64], out: &mut [f64]) {
 fn max_half_width(levels: usize) -> f64 {
     2f64.powi(levels.clamp(1, 1000) as i32 - 1)
 }
-
-/// Richardson rounds of docs/methods.md §4.7.
-const RICHARDSON_ROUNDS: usize = 4;
 
 impl Arma {
     /// The coefficients `ar ++ ma` with `sigma2` last, as in [`LatentProcess::params`].
@@ -590,46 +595,40 @@ impl Arma {
         arma_wv(&c[..p], &c[p..], self.sigma2, levels)
     }
 
-    /// docs/methods.md §4.7: Richardson-extrapolated central differences with respect to the
-    /// coefficient `k` of `c`, four rounds halving the step. The initial step is
-    /// `1e-3 max(|c_k|, 0.1)`, at most `0.05 / m_max` (the WV varies through `phi^m`), instead of
-    /// numDeriv's `|1e-4 c_k| + 1e-4 [|c_k| < zero_tol]`, whose step for a small non-zero
-    /// coefficient (e.g. `1e-4`, step `1e-8`) leaves only ~7 digits.
-    fn d_coef(&self, c: &[f64], k: usize, levels: usize) -> Vec<f64> {
-        let mut h = (1e-3 * c[k].abs().max(0.1)).min(0.05 / max_half_width(levels));
-        let mut rounds: Vec<Vec<f64>> = Vec::with_capacity(RICHARDSON_ROUNDS);
-        for _ in 0..RICHARDSON_ROUNDS {
-            let mut up = c.to_vec();
-            up[k] += h;
-            let mut dn = c.to_vec();
-            dn[k] -= h;
-            let (wu, wd) = (self.wv_at(&up, levels), self.wv_at(&dn, levels));
-            rounds.push(
-                wu.iter()
-                    .zip(&wd)
-                    .map(|(a, b)| (a - b) / (2.0 * h))
-                    .collect(),
-            );
-            h /= 2.0;
-        }
-        for m in 1..RICHARDSON_ROUNDS {
-            let w = 4f64.powi(m as i32);
-            rounds = rounds
-                .windows(2)
-                .map(|pair| {
-                    pair[1]
-                        .iter()
-                        .zip(&pair[0])
-                        .map(|(d1, d0)| (w * d1 - d0) / (w - 1.0))
-                        .collect()
-                })
-                .collect();
-        }
-        rounds.pop().unwrap_or_default()
+    /// `d nu2 / d c_k` for the coefficients `k = first..first + W` (those that exist), as columns,
+    /// by one pass of [`arma_wv`] in [`Dual`] numbers seeded on them.
+    fn d_coefs<const W: usize>(&self, c: &[f64], first: usize, levels: usize) -> Vec<Vec<f64>> {
+        let p = self.ar.len();
+        let seeded: Vec<Dual<W>> = c
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| match k.checked_sub(first) {
+                Some(lane) if lane < W => Dual::var(v, lane),
+                _ => Dual::lift(v),
+            })
+            .collect();
+        let wv = arma_wv(&seeded[..p], &seeded[p..], self.sigma2, levels);
+        let width = W.min(c.len() - first);
+        (0..width)
+            .map(|lane| wv.iter().map(|x| x.g[lane]).collect())
+            .collect()
     }
 
+    /// docs/methods.md §4.7: the exact derivatives of the §4.4 computation with respect to the
+    /// coefficients (forward mode, [`Dual`] passes of up to eight coefficients), and
+    /// `nu2 / sigma2` (§4.5) for `sigma2`.
     fn jacobian_at(&self, c: &[f64], levels: usize) -> Vec<Vec<f64>> {
-        let cols: Vec<Vec<f64>> = (0..c.len()).map(|k| self.d_coef(c, k, levels)).collect();
+        let mut cols: Vec<Vec<f64>> = Vec::with_capacity(c.len());
+        while cols.len() < c.len() {
+            let (first, left) = (cols.len(), c.len() - cols.len());
+            cols.extend(match left {
+                1 => self.d_coefs::<1>(c, first, levels),
+                2 => self.d_coefs::<2>(c, first, levels),
+                3 | 4 => self.d_coefs::<4>(c, first, levels),
+                5 | 6 => self.d_coefs::<6>(c, first, levels),
+                _ => self.d_coefs::<8>(c, first, levels),
+            });
+        }
         let nu = self.wv_at(c, levels);
         (0..nu.len())
             .map(|j| {
@@ -642,8 +641,8 @@ impl Arma {
 }
 
 /// Relative step of the Richardson-extrapolated central differences of the Jacobian used for the
-/// generic ARMA Hessian: the §4.7 Jacobian is accurate to ~1e-11, so a 1e-3 step keeps the noise
-/// near 1e-7 and the O(h^4) truncation error below it.
+/// generic ARMA Hessian: the §4.7 Jacobian is exact to rounding, so a 1e-3 step keeps the noise
+/// near 1e-13 and the O(h^4) truncation error near 1e-12.
 const HESSIAN_STEP: f64 = 1e-3;
 
 impl LatentProcess for Arma {

@@ -34,6 +34,7 @@ mod param;
 pub(crate) mod qn;
 pub(crate) mod rw;
 pub(crate) mod sampler;
+pub(crate) mod scalar;
 pub(crate) mod sin;
 #[cfg(test)]
 pub(crate) mod spectral;
@@ -61,6 +62,7 @@ pub(crate) use param::ChainSlot;
 pub use param::TransformPreset;
 pub(crate) use param::{logistic, ParamTransform, RESTART_EDGE};
 pub use sampler::StartMode;
+use scalar::Scalar;
 
 use crate::error::ParamError;
 use sampler::{Sampler, SimRng};
@@ -303,16 +305,16 @@ impl LatentProcess for Process {
 /// all given are left out, so the result may be shorter than `levels`.
 ///
 /// Cost: `O(2^levels)`.
-pub(crate) fn autocovariance_wv(gamma: &[f64], levels: usize) -> Vec<f64> {
+pub(crate) fn autocovariance_wv<T: Scalar>(gamma: &[T], levels: usize) -> Vec<T> {
     let mut out = Vec::with_capacity(levels);
     for j in 1..=levels.min(62) {
         let m = 1usize << (j - 1);
         if 2 * m > gamma.len() {
             break;
         }
-        let mut s = m as f64 * (gamma[0] - gamma[m]);
+        let mut s = (gamma[0] - gamma[m]) * m as f64;
         for i in 1..m {
-            s += i as f64 * (2.0 * gamma[m - i] - gamma[i] - gamma[2 * m - i]);
+            s = s + (gamma[m - i] * 2.0 - gamma[i] - gamma[2 * m - i]) * i as f64;
         }
         let mf = m as f64;
         out.push(s / (2.0 * mf * mf));
