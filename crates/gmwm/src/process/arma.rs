@@ -596,8 +596,15 @@ impl Arma {
     }
 
     /// `d nu2 / d c_k` for the coefficients `k = first..first + W` (those that exist), as columns,
-    /// by one pass of [`arma_wv`] in [`Dual`] numbers seeded on them.
-    fn d_coefs<const W: usize>(&self, c: &[f64], first: usize, levels: usize) -> Vec<Vec<f64>> {
+    /// by one pass of [`arma_wv`] in [`Dual`] numbers seeded on them; and the WV itself (the
+    /// values, computed by the same operations as in `f64`, up to how long the deep levels'
+    /// squaring runs: that waits for the derivatives to settle too).
+    fn d_coefs<const W: usize>(
+        &self,
+        c: &[f64],
+        first: usize,
+        levels: usize,
+    ) -> (Vec<f64>, Vec<Vec<f64>>) {
         let p = self.ar.len();
         let seeded: Vec<Dual<W>> = c
             .iter()
@@ -609,9 +616,10 @@ impl Arma {
             .collect();
         let wv = arma_wv(&seeded[..p], &seeded[p..], self.sigma2, levels);
         let width = W.min(c.len() - first);
-        (0..width)
+        let cols = (0..width)
             .map(|lane| wv.iter().map(|x| x.g[lane]).collect())
-            .collect()
+            .collect();
+        (wv.iter().map(|x| x.v).collect(), cols)
     }
 
     /// docs/methods.md §4.7: the exact derivatives of the §4.4 computation with respect to the
@@ -619,17 +627,20 @@ impl Arma {
     /// `nu2 / sigma2` (§4.5) for `sigma2`.
     fn jacobian_at(&self, c: &[f64], levels: usize) -> Vec<Vec<f64>> {
         let mut cols: Vec<Vec<f64>> = Vec::with_capacity(c.len());
+        let mut nu: Option<Vec<f64>> = None;
         while cols.len() < c.len() {
             let (first, left) = (cols.len(), c.len() - cols.len());
-            cols.extend(match left {
+            let (values, more) = match left {
                 1 => self.d_coefs::<1>(c, first, levels),
                 2 => self.d_coefs::<2>(c, first, levels),
                 3 | 4 => self.d_coefs::<4>(c, first, levels),
                 5 | 6 => self.d_coefs::<6>(c, first, levels),
                 _ => self.d_coefs::<8>(c, first, levels),
-            });
+            };
+            nu.get_or_insert(values);
+            cols.extend(more);
         }
-        let nu = self.wv_at(c, levels);
+        let nu = nu.unwrap_or_else(|| self.wv_at(c, levels));
         (0..nu.len())
             .map(|j| {
                 let mut row: Vec<f64> = cols.iter().map(|col| col[j]).collect();
