@@ -376,7 +376,7 @@ pub fn wv_fit(data: &[u8]) {
         // the starting-value search's draws (20000 by default) repeat one computation, and so
         // do the optimiser's steps past the first hundred (2000 by default: a deep-level ARMA
         // fit that never converges ran them all, 1.4 s natively and 4 s in this build): a few
-        // cover their paths (100 steps include two refreshes of the scaling, every 50) and
+        // cover their paths (100 steps include the refresh of the scaling at step 50) and
         // leave the executions to the inputs
         let gmwm = Gmwm::new(model.clone())
             .with_draws(64)

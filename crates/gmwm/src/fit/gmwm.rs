@@ -134,7 +134,7 @@ impl Gmwm {
         self
     }
 
-    /// Caps the optimiser's accepted steps (default 2000). A fit that reaches the cap ends
+    /// Caps the optimiser's accepted steps (default 2000; 0 is taken as 1). A fit that reaches the cap ends
     /// "not converged" (the fit's `convergence()` says so): for callers that bound
     /// the time of a fit whatever the data (the fuzz targets), not for estimates.
     ///

@@ -15,8 +15,8 @@
 //!
 //! Derivatives of the closed forms are exact (forward-mode automatic differentiation of the
 //! numerically stable evaluation, see `ar1`), so they stay accurate where the textbook quotient
-//! of §4.5 cancels (AR1/GM with `phi` near 1). The generic [`Arma`] is differentiated numerically
-//! (§4.7). `spectral` holds the slow quadrature oracle of §1.9.
+//! of §4.5 cancels (AR1/GM with `phi` near 1). The generic [`Arma`]'s §4.4 computation is
+//! differentiated the same way, in the dual numbers of `scalar` (§4.7). `spectral` holds the slow quadrature oracle of §1.9.
 
 use serde::Serialize;
 

@@ -22,6 +22,9 @@ pub(crate) trait Scalar:
 {
     /// A constant.
     fn lift(v: f64) -> Self;
+    /// Not a number, in every component (a failed computation must not pass for a zero
+    /// derivative).
+    fn nan() -> Self;
     /// The value (for pivoting and tests of finiteness).
     fn value(self) -> f64;
     /// Whether every component is exactly zero (a product with it may be skipped).
@@ -47,6 +50,9 @@ const SETTLED: f64 = f64::EPSILON;
 impl Scalar for f64 {
     fn lift(v: f64) -> Self {
         v
+    }
+    fn nan() -> Self {
+        f64::NAN
     }
     fn value(self) -> f64 {
         self
@@ -87,6 +93,12 @@ impl<const N: usize> Dual<N> {
 impl<const N: usize> Scalar for Dual<N> {
     fn lift(v: f64) -> Self {
         Self { v, g: [0.0; N] }
+    }
+    fn nan() -> Self {
+        Self {
+            v: f64::NAN,
+            g: [f64::NAN; N],
+        }
     }
     fn value(self) -> f64 {
         self.v
@@ -206,6 +218,9 @@ mod tests {
         assert!((f.g[1] - dy).abs() <= 1e-8 * dy.abs(), "{} {dy}", f.g[1]);
         let n = -Dual::<2>::var(2.0, 1);
         assert_eq!((n.v, n.g), (-2.0, [0.0, -1.0]));
+        let q = Dual::<2>::var(3.0, 0) / 4.0;
+        assert_eq!((q.v, q.g), (0.75, [0.25, 0.0]));
+        assert!(Dual::<2>::nan().g.iter().all(|g| g.is_nan()));
     }
 
     #[test]
