@@ -1027,6 +1027,17 @@ fn issue_10_fit_reports_the_canonical_model() {
         text.contains("the data cannot tell this fit from one of GM()+QN()+RW()"),
         "{text}"
     );
+    // a model written in another order than the canonical one is not "another model to fit"
+    // (the table told the user to fit WN()+RW()+ARMA(2,1) after fitting ARMA(2,1)+WN()+RW())
+    let out = gmwm()
+        .arg("fit")
+        .arg(&kvh)
+        .args(["--columns", "gyro_x", "--model", "RW()+QN()+GM()"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("canonical model: GM()+QN()+RW()"), "{text}");
+    assert!(!text.contains("fit that model"), "{text}");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -322,7 +322,7 @@ fn render_fits(
                 if let Some(a) = plus(i) {
                     writeln!(out, "{a}")?;
                 }
-                if canonical.reduced != fit.model().without_values() {
+                if !canonical.reduced.same_terms(fit.model()) {
                     writeln!(
                         out,
                         "  (the data cannot tell this fit from one of {}: fit that model for \

@@ -402,6 +402,23 @@ impl Model {
     pub fn kinds(&self) -> Vec<ProcessKind> {
         self.components.iter().map(|c| c.kind).collect()
     }
+
+    /// Whether `other` has the same terms, in any order and whatever their values
+    /// (`ARMA(2,1)+WN()` and `WN()+ARMA(2,1)` do; `AR(2)` and `AR(3)` do not).
+    ///
+    /// ```
+    /// use gmwm::Model;
+    /// let a: Model = "AR1(phi=0.9, sigma2=1)+WN()+AR1()".parse().unwrap();
+    /// assert!(a.same_terms(&"WN()+2*AR1()".parse().unwrap()));
+    /// assert!(!a.same_terms(&"WN()+AR1()".parse().unwrap()));
+    /// ```
+    pub fn same_terms(&self, other: &Model) -> bool {
+        self.components.len() == other.components.len()
+            && self
+                .components
+                .iter()
+                .all(|c| self.count(c.kind) == other.count(c.kind))
+    }
 }
 
 impl fmt::Display for Model {
