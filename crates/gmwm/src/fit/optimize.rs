@@ -387,9 +387,14 @@ pub(crate) fn minimize(
             }
             g[k] = 0.0;
         }
+        // a curvature that is not a number (an implied WV whose derivatives overflow) is no
+        // stationary point: the cosine is then infinite, and the damping decides below
         let cosine = (0..p)
-            .filter(|&k| a[k * p + k] > 0.0 && !collapsed.contains(&k))
-            .map(|k| g[k].abs() / (a[k * p + k].sqrt() * r_norm))
+            .filter(|&k| !(a[k * p + k] <= 0.0) && !collapsed.contains(&k))
+            .map(|k| match g[k].abs() / (a[k * p + k].sqrt() * r_norm) {
+                c if c.is_nan() => f64::INFINITY,
+                c => c,
+            })
             .fold(0.0, f64::max);
         if cosine <= opts.gradient_tolerance {
             return Ok(finish(
@@ -445,6 +450,19 @@ pub(crate) fn minimize(
             if !cholesky_solve(&mut m, &mut h, p) {
                 mu *= nu;
                 nu *= 2.0;
+                // a system no damping makes solvable (a non-finite curvature: an implied WV
+                // whose derivatives overflow) would raise it forever without an evaluation;
+                // once the damping overflows, the step has vanished
+                if !mu.is_finite() {
+                    return Ok(finish(
+                        StopReason::Stalled,
+                        u,
+                        &cur,
+                        q,
+                        iterations,
+                        evaluations,
+                    ));
+                }
                 continue;
             }
             let h_norm = sum_sq(&h).sqrt();
@@ -537,6 +555,74 @@ fn normal_equations(ev: &Eval, levels: usize, p: usize, a: &mut [f64], g: &mut [
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Residuals `u - 1` (finite everywhere) whose Jacobian is not a number: the curvature no
+    /// damping makes positive definite (found by the `wv_fit` fuzz target: a deep-level ARMA
+    /// whose derivatives overflowed hung the optimiser raising the damping forever).
+    struct NanCurvature {
+        /// Every column not a number (else the second only).
+        all: bool,
+    }
+
+    impl LeastSquares for NanCurvature {
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn levels(&self) -> usize {
+            3
+        }
+        fn buffer(&self) -> Eval {
+            Eval {
+                theta: vec![0.0; 2],
+                dtheta: vec![0.0; 4],
+                r: vec![0.0; 3],
+                jac: vec![0.0; 6],
+                nu: vec![0.0; 3],
+            }
+        }
+        fn evaluate(
+            &self,
+            u: &[f64],
+            ev: &mut Eval,
+            with_jacobian: bool,
+        ) -> Result<(), crate::InputError> {
+            ev.theta.copy_from_slice(u);
+            for (j, r) in ev.r.iter_mut().enumerate() {
+                *r = u[j % 2] - 1.0;
+            }
+            ev.nu.copy_from_slice(&ev.r);
+            if with_jacobian {
+                // d r_j / d u_0 = [j even]; d r_j / d u_1 not a number
+                for (j, row) in ev.jac.chunks_exact_mut(2).enumerate() {
+                    row[0] = match (self.all, j % 2) {
+                        (true, _) => f64::NAN,
+                        (false, 0) => 1.0,
+                        (false, _) => 0.0,
+                    };
+                    row[1] = f64::NAN;
+                }
+            }
+            Ok(())
+        }
+        fn scale(&self) -> f64 {
+            3.0
+        }
+        fn edges(&self) -> Vec<Edge> {
+            vec![Edge::Free; 2]
+        }
+    }
+
+    #[test]
+    fn a_curvature_no_damping_repairs_stops_the_fit() {
+        // one column not a number, then all: neither is a stationary point, and the damping
+        // gives up without evaluating (it raised the damping forever before)
+        for all in [false, true] {
+            let min = minimize(&NanCurvature { all }, &[0.0, 0.0], &LmOptions::default()).unwrap();
+            assert_eq!(min.convergence.reason, StopReason::Stalled, "all {all}");
+            assert!(!min.convergence.converged);
+            assert_eq!(min.convergence.evaluations, 1);
+        }
+    }
 
     #[test]
     fn cholesky_solves_spd_and_rejects_indefinite() {
