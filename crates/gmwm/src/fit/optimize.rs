@@ -390,7 +390,7 @@ pub(crate) fn minimize(
         // a curvature that is not a number (an implied WV whose derivatives overflow) is no
         // stationary point: the cosine is then infinite, and the damping decides below
         let cosine = (0..p)
-            .filter(|&k| !(a[k * p + k] <= 0.0) && !collapsed.contains(&k))
+            .filter(|&k| (a[k * p + k] > 0.0 || a[k * p + k].is_nan()) && !collapsed.contains(&k))
             .map(|k| match g[k].abs() / (a[k * p + k].sqrt() * r_norm) {
                 c if c.is_nan() => f64::INFINITY,
                 c => c,
