@@ -61,11 +61,16 @@ impl Scalar for f64 {
         self == 0.0
     }
     fn settled(next: &[Self], prev: &[Self]) -> bool {
-        let size = next.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        next.iter()
-            .zip(prev)
-            .all(|(a, b)| (a - b).abs() <= SETTLED * size)
+        component_settled(next, prev, |x| *x)
     }
+}
+
+/// [`Scalar::settled`] for one component of the items, read by `part`.
+fn component_settled<T>(next: &[T], prev: &[T], part: impl Fn(&T) -> f64) -> bool {
+    let size = next.iter().fold(0.0f64, |m, x| m.max(part(x).abs()));
+    next.iter()
+        .zip(prev)
+        .all(|(a, b)| (part(a) - part(b)).abs() <= SETTLED * size)
 }
 
 /// A forward-mode dual number: a value and its gradient with respect to `N` variables.
@@ -107,17 +112,8 @@ impl<const N: usize> Scalar for Dual<N> {
         self.v == 0.0 && self.g.iter().all(|&g| g == 0.0)
     }
     fn settled(next: &[Self], prev: &[Self]) -> bool {
-        let values_next: Vec<f64> = next.iter().map(|x| x.v).collect();
-        let values_prev: Vec<f64> = prev.iter().map(|x| x.v).collect();
-        if !f64::settled(&values_next, &values_prev) {
-            return false;
-        }
-        (0..N).all(|k| {
-            let size = next.iter().fold(0.0f64, |m, x| m.max(x.g[k].abs()));
-            next.iter()
-                .zip(prev)
-                .all(|(a, b)| (a.g[k] - b.g[k]).abs() <= SETTLED * size)
-        })
+        component_settled(next, prev, |x| x.v)
+            && (0..N).all(|k| component_settled(next, prev, |x| x.g[k]))
     }
 }
 
