@@ -293,7 +293,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReadError> {
 
 enum Sink {
     Plain(AtomicFile),
-    Gzip(GzEncoder<AtomicFile>),
+    Gzip(Box<GzEncoder<AtomicFile>>),
 }
 
 impl Sink {
@@ -332,7 +332,7 @@ impl SeriesWriter {
         let buffered = AtomicFile::create(path)?;
         let sink = match format {
             OutputFormat::Text { gzip: true, .. } => {
-                Sink::Gzip(GzEncoder::new(buffered, Compression::default()))
+                Sink::Gzip(Box::new(GzEncoder::new(buffered, Compression::default())))
             }
             _ => Sink::Plain(buffered),
         };
