@@ -411,6 +411,9 @@ impl Model {
     /// let a: Model = "AR1(phi=0.9, sigma2=1)+WN()+AR1()".parse().unwrap();
     /// assert!(a.same_terms(&"WN()+2*AR1()".parse().unwrap()));
     /// assert!(!a.same_terms(&"WN()+AR1()".parse().unwrap()));
+    /// let ar2: Model = "AR(2)+WN()".parse().unwrap();
+    /// assert!(ar2.same_terms(&"WN()+AR(2)".parse().unwrap()));
+    /// assert!(!ar2.same_terms(&"WN()+AR(3)".parse().unwrap()));
     /// ```
     pub fn same_terms(&self, other: &Model) -> bool {
         self.components.len() == other.components.len()
